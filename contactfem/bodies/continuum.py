@@ -1,0 +1,340 @@
+"""Two-dimensional continuum bodies (plane strain, plane stress, axisymmetric).
+
+One class, ``Continuum``, implements the body interface (see ``__init__.py``)
+with scikit-fem: four-node quadrilaterals (``MeshQuad``) or three-node
+triangles (``MeshTri``), total Lagrangian formulation.
+
+Every material is written as one pure function ``F -> (W, P, A)`` of the 3x3
+deformation gradient at all quadrature points: strain energy density W, first
+Piola-Kirchhoff stress P and material tangent A = dP/dF (Holzapfel, Nonlinear
+Solid Mechanics, ch. 6; Wriggers, Nonlinear FEM, ch. 3-4). In 2D the third
+direction is
+
+    plane strain   F_33 = 1
+    plane stress   linear material only, reduced Lame constant (no F_33 needed)
+    axisymmetric   x = r, y = z, F_33 = (R + u_r) / R   (hoop stretch)
+
+so that one pair of weak forms serves all cases (principle of virtual work):
+
+    R(u) . v = int  P : grad v  +  P_33 v_r / R   dV
+    K        = int  grad v : A : grad du  + (hoop couplings)   dV
+
+with dV = thickness dA (plane) or 2 pi R dA (axisymmetric). The linear material
+uses the same forms with F = I + grad u and P = C : eps (small strain).
+"""
+import numpy as np
+from skfem import (Basis, BilinearForm, ElementQuad1, ElementTriP1,
+                   ElementVector, Functional, LinearForm, MeshQuad, MeshTri,
+                   asm)
+
+KINDS = ("plane_strain", "plane_stress", "axisymmetric")
+MATERIALS = ("linear", "svk", "neohooke")
+
+
+class InvertedElementError(FloatingPointError):
+    """Raised when det F <= 0 at a quadrature point (an element turned inside out)."""
+
+
+# ---------------------------------------------------------------------------
+# Materials: pure functions of F, shape (3, 3, nel, nqp)
+# ---------------------------------------------------------------------------
+
+def _eye(F):
+    """Identity with the trailing shape of F."""
+    return np.einsum("ij,...->ij...", np.eye(3), np.ones(F.shape[2:]))
+
+
+def _isotropic_tangent(lam, mu, shape):
+    """C_ijkl = lam d_ij d_kl + mu (d_ik d_jl + d_il d_jk), broadcast to shape."""
+    d = np.eye(3)
+    C = (lam * np.einsum("ij,kl->ijkl", d, d)
+         + mu * (np.einsum("ik,jl->ijkl", d, d) + np.einsum("il,jk->ijkl", d, d)))
+    return np.einsum("ijkl,...->ijkl...", C, np.ones(shape))
+
+
+def linear_elastic(F, lam, mu):
+    """Small strain: eps = sym(F - I), sigma = lam tr(eps) I + 2 mu eps, W = sigma:eps/2."""
+    I = _eye(F)
+    eps = 0.5 * (F + F.transpose(1, 0, 2, 3)) - I
+    tr = np.einsum("ii...->...", eps)
+    P = lam * tr * I + 2.0 * mu * eps
+    W = 0.5 * np.einsum("ij...,ij...->...", P, eps)
+    return W, P, _isotropic_tangent(lam, mu, F.shape[2:])
+
+
+def saint_venant_kirchhoff(F, lam, mu):
+    """St Venant-Kirchhoff: E = (F^T F - I)/2, S = lam tr(E) I + 2 mu E, P = F S.
+
+    A_iJkL = d_ik S_JL + lam F_iJ F_kL + mu (F F^T)_ik d_JL + mu F_iL F_kJ
+    (= d_ik S_JL + F_iI C_IJKL F_kK, Holzapfel eq. 6.186 written out).
+    """
+    I = _eye(F)
+    E = 0.5 * (np.einsum("ki...,kj...->ij...", F, F) - I)
+    trE = np.einsum("ii...->...", E)
+    S = lam * trE * I + 2.0 * mu * E
+    P = np.einsum("ik...,kj...->ij...", F, S)
+    W = 0.5 * lam * trE**2 + mu * np.einsum("ij...,ij...->...", E, E)
+    FFt = np.einsum("ik...,jk...->ij...", F, F)
+    A = (np.einsum("ik,jl...->ijkl...", np.eye(3), S)
+         + lam * np.einsum("ij...,kl...->ijkl...", F, F)
+         + mu * np.einsum("ik...,jl->ijkl...", FFt, np.eye(3))
+         + mu * np.einsum("il...,kj...->ijkl...", F, F))
+    return W, P, A
+
+
+def neo_hooke(F, lam, mu):
+    """Compressible neo-Hooke: W = mu/2 (I1 - 3) - mu ln J + lam/2 (ln J)^2.
+
+    P = mu (F - F^-T) + lam ln J F^-T,
+    A_iJkL = mu d_ik d_JL + (mu - lam ln J) Fi_Li Fi_Jk + lam Fi_Ji Fi_Lk  (Fi = F^-1).
+    """
+    Fm = np.moveaxis(F, (0, 1), (-2, -1))           # (..., 3, 3) for numpy.linalg
+    J = np.linalg.det(Fm)
+    Fi = np.moveaxis(np.linalg.inv(Fm), (-2, -1), (0, 1))
+    FiT = Fi.transpose(1, 0, 2, 3)
+    lnJ = np.log(J)
+    I1 = np.einsum("ij...,ij...->...", F, F)
+    W = 0.5 * mu * (I1 - 3.0) - mu * lnJ + 0.5 * lam * lnJ**2
+    P = mu * (F - FiT) + lam * lnJ * FiT
+    d = np.eye(3)
+    A = (mu * np.einsum("ik,jl,...->ijkl...", d, d, np.ones(J.shape))
+         + (mu - lam * lnJ) * np.einsum("li...,jk...->ijkl...", Fi, Fi)
+         + lam * np.einsum("ji...,lk...->ijkl...", Fi, Fi))
+    return W, P, A
+
+
+_MATERIAL_FUNCTIONS = {"linear": linear_elastic,
+                       "svk": saint_venant_kirchhoff,
+                       "neohooke": neo_hooke}
+
+
+# ---------------------------------------------------------------------------
+# Weak forms. w.axi (bool) and w.thickness are scalars passed to asm.
+# ---------------------------------------------------------------------------
+
+def _weight(w):
+    """Volume element factor: 2 pi r (axisymmetric) or the thickness (plane)."""
+    return 2.0 * np.pi * w.x[0] if w.axi else w.thickness
+
+
+def _hoop(v, w):
+    """Hoop part v_r / r of a (test or trial) displacement; zero in plane problems."""
+    return v.value[0] / w.x[0] if w.axi else 0.0 * v.value[0]
+
+
+@LinearForm
+def _internal_form(v, w):
+    """Virtual work of the stresses: P : grad v + P_33 v_r / r."""
+    P = w.P
+    work = np.einsum("ij...,ij...->...", P[:2, :2], v.grad) + P[2, 2] * _hoop(v, w)
+    return work * _weight(w)
+
+
+@BilinearForm
+def _tangent_form(u, v, w):
+    """Linearised virtual work: grad v : A : grad du (+ hoop couplings)."""
+    A = w.A
+    hu, hv = _hoop(u, w), _hoop(v, w)
+    k = (np.einsum("ijkl...,ij...,kl...->...", A[:2, :2, :2, :2], v.grad, u.grad)
+         + np.einsum("ij...,ij...->...", A[:2, :2, 2, 2], v.grad) * hu
+         + np.einsum("kl...,kl...->...", A[2, 2, :2, :2], u.grad) * hv
+         + A[2, 2, 2, 2] * hu * hv)
+    return k * _weight(w)
+
+
+@BilinearForm
+def _mass_form(u, v, w):
+    return w.rho * np.einsum("i...,i...->...", u.value, v.value) * _weight(w)
+
+
+@Functional
+def _energy_form(w):
+    return w.W * _weight(w)
+
+
+# ---------------------------------------------------------------------------
+# Boundary helper
+# ---------------------------------------------------------------------------
+
+def oriented_facets(mesh, facets):
+    """Boundary facets as node pairs (a, b), shape (nf, 2), oriented so that the
+    body lies to the RIGHT of b - a: the outward normal is e3 x (x_b - x_a),
+    the master-segment convention of the paper's eq (18)."""
+    ab = mesh.facets[:, facets].T.copy()
+    centre = mesh.p[:, mesh.t[:, mesh.f2t[0, facets]]].mean(axis=1).T
+    xa, xb = mesh.p[:, ab[:, 0]].T, mesh.p[:, ab[:, 1]].T
+    d = xb - xa
+    left = np.column_stack([-d[:, 1], d[:, 0]])
+    flip = np.einsum("ij,ij->i", left, centre - xa) > 0.0
+    ab[flip] = ab[flip, ::-1]
+    return ab
+
+
+# ---------------------------------------------------------------------------
+# The body
+# ---------------------------------------------------------------------------
+
+class Continuum:
+    """A 2D continuum body (see module docstring); implements the body interface.
+
+    Parameters: mesh (MeshQuad or MeshTri, optionally with named boundaries),
+    E > 0, -1 < nu < 0.5, rho >= 0, kind in KINDS, material in MATERIALS,
+    thickness > 0 (plane problems only).
+    """
+
+    def __init__(self, mesh, E, nu, rho, kind="plane_strain", material="linear",
+                 name="body", thickness=1.0):
+        if not E > 0:
+            raise ValueError(f"E must be > 0, got {E}")
+        if not -1.0 < nu < 0.5:
+            raise ValueError(f"nu must satisfy -1 < nu < 0.5, got {nu}")
+        if not rho >= 0:
+            raise ValueError(f"rho must be >= 0, got {rho}")
+        if not thickness > 0:
+            raise ValueError(f"thickness must be > 0, got {thickness}")
+        if kind not in KINDS:
+            raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
+        if material not in MATERIALS:
+            raise ValueError(f"material must be one of {MATERIALS}, got {material!r}")
+        if kind == "plane_stress" and material != "linear":
+            raise ValueError(f"material must be 'linear' for kind='plane_stress', got {material!r}")
+        if isinstance(mesh, MeshQuad):
+            element = ElementVector(ElementQuad1())
+        elif isinstance(mesh, MeshTri):
+            element = ElementVector(ElementTriP1())
+        else:
+            raise ValueError(f"mesh must be a MeshQuad or MeshTri, got {type(mesh).__name__}")
+        if kind == "axisymmetric" and mesh.p[0].min() < 0:
+            raise ValueError("mesh x coordinates (= r) must be >= 0 for kind='axisymmetric'")
+
+        self.mesh, self.name, self.kind, self.material = mesh, name, kind, material
+        self.E, self.nu, self.rho = float(E), float(nu), float(rho)
+        self.mu = E / (2.0 * (1.0 + nu))
+        self.lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
+        if kind == "plane_stress":                      # sigma_33 = 0 eliminated
+            self.lam = 2.0 * self.lam * self.mu / (self.lam + 2.0 * self.mu)
+        self.axi = kind == "axisymmetric"
+        self.thickness = 1.0 if self.axi else float(thickness)
+
+        self.basis = Basis(mesh, element)
+        self.element = element
+        self.ndof = self.basis.N
+        self.X = mesh.p.T.copy()
+        self.xdofs = self.basis.nodal_dofs.T.copy()
+        self.dof_offset = 0
+        self._K_linear = None
+        self._mass = None
+
+    # -- kinematics and constitutive update at the quadrature points --------
+
+    def _params(self):
+        return dict(axi=self.axi, thickness=self.thickness)
+
+    def _deformation_gradient(self, u, basis):
+        """3x3 F = I + grad u at the quadrature points of `basis`, with
+        F_33 = 1 + u_r / R (axisymmetric) or 1 (plane)."""
+        uq = basis.interpolate(u)
+        F = np.zeros((3, 3) + uq.value.shape[1:])
+        F[:2, :2] = uq.grad
+        if self.axi:
+            F[2, 2] = uq.value[0] / basis.global_coordinates().value[0]
+        F += _eye(F)
+        return F
+
+    def _constitutive(self, u, basis):
+        """(W, P, A) at the quadrature points; raises InvertedElementError if det F <= 0."""
+        F = self._deformation_gradient(u, basis)
+        if self.material != "linear":
+            J = np.linalg.det(np.moveaxis(F, (0, 1), (-2, -1)))
+            if np.any(J <= 0.0) or not np.all(np.isfinite(J)):
+                e = np.unique(np.nonzero(~(J > 0.0))[0])
+                raise InvertedElementError(
+                    f"element volume non-positive (det F <= 0) in body {self.name!r}, elements {e[:10]}")
+        return _MATERIAL_FUNCTIONS[self.material](F, self.lam, self.mu)
+
+    # -- body interface ----------------------------------------------------
+
+    def internal(self, u):
+        """Internal force R(u) and consistent tangent K = dR/du (csr)."""
+        u = np.asarray(u, dtype=float)
+        if self.material == "linear":
+            if self._K_linear is None:
+                _, _, A = self._constitutive(np.zeros(self.ndof), self.basis)
+                self._K_linear = asm(_tangent_form, self.basis, A=A, **self._params()).tocsr()
+            return self._K_linear @ u, self._K_linear
+        _, P, A = self._constitutive(u, self.basis)
+        R = asm(_internal_form, self.basis, P=P, **self._params())
+        K = asm(_tangent_form, self.basis, A=A, **self._params()).tocsr()
+        return R, K
+
+    def strain_energy(self, u):
+        """Stored energy int W dV (2 pi r dA for axisymmetric)."""
+        W, _, _ = self._constitutive(np.asarray(u, dtype=float), self.basis)
+        return float(asm(_energy_form, self.basis, W=W, **self._params()))
+
+    def mass(self):
+        """Lumped mass: row sums of the consistent mass int rho N_i N_j dV, shape (ndof,)."""
+        if self._mass is None:
+            M = asm(_mass_form, self.basis, rho=self.rho, **self._params())
+            self._mass = np.asarray(M.sum(axis=1)).ravel()
+        return self._mass.copy()
+
+    def commit(self, u):
+        """Elastic: no history to update."""
+
+    def volume(self):
+        """Reference volume int dV (2 pi r dA axisymmetric, thickness * area plane)."""
+        ones = np.ones_like(self.basis.global_coordinates().value[0])
+        return float(asm(_energy_form, self.basis, W=ones, **self._params()))
+
+    # -- output ------------------------------------------------------------
+
+    def cauchy_stress(self, u):
+        """Cauchy stress sigma = P F^T / det F at the ELEMENT CENTRES, shape (nel, 3, 3).
+
+        Component [2, 2] is the hoop stress (axisymmetric), the out-of-plane stress
+        (plane strain) or zero (plane stress). Linear material: sigma = C : eps.
+        """
+        centre = self.element.refdom.p.mean(axis=1)[:, None]
+        basis = Basis(self.mesh, self.element, quadrature=(centre, np.array([1.0])))
+        u = np.asarray(u, dtype=float)
+        _, P, _ = self._constitutive(u, basis)
+        if self.material == "linear":
+            sigma = P
+        else:
+            F = self._deformation_gradient(u, basis)
+            J = np.linalg.det(np.moveaxis(F, (0, 1), (-2, -1)))
+            sigma = np.einsum("ik...,jk...->ij...", P, F) / J
+        if self.kind == "plane_stress":
+            sigma = sigma.copy()
+            sigma[2, 2] = 0.0
+        return np.moveaxis(sigma[..., 0], -1, 0)
+
+    # -- named boundaries --------------------------------------------------
+
+    def boundary_facets(self, name):
+        """Facet indices of the named boundary (mesh.with_boundaries)."""
+        names = tuple(self.mesh.boundaries or ())
+        if name not in names:
+            raise ValueError(f"boundary name must be one of {names}, got {name!r}")
+        return np.asarray(self.mesh.boundaries[name])
+
+    def boundary_nodes(self, name):
+        """Node indices of the named boundary, in order along it, walking with the
+        body on the right (outward normal = e3 x tangent, as for a master segment
+        in eq 18). A closed boundary starts anywhere and is not repeated."""
+        ab = oriented_facets(self.mesh, self.boundary_facets(name))
+        nxt = dict(ab)
+        if len(nxt) != len(ab):
+            raise ValueError(f"boundary {name!r} is not a simple curve")
+        starts = set(ab[:, 0]) - set(ab[:, 1])
+        node = starts.pop() if starts else ab[0, 0]
+        order = [node]
+        while node in nxt and len(order) <= len(ab):
+            node = nxt[node]
+            if node == order[0]:
+                break
+            order.append(node)
+        if len(order) != len(set(ab.ravel())):
+            raise ValueError(f"boundary {name!r} must be one connected curve")
+        return np.array(order)
