@@ -1,0 +1,140 @@
+"""External loads on a ``Continuum`` body.
+
+Each load has ``assemble(u_global, t) -> (P, rows, cols, vals)``: the external
+force vector P (ndof_global,) and dP/du as COO triplets in global numbering
+(empty for dead loads). The body's dofs start at ``body.dof_offset``.
+``total_force(u_global, t)`` sums the nodal forces: the resultant (Fx, Fy).
+
+Axisymmetric bodies integrate over the full ring (2 pi r), plane bodies over
+the thickness, exactly as in ``Continuum``.
+"""
+import numpy as np
+from skfem import FacetBasis, LinearForm, asm
+
+from .continuum import _weight, oriented_facets
+
+_EMPTY = (np.zeros(0, dtype=int), np.zeros(0, dtype=int), np.zeros(0))
+
+
+def _value(f, t):
+    """A constant, or a callable evaluated at time t, as a float array."""
+    return np.asarray(f(t) if callable(f) else f, dtype=float)
+
+
+@LinearForm
+def _unit_load(v, w):
+    """int N_i e_comp . v dV (or dS): nodal forces of a unit load in direction comp."""
+    return v.value[w.comp] * _weight(w)
+
+
+@LinearForm
+def _unit_pressure(v, w):
+    """-int n . v dS: nodal forces of a unit dead pressure (n = reference outward normal)."""
+    return -np.einsum("i...,i...->...", w.n, v.value) * _weight(w)
+
+
+class _Load:
+    """Shared plumbing: local (body) vector -> global vector and triplets."""
+
+    def __init__(self, body):
+        self.body = body
+
+    def _local(self, u, t):
+        raise NotImplementedError
+
+    def assemble(self, u_global, t):
+        off, n = self.body.dof_offset, self.body.ndof
+        P_local, rows, cols, vals = self._local(np.asarray(u_global)[off:off + n], t)
+        P = np.zeros(len(u_global))
+        P[off:off + n] = P_local
+        return P, rows + off, cols + off, vals
+
+    def total_force(self, u_global, t):
+        """Resultant (sum of the nodal forces) in x and y."""
+        P = self.assemble(u_global, t)[0]
+        dofs = self.body.xdofs + self.body.dof_offset
+        return np.array([P[dofs[:, 0]].sum(), P[dofs[:, 1]].sum()])
+
+
+class BodyForce(_Load):
+    """Dead load b = (bx, by) per unit reference volume (e.g. (0, -g rho)),
+    or a callable t -> (bx, by). P = int N^T b dV."""
+
+    def __init__(self, body, b):
+        super().__init__(body)
+        self.b = b
+        params = dict(axi=body.axi, thickness=body.thickness)
+        self._unit = [asm(_unit_load, body.basis, comp=c, **params) for c in (0, 1)]
+
+    def _local(self, u, t):
+        b = _value(self.b, t)
+        return b[0] * self._unit[0] + b[1] * self._unit[1], *_EMPTY
+
+
+class Traction(_Load):
+    """Dead traction (tx, ty) per unit reference length on a named boundary,
+    or a callable t -> (tx, ty). P = int_boundary N^T t dS."""
+
+    def __init__(self, body, boundary_name, traction):
+        super().__init__(body)
+        self.traction = traction
+        fb = FacetBasis(body.mesh, body.element, facets=body.boundary_facets(boundary_name))
+        params = dict(axi=body.axi, thickness=body.thickness)
+        self._unit = [asm(_unit_load, fb, comp=c, **params) for c in (0, 1)]
+
+    def _local(self, u, t):
+        tr = _value(self.traction, t)
+        return tr[0] * self._unit[0] + tr[1] * self._unit[1], *_EMPTY
+
+
+class Pressure(_Load):
+    """Pressure p (or callable t -> p) on a named boundary, pushing into the body
+    (along minus the outward normal).
+
+    follower=False: dead load on the reference geometry (FacetBasis normals).
+    follower=True: acts on the current facet. For a straight two-node facet a -> b
+    (body on the right, so the outward normal times length is nL = e3 x (x_b - x_a))
+    the nodal forces are exact:
+        plane         f_a = f_b = -p nL thickness / 2
+        axisymmetric  f_a = -p nL 2 pi (2 r_a + r_b) / 6,  f_b = -p nL 2 pi (r_a + 2 r_b) / 6
+    (int N_i 2 pi r ds with r linear along the edge, current radii r = x).
+    The tangent dP/du follows by the product rule and is returned as COO triplets.
+    """
+
+    # d nL / d(u_ax, u_ay, u_bx, u_by), nL = (-(y_b - y_a), x_b - x_a)
+    _dnL = np.array([[0.0, 1.0, 0.0, -1.0],
+                     [-1.0, 0.0, 1.0, 0.0]])
+
+    def __init__(self, body, boundary_name, p, follower=False):
+        super().__init__(body)
+        self.p, self.follower = p, bool(follower)
+        facets = body.boundary_facets(boundary_name)
+        if self.follower:
+            ab = oriented_facets(body.mesh, facets)
+            self._dofs = body.xdofs[ab].reshape(-1, 4)    # [a_x, a_y, b_x, b_y] per facet
+            self._X = body.X[ab].reshape(-1, 4)          # reference (X_a, Y_a, X_b, Y_b)
+        else:
+            fb = FacetBasis(body.mesh, body.element, facets=facets)
+            self._unit = asm(_unit_pressure, fb, axi=body.axi, thickness=body.thickness)
+
+    def _local(self, u, t):
+        p = float(_value(self.p, t))
+        if not self.follower:
+            return p * self._unit, *_EMPTY
+        x = self._X + u[self._dofs]             # current (x_a, y_a, x_b, y_b), (nf, 4)
+        nL = np.column_stack([-(x[:, 3] - x[:, 1]), x[:, 2] - x[:, 0]])
+        if self.body.axi:
+            ra, rb = x[:, 0], x[:, 2]
+            c = 2.0 * np.pi * np.column_stack([2 * ra + rb, ra + 2 * rb]) / 6.0
+            dc = 2.0 * np.pi * np.array([[2, 0, 1, 0], [1, 0, 2, 0]]) / 6.0
+        else:
+            c = np.full((len(x), 2), 0.5 * self.body.thickness)
+            dc = np.zeros((2, 4))
+        f = -p * np.concatenate([c[:, 0:1] * nL, c[:, 1:2] * nL], axis=1)     # (nf, 4)
+        K = np.concatenate([c[:, i, None, None] * self._dnL + nL[:, :, None] * dc[i]
+                            for i in (0, 1)], axis=1) * -p                   # (nf, 4, 4)
+        P = np.zeros(self.body.ndof)
+        np.add.at(P, self._dofs, f)
+        rows = np.repeat(self._dofs, 4, axis=1).ravel()
+        cols = np.tile(self._dofs, (1, 4)).ravel()
+        return P, rows, cols, K.ravel()
