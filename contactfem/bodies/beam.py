@@ -1,0 +1,283 @@
+"""Geometrically exact plane beam (Reissner 1972 / Simo & Vu-Quoc 1986), the
+finite-deformation beam element of the paper's rings (Sec. 5.3, 5.4).
+
+Unknowns per node: (u_x, u_y, theta), numbered node by node: dof 3*i + k.
+
+Kinematics (exact under large rotations; textbook: Simo & Vu-Quoc 1986, Crisfield vol. 2 ch. 17):
+    current centreline   x = X + u
+    total rotation       phi = theta0 + theta   (theta0: reference tangent angle of the element)
+    t(phi) = (cos phi, sin phi),  n(phi) = (-sin phi, cos phi)  (normal to the left of t)
+    axial strain         eps = x' . t - 1
+    shear strain         gam = x' . n
+    curvature change     kap = theta'
+    resultants           N = EA eps,  Q = kappa_s G A gam,  M = EI kap
+    energy               W = int (N eps + Q gam + M kap) / 2 ds
+
+Discretisation: straight two-node elements (a polygon in the reference state), linear
+interpolation in the reference arc length s, ONE-point (midpoint) integration against
+shear locking. The element kernel is vectorised numpy over all elements; K is
+assembled from COO triplets with one ``coo_matrix(...).tocsr()``.
+
+What scikit-fem does here: the 1D mesh in the arc length s (``MeshLine``; its
+element lengths are the reference chord lengths), and the lumped mass (row sums of
+the P1 mass matrix ``asm(mass, basis)``). A closed ring is an open 1D mesh of
+length L whose last node (s = L) is identified with the first; the identification
+is the index map ``self.fold`` (mesh node -> beam node).
+
+Viscoplastic variant (paper Sec. 5.3 gives only the plastic resultants N0, Q0, M0):
+a Perzyna overstress model, decoupled per resultant S in (N, Q, M) with elastic
+modulus D in (EA, kappa_s GA, EI):
+    plastic strain rate   e_p' = <|S| - S0> / (eta D) * sign(S)
+eta is a relaxation time (units of time): eta -> 0 is rate-independent perfect
+plasticity, eta -> inf is elastic. The scan gives no viscosity; the default
+eta = 0.1 equals the paper's time step in Sec. 5.3, so the overstress relaxes
+within about one step (nearly rate-independent, but the tangent stays regular).
+Backward Euler gives the closed-form return map (see ``return_map``).
+"""
+
+import numpy as np
+from scipy.sparse import coo_matrix
+from skfem import Basis, ElementLineP1, MeshLine, asm
+from skfem.models import mass as mass_form
+
+
+def _check(name, value, low, low_open=True):
+    """Raise ValueError unless value is a finite number > low (>= low if not low_open)."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"parameter {name} must be a number, got {value!r}") from None
+    ok = np.isfinite(v) and (v > low if low_open else v >= low)
+    if not ok:
+        bracket = "(" if low_open else "["
+        raise ValueError(f"parameter {name} = {value!r} is out of range: allowed {bracket}{low:g}, inf)")
+    return v
+
+
+def ring(R, n_el, center=(0.0, 0.0)):
+    """Nodes of a closed ring of radius R with n_el elements, counter-clockwise.
+
+    For a counter-clockwise ring the beam normal n = e3 x t points INTO the ring,
+    so the outer surface is ``offset_positions(u, -thickness / 2)``.
+    """
+    R = _check("R", R, 0.0)
+    if int(n_el) != n_el or n_el < 3:
+        raise ValueError(f"parameter n_el = {n_el!r} is out of range: allowed integers >= 3")
+    a = 2 * np.pi * np.arange(int(n_el)) / n_el
+    return np.asarray(center, float) + R * np.column_stack([np.cos(a), np.sin(a)])
+
+
+def return_map(E, ep, D, S0, eta, dt):
+    """Backward-Euler Perzyna return map, per resultant (vectorised).
+
+    Trial S_tr = D (E - ep), overstress f = |S_tr| - S0. Elastic if f <= 0, else
+        S = sign(S_tr) (S0 + f eta / (eta + dt)),   dS/dE = D eta / (eta + dt)
+    (from S = S_tr - D de_p sign and D de_p = dt/eta (|S| - S0)).
+    Returns S, the algorithmic modulus C = dS/dE, and the updated plastic strain.
+    """
+    S_tr = D * (E - ep)
+    if S0 is None:
+        return S_tr, D * np.ones_like(E), ep
+    f = np.abs(S_tr) - S0
+    yielding = f > 0
+    r = eta / (eta + dt)
+    S = np.where(yielding, np.sign(S_tr) * (S0 + f * r), S_tr)
+    C = np.where(yielding, D * r, D)
+    return S, C, E - S / D
+
+
+class Beam:
+    """Plane Reissner beam body (see the module docstring for the formulas).
+
+    X        (nn, 2) reference centreline nodes (an open arc, or a ring if closed)
+    closed   True: the last node connects back to the first
+    E, A, I  Young's modulus, cross-section area, second moment of area (> 0)
+    rho      density (>= 0)
+    G        shear modulus (default E / (2 (1 + nu)))
+    nu       Poisson's ratio, used only for the default G
+    kappa_s  shear correction factor (default 5/6, rectangle)
+    plastic  None (elastic) or dict(N0=, Q0=, M0=, eta=0.1): Perzyna viscoplasticity;
+             then set the step with ``beam.set_dt(dt)`` before calling internal().
+    """
+
+    def __init__(self, X, closed, E, A, I, rho, G=None, nu=0.0, kappa_s=5 / 6,
+                 name="beam", plastic=None):
+        X = np.asarray(X, dtype=float)
+        if X.ndim != 2 or X.shape[1] != 2 or not np.all(np.isfinite(X)):
+            raise ValueError(f"parameter X must be a finite (nn, 2) array, got shape {X.shape}")
+        nn = X.shape[0]
+        nmin = 3 if closed else 2
+        if nn < nmin:
+            raise ValueError(f"parameter X has {nn} nodes: allowed nn >= {nmin} for closed={closed}")
+        self.name, self.X, self.closed = name, X, bool(closed)
+        E = _check("E", E, 0.0)
+        self.A, self.I = _check("A", A, 0.0), _check("I", I, 0.0)
+        self.rho = _check("rho", rho, 0.0, low_open=False)
+        kappa_s = _check("kappa_s", kappa_s, 0.0)
+        if G is None:
+            if not -1.0 < float(nu) <= 0.5:
+                raise ValueError(f"parameter nu = {nu!r} is out of range: allowed (-1, 0.5]")
+            G = E / (2 * (1 + nu))
+        G = _check("G", G, 0.0)
+        self.D = np.array([E * self.A, kappa_s * G * self.A, E * self.I])  # EA, kGA, EI
+
+        # connectivity: element e joins nodes a = e and b = e + 1 (closed: n-1 -> 0)
+        ne = nn if closed else nn - 1
+        a = np.arange(ne)
+        self.conn = np.column_stack([a, (a + 1) % nn])
+        chord = X[self.conn[:, 1]] - X[self.conn[:, 0]]
+        self.L0 = np.hypot(chord[:, 0], chord[:, 1])
+        if np.any(self.L0 <= 1e-14 * np.max(np.abs(X)) + 1e-300):
+            raise ValueError("parameter X has coincident consecutive nodes: element lengths must be > 0")
+        self.theta0 = np.arctan2(chord[:, 1], chord[:, 0])
+
+        # scikit-fem: 1D mesh in the reference arc length s (closed: node nn sits at s = L
+        # and is identified with node 0 through `fold`)
+        s = np.concatenate([[0.0], np.cumsum(self.L0)])
+        self.mesh = MeshLine(s)
+        self.fold = np.arange(ne + 1) % nn
+
+        self.ndof = 3 * nn
+        self.xdofs = 3 * np.arange(nn)[:, None] + np.array([0, 1])
+        self.edofs = np.column_stack([3 * self.conn[:, 0] + k for k in range(3)]
+                                     + [3 * self.conn[:, 1] + k for k in range(3)])
+        self.dof_offset = 0
+
+        self.S0, self.eta, self.dt = None, None, None
+        if plastic is not None:
+            unknown = set(plastic) - {"N0", "Q0", "M0", "eta"}
+            if unknown:
+                raise ValueError(f"parameter plastic has unknown keys {sorted(unknown)}: allowed N0, Q0, M0, eta")
+            self.S0 = np.array([_check(k, plastic.get(k, d), 0.0)
+                                for k, d in (("N0", 1.0), ("Q0", 0.5), ("M0", 0.25))])
+            self.eta = _check("eta", plastic.get("eta", 0.1), 0.0)
+        self.ep = np.zeros((ne, 3))   # committed plastic strains (eps_p, gam_p, kap_p)
+
+    # ---- time step for the viscoplastic update ---------------------------------
+    def set_dt(self, dt):
+        """Time step used by the backward-Euler viscoplastic update."""
+        self.dt = _check("dt", dt, 0.0)
+
+    # ---- kinematics ----------------------------------------------------------------
+    def positions(self, u):
+        """Current centreline node positions x = X + u, (nn, 2)."""
+        return self.X + np.asarray(u).reshape(-1, 3)[:, :2]
+
+    def strains(self, u):
+        """Midpoint strains (eps, gam, kap) per element, (ne, 3), and t, n of the total angle."""
+        U = np.asarray(u, float).reshape(-1, 3)
+        a, b = self.conn.T
+        xp = (self.X[b] + U[b, :2] - self.X[a] - U[a, :2]) / self.L0[:, None]   # x'
+        phi = self.theta0 + 0.5 * (U[a, 2] + U[b, 2])
+        t = np.column_stack([np.cos(phi), np.sin(phi)])
+        n = np.column_stack([-np.sin(phi), np.cos(phi)])
+        E = np.column_stack([np.sum(xp * t, 1) - 1, np.sum(xp * n, 1),
+                             (U[b, 2] - U[a, 2]) / self.L0])
+        return E, t, n
+
+    def resultants(self, u):
+        """(N, Q, M) per element, (ne, 3), with the algorithmic moduli dS/dE and new plastic strains."""
+        E, _, _ = self.strains(u)
+        if self.S0 is not None and self.dt is None:
+            raise RuntimeError("viscoplastic beam: call beam.set_dt(dt) before evaluating it")
+        return return_map(E, self.ep, self.D, self.S0, self.eta, self.dt)
+
+    # ---- body interface ------------------------------------------------------------
+    def internal(self, u):
+        """Internal force R = dW/du and consistent tangent K = dR/du (virtual work, midpoint rule).
+
+        Per element, with q = (u_a, theta_a, u_b, theta_b) and B = dE/dq (3 x 6):
+            r_e = L0 B^T S,     K_e = L0 (B^T C B + N d2eps/dq2 + Q d2gam/dq2)
+        deps/dphi = gam, dgam/dphi = -(1 + eps), phi = theta0 + (theta_a + theta_b)/2.
+        """
+        E, t, n = self.strains(u)
+        S, C, _ = self.resultants(u)
+        eps, gam = E[:, 0], E[:, 1]
+        L0 = self.L0[:, None]
+        z = np.zeros_like(self.L0)
+        p = np.array([0, 0, 0.5, 0, 0, 0.5])                       # dphi/dq
+        a_t = np.column_stack([-t / L0, z, t / L0, z])              # (x' . t) derivative
+        a_n = np.column_stack([-n / L0, z, n / L0, z])              # (x' . n) derivative
+        B = np.stack([a_t + gam[:, None] * p,
+                      a_n - (1 + eps)[:, None] * p,
+                      np.outer(1 / self.L0, [0, 0, -1, 0, 0, 1])], axis=1)   # (ne, 3, 6)
+        pp = np.outer(p, p)
+        G_eps = np.einsum("ei,j->eij", a_n, p) + np.einsum("i,ej->eij", p, a_n) - (1 + eps)[:, None, None] * pp
+        G_gam = -np.einsum("ei,j->eij", a_t, p) - np.einsum("i,ej->eij", p, a_t) - gam[:, None, None] * pp
+        re = L0 * np.einsum("eki,ek->ei", B, S)
+        Ke = L0[:, :, None] * (np.einsum("eki,ek,ekj->eij", B, C, B)
+                               + S[:, 0, None, None] * G_eps + S[:, 1, None, None] * G_gam)
+        R = np.bincount(self.edofs.ravel(), re.ravel(), minlength=self.ndof)
+        rows = np.repeat(self.edofs, 6, axis=1).ravel()
+        cols = np.tile(self.edofs, (1, 6)).ravel()
+        K = coo_matrix((Ke.ravel(), (rows, cols)), shape=(self.ndof, self.ndof)).tocsr()
+        return R, K
+
+    def strain_energy(self, u):
+        """Stored (elastic) energy sum_e L0 sum_k S_k^2 / (2 D_k); elastic case: L0 D E^2 / 2."""
+        S, _, _ = self.resultants(u)
+        return float(np.sum(self.L0[:, None] * S**2 / (2 * self.D)))
+
+    def commit(self, u):
+        """Accept u as converged: store the plastic strains (no-op if elastic)."""
+        if self.S0 is not None:
+            self.ep = self.resultants(u)[2]
+
+    def mass(self):
+        """Lumped mass: rho A per length on u_x, u_y and rho I per length on theta (half to each node).
+
+        scikit-fem: row sums of the P1 mass matrix on the arc-length mesh = L0/2 per element end.
+        """
+        lumped_mesh = np.asarray(asm(mass_form, Basis(self.mesh, ElementLineP1())).sum(axis=1)).ravel()
+        length = np.bincount(self.fold, lumped_mesh, minlength=self.X.shape[0])   # fold s = L onto s = 0
+        return (self.rho * np.column_stack([self.A * length, self.A * length, self.I * length])).ravel()
+
+    # ---- surface offset (for contact on the outer face of a ring) -------------------
+    def _node_angle0(self):
+        """Reference tangent angle at the nodes: bisector of the adjacent element angles."""
+        nn, th = self.X.shape[0], self.theta0
+        if self.closed:
+            left, right = th[np.arange(nn) - 1], th
+        else:
+            left, right = th[np.r_[0, np.arange(nn - 1)]], th[np.r_[np.arange(nn - 1), nn - 2]]
+        return left + 0.5 * ((right - left + np.pi) % (2 * np.pi) - np.pi)
+
+    def offset_positions(self, u, h):
+        """Node positions offset by h along the current normal n(psi0 + theta), (nn, 2).
+
+        psi0: reference nodal tangent angle (bisector of the neighbouring elements).
+        """
+        U = np.asarray(u, float).reshape(-1, 3)
+        psi = self._node_angle0() + U[:, 2]
+        return self.X + U[:, :2] + h * np.column_stack([-np.sin(psi), np.cos(psi)])
+
+    def offset_jacobian(self, u, h):
+        """d(offset position)/d(u_x, u_y, theta) per node, (nn, 2, 3): [I | -h t(psi0 + theta)]."""
+        U = np.asarray(u, float).reshape(-1, 3)
+        psi = self._node_angle0() + U[:, 2]
+        J = np.zeros((U.shape[0], 2, 3))
+        J[:, 0, 0] = J[:, 1, 1] = 1.0
+        J[:, 0, 2], J[:, 1, 2] = -h * np.cos(psi), -h * np.sin(psi)
+        return J
+
+
+class BeamGravity:
+    """Dead gravity load on a beam: P = m_lumped * g on the (u_x, u_y) dofs.
+
+    g: a 2-vector (g_x, g_y), or a number meaning (0, -g).
+    """
+
+    def __init__(self, beam, g):
+        g = np.array([0.0, -float(g)]) if np.ndim(g) == 0 else np.asarray(g, float)
+        if g.shape != (2,) or not np.all(np.isfinite(g)):
+            raise ValueError(f"parameter g must be a finite number or 2-vector, got {g!r}")
+        self.beam, self.g = beam, g
+
+    def assemble(self, u_global, t):
+        """(P, rows, cols, vals): the dead load and an empty tangent."""
+        b = self.beam
+        P = np.zeros(np.size(u_global))
+        m = b.mass()
+        P[b.dof_offset + b.xdofs] = m[b.xdofs] * self.g
+        empty_i, empty_v = np.zeros(0, dtype=int), np.zeros(0)
+        return P, empty_i, empty_i, empty_v
