@@ -119,7 +119,7 @@ def _weight(w):
 
 def _hoop(v, w):
     """Hoop part v_r / r of a (test or trial) displacement; zero in plane problems."""
-    return v.value[0] / w.x[0] if w.axi else 0.0 * v.value[0]
+    return v[0] / w.x[0] if w.axi else 0.0 * v[0]
 
 
 @LinearForm
@@ -144,7 +144,7 @@ def _tangent_form(u, v, w):
 
 @BilinearForm
 def _mass_form(u, v, w):
-    return w.rho * np.einsum("i...,i...->...", u.value, v.value) * _weight(w)
+    return w.rho * np.einsum("i...,i...->...", u, v) * _weight(w)
 
 
 @Functional
@@ -234,10 +234,10 @@ class Continuum:
         """3x3 F = I + grad u at the quadrature points of `basis`, with
         F_33 = 1 + u_r / R (axisymmetric) or 1 (plane)."""
         uq = basis.interpolate(u)
-        F = np.zeros((3, 3) + uq.value.shape[1:])
+        F = np.zeros((3, 3) + uq.shape[1:])
         F[:2, :2] = uq.grad
         if self.axi:
-            F[2, 2] = uq.value[0] / basis.global_coordinates().value[0]
+            F[2, 2] = uq[0] / basis.global_coordinates()[0]
         F += _eye(F)
         return F
 
@@ -284,7 +284,7 @@ class Continuum:
 
     def volume(self):
         """Reference volume int dV (2 pi r dA axisymmetric, thickness * area plane)."""
-        ones = np.ones_like(self.basis.global_coordinates().value[0])
+        ones = np.ones_like(self.basis.global_coordinates()[0])
         return float(asm(_energy_form, self.basis, W=ones, **self._params()))
 
     # -- output ------------------------------------------------------------

@@ -24,13 +24,13 @@ def _value(f, t):
 @LinearForm
 def _unit_load(v, w):
     """int N_i e_comp . v dV (or dS): nodal forces of a unit load in direction comp."""
-    return v.value[w.comp] * _weight(w)
+    return v[w.comp] * _weight(w)
 
 
 @LinearForm
 def _unit_pressure(v, w):
     """-int n . v dS: nodal forces of a unit dead pressure (n = reference outward normal)."""
-    return -np.einsum("i...,i...->...", w.n, v.value) * _weight(w)
+    return -np.einsum("i...,i...->...", w.n, v) * _weight(w)
 
 
 class _Load:
