@@ -144,11 +144,13 @@ def _tangent_form(u, v, w):
 
 @BilinearForm
 def _mass_form(u, v, w):
+    """Consistent mass int rho u . v dV (lumped by row sums in Continuum.mass)."""
     return w.rho * np.einsum("i...,i...->...", u, v) * _weight(w)
 
 
 @Functional
 def _energy_form(w):
+    """Integral of a quadrature-point field, int W dV."""
     return w.W * _weight(w)
 
 
