@@ -1,0 +1,4 @@
+"""contactfem: large-deformation impact-contact with friction after
+Wriggers, Vu Van & Stein (1990), on scikit-fem. A teaching and reference toolkit."""
+
+__version__ = "0.1.0"

@@ -1,0 +1,19 @@
+"""Bodies: the bulk mechanics, assembled with scikit-fem.
+
+Every body offers the same small interface, so that a scene can swap a beam ring
+for a continuum ring and the solver never knows the difference:
+
+    body.name          str
+    body.X             (nn, 2) reference positions of the nodes that can touch
+                       (continuum: mesh nodes; beam: centreline nodes)
+    body.ndof          int, number of unknowns of this body
+    body.xdofs         (nn, 2) int, local dof numbers of each node's (u_x, u_y)
+    body.mass()        (ndof,) lumped (diagonal) mass
+    body.internal(u)   -> (R, K): internal force vector R(u) (ndof,) and its
+                       consistent tangent K = dR/du (scipy.sparse, ndof x ndof)
+    body.strain_energy(u) -> float
+    body.commit(u)     accept u as converged (history variables; no-op if elastic)
+
+`u` is always the body's own (local) displacement vector; the solver's System
+places bodies one after another in the global vector (``body.dof_offset``).
+"""

@@ -1,0 +1,38 @@
+"""The contact element: residual (eq 28) and consistent tangent (eqs 33, 39, 49, 50),
+vectorised over contact pairs, returned as COO triplets ready to add to a global matrix."""
+
+import numpy as np
+
+from .kinematics import outer
+
+
+def contact_element(w, t_N, dt_N, t_T, c_T_s, c_N_s, dg_N, d2g_N, ds, d2s):
+    """Nodal contact forces and their tangent for each pair.
+
+    w: weight of each slave (tributary length for tractions per unit length, 1 for
+    nodal laws). With the variations of the gap and of the arc coordinate s
+    (Delta g_T = s - s_bar):
+
+    eq (28)   R_c = w [ t_N dg_N + t_T ds ]
+              (for a segment: dg_N = N_s and ds = (l_bar/l)(T_s + (g_N/l) N_0))
+    eq (33)   K_N = w [ dt_N/dg_N dg_N dg_N^T + t_N d2g_N ]
+    eq (39)   K_T = w [ c_T (ds ds^T) + t_T d2s ]                  (stick; ds ds^T = (l_bar/l)^2 A,
+                                                                    d2s = l_bar B / l^2)
+    eq (49)   K_T = w [ c_T^s (ds ds^T) + t_T d2s + c_N^s C ]      (slip)
+    eq (50)   C = ds dg_N^T                                         (non-symmetric)
+    """
+    W = w[:, None]
+    R = W * (t_N[:, None] * dg_N + t_T[:, None] * ds)
+    K = w[:, None, None] * (dt_N[:, None, None] * outer(dg_N, dg_N) + t_N[:, None, None] * d2g_N
+                            + c_T_s[:, None, None] * outer(ds, ds) + t_T[:, None, None] * d2s
+                            + c_N_s[:, None, None] * outer(ds, dg_N))
+    return R, K
+
+
+def to_coo(dofs, K):
+    """COO triplets (rows, cols, vals) of the element matrices K (nc, k, k) placed at
+    global dofs (nc, k)."""
+    k = dofs.shape[1]
+    rows = np.repeat(dofs, k, axis=1).ravel()
+    cols = np.tile(dofs, (1, k)).ravel()
+    return rows, cols, K.ravel()

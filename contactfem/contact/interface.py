@@ -1,0 +1,123 @@
+"""A contact interface: slave nodes of one body against a master, with their
+friction history (paper Sec. 4.3, step 4: per slave node, check the gap -> normal
+force -> trial friction -> slip check -> stick or return map -> tangents).
+
+History (s_bar, t_T_bar, q_bar) is committed only on a converged step (commit)."""
+
+import numpy as np
+
+from .element import contact_element, to_coo
+from ..laws.friction import Frictionless
+from .return_map import STATE_NAMES, return_map
+
+
+def tributary_lengths(X):
+    """Half the length of the two neighbouring edges of each node of an ordered chain X (n, 2)."""
+    L = np.linalg.norm(np.diff(np.asarray(X, dtype=float), axis=0), axis=1)
+    w = np.zeros(len(X))
+    w[:-1] += L / 2
+    w[1:] += L / 2
+    return w
+
+
+class NodeToSegment:
+    """Node-to-segment frictional contact of `nodes` of `slave` (a body) on `master`.
+
+    normal:   a normal law (t_N(g_N), e.g. PowerLaw, eq 4)
+    friction: a friction law (c_T and slip_bound, eqs 5, 10) or None (frictionless)
+    weights:  per-slave weight multiplying the tractions into nodal forces: a
+              tributary length when the laws are tractions per unit length
+              (the block, Sec. 5.1), 1 when c_N, c_T are nodal stiffnesses (rings, cork)
+    offset:   the slave surface lies `offset` beyond the node along the master normal
+              (half the thickness of a beam whose centreline nodes are the slaves)
+    """
+
+    def __init__(self, slave, nodes, master, normal, friction=None, weights=1.0, offset=0.0, name="contact"):
+        self.slave, self.master, self.normal, self.friction, self.name = slave, master, normal, friction, name
+        self.nodes = np.asarray(nodes, dtype=int)
+        self.weights = np.broadcast_to(np.asarray(weights, dtype=float), self.nodes.shape).copy()
+        if np.any(self.weights <= 0):
+            raise ValueError("parameter weights must be positive (tributary lengths or 1)")
+        self.offset = float(offset)
+        nc = len(self.nodes)
+        self.s_bar = None                   # set at the first evaluation (or initialize)
+        self.t_T_bar = np.zeros(nc)
+        self.q_bar = np.zeros(nc)
+        self.dissipation = 0.0              # of the last committed step
+        self.dissipation_total = 0.0
+
+    # -- kinematics -------------------------------------------------------------
+    def slave_dofs(self):
+        return self.slave.dof_offset + self.slave.xdofs[self.nodes]
+
+    def slave_positions(self, u):
+        return self.slave.X[self.nodes] + u[self.slave_dofs()]
+
+    def initialize(self, u):
+        """Take the projections at u as the reference for the first slip increment."""
+        x_s = self.slave_positions(u)
+        s0 = np.zeros(len(self.nodes))
+        self.s_bar = self.master.locate(x_s, s0, u)["s"]
+
+    def evaluate(self, u):
+        """Everything at displacement u with the committed history: kinematics,
+        tractions, return mapping, element residuals and tangents."""
+        if self.s_bar is None:
+            self.initialize(u)
+        x_s = self.slave_positions(u)
+        k = self.master.locate(x_s, self.s_bar, u)
+        g_N = k["g_N"] - self.offset
+        active = k["inside"] & (g_N < 0.0)
+        t_N, dt_N = self.normal.traction(np.where(active, g_N, 1.0))
+        dg_T = k["s"] - self.s_bar
+        if self.friction is None:
+            z = np.zeros_like(t_N)
+            fr = return_map(Frictionless(), t_N, dt_N, z, z, self.q_bar)
+        else:
+            fr = return_map(self.friction, t_N, dt_N, dg_T, self.t_T_bar, self.q_bar)
+        R, K = contact_element(self.weights, t_N, dt_N, fr.t_T, fr.c_T_s, fr.c_N_s,
+                               k["dg_N"], k["d2g_N"], k["ds"], k["d2s"])
+        dofs = np.concatenate([self.slave_dofs(), k["master_dofs"]], axis=1)
+        return dict(k, x_s=x_s, g_N=g_N, active=active, t_N=t_N, dt_N=dt_N, dg_T=dg_T, friction=fr,
+                    R=R, K=K, dofs=dofs)
+
+    # -- the contact interface used by the solver -------------------------------
+    def assemble(self, u):
+        """Global contact residual R_c (eq 28) and tangent triplets (eqs 33, 39, 49)."""
+        e = self.evaluate(u)
+        on = e["active"]
+        R_c = np.zeros(len(u))
+        np.add.at(R_c, e["dofs"][on].ravel(), e["R"][on].ravel())
+        rows, cols, vals = to_coo(e["dofs"][on], e["K"][on])
+        return R_c, rows, cols, vals
+
+    def commit(self, u):
+        """Accept u as converged: store t_T, accumulated slip and the projection."""
+        e = self.evaluate(u)
+        fr = e["friction"]
+        self.dissipation = float(np.sum(self.weights * fr.dissipation))
+        self.dissipation_total += self.dissipation
+        self.t_T_bar = np.where(e["active"], fr.t_T, 0.0)
+        self.q_bar = fr.q
+        if hasattr(self.master, "commit"):
+            self.master.commit(u)           # new converged metric l_bar of a deformable master
+        self.s_bar = self.master.locate(e["x_s"], self.s_bar, u)["s"]
+
+    def energy(self, u):
+        """Energy stored in the interface: the normal law's potential plus the elastic
+        tangential (stick) spring t_T^2 / (2 c_T)."""
+        e = self.evaluate(u)
+        g = np.where(e["active"], e["g_N"], 1.0)
+        W_N = self.normal.energy(g) if hasattr(self.normal, "energy") else np.zeros_like(g)
+        W_T = 0.0
+        if self.friction is not None and self.friction.c_T > 0:
+            W_T = e["friction"].t_T ** 2 / (2.0 * self.friction.c_T)
+        return float(np.sum(self.weights * (W_N + W_T)))
+
+    def report(self, u):
+        """Per slave node: reference and current position, gap, tractions, forces, state."""
+        e = self.evaluate(u)
+        fr = e["friction"]
+        return dict(X=self.slave.X[self.nodes], x=e["x_s"], g_N=e["g_N"], t_N=e["t_N"], t_T=fr.t_T,
+                    f_N=self.weights * e["t_N"], f_T=self.weights * fr.t_T, n=e["n"], t=e["t"],
+                    state=STATE_NAMES[fr.state], seg=e["seg"], weights=self.weights)

@@ -1,0 +1,173 @@
+"""Master surfaces: where a slave node touches, and how the gap and the arc
+coordinate vary with the unknowns.
+
+Every master answers one question for an array of slave positions x_s (nc, 2):
+``locate(x_s, s_bar, u)`` returns the contact kinematics of each slave with its
+closest master segment (or point of a smooth obstacle):
+
+    g_N (nc,), s (nc,)        gap (eq 17) and arc coordinate of the projection
+    dg_N, ds (nc, k)          first variations w.r.t. the pair's dofs (eq 27)
+    d2g_N, d2s (nc, k, k)     second variations (eqs 31-32, 37-38)
+    master_dofs (nc, k - 2)   global dofs of the master nodes (none for rigid masters)
+    inside (nc,) bool         the projection falls on the master
+    seg (nc,) int             segment index (-1 for smooth obstacles)
+
+The first two dofs of each pair are the slave's. The tangential slip increment of
+eq (20) is Delta g_T = s - s_bar: s is measured along the master in the metric of
+the last converged configuration, s = S_bar[j] + alpha l_bar[j] on segment j
+(S_bar: converged arc length up to node j), so a slave that moves on to a
+neighbouring segment keeps its friction history.
+"""
+
+import numpy as np
+
+from .kinematics import arc_variations, line_variations, segment_variations
+
+
+def _check_points(points, name):
+    P = np.asarray(points, dtype=float)
+    if P.ndim != 2 or P.shape[1] != 2 or len(P) < 2:
+        raise ValueError(f"parameter {name} must be an array of at least 2 points (shape (n, 2)), got shape {P.shape}")
+    if np.any(np.linalg.norm(np.diff(P, axis=0), axis=1) <= 0.0):
+        raise ValueError(f"parameter {name} has a zero-length (degenerate) segment: two consecutive points coincide")
+    return P
+
+
+def closest_segment(x_s, P):
+    """Closest segment of the polyline P (m+1, 2) to each slave: the one at the
+    smallest distance (to the clamped projection). Returns (j, inside) where inside
+    is False when the projection falls beyond either end of the polyline."""
+    a = P[1:] - P[:-1]
+    l2 = np.einsum("ij,ij->i", a, a)
+    d = x_s[:, None, :] - P[None, :-1, :]
+    alpha = np.einsum("kij,ij->ki", d, a) / l2
+    ac = np.clip(alpha, 0.0, 1.0)
+    dist2 = np.sum((d - ac[..., None] * a) ** 2, axis=2)
+    j = np.argmin(dist2, axis=1)
+    aj = alpha[np.arange(len(x_s)), j]
+    inside = ~(((j == 0) & (aj < 0.0)) | ((j == len(a) - 1) & (aj > 1.0)))
+    return j, inside
+
+
+def _arc_lengths(P):
+    return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(P, axis=0), axis=1))])
+
+
+class RigidLine:
+    """A fixed infinite straight line through `point` with unit `normal` pointing
+    towards the slave body (the rigid foundation of Secs 5.1-5.3)."""
+
+    rigid = True
+
+    def __init__(self, point=(0.0, 0.0), normal=(0.0, 1.0)):
+        nrm = np.asarray(normal, dtype=float)
+        if nrm.shape != (2,) or not np.linalg.norm(nrm) > 0:
+            raise ValueError(f"parameter normal must be a non-zero 2-vector, got {normal!r}")
+        self.point = np.asarray(point, dtype=float)
+        self.normal = nrm / np.linalg.norm(nrm)
+
+    def locate(self, x_s, s_bar, u):
+        k = line_variations(x_s, self.point, self.normal)
+        nc = len(x_s)
+        return dict(k, master_dofs=np.zeros((nc, 0), dtype=int), inside=np.ones(nc, bool), seg=np.full(nc, -1))
+
+    def outline(self, extent=(-1.0, 1.0)):
+        t = np.array([self.normal[1], -self.normal[0]])
+        return np.array([self.point + extent[0] * t, self.point + extent[1] * t])
+
+
+class RigidPolyline:
+    """A fixed polyline through `points`, ordered so that n = e3 x t (to the left
+    of the direction of travel) points towards the slave body. Node-to-segment
+    with x_1, x_2 fixed: only the slave rows of eqs (25)-(38) remain."""
+
+    rigid = True
+
+    def __init__(self, points):
+        self.points = _check_points(points, "points")
+        self.S = _arc_lengths(self.points)
+
+    def locate(self, x_s, s_bar, u):
+        P = self.points
+        j, inside = closest_segment(x_s, P)
+        k = segment_variations(x_s, P[j], P[j + 1])
+        l = k["l"]
+        sl = slice(0, 2)  # slave rows/columns only
+        return dict(g_N=k["g_N"], s=self.S[j] + k["alpha"] * l, t=k["t"], n=k["n"],
+                    dg_N=k["dg_N"][:, sl], d2g_N=k["d2g_N"][:, sl, sl],
+                    ds=l[:, None] * k["dalpha"][:, sl], d2s=l[:, None, None] * k["d2alpha"][:, sl, sl],
+                    master_dofs=np.zeros((len(x_s), 0), dtype=int), inside=inside, seg=j)
+
+    def outline(self):
+        return self.points
+
+
+class RigidArc:
+    """A fixed circular arc of radius R about `center`, covering angles
+    theta0..theta1 (radians, counter-clockwise). inside=False: a rigid cylinder the
+    slave touches from outside; inside=True: a hole or rounded fillet touched from
+    within. Exact curvature terms (no polyline facets)."""
+
+    rigid = True
+
+    def __init__(self, center, R, theta0=-np.pi, theta1=np.pi, inside=False):
+        if not float(R) > 0:
+            raise ValueError(f"parameter R = {R!r} is out of range: allowed (0, inf)")
+        if not theta1 > theta0:
+            raise ValueError("parameters theta0 < theta1 required for a rigid arc")
+        self.center = np.asarray(center, dtype=float)
+        self.R, self.theta0, self.theta1, self.inside = float(R), float(theta0), float(theta1), bool(inside)
+
+    def locate(self, x_s, s_bar, u):
+        theta_ref = np.asarray(s_bar, dtype=float) / self.R
+        k = arc_variations(x_s, self.center, self.R, self.inside, theta_ref)
+        th = k["theta"]
+        # in range if some 2 pi shift of theta lies in [theta0, theta1]
+        th0 = self.theta0 + np.mod(th - self.theta0, 2 * np.pi)
+        inside = (th0 <= self.theta1) | (self.theta1 - self.theta0 >= 2 * np.pi - 1e-12)
+        nc = len(x_s)
+        return dict(k, master_dofs=np.zeros((nc, 0), dtype=int), inside=inside, seg=np.full(nc, -1))
+
+    def outline(self, n=64):
+        th = np.linspace(self.theta0, self.theta1, n)
+        return self.center + self.R * np.stack([np.cos(th), np.sin(th)], axis=1)
+
+
+class BodySurface:
+    """A deformable master: the boundary of another body through its `nodes`,
+    ordered so that n = e3 x t points out of the master body (towards the slave).
+    All three nodes of each pair carry unknowns: the full 6x6 element of eqs (25)-(50)."""
+
+    rigid = False
+
+    def __init__(self, body, nodes):
+        self.body = body
+        self.nodes = np.asarray(nodes, dtype=int)
+        if self.nodes.ndim != 1 or len(self.nodes) < 2:
+            raise ValueError("parameter nodes of a master surface must list at least 2 nodes")
+        _check_points(body.X[self.nodes], "master nodes (reference positions)")
+        self.x_bar = body.X[self.nodes].copy()   # last converged positions
+
+    def dofs(self):
+        return self.body.dof_offset + self.body.xdofs[self.nodes]       # (nm, 2)
+
+    def positions(self, u):
+        return self.body.X[self.nodes] + u[self.dofs()]
+
+    def locate(self, x_s, s_bar, u):
+        P = self.positions(u)
+        j, inside = closest_segment(x_s, P)
+        k = segment_variations(x_s, P[j], P[j + 1])
+        l_bar = np.linalg.norm(self.x_bar[j + 1] - self.x_bar[j], axis=1)
+        S_bar = _arc_lengths(self.x_bar)
+        dofs = self.dofs()
+        return dict(g_N=k["g_N"], s=S_bar[j] + k["alpha"] * l_bar, t=k["t"], n=k["n"],
+                    dg_N=k["dg_N"], d2g_N=k["d2g_N"],
+                    ds=l_bar[:, None] * k["dalpha"], d2s=l_bar[:, None, None] * k["d2alpha"],
+                    master_dofs=np.concatenate([dofs[j], dofs[j + 1]], axis=1), inside=inside, seg=j)
+
+    def commit(self, u):
+        self.x_bar = self.positions(u)
+
+    def outline(self, u=None):
+        return self.x_bar if u is None else self.positions(u)

@@ -1,0 +1,161 @@
+"""Every contact residual has its tangent checked against a finite-difference Jacobian:
+open, stick, slip both ways; rigid line, polyline, arc and deformable master; node
+switching segments; every shipped law; m != 1, n < 1."""
+
+import numpy as np
+import pytest
+from conftest import PointCloud
+from fd import fd_jacobian, rel_error
+
+from contactfem.contact import BodySurface, NodeToSegment, RigidArc, RigidLine, RigidPolyline, SLIP, STICK, OPEN
+from contactfem.laws import Coulomb, ExponentialLaw, ParabolicSlip, PowerLaw, SlipHardening
+
+NORMALS = {"penalty": PowerLaw(c_N=50.0, m=1.0), "power2.5": PowerLaw(c_N=80.0, m=2.5),
+           "exp": ExponentialLaw(a=20.0, b=8.0)}
+FRICTIONS = {"none": None, "coulomb": Coulomb(c_T=30.0, mu=0.3),
+             "parabolic": ParabolicSlip(c_T=30.0, alpha=0.2, beta=0.3, n=0.5),
+             "parabolic08": ParabolicSlip(c_T=30.0, alpha=0.2, beta=0.3, n=0.8),
+             "hardening": SlipHardening(c_T=30.0, mu=0.2, h=0.5),
+             "softening": SlipHardening(c_T=30.0, mu=0.4, h=-0.3)}
+
+
+def check_tangent(iface, u, tol=1e-6):
+    R0, rows, cols, vals = iface.assemble(u)
+    n = len(u)
+    K = np.zeros((n, n))
+    np.add.at(K, (rows, cols), vals)
+    Kfd = fd_jacobian(lambda v: iface.assemble(v)[0], u)
+    assert np.linalg.norm(K) > 0, "nothing in contact: the test is vacuous"
+    err = rel_error(K, Kfd)
+    assert err < tol, f"tangent mismatch {err:.2e}"
+    return K
+
+
+def slave_cloud(rng, n=4, y=-0.05):
+    X = np.stack([np.linspace(0.15, 0.85, n), np.full(n, 0.0)], axis=1)
+    body = PointCloud(X, "slave")
+    u = np.zeros(body.ndof)
+    u[1::2] = y * (0.5 + rng.random(n))      # penetrations of various depth
+    u[0::2] = 0.01 * rng.standard_normal(n)
+    return body, u
+
+
+def set_history(iface, u, t_T_bar, dg):
+    """History such that the slip increment is dg: s_bar = s(u) - dg."""
+    iface.initialize(u)
+    iface.s_bar = iface.s_bar - dg
+    iface.t_T_bar = np.full(len(iface.nodes), t_T_bar)
+
+
+MASTERS = ["line", "tilted_polyline", "arc_outside", "arc_inside"]
+
+
+def make_master(kind):
+    if kind == "line":
+        return RigidLine(point=(0.0, 0.0), normal=(0.0, 1.0))
+    if kind == "tilted_polyline":
+        return RigidPolyline([[-1.0, 0.05], [0.3, -0.02], [0.6, 0.01], [2.0, -0.03]])
+    if kind == "arc_outside":
+        return RigidArc(center=(0.5, -5.0), R=5.0)
+    if kind == "arc_inside":
+        return RigidArc(center=(0.5, 5.0), R=5.0, inside=True)
+
+
+@pytest.mark.parametrize("master", MASTERS)
+@pytest.mark.parametrize("nlaw", list(NORMALS))
+@pytest.mark.parametrize("flaw", list(FRICTIONS))
+@pytest.mark.parametrize("regime", ["stick", "slip+", "slip-"])
+def test_rigid_master_tangent(rng, master, nlaw, flaw, regime):
+    body, u = slave_cloud(rng)
+    iface = NodeToSegment(body, np.arange(4), make_master(master), NORMALS[nlaw], FRICTIONS[flaw],
+                          weights=rng.uniform(0.5, 1.5, 4))
+    dg = {"stick": 1e-6, "slip+": 0.5, "slip-": -0.5}[regime]
+    set_history(iface, u, t_T_bar=0.0, dg=dg)
+    e = iface.evaluate(u)
+    assert np.all(e["active"])
+    if FRICTIONS[flaw] is not None:
+        expected = STICK if regime == "stick" else SLIP
+        assert np.all(e["friction"].state == expected)
+        if regime != "stick":
+            assert np.all(np.sign(e["friction"].t_T) == np.sign(dg))
+    check_tangent(iface, u)
+
+
+@pytest.mark.parametrize("flaw", list(FRICTIONS))
+@pytest.mark.parametrize("regime", ["stick", "slip+", "slip-"])
+@pytest.mark.parametrize("nlaw", ["penalty", "power2.5"])
+def test_deformable_master_tangent(rng, flaw, regime, nlaw):
+    Xm = np.stack([np.linspace(-0.2, 1.2, 5), np.zeros(5)], axis=1)
+    master_body = PointCloud(Xm, "master", dof_offset=0)
+    Xs = np.stack([np.linspace(0.1, 0.9, 3), np.full(3, 0.0)], axis=1)
+    slave_body = PointCloud(Xs, "slave", dof_offset=master_body.ndof)
+    u = np.zeros(master_body.ndof + slave_body.ndof)
+    u[: master_body.ndof] = 0.02 * rng.standard_normal(master_body.ndof)
+    u[master_body.ndof + 1::2] = -0.06 - 0.02 * rng.random(3)
+    # move the master a little first so that l_bar differs from l
+    surface = BodySurface(master_body, np.arange(5))
+    iface = NodeToSegment(slave_body, np.arange(3), surface, NORMALS[nlaw], FRICTIONS[flaw], weights=0.7)
+    u_old = u.copy()
+    u_old[: master_body.ndof] *= 0.3
+    surface.commit(u_old)
+    dg = {"stick": 1e-6, "slip+": 0.5, "slip-": -0.5}[regime]
+    set_history(iface, u, t_T_bar=0.01, dg=dg)
+    e = iface.evaluate(u)
+    assert np.all(e["active"])
+    K = check_tangent(iface, u)
+    if FRICTIONS[flaw] is not None and regime != "stick":
+        assert not np.allclose(K, K.T), "the slip tangent is non-symmetric (eq 50)"
+
+
+def test_open_node_has_no_force_nor_tangent(rng):
+    body, u = slave_cloud(rng, y=+0.05)
+    iface = NodeToSegment(body, np.arange(4), RigidLine(), NORMALS["penalty"], FRICTIONS["coulomb"])
+    R, rows, cols, vals = iface.assemble(u)
+    assert np.all(R == 0) and len(vals) == 0
+    assert np.all(iface.evaluate(u)["friction"].state == OPEN)
+
+
+def test_node_switches_segment_and_keeps_history(rng):
+    """A slave sliding along a polyline onto the next segment: the slip increment is
+    the arc length travelled, and t_T_bar carries over."""
+    P = [[0.0, 0.0], [1.0, 0.0], [2.0, 0.1]]
+    master = RigidPolyline(P)
+    body = PointCloud([[0.9, 0.0]], "slave")
+    iface = NodeToSegment(body, [0], master, NORMALS["penalty"], Coulomb(c_T=100.0, mu=10.0))
+    u = np.array([0.0, -0.01])
+    iface.initialize(u)
+    iface.commit(u)
+    e0 = iface.evaluate(u)
+    assert e0["seg"][0] == 0
+    u1 = np.array([0.2, -0.01 + 0.1 * 0.1])     # now above segment 1
+    e1 = iface.evaluate(u1)
+    assert e1["seg"][0] == 1
+    L1 = np.hypot(1.0, 0.1)
+    alpha = ((np.array([1.1, e1["x_s"][0, 1]]) - [1.0, 0.0]) @ np.array([1.0, 0.1]) / L1) / L1
+    assert np.isclose(e1["dg_T"][0], 0.1 + alpha * L1)
+    check_tangent(iface, u1)
+
+
+def test_deformable_master_node_switch_tangent(rng):
+    Xm = np.stack([np.linspace(0.0, 2.0, 3), np.zeros(3)], axis=1)
+    mb = PointCloud(Xm, "master")
+    sb = PointCloud([[0.95, 0.0]], "slave", dof_offset=mb.ndof)
+    surf = BodySurface(mb, [0, 1, 2])
+    iface = NodeToSegment(sb, [0], surf, NORMALS["penalty"], ParabolicSlip(c_T=40.0, alpha=0.2, beta=0.3, n=0.5))
+    u = np.zeros(mb.ndof + 2)
+    u[-1] = -0.03
+    iface.initialize(u)
+    iface.commit(u)
+    u2 = u.copy()
+    u2[-2] = 0.12                     # slides past the middle master node
+    u2[:mb.ndof] = 0.01 * rng.standard_normal(mb.ndof)
+    e = iface.evaluate(u2)
+    assert e["seg"][0] == 1 and e["friction"].state[0] == SLIP
+    check_tangent(iface, u2)
+
+
+def test_offset_surface_contacts_earlier():
+    body = PointCloud([[0.0, 0.4]], "beam")
+    iface = NodeToSegment(body, [0], RigidLine(), NORMALS["penalty"], offset=0.5)
+    e = iface.evaluate(np.zeros(2))
+    assert e["active"][0] and np.isclose(e["g_N"][0], -0.1)
