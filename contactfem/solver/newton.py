@@ -1,0 +1,92 @@
+"""Full Newton iteration within a step (paper Sec. 4.3).
+
+Solves G(u) = 0 on the free dofs, where ``fun(u) -> (G, K)`` returns the full
+residual vector and its tangent K = dG/du (scipy.sparse). The prescribed dofs keep
+the values they have in the initial guess.
+
+Linear solver: ``scipy.sparse.linalg.splu`` (SuperLU). The contact tangent with
+friction is non-symmetric (paper eq 49-50), so no symmetric solver applies; splu
+rather than spsolve because splu *raises* on an exactly singular matrix, while
+spsolve only warns and returns NaNs.
+
+Convergence test (on the Euclidean norm of the free part of G):
+
+    ||G_k|| <= atol + rtol * ||G_0||
+
+with G_0 the residual at the initial guess. atol is in force units, so a scene
+with very large or very small forces should set it; rtol alone fails when
+||G_0|| is at roundoff level (a state already in equilibrium).
+"""
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.linalg import splu
+
+
+class NewtonError(RuntimeError):
+    """Newton did not converge. ``history`` holds the (finite) residual norms of
+    all iterations done, ``label`` names the step/time."""
+
+    def __init__(self, message, history, label=""):
+        super().__init__(message)
+        self.history = list(history)
+        self.label = label
+
+
+@dataclass
+class NewtonResult:
+    u: np.ndarray                                 # the converged solution
+    residuals: list = field(default_factory=list)  # ||G|| of every iterate, first = initial guess
+    iterations: int = 0                           # number of linear solves
+    G: np.ndarray = None                          # full residual at u (its fixed-dof part = reactions)
+
+
+def newton(fun, u0, free, atol=1e-10, rtol=1e-10, maxit=25, label=""):
+    """Full Newton method: K_ff du_f = -G_f, u_f += du_f, until converged.
+
+    Parameters
+    ----------
+    fun   : u -> (G, K), full residual (n,) and tangent (n, n) sparse
+    u0    : (n,) initial guess, prescribed dofs already set
+    free  : indices (or boolean mask) of the unknown dofs
+    atol, rtol : convergence test ||G_k|| <= atol + rtol * ||G_0|| (module docstring)
+    maxit : maximal number of linear solves
+    label : names the step/time in error messages
+
+    Returns a NewtonResult; raises NewtonError (never returns NaN).
+    """
+    if maxit < 0:
+        raise ValueError(f"maxit must be >= 0, got {maxit}")
+    if atol < 0 or rtol < 0:
+        raise ValueError(f"atol and rtol must be >= 0, got atol={atol}, rtol={rtol}")
+    u = np.array(u0, dtype=float)
+    free = np.asarray(free)
+    if free.dtype == bool:
+        free = np.flatnonzero(free)
+    where = f" ({label})" if label else ""
+    history = []
+
+    for k in range(maxit + 1):
+        G, K = fun(u)
+        r = float(np.linalg.norm(G[free]))
+        if not np.isfinite(r):
+            raise NewtonError(f"Newton: residual is NaN/inf at iteration {k}{where}", history, label)
+        history.append(r)
+        if r <= atol + rtol * history[0]:
+            return NewtonResult(u=u, residuals=history, iterations=k, G=G)
+        if k == maxit:
+            break
+        Kff = sp.csr_matrix(K)[free][:, free].tocsc()
+        try:
+            du = splu(Kff).solve(-G[free])
+        except RuntimeError as err:                   # "Factor is exactly singular"
+            raise NewtonError(f"Newton: singular tangent at iteration {k}{where}: {err}",
+                              history, label) from err
+        if not np.all(np.isfinite(du)):
+            raise NewtonError(f"Newton: non-finite correction at iteration {k}{where}",
+                              history, label)
+        u[free] += du
+
+    raise NewtonError(f"Newton: no convergence in {maxit} iterations{where}; "
+                      f"residuals {', '.join(f'{x:.3e}' for x in history)}", history, label)

@@ -1,0 +1,180 @@
+"""The System: bodies, contacts, loads and Dirichlet conditions in one global vector.
+
+The System implements the static part of the paper's equation of motion (eq 29),
+
+    G(u, t) = R(u) + R_c(u) - P(u, t),
+
+with R the internal forces of the bodies, R_c the contact residual (eq 28) and P
+the external loads, together with its tangent K = dG/du = K_int + K_c - dP/du.
+The inertia term M a of eq 29 is added by the time steppers (newmark.py).
+
+Bodies are placed one after another in the global vector: body b owns the global
+dofs ``b.dof_offset + local``.
+"""
+import numpy as np
+import scipy.sparse as sp
+
+
+class Dirichlet:
+    """Prescribed values of some dofs of one body.
+
+    ``value`` is a number, an array of ``len(local_dofs)`` numbers, or a callable
+    ``t -> number or array`` for time-dependent (moving) supports.
+    """
+
+    def __init__(self, body, local_dofs, value=0.0):
+        self.body = body
+        self.local_dofs = np.atleast_1d(np.asarray(local_dofs, dtype=int)).ravel()
+        self.value = value
+
+    def values(self, t):
+        """The prescribed values at time t, one per constrained dof."""
+        value = self.value(t) if callable(self.value) else self.value
+        value = np.asarray(value, dtype=float)
+        if value.ndim > 0 and value.size != self.local_dofs.size:
+            raise ValueError(f"Dirichlet value must be a scalar or have {self.local_dofs.size} "
+                             f"entries (one per dof), got {value.size}")
+        return np.broadcast_to(value.ravel() if value.ndim else value, self.local_dofs.shape)
+
+
+def _triplets(rows, cols, vals):
+    """COO triplets as three flat arrays (accepts lists and empty inputs)."""
+    return (np.asarray(rows, dtype=int).ravel(), np.asarray(cols, dtype=int).ravel(),
+            np.asarray(vals, dtype=float).ravel())
+
+
+class System:
+    """Bodies, contacts, loads and Dirichlet conditions assembled into one problem.
+
+    Parameters
+    ----------
+    bodies   : list of bodies (the interface of contactfem.bodies)
+    contacts : list of contacts, ``assemble(u) -> (R_c, rows, cols, vals)``
+    loads    : list of loads, ``assemble(u, t) -> (P, rows, cols, vals)``
+    fixed    : list of Dirichlet conditions
+
+    Attributes: ``ndof``, ``fixed_dofs`` and ``free_dofs`` (global, sorted),
+    ``dissipation`` (frictional dissipation summed over all committed steps).
+    """
+
+    def __init__(self, bodies, contacts=(), loads=(), fixed=()):
+        self.bodies = list(bodies)
+        self.contacts = list(contacts)
+        self.loads = list(loads)
+        self.fixed = list(fixed)
+        if not self.bodies:
+            raise ValueError("bodies must contain at least one body")
+
+        offset = 0
+        for body in self.bodies:
+            body.dof_offset = offset
+            offset += body.ndof
+        self.ndof = offset
+
+        for d in self.fixed:
+            if d.body not in self.bodies:
+                raise ValueError(f"Dirichlet condition on body {d.body.name!r}, which is not in bodies")
+            if np.any(d.local_dofs < 0) or np.any(d.local_dofs >= d.body.ndof):
+                raise ValueError(f"Dirichlet local_dofs of body {d.body.name!r} must be in "
+                                 f"[0, {d.body.ndof - 1}]")
+        self.fixed_dofs = np.unique(np.concatenate(
+            [self.global_dofs(d.body, d.local_dofs) for d in self.fixed] + [np.zeros(0, int)]))
+        self.free_dofs = np.setdiff1d(np.arange(self.ndof), self.fixed_dofs)
+        self.dissipation = 0.0
+        self._mass = None
+
+    def global_dofs(self, body, local):
+        """Global numbers of a body's local dofs."""
+        return body.dof_offset + np.asarray(local, dtype=int)
+
+    def local(self, body, u):
+        """The body's own part (a view) of a global vector."""
+        return u[body.dof_offset:body.dof_offset + body.ndof]
+
+    # -- Dirichlet conditions -------------------------------------------------
+
+    def prescribed(self, t):
+        """Prescribed values at time t, aligned with ``self.fixed_dofs``.
+        If several conditions constrain the same dof, the last one wins."""
+        full = np.zeros(self.ndof)
+        for d in self.fixed:
+            full[self.global_dofs(d.body, d.local_dofs)] = d.values(t)
+        return full[self.fixed_dofs]
+
+    def apply_dirichlet(self, u, t):
+        """A copy of u with the prescribed values at time t written in."""
+        u = np.array(u, dtype=float)
+        u[self.fixed_dofs] = self.prescribed(t)
+        return u
+
+    # -- assembly ---------------------------------------------------------------
+
+    def mass(self):
+        """Global lumped (diagonal) mass, (ndof,)."""
+        if self._mass is None:
+            self._mass = np.concatenate([np.asarray(b.mass(), dtype=float) for b in self.bodies])
+        return self._mass
+
+    def external_force(self, u, t):
+        """P(u, t), the sum of all loads (ndof,)."""
+        P = np.zeros(self.ndof)
+        for load in self.loads:
+            P += load.assemble(u, t)[0]
+        return P
+
+    def residual_tangent(self, u, t):
+        """G = R(u) + R_c(u) - P(u, t) (static part of eq 29) and K = dG/du (CSR).
+
+        All contributions are collected as COO triplets and the sparse matrix is
+        built once (duplicates are summed by the COO -> CSR conversion).
+        """
+        u = np.asarray(u, dtype=float)
+        if u.shape != (self.ndof,):
+            raise ValueError(f"u must have shape ({self.ndof},), got {u.shape}")
+        G = np.zeros(self.ndof)
+        rows, cols, vals = [], [], []
+
+        for body in self.bodies:                       # block diagonal: internal forces
+            R, K = body.internal(self.local(body, u))
+            G[body.dof_offset:body.dof_offset + body.ndof] += R
+            K = sp.coo_matrix(K)
+            rows.append(K.row + body.dof_offset)
+            cols.append(K.col + body.dof_offset)
+            vals.append(K.data)
+
+        for contact in self.contacts:                  # contact residual eq 28 and its tangent
+            Rc, r, c, v = contact.assemble(u)
+            G += Rc
+            r, c, v = _triplets(r, c, v)
+            rows.append(r), cols.append(c), vals.append(v)
+
+        for load in self.loads:                        # loads enter with a minus sign
+            P, r, c, v = load.assemble(u, t)
+            G -= P
+            r, c, v = _triplets(r, c, v)
+            rows.append(r), cols.append(c), vals.append(-v)
+
+        K = sp.coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                          shape=(self.ndof, self.ndof)).tocsr()
+        return G, K
+
+    # -- history and energies ---------------------------------------------------
+
+    def commit(self, u):
+        """Accept u as converged: bodies and contacts update their history, and the
+        frictional dissipation of the step is added to ``self.dissipation``."""
+        for body in self.bodies:
+            body.commit(self.local(body, u).copy())
+        for contact in self.contacts:
+            contact.commit(u)
+            self.dissipation += float(contact.dissipation)
+
+    def energies(self, u, v):
+        """Kinetic (1/2 v.M v), strain and contact energy, and the accumulated
+        frictional dissipation, as a dict of floats."""
+        return {
+            "kinetic": 0.5 * float(np.dot(v, self.mass() * v)),
+            "strain": float(sum(b.strain_energy(self.local(b, u)) for b in self.bodies)),
+            "contact": float(sum(c.energy(u) for c in self.contacts)),
+            "dissipation": self.dissipation,
+        }
