@@ -6,3 +6,7 @@ from .friction import Coulomb, Frictionless, ParabolicSlip, SlipHardening
 from .normal import ExponentialLaw, PowerLaw
 
 __all__ = ["PowerLaw", "ExponentialLaw", "ParabolicSlip", "Coulomb", "SlipHardening", "Frictionless"]
+
+from .check import LawReport, check_law  # noqa: E402  (check uses the return mapping)
+
+__all__ += ["check_law", "LawReport"]

@@ -1,2 +1,48 @@
 """Scenes: each module composes bodies, obstacles, laws and loads into one of the
-paper's examples (or a verification problem) and declares its parameters."""
+paper's examples (or a verification problem with a closed form) and declares its
+parameters. A module becomes a scene by defining ``SCENE = Scene(...)``."""
+
+import importlib
+import pkgutil
+
+from .base import Param, Scene, jsonable
+
+
+def all_scenes():
+    """name -> Scene, for every module of this package that defines SCENE."""
+    found = {}
+    for info in sorted(pkgutil.iter_modules(__path__), key=lambda i: i.name):
+        if info.name == "base" or info.name.startswith("_"):
+            continue
+        mod = importlib.import_module(f"{__name__}.{info.name}")
+        scene = getattr(mod, "SCENE", None)
+        if scene is not None:
+            found[scene.name] = scene
+    return found
+
+
+def get_scene(name):
+    scenes = all_scenes()
+    if name not in scenes:
+        raise ValueError(f"unknown scene {name!r}: known are {', '.join(scenes) or '(none)'}")
+    return scenes[name]
+
+
+def run_scene(name, preset="fast", overrides=None):
+    """Run a scene and return its results with wall time, Newton iteration count and parameters."""
+    import time
+
+    scene = get_scene(name)
+    params = scene.resolve(preset, overrides)
+    t0 = time.perf_counter()
+    results = scene.run(params)
+    results = dict(results)
+    results["wall_time_s"] = time.perf_counter() - t0
+    results.setdefault("newton_iterations_total", 0)
+    results["scene"] = name
+    results["preset"] = preset
+    results["parameters"] = params
+    return jsonable(results)
+
+
+__all__ = ["Param", "Scene", "all_scenes", "get_scene", "run_scene", "jsonable"]

@@ -1,0 +1,88 @@
+"""Command line: `contactfem list | show SCENE | run SCENE [--preset fast|paper]
+[--set NAME=VALUE ...] [--json FILE]` (and the commands later issues add).
+
+Bad input (unknown scene, unknown or out-of-range parameter) prints one line on
+stderr and exits with code 2, without a traceback. A failed Newton solve exits
+with code 1 and prints the residual history."""
+
+import argparse
+import json
+import sys
+
+from . import scenes
+
+
+def parse_sets(items):
+    out = {}
+    for item in items or []:
+        if "=" not in item:
+            raise ValueError(f"--set expects NAME=VALUE, got {item!r}")
+        k, v = item.split("=", 1)
+        out[k.strip()] = v.strip()
+    return out
+
+
+def cmd_list(args):
+    for name, sc in scenes.all_scenes().items():
+        print(f"{name:16s} {sc.title}")
+
+
+def cmd_show(args):
+    sc = scenes.get_scene(args.scene)
+    print(f"{sc.name}: {sc.title}")
+    print(f"{'parameter':14s} {'default':>12s} {'fast':>10s} {'paper':>10s}  {'unit':10s} allowed")
+    for p in sc.params:
+        fast = sc.presets.get("fast", {}).get(p.name, "")
+        paper = sc.presets.get("paper", {}).get(p.name, "")
+        print(f"{p.name:14s} {str(p.default):>12s} {str(fast):>10s} {str(paper):>10s}  {p.unit:10s} {p.range_text()}"
+              + (f"  -- {p.doc}" if p.doc else ""))
+    if sc.reports:
+        print("reports: " + ", ".join(sc.reports))
+
+
+def cmd_run(args):
+    res = scenes.run_scene(args.scene, args.preset, parse_sets(args.set))
+    text = json.dumps(res, indent=1)
+    if args.json:
+        with open(args.json, "w") as fh:
+            fh.write(text)
+    summary = {k: v for k, v in res.items() if not isinstance(v, (list, dict))}
+    for k, v in summary.items():
+        print(f"{k}: {v}")
+
+
+def build_parser():
+    ap = argparse.ArgumentParser(prog="contactfem", description=__doc__.split("\n\n")[0])
+    sub = ap.add_subparsers(dest="command", required=True)
+    sub.add_parser("list", help="the scenes").set_defaults(func=cmd_list)
+    sp = sub.add_parser("show", help="a scene's parameters with defaults, units and allowed ranges")
+    sp.add_argument("scene")
+    sp.set_defaults(func=cmd_show)
+    rp = sub.add_parser("run", help="run a scene")
+    rp.add_argument("scene")
+    rp.add_argument("--preset", default="fast", choices=["fast", "paper"])
+    rp.add_argument("--set", action="append", metavar="NAME=VALUE", help="override a parameter (repeatable)")
+    rp.add_argument("--json", metavar="FILE", help="write all results to FILE as JSON")
+    rp.set_defaults(func=cmd_run)
+    return ap
+
+
+def main(argv=None):
+    ap = build_parser()
+    args = ap.parse_args(argv)
+    try:
+        args.func(args)
+    except ValueError as exc:
+        print(f"contactfem: error: {exc}", file=sys.stderr)
+        return 2
+    except FloatingPointError as exc:   # NewtonError, ReturnMapError, inverted elements
+        print(f"contactfem: solver failed: {exc}", file=sys.stderr)
+        hist = getattr(exc, "history", None)
+        if hist is not None:
+            print("residual history: " + " ".join(f"{r:.3e}" for r in hist), file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
