@@ -18,6 +18,10 @@ class SpringChain:
         self.ndof = 2 * n
         self.xdofs = np.arange(2 * n).reshape(n, 2)
         self.commits = 0
+        self.dt = None
+
+    def set_dt(self, dt):                 # like a rate-dependent body
+        self.dt = dt
 
     def mass(self):
         return np.full(self.ndof, self.m)
@@ -192,6 +196,11 @@ def test_newton_error_on_nan_and_singular():
         newton(singular, np.zeros(2), np.array([True, True]))
     assert len(info.value.history) == 1
 
+    def inverted(u):                      # bodies/contacts signal trouble by FloatingPointError
+        raise FloatingPointError("det F <= 0")
+    with pytest.raises(NewtonError, match="det F"):
+        newton(inverted, np.zeros(2), [0, 1])
+
 
 # -- Newmark, Static, CentralDifference -------------------------------------------------
 
@@ -319,7 +328,7 @@ def test_cutback_halves_the_step_and_keeps_the_time_grid():
                      cutback=True, max_cuts=4)
     assert np.allclose(hist.dt[1:], 0.025) and len(hist.t) == 1 + 3 * 4
     assert hist.t[-1] == pytest.approx(0.3) and hist.cuts[1] == 2
-    assert body.commits == 12
+    assert body.commits == 12 and body.dt == pytest.approx(0.025)       # the body was told the cut dt
     with pytest.raises(NewtonError, match="step 1") as info:
         integrate(FussyNewmark(s, 0.1), 0.0, np.zeros(4), n_steps=3, cutback=True, max_cuts=1)
     assert info.value.history == [1.0, 2.0] and len(info.value.partial.t) == 1

@@ -73,6 +73,7 @@ class Newmark:
         dt = self.dt if dt is None else dt
         _check_dt(dt)
         s, beta, delta = self.system, self.beta, self.delta
+        s.set_dt(dt)
         t1 = t + dt
         M = s.mass()
         c = 1.0 / (beta * dt ** 2)
@@ -107,6 +108,7 @@ class Static:
         dt = self.dt if dt is None else dt
         _check_dt(dt)
         s, t1 = self.system, t + dt
+        s.set_dt(dt)
         result = newton(lambda w: s.residual_tangent(w, t1), s.apply_dirichlet(u, t1),
                         s.free_dofs, label=label or f"t = {t1:.6g}", **self.newton_options)
         zero = np.zeros(s.ndof)
@@ -133,6 +135,7 @@ class CentralDifference:
         dt = self.dt if dt is None else dt
         _check_dt(dt)
         s, t1 = self.system, t + dt
+        s.set_dt(dt)
         u1 = s.apply_dirichlet(u + dt * v + 0.5 * dt ** 2 * a, t1)
         G, _ = s.residual_tangent(u1, t1)
         a1 = _acceleration(s, G)

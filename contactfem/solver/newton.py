@@ -16,6 +16,10 @@ Convergence test (on the Euclidean norm of the free part of G):
 with G_0 the residual at the initial guess. atol is in force units, so a scene
 with very large or very small forces should set it; rtol alone fails when
 ||G_0|| is at roundoff level (a state already in equilibrium).
+
+Failures raise NewtonError: maxit reached, NaN/inf residual or correction, singular
+tangent, or a FloatingPointError raised by fun (the bodies' InvertedElementError and
+the contact's ReturnMapError derive from it), so a driver can cut the step back.
 """
 from dataclasses import dataclass, field
 
@@ -68,7 +72,11 @@ def newton(fun, u0, free, atol=1e-10, rtol=1e-10, maxit=25, label=""):
     history = []
 
     for k in range(maxit + 1):
-        G, K = fun(u)
+        try:
+            G, K = fun(u)
+        except FloatingPointError as err:             # inverted element, failed return map
+            raise NewtonError(f"Newton: {type(err).__name__} at iteration {k}{where}: {err}",
+                              history, label) from err
         r = float(np.linalg.norm(G[free]))
         if not np.isfinite(r):
             raise NewtonError(f"Newton: residual is NaN/inf at iteration {k}{where}", history, label)

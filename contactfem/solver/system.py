@@ -158,6 +158,12 @@ class System:
                           shape=(self.ndof, self.ndof)).tocsr()
         return G, K
 
+    def set_dt(self, dt):
+        """Tell rate-dependent bodies (viscoplastic beam: ``set_dt``) the step size."""
+        for body in self.bodies:
+            if hasattr(body, "set_dt"):
+                body.set_dt(dt)
+
     # -- history and energies ---------------------------------------------------
 
     def commit(self, u):
