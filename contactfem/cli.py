@@ -10,6 +10,7 @@ import json
 import sys
 
 from . import scenes
+from .solver.newton import NewtonError
 
 
 def parse_sets(items):
@@ -51,6 +52,13 @@ def cmd_run(args):
         print(f"{k}: {v}")
 
 
+def cmd_figures(args):
+    from .plots import make_all
+
+    for path in make_all(args.preset, args.outdir, args.only):
+        print(path)
+
+
 def build_parser():
     ap = argparse.ArgumentParser(prog="contactfem", description=__doc__.split("\n\n")[0])
     sub = ap.add_subparsers(dest="command", required=True)
@@ -64,6 +72,11 @@ def build_parser():
     rp.add_argument("--set", action="append", metavar="NAME=VALUE", help="override a parameter (repeatable)")
     rp.add_argument("--json", metavar="FILE", help="write all results to FILE as JSON")
     rp.set_defaults(func=cmd_run)
+    fp = sub.add_parser("figures", help="regenerate every figure and table of the paper into figures/")
+    fp.add_argument("--preset", default="fast", choices=["fast", "paper"])
+    fp.add_argument("--outdir", default="figures")
+    fp.add_argument("--only", default=None, help="only figures whose file name contains this text")
+    fp.set_defaults(func=cmd_figures)
     return ap
 
 
@@ -75,7 +88,7 @@ def main(argv=None):
     except ValueError as exc:
         print(f"contactfem: error: {exc}", file=sys.stderr)
         return 2
-    except FloatingPointError as exc:   # NewtonError, ReturnMapError, inverted elements
+    except (FloatingPointError, NewtonError) as exc:   # Newton, return map, inverted elements
         print(f"contactfem: solver failed: {exc}", file=sys.stderr)
         hist = getattr(exc, "history", None)
         if hist is not None:

@@ -1,0 +1,51 @@
+"""Figures and tables of the paper, drawn from code.
+
+Each module here draws the figures of one example. A figure function is
+registered with ``@figure("fig07_block_conical_stresses", "Fig 7")`` and has the
+signature ``fn(preset="fast", outdir="figures") -> list[str]`` (the files it
+wrote). The lectures call these same functions; ``contactfem figures`` calls all
+of them."""
+
+import importlib
+import pkgutil
+from pathlib import Path
+
+REGISTRY = {}   # file stem -> (paper label, function)
+
+
+def figure(stem, label):
+    """Register a function drawing the paper's figure/table `label` into `stem`.*"""
+    def deco(fn):
+        REGISTRY[stem] = (label, fn)
+        fn.figure_stem = stem
+        return fn
+    return deco
+
+
+def load_all():
+    for info in pkgutil.iter_modules(__path__):
+        if not info.name.startswith("_"):
+            importlib.import_module(f"{__name__}.{info.name}")
+    return REGISTRY
+
+
+def make_all(preset="fast", outdir="figures", only=None):
+    """Draw every registered figure (or those whose stem contains `only`)."""
+    Path(outdir).mkdir(parents=True, exist_ok=True)
+    written = []
+    for stem, (label, fn) in sorted(load_all().items()):
+        if only and only not in stem:
+            continue
+        written += fn(preset=preset, outdir=outdir)
+    return written
+
+
+def savefig(fig, outdir, stem):
+    """Save a matplotlib figure as outdir/stem.png and close it."""
+    import matplotlib.pyplot as plt
+
+    path = Path(outdir) / f"{stem}.png"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110, bbox_inches="tight")
+    plt.close(fig)
+    return str(path)
