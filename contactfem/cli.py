@@ -74,7 +74,7 @@ def build_parser():
     rp.set_defaults(func=cmd_run)
     fp = sub.add_parser("figures", help="regenerate every figure and table of the paper into figures/")
     fp.add_argument("--preset", default="fast", choices=["fast", "paper"])
-    fp.add_argument("--outdir", default="figures")
+    fp.add_argument("--outdir", default=None, help="default: the repo's figures/ folder")
     fp.add_argument("--only", default=None, help="only figures whose file name contains this text")
     fp.set_defaults(func=cmd_figures)
     return ap

@@ -7,6 +7,7 @@ wrote). The lectures call these same functions; ``contactfem figures`` calls all
 of them."""
 
 import importlib
+import os
 import pkgutil
 from pathlib import Path
 
@@ -22,6 +23,20 @@ def figure(stem, label):
     return deco
 
 
+def default_outdir():
+    """$CONTACTFEM_FIGURES if set (the tests use a temporary folder), else the repo's figures/."""
+    env = os.environ.get("CONTACTFEM_FIGURES")
+    if env:
+        return env
+    repo = Path(__file__).resolve().parents[2]
+    return str(repo / "figures") if (repo / "pyproject.toml").exists() else "figures"
+
+
+def default_preset():
+    """$CONTACTFEM_PRESET if set, else "fast" (what the lectures use)."""
+    return os.environ.get("CONTACTFEM_PRESET", "fast")
+
+
 def load_all():
     for info in pkgutil.iter_modules(__path__):
         if not info.name.startswith("_"):
@@ -29,8 +44,9 @@ def load_all():
     return REGISTRY
 
 
-def make_all(preset="fast", outdir="figures", only=None):
+def make_all(preset="fast", outdir=None, only=None):
     """Draw every registered figure (or those whose stem contains `only`)."""
+    outdir = outdir or default_outdir()
     Path(outdir).mkdir(parents=True, exist_ok=True)
     written = []
     for stem, (label, fn) in sorted(load_all().items()):
