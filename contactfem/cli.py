@@ -59,6 +59,16 @@ def cmd_figures(args):
         print(path)
 
 
+def cmd_sweep(args):
+    from .studies.sweep import parse_grid, sweep, write_table
+
+    if args.jobs < 1:
+        raise ValueError(f"parameter jobs = {args.jobs} is out of range: allowed [1, inf)")
+    rows = sweep(args.scene, parse_grid(parse_sets(args.set)), args.preset, args.jobs, args.scheduler)
+    write_table(rows, args.out)
+    print(f"{len(rows)} runs -> {args.out}")
+
+
 def build_parser():
     ap = argparse.ArgumentParser(prog="contactfem", description=__doc__.split("\n\n")[0])
     sub = ap.add_subparsers(dest="command", required=True)
@@ -77,6 +87,14 @@ def build_parser():
     fp.add_argument("--outdir", default=None, help="default: the repo's figures/ folder")
     fp.add_argument("--only", default=None, help="only figures whose file name contains this text")
     fp.set_defaults(func=cmd_figures)
+    sw = sub.add_parser("sweep", help="run a scene over a grid of parameter values, in parallel")
+    sw.add_argument("scene")
+    sw.add_argument("--preset", default="fast", choices=["fast", "paper"])
+    sw.add_argument("--set", action="append", metavar="NAME=V1,V2,...", help="values of a parameter (repeatable)")
+    sw.add_argument("--jobs", type=int, default=1, help="local worker processes (joblib)")
+    sw.add_argument("--scheduler", default=None, help="Dask scheduler address: run on that cluster instead")
+    sw.add_argument("--out", default="sweep.csv", help="table of results (.csv or .json)")
+    sw.set_defaults(func=cmd_sweep)
     return ap
 
 
