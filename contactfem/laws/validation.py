@@ -15,5 +15,5 @@ def require(name, value, low=None, high=None, low_open=False, high_open=False):
         lo = "-inf" if low is None else f"{low:g}"
         hi = "inf" if high is None else f"{high:g}"
         rng = ("(" if low_open or low is None else "[") + f"{lo}, {hi}" + (")" if high_open or high is None else "]")
-        raise ValueError(f"parameter {name} = {value!r} is out of range: allowed {rng}")
+        raise ValueError(f"parameter {name} = {value} is out of range: allowed {rng}")
     return v

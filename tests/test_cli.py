@@ -1,0 +1,55 @@
+"""The command line: list/show/run, and bad input as one clear line with exit code 2."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from contactfem.cli import main
+from contactfem.scenes import all_scenes
+
+
+def cli(*args):
+    return subprocess.run([sys.executable, "-m", "contactfem", *args], capture_output=True, text=True)
+
+
+def test_list_names_every_scene():
+    out = cli("list")
+    assert out.returncode == 0
+    for name in all_scenes():
+        assert name in out.stdout
+
+
+@pytest.mark.parametrize("name", sorted(all_scenes()))
+def test_show_gives_defaults_units_ranges(name, capsys):
+    assert main(["show", name]) == 0
+    text = capsys.readouterr().out
+    for p in all_scenes()[name].params:
+        assert p.name in text
+
+
+@pytest.mark.parametrize("args,needle", [
+    (["show", "no_such_scene"], "unknown scene 'no_such_scene'"),
+    (["run", "no_such_scene"], "unknown scene 'no_such_scene'"),
+    (["run", "block", "--set", "no_such=1"], "unknown parameter 'no_such'"),
+    (["run", "block", "--set", "c_T=-5"], "parameter c_T = -5 is out of range"),
+    (["run", "block", "--set", "mu=abc"], "parameter mu must be a number"),
+    (["run", "block", "--set", "law=magic"], "parameter law = 'magic' is not allowed"),
+    (["run", "block", "--set", "nonsense"], "--set expects NAME=VALUE"),
+])
+def test_bad_input_is_one_line_exit_2(args, needle):
+    out = cli(*args)
+    assert out.returncode == 2, out.stderr
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1 and needle in lines[0], out.stderr
+    assert "Traceback" not in out.stderr
+
+
+def test_run_writes_json_with_the_contract_keys(tmp_path):
+    path = tmp_path / "block.json"
+    assert main(["run", "block", "--json", str(path)]) == 0
+    res = json.loads(path.read_text())
+    for key in ("wall_time_s", "newton_iterations_total", "parameters"):
+        assert key in res
+    assert res["parameters"]["c_T"] > 0
