@@ -1,0 +1,210 @@
+"""Hertz: an elastic cylinder pressed on a rigid plane (plane strain), a verification
+scene with a closed form (not one of the paper's examples).
+
+A cylinder of radius R carries a line load P (force per unit thickness). Hertz's
+solution for a cylinder on a rigid half-space (Johnson, Contact Mechanics, eqs 4.43, 4.45
+with E* = E / (1 - nu^2) for one elastic body):
+
+    a  = sqrt(4 P R (1 - nu^2) / (pi E))          contact half-width
+    p0 = 2 P / (pi a)                             peak pressure
+    p(x) = p0 sqrt(1 - x^2 / a^2)                 pressure profile
+
+Model: by symmetry the quarter disk x >= 0, y <= 0 (centre at the origin, contact point
+B = (0, -R)); u_x = 0 on x = 0; a uniform pressure q = P / (2 R) on the flat cut y = 0
+carries the half load P / 2. The mesh is a transfinite (Coons) map of a square onto the
+quarter disk, graded with a sinh stretching towards the contact point (see quarter_disk).
+Contact: the nodes of the arc near B against RigidLine y = -R, penalty law eq (4) with m = 1:
+
+    penalty = per_length:  c_N is a traction per unit gap (stress/length); nodal forces
+                           f_i = w_i c_N g_i with w_i the tributary lengths (the block's units)
+    penalty = nodal:       c_N is a nodal stiffness (force/length per unit thickness; the
+                           rings' and the cork's units): f_i = c_N g_i, whatever the mesh
+
+With `nodal` the effective interface stiffness per unit length, c_N / w_i, grows as the
+mesh is refined and varies along a graded mesh: the answer depends on the mesh.
+
+The pressure at each contact node is p_i = -f_i / w_i (for both penalty kinds). Reported:
+p0 (largest nodal pressure, at x = 0) and a, p0 from a least-squares fit of
+p^2 = p0^2 (1 - x^2/a^2) (linear in x^2) over the nodes in contact.
+"""
+
+import numpy as np
+from skfem import MeshQuad
+
+from ..bodies.continuum import Continuum
+from ..bodies.loads import Pressure
+from ..contact import NodeToSegment, RigidLine, tributary_lengths
+from ..laws import PowerLaw
+from ..solver import Dirichlet, Static, System, integrate
+from .base import Param, Scene
+
+
+def hertz_exact(P, R, E, nu):
+    """Hertz line contact of an elastic cylinder on a rigid plane: (a, p0)."""
+    a = np.sqrt(4.0 * P * R * (1.0 - nu**2) / (np.pi * E))
+    return a, 2.0 * P / (np.pi * a)
+
+
+def stretching(n, k):
+    """n + 1 points in [0, 1], sinh(k s) / sinh(k) for uniform s: fine and almost
+    uniform near 0, growing geometrically towards 1 (k -> 0: uniform)."""
+    s = np.linspace(0.0, 1.0, n + 1)
+    return s if k < 1e-8 else np.sinh(k * s) / np.sinh(k)
+
+
+def grading_for(xi_zone, frac):
+    """The k of `stretching` that maps s = frac onto xi = xi_zone (bisection on the
+    monotone function sinh(k frac) / sinh(k))."""
+    if xi_zone >= frac:
+        return 0.0
+    lo, hi = 1e-6, 200.0
+    for _ in range(100):
+        k = 0.5 * (lo + hi)
+        if np.sinh(k * frac) / np.sinh(k) > xi_zone:
+            lo = k
+        else:
+            hi = k
+    return 0.5 * (lo + hi)
+
+
+def quarter_disk(R, n_el, k):
+    """MeshQuad of the quarter disk x >= 0, y <= 0, x^2 + y^2 <= R^2 with n_el x n_el quads.
+
+    Transfinite (Coons) interpolation of the unit square (xi, eta):
+    eta = 0 -> arc from B = (0, -R) to angle -45 deg, eta = 1 -> flat cut y = 0,
+    xi = 0 -> symmetry line x = 0, xi = 1 -> arc from -45 deg to A = (R, 0).
+    Both coordinates are stretched with sinh(k s)/sinh(k), so the mesh is finest at B.
+    Boundaries: 'symmetry' (x = 0), 'top' (y = 0), 'arc'."""
+    xi = stretching(n_el, k)
+    XI, ETA = np.meshgrid(xi, xi, indexing="ij")               # (n+1, n+1)
+
+    def arc(theta):
+        return R * np.stack([np.cos(theta), np.sin(theta)])
+
+    bottom = arc(-np.pi / 2 + XI * np.pi / 4)
+    top = np.stack([XI * R, 0.0 * XI])
+    left = np.stack([0.0 * ETA, -R + ETA * R])
+    right = arc(-np.pi / 4 + ETA * np.pi / 4)
+    P00, P10, P01, P11 = arc(-np.pi / 2), arc(-np.pi / 4), np.zeros(2), arc(0.0)
+    corners = ((1 - XI) * (1 - ETA))[None] * P00[:, None, None] + (XI * (1 - ETA))[None] * P10[:, None, None] \
+        + ((1 - XI) * ETA)[None] * P01[:, None, None] + (XI * ETA)[None] * P11[:, None, None]
+    x = (1 - ETA) * bottom + ETA * top + (1 - XI) * left + XI * right - corners
+    p = x.reshape(2, -1)
+    idx = np.arange((n_el + 1) ** 2).reshape(n_el + 1, n_el + 1)
+    t = np.stack([idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]]).reshape(4, -1)
+    # counter-clockwise: (xi, eta) -> (x, y) reverses orientation? check with the signed area
+    a, b, d = p[:, t[0]], p[:, t[1]], p[:, t[3]]
+    area = (b[0] - a[0]) * (d[1] - a[1]) - (b[1] - a[1]) * (d[0] - a[0])
+    if np.mean(area) < 0:
+        t = t[::-1]
+    tol = 1e-9 * R
+    return MeshQuad(p, t).with_boundaries({
+        "symmetry": lambda x: np.abs(x[0]) < tol,
+        "top": lambda x: np.abs(x[1]) < tol,
+        "arc": lambda x: (np.abs(x[0]) > tol) & (np.abs(x[1]) > tol),
+    })
+
+
+def fit_hertz(x, p):
+    """Least squares of p^2 = p0^2 - (p0/a)^2 x^2 over the nodes with p > 0: (a, p0).
+    Needs at least two loaded nodes."""
+    on = p > 0.0
+    if np.count_nonzero(on) < 2:
+        raise ValueError("fewer than two contact nodes carry pressure: refine the mesh (n_el)")
+    A = np.column_stack([np.ones(np.count_nonzero(on)), x[on] ** 2])
+    c0, c1 = np.linalg.lstsq(A, p[on] ** 2, rcond=None)[0]
+    if not (c0 > 0 and c1 < 0):
+        raise ValueError("the contact pressure is not Hertz-like (fit of p^2 against x^2 failed)")
+    return float(np.sqrt(-c0 / c1)), float(np.sqrt(c0))
+
+
+def build(params):
+    """Body, contact, load and supports of the quarter cylinder; returns a dict."""
+    R, E, nu, P = params["R"], params["E"], params["nu"], params["P"]
+    a_ex, p0_ex = hertz_exact(P, R, E, nu)
+    n = params["n_el"]
+    # grade so that about a third of the elements along the arc lie within 1.5 a of B
+    xi_zone = min(1.0, 1.5 * a_ex / (R * np.pi / 4))
+    k = grading_for(xi_zone, 1.0 / 3.0) * params["grading"]
+    mesh = quarter_disk(R, n, k)
+    body = Continuum(mesh, E, nu, 0.0, kind="plane_strain", material=params["material"], name="cylinder")
+
+    arc = body.X[:, 0] ** 2 + body.X[:, 1] ** 2 > (R * (1 - 1e-9)) ** 2
+    near = arc & (body.X[:, 0] < min(0.7 * R, 4.0 * a_ex))
+    nodes = np.flatnonzero(near)
+    nodes = nodes[np.argsort(body.X[nodes, 0])]                # chain from B outwards
+    w = tributary_lengths(body.X[nodes])
+    weights = w if params["penalty"] == "per_length" else 1.0
+    contact = NodeToSegment(body, nodes, RigidLine((0.0, -R), (0.0, 1.0)), PowerLaw(params["c_N"], 1.0),
+                            weights=weights, name="plane")
+    sym = np.flatnonzero(np.abs(body.X[:, 0]) < 1e-9 * R)
+    fixed = [Dirichlet(body, body.xdofs[sym, 0], 0.0)]
+    q = P / (2.0 * R)
+    load = Pressure(body, "top", lambda t: q * min(t, 1.0))
+    system = System([body], [contact], [load], fixed)
+    return dict(body=body, contact=contact, system=system, nodes=nodes, w=w, a_exact=a_ex, p0_exact=p0_ex,
+                grading_k=k)
+
+
+def run(params):
+    m = build(params)
+    body, contact, system, w = m["body"], m["contact"], m["system"], m["w"]
+    R, P = params["R"], params["P"]
+    a_ex = m["a_exact"]
+    # initial guess: the rigid translation that overlaps the plane over |x| < a (a^2 / 2R),
+    # so that the first tangent is not singular (the plane is the only vertical support)
+    u0 = np.zeros(body.ndof)
+    u0[body.xdofs[:, 1]] = -a_ex**2 / (2.0 * R)
+    contact.initialize(u0)
+    scale = P                                               # force scale of the residual
+    stepper = Static(system, dt=1.0 / params["n_steps"], atol=1e-10 * scale, rtol=1e-12, maxit=40)
+    hist = integrate(stepper, 0.0, u0, n_steps=params["n_steps"], cutback=True, max_cuts=6)
+    u = hist.u
+
+    rep = contact.report(u)
+    x = rep["x"][:, 0]
+    p = -rep["f_N"] / w                                       # pressure at the nodes
+    a_fit, p0_fit = fit_hertz(x, p)
+    p0_max = float(p.max())
+    a_ex, p0_ex = m["a_exact"], m["p0_exact"]
+    in_contact = p > 0
+    h_c = float(np.median(np.diff(rep["X"][:, 0])[: max(2, np.count_nonzero(in_contact))]))
+    c_eff = params["c_N"] if params["penalty"] == "per_length" else params["c_N"] / w[in_contact]
+    return dict(
+        a=a_fit, p0=p0_max, p0_fit=p0_fit, a_exact=a_ex, p0_exact=m["p0_exact"],
+        error_a=(a_fit - a_ex) / a_ex, error_p0=(p0_max - p0_ex) / p0_ex, error_p0_fit=(p0_fit - p0_ex) / p0_ex,
+        contact_force=float(-rep["f_N"].sum()), half_load=P / 2.0,
+        n_quads=int(body.mesh.t.shape[1]), n_dofs=int(body.ndof),
+        n_contact_nodes=int(np.count_nonzero(in_contact)), h_contact=h_c,
+        penetration_max=float(-rep["g_N"].min()),
+        c_N_per_length_min=float(np.min(c_eff)), c_N_per_length_max=float(np.max(c_eff)),
+        profile_x=x, profile_p=p, profile_p_exact=p0_ex * np.sqrt(np.clip(1 - (x / a_ex) ** 2, 0, None)),
+        newton_iterations_total=int(np.sum(hist.iterations)),
+        newton_residuals=[list(r) for r in hist.residuals[1:]],
+    )
+
+
+SCENE = Scene(
+    name="hertz",
+    title="Hertz: elastic cylinder on a rigid plane (verification, closed form)",
+    params=(
+        Param("R", 10.0, "mm", 0.0, None, low_open=True, doc="cylinder radius"),
+        Param("E", 2.0e5, "MPa", 0.0, None, low_open=True, doc="Young's modulus"),
+        Param("nu", 0.3, "", -1.0, 0.5, low_open=True, high_open=True, doc="Poisson's ratio (plane strain)"),
+        Param("P", 2000.0, "N/mm", 0.0, None, low_open=True,
+              doc="line load per unit thickness (default: a/R = 0.034, small strain)"),
+        Param("material", "linear", "", choices=("linear", "svk", "neohooke"),
+              doc="linear (small strain, Hertz's setting) or finite strain"),
+        Param("n_el", 64, "", 2, 2000, doc="quads per side of the quarter disk (n_el^2 quads)"),
+        Param("grading", 1.0, "", 0.0, 3.0,
+              doc="multiplies the sinh stretching that puts a third of the elements within 1.5 a (0: uniform)"),
+        Param("penalty", "per_length", "", choices=("per_length", "nodal"),
+              doc="per_length: c_N in MPa/mm, weights = tributary lengths; nodal: c_N in N/mm per node"),
+        Param("c_N", 1.0e9, "MPa/mm or N/mm", 0.0, None, low_open=True,
+              doc="penalty stiffness (eq 4, m = 1); chosen: stiff enough that the penalty error is < 0.1 %"),
+        Param("n_steps", 1, "", 1, 1000, doc="load steps (the whole load in one step by default)"),
+    ),
+    run=run,
+    presets={"fast": {"n_el": 32}, "paper": {"n_el": 64}},
+    reports=("a", "p0", "a_exact", "p0_exact", "error_a", "error_p0"),
+)
