@@ -4,7 +4,7 @@ The small formula functions below are the parts of Sec. 2 that only the figures
 need (eqs 3, 6-9, 13); the laws used in computations live in contactfem.laws.
 
     fig01_true_contact_area            Fig 1, eq (3)
-    fig02_force_vs_microdisplacement   Fig 2, eq (5) then sliding (return mapping, eqs 40-45)
+    fig02_force_vs_microdisplacement   Fig 2, eq (5) then sliding (return mapping, eqs 40-44)
     fig03_shear_vs_normal              Fig 3, eqs (6)-(11)
     fig04_parabolic_slip_surface       Fig 4, eq (10) with the return-mapping geometry (eqs 13, 14)
 """
@@ -66,7 +66,7 @@ def parabolic_alpha(tau_0, H, n, A=1.0):
 def drive_slip_history(law, p, g_T):
     """Tangential traction along a prescribed history of the tangential displacement
     g_T (a 1D array, starting from 0) at constant pressure p: one return mapping
-    (eqs 40-45) per increment, committing t_T and the accumulated slip q after each.
+    (eqs 40-44) per increment, committing t_T and the accumulated slip q after each.
     Returns (t_T, state, q), arrays of len(g_T)."""
     g_T = np.asarray(g_T, dtype=float)
     t_N = np.array([-float(p)])
