@@ -1,0 +1,20 @@
+"""Results a student wants to look at after (or during) a run.
+
+    runs.py      save_run(results, path) / load_run(path): a scene's results (dicts of
+                 numbers, strings and numpy arrays) to .json or .npz and back, without
+                 re-running; Recorder, an integrate callback that keeps snapshots
+    paraview.py  export_series(...), export_continuum(...), export_polyline(...): time
+                 series as VTU files + a .pvd collection for ParaView (needs meshio)
+    animate.py   animate_outlines(frames, "motion.gif"): body outlines over time with
+                 matplotlib's PillowWriter (GIF) or FFMpegWriter (MP4)
+    progress.py  ProgressBar: a progress bar on stderr for integrate(..., callback=bar);
+                 chain(...) to give integrate several callbacks
+"""
+
+from .animate import animate_outlines
+from .paraview import export_continuum, export_polyline, export_series
+from .progress import ProgressBar, chain
+from .runs import Recorder, load_run, save_run
+
+__all__ = ["save_run", "load_run", "Recorder", "export_series", "export_continuum", "export_polyline",
+           "animate_outlines", "ProgressBar", "chain"]
