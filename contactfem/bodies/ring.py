@@ -122,6 +122,14 @@ class RingModel:
         """Radius of the contact (outer) surface, R + h/2."""
         return self.R + 0.5 * self.thickness
 
+    @property
+    def rolling_radius(self):
+        """Lever arm of the friction force for rolling without slip: the distance from
+        the centre to the point whose tangential slip the contact measures.
+        beam: R (NodeToSegment measures the slip of the centreline node; the offset h/2
+        enters the gap only), continuum: R + h/2 (the outer nodes)."""
+        return self.R if self.kind == "beam" else self.R_outer
+
     def _u(self, u):
         """The body's local part of u (a global vector is accepted too)."""
         u = np.asarray(u, float)
