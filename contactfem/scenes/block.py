@@ -31,7 +31,13 @@ eq 28): ``consistent`` (eqs 33, 39, 49-50, non-symmetric), ``symmetric``
 (K_c replaced by (K_c + K_c^T)/2) or ``frozen`` (the coupling c_N^s C of eq 49
 dropped: the slip bound's dependence on the normal pressure is ignored in the
 tangent, as in elements that treat the normal force as fixed during the slip
-update). Only ``consistent`` converges quadratically.
+update). Only ``consistent`` converges quadratically; ``symmetric`` diverges
+once nodes slip (the symmetrised 2x2 slip block [[c_T^s, c_N^s/2], [c_N^s/2, c_N]]
+is indefinite when (c_N^s)^2 > 4 c_T^s c_N, e.g. Coulomb: c_T^s = 0).
+
+Finite strain (material=svk|neohooke) is an option for lighter loads: with the
+paper's loads the block is compressed by ~20% under a dead top load of about half
+its shear-buckling load G A, and elements invert (p_y <= 50 converges).
 """
 
 import numpy as np
@@ -93,6 +99,10 @@ PARAMS = (
     Param("g_N0", -1.0e-12, "L", -1e-3, 0.0, high_open=True,
           doc="initial gap of the bottom nodes. Chosen: a touch (-1e-12) so the first Newton iterate has "
               "contact stiffness (at g_N = 0 the contact is inactive and the tangent singular)"),
+    Param("n_steps", 1, "", 1, 1000,
+          doc="load steps of a pseudo-time ramp (the paper: the whole load in ONE step). Note: with the "
+              "finite-strain materials the paper's loads (compressive strain ~20%, dead top load near the block's "
+              "shear-buckling load) invert elements; they converge up to about p_y = 50, p_x = 15"),
     Param("rtol", 1e-10, "", 0.0, 1e-3, low_open=True, doc="Newton: ||G_k|| <= atol + rtol ||G_0||"),
     Param("atol", 1e-12, "F", 0.0, doc="Newton absolute tolerance"),
     Param("maxit", 40, "", 1, 500, doc="Newton: maximal number of linear solves"),
@@ -169,27 +179,33 @@ def build(params):
     contact = NodeToSegment(body, slaves, RigidLine((0.0, 0.0), (0.0, 1.0)),
                             PowerLaw(c_N=params["c_N"], m=params["m"]), friction_law(params),
                             weights=weights, offset=-params["g_N0"], name="foundation")
-    loads = [Pressure(body, "top", params["p_y"]),                  # dead load, reference normal
-             Traction(body, "right", (params["p_x"], 0.0))]
+    p_y, p_x = params["p_y"], params["p_x"]
+    loads = [Pressure(body, "top", lambda t: p_y * t),                # dead loads, ramped over the
+             Traction(body, "right", lambda t: (p_x * t, 0.0))]      # pseudo-time t in [0, 1]
     system_contact = contact if params["tangent"] == "consistent" else ContactTangent(contact, params["tangent"])
     system = System([body], [system_contact], loads)
     return dict(body=body, contact=contact, loads=loads, system=system, slaves=slaves)
 
 
 def solve(params):
-    """Build the block and apply the whole load in one static step (Newton from u = 0).
-    Returns build()'s dict plus u, the NewtonResult and the contact report at the
-    converged state (taken before the friction history is committed)."""
+    """Build the block and apply the load in ``n_steps`` static steps of the pseudo-time
+    (default: the whole load in ONE step, Newton from u = 0). Returns build()'s dict plus
+    u, the NewtonResult of every step and the contact report and contact forces R_c at
+    the converged final state (taken before the friction history is committed)."""
     sc = build(params)
     system, contact = sc["system"], sc["contact"]
-    u0 = np.zeros(system.ndof)
-    contact.initialize(u0)
-    stepper = Static(system, dt=1.0, atol=params["atol"], rtol=params["rtol"], maxit=params["maxit"])
-    u, _, _, result = stepper.step(0.0, u0, u0, u0, label="block, whole load in one step")
-    report = contact.report(u)
-    R_c = contact.assemble(u)[0]
-    system.commit(u)
-    return dict(sc, u=u, result=result, report=report, R_c=R_c)
+    n = params["n_steps"]
+    stepper = Static(system, dt=1.0 / n, atol=params["atol"], rtol=params["rtol"], maxit=params["maxit"])
+    u = np.zeros(system.ndof)
+    contact.initialize(u)
+    results = []
+    for k in range(n):
+        u, _, _, result = stepper.step(k / n, u, u, u, label=f"block, load step {k + 1} of {n}")
+        results.append(result)
+        if k == n - 1:
+            report, R_c = contact.report(u), contact.assemble(u)[0]
+        system.commit(u)
+    return dict(sc, u=u, result=results[-1], results=results, report=report, R_c=R_c)
 
 
 def slip_bound(params, t_N):
@@ -219,9 +235,10 @@ def run(params):
     top, right = load_norms(body, s["loads"])
     u = s["u"]
     return {
-        "newton_residuals": list(res.residuals),
-        "iterations": int(res.iterations),
-        "newton_iterations_total": int(res.iterations),
+        "newton_residuals": list(res.residuals),                     # of the (last) load step
+        "newton_residuals_per_step": [list(r.residuals) for r in s["results"]],
+        "iterations": int(sum(r.iterations for r in s["results"])),  # linear solves
+        "newton_iterations_total": int(sum(r.iterations for r in s["results"])),
         "total_normal": total_normal,
         "total_tangential": total_tangential,
         "applied_normal": applied_normal,
