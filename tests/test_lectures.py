@@ -1,0 +1,71 @@
+"""Every notebook in lectures/ runs top to bottom (a failing notebook is a failed test)
+and is stored without outputs.
+
+Each notebook is executed with nbclient in a temporary copy of lectures/ (so nothing
+is written next to the originals), with CONTACTFEM_PRESET=fast and CONTACTFEM_FIGURES
+pointing to a temporary folder. The kernel is called "python3" but is defined here, in a
+temporary JUPYTER_PATH, as *this* interpreter with the repository first on PYTHONPATH:
+the test runs the code of this checkout, whatever kernel the machine has registered.
+New notebooks are picked up automatically (glob, sorted).
+"""
+
+import json
+import os
+import shutil
+import sys
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+LECTURES = sorted((REPO / "lectures").glob("*.ipynb"))
+CELL_TIMEOUT = 300        # seconds per cell
+MAX_STORED_OUTPUT = 2000  # characters of stored output allowed per notebook ("small ones")
+
+
+def _stored_output_size(nb):
+    return sum(len(json.dumps(c.get("outputs", []))) for c in nb["cells"] if c["cell_type"] == "code"
+               if c.get("outputs"))
+
+
+@pytest.fixture
+def kernel_env(tmp_path, monkeypatch):
+    spec = tmp_path / "jupyter" / "kernels" / "python3"
+    spec.mkdir(parents=True)
+    (spec / "kernel.json").write_text(json.dumps({
+        "argv": [sys.executable, "-m", "ipykernel_launcher", "-f", "{connection_file}"],
+        "display_name": "Python 3 (contactfem tests)", "language": "python"}))
+    monkeypatch.setenv("JUPYTER_PATH", str(tmp_path / "jupyter"))
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join([str(REPO)] + [p for p in [os.environ.get("PYTHONPATH")] if p]))
+    monkeypatch.setenv("CONTACTFEM_PRESET", "fast")
+    monkeypatch.setenv("CONTACTFEM_FIGURES", str(tmp_path / "figures"))
+    monkeypatch.setenv("MPLBACKEND", "module://matplotlib_inline.backend_inline")
+    return tmp_path
+
+
+def test_there_are_lectures():
+    assert len(LECTURES) >= 4, f"expected the numbered course in {REPO / 'lectures'}, found {len(LECTURES)} notebooks"
+
+
+@pytest.mark.parametrize("path", LECTURES, ids=[p.name for p in LECTURES])
+def test_stored_without_outputs(path):
+    nbformat = pytest.importorskip("nbformat")
+    nb = nbformat.read(path, as_version=4)
+    nbformat.validate(nb)
+    size = _stored_output_size(nb)
+    assert size <= MAX_STORED_OUTPUT, f"{path.name} is stored with {size} characters of outputs: clear them"
+
+
+@pytest.mark.parametrize("path", LECTURES, ids=[p.name for p in LECTURES])
+def test_lecture_runs(path, kernel_env):
+    nbformat = pytest.importorskip("nbformat")
+    nbclient = pytest.importorskip("nbclient")
+    work = kernel_env / "lectures"
+    shutil.copytree(REPO / "lectures", work)
+    nb = nbformat.read(work / path.name, as_version=4)
+    client = nbclient.NotebookClient(nb, timeout=CELL_TIMEOUT, kernel_name="python3",
+                                     resources={"metadata": {"path": str(work)}})
+    try:
+        client.execute()
+    except nbclient.exceptions.CellExecutionError as err:
+        pytest.fail(f"{path.name} failed:\n{str(err)[-4000:]}", pytrace=False)
