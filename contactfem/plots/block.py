@@ -1,0 +1,217 @@
+"""Figures 6-8 and Table 1 of the paper: the elastic block on a rough rigid
+foundation (Sec. 5.1), whole load in one step.
+
+    fig06_block_mesh_deformed         Fig 6: system, discretisation, deformed configuration
+    fig07_block_conical_stresses      Fig 7: normal and friction stress on the contact side, conical slip surface
+    fig08_block_parabolic_stresses    Fig 8: the same for the parabolic slip surface
+    table1_block_newton_residuals     Table 1: ||G|| per Newton iteration, ours beside the paper's (.md and .png)
+
+The paper's figures also show Oden & Pires' results; their numbers are not
+available here, so only ours are drawn. The stresses are tractions (force per
+unit length of the contact side); the normal stress is drawn as the pressure
+|t_N|, the friction stress as t_T (> 0: the foundation holds the block back).
+"""
+
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from ..scenes import run_scene
+from ..scenes.block import PAPER_TABLE1, PAPER_TABLE1_UNCERTAIN, SCENE, solve
+from ..solver.newton import NewtonError
+from . import default_outdir, figure, savefig
+
+STATE_COLORS = {"stick": "tab:blue", "slip": "tab:red", "open": "0.6"}
+
+
+def _plt():
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+@lru_cache(maxsize=16)
+def result(preset="fast", **overrides):
+    """The block scene's JSON result (cached)."""
+    return run_scene("block", preset, overrides)
+
+
+def draw_mesh(ax, X, t, **kw):
+    """Outline every quadrilateral of the mesh (nodes X (nn, 2), connectivity t (4, nel))."""
+    from matplotlib.collections import PolyCollection
+
+    ax.add_collection(PolyCollection(X[t.T], facecolors="none", **kw))
+
+
+@figure("fig06_block_mesh_deformed", "Fig 6")
+def fig06(preset="fast", outdir=None, law="conical"):
+    plt = _plt()
+    s = solve(SCENE.resolve(preset, {"law": law}))
+    body, u, rep = s["body"], s["u"], s["report"]
+    X, t = body.X, body.mesh.t
+    x = X + u[body.xdofs]
+    W, H = X[:, 0].max(), X[:, 1].max()
+    fig, axes = plt.subplots(1, 2, figsize=(12, 5.2))
+    ax = axes[0]
+    draw_mesh(ax, X, t, edgecolors="k", linewidths=0.6)
+    for xi in np.linspace(0, W, 9):                               # pressure p_y on the top
+        ax.annotate("", (xi, H), (xi, H + 0.5), arrowprops=dict(arrowstyle="->", color="tab:green"))
+    for yi in np.linspace(0, H, 8):                               # traction p_x on the right side
+        ax.annotate("", (W + 0.5, yi), (W, yi), arrowprops=dict(arrowstyle="->", color="tab:purple"))
+    ax.text(W / 2, H + 0.6, "p_y = 200", ha="center", color="tab:green")
+    ax.text(W + 0.55, H / 2, "p_x = 60", va="center", color="tab:purple")
+    Xs = rep["X"]
+    ax.plot(Xs[:, 0], Xs[:, 1], "o", ms=4, color="tab:orange", label="contact nodes (17)")
+    ax.set_title("system and discretisation: 20 x 10 quads, width 4, height 3.5", fontsize=9)
+    ax.legend(loc="lower left", fontsize=8)
+    ax = axes[1]
+    draw_mesh(ax, X, t, edgecolors="0.8", linewidths=0.5)
+    draw_mesh(ax, x, t, edgecolors="k", linewidths=0.6)
+    for state, color in STATE_COLORS.items():
+        sel = rep["state"] == state
+        if sel.any():
+            ax.plot(rep["x"][sel, 0], rep["x"][sel, 1], "o", ms=4, color=color, label=state)
+    ax.set_title(f"deformed ({law} law), displacements at true scale (x1): max |u| = "
+                 f"{np.linalg.norm(u[body.xdofs], axis=1).max():.2f}; grey: undeformed", fontsize=9)
+    ax.legend(loc="lower left", fontsize=8)
+    for ax in axes:
+        ax.axhline(0.0, color="k", lw=2.5)
+        ax.fill_between([-0.5, W + 1.5], -0.4, 0.0, color="0.85", alpha=0.5, lw=0, zorder=0)
+        ax.set_xlim(-0.5, W + 1.5)
+        ax.set_ylim(-0.45, H + 1.0)
+        ax.set_aspect("equal")
+    fig.suptitle("Fig 6: elastic block on a rigid rough foundation, whole load in one step", fontsize=10)
+    fig.tight_layout()
+    return [savefig(fig, outdir or default_outdir(), "fig06_block_mesh_deformed")]
+
+
+def draw_stresses(ax, r, label="", style="-", faint=False):
+    """Pressure |t_N| and friction stress t_T along the contact side (reference x),
+    the slip bound Y(|t_N|) dashed, each node marked by its state."""
+    c = r["contact"]
+    x, p, tT, Y = (np.asarray(c[k]) for k in ("x", "t_N", "t_T", "slip_bound"))
+    p = -p
+    state = np.asarray(c["state"])
+    if faint:
+        ax.plot(x, p, style, color="0.6", lw=1, label=f"|t_N| {label}")
+        ax.plot(x, tT, style, color="0.6", lw=1, marker="x", ms=4, label=f"t_T {label}")
+        return
+    ax.plot(x, p, style, color="k", lw=1.3, marker="+", ms=7, label=f"|t_N| {label}")
+    ax.plot(x, tT, style, color="tab:red", lw=1.3, label=f"t_T {label}")
+    ax.plot(x, Y, "--", color="tab:red", lw=0.8, alpha=0.7, label=f"slip bound Y(|t_N|) {label}")
+    for st, color in STATE_COLORS.items():
+        sel = state == st
+        if sel.any():
+            ax.plot(x[sel], tT[sel], "o", color=color, ms=5, label=f"{st} ({sel.sum()})")
+
+
+def _stress_axes(ax, title):
+    ax.set_xlabel("x-coordinate (reference)")
+    ax.set_ylabel("contact stress (force / length)")
+    ax.set_ylim(0, None)
+    ax.grid(alpha=0.3)
+    ax.set_title(title, fontsize=9)
+    ax.legend(fontsize=7, ncol=2)
+
+
+@figure("fig07_block_conical_stresses", "Fig 7")
+def fig07(preset="fast", outdir=None):
+    plt = _plt()
+    r = result(preset, law="conical")
+    fig, ax = plt.subplots(figsize=(7.5, 5))
+    draw_stresses(ax, r, "(conical)")
+    _stress_axes(ax, "Fig 7: stresses on the contact area, conical slip surface (n = 1, alpha + beta = 0.5)\n"
+                     f"sum |t_N| w = {-r['total_normal']:.6g}, sum t_T w = {r['total_tangential']:.6g}; "
+                     "no node reaches the slip bound on this block")
+    return [savefig(fig, outdir or default_outdir(), "fig07_block_conical_stresses")]
+
+
+@figure("fig08_block_parabolic_stresses", "Fig 8")
+def fig08(preset="fast", outdir=None):
+    plt = _plt()
+    r = result(preset, law="parabolic")
+    rc = result(preset, law="conical")
+    fig, ax = plt.subplots(figsize=(7.5, 5))
+    draw_stresses(ax, rc, "conical", style=":", faint=True)
+    draw_stresses(ax, r, "(parabolic)")
+    _stress_axes(ax, "Fig 8: stresses on the contact area, parabolic slip surface (n = 0.5, alpha = 0.2, beta = 0.3)\n"
+                     "grey: the conical case (Fig 7)")
+    return [savefig(fig, outdir or default_outdir(), "fig08_block_parabolic_stresses")]
+
+
+def residual_histories(preset="fast"):
+    """Our ||G|| per iteration for the paper's two laws, Coulomb mu = 0.3 and the
+    Coulomb case with the tangent without the c_N^s coupling ('frozen')."""
+    out = {law: result(preset, law=law)["newton_residuals"] for law in ("conical", "parabolic", "coulomb")}
+    out["coulomb, frozen tangent"] = result(preset, law="coulomb", tangent="frozen")["newton_residuals"]
+    try:
+        out["coulomb, symmetric tangent"] = result(preset, law="coulomb", tangent="symmetric", maxit=12)["newton_residuals"]
+    except NewtonError as err:
+        out["coulomb, symmetric tangent"] = err.history
+    return out
+
+
+def table1_markdown(hist):
+    """Table 1 as markdown: the paper's values beside ours (linear solves = rows - 1)."""
+    def cell(values, k, law=None):
+        if k >= len(values):
+            return ""
+        text = f"{values[k]:.6e}"
+        if law and k in PAPER_TABLE1_UNCERTAIN.get(law, ()):
+            text += " (scan?)"
+        return text
+    n = max(len(PAPER_TABLE1["parabolic"]), len(hist["conical"]), len(hist["parabolic"]), len(hist["coulomb"]))
+    lines = ["# Table 1: norm of the residual ||G|| per Newton iteration, whole load in one step",
+             "",
+             "Block of Sec. 5.1 (canonical data of issue 3: width 4, height 3.5, 20 x 10 quads, E = 1000, "
+             "nu = 0.3, c_N = 1e5 chosen, c_T = 5e4 per unit length). Iteration 1 is the initial state u = 0: its "
+             "residual is the nodal load vector (top pressure and right traction; the contact forces at "
+             "g_N0 = -1e-12 are ~1e-8). The paper's block dimensions are not known, hence its different "
+             "first value. (scan?): exponent garbled in the scan, value uncertain.",
+             "",
+             "| iteration | paper conical | ours conical | paper parabolic | ours parabolic | ours Coulomb mu = 0.3 |",
+             "|---:|---:|---:|---:|---:|---:|"]
+    for k in range(n):
+        lines.append(f"| {k + 1} | {cell(PAPER_TABLE1['conical'], k, 'conical')} | {cell(hist['conical'], k)} | "
+                     f"{cell(PAPER_TABLE1['parabolic'], k, 'parabolic')} | {cell(hist['parabolic'], k)} | "
+                     f"{cell(hist['coulomb'], k)} |")
+    lines += ["", "Linear solves: paper conical 3, parabolic 6; ours conical "
+              f"{len(hist['conical']) - 1}, parabolic {len(hist['parabolic']) - 1}, Coulomb {len(hist['coulomb']) - 1}; "
+              f"Coulomb with the tangent without the c_N^s coupling (frozen): {len(hist['coulomb, frozen tangent']) - 1}; "
+              f"with the symmetrised tangent: diverges (residuals "
+              + ", ".join(f"{v:.2e}" for v in hist["coulomb, symmetric tangent"][:6]) + ", ...).", ""]
+    return "\n".join(lines)
+
+
+@figure("table1_block_newton_residuals", "Table 1")
+def table1(preset="fast", outdir=None):
+    plt = _plt()
+    outdir = outdir or default_outdir()
+    hist = residual_histories(preset)
+    md = Path(outdir) / "table1_block_newton_residuals.md"
+    md.parent.mkdir(parents=True, exist_ok=True)
+    md.write_text(table1_markdown(hist))
+    fig, ax = plt.subplots(figsize=(7.5, 5))
+    colors = {"conical": "tab:blue", "parabolic": "tab:red"}
+    for law, color in colors.items():
+        paper = np.array(PAPER_TABLE1[law])
+        k = np.arange(1, len(paper) + 1)
+        ok = np.array([i not in PAPER_TABLE1_UNCERTAIN[law] for i in range(len(paper))])
+        ax.semilogy(k, paper, ":", color=color, lw=1)
+        ax.semilogy(k[ok], paper[ok], "s", mfc="none", color=color, label=f"paper, {law}")
+        if (~ok).any():
+            ax.semilogy(k[~ok], paper[~ok], "s", mfc="none", color=color, alpha=0.4,
+                        label=f"paper, {law}: exponent uncertain (scan?)")
+        ours = hist[law]
+        ax.semilogy(np.arange(1, len(ours) + 1), ours, "-o", color=color, label=f"ours, {law}")
+    for key, style in (("coulomb", "-^"), ("coulomb, frozen tangent", "--v")):
+        ours = hist[key]
+        ax.semilogy(np.arange(1, len(ours) + 1), ours, style, color="tab:green" if key == "coulomb" else "0.5",
+                    label=f"ours, {key} (mu = 0.3)")
+    ax.set_xlabel("iteration (1 = initial state)")
+    ax.set_ylabel("||G||")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7)
+    ax.set_title("Table 1: residual norm per Newton iteration, whole load in one step", fontsize=9)
+    return [str(md), savefig(fig, outdir, "table1_block_newton_residuals")]
