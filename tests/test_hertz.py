@@ -1,0 +1,55 @@
+"""The hertz scene against Hertz's closed form (cylinder on a rigid plane, plane strain):
+a = sqrt(4 P R (1 - nu^2) / (pi E)), p0 = 2 P / (pi a)."""
+import numpy as np
+import pytest
+
+from contactfem.scenes import run_scene
+from contactfem.scenes.hertz import fit_hertz, hertz_exact
+
+
+def test_closed_form_values():
+    a, p0 = hertz_exact(P=2000.0, R=10.0, E=2e5, nu=0.3)
+    assert a == pytest.approx(np.sqrt(4 * 2000 * 10 * 0.91 / (np.pi * 2e5)))
+    assert p0 * np.pi * a / 2 == pytest.approx(2000.0)      # the load is the integral of p(x)
+
+
+def test_fit_recovers_an_exact_profile():
+    x = np.linspace(0, 1.2, 30)
+    p = 5.0 * np.sqrt(np.clip(1 - x**2 / 0.9**2, 0, None))
+    assert fit_hertz(x, p) == pytest.approx((0.9, 5.0), rel=1e-10)
+
+
+def test_fast_preset_matches_hertz():
+    r = run_scene("hertz", "fast")
+    # closed form p0 = 3740.5 MPa, a = 0.3404 mm; fast mesh 32 x 32 quads:
+    # ours p0 within 0.5 %, a (fit) within 1.5 %
+    assert abs(r["error_p0"]) < 5e-3, f"p0 {r['p0']:.1f} vs Hertz {r['p0_exact']:.1f} (tol 0.5 %)"
+    assert abs(r["error_a"]) < 1.5e-2, f"a {r['a']:.4f} vs Hertz {r['a_exact']:.4f} (tol 1.5 %)"
+    assert r["contact_force"] == pytest.approx(r["half_load"], rel=1e-6)   # equilibrium
+    assert r["n_contact_nodes"] >= 5
+    assert r["newton_iterations_total"] >= 1
+
+
+def test_per_length_penalty_is_mesh_independent_nodal_is_not():
+    # a soft penalty (c_N = 1e7 MPa/mm) so that the penalty compliance shows; the nodal
+    # value is the per-length one times the contact element size of the 16 x 16 mesh
+    pl = [run_scene("hertz", "fast", {"n_el": n, "c_N": 1e7}) for n in (16, 32)]
+    nd = [run_scene("hertz", "fast", {"n_el": n, "c_N": 1e7 * 0.0842, "penalty": "nodal"}) for n in (16, 32)]
+    # per length: the same interface law on both meshes, the same penetration and p0
+    assert pl[1]["penetration_max"] == pytest.approx(pl[0]["penetration_max"], rel=0.01)
+    assert pl[1]["p0"] == pytest.approx(pl[0]["p0"], rel=0.005)
+    # nodal: halving the element size doubles the stiffness per unit length
+    ratio = nd[0]["penetration_max"] / nd[1]["penetration_max"]
+    assert 1.7 < ratio < 2.3, ratio
+    assert nd[1]["c_N_per_length_max"] / nd[0]["c_N_per_length_max"] == pytest.approx(2.0, rel=0.1)
+
+
+def test_finite_strain_option_runs():
+    r = run_scene("hertz", "fast", {"n_el": 16, "material": "neohooke"})
+    assert abs(r["error_p0"]) < 0.02
+
+
+@pytest.mark.parametrize("bad", [{"n_el": 1}, {"penalty": "both"}, {"c_N": 0.0}, {"nu": 0.5}])
+def test_bad_parameters_raise(bad):
+    with pytest.raises(ValueError):
+        run_scene("hertz", "fast", bad)
