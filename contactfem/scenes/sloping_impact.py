@@ -137,6 +137,8 @@ def run(params):
         energy_total_final_rel=float(mech[-1] / E0),
         outlines=np.array(rec["outlines"]), outline_t=np.array(rec["outline_t"]), outline_spin=omega,
         mass=ring.total_mass(),
+        # committed plastic strains of the beam (eps_p, gam_p, kap_p): the permanent deformation
+        plastic_strain_max=np.max(np.abs(getattr(ring.body, "ep", np.zeros((1, 3)))), axis=0),
         newton_iterations_total=int(np.sum(hist.iterations)),
         step_cuts_total=int(np.sum(hist.cuts)),
     )

@@ -1,0 +1,81 @@
+"""Fall of a ring into a rigid funnel (paper Sec. 5.4, Figs 12-13): frictionless rebounds,
+frictional sticks with a smaller deformation. Fast preset = the paper's 30 elements on
+the half ring, dt = 0.1 (about a second per run)."""
+
+import json
+
+import numpy as np
+import pytest
+
+from contactfem.plots import funnel as plots
+from contactfem.scenes import run_scene
+from contactfem.scenes.funnel import SCENE, build
+
+
+@pytest.fixture(scope="module")
+def res():
+    return {v: plots.result(v, "fast") for v in ("frictionless", "frictional")}
+
+
+def test_json_and_history(res):
+    for r in res.values():
+        n = r["parameters"]["n_steps"] + 1
+        for key in ("t", "x_c", "y_c", "v_c"):
+            assert len(r[key]) == n, key
+        assert np.all(np.asarray(r["x_c"]) == 0.0), "the centre stays on the symmetry axis"
+        assert isinstance(r["stuck"], bool)
+        assert r["newton_iterations_total"] > r["parameters"]["n_steps"]
+        json.dumps(r)
+
+
+def test_frictionless_rebounds(res):
+    """Paper Fig 12: no energy loss at the interface, the ring rebounds: stuck is false, the
+    centre moves up at the end and is above its start."""
+    r = res["frictionless"]
+    assert not r["stuck"]
+    assert r["v_c_final"] > 0.5 * r["parameters"]["v0"], r["v_c_final"]
+    assert r["y_c_final"] > r["y_c_start"]
+    assert r["contact_nodes_final"] == 0
+
+
+def test_frictional_sticks(res):
+    """Paper Fig 13: the ring sticks in the funnel; its deformation is smaller."""
+    r, fl = res["frictional"], res["frictionless"]
+    assert r["stuck"], f"mean centre speed {r['mean_v_c_last_quarter']:.3f} over the last quarter"
+    assert r["contact_nodes_final"] > 0
+    assert r["max_deformation"] < 0.85 * fl["max_deformation"], (r["max_deformation"], fl["max_deformation"])
+    assert r["y_c_min"] > fl["y_c_min"], "the frictional ring does not get as deep"
+
+
+def test_a_wider_funnel_lets_the_ring_go():
+    """The chosen wall angle matters: at 30 deg from the vertical (tan = 0.58, above the
+    friction coefficient of eq 10 at these pressures) the frictional ring slides back out."""
+    r = run_scene("funnel", "fast", {"variant": "frictional", "phi_deg": 30.0, "n_steps": 100})
+    assert not r["stuck"]
+    assert r["v_c_final"] > 0.3
+
+
+def test_energy_never_increases(res):
+    for v, r in res.items():
+        E = np.asarray(r["energy_total"])
+        assert np.max(np.diff(E)) <= 1e-6 * E[0], v
+
+
+def test_symmetry_conditions():
+    m = build(SCENE.resolve("fast", {}))
+    ring, system = m["ring"], m["system"]
+    ends = [0, ring.body.X.shape[0] - 1]
+    assert np.allclose(ring.body.X[ends, 0], 0.0)
+    assert set(system.fixed_dofs) == {0, 2, 3 * ends[1], 3 * ends[1] + 2}   # u_x and theta
+
+
+def test_bad_input():
+    with pytest.raises(ValueError, match="phi_deg"):
+        SCENE.resolve("fast", {"phi_deg": 0})
+    with pytest.raises(ValueError, match="variant"):
+        SCENE.resolve("fast", {"variant": "viscoplastic"})
+
+
+def test_figures(tmp_path):
+    files = plots.fig12(outdir=tmp_path) + plots.fig13(outdir=tmp_path)
+    assert len(files) == 2 and all((tmp_path / f).exists() for f in files)
