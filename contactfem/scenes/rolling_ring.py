@@ -131,7 +131,9 @@ def run(params):
     contact.initialize(u0)
 
     every = max(1, int(round(params["outline_interval"] / params["dt"])))
-    rec = dict(t=[], xc=[], vc=[], omega=[], outlines=[], outline_t=[], outline_vc=[], outline_omega=[])
+    rec = dict(t=[], xc=[], vc=[], omega=[], outlines=[], outline_t=[], outline_vc=[], outline_omega=[],
+               node_y=[], node_vx=[])
+    nodes = ring.body.xdofs[ring.contact_nodes]          # (u_x, u_y) dofs of the contact nodes
     step = [0]
 
     def record(t, u, v):
@@ -144,6 +146,8 @@ def run(params):
             rec["outline_t"].append(t)
             rec["outline_vc"].append(rec["vc"][-1])
             rec["outline_omega"].append(rec["omega"][-1])
+            rec["node_y"].append(ring.body.X[ring.contact_nodes, 1] + u[nodes[:, 1]])   # velocity profile
+            rec["node_vx"].append(v[nodes[:, 0]])
         step[0] += 1
 
     record(0.0, u0, vel0)
@@ -186,6 +190,7 @@ def run(params):
         x_exact=hoop["x"], vx_exact=hoop["v"], omega_exact=hoop["omega"],
         outlines=np.array(rec["outlines"]), outline_t=np.array(rec["outline_t"]),
         outline_vc=np.array(rec["outline_vc"]), outline_omega=np.array(rec["outline_omega"]),
+        outline_node_y=np.array(rec["node_y"]), outline_node_vx=np.array(rec["node_vx"]),
         energy_kinetic=hist.kinetic, energy_strain=hist.strain, energy_dissipation=hist.dissipation,
         newton_iterations_total=int(np.sum(hist.iterations)),
         step_cuts_total=int(np.sum(hist.cuts)),
