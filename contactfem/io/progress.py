@@ -30,6 +30,7 @@ class ProgressBar:
         self.n, self.fraction, self.t = 0, 0.0, float(t0)
         self.start = time.perf_counter()
         self._last = -1e300
+        self._drawn_at = None
         self.closed = False
 
     def text(self):
@@ -45,6 +46,7 @@ class ProgressBar:
             self.stream.write("\r" + self.text())
             self.stream.flush()
             self._last = now
+            self._drawn_at = self.fraction
 
     def update(self, n=1):
         """Count n more steps (with total)."""
@@ -65,7 +67,8 @@ class ProgressBar:
     def close(self):
         """Draw the final state and end the line."""
         if not self.closed:
-            self._draw(force=True)
+            if self._drawn_at != self.fraction:      # the final state is not on screen yet
+                self._draw(force=True)
             self.stream.write("\n")
             self.stream.flush()
             self.closed = True
