@@ -113,6 +113,9 @@ def run(params):
     in_contact_window = bool(np.all(n_contact[k0:] > 0))
     stuck = in_contact_window and abs(mean_v_window) < 0.02 * params["v0"]
     k_low = int(np.argmin(y_c))
+    rep = contact.report(hist.u)                                # the interface at the end of the run
+    on = rep["state"] != "open"
+    contact_final = dict(x=rep["x"][on], t_N=rep["t_N"][on], t_T=rep["t_T"][on], state=rep["state"][on].tolist())
     mech = hist.kinetic + hist.strain + hist.contact
     return dict(
         variant=params["variant"], stuck=bool(stuck),
@@ -123,6 +126,7 @@ def run(params):
         y_c_min=float(y_c[k_low]), t_y_c_min=float(t[k_low]), y_c_start=float(y_c[0]),
         v_c_final=float(v_c[-1]), y_c_final=float(y_c[-1]),
         slipping_nodes_final=int(rec["n_slip"][-1]), contact_nodes_final=int(n_contact[-1]),
+        contact_final=contact_final,
         energy_kinetic=hist.kinetic, energy_strain=hist.strain, energy_contact=hist.contact,
         energy_dissipation=hist.dissipation, energy_total=mech,
         outlines=np.array(rec["outlines"]), outline_t=np.array(rec["outline_t"]),
