@@ -31,7 +31,7 @@ def check_same(a, b):
 
 @pytest.mark.parametrize("suffix", [".json", ".npz"])
 def test_save_load_roundtrip(tmp_path, suffix):
-    path = save_run(RESULTS, tmp_path / f"run{suffix}")
+    path = save_run(RESULTS, tmp_path / "new_folder" / f"run{suffix}")
     check_same(RESULTS, load_run(path))
 
 

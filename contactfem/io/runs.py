@@ -75,6 +75,9 @@ def save_run(results, path):
     path = Path(path)
     if not isinstance(results, dict):
         raise TypeError(f"results must be a dict, got {type(results).__name__}")
+    if path.suffix not in (".json", ".npz"):
+        raise ValueError(f"parameter path must end in .json or .npz, got {path.name!r}")
+    path.parent.mkdir(parents=True, exist_ok=True)
     if path.suffix == ".json":
         doc = {"format": FORMAT, "results": _encode(results, "results", None)}
         path.write_text(json.dumps(doc, indent=1, allow_nan=False))
@@ -82,8 +85,6 @@ def save_run(results, path):
         arrays = {}
         doc = {"format": FORMAT, "results": _encode(results, "results", arrays)}
         np.savez_compressed(path, __json__=np.array(json.dumps(doc, allow_nan=False)), **arrays)
-    else:
-        raise ValueError(f"parameter path must end in .json or .npz, got {path.name!r}")
     return str(path)
 
 
