@@ -98,6 +98,21 @@ def annulus_mesh(R_in, R_out, n_el, n_radial, center=(0.0, 0.0), half=False):
     return mesh.with_boundaries(bnd), n_ang
 
 
+class _BeamWeight(BeamGravity):
+    """BeamGravity with the lumped mass assembled once (Beam.mass() re-assembles it with
+    scikit-fem at every call, and the load is evaluated at every Newton iteration)."""
+
+    def __init__(self, beam, g):
+        super().__init__(beam, g)
+        self._P = beam.mass()[beam.xdofs] * self.g        # (nn, 2) nodal weights
+
+    def assemble(self, u_global, t):
+        P = np.zeros(np.size(u_global))
+        P[self.beam.dof_offset + self.beam.xdofs] = self._P
+        empty_i, empty_v = np.zeros(0, dtype=int), np.zeros(0)
+        return P, empty_i, empty_i, empty_v
+
+
 @dataclass
 class RingModel:
     """A ring body with what the ring scenes need (see the module docstring).
@@ -170,11 +185,14 @@ class RingModel:
 
     # -- masses and rigid-body measures -----------------------------------------------
     def _mass_split(self):
-        """Translational mass per node (nn,) and rotary inertia per node (beam theta dofs)."""
-        M = self.body.mass()
-        m = M[self.body.xdofs[:, 0]]
-        J = M[2::3] if self.kind == "beam" else np.zeros_like(m)
-        return m, J
+        """Translational mass per node (nn,) and rotary inertia per node (beam theta dofs);
+        computed once (the lumped mass is constant)."""
+        if getattr(self, "_masses", None) is None:
+            M = self.body.mass()
+            m = M[self.body.xdofs[:, 0]]
+            J = M[2::3] if self.kind == "beam" else np.zeros_like(m)
+            self._masses = (m, J)
+        return self._masses
 
     def total_mass(self):
         """Sum of the lumped translational masses (the half ring's is half the ring's)."""
@@ -242,7 +260,7 @@ class RingModel:
         """Dead weight: BeamGravity (lumped) for the beam, BodyForce (0, -rho g) for the continuum."""
         g = float(g)
         if self.kind == "beam":
-            return BeamGravity(self.body, g)
+            return _BeamWeight(self.body, g)
         return BodyForce(self.body, (0.0, -self.body.rho * g))
 
     def symmetry_dofs(self):
