@@ -18,7 +18,8 @@ Choices the paper does not state:
       gravity stays put only if the friction carries the walls' outward push,
       |t_T| / |t_N| = tan(phi) <= mu_eff = alpha |t_N|^(n - 1) + beta (eq 10). For the
       light contact pressures here mu_eff is about 0.5-0.7: phi = 20 deg (tan = 0.36)
-      sticks with a clear margin, phi = 25 deg creeps out slowly, phi = 30 deg leaves.
+      sticks with a clear margin, phi = 25 deg is marginal (the centre creeps up at about
+      1 % of v0), phi = 30 deg leaves at about 0.2 v0.
     * no gravity (the paper gives none for Secs 5.3-5.4), so "falls" is the initial
       velocity only; the ring starts with its outer surface `gap0` = 0.2 above the wall.
 
