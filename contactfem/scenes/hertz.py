@@ -26,6 +26,11 @@ mesh is refined and varies along a graded mesh: the answer depends on the mesh.
 The pressure at each contact node is p_i = -f_i / w_i (for both penalty kinds). Reported:
 p0 (largest nodal pressure, at x = 0) and a, p0 from a least-squares fit of
 p^2 = p0^2 (1 - x^2/a^2) (linear in x^2) over the nodes in contact.
+
+Our numbers (defaults, a / R = 0.034, c_N = 1e9 MPa/mm per length): p0 error +0.10 %,
+-0.03 %, -0.05 % on 16^2, 32^2 (fast), 64^2 = 4096 quads (paper); a from the fit -0.4 %,
+-0.7 %, -0.8 % (the fit and the finite a / R, not the mesh, limit a). One Newton
+iteration: the initial overlap a^2 / 2R guesses the active set.
 """
 
 import numpy as np

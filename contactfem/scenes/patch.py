@@ -18,9 +18,8 @@ and flips in and out of contact; and a slave sitting exactly on a master node sw
 segments at the kink from one Newton iterate to the next. The homogeneous solution is
 unchanged (sigma_yy = -p, sigma_xx = 0 in both blocks, the blocks sliding against each
 other without friction); rigid sliding is removed by one pin (u_x = 0) on each block
-and rollers under the lower block.
-Penalty per unit length (eq 4, m = 1)
-with tributary-length weights; the interface is deformable on both sides, so every
+and rollers under the lower block. Penalty per unit length (eq 4, m = 1) with
+tributary-length weights; the interface is deformable on both sides, so every
 contact pair is the full 6-dof element of eqs (25)-(50) (BodySurface master).
 
     passes = 1: the upper block's bottom nodes are slaves on the lower block's top
@@ -42,7 +41,8 @@ one pass 2.6 % interface pressure and 1.7 % stress deviation, two passes 0.8 % a
 paper preset (8 | 13): one pass 5.2 % and 2.4 %, two passes 2.0 % and 0.7 %. The
 two-pass error falls roughly like 1 / c_N (0.3 % at c_N = 1e7) while one pass stalls
 (its error comes from the load transfer, not from the penalty). Within the two-pass
-method the load splits unevenly between the passes (each pass's own t_N is far from p): only the sum is meaningful.
+method the load splits unevenly between the passes (each pass's own t_N is far from
+p): only the sum is meaningful.
 """
 
 import numpy as np
