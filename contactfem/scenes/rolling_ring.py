@@ -130,25 +130,25 @@ def run(params):
     vel0 = ring.initial_velocity((v0, 0.0))
     contact.initialize(u0)
 
-    every = max(1, int(round(params["outline_interval"] / params["dt"])))
+    interval = params["outline_interval"]
+    next_snap = [0.0]                                     # next outline time
     rec = dict(t=[], xc=[], vc=[], omega=[], outlines=[], outline_t=[], outline_vc=[], outline_omega=[],
                node_y=[], node_vx=[])
     nodes = ring.body.xdofs[ring.contact_nodes]          # (u_x, u_y) dofs of the contact nodes
-    step = [0]
 
     def record(t, u, v):
         rec["t"].append(t)
         rec["xc"].append(ring.center_of_mass(u))
         rec["vc"].append(ring.velocity_of_mass(v))
         rec["omega"].append(ring.angular_velocity(u, v))
-        if step[0] % every == 0:
+        if t >= next_snap[0] - 1e-6 * params["dt"]:
+            next_snap[0] += interval
             rec["outlines"].append(ring.outline(u))
             rec["outline_t"].append(t)
             rec["outline_vc"].append(rec["vc"][-1])
             rec["outline_omega"].append(rec["omega"][-1])
             rec["node_y"].append(ring.body.X[ring.contact_nodes, 1] + u[nodes[:, 1]])   # velocity profile
             rec["node_vx"].append(v[nodes[:, 0]])
-        step[0] += 1
 
     record(0.0, u0, vel0)
     stepper = Newmark(system, params["dt"], params["delta"], params["beta_newmark"],
