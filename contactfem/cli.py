@@ -47,6 +47,10 @@ def cmd_run(args):
     if args.json:
         with open(args.json, "w") as fh:
             fh.write(text)
+    if args.save:
+        from .io import save_run
+
+        save_run(res, args.save)
     summary = {k: v for k, v in res.items() if not isinstance(v, (list, dict))}
     for k, v in summary.items():
         print(f"{k}: {v}")
@@ -69,6 +73,12 @@ def cmd_sweep(args):
     print(f"{len(rows)} runs -> {args.out}")
 
 
+def cmd_equations(args):
+    from .equations import markdown_table
+
+    print(markdown_table())
+
+
 def build_parser():
     ap = argparse.ArgumentParser(prog="contactfem", description=__doc__.split("\n\n")[0])
     sub = ap.add_subparsers(dest="command", required=True)
@@ -81,12 +91,15 @@ def build_parser():
     rp.add_argument("--preset", default="fast", choices=["fast", "paper"])
     rp.add_argument("--set", action="append", metavar="NAME=VALUE", help="override a parameter (repeatable)")
     rp.add_argument("--json", metavar="FILE", help="write all results to FILE as JSON")
+    rp.add_argument("--save", metavar="FILE", help="save the run (.json or .npz) for contactfem.io.load_run")
     rp.set_defaults(func=cmd_run)
     fp = sub.add_parser("figures", help="regenerate every figure and table of the paper into figures/")
     fp.add_argument("--preset", default="fast", choices=["fast", "paper"])
     fp.add_argument("--outdir", default=None, help="default: the repo's figures/ folder")
     fp.add_argument("--only", default=None, help="only figures whose file name contains this text")
     fp.set_defaults(func=cmd_figures)
+    sub.add_parser("equations", help="the equation index: paper equation -> implementing function"
+                   ).set_defaults(func=cmd_equations)
     sw = sub.add_parser("sweep", help="run a scene over a grid of parameter values, in parallel")
     sw.add_argument("scene")
     sw.add_argument("--preset", default="fast", choices=["fast", "paper"])
