@@ -125,7 +125,7 @@ def _hoop(v, w):
 @LinearForm
 def _internal_form(v, w):
     """Virtual work of the stresses: P : grad v + P_33 v_r / r."""
-    P = w.P
+    P = np.asarray(w.P)     # plain array: indexing a DiscreteField copies all of it
     work = np.einsum("ij...,ij...->...", P[:2, :2], v.grad) + P[2, 2] * _hoop(v, w)
     return work * _weight(w)
 
@@ -133,7 +133,7 @@ def _internal_form(v, w):
 @BilinearForm
 def _tangent_form(u, v, w):
     """Linearised virtual work: grad v : A : grad du (+ hoop couplings)."""
-    A = w.A
+    A = np.asarray(w.A)     # plain array: indexing a DiscreteField copies all of it (8x slower)
     hu, hv = _hoop(u, w), _hoop(v, w)
     k = (np.einsum("ijkl...,ij...,kl...->...", A[:2, :2, :2, :2], v.grad, u.grad)
          + np.einsum("ij...,ij...->...", A[:2, :2, 2, 2], v.grad) * hu
