@@ -228,9 +228,11 @@ class Beam:
 
         scikit-fem: row sums of the P1 mass matrix on the arc-length mesh = L0/2 per element end.
         """
-        lumped_mesh = np.asarray(asm(mass_form, Basis(self.mesh, ElementLineP1())).sum(axis=1)).ravel()
-        length = np.bincount(self.fold, lumped_mesh, minlength=self.X.shape[0])   # fold s = L onto s = 0
-        return (self.rho * np.column_stack([self.A * length, self.A * length, self.I * length])).ravel()
+        if getattr(self, "_mass", None) is None:   # assembled once, then reused
+            lumped_mesh = np.asarray(asm(mass_form, Basis(self.mesh, ElementLineP1())).sum(axis=1)).ravel()
+            length = np.bincount(self.fold, lumped_mesh, minlength=self.X.shape[0])   # fold s = L onto s = 0
+            self._mass = (self.rho * np.column_stack([self.A * length, self.A * length, self.I * length])).ravel()
+        return self._mass.copy()
 
     # ---- surface offset (for contact on the outer face of a ring) -------------------
     def _node_angle0(self):
