@@ -184,7 +184,7 @@ def run(params):
         v_final_rel_err=v_final / hoop["v_star"] - 1.0,
         x_end_rel_err=float(xc[-1, 0] / hoop["x"][-1] - 1.0),
         t_star_model=model["t_star"], x_roll_model=model["x_star"], v_final_model=model["v_star"],
-        rolling_radius=a, gyration_radius2=k2, mass=ring.total_mass(),
+        rolling_radius=a, gyration_radius2=k2, mass=ring.total_mass(), ndof=ring.body.ndof,
         paper=PAPER,
         t=t, x_c=xc[:, 0], y_c=xc[:, 1], vx_c=vc[:, 0], vy_c=vc[:, 1], omega=omega, slip_velocity=slip,
         x_exact=hoop["x"], vx_exact=hoop["v"], omega_exact=hoop["omega"],
