@@ -98,21 +98,6 @@ def annulus_mesh(R_in, R_out, n_el, n_radial, center=(0.0, 0.0), half=False):
     return mesh.with_boundaries(bnd), n_ang
 
 
-class _BeamWeight(BeamGravity):
-    """BeamGravity with the lumped mass assembled once (Beam.mass() re-assembles it with
-    scikit-fem at every call, and the load is evaluated at every Newton iteration)."""
-
-    def __init__(self, beam, g):
-        super().__init__(beam, g)
-        self._P = beam.mass()[beam.xdofs] * self.g        # (nn, 2) nodal weights
-
-    def assemble(self, u_global, t):
-        P = np.zeros(np.size(u_global))
-        P[self.beam.dof_offset + self.beam.xdofs] = self._P
-        empty_i, empty_v = np.zeros(0, dtype=int), np.zeros(0)
-        return P, empty_i, empty_i, empty_v
-
-
 @dataclass
 class RingModel:
     """A ring body with what the ring scenes need (see the module docstring).
@@ -260,7 +245,7 @@ class RingModel:
         """Dead weight: BeamGravity (lumped) for the beam, BodyForce (0, -rho g) for the continuum."""
         g = float(g)
         if self.kind == "beam":
-            return _BeamWeight(self.body, g)
+            return BeamGravity(self.body, g)
         return BodyForce(self.body, (0.0, -self.body.rho * g))
 
     def symmetry_dofs(self):
