@@ -95,7 +95,12 @@ class NodeToSegment:
         """Accept u as converged: store t_T, accumulated slip and the projection."""
         e = self.evaluate(u)
         fr = e["friction"]
-        self.dissipation = float(np.sum(self.weights * fr.dissipation))
+        # energy dissipated in the step: the trapezoidal work of the traction on the slip,
+        # 1/2 (t_T_bar + t_T) dg_T^s with dg_T^s = lambda sign(t_T) (eq 45). It balances
+        # the trapezoidal energy bookkeeping of the time integrator; the return map's
+        # lambda |t_T| (FrictionState.dissipation, >= 0) is the algorithmic measure.
+        slip_work = 0.5 * (self.t_T_bar + fr.t_T) * fr.lam * np.sign(fr.t_T)
+        self.dissipation = float(np.sum(self.weights * slip_work))
         self.dissipation_total += self.dissipation
         self.t_T_bar = np.where(e["active"], fr.t_T, 0.0)
         self.q_bar = fr.q
