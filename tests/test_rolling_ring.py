@@ -87,3 +87,13 @@ def test_continuum_ring_rolls_too():
 def test_bad_parameter():
     with pytest.raises(ValueError, match="mu"):
         get_scene("rolling_ring").resolve("fast", {"mu": -0.1})
+
+
+def test_fig09_draws_from_the_result(fast, tmp_path):
+    import matplotlib
+    matplotlib.use("Agg")
+    from contactfem.plots import savefig
+    from contactfem.plots.rolling_ring import draw_rolling
+
+    path = savefig(draw_rolling(fast, "Fig 9 (test)"), str(tmp_path), "fig09_rolling_ring")
+    assert (tmp_path / "fig09_rolling_ring.png").stat().st_size > 10_000, path
