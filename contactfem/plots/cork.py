@@ -1,0 +1,184 @@
+"""Figures 14-17 of the paper: the champagne cork (Sec. 5.5).
+
+    fig14_cork_mesh             Fig 14: the mesh of the free cork, and pressed into the neck
+    fig15_cork_configurations   Fig 15: the cork at the paper's instants (0 ... 3.0 ms), mapped
+                                onto our run (``scenes.cork.snapshot_times``)
+    fig16_cork_pressure         Fig 16: the gas pressure on the cork against time
+    fig17_cork_displacement     Fig 17: the axial displacement of the cork against time
+    table_cork_sensitivity      exit velocity against the reconstructed data (lecture 08)
+
+The problem is axisymmetric (x = r, y = z); the drawings mirror the meridian in the
+axis to show the whole cork and both sides of the neck.
+"""
+
+from functools import lru_cache
+
+import numpy as np
+
+from ..scenes import get_scene, run_scene
+from ..scenes.cork import Neck, cork_mesh
+from . import default_outdir, figure, savefig
+
+
+def _plt():
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+@lru_cache(maxsize=16)
+def _run(preset, overrides=()):
+    return run_scene("cork", preset, dict(overrides))
+
+
+def result(preset="fast", **overrides):
+    """The scene's result dict (cached per preset and overrides)."""
+    return _run(preset, tuple(sorted(overrides.items())))
+
+
+def _geometry(params):
+    P = params
+    mesh = cork_mesh(P["R_tip"], P["R_cork"], P["L_neck"], P["L_neck"] + P["r_mouth"] + P["L_head"],
+                     P["n_r"], P["n_z"])
+    neck = Neck(P["R_neck"], P["L_neck"], P["r_mouth"], z_low=-P["gas_column"])
+    return mesh, neck
+
+
+def draw_mesh(ax, mesh, x, color="k", lw=0.6):
+    """The quadrilaterals of `mesh` at node positions x (nn, 2), and their mirror image."""
+    for sign in (1.0, -1.0):
+        for quad in mesh.t.T:
+            q = x[np.append(quad, quad[0])]
+            ax.plot(sign * q[:, 0], q[:, 1], color=color, lw=lw)
+
+
+def draw_neck(ax, neck, gas_column=None):
+    """Both walls of the rigid neck (and the gas column below the cork)."""
+    P = neck.outline()
+    for sign in (1.0, -1.0):
+        ax.plot(sign * P[:, 0], P[:, 1], color="0.25", lw=2.0)
+    if gas_column is not None:
+        ax.fill_between([-neck.R_neck, neck.R_neck], -gas_column, 0.0, color="#cfe3f5", zorder=0)
+
+
+@figure("fig14_cork_mesh", "Fig 14")
+def fig14_cork_mesh(preset="fast", outdir=None):
+    plt = _plt()
+    r = result(preset)
+    mesh, neck = _geometry(r["parameters"])
+    fig, axes = plt.subplots(1, 2, figsize=(9, 6.5), sharey=True)
+    draw_mesh(axes[0], mesh, mesh.p.T)
+    axes[0].set_title(f"free cork: {r['n_elements']} four-node elements")
+    draw_neck(axes[1], neck, r["parameters"]["gas_column"])
+    draw_mesh(axes[1], mesh, np.asarray(r["snapshots_x"][0]))
+    axes[1].set_title(f"pressed in: normal force {r['press_fit_normal_force_N']:.0f} N (paper ~2500 N)")
+    for ax in axes:
+        ax.set_aspect("equal")
+        ax.set_xlabel("r (mm)")
+    axes[0].set_ylabel("z (mm)")
+    fig.suptitle("Fig 14: the cork (axisymmetric, the meridian mirrored)")
+    return [savefig(fig, outdir or default_outdir(), "fig14_cork_mesh")]
+
+
+@figure("fig15_cork_configurations", "Fig 15")
+def fig15_cork_configurations(preset="fast", outdir=None):
+    plt = _plt()
+    r = result(preset)
+    mesh, neck = _geometry(r["parameters"])
+    xs, ts, tp = r["snapshots_x"], r["snapshot_times_ms"], r["snapshot_paper_times_ms"]
+    fig, axes = plt.subplots(1, len(xs), figsize=(1.9 * len(xs), 5.5), sharey=True)
+    top = max(np.max(np.asarray(x)[:, 1]) for x in xs)
+    for ax, x, t, t_paper in zip(axes, xs, ts, tp):
+        draw_neck(ax, neck)
+        draw_mesh(ax, mesh, np.asarray(x), lw=0.4)
+        ax.set_title(f"{t:.2f} ms\n(paper {t_paper:.1f})", fontsize=9)
+        ax.set_aspect("equal")
+        ax.set_xlim(-20, 20)
+        ax.set_ylim(-4, top + 2)
+        ax.set_xticks([])
+    v = r["exit_velocity_m_s"]
+    fig.suptitle("Fig 15: the cork leaving the bottle"
+                 + (f"; exit velocity {v:.1f} m/s (paper ~28 m/s)" if v is not None else "; it did not leave"))
+    return [savefig(fig, outdir or default_outdir(), "fig15_cork_configurations")]
+
+
+@figure("fig16_cork_pressure", "Fig 16")
+def fig16_cork_pressure(preset="fast", outdir=None):
+    plt = _plt()
+    r = result(preset)
+    fig, ax = plt.subplots(figsize=(6.5, 4))
+    ax.step(r["time_ms"], r["pressure_MPa"], where="pre", color="C0", label="gas pressure (used in the step)")
+    if r["gas_release_time_ms"] is not None:
+        ax.axvline(r["gas_release_time_ms"], color="0.5", ls="--", lw=0.8, label="bottom passes the mouth")
+    ax.axhline(0.8 * 30 / 54, color="C3", ls=":", lw=1, label="Boyle at 24 mm travel: 0.8 * 30/54")
+    ax.set_xlabel("time (ms)")
+    ax.set_ylabel("p (MPa)")
+    ax.set_title("Fig 16: the pressure on the cork")
+    ax.legend(fontsize=8)
+    return [savefig(fig, outdir or default_outdir(), "fig16_cork_pressure")]
+
+
+@figure("fig17_cork_displacement", "Fig 17")
+def fig17_cork_displacement(preset="fast", outdir=None):
+    plt = _plt()
+    r = result(preset)
+    fig, ax = plt.subplots(figsize=(6.5, 4))
+    ax.plot(r["time_ms"], r["displacement_bottom_mm"], label="bottom centre")
+    ax.plot(r["time_ms"], r["displacement_cm_mm"], label="centre of mass")
+    ax.plot(r["time_ms"], r["displacement_top_mm"], label="top centre")
+    ax.axhline(r["parameters"]["L_neck"], color="0.5", ls="--", lw=0.8, label="length of the neck")
+    ax.set_xlabel("time (ms)")
+    ax.set_ylabel("axial displacement (mm)")
+    ax.set_title("Fig 17: the displacement of the cork")
+    ax.legend(fontsize=8)
+    return [savefig(fig, outdir or default_outdir(), "fig17_cork_displacement")]
+
+
+# The sensitivity study of lecture 08: one reconstructed datum changed at a time.
+SENSITIVITY = (
+    ("as chosen", {}),
+    ("mu = 0.08", {"mu": 0.08}),
+    ("mu = 0.12", {"mu": 0.12}),
+    ("rho = 2.4e-10 (cork 240 kg/m^3)", {"rho": 2.4e-10}),
+    ("L_head = 12 mm (38 mm cork)", {"L_head": 12.0}),
+    ("R_tip = 10.5 mm (less taper)", {"R_tip": 10.5}),
+    ("weights = ring (c_N per circumference)", {"weights": "ring"}),
+)
+
+
+def sensitivity_rows(preset="fast", cases=SENSITIVITY):
+    """(label, exit velocity or None, press-fit force, breakaway pressure, exit time) per case;
+    a run that fails is reported as such, not skipped."""
+    rows = []
+    for label, over in cases:
+        try:
+            r = result(preset, **over)
+            rows.append((label, r["exit_velocity_m_s"], r["press_fit_normal_force_N"],
+                         r["breakaway_pressure_MPa"], r["exit_time_ms"]))
+        except Exception as err:                    # NewtonError: reported in the table
+            rows.append((label, None, None, None, f"failed: {type(err).__name__}"))
+    return rows
+
+
+def _fmt(x, f):
+    return "-" if x is None else (x if isinstance(x, str) else format(x, f))
+
+
+@figure("table_cork_sensitivity", "Sec 5.5")
+def table_cork_sensitivity(preset="fast", outdir=None):
+    """Markdown table of the exit velocity against the reconstructed data."""
+    from pathlib import Path
+
+    rows = sensitivity_rows(preset)
+    lines = ["| case | exit velocity (m/s) | press-fit force (N) | breakaway p (MPa) | exit time (ms) |",
+             "|---|---|---|---|---|"]
+    for label, v, F, p, t in rows:
+        lines.append(f"| {label} | {_fmt(v, '.1f') if v is not None else 'stays in'} | {_fmt(F, '.0f')} | "
+                     f"{_fmt(p, '.2f')} | {_fmt(t, '.2f')} |")
+    lines.append("")
+    lines.append(f"Paper: 28 m/s, ~2500 N, ~0.8 MPa. Preset: {preset}. Scene parameters: "
+                 + ", ".join(p.name for p in get_scene("cork").params[:3]) + ", ...")
+    path = Path(outdir or default_outdir()) / "table_cork_sensitivity.md"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text("\n".join(lines) + "\n")
+    return [str(path)]
