@@ -11,17 +11,21 @@ What the paper gives (NOTES.md, table row 5.5): E = 10 MPa, nu = 0.25,
 density 3.5e-? N s^2/mm^4, m = 1, c_N = 100 N/mm, c_T = 10 N/mm, mu = 0.1,
 h = 0.001, 114 four-node elements, neck radius 10 mm, cork radius 12 mm, pressure
 raised in 8 steps of 0.1 MPa, then Boyle's law with a 30 mm gas column
-(0.56 MPa = 30/54 * 0.8 just before the exit, hence 24 mm of travel), dt = 1e-4 s
+(the scan reads "(30/54) 0.8 = 0.56 MPa" just before the exit, hence 24 mm of
+travel; note 30/54 * 0.8 = 0.44 MPa, and 0.56 = 30/54 is the ratio p/p0), dt = 1e-4 s
 in the neck and 5e-6 s around the exit. Results: press-fit normal force about
 2500 N, sliding at about 250 N (0.8 MPa), exit velocity about 28 m/s.
 
 Reconstructed (the scan lost them; each is a Param with "chosen: ..." in its doc):
 
-* Geometry. The cork is a cylinder of radius 12 mm and length 38 mm meshed with
-  6 x 19 = 114 four-node elements (2 mm each way): 24 mm of it sit in the
-  straight part of the neck (the 24 mm of travel), 2 mm in the rounded mouth and
-  12 mm above the bottle. Pressed into the 10 mm neck, the part outside keeps its
-  12 mm radius: that is the "wider head" of Fig 14.
+* Geometry. The cork is 48 mm long (a standard champagne cork), meshed with
+  6 x 19 = 114 four-node elements: a conical shaft of 24 mm in the straight neck
+  (the 24 mm of travel), radius R_tip = 10 mm at the bottom ("a shaft that fits the
+  neck") growing to the maximum radius 12 mm at the mouth, and a cylindrical head
+  of radius 12 mm (2 mm in the rounded mouth, 22 mm above). Pressed into the 10 mm
+  neck, the head keeps its radius: the "wider head" of Fig 14. The taper is what
+  gives the paper's ~2500 N press-fit force: a 12 mm cylinder gives ~4900 N, twice
+  the friction 0.8 MPa can overcome. The head length sets the mass (7 g).
 * The neck (``Neck``, a smooth rigid master defined here) has three pieces: the
   straight wall r = 10 mm up to z = 24 mm (traversed upwards, so that its normal
   n = e3 x t of eq 18 points into the neck, towards the cork), a rounded mouth
@@ -29,7 +33,7 @@ Reconstructed (the scan lost them; each is a Param with "chosen: ..." in its doc
   at z = 26 mm. (The paper used two stiff elements.)
 * Density 3.5e-10 N s^2/mm^4 (350 kg/m^3; natural cork is 120-240 kg/m^3, a
   compressed champagne cork more): "3.5" survived, the exponent did not, and -10
-  is the only one that gives a cork of a few grams (6 g here).
+  is the only one that gives a cork of a few grams (7 g here).
 * c_N and c_T are read as stiffnesses per unit contact AREA (N/mm^2 per mm):
   nodal weight w = 2 pi R_neck * (tributary length along the cork side). Read as
   nodal stiffnesses (w = 1), c_N = 100 N/mm would need ~2 mm of penetration per
@@ -38,9 +42,10 @@ Reconstructed (the scan lost them; each is a Param with "chosen: ..." in its doc
 Stage 1 (press fit, ``Static``): the neck starts at r = 12 mm (touching the cork)
 and is moved radially inwards to r = 10 mm in ``n_press`` increments (prescribed
 rigid-obstacle motion, ``Neck.set_shift``), friction active; the axial position is
-held at one axis node at the mouth level. That hold is released when stage 2
-starts: its reaction (``hold_reaction_N``, a few per cent of the friction force)
-is the small imbalance the first dynamic step absorbs. (A static release step
+held at one axis node (at 2/3 of the shaft, ``z_hold``). That hold is released
+when stage 2 starts: its reaction (``hold_reaction_N``, 2.5 N in the paper preset,
+~20 N in the coarse fast one, against ~250 N of friction) is the small imbalance
+the first dynamic step absorbs. (A static release step
 without the hold, where friction alone carries the cork, is singular whenever all
 nodes slip and its Newton iteration chatters between stick and slip.)
 
@@ -59,11 +64,14 @@ fails is halved (up to ``max_cuts`` times, each counted in ``newton_failures``),
 then the NewtonError is raised with its residual history.
 
 Exit: the cork has left when its bottom has passed the mouth and no node touches
-the neck; ``exit_velocity_m_s`` is the axial velocity of its centre of mass then.
+the neck (``exit_time_ms``: the last time the contact opened); ``exit_velocity_m_s``
+is the axial velocity of its centre of mass at the end of the run (free flight, no
+force: constant). ``breakaway_pressure_MPa``: the pressure of the first step at
+which the centre of mass moves faster than 1 m/s (before, the cork only creeps);
+``breakaway_pressure_static_MPa`` = mu N / (pi R_neck^2), the paper's own estimate.
 """
 
 import numpy as np
-import scipy.sparse as sp
 from skfem import MeshQuad
 
 from ..bodies.continuum import Continuum
