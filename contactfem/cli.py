@@ -108,6 +108,8 @@ def build_parser():
     sw.add_argument("--scheduler", default=None, help="Dask scheduler address: run on that cluster instead")
     sw.add_argument("--out", default="sweep.csv", help="table of results (.csv or .json)")
     sw.set_defaults(func=cmd_sweep)
+    from .studies.bench import add_bench_parser
+    add_bench_parser(sub)
     return ap
 
 
