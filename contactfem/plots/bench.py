@@ -1,0 +1,177 @@
+"""Figures of `contactfem bench` (issue 6; lecture 09): the tangent comparison, the
+work-precision diagrams and the cost of a Newton iteration.
+
+Data: the bench JSON named by $CONTACTFEM_BENCH, else the repository's bench.json (a
+committed full run), else a quick bench run here (about half a minute)."""
+
+import json
+import os
+from pathlib import Path
+
+import numpy as np
+
+from . import default_outdir, figure, savefig
+
+_CACHE = {}
+
+
+def bench_json_path():
+    """$CONTACTFEM_BENCH if set, else bench.json at the repository root (may not exist)."""
+    env = os.environ.get("CONTACTFEM_BENCH")
+    if env:
+        return Path(env)
+    return Path(__file__).resolve().parents[2] / "bench.json"
+
+
+def load_bench(preset="fast"):
+    """The bench result: from the JSON if present, else a quick bench of the three studies
+    the figures need (tangents, work_precision, cost), computed once per process."""
+    path = bench_json_path()
+    if path.exists():
+        return json.loads(path.read_text())
+    if "quick" not in _CACHE:
+        from ..studies.bench import run_bench
+
+        _CACHE["quick"] = run_bench(quick=True, only=("tangents", "work_precision", "cost"), progress=None)
+    return _CACHE["quick"]
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+@figure("bench_tangents", "issue 6")
+def bench_tangents(preset="fast", outdir=None):
+    """Linear solves to the same tolerance: consistent tangent vs symmetric, frozen, staggered."""
+    plt = _plt()
+    tg = load_bench(preset)["tangents"]
+    problems = [(f"block, {law}", rows) for law, rows in tg["block"].items()]
+    problems.append((f"sloping impact\n({tg['sloping_impact_steps']} steps)", tg["sloping_impact"]))
+    variants = ("consistent", "symmetric", "frozen", "staggered")
+    colors = dict(consistent="C0", symmetric="C3", frozen="C1", staggered="C2")
+    fig, axes = plt.subplots(1, len(problems), figsize=(4.2 * len(problems), 3.6))
+    for ax, (title, rows) in zip(np.atleast_1d(axes), problems):
+        top = max((r["iterations"] or 0) for r in rows.values()) or 1
+        for i, v in enumerate(variants):
+            r = rows[v]
+            if r["converged"]:
+                ax.bar(i, r["iterations"], color=colors[v])
+                ax.text(i, r["iterations"], f"{r['iterations']}\n{r['time_s']:.2g} s", ha="center", va="bottom",
+                        fontsize=8)
+            else:
+                ax.bar(i, top * 1.1, color="none", edgecolor=colors[v], hatch="//")
+                ax.text(i, top * 0.5, "diverged", ha="center", rotation=90, fontsize=9)
+        ax.set_xticks(range(len(variants)), variants, rotation=20)
+        ax.set_title(title)
+        ax.set_ylim(0, top * 1.35)
+    np.atleast_1d(axes)[0].set_ylabel("linear solves to convergence")
+    fig.suptitle("The consistent non-symmetric tangent (eqs 49-50) against the alternatives")
+    fig.tight_layout()
+    return [savefig(fig, outdir or default_outdir(), "bench_tangents")]
+
+
+def _rows(block):
+    return [r for r in block["rows"] if r.get("ok") and r.get("error_x_roll", r.get("error_p0")) is not None]
+
+
+@figure("bench_work_precision", "issue 6")
+def bench_work_precision(preset="fast", outdir=None):
+    """Error against wall time: hertz (mesh), rolling ring (dt, mesh, Newmark, beam vs
+    continuum), bar impact (implicit Newmark vs explicit central differences)."""
+    plt = _plt()
+    wp = load_bench(preset)["work_precision"]
+    fig, axes = plt.subplots(1, 3, figsize=(14, 4.2))
+
+    ax = axes[0]
+    rows = _rows(wp["hertz_mesh"])
+    ax.loglog([r["time_s"] for r in rows], [abs(r["error_p0"]) for r in rows], "o-", label="|error p0|")
+    ax.loglog([r["time_s"] for r in rows], [abs(r["error_a"]) for r in rows], "s--", label="|error a| (fit)")
+    for r in rows:
+        ax.annotate(f"{r['n_quads']} quads", (r["time_s"], abs(r["error_p0"])), fontsize=7,
+                    textcoords="offset points", xytext=(4, 4))
+    order = wp["hertz_mesh"]["order_p0"]
+    ax.set_title("Hertz, mesh refinement" + (f" (p0: order {order:.1f} in h)" if order else ""))
+    ax.set_xlabel("wall time of the solve [s]")
+    ax.set_ylabel("relative error")
+    ax.legend(fontsize=8)
+
+    ax = axes[1]
+    series = [("ring_dt_newmark_0.7/0.4", "dt, Newmark 0.7/0.4", "o-"),
+              ("ring_dt_newmark_0.5/0.25", "dt, Newmark 0.5/0.25", "v-"),
+              ("ring_mesh", "mesh (n_el)", "s--")]
+    for key, label, style in series:
+        rows = [r for r in _rows(wp[key]) if r["error_x_roll"]]
+        if rows:
+            ax.loglog([r["time_s"] for r in rows], [r["error_x_roll"] for r in rows], style, label=label)
+            for r in rows:
+                ax.annotate(f"dt {r['dt']}, {r['n_el']} el", (r["time_s"], r["error_x_roll"]), fontsize=6,
+                            textcoords="offset points", xytext=(3, 3))
+    for r in _rows(wp["ring_kind"]):
+        if r["error_x_roll"]:
+            ax.loglog(r["time_s"], r["error_x_roll"], "*" if r["kind"] == "continuum" else "D", ms=10,
+                      label=f"{r['kind']} ring ({r['n_el']} el, dt {r['dt']})")
+    ax.set_title("Rolling ring: error of the rolling point x*")
+    ax.set_xlabel("wall time of the run [s]")
+    ax.set_ylabel("|x_roll / x*_rigid - 1|")
+    ax.legend(fontsize=7)
+
+    ax = axes[2]
+    b = wp["bar_implicit_explicit"]
+    for key, label, style in (("newmark", "implicit Newmark 1/2, 1/4", "o-"),
+                              ("central_difference", "explicit central differences", "s-")):
+        rows = b[key]
+        ax.loglog([r["time_s"] for r in rows], [abs(r["error_duration"]) for r in rows], style, label=label)
+        for r in rows:
+            ax.annotate(f"c dt/h = {r['courant']}", (r["time_s"], abs(r["error_duration"])), fontsize=7,
+                        textcoords="offset points", xytext=(3, 3))
+    ax.set_title(f"Bar impact ({b['n_el']} elements): contact duration")
+    from matplotlib.ticker import NullFormatter
+
+    for a in axes:
+        a.xaxis.set_minor_formatter(NullFormatter())
+    ax.set_xlabel("wall time of the run [s]")
+    ax.set_ylabel("|duration / (2L/c) - 1|")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return [savefig(fig, outdir or default_outdir(), "bench_work_precision")]
+
+
+@figure("bench_cost", "issue 6")
+def bench_cost(preset="fast", outdir=None):
+    """Time of one Newton iteration split into bulk, contact, assembly and solve; contact
+    time against the number of contact nodes."""
+    plt = _plt()
+    c = load_bench(preset)["cost"]
+    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(13, 4.2), gridspec_kw=dict(width_ratios=[2, 1]))
+    names = list(c["cases"])
+    parts = (("bulk_s", "bulk (body.internal)", "C0"), ("contact_s", "contact", "C3"),
+             ("assembly_s", "global assembly", "C7"), ("solve_s", "linear solve (SuperLU)", "C2"))
+    bottom = np.zeros(len(names))
+    for key, label, color in parts:
+        vals = np.array([c["cases"][n][key] for n in names])
+        tot = np.array([sum(c["cases"][n][k] for k, _, _ in parts) for n in names])
+        ax.barh(range(len(names)), vals / tot, left=bottom, color=color, label=label)
+        bottom += vals / tot
+    for i, n in enumerate(names):
+        tot = sum(c["cases"][n][k] for k, _, _ in parts)
+        ax.text(1.01, i, f"{tot * 1e3:.3g} ms, {c['cases'][n]['ndof']} dofs", va="center", fontsize=8)
+    ax.set_yticks(range(len(names)), names, fontsize=8)
+    ax.set_xlim(0, 1.45)
+    ax.set_xlabel("share of one Newton iteration")
+    ax.legend(fontsize=7, loc="lower right")
+    sc = c["contact_scaling"]
+    n = np.array([r["n_contact_nodes"] for r in sc])
+    t = np.array([r["contact_s"] for r in sc])
+    ax2.loglog(n, t * 1e3, "o-", label=f"contact.assemble (slope {c['contact_scaling_slope']:.2f})")
+    ax2.loglog(n, t[-1] * 1e3 * n / n[-1], "k:", label="linear")
+    ax2.set_xlabel("contact nodes")
+    ax2.set_ylabel("time [ms]")
+    ax2.legend(fontsize=8)
+    ax2.set_title("contact cost is linear in the contact nodes")
+    fig.tight_layout()
+    return [savefig(fig, outdir or default_outdir(), "bench_cost")]
