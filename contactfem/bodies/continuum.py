@@ -49,7 +49,7 @@ def _isotropic_tangent(lam, mu, shape):
     d = np.eye(3)
     C = (lam * np.einsum("ij,kl->ijkl", d, d)
          + mu * (np.einsum("ik,jl->ijkl", d, d) + np.einsum("il,jk->ijkl", d, d)))
-    return np.einsum("ijkl,...->ijkl...", C, np.ones(shape))
+    return np.broadcast_to(C.reshape(C.shape + (1,) * len(shape)), C.shape + tuple(shape))  # a view, no copy
 
 
 def linear_elastic(F, lam, mu):
@@ -134,9 +134,11 @@ def _internal_form(v, w):
 def _tangent_form(u, v, w):
     """Linearised virtual work: grad v : A : grad du (+ hoop couplings)."""
     A = np.asarray(w.A)     # plain array: indexing a DiscreteField copies all of it (8x slower)
+    k = np.einsum("ijkl...,ij...,kl...->...", A[:2, :2, :2, :2], v.grad, u.grad)
+    if not w.axi:           # plane: no hoop terms
+        return k * w.thickness
     hu, hv = _hoop(u, w), _hoop(v, w)
-    k = (np.einsum("ijkl...,ij...,kl...->...", A[:2, :2, :2, :2], v.grad, u.grad)
-         + np.einsum("ij...,ij...->...", A[:2, :2, 2, 2], v.grad) * hu
+    k = (k + np.einsum("ij...,ij...->...", A[:2, :2, 2, 2], v.grad) * hu
          + np.einsum("kl...,kl...->...", A[2, 2, :2, :2], u.grad) * hv
          + A[2, 2, 2, 2] * hu * hv)
     return k * _weight(w)
@@ -276,6 +278,8 @@ class Continuum:
 
     def mass(self):
         """Lumped mass: row sums of the consistent mass int rho N_i N_j dV, shape (ndof,)."""
+        if self._mass is None and self.rho == 0.0:       # quasi-static body: nothing to integrate
+            self._mass = np.zeros(self.ndof)
         if self._mass is None:
             M = asm(_mass_form, self.basis, rho=self.rho, **self._params())
             self._mass = np.asarray(M.sum(axis=1)).ravel()
