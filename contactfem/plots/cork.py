@@ -138,8 +138,8 @@ def fig17_cork_displacement(preset="fast", outdir=None):
 # at the paper's final ramp pressure 0.8 MPa and at 0.9 MPa (one more ramp step).
 SENSITIVITY = (
     ("as chosen", {}),
-    ("mu = 0.08", {"mu": 0.08}),
-    ("mu = 0.12", {"mu": 0.12}),
+    ("mu = 0.09", {"mu": 0.09}),
+    ("mu = 0.11", {"mu": 0.11}),
     ("rho = 2.4e-10 (240 kg/m^3, lighter)", {"rho": 2.4e-10}),
     ("R_tip = 10.5 mm (less taper)", {"R_tip": 10.5}),
 )
@@ -158,11 +158,14 @@ def _case(preset, over):
 
 def sensitivity_rows(preset="fast", cases=SENSITIVITY, jobs=2):
     """One row per case: label, press-fit force, and the outcome for each n_ramp of
-    P0_STEPS; the runs in parallel on `jobs` cores (joblib)."""
-    from joblib import Parallel, delayed
-
+    P0_STEPS; the runs in parallel on `jobs` cores (joblib, if installed; else one by one)."""
     todo = [(label, dict(over, n_ramp=n)) for label, over in cases for n in P0_STEPS]
-    out = Parallel(n_jobs=jobs)(delayed(_case)(preset, over) for _, over in todo)
+    try:
+        from joblib import Parallel, delayed
+    except ImportError:
+        out = [_case(preset, over) for _, over in todo]
+    else:
+        out = Parallel(n_jobs=jobs)(delayed(_case)(preset, over) for _, over in todo)
     rows = []
     for i, (label, _) in enumerate(cases):
         res = out[i * len(P0_STEPS):(i + 1) * len(P0_STEPS)]

@@ -94,7 +94,7 @@ PARAMS = (
     Param("E", 10.0, "MPa", 0.0, low_open=True, doc="Young's modulus (paper)"),
     Param("nu", 0.25, "", -1.0, 0.5, low_open=True, high_open=True, doc="Poisson's ratio (paper)"),
     Param("rho", 3.5e-10, "N s^2/mm^4", 0.0, low_open=True,
-          doc="density. Chosen: scan lost the exponent of 3.5e-?; -10 (350 kg/m^3) gives a 6 g cork"),
+          doc="density. Chosen: scan lost the exponent of 3.5e-?; -10 (350 kg/m^3) gives a 7 g cork"),
     Param("c_N", 100.0, "N/mm^3", 0.0, low_open=True,
           doc="normal penalty (eq 4, m = 1; paper: 100 'N/mm'), per unit area with weights=area"),
     Param("m", 1.0, "", 1.0, doc="exponent of the normal law (paper: 1, penalty)"),
