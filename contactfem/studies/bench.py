@@ -463,7 +463,7 @@ def machine():
 
 def run_bench(quick=False, only=None, progress=print):
     """Run the studies (all, or those named in `only`); returns the JSON-able dict."""
-    out = dict(quick=bool(quick), machine=machine(), targets=TARGETS)
+    out = dict(quick=bool(quick), machine=machine(), target_values=TARGETS)
     for name, fn in STUDIES.items():
         if only and name not in only:
             continue
