@@ -1,6 +1,5 @@
 """The contact patch test: stacked blocks with non-matching meshes under a uniform
 pressure; exact answer: the same pressure p all along the interface, sigma_yy = -p."""
-import numpy as np
 import pytest
 
 from contactfem.scenes import run_scene

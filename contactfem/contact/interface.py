@@ -59,9 +59,8 @@ class NodeToSegment:
         s0 = np.zeros(len(self.nodes))
         self.s_bar = self.master.locate(x_s, s0, u)["s"]
 
-    def evaluate(self, u):
-        """Everything at displacement u with the committed history: kinematics,
-        tractions, return mapping, element residuals and tangents."""
+    def kinematics(self, u):
+        """Gap, normal traction and variations at u (step 4a-b of Sec. 4.3), before friction."""
         if self.s_bar is None:
             self.initialize(u)
         x_s = self.slave_positions(u)
@@ -69,27 +68,39 @@ class NodeToSegment:
         g_N = k["g_N"] - self.offset
         active = k["inside"] & (g_N < 0.0)
         t_N, dt_N = self.normal.traction(np.where(active, g_N, 1.0))
-        dg_T = k["s"] - self.s_bar
-        if self.friction is None:
-            z = np.zeros_like(t_N)
-            fr = return_map(Frictionless(), t_N, dt_N, z, z, self.q_bar)
-        else:
-            fr = return_map(self.friction, t_N, dt_N, dg_T, self.t_T_bar, self.q_bar)
-        R, K = contact_element(self.weights, t_N, dt_N, fr.t_T, fr.c_T_s, fr.c_N_s,
-                               k["dg_N"], k["d2g_N"], k["ds"], k["d2s"])
         dofs = np.concatenate([self.slave_dofs(), k["master_dofs"]], axis=1)
-        return dict(k, x_s=x_s, g_N=g_N, active=active, t_N=t_N, dt_N=dt_N, dg_T=dg_T, friction=fr,
-                    R=R, K=K, dofs=dofs)
+        return dict(k, x_s=x_s, g_N=g_N, active=active, t_N=t_N, dt_N=dt_N, dg_T=k["s"] - self.s_bar, dofs=dofs)
+
+    def evaluate(self, u):
+        """Everything at displacement u with the committed history: kinematics,
+        tractions, return mapping, element residuals and tangents."""
+        e = self.kinematics(u)
+        if self.friction is None:
+            z = np.zeros_like(e["t_N"])
+            fr = return_map(Frictionless(), e["t_N"], e["dt_N"], z, z, self.q_bar)
+        else:
+            fr = return_map(self.friction, e["t_N"], e["dt_N"], e["dg_T"], self.t_T_bar, self.q_bar)
+        return self.element(e, fr.t_T, fr.c_T_s, fr.c_N_s, friction=fr)
+
+    def element(self, e, t_T, c_T_s, c_N_s, **extra):
+        """Add the element residuals and tangents (eqs 28, 33, 39, 49) to the kinematics e."""
+        R, K = contact_element(self.weights, e["t_N"], e["dt_N"], t_T, c_T_s, c_N_s,
+                               e["dg_N"], e["d2g_N"], e["ds"], e["d2s"])
+        return dict(e, R=R, K=K, **extra)
+
+    @staticmethod
+    def scatter(e, ndof):
+        """Global residual and COO triplets of the active pairs of an evaluation e."""
+        on = e["active"]
+        R_c = np.zeros(ndof)
+        np.add.at(R_c, e["dofs"][on].ravel(), e["R"][on].ravel())
+        rows, cols, vals = to_coo(e["dofs"][on], e["K"][on])
+        return R_c, rows, cols, vals
 
     # -- the contact interface used by the solver -------------------------------
     def assemble(self, u):
         """Global contact residual R_c (eq 28) and tangent triplets (eqs 33, 39, 49)."""
-        e = self.evaluate(u)
-        on = e["active"]
-        R_c = np.zeros(len(u))
-        np.add.at(R_c, e["dofs"][on].ravel(), e["R"][on].ravel())
-        rows, cols, vals = to_coo(e["dofs"][on], e["K"][on])
-        return R_c, rows, cols, vals
+        return self.scatter(self.evaluate(u), len(u))
 
     def commit(self, u):
         """Accept u as converged: store t_T, accumulated slip and the projection."""

@@ -117,7 +117,7 @@ def _fmt(x, f="{:.2f}"):
 def table2(preset="fast", outdir=None, refined_n_el=32):
     rows = table2_rows(preset, refined_n_el)
     n_el = rows[0]["n_el"]
-    head = ["contact", f"ours v_x", "ours v_y", "ours angle", "ours spin",
+    head = ["contact", "ours v_x", "ours v_y", "ours angle", "ours spin",
             f"{refined_n_el} el. v_x", f"{refined_n_el} el. v_y", f"{refined_n_el} el. angle",
             "paper v_x", "paper v_y", "paper angle"]
     body = []
@@ -125,7 +125,7 @@ def table2(preset="fast", outdir=None, refined_n_el=32):
         body.append([r["variant"], _fmt(r["vx"]), _fmt(r["vy"]), _fmt(r["angle"], "{:.1f}"), _fmt(r["spin"], "{:.3f}"),
                      _fmt(r["vx_ref"]), _fmt(r["vy_ref"]), _fmt(r["angle_ref"], "{:.1f}"),
                      _fmt(r["paper_vx"]), _fmt(r["paper_vy"]), _fmt(r["paper_angle"], "{:.0f}")])
-    lines = [f"# Table 2: rebound of the ring after the sloping impact (Sec. 5.3)", "",
+    lines = ["# Table 2: rebound of the ring after the sloping impact (Sec. 5.3)", "",
              f"Centre-of-mass velocity after rebound and angle of reflection from the normal, "
              f"atan(|v_x|/|v_y|) in degrees. 'ours': the paper's mesh ({n_el} beam elements), "
              f"Newmark 0.7/0.4, dt = 0.1, 200 steps; '{refined_n_el} el.': the same on a refined ring. "

@@ -38,7 +38,6 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from ..contact.element import contact_element, to_coo
 from ..contact.return_map import return_map
 from .newton import NewtonError, newton
 
@@ -81,28 +80,16 @@ class SplitContact:
             return c.assemble(u)
         if self.p_star is None:
             raise ValueError("SplitContact: call freeze(u) before assembling a normal or friction phase")
-        if c.s_bar is None:
-            c.initialize(u)
-        x_s = c.slave_positions(u)
-        k = c.master.locate(x_s, c.s_bar, u)
-        g_N = k["g_N"] - c.offset
-        active = k["inside"] & (g_N < 0.0)
-        t_N, dt_N = c.normal.traction(np.where(active, g_N, 1.0))
-        zero = np.zeros_like(t_N)
+        e = c.kinematics(u)
+        zero = np.zeros_like(e["t_N"])
         if self.phase == "normal":         # stick about the frozen state: t_T = t_T* + c_T (s - s*)
             c_T = float(c.friction.c_T)
-            t_T = self.t_T_star + c_T * (k["s"] - self.s_star)
-            c_T_s, c_N_s = np.full_like(t_N, c_T), zero
+            t_T = self.t_T_star + c_T * (e["s"] - self.s_star)
+            c_T_s, c_N_s = np.full_like(zero, c_T), zero
         else:                              # eqs 40-45 at the frozen pressure p*: c_N^s = 0
-            fr = return_map(c.friction, -self.p_star, zero, k["s"] - c.s_bar, c.t_T_bar, c.q_bar)
+            fr = return_map(c.friction, -self.p_star, zero, e["dg_T"], c.t_T_bar, c.q_bar)
             t_T, c_T_s, c_N_s = fr.t_T, fr.c_T_s, fr.c_N_s
-        R, K = contact_element(c.weights, t_N, dt_N, t_T, c_T_s, c_N_s,
-                               k["dg_N"], k["d2g_N"], k["ds"], k["d2s"])
-        dofs = np.concatenate([c.slave_dofs(), k["master_dofs"]], axis=1)
-        R_c = np.zeros(len(u))
-        np.add.at(R_c, dofs[active].ravel(), R[active].ravel())
-        rows, cols, vals = to_coo(dofs[active], K[active])
-        return R_c, rows, cols, vals
+        return c.scatter(c.element(e, t_T, c_T_s, c_N_s), len(u))
 
 
 @dataclass

@@ -387,6 +387,8 @@ def _process_time(args):
     t0 = time.perf_counter()
     proc = subprocess.run([sys.executable, "-m", "contactfem", *args], capture_output=True, text=True)
     wall = time.perf_counter() - t0
+    if proc.returncode != 0:
+        raise RuntimeError(f"bench: 'contactfem {' '.join(args)}' failed: {proc.stderr.strip()[-500:]}")
     r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
     cpu = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
     return wall, cpu
