@@ -7,6 +7,7 @@ with code 1 and prints the residual history."""
 
 import argparse
 import json
+import os
 import sys
 
 from . import scenes
@@ -42,6 +43,8 @@ def cmd_show(args):
 
 
 def cmd_run(args):
+    if args.progress:
+        os.environ["CONTACTFEM_PROGRESS"] = "1"
     res = scenes.run_scene(args.scene, args.preset, parse_sets(args.set))
     text = json.dumps(res, indent=1)
     if args.json:
@@ -51,6 +54,8 @@ def cmd_run(args):
         from .io import save_run
 
         save_run(res, args.save)
+    if args.gif:
+        write_animation(res, args.gif)
     summary = {k: v for k, v in res.items() if not isinstance(v, (list, dict))}
     for k, v in summary.items():
         print(f"{k}: {v}")
@@ -79,6 +84,20 @@ def cmd_equations(args):
     print(markdown_table())
 
 
+def write_animation(res, path):
+    """Animate the outlines a scene recorded (rings, the cork) into a GIF or MP4."""
+    from .io import animate_outlines
+
+    if not res.get("outlines"):
+        raise ValueError(f"--gif: scene {res['scene']} records no outlines to animate")
+    import numpy as np
+
+    frames = [[np.asarray(f)] if np.asarray(f).ndim == 2 else [np.asarray(p) for p in f] for f in res["outlines"]]
+    animate_outlines(frames, path, times=res.get("outline_t"), closed=True,
+                     obstacles=res.get("obstacles", ()), title=res["scene"])
+    print(f"animation -> {path}")
+
+
 def build_parser():
     ap = argparse.ArgumentParser(prog="contactfem", description=__doc__.split("\n\n")[0])
     sub = ap.add_subparsers(dest="command", required=True)
@@ -91,6 +110,8 @@ def build_parser():
     rp.add_argument("--preset", default="fast", choices=["fast", "paper"])
     rp.add_argument("--set", action="append", metavar="NAME=VALUE", help="override a parameter (repeatable)")
     rp.add_argument("--json", metavar="FILE", help="write all results to FILE as JSON")
+    rp.add_argument("--gif", metavar="FILE", help="animate the recorded outlines (.gif, or .mp4 with ffmpeg)")
+    rp.add_argument("--progress", action="store_true", help="show a progress bar on stderr during the time loop")
     rp.add_argument("--save", metavar="FILE", help="save the run (.json or .npz) for contactfem.io.load_run")
     rp.set_defaults(func=cmd_run)
     fp = sub.add_parser("figures", help="regenerate every figure and table of the paper into figures/")

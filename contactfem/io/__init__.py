@@ -11,7 +11,7 @@
                  chain(...) to give integrate several callbacks
 """
 
-from .animate import animate_outlines
+from .animate import animate_outlines, boundary_loop
 from .paraview import export_continuum, export_polyline, export_series
 from .progress import ProgressBar, chain
 from .runs import Recorder, load_run, save_run

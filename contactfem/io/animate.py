@@ -22,6 +22,24 @@ def _polylines(frame):
     return out
 
 
+def boundary_loop(mesh):
+    """Node indices of the boundary of a 2D scikit-fem mesh, in order around it (the outer
+    loop of a simply connected mesh): to draw a continuum's outline as one polyline."""
+    edges = mesh.facets[:, mesh.boundary_facets()].T
+    nxt = {}
+    for a, b in edges:
+        nxt.setdefault(a, []).append(b)
+        nxt.setdefault(b, []).append(a)
+    start = edges[0, 0]
+    loop, prev, cur = [start], None, start
+    while True:
+        step = [n for n in nxt[cur] if n != prev][0]
+        if step == start:
+            return np.array(loop)
+        loop.append(step)
+        prev, cur = cur, step
+
+
 def animate_outlines(frames, path, times=None, obstacles=(), closed=False, fps=20, title="",
                      xlim=None, ylim=None, dpi=80):
     """Draw the polylines of each frame (bodies' outlines, a beam's centreline) and save

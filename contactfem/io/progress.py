@@ -8,6 +8,7 @@ or, counting steps: ``bar = ProgressBar(total=200)`` and ``bar.update()`` per st
 Several callbacks at once: ``integrate(..., callback=chain(bar, recorder))``.
 """
 
+import os
 import sys
 import time
 
@@ -90,3 +91,11 @@ def chain(*callbacks):
             fn(t, u, v, a)
 
     return call
+
+
+def progress_from_env(t0, t_end, label=""):
+    """A ProgressBar when CONTACTFEM_PROGRESS=1 (set by `contactfem run --progress`), else None:
+    the scenes' time loops call this, so any long run can show its progress."""
+    if os.environ.get("CONTACTFEM_PROGRESS") == "1" and t_end > t0:
+        return ProgressBar(t0=t0, t_end=t_end, label=label)
+    return None

@@ -78,6 +78,7 @@ from ..bodies.continuum import Continuum
 from ..bodies.loads import Pressure
 from ..contact import NodeToSegment, tributary_lengths
 from ..contact.kinematics import arc_variations, line_variations
+from ..io.animate import boundary_loop
 from ..laws.friction import SlipHardening
 from ..laws.normal import PowerLaw
 from ..solver import Dirichlet, Newmark, NewtonError, Static, System
@@ -554,6 +555,8 @@ def run(params):
     snaps = snapshot_times(t_ramp, out["exit_time"], h["t"][-1])
     idx = [int(np.argmin(np.abs(h["t"] - ts))) for ts in snaps]
     cork = model["cork"]
+    loop = boundary_loop(cork.mesh)                                  # outlines for animations
+    frames = np.unique(np.linspace(0, len(h["t"]) - 1, 80).astype(int))
     return dict(
         exit_velocity_m_s=float(h["v_cm"][-1]) if out["exited"] else None,
         exit_time_ms=out["exit_time"] * 1e3 if out["exited"] else None,
@@ -582,6 +585,9 @@ def run(params):
         contact_nodes=h["n_contact"], gas_volume_mm3=h["volume"],
         snapshot_times_ms=h["t"][idx] * 1e3, snapshot_paper_times_ms=list(PAPER["snapshot_times_ms"]),
         snapshots_x=[(cork.X + out["states"][k][cork.xdofs]).tolist() for k in idx],
+        outlines=[cork.X[loop] + out["states"][k][cork.xdofs[loop]] for k in frames],
+        outline_t=h["t"][frames],
+        obstacles=[model["neck"].outline()],
         paper=PAPER,
     )
 

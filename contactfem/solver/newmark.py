@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
+from ..io.progress import chain, progress_from_env
 from .newton import NewtonError, NewtonResult, newton
 
 
@@ -221,6 +222,8 @@ def integrate(stepper, t0, u0, v0=None, n_steps=None, t_end=None, callback=None,
     P, F = s.external_force(u, t0), G[fixed]          # loads and support reactions at t0
     work = 0.0
 
+    bar = progress_from_env(t0, t_end, label=type(stepper).__name__)
+    callback = chain(callback, bar)
     hist = History()
     hist.append(t0, 0.0, None, 0, s.energies(u, v), work)
     t = t0
@@ -237,6 +240,8 @@ def integrate(stepper, t0, u0, v0=None, n_steps=None, t_end=None, callback=None,
                     h, cuts = h / 2, cuts + 1
                     continue
                 err.partial = hist.finish(u, v, a)
+                if bar is not None:
+                    bar.close()
                 raise
             s.commit(u1)
             t = t_target if t_target - (t + h) < 1e-12 * DT else t + h
@@ -244,6 +249,7 @@ def integrate(stepper, t0, u0, v0=None, n_steps=None, t_end=None, callback=None,
             work += 0.5 * (P + P1) @ (u1 - u) + 0.5 * (F + F1) @ (u1 - u)[fixed]
             u, v, a, P, F = u1, v1, a1, P1, F1
             hist.append(t, h, result, cuts, s.energies(u, v), work)
-            if callback is not None:
-                callback(t, u, v, a)
+            callback(t, u, v, a)
+    if bar is not None:
+        bar.close()
     return hist.finish(u, v, a)
