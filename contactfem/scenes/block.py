@@ -163,8 +163,9 @@ class ContactTangent:
         return R_c, rows, cols, vals
 
 
-def build(params):
-    """Body, contact, loads and System of the block (no solve). Returns a dict."""
+def build(params, friction=None):
+    """Body, contact, loads and System of the block (no solve). Returns a dict.
+    ``friction``: a friction law object to use instead of params["law"] (a student's law)."""
     W, H = params["width"], params["height"]
     mesh = block_mesh(W, H, params["nx"], params["ny"])
     body = Continuum(mesh, E=params["E"], nu=params["nu"], rho=0.0, kind="plane_strain",
@@ -177,7 +178,7 @@ def build(params):
     weights = tributary_lengths(body.X[bottom])[k:-k]        # tractions per unit length of the bottom
     slaves = bottom[k:-k]                                   # the first and last element never touch
     contact = NodeToSegment(body, slaves, RigidLine((0.0, 0.0), (0.0, 1.0)),
-                            PowerLaw(c_N=params["c_N"], m=params["m"]), friction_law(params),
+                            PowerLaw(c_N=params["c_N"], m=params["m"]), friction or friction_law(params),
                             weights=weights, offset=-params["g_N0"], name="foundation")
     p_y, p_x = params["p_y"], params["p_x"]
     loads = [Pressure(body, "top", lambda t: p_y * t),                # dead loads, ramped over the
@@ -187,12 +188,12 @@ def build(params):
     return dict(body=body, contact=contact, loads=loads, system=system, slaves=slaves)
 
 
-def solve(params):
+def solve(params, friction=None):
     """Build the block and apply the load in ``n_steps`` static steps of the pseudo-time
     (default: the whole load in ONE step, Newton from u = 0). Returns build()'s dict plus
     u, the NewtonResult of every step and the contact report and contact forces R_c at
     the converged final state (taken before the friction history is committed)."""
-    sc = build(params)
+    sc = build(params, friction)
     system, contact = sc["system"], sc["contact"]
     n = params["n_steps"]
     stepper = Static(system, dt=1.0 / n, atol=params["atol"], rtol=params["rtol"], maxit=params["maxit"])
