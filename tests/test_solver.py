@@ -363,3 +363,19 @@ def test_bad_input_raises():
         integrate(Static(s), 0.0, np.zeros(4), n_steps=0)
     with pytest.raises(ValueError, match="mass"):
         CentralDifference(System([SpringChain(2, m=0.0)]), 0.1)
+
+
+def test_line_search_rescues_newton_where_full_steps_diverge():
+    """G(u) = atan(u) from u0 = 2: full Newton steps overshoot and diverge; backtracking
+    converges, and near the solution takes full steps (quadratic, here cubic, rate)."""
+    import scipy.sparse as sp_
+
+    def fun(u):
+        return np.arctan(u), sp_.csr_matrix(np.diag(1.0 / (1.0 + u**2)))
+
+    with pytest.raises(NewtonError), np.errstate(over="ignore"):
+        newton(fun, np.array([2.0]), [0], maxit=10)
+    res = newton(fun, np.array([2.0]), [0], maxit=20, line_search=10)
+    assert abs(res.u[0]) < 1e-10 and res.residuals[-1] < 1e-10
+    with pytest.raises(ValueError, match="line_search"):
+        newton(fun, np.array([2.0]), [0], line_search=-1)

@@ -52,7 +52,7 @@ class NewtonResult:
     G: np.ndarray = None                          # full residual at u (its fixed-dof part = reactions)
 
 
-def newton(fun, u0, free, atol=1e-10, rtol=1e-10, maxit=25, label=""):
+def newton(fun, u0, free, atol=1e-10, rtol=1e-10, maxit=25, label="", line_search=0):
     """Full Newton method: K_ff du_f = -G_f, u_f += du_f, until converged.
 
     Parameters
@@ -63,6 +63,11 @@ def newton(fun, u0, free, atol=1e-10, rtol=1e-10, maxit=25, label=""):
     atol, rtol : convergence test ||G_k|| <= atol + rtol * ||G_0|| (module docstring)
     maxit : maximal number of linear solves
     label : names the step/time in error messages
+    line_search : 0 (default: full Newton steps, the paper's method) or the number of
+            step halvings allowed when a full step does not lower ||G_f|| (backtracking:
+            accept u + s du at the first s = 1, 1/2, 1/4, ... with ||G_f|| < (1 - 1e-4 s) ||G_f,k||,
+            else the smallest step). It helps where stick/slip switching makes full steps cycle;
+            near the solution full steps are accepted, so the quadratic rate is kept.
 
     Returns a NewtonResult; raises NewtonError (never returns NaN).
     """
@@ -76,14 +81,21 @@ def newton(fun, u0, free, atol=1e-10, rtol=1e-10, maxit=25, label=""):
         free = np.flatnonzero(free)
     where = f" ({label})" if label else ""
     all_free = len(free) == len(u) and np.array_equal(free, np.arange(len(u)))
+    if int(line_search) != line_search or line_search < 0:
+        raise ValueError(f"parameter line_search = {line_search} is out of range: allowed integers [0, inf)")
     history = []
 
-    for k in range(maxit + 1):
+    def evaluate(v, k):
         try:
-            G, K = fun(u)
+            return fun(v)
         except FloatingPointError as err:             # inverted element, failed return map
             raise NewtonError(f"Newton: {type(err).__name__} at iteration {k}{where}: {err}",
                               history, label) from err
+
+    evaluated = None                                  # (G, K) at u from the line search
+    for k in range(maxit + 1):
+        G, K = evaluated if evaluated is not None else evaluate(u, k)
+        evaluated = None
         r = float(np.linalg.norm(G[free]))
         if not np.isfinite(r):
             raise NewtonError(f"Newton: residual is NaN/inf at iteration {k}{where}", history, label)
@@ -101,7 +113,19 @@ def newton(fun, u0, free, atol=1e-10, rtol=1e-10, maxit=25, label=""):
         if not np.all(np.isfinite(du)):
             raise NewtonError(f"Newton: non-finite correction at iteration {k}{where}",
                               history, label)
-        u[free] += du
+        if line_search:
+            step = 1.0
+            for _ in range(int(line_search) + 1):
+                trial = u.copy()
+                trial[free] += step * du
+                evaluated = evaluate(trial, k + 1)
+                r_trial = float(np.linalg.norm(evaluated[0][free]))
+                if np.isfinite(r_trial) and r_trial < (1.0 - 1e-4 * step) * r:
+                    break
+                step /= 2
+            u = trial
+        else:
+            u[free] += du
 
     raise NewtonError(f"Newton: no convergence in {maxit} iterations{where}; "
                       f"residuals {', '.join(f'{x:.3e}' for x in history)}", history, label)
