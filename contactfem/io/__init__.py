@@ -16,5 +16,5 @@ from .paraview import export_continuum, export_polyline, export_series
 from .progress import ProgressBar, chain
 from .runs import Recorder, load_run, save_run
 
-__all__ = ["save_run", "load_run", "Recorder", "export_series", "export_continuum", "export_polyline",
+__all__ = ["save_run", "load_run", "Recorder", "boundary_loop", "export_series", "export_continuum", "export_polyline",
            "animate_outlines", "ProgressBar", "chain"]

@@ -9,6 +9,7 @@ of them."""
 import importlib
 import os
 import pkgutil
+from functools import lru_cache
 from pathlib import Path
 
 REGISTRY = {}   # file stem -> (paper label, function)
@@ -54,6 +55,30 @@ def make_all(preset="fast", outdir=None, only=None):
             continue
         written += fn(preset=preset, outdir=outdir)
     return written
+
+
+def pyplot():
+    """matplotlib.pyplot, imported only when a figure is drawn."""
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+@lru_cache(maxsize=64)
+def _cached(scene, preset, changed):
+    from ..scenes import run_scene
+
+    return run_scene(scene, preset, dict(changed))
+
+
+def cached_run(scene, preset="fast", **overrides):
+    """A scene's result dict, cached on the resolved parameters: figures, tables and
+    lectures share runs, and an override equal to the preset's value is no new run."""
+    from ..scenes import get_scene
+
+    sc = get_scene(scene)
+    base, full = sc.resolve(preset), sc.resolve(preset, overrides)
+    return _cached(scene, preset, tuple(sorted((k, v) for k, v in full.items() if v != base[k])))
 
 
 def savefig(fig, outdir, stem):

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import default_outdir, figure, savefig
+from . import default_outdir, figure, pyplot, savefig
 
 _CACHE = {}
 
@@ -36,19 +36,10 @@ def load_bench(preset="fast"):
     return _CACHE["quick"]
 
 
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
 @figure("bench_tangents", "issue 6")
 def bench_tangents(preset="fast", outdir=None):
     """Linear solves to the same tolerance: consistent tangent vs symmetric, frozen, staggered."""
-    plt = _plt()
+    plt = pyplot()
     tg = load_bench(preset)["tangents"]
     problems = [(f"block, {law}", rows) for law, rows in tg["block"].items()]
     problems.append((f"sloping impact\n({tg['sloping_impact_steps']} steps)", tg["sloping_impact"]))
@@ -83,7 +74,7 @@ def _rows(block):
 def bench_work_precision(preset="fast", outdir=None):
     """Error against wall time: hertz (mesh), rolling ring (dt, mesh, Newmark, beam vs
     continuum), bar impact (implicit Newmark vs explicit central differences)."""
-    plt = _plt()
+    plt = pyplot()
     wp = load_bench(preset)["work_precision"]
     fig, axes = plt.subplots(1, 3, figsize=(14, 4.2))
 
@@ -145,7 +136,7 @@ def bench_work_precision(preset="fast", outdir=None):
 def bench_cost(preset="fast", outdir=None):
     """Time of one Newton iteration split into bulk, contact, assembly and solve; contact
     time against the number of contact nodes."""
-    plt = _plt()
+    plt = pyplot()
     c = load_bench(preset)["cost"]
     fig, (ax, ax2) = plt.subplots(1, 2, figsize=(13, 4.2), gridspec_kw=dict(width_ratios=[2, 1]))
     names = list(c["cases"])

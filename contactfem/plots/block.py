@@ -12,29 +12,20 @@ unit length of the contact side); the normal stress is drawn as the pressure
 |t_N|, the friction stress as t_T (> 0: the foundation holds the block back).
 """
 
-from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
-from ..scenes import run_scene
 from ..scenes.block import PAPER_TABLE1, PAPER_TABLE1_UNCERTAIN, SCENE, solve
 from ..solver.newton import NewtonError
-from . import default_outdir, figure, savefig
+from . import cached_run, default_outdir, figure, pyplot, savefig
 
 STATE_COLORS = {"stick": "tab:blue", "slip": "tab:red", "open": "0.6"}
 
 
-def _plt():
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-@lru_cache(maxsize=16)
 def result(preset="fast", **overrides):
-    """The block scene's JSON result (cached)."""
-    return run_scene("block", preset, overrides)
+    """The block scene's JSON result (cached: see plots.cached_run)."""
+    return cached_run("block", preset, **overrides)
 
 
 def draw_mesh(ax, X, t, **kw):
@@ -46,7 +37,7 @@ def draw_mesh(ax, X, t, **kw):
 
 @figure("fig06_block_mesh_deformed", "Fig 6")
 def fig06(preset="fast", outdir=None, law="conical"):
-    plt = _plt()
+    plt = pyplot()
     s = solve(SCENE.resolve(preset, {"law": law}))
     body, u, rep = s["body"], s["u"], s["report"]
     X, t = body.X, body.mesh.t
@@ -117,7 +108,7 @@ def _stress_axes(ax, title):
 
 @figure("fig07_block_conical_stresses", "Fig 7")
 def fig07(preset="fast", outdir=None):
-    plt = _plt()
+    plt = pyplot()
     r = result(preset, law="conical")
     fig, ax = plt.subplots(figsize=(7.5, 5))
     draw_stresses(ax, r, "(conical)")
@@ -129,7 +120,7 @@ def fig07(preset="fast", outdir=None):
 
 @figure("fig08_block_parabolic_stresses", "Fig 8")
 def fig08(preset="fast", outdir=None):
-    plt = _plt()
+    plt = pyplot()
     r = result(preset, law="parabolic")
     rc = result(preset, law="conical")
     fig, ax = plt.subplots(figsize=(7.5, 5))
@@ -186,7 +177,7 @@ def table1_markdown(hist):
 
 @figure("table1_block_newton_residuals", "Table 1")
 def table1(preset="fast", outdir=None):
-    plt = _plt()
+    plt = pyplot()
     outdir = outdir or default_outdir()
     hist = residual_histories(preset)
     md = Path(outdir) / "table1_block_newton_residuals.md"

@@ -11,29 +11,16 @@ The problem is axisymmetric (x = r, y = z); the drawings mirror the meridian in 
 axis to show the whole cork and both sides of the neck.
 """
 
-from functools import lru_cache
 
 import numpy as np
 
-from ..scenes import run_scene
 from ..scenes.cork import Neck, cork_mesh
-from . import default_outdir, figure, savefig
-
-
-def _plt():
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-@lru_cache(maxsize=16)
-def _run(preset, overrides=()):
-    return run_scene("cork", preset, dict(overrides))
+from . import cached_run, default_outdir, figure, pyplot, savefig
 
 
 def result(preset="fast", **overrides):
-    """The scene's result dict (cached per preset and overrides)."""
-    return _run(preset, tuple(sorted(overrides.items())))
+    """The scene's result dict (cached: see plots.cached_run)."""
+    return cached_run("cork", preset, **overrides)
 
 
 def _geometry(params):
@@ -63,7 +50,7 @@ def draw_neck(ax, neck, gas_column=None):
 
 @figure("fig14_cork_mesh", "Fig 14")
 def fig14_cork_mesh(preset="fast", outdir=None):
-    plt = _plt()
+    plt = pyplot()
     r = result(preset)
     mesh, neck = _geometry(r["parameters"])
     fig, axes = plt.subplots(1, 2, figsize=(9, 6.5), sharey=True)
@@ -82,7 +69,7 @@ def fig14_cork_mesh(preset="fast", outdir=None):
 
 @figure("fig15_cork_configurations", "Fig 15")
 def fig15_cork_configurations(preset="fast", outdir=None):
-    plt = _plt()
+    plt = pyplot()
     r = result(preset)
     mesh, neck = _geometry(r["parameters"])
     xs, ts, tp = r["snapshots_x"], r["snapshot_times_ms"], r["snapshot_paper_times_ms"]
@@ -104,7 +91,7 @@ def fig15_cork_configurations(preset="fast", outdir=None):
 
 @figure("fig16_cork_pressure", "Fig 16")
 def fig16_cork_pressure(preset="fast", outdir=None):
-    plt = _plt()
+    plt = pyplot()
     r = result(preset)
     fig, ax = plt.subplots(figsize=(6.5, 4))
     ax.step(r["time_ms"], r["pressure_MPa"], where="pre", color="C0", label="gas pressure (used in the step)")
@@ -120,7 +107,7 @@ def fig16_cork_pressure(preset="fast", outdir=None):
 
 @figure("fig17_cork_displacement", "Fig 17")
 def fig17_cork_displacement(preset="fast", outdir=None):
-    plt = _plt()
+    plt = pyplot()
     r = result(preset)
     fig, ax = plt.subplots(figsize=(6.5, 4))
     ax.plot(r["time_ms"], r["displacement_bottom_mm"], label="bottom centre")

@@ -9,32 +9,19 @@ the deepest position of the centre, panel (b) those after it; panel (c) the heig
 the centre against time. Panel (b) stops when the centre is back at its starting height.
 """
 
-from functools import lru_cache
 
 import numpy as np
 
-from ..scenes import run_scene
-from . import default_outdir, figure, savefig
-
-
-def _plt():
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-@lru_cache(maxsize=8)
-def _run(preset, **overrides):
-    return run_scene("funnel", preset, overrides)
+from . import cached_run, default_outdir, figure, pyplot, savefig
 
 
 def result(variant, preset="fast", **overrides):
-    """The scene's result dict for one variant (cached)."""
-    return _run(preset, variant=variant, **overrides)
+    """The scene's result dict for one variant (cached: see plots.cached_run)."""
+    return cached_run("funnel", preset, variant=variant, **overrides)
 
 
 def draw_funnel(r, title):
-    plt = _plt()
+    plt = pyplot()
     fig, axes = plt.subplots(1, 3, figsize=(13, 5.2), gridspec_kw=dict(width_ratios=[1, 1, 1.1]))
     wall = np.asarray(r["wall"])
     both = np.vstack([wall, wall[::-1] * [-1, 1]])          # left wall, vertex, mirrored right wall

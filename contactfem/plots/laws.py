@@ -14,13 +14,7 @@ import numpy as np
 from ..contact.return_map import return_map
 from ..laws import Coulomb, ParabolicSlip, SlipHardening
 from ..laws.validation import require
-from . import default_outdir, figure, savefig
-
-
-def _plt():
-    import matplotlib.pyplot as plt   # headless machines fall back to Agg by themselves
-
-    return plt
+from . import default_outdir, figure, pyplot, savefig
 
 
 # -- formulas of Sec. 2 used only by the figures ------------------------------
@@ -96,7 +90,7 @@ def associated_direction(law, t_N, t_T):
 @figure("fig01_true_contact_area", "Fig 1")
 def fig01_true_contact_area(preset="fast", outdir=None):
     """Fig 1: true contact area ratio vs dimensionless pressure, eq (3), log-log."""
-    plt = _plt()
+    plt = pyplot()
     p = np.geomspace(1e-4, 1.0, 200)
     fig, ax = plt.subplots(figsize=(5.0, 4.0))
     for n, label in ((2 / 3, "n = 2/3 (elastic, Tabor)"), (0.8, "n = 0.8"), (0.9, "n = 0.9 (Kragelski, elastic)"),
@@ -121,7 +115,7 @@ def fig02_force_vs_microdisplacement(preset="fast", outdir=None):
     """Fig 2: tangential force vs micro-displacement: the stick law t_T = c_T g_T (eq 5,
     zone 1) up to the slip bound, then sliding (zone 2), and the elastic unloading on
     reversal. Computed by the return mapping over a ramped displacement history."""
-    plt = _plt()
+    plt = pyplot()
     c_T, mu, p = 30.0, 0.3, 1.0
     g_stick = mu * p / c_T
     g = fig02_history() * g_stick
@@ -150,7 +144,7 @@ def fig03_shear_vs_normal(preset="fast", outdir=None):
     """Fig 3: shear vs normal stress. Left: the junction shear strength tau = tau_0 + beta p_r
     (eq 6) and the friction coefficient mu = tau_0/p_r + beta (eq 7). Right: the nominal
     slip bound |t_T| = alpha |t_N|^n + beta |t_N| (eqs 8-10) against Coulomb's line (eq 11)."""
-    plt = _plt()
+    plt = pyplot()
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(11.0, 4.2), layout="constrained")
     H, tau_0, beta = 1.0, 0.1, 0.2
     p_r = np.linspace(0.02, 1.0, 200) * H
@@ -198,7 +192,7 @@ def fig04_parabolic_slip_surface(preset="fast", outdir=None):
     """Fig 4: the parabolic slip surface f(t_N, t_T) = 0 (eq 10) in the (t_N, t_T) plane with
     Coulomb's cone (eq 11), a trial state outside it, its non-associated return along t_T
     (eq 14, what the package does) and the associated direction (eq 13) that would lift off."""
-    plt = _plt()
+    plt = pyplot()
     law = ParabolicSlip(c_T=30.0, alpha=0.2, beta=0.3, n=0.5)
     coul = Coulomb(c_T=30.0, mu=0.5)
     p = np.linspace(0.0, 4.0, 400)

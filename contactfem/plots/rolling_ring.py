@@ -11,34 +11,16 @@ Exact: the rigid thin hoop (scenes.rolling_ring.rigid_ring_exact): x* = 229.4 cm
 v* = 150 cm/s, and x(2 s) = 376.5 cm.
 """
 
-from functools import lru_cache
 
 import numpy as np
 
-from ..scenes import get_scene, run_scene
 from ..scenes.rolling_ring import rigid_ring_exact
-from . import default_outdir, figure, savefig
-
-
-def _plt():
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-@lru_cache(maxsize=32)
-def _run(preset, overrides):
-    return run_scene("rolling_ring", preset, dict(overrides))
+from . import cached_run, default_outdir, figure, pyplot, savefig
 
 
 def result(preset="fast", **overrides):
-    """The scene's result dict (cached on the resolved parameters: the figures and the
-    lecture share the runs, and an override equal to the preset's value is no new run)."""
-    scene = get_scene("rolling_ring")
-    base = scene.resolve(preset)
-    full = scene.resolve(preset, overrides)
-    changed = tuple(sorted((k, v) for k, v in full.items() if v != base[k]))
-    return _run(preset, changed)
+    """The scene's result dict (cached: see plots.cached_run)."""
+    return cached_run("rolling_ring", preset, **overrides)
 
 
 def joint_refinement(preset="fast"):
@@ -72,7 +54,7 @@ def convergence_study(preset="fast"):
 
 def draw_rolling(r, title):
     """Outlines along the plane (top), velocity profiles (bottom left), histories (bottom right)."""
-    plt = _plt()
+    plt = pyplot()
     fig = plt.figure(figsize=(12, 8.5))
     gs = fig.add_gridspec(2, 2, height_ratios=[1.0, 1.1])
     ax = fig.add_subplot(gs[0, :])
@@ -165,7 +147,7 @@ def fig09(preset="fast", outdir=None, **overrides):
 @figure("fig09b_rolling_ring_convergence", "Fig 9 (convergence)")
 def fig09b(preset="fast", outdir=None):
     c = convergence_study(preset)
-    plt = _plt()
+    plt = pyplot()
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.2))
     n = c["n_el"]
     a1.loglog(n, np.abs(c["x_err_joint"]), "o-", label="|x_roll error|")

@@ -10,35 +10,21 @@ i.e. every 2 time units) over the plane, the path of the centre, and below it th
 energy histories (kinetic, strain, contact, their sum, and the frictional dissipation).
 """
 
-from functools import lru_cache
 
 import numpy as np
 
-from ..scenes import run_scene
 from ..scenes.sloping_impact import PAPER_TABLE2
-from . import default_outdir, figure, savefig
-
-
-def _plt():
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-@lru_cache(maxsize=16)
-def _run(preset, **overrides):
-    """One scene run, cached: the figures and the table share the runs."""
-    return run_scene("sloping_impact", preset, overrides)
+from . import cached_run, default_outdir, figure, pyplot, savefig
 
 
 def result(variant, preset="fast", **overrides):
-    """The scene's result dict for one variant (cached)."""
-    return _run(preset, variant=variant, **overrides)
+    """The scene's result dict for one variant (cached: see plots.cached_run)."""
+    return cached_run("sloping_impact", preset, variant=variant, **overrides)
 
 
 def draw_impact(r, title):
     """Outlines over the plane (top) and energy histories (bottom); returns the figure."""
-    plt = _plt()
+    plt = pyplot()
     fig, (ax, ae) = plt.subplots(2, 1, figsize=(9, 7.5), gridspec_kw=dict(height_ratios=[1.6, 1]))
     outlines, times = np.asarray(r["outlines"]), np.asarray(r["outline_t"])
     colors = plt.cm.viridis(np.linspace(0, 0.9, len(outlines)))
@@ -140,7 +126,7 @@ def table2(preset="fast", outdir=None, refined_n_el=32):
     md = Path(out) / "table2_sloping_impact.md"
     md.write_text("\n".join(lines) + "\n")
 
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(12, 1.9))
     ax.axis("off")
     tab = ax.table(cellText=body, colLabels=head, loc="center", cellLoc="center")

@@ -9,19 +9,13 @@
 import numpy as np
 
 from ..scenes import run_scene
-from . import default_outdir, figure, savefig
-
-
-def _plt():
-    import matplotlib.pyplot as plt
-
-    return plt
+from . import default_outdir, figure, pyplot, savefig
 
 
 @figure("verif_hertz_pressure", "verification")
 def verif_hertz_pressure(preset="fast", outdir=None):
     """Nodal contact pressure p_i = -f_i / w_i of the hertz scene against Hertz."""
-    plt = _plt()
+    plt = pyplot()
     r = run_scene("hertz", preset)
     a, p0 = r["a_exact"], r["p0_exact"]
     x, p = np.asarray(r["profile_x"]), np.asarray(r["profile_p"])
@@ -53,7 +47,7 @@ def hertz_refinement_data(preset="fast", c_N=1e7):
 
 @figure("verif_hertz_refinement", "verification")
 def verif_hertz_refinement(preset="fast", outdir=None):
-    plt = _plt()
+    plt = pyplot()
     d = hertz_refinement_data(preset)
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 3.8))
     for key, style, label in (("per_length", "o-", f"per length $c_N$ = {d['c_N']:.0e} MPa/mm"),
@@ -78,7 +72,7 @@ def verif_hertz_refinement(preset="fast", outdir=None):
 
 @figure("verif_bar_impact", "verification")
 def verif_bar_impact(preset="fast", outdir=None):
-    plt = _plt()
+    plt = pyplot()
     r = run_scene("bar_impact", preset)
     T, s0 = r["duration_exact"], r["stress_exact"]
     t, s = np.asarray(r["time"]), np.asarray(r["contact_stress"])
@@ -100,7 +94,7 @@ def verif_bar_impact(preset="fast", outdir=None):
 
 @figure("verif_patch", "verification")
 def verif_patch(preset="fast", outdir=None):
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6, 3.6))
     for passes, style in ((1, "o-"), (2, "s--")):
         r = run_scene("patch", preset, {"passes": passes})
