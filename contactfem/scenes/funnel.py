@@ -36,6 +36,7 @@ from ..contact import NodeToSegment, RigidPolyline
 from ..laws import ParabolicSlip, PowerLaw
 from ..solver import Dirichlet, Newmark, System, integrate
 from .base import Param, Scene
+from .sloping_impact import RING_PARAMS
 
 VARIANTS = ("frictionless", "frictional")
 
@@ -143,14 +144,7 @@ SCENE = Scene(
     params=(
         Param("variant", "frictionless", choices=VARIANTS,
               doc="frictionless (Fig 12: rebounds) or frictional eq (10) (Fig 13: sticks)"),
-        Param("kind", "beam", choices=("beam", "continuum"),
-              doc="beam: the paper's finite-deformation beam; continuum: half annulus of quads (plane strain, SVK)"),
-        Param("R", 10.0, "", 0.0, None, low_open=True, doc="mean radius (paper: the ring of Sec. 5.3)"),
-        Param("thickness", 1.0, "", 0.0, None, low_open=True, doc="radial wall thickness h (paper: A = 1, square)"),
-        Param("width", 1.0, "", 0.0, None, low_open=True, doc="out-of-plane depth b (paper: A = 1, square)"),
-        Param("E", 100.0, "", 0.0, None, low_open=True, doc="Young's modulus (paper)"),
-        Param("nu", 0.0, "", -1.0, 0.5, low_open=True, high_open=True, doc="Poisson's ratio (paper)"),
-        Param("rho", 0.01, "", 0.0, None, low_open=True, doc="density (paper)"),
+        *RING_PARAMS,                      # "the same ring as in Sec. 5.3" (half of it, by symmetry)
         Param("n_el", 30, "", 2, 2000, doc="elements on the half ring (paper: 30 beam elements)"),
         Param("v0", 4.0, "", 0.0, None, low_open=True, doc="initial downward speed (paper)"),
         Param("phi_deg", 20.0, "deg", 0.0, 90.0, low_open=True, high_open=True,

@@ -148,20 +148,25 @@ def run(params):
     return out
 
 
+# The ring of Sec. 5.3; Sec. 5.4 (the funnel) uses "the same ring" and imports these.
+RING_PARAMS = (
+    Param("kind", "beam", choices=("beam", "continuum"),
+          doc="beam: the paper's finite-deformation beam; continuum: annulus of quads (plane strain, SVK)"),
+    Param("R", 10.0, "", 0.0, None, low_open=True, doc="mean radius of the ring (paper, Sec. 5.3)"),
+    Param("thickness", 1.0, "", 0.0, None, low_open=True, doc="radial wall thickness h (paper: square section A = 1)"),
+    Param("width", 1.0, "", 0.0, None, low_open=True, doc="out-of-plane depth b (paper: square section A = 1)"),
+    Param("E", 100.0, "", 0.0, None, low_open=True, doc="Young's modulus (paper)"),
+    Param("nu", 0.0, "", -1.0, 0.5, low_open=True, high_open=True, doc="Poisson's ratio (paper)"),
+    Param("rho", 0.01, "", 0.0, None, low_open=True, doc="density (paper)"),
+)
+
 SCENE = Scene(
     name="sloping_impact",
     title="Sloping impact of a ring on a rigid plane at 45 degrees (Sec. 5.3, Figs 10-11, Table 2)",
     params=(
         Param("variant", "frictionless", choices=VARIANTS,
               doc="frictionless (Fig 10), frictional eq (10) (Fig 11a), viscoplastic + frictional (Fig 11b)"),
-        Param("kind", "beam", choices=("beam", "continuum"),
-              doc="beam: the paper's finite-deformation beam; continuum: annulus of quads (plane strain, SVK)"),
-        Param("R", 10.0, "", 0.0, None, low_open=True, doc="mean radius of the ring (paper)"),
-        Param("thickness", 1.0, "", 0.0, None, low_open=True, doc="radial wall thickness h (paper: square section A = 1)"),
-        Param("width", 1.0, "", 0.0, None, low_open=True, doc="out-of-plane depth b (paper: square section A = 1)"),
-        Param("E", 100.0, "", 0.0, None, low_open=True, doc="Young's modulus (paper)"),
-        Param("nu", 0.0, "", -1.0, 0.5, low_open=True, high_open=True, doc="Poisson's ratio (paper)"),
-        Param("rho", 0.01, "", 0.0, None, low_open=True, doc="density (paper)"),
+        *RING_PARAMS,
         Param("n_el", 16, "", 3, 2000, doc="elements around the ring (paper: 16 linear beam elements)"),
         Param("vx0", 2.0, "", doc="initial velocity along the plane (paper)"),
         Param("vy0", -2.0, "", None, 0.0, high_open=True, doc="initial velocity normal to the plane, < 0 (paper)"),
