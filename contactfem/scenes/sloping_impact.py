@@ -34,6 +34,7 @@ from ..bodies.ring import make_ring
 from ..contact import NodeToSegment, RigidLine
 from ..laws import ParabolicSlip, PowerLaw
 from ..solver import Newmark, System, integrate
+from .rolling_ring import ring_size
 from .base import Param, Scene
 
 VARIANTS = ("frictionless", "frictional", "viscoplastic")
@@ -48,6 +49,11 @@ PAPER_TABLE2 = {
 def rebound_angle(vx, vy):
     """Angle of reflection from the plane's normal (Table 2): atan(|v_x| / |v_y|) in degrees."""
     return float(np.degrees(np.arctan2(abs(vx), abs(vy))))
+
+
+def check(params):
+    if params["variant"] == "viscoplastic" and params["kind"] != "beam":
+        raise ValueError("parameter variant = 'viscoplastic' needs kind = 'beam' (the continuum ring is elastic)")
 
 
 def build(params):
@@ -152,12 +158,12 @@ def run(params):
 RING_PARAMS = (
     Param("kind", "beam", choices=("beam", "continuum"),
           doc="beam: the paper's finite-deformation beam; continuum: annulus of quads (plane strain, SVK)"),
-    Param("R", 10.0, "", 0.0, None, low_open=True, doc="mean radius of the ring (paper, Sec. 5.3)"),
-    Param("thickness", 1.0, "", 0.0, None, low_open=True, doc="radial wall thickness h (paper: square section A = 1)"),
-    Param("width", 1.0, "", 0.0, None, low_open=True, doc="out-of-plane depth b (paper: square section A = 1)"),
-    Param("E", 100.0, "", 0.0, None, low_open=True, doc="Young's modulus (paper)"),
+    Param("R", 10.0, "L", 0.0, None, low_open=True, doc="mean radius of the ring (paper, Sec. 5.3)"),
+    Param("thickness", 1.0, "L", 0.0, None, low_open=True, doc="radial wall thickness h (paper: square section A = 1)"),
+    Param("width", 1.0, "L", 0.0, None, low_open=True, doc="out-of-plane depth b (paper: square section A = 1)"),
+    Param("E", 100.0, "F/L^2", 0.0, None, low_open=True, doc="Young's modulus (paper)"),
     Param("nu", 0.0, "", -1.0, 0.5, low_open=True, high_open=True, doc="Poisson's ratio (paper)"),
-    Param("rho", 0.01, "", 0.0, None, low_open=True, doc="density (paper)"),
+    Param("rho", 0.01, "M/L^3", 0.0, None, low_open=True, doc="density (paper)"),
 )
 
 SCENE = Scene(
@@ -168,23 +174,24 @@ SCENE = Scene(
               doc="frictionless (Fig 10), frictional eq (10) (Fig 11a), viscoplastic + frictional (Fig 11b)"),
         *RING_PARAMS,
         Param("n_el", 16, "", 3, 2000, doc="elements around the ring (paper: 16 linear beam elements)"),
-        Param("vx0", 2.0, "", doc="initial velocity along the plane (paper)"),
-        Param("vy0", -2.0, "", None, 0.0, high_open=True, doc="initial velocity normal to the plane, < 0 (paper)"),
-        Param("gap0", 0.05, "", 0.0, None,
+        Param("vx0", 2.0, "L/T", doc="initial velocity along the plane (paper)"),
+        Param("vy0", -2.0, "L/T", None, 0.0, high_open=True, doc="initial velocity normal to the plane, < 0 (paper)"),
+        Param("gap0", 0.05, "L", 0.0, None,
               doc="initial clearance of the outer surface above the plane (chosen: the paper starts 'just above')"),
-        Param("c_N", 50.0, "", 0.0, None, low_open=True, doc="normal penalty, nodal stiffness, eq (4) (paper)"),
+        Param("c_N", 50.0, "F/L", 0.0, None, low_open=True, doc="normal penalty, nodal stiffness, eq (4) (paper)"),
         Param("m", 1.0, "", 1.0, None, doc="exponent of the normal law eq (4) (paper)"),
-        Param("c_T", 30.0, "", 0.0, None, low_open=True, doc="tangential stick stiffness, nodal, eq (5) (paper)"),
-        Param("n", 0.8, "", 0.0, 1.0, low_open=True, doc="exponent of the slip surface eq (10) (paper)"),
-        Param("alpha", 0.2, "", 0.0, None, doc="alpha of the slip surface eq (10) (paper)"),
-        Param("beta", 0.3, "", 0.0, None, doc="beta of the slip surface eq (10) (paper)"),
-        Param("N0", 1.0, "", 0.0, None, low_open=True, doc="plastic axial force (paper, viscoplastic variant)"),
-        Param("Q0", 0.5, "", 0.0, None, low_open=True, doc="plastic shear force (paper, viscoplastic variant)"),
-        Param("M0", 0.25, "", 0.0, None, low_open=True, doc="plastic moment (paper, viscoplastic variant)"),
-        Param("eta", 0.1, "", 0.0, None, low_open=True,
+        Param("c_T", 30.0, "F/L", 0.0, None, low_open=True, doc="tangential stick stiffness, nodal, eq (5) (paper)",
+              when=(("variant", ("frictional", "viscoplastic")),)),
+        Param("n", 0.8, "", 0.0, 1.0, low_open=True, doc="exponent of the slip surface eq (10) (paper)", when=(("variant", ("frictional", "viscoplastic")),)),
+        Param("alpha", 0.2, "F^(1-n)", 0.0, None, doc="alpha of the slip surface eq (10) (paper)", when=(("variant", ("frictional", "viscoplastic")),)),
+        Param("beta", 0.3, "", 0.0, None, doc="beta of the slip surface eq (10) (paper)", when=(("variant", ("frictional", "viscoplastic")),)),
+        Param("N0", 1.0, "F", 0.0, None, low_open=True, doc="plastic axial force (paper, viscoplastic variant)", when=(("variant", ("viscoplastic",)),)),
+        Param("Q0", 0.5, "F", 0.0, None, low_open=True, doc="plastic shear force (paper, viscoplastic variant)", when=(("variant", ("viscoplastic",)),)),
+        Param("M0", 0.25, "F L", 0.0, None, low_open=True, doc="plastic moment (paper, viscoplastic variant)", when=(("variant", ("viscoplastic",)),)),
+        Param("eta", 0.1, "T", 0.0, None, low_open=True, when=(("variant", ("viscoplastic",)),),
               doc="Perzyna relaxation time (chosen: scan lost it; eta = dt = 0.1 makes the overstress relax "
                   "within about one step, nearly rate-independent plasticity with a regular tangent)"),
-        Param("dt", 0.1, "", 0.0, None, low_open=True, doc="time step (paper)"),
+        Param("dt", 0.1, "T", 0.0, None, low_open=True, doc="time step (paper)"),
         Param("n_steps", 200, "", 1, 100000, doc="number of steps (paper: 200)"),
         Param("delta", 0.7, "", 0.5, 1.0, doc="Newmark delta (paper: 0.7; 0.5 with beta 0.25 conserves energy)"),
         Param("beta_newmark", 0.4, "", 0.0, 0.5, low_open=True, doc="Newmark beta (paper: 0.4)"),
@@ -193,4 +200,7 @@ SCENE = Scene(
     run=run,
     presets={"fast": {}, "paper": {}},   # 16 elements, 200 steps: the paper's run takes ~2 s
     reports=("rebound_vx", "rebound_vy", "rebound_angle_deg", "rebound_spin", "newton_iterations_total"),
+    check=check,
+    size=lambda p: dict(ring_size(p), steps=p["n_steps"]),
+    outlines=True,
 )
