@@ -196,7 +196,8 @@ def integrate(stepper, t0, u0, v0=None, n_steps=None, t_end=None, callback=None,
     External work is summed with the trapezoidal rule, 1/2 (F_n + F_n+1) . (u_n+1 - u_n),
     over the loads P and the support reactions (the prescribed-dof part of G).
     Returns a History; a NewtonError that ends the run carries the History so far as
-    ``error.partial``.
+    ``error.partial``. A KeyboardInterrupt (Ctrl-C) leaves with the time reached and the
+    step in progress as its attributes t, step and n_steps.
     """
     s = stepper.system
     if (n_steps is None) == (t_end is None):
@@ -226,30 +227,35 @@ def integrate(stepper, t0, u0, v0=None, n_steps=None, t_end=None, callback=None,
     callback = chain(callback, bar)
     hist = History()
     hist.append(t0, 0.0, None, 0, s.energies(u, v), work)
-    t = t0
-    for k in range(1, n_steps + 1):
-        t_target = min(t0 + k * DT, t_end)
-        h, cuts = t_target - t, 0
-        while t < t_target - 1e-12 * DT:
-            h = min(h, t_target - t)
-            try:
-                u1, v1, a1, result = stepper.step(t, u, v, a, dt=h,
-                                                  label=f"step {k}, t = {t + h:.6g}, dt = {h:.3g}")
-            except NewtonError as err:
-                if cutback and cuts < max_cuts:
-                    h, cuts = h / 2, cuts + 1
-                    continue
-                err.partial = hist.finish(u, v, a)
-                if bar is not None:
-                    bar.close()
-                raise
-            s.commit(u1)
-            t = t_target if t_target - (t + h) < 1e-12 * DT else t + h
-            P1, F1 = s.external_force(u1, t), result.G[fixed]
-            work += 0.5 * (P + P1) @ (u1 - u) + 0.5 * (F + F1) @ (u1 - u)[fixed]
-            u, v, a, P, F = u1, v1, a1, P1, F1
-            hist.append(t, h, result, cuts, s.energies(u, v), work)
-            callback(t, u, v, a)
+    t, k = t0, 0
+    try:
+        for k in range(1, n_steps + 1):
+            t_target = min(t0 + k * DT, t_end)
+            h, cuts = t_target - t, 0
+            while t < t_target - 1e-12 * DT:
+                h = min(h, t_target - t)
+                try:
+                    u1, v1, a1, result = stepper.step(t, u, v, a, dt=h,
+                                                      label=f"step {k}, t = {t + h:.6g}, dt = {h:.3g}")
+                except NewtonError as err:
+                    if cutback and cuts < max_cuts:
+                        h, cuts = h / 2, cuts + 1
+                        continue
+                    err.partial = hist.finish(u, v, a)
+                    if bar is not None:
+                        bar.close()
+                    raise
+                s.commit(u1)
+                t = t_target if t_target - (t + h) < 1e-12 * DT else t + h
+                P1, F1 = s.external_force(u1, t), result.G[fixed]
+                work += 0.5 * (P + P1) @ (u1 - u) + 0.5 * (F + F1) @ (u1 - u)[fixed]
+                u, v, a, P, F = u1, v1, a1, P1, F1
+                hist.append(t, h, result, cuts, s.energies(u, v), work)
+                callback(t, u, v, a)
+    except KeyboardInterrupt as stop:          # Ctrl-C: say where (the innermost loop names it)
+        if not hasattr(stop, "step"):
+            stop.t, stop.step, stop.n_steps = t, k, n_steps
+        raise
     if bar is not None:
         bar.close()
     return hist.finish(u, v, a)
