@@ -1,5 +1,5 @@
 """Command line: `contactfem list | show SCENE | run SCENE [--preset fast|paper]
-[--set NAME=VALUE ...] [--json FILE]` (and the commands later issues add).
+[--set NAME=VALUE ...] [--json FILE] | figures | sweep | bench | equations`.
 
 Exit codes: 0 done; 2 bad input (unknown scene, unknown, repeated, out-of-range or
 inapplicable parameter, an output file that cannot be written, a run too large for this
