@@ -295,6 +295,10 @@ def main(argv=None):
     except Exception as exc:
         from .solver.newton import NewtonError
 
+        if isinstance(exc, (ZeroDivisionError, OverflowError)):       # Python arithmetic at the float limits
+            print(f"contactfem: solver failed: {_one_line(exc)} in {_where(exc)} (parameter values near the limits "
+                  "of floating point?)", file=sys.stderr)
+            return 1
         if not isinstance(exc, (FloatingPointError, NewtonError)):   # Newton, return map, inverted elements
             if os.environ.get("CONTACTFEM_DEBUG") == "1":
                 raise
@@ -308,6 +312,17 @@ def main(argv=None):
             print(f"residual history: {text}", file=sys.stderr)
         return 1
     return 0
+
+
+def _where(exc):
+    """The innermost function of contactfem the exception passed through: 'name (module)'."""
+    import traceback
+
+    frames = [f for f in traceback.extract_tb(exc.__traceback__) if "contactfem" in f.filename]
+    if not frames:
+        return "a library"
+    f = frames[-1]
+    return f"{f.name} ({f.filename.split('contactfem')[-1].strip('/').replace('/', '.')[:-3]}, line {f.lineno})"
 
 
 def _one_line(exc):

@@ -357,6 +357,16 @@ def test_fuzz_laws(kind, values):
     except BaseException as exc:
         violation("laws", kw, f"{type(exc).__name__}: {exc}")
     COUNTS["law accepted"] += 1
+    from contactfem import check_law
+
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            report = check_law(law)                       # a report in words, whatever the values
+        except BaseException as exc:
+            violation("laws", kw, f"check_law raised {type(exc).__name__}: {exc}")
+    if not isinstance(str(report), str):
+        violation("laws", kw, "check_law gave no report")
     with np.errstate(all="ignore"):
         if kind in ("PowerLaw", "ExponentialLaw"):
             t_N, dt_N = law.traction(-np.logspace(-6, 0, 7))

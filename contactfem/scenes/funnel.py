@@ -134,6 +134,7 @@ def run(params):
         energy_dissipation=hist.dissipation, energy_total=mech,
         outlines=np.array(rec["outlines"]), outline_t=np.array(rec["outline_t"]),
         wall=m["wall"].points,
+        obstacles=[m["wall"].points, m["wall"].points * [-1.0, 1.0]],     # the wall and its mirror image
         newton_iterations_total=int(np.sum(hist.iterations)),
         step_cuts_total=int(np.sum(hist.cuts)),
     )

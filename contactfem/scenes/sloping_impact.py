@@ -142,6 +142,7 @@ def run(params):
         energy_total_max_rel_increase_per_step=float(np.max(np.diff(mech)) / E0),
         energy_total_final_rel=float(mech[-1] / E0),
         outlines=np.array(rec["outlines"]), outline_t=np.array(rec["outline_t"]), outline_spin=omega,
+        obstacles=[np.array([[x_c[:, 0].min() - 1.5 * params["R"], 0.0], [x_c[:, 0].max() + 1.5 * params["R"], 0.0]])],
         mass=ring.total_mass(),
         # committed plastic strains of the beam (eps_p, gam_p, kap_p): the permanent deformation
         plastic_strain_max=np.max(np.abs(getattr(ring.body, "ep", np.zeros((1, 3)))), axis=0),
