@@ -151,7 +151,7 @@ def build(params):
                 grading_k=k)
 
 
-def run(params):
+def run(params, progress=None):
     m = build(params)
     body, contact, system, w = m["body"], m["contact"], m["system"], m["w"]
     R, P = params["R"], params["P"]
@@ -163,7 +163,7 @@ def run(params):
     contact.initialize(u0)
     scale = P                                               # force scale of the residual
     stepper = Static(system, dt=1.0 / params["n_steps"], atol=1e-10 * scale, rtol=1e-12, maxit=40)
-    hist = integrate(stepper, 0.0, u0, n_steps=params["n_steps"], cutback=True, max_cuts=6)
+    hist = integrate(stepper, 0.0, u0, n_steps=params["n_steps"], cutback=True, max_cuts=6, progress=progress)
     u = hist.u
 
     rep = contact.report(u)
