@@ -6,11 +6,11 @@ whole load in ONE static step. The block is held only by the contact: normal
 penalty (eq 4, m = 1) and friction (eq 10 conical or parabolic, eq 11 Coulomb)
 at the nodes of its bottom side against ``RigidLine`` y = 0.
 
-Canonical data (the paper does not give the dimensions; see issue 3):
+Canonical data (chosen: the paper does not give the dimensions):
 width 4, height 3.5, 20 x 10 four-node elements, plane strain, E = 1000,
 nu = 0.3, p_y = 200 (down, on the top), p_x = 60 (+x, on the right side).
 The paper keeps "the first and the last element in the contact area" out of
-contact; the issue: "the bottom nodes may touch except the two at each end". So
+contact; we read that as "the bottom nodes may touch except the two at each end". So
 the slave nodes are the bottom nodes without the two at each end (both nodes of
 the first and of the last bottom element; ``free_end_nodes`` = 2), 17 nodes from
 x = 0.4 to 3.6. Their weights are their tributary lengths on the bottom side
@@ -45,11 +45,13 @@ from skfem import MeshQuad
 
 from ..bodies.continuum import MATERIALS, Continuum
 from ..bodies.loads import Pressure, Traction
-from ..contact import NodeToSegment, RigidLine, tributary_lengths
+from ..contact import RigidLine, tributary_lengths
+from ..contact.augmented import make_interface
 from ..contact.tangents import TANGENTS, ContactTangent  # noqa: F401  (ContactTangent: public here too)
 from ..laws.friction import Coulomb, ParabolicSlip
 from ..laws.normal import PowerLaw
 from ..solver import Static, System, integrate
+from . import enforcement
 from .base import Param, Scene
 
 # Table 1 of the paper: norm of the residual ||G|| per Newton iteration (the first
@@ -75,10 +77,10 @@ PARAMS = (
               "frozen (without the c_N^s C coupling of eq 49)"),
     Param("E", 1000.0, "F/L^2", 0.0, low_open=True, doc="Young's modulus (paper)"),
     Param("nu", 0.3, "", -1.0, 0.5, low_open=True, high_open=True, doc="Poisson's ratio (paper)"),
-    Param("width", 4.0, "L", 0.0, low_open=True, doc="block width (canonical, issue 3; the paper does not give it)"),
-    Param("height", 3.5, "L", 0.0, low_open=True, doc="block height (canonical, issue 3)"),
+    Param("width", 4.0, "L", 0.0, low_open=True, doc="block width. Chosen: the paper does not give it"),
+    Param("height", 3.5, "L", 0.0, low_open=True, doc="block height. Chosen: the paper does not give it"),
     Param("free_end_nodes", 2, "", 1, 100,
-          doc="bottom nodes at each end kept out of contact (issue 3: two; the paper: first and last element)"),
+          doc="bottom nodes at each end kept out of contact (chosen: two, both nodes of the paper's first and last element)"),
     Param("nx", 20, "", 3, 400, doc="elements along the width (paper: 200 elements in all)"),
     Param("ny", 10, "", 1, 400, doc="elements along the height"),
     Param("p_y", 200.0, "F/L", 0.0, doc="downward pressure on the top (paper: p_y = 200 per unit length)"),
@@ -94,7 +96,7 @@ PARAMS = (
     Param("beta", 0.3, "", 0.0, doc="eq 10 (paper: 0.3)"),
     Param("n", 0.5, "", 0.0, 1.0, low_open=True, doc="exponent of the parabolic slip surface (paper: 0.5); "
                                                       "the conical law has n = 1"),
-    Param("mu", 0.3, "", 0.0, doc="Coulomb coefficient for law=coulomb (issue 3: 0.3, a wide slip zone)"),
+    Param("mu", 0.3, "", 0.0, doc="Coulomb coefficient for law=coulomb (ours, not the paper's: 0.3, a wide slip zone)"),
     Param("g_N0", -1.0e-12, "L", -1e-3, 0.0, high_open=True,
           doc="initial gap of the bottom nodes. Chosen: a touch (-1e-12) so the first Newton iterate has "
               "contact stiffness (at g_N = 0 the contact is inactive and the tangent singular)"),
@@ -105,6 +107,7 @@ PARAMS = (
     Param("rtol", 1e-10, "", 0.0, 1e-3, low_open=True, doc="Newton: ||G_k|| <= atol + rtol ||G_0||"),
     Param("atol", 1e-12, "F", 0.0, doc="Newton absolute tolerance"),
     Param("maxit", 40, "", 1, 500, doc="Newton: maximal number of linear solves"),
+    *enforcement.ENFORCEMENT_PARAMS,
 )
 
 
@@ -146,9 +149,9 @@ def build(params, friction=None):
         raise ValueError(f"parameter free_end_nodes = {k} is out of range: allowed [1, {(len(bottom) - 2) // 2}] for nx = {params['nx']}")
     weights = tributary_lengths(body.X[bottom])[k:-k]        # tractions per unit length of the bottom
     slaves = bottom[k:-k]                                   # the first and last element never touch
-    contact = NodeToSegment(body, slaves, RigidLine((0.0, 0.0), (0.0, 1.0)),
-                            PowerLaw(c_N=params["c_N"], m=params["m"]), friction or friction_law(params),
-                            weights=weights, offset=-params["g_N0"], name="foundation")
+    contact = make_interface(params.get("enforcement", "penalty"), body, slaves, RigidLine((0.0, 0.0), (0.0, 1.0)),
+                             PowerLaw(c_N=params["c_N"], m=params["m"]), friction or friction_law(params),
+                             weights=weights, offset=-params["g_N0"], name="foundation")
     p_y, p_x = params["p_y"], params["p_x"]
     loads = [Pressure(body, "top", lambda t: p_y * t),                # dead loads, ramped over the
              Traction(body, "right", lambda t: (p_x * t, 0.0))]      # pseudo-time t in [0, 1]
@@ -166,6 +169,9 @@ def solve(params, friction=None, progress=None):
     system, contact = sc["system"], sc["contact"]
     n = params["n_steps"]
     stepper = Static(system, dt=1.0 / n, atol=params["atol"], rtol=params["rtol"], maxit=params["maxit"])
+    h = params["width"] / params["nx"]                        # gap_violation: penetration / element size
+    stepper = enforcement.wrap(dict(params, enforcement=params.get("enforcement", "penalty")), stepper,
+                               [contact], length=h)
     u = np.zeros(system.ndof)
     contact.initialize(u)
     results, last = [], {}
@@ -176,8 +182,8 @@ def solve(params, friction=None, progress=None):
             last.update(report=contact.report(u), R_c=contact.assemble(u)[0])
 
     hist = integrate(stepper, 0.0, u, n_steps=n, before_commit=converged, progress=progress,
-                     label=lambda k, t1, h: f"block, load step {k} of {n}")
-    return dict(sc, u=hist.u, result=results[-1], results=results, **last)
+                     label=lambda k, t1, dt: f"block, load step {k} of {n}")
+    return dict(sc, u=hist.u, result=results[-1], results=results, stepper=stepper, element_size=h, **last)
 
 
 def slip_bound(params, t_N):
@@ -227,6 +233,8 @@ def run(params, progress=None):
                     "state": [str(v) for v in rep["state"]], "g_N": rep["g_N"], "slip_bound": Y,
                     "weights": rep["weights"]},
         "paper_table1": PAPER_TABLE1.get(params["law"], []),
+        **enforcement.report(params, s["stepper"], [r.iterations for r in s["results"]],
+                             enforcement.penetration(s["contact"], u), s["element_size"], "the element size width / nx"),
     }
 
 

@@ -260,6 +260,7 @@ def integrate(stepper, t0, u0, v0=None, n_steps=None, t_end=None, callback=None,
         raise ValueError(f"parameter growth = {growth!r} is out of range: allowed [1, inf)")
 
     fixed = s.fixed_dofs
+    s.set_dt(DT)                    # rate-dependent bodies and laws evaluate the initial state too
     u = s.apply_dirichlet(u0, t0)
     v = np.zeros(s.ndof) if v0 is None else np.array(v0, dtype=float)
     G, _ = s.residual_tangent(u, t0)
