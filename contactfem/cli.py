@@ -105,10 +105,12 @@ def cmd_run(args):
     est = check_resources(scene, params, args.force)
     if est is not None and est.get("elements", 0) > 1e5:
         print(f"{scene.name}: building the mesh and the system ({describe(est)}) ...", file=sys.stderr, flush=True)
+    progress = None
     if args.progress:
-        os.environ["CONTACTFEM_PROGRESS"] = "1"
+        from .io import progress_bar as progress
+        _RUN["progress"] = True
     _RUN["phase"] = "run"
-    res, notes = run_quietly(lambda: scenes.run_scene(args.scene, args.preset, overrides))
+    res, notes = run_quietly(lambda: scenes.run_scene(args.scene, args.preset, overrides, progress=progress))
     _RUN["phase"] = "write"
     with out:                                         # temporaries first, then all renamed at once
         if args.json:
@@ -264,7 +266,8 @@ def interrupted(exc):
     if phase == "done":
         return "contactfem: interrupted after the outputs were written"
     if getattr(exc, "step", None) is not None:
-        where = f" at t = {exc.t:.6g}, step {exc.step} of {exc.n_steps}"
+        of = f" of {exc.n_steps}" if getattr(exc, "n_steps", None) else " (adaptive steps)"
+        where = f" at t = {exc.t:.6g}, step {exc.step}{of}"
     elif phase == "write":
         where = " while writing the outputs"
     elif phase == "run":
@@ -275,13 +278,24 @@ def interrupted(exc):
 
 
 def main(argv=None):
+    """The command line; returns the exit code. Called without argv (as the program), a
+    Ctrl-C after the work is done (while Python shuts down) no longer changes the outcome."""
+    try:
+        return _main(argv)
+    finally:
+        if argv is None:
+            import signal
+
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _main(argv):
     _RUN.clear()
     try:
         args = build_parser().parse_args(argv)
         args.func(args)
     except KeyboardInterrupt as exc:
-        print(("\n" if os.environ.get("CONTACTFEM_PROGRESS") == "1" else "") + interrupted(exc),
-              file=sys.stderr)
+        print(("\n" if _RUN.get("progress") else "") + interrupted(exc), file=sys.stderr)
         return 130
     except UsageError as exc:
         print(f"contactfem: error: {exc}", file=sys.stderr)

@@ -10,14 +10,16 @@
     outputs.py   Outputs: a run's output files checked before the run, written to temporaries
                  and renamed into place together (none or all); check_output_path
     progress.py  ProgressBar: a progress bar on stderr for integrate(..., callback=bar);
-                 chain(...) to give integrate several callbacks
+                 chain(...) to give integrate several callbacks; progress_bar, the factory
+                 for integrate(..., progress=) and run_scene(..., progress=)
 """
 
 from .animate import animate_outlines, boundary_loop
 from .paraview import export_continuum, export_polyline, export_series
-from .progress import ProgressBar, chain
 from .outputs import Outputs, check_output_path
+from .progress import ProgressBar, chain, progress_bar
 from .runs import Recorder, as_arrays, load_run, save_run
 
-__all__ = ["save_run", "load_run", "as_arrays", "Outputs", "check_output_path", "Recorder", "boundary_loop", "export_series", "export_continuum", "export_polyline",
-           "animate_outlines", "ProgressBar", "chain"]
+__all__ = ["save_run", "load_run", "as_arrays", "Outputs", "check_output_path", "Recorder", "boundary_loop",
+           "export_series", "export_continuum", "export_polyline", "animate_outlines", "ProgressBar", "chain",
+           "progress_bar"]
