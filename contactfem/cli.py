@@ -65,7 +65,7 @@ def cmd_show(args):
         note = ""
         if p is not None:
             note = "; ".join(x for x in (p.doc, f"used only with {p.when_text()}" if p.when else "") if x)
-        print("  ".join(cells).rstrip() + (f"  -- {note}" if note else ""))
+        print("  ".join(cells) + f"  -- {note}" if note else "  ".join(cells).rstrip())
     print("fast is the default preset; paper uses the paper's data and meshes. Values: --set NAME=VALUE.")
     if sc.reports:
         print("reports: " + ", ".join(sc.reports))

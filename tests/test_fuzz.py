@@ -339,7 +339,7 @@ NUMBERS = st.one_of(st.floats(0.01, 10.0), st.floats(0.01, 10.0), st.floats(0.01
        values=st.lists(NUMBERS, min_size=4, max_size=4))
 def test_fuzz_laws(kind, values):
     from contactfem import laws
-    from contactfem.contact.return_map import return_map
+    from contactfem.laws import return_map
 
     cls = getattr(laws, kind)
     names = {"Coulomb": ("c_T", "mu"), "ParabolicSlip": ("c_T", "alpha", "beta", "n"),

@@ -133,7 +133,8 @@ def run(params, progress=None):
 RING_PARAMS = (
     Param("kind", "beam", choices=("beam", "continuum"),
           doc="beam: the paper's finite-deformation beam; continuum: annulus of quads (plane strain, SVK)"),
-    Param("R", 10.0, "L", 0.0, None, low_open=True, doc="mean radius of the ring (paper, Sec. 5.3)"),
+    Param("R", 10.0, "L", 0.0, None, low_open=True, doc="mean radius of the ring (paper, Sec. 5.3). The paper gives no "
+          "units: any consistent set of length L, time T, force F (mass M = F T^2 / L)"),
     Param("thickness", 1.0, "L", 0.0, None, low_open=True, doc="radial wall thickness h (paper: square section A = 1)"),
     Param("width", 1.0, "L", 0.0, None, low_open=True, doc="out-of-plane depth b (paper: square section A = 1)"),
     Param("E", 100.0, "F/L^2", 0.0, None, low_open=True, doc="Young's modulus (paper)"),
