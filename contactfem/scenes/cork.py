@@ -300,7 +300,7 @@ def press_fit(model, P, log=None, progress=None):
     hist = integrate(stepper, 0.0, u, t_end=1.0, dt_rule=lambda t, u, v, a: ds, growth=1.0,
                      cutback=True, max_cuts=P["max_cuts"], min_dt=ds / 2**P["max_cuts"],
                      motion=lambda t1: neck.set_shift(shift0 * (1.0 - t1)),
-                     label=lambda k, t1, h: f"press fit {t1:.3f}", progress=progress)
+                     label=lambda k, t1, h: f"press fit {t1:.3f}", progress=progress, name="cork: press fit")
     # the axial hold's reaction: released at the start of stage 2 (the dynamic run
     # absorbs this small imbalance; it is reported, not hidden)
     reaction = float(hist.result.G[cork.xdofs[hold, 1]])
@@ -375,7 +375,7 @@ def pop(model, P, u0, log=None, progress=None):
     zero = np.zeros(system.ndof)
     hist = integrate(stepper, 0.0, u0.copy(), zero, t_end=P["t_end"], a0=zero, dt_rule=dt_rule,
                      cutback=True, max_cuts=P["max_cuts"], before_step=lambda t, u, v, a: gas.update(u, t),
-                     stop=flown, recorder=record, progress=progress,
+                     stop=flown, recorder=record, progress=progress, name="cork: pop",
                      label=lambda k, t1, h: f"cork t = {t1 * 1e3:.5f} ms, dt = {h:.2e}")
     H = {k: np.asarray(x) for k, x in H.items()}
     exited = bool(gas.released and H["n_contact"][-1] == 0)
