@@ -293,7 +293,7 @@ def cork_knife_edge(preset="fast", outdir=None, data=None):
                  "(static breakaway = applied pressure); square: the fitted point", fontsize=9)
     line = sorted(d["p0"], key=lambda o: o["p0"])
     ok = [o for o in line if o["error"] is None]
-    ap.plot([o["p0"] for o in ok], [o["v"] if o["exited"] else 0.0 for o in ok], "o-", color="tab:green")
+    ap.plot([o["p0"] for o in ok], [o["v"] if o["exited"] else 0.0 for o in ok], "o:", color="tab:green", lw=0.8)
     for o in ok:
         if not o["exited"]:
             ap.annotate("stays in", (o["p0"], 0.0), fontsize=8, xytext=(0, 6), textcoords="offset points", ha="center")
