@@ -32,7 +32,7 @@ Reconstructed (the scan lost them; each is a Param with "chosen: ..." in its doc
   breakaway pressure mu N / (pi R_neck^2) is 0.786 MPa against the 0.8 MPa applied
   (``breakaway_margin_MPa`` = applied - static breakaway, +0.014 MPa); R_tip + 0.1 mm
   or mu = 0.105 and the cork stays in (figure ``cork_knife_edge``, lecture 08).
-* The neck (``Neck``, a smooth rigid master defined here) has three pieces: the
+* The neck (``Neck``, a ``RigidComposite`` of contact/masters.py) has three pieces: the
   straight wall r = 10 mm up to z = 24 mm (traversed upwards, so that its normal
   n = e3 x t of eq 18 points into the neck, towards the cork), a rounded mouth
   (quarter circle of radius 2 mm, exact curvature) and the flat top of the bottle
