@@ -172,3 +172,25 @@ def test_paper_preset_leaves_by_static_breakaway_near_28_m_s():
     # that twice, plus the rounding
     assert abs(v - PAPER_V) / PAPER_V < 0.10, f"paper {PAPER_V} m/s, ours {v:.2f} m/s, tolerance 10 %"
     assert r["max_penetration_ratio"] < 0.02
+
+
+def test_knife_edge_figure_draws_from_its_data(tmp_path, monkeypatch):
+    # the figure is computed by `contactfem figures` (minutes); here it is drawn from data of
+    # the same shape, and the grid switches to the full one with CONTACTFEM_SLOW
+    import matplotlib
+    matplotlib.use("Agg")
+    from contactfem.plots import cork as F
+
+    field = [dict(mu=m, R_tip=R, breakaway_margin_MPa=0.8 - m * 2470 * (1 + (R - 10)) / (np.pi * 100), error=None)
+             for m in (0.095, 0.1, 0.105) for R in (10.0, 10.1)]
+    runs = [dict(mu=0.1, R_tip=10.0, exited=True, v=30.7, margin=0.014, error=None),
+            dict(mu=0.105, R_tip=10.0, exited=False, v=None, margin=-0.028, error=None),
+            dict(mu=0.1, R_tip=10.1, exited=None, v=None, margin=None, error="NewtonError")]
+    line = [dict(p0=p, p_step=p / 8, n_ramp=8, exited=p > 0.79, v=30.0 if p > 0.79 else None,
+                 margin=p - 0.786, error=None) for p in (0.78, 0.8)]
+    files = F.cork_knife_edge(outdir=str(tmp_path), data=dict(field=field, runs=runs, p0=line, preset="fast"))
+    assert all((tmp_path / f).exists() for f in ("cork_knife_edge.png", "cork_knife_edge.json")), files
+    monkeypatch.delenv("CONTACTFEM_SLOW", raising=False)
+    assert F.knife_grid() is F.KNIFE_GRID
+    monkeypatch.setenv("CONTACTFEM_SLOW", "1")
+    assert F.knife_grid() is F.KNIFE_GRID_SLOW
