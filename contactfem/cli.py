@@ -84,6 +84,12 @@ def cmd_equations(args):
     print(markdown_table())
 
 
+def cmd_site(args):
+    from .site import build
+
+    print(f"site -> {build(args.out)}")
+
+
 def write_animation(res, path):
     """Animate the outlines a scene recorded (rings, the cork) into a GIF or MP4."""
     from .io import animate_outlines
@@ -129,6 +135,9 @@ def build_parser():
     sw.add_argument("--scheduler", default=None, help="Dask scheduler address: run on that cluster instead")
     sw.add_argument("--out", default="sweep.csv", help="table of results (.csv or .json)")
     sw.set_defaults(func=cmd_sweep)
+    st = sub.add_parser("site", help="build the course website (lectures executed, gallery, equation index, API)")
+    st.add_argument("--out", default=None, metavar="DIR", help="output folder, DIR/index.html (default: build/site)")
+    st.set_defaults(func=cmd_site)
     from .studies.bench import add_bench_parser
     add_bench_parser(sub)
     return ap
