@@ -222,3 +222,10 @@ def test_browser_check_fails_on_the_real_site_broken(site, chromium, tmp_path):
     problems = check_site(broken, pages=[name], chromium=chromium)["problems"]
     assert any(f"{name}: 1 image(s) did not load" in p for p in problems), problems
     assert any(f"{name}: 1 equation(s) failed to typeset" in p for p in problems), problems
+
+
+def test_site_command_line():
+    from contactfem.cli import build_parser
+
+    args = build_parser().parse_args(["site", "--out", "somewhere"])
+    assert args.out == "somewhere" and args.func.__name__ == "cmd_site"
