@@ -25,10 +25,13 @@ REPO = Path(__file__).resolve().parents[2]
 
 
 def code_hash(package_dir=None):
-    """A hash of the package's source files: executed notebooks are cached per hash."""
+    """A hash of the package's source files (the site builder's own excepted): executed
+    notebooks are cached per hash."""
     package_dir = Path(package_dir or Path(__file__).resolve().parents[1])
     h = hashlib.sha256()
     for path in sorted(package_dir.rglob("*.py")):
+        if path.relative_to(package_dir).parts[0] == "site":
+            continue
         h.update(str(path.relative_to(package_dir)).encode())
         h.update(path.read_bytes())
     return h.hexdigest()[:16]

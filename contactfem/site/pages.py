@@ -41,6 +41,22 @@ def readme_section(text, heading=GALLERY_HEADING):
     return lines[start + 1:end]
 
 
+_COMMENT = re.compile(r"^\s*<!--.*-->\s*$")
+_ANY_LINK = re.compile(r"\[([^\]]+)\]\(([^)\s]+)\)")
+_IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".gif", ".svg")
+
+
+def _repo_link(line):
+    """A link of the README to a repository file that is not a figure: the file's path as
+    text (the site does not carry it)."""
+    def sub(m):
+        label, target = m.groups()
+        if re.match(r"[a-z]+:", target) or target.startswith("#") or target.lower().endswith(_IMAGE_SUFFIXES):
+            return m.group(0)
+        return f"`{target}`" if label == target else f"{label} (`{target}` in the repository)"
+    return _ANY_LINK.sub(sub, line)
+
+
 def _cells(row):
     return [c.strip() for c in row.strip().strip("|").split("|")]
 
@@ -92,6 +108,8 @@ def gallery_page(repo):
         out += ["| paper's value | ours |", "|---|---|", f"| {theirs} | {cells.get('ours', '-')} |", ""]
         for label, target in _LINK.findall(cells.get("figure", "")):
             out += _figure_block(label, target, repo)
+    out[2:] = [_repo_link(ln) for ln in out[2:] if not _COMMENT.match(ln)]
+    rest = [_repo_link(ln) for ln in rest if not _COMMENT.match(ln)]
     extra = []
     for ln in rest:
         m = _IMAGE_LINE.match(ln)
