@@ -69,6 +69,8 @@ PARAMS = (
     Param("law", "conical", choices=LAWS,
           doc="slip surface: conical (eq 10, n = 1: Coulomb with mu = alpha + beta), "
               "parabolic (eq 10 with exponent n) or coulomb (eq 11 with mu)"),
+    Param("plane", "strain", choices=("strain", "stress"),
+          doc="plane strain or plane stress (the scan does not say; plane stress needs material = linear)"),
     Param("material", "linear", choices=MATERIALS,
           doc="bulk material: small-strain linear (as Oden & Pires), St Venant-Kirchhoff or neo-Hooke"),
     Param("tangent", "consistent", choices=TANGENTS,
@@ -83,11 +85,17 @@ PARAMS = (
     Param("nx", 20, "", 3, 400, doc="elements along the width (paper: 200 elements in all)"),
     Param("ny", 10, "", 1, 400, doc="elements along the height"),
     Param("p_y", 200.0, "F/L", 0.0, doc="downward pressure on the top (paper: p_y = 200 per unit length)"),
-    Param("p_x", 60.0, "F/L", doc="traction along +x on the right side (paper: p_x = 60 per unit length)"),
+    Param("p_x", 60.0, "F/L", doc="tangential traction along +x on the side p_x_face (paper: p_x = 60 per unit length)"),
+    Param("p_x_face", "right", choices=("right", "left"),
+          doc="lateral side carrying p_x (the scan: 'one of its lateral sides'); with p_x > 0 the right side is "
+              "pulled, the left side pushed"),
     Param("c_N", 1.0e5, "F/L^2", 0.0, low_open=True,
           doc="normal penalty per unit length (eq 4). Chosen: scan lost it (it reads 'lo*'). 1e5 keeps the "
               "penetration (~2e-3) three orders below the elastic settlement (~0.6) yet is only twice c_T, "
               "so the normal and tangential springs are balanced; see the c_N sweep in lecture 04"),
+    Param("penalty", "per_length", choices=("per_length", "per_node"),
+          doc="unit of c_N and c_T: per_length (tractions per unit gap) or per_node (nodal stiffnesses, "
+              "converted to per length by the bottom element length width/nx; the scan gives no unit)"),
     Param("m", 1.0, "", 1.0, doc="exponent of the normal law (eq 4); m = 1 is the penalty method (paper)"),
     Param("c_T", 5.0e4, "F/L^2", 0.0, low_open=True,
           doc="stick stiffness per unit length (eq 5); 1e4 per interior node of tributary length 0.2 (paper: c_T = 1e4)"),
@@ -121,15 +129,23 @@ def block_mesh(width, height, nx, ny):
     })
 
 
+def per_length(params):
+    """Factor from the parameters c_N, c_T to stiffnesses per unit length: 1 for
+    penalty = per_length; 1 / (width / nx) for per_node (every contact node of the
+    uniform mesh has the tributary length width / nx)."""
+    return 1.0 if params.get("penalty", "per_length") == "per_length" else params["nx"] / params["width"]
+
+
 def friction_law(params):
     """The friction law of the scene: conical/parabolic slip surface (eq 10) or Coulomb (eq 11)."""
     law = params["law"]
+    c_T = params["c_T"] * per_length(params)
     if law == "conical":
-        return ParabolicSlip(c_T=params["c_T"], alpha=params["alpha"], beta=params["beta"], n=1.0)
+        return ParabolicSlip(c_T=c_T, alpha=params["alpha"], beta=params["beta"], n=1.0)
     if law == "parabolic":
-        return ParabolicSlip(c_T=params["c_T"], alpha=params["alpha"], beta=params["beta"], n=params["n"])
+        return ParabolicSlip(c_T=c_T, alpha=params["alpha"], beta=params["beta"], n=params["n"])
     if law == "coulomb":
-        return Coulomb(c_T=params["c_T"], mu=params["mu"])
+        return Coulomb(c_T=c_T, mu=params["mu"])
     raise ValueError(f"parameter law = {law!r} is not allowed: one of {'|'.join(LAWS)}")
 
 
@@ -168,7 +184,7 @@ def build(params, friction=None):
     ``friction``: a friction law object to use instead of params["law"] (a student's law)."""
     W, H = params["width"], params["height"]
     mesh = block_mesh(W, H, params["nx"], params["ny"])
-    body = Continuum(mesh, E=params["E"], nu=params["nu"], rho=0.0, kind="plane_strain",
+    body = Continuum(mesh, E=params["E"], nu=params["nu"], rho=0.0, kind="plane_" + params["plane"],
                      material=params["material"], name="block")
     bottom = body.boundary_nodes("bottom")
     bottom = bottom[np.argsort(body.X[bottom, 0])]          # left to right
@@ -178,11 +194,11 @@ def build(params, friction=None):
     weights = tributary_lengths(body.X[bottom])[k:-k]        # tractions per unit length of the bottom
     slaves = bottom[k:-k]                                   # the first and last element never touch
     contact = NodeToSegment(body, slaves, RigidLine((0.0, 0.0), (0.0, 1.0)),
-                            PowerLaw(c_N=params["c_N"], m=params["m"]), friction or friction_law(params),
+                            PowerLaw(c_N=params["c_N"] * per_length(params), m=params["m"]), friction or friction_law(params),
                             weights=weights, offset=-params["g_N0"], name="foundation")
     p_y, p_x = params["p_y"], params["p_x"]
     loads = [Pressure(body, "top", lambda t: p_y * t),                # dead loads, ramped over the
-             Traction(body, "right", lambda t: (p_x * t, 0.0))]      # pseudo-time t in [0, 1]
+             Traction(body, params["p_x_face"], lambda t: (p_x * t, 0.0))]   # pseudo-time t in [0, 1]
     system_contact = contact if params["tangent"] == "consistent" else ContactTangent(contact, params["tangent"])
     system = System([body], [system_contact], loads)
     return dict(body=body, contact=contact, loads=loads, system=system, slaves=slaves)
