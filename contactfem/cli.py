@@ -1,5 +1,5 @@
 """Command line: `contactfem list | show SCENE | run SCENE [--preset fast|paper]
-[--set NAME=VALUE ...] [--json FILE]` (and the commands later issues add).
+[--set NAME=VALUE ...] [--json FILE] | figures | sweep | bench | equations`.
 
 Bad input (unknown scene, unknown or out-of-range parameter) prints one line on
 stderr and exits with code 2, without a traceback. A failed Newton solve exits

@@ -7,6 +7,10 @@ pointing to a temporary folder. The kernel is called "python3" but is defined he
 temporary JUPYTER_PATH, as *this* interpreter with the repository first on PYTHONPATH:
 the test runs the code of this checkout, whatever kernel the machine has registered.
 New notebooks are picked up automatically (glob, sorted).
+
+A missing notebook dependency (nbformat, nbclient, ipykernel) skips these tests on a
+student's machine, but FAILS them when CI=true: CI installs ".[all]", so a missing
+package there is a broken install, not an optional extra.
 """
 
 import json
@@ -17,10 +21,23 @@ from pathlib import Path
 
 import pytest
 
+ON_CI = os.environ.get("CI", "").lower() in ("true", "1", "yes")
+
 REPO = Path(__file__).resolve().parents[1]
 LECTURES = sorted((REPO / "lectures").glob("*.ipynb"))
 CELL_TIMEOUT = 300        # seconds per cell
 MAX_STORED_OUTPUT = 2000  # characters of stored output allowed per notebook ("small ones")
+
+
+def require(module):
+    """Import a notebook dependency: skip without it, except on CI (CI=true), where it fails."""
+    if ON_CI:
+        try:
+            return __import__(module)
+        except ImportError as err:
+            pytest.fail(f"CI=true but the notebook dependency {module!r} is missing ({err}): "
+                        "install '.[all]'", pytrace=False)
+    return pytest.importorskip(module)
 
 
 def _stored_output_size(nb):
@@ -49,7 +66,7 @@ def test_there_are_lectures():
 
 @pytest.mark.parametrize("path", LECTURES, ids=[p.name for p in LECTURES])
 def test_stored_without_outputs(path):
-    nbformat = pytest.importorskip("nbformat")
+    nbformat = require("nbformat")
     nb = nbformat.read(path, as_version=4)
     nbformat.validate(nb)
     size = _stored_output_size(nb)
@@ -58,8 +75,9 @@ def test_stored_without_outputs(path):
 
 @pytest.mark.parametrize("path", LECTURES, ids=[p.name for p in LECTURES])
 def test_lecture_runs(path, kernel_env):
-    nbformat = pytest.importorskip("nbformat")
-    nbclient = pytest.importorskip("nbclient")
+    nbformat = require("nbformat")
+    nbclient = require("nbclient")
+    require("ipykernel")
     work = kernel_env / "lectures"
     shutil.copytree(REPO / "lectures", work)
     nb = nbformat.read(work / path.name, as_version=4)
@@ -69,3 +87,13 @@ def test_lecture_runs(path, kernel_env):
         client.execute()
     except nbclient.exceptions.CellExecutionError as err:
         pytest.fail(f"{path.name} failed:\n{str(err)[-4000:]}", pytrace=False)
+
+
+def test_a_missing_dependency_fails_on_ci(monkeypatch):
+    # the rule above, checked: on CI a missing module is a failure, elsewhere a skip
+    monkeypatch.setattr(sys.modules[__name__], "ON_CI", True)
+    with pytest.raises(pytest.fail.Exception, match="CI=true"):
+        require("contactfem_no_such_module")
+    monkeypatch.setattr(sys.modules[__name__], "ON_CI", False)
+    with pytest.raises(pytest.skip.Exception):
+        require("contactfem_no_such_module")

@@ -1,4 +1,4 @@
-"""Figures of `contactfem bench` (issue 6; lecture 09): the tangent comparison, the
+"""Figures of `contactfem bench` (lecture 09): the tangent comparison, the
 work-precision diagrams and the cost of a Newton iteration.
 
 Data: the bench JSON named by $CONTACTFEM_BENCH, else the repository's bench.json (a
@@ -36,7 +36,7 @@ def load_bench(preset="fast"):
     return _CACHE["quick"]
 
 
-@figure("bench_tangents", "issue 6")
+@figure("bench_tangents", "bench")
 def bench_tangents(preset="fast", outdir=None):
     """Linear solves to the same tolerance: consistent tangent vs symmetric, frozen, staggered."""
     plt = pyplot()
@@ -70,7 +70,7 @@ def _rows(block):
     return [r for r in block["rows"] if r.get("ok") and r.get("error_x_roll", r.get("error_p0")) is not None]
 
 
-@figure("bench_work_precision", "issue 6")
+@figure("bench_work_precision", "bench")
 def bench_work_precision(preset="fast", outdir=None):
     """Error against wall time: hertz (mesh), rolling ring (dt, mesh, Newmark, beam vs
     continuum), bar impact (implicit Newmark vs explicit central differences)."""
@@ -132,7 +132,7 @@ def bench_work_precision(preset="fast", outdir=None):
     return [savefig(fig, outdir or default_outdir(), "bench_work_precision")]
 
 
-@figure("bench_cost", "issue 6")
+@figure("bench_cost", "bench")
 def bench_cost(preset="fast", outdir=None):
     """Time of one Newton iteration split into bulk, contact, assembly and solve; contact
     time against the number of contact nodes."""

@@ -155,7 +155,7 @@ def table1_markdown(hist):
     n = max(len(PAPER_TABLE1["parabolic"]), len(hist["conical"]), len(hist["parabolic"]), len(hist["coulomb"]))
     lines = ["# Table 1: norm of the residual ||G|| per Newton iteration, whole load in one step",
              "",
-             "Block of Sec. 5.1 (canonical data of issue 3: width 4, height 3.5, 20 x 10 quads, E = 1000, "
+             "Block of Sec. 5.1 (canonical data, chosen: width 4, height 3.5, 20 x 10 quads, E = 1000, "
              "nu = 0.3, c_N = 1e5 chosen, c_T = 5e4 per unit length). Iteration 1 is the initial state u = 0: its "
              "residual is the nodal load vector (top pressure and right traction; the contact forces at "
              "g_N0 = -1e-12 are ~1e-8). The paper's block dimensions are not known, hence its different "

@@ -6,11 +6,11 @@ whole load in ONE static step. The block is held only by the contact: normal
 penalty (eq 4, m = 1) and friction (eq 10 conical or parabolic, eq 11 Coulomb)
 at the nodes of its bottom side against ``RigidLine`` y = 0.
 
-Canonical data (the paper does not give the dimensions; see issue 3):
+Canonical data (chosen: the paper does not give the dimensions):
 width 4, height 3.5, 20 x 10 four-node elements, plane strain, E = 1000,
 nu = 0.3, p_y = 200 (down, on the top), p_x = 60 (+x, on the right side).
 The paper keeps "the first and the last element in the contact area" out of
-contact; the issue: "the bottom nodes may touch except the two at each end". So
+contact; we read that as "the bottom nodes may touch except the two at each end". So
 the slave nodes are the bottom nodes without the two at each end (both nodes of
 the first and of the last bottom element; ``free_end_nodes`` = 2), 17 nodes from
 x = 0.4 to 3.6. Their weights are their tributary lengths on the bottom side
@@ -78,10 +78,10 @@ PARAMS = (
               "frozen (without the c_N^s C coupling of eq 49)"),
     Param("E", 1000.0, "F/L^2", 0.0, low_open=True, doc="Young's modulus (paper)"),
     Param("nu", 0.3, "", -1.0, 0.5, low_open=True, high_open=True, doc="Poisson's ratio (paper)"),
-    Param("width", 4.0, "L", 0.0, low_open=True, doc="block width (canonical, issue 3; the paper does not give it)"),
-    Param("height", 3.5, "L", 0.0, low_open=True, doc="block height (canonical, issue 3)"),
+    Param("width", 4.0, "L", 0.0, low_open=True, doc="block width. Chosen: the paper does not give it"),
+    Param("height", 3.5, "L", 0.0, low_open=True, doc="block height. Chosen: the paper does not give it"),
     Param("free_end_nodes", 2, "", 1, 100,
-          doc="bottom nodes at each end kept out of contact (issue 3: two; the paper: first and last element)"),
+          doc="bottom nodes at each end kept out of contact (chosen: two, both nodes of the paper's first and last element)"),
     Param("nx", 20, "", 3, 400, doc="elements along the width (paper: 200 elements in all)"),
     Param("ny", 10, "", 1, 400, doc="elements along the height"),
     Param("p_y", 200.0, "F/L", 0.0, doc="downward pressure on the top (paper: p_y = 200 per unit length)"),
@@ -103,7 +103,7 @@ PARAMS = (
     Param("beta", 0.3, "", 0.0, doc="eq 10 (paper: 0.3)"),
     Param("n", 0.5, "", 0.0, 1.0, low_open=True, doc="exponent of the parabolic slip surface (paper: 0.5); "
                                                       "the conical law has n = 1"),
-    Param("mu", 0.3, "", 0.0, doc="Coulomb coefficient for law=coulomb (issue 3: 0.3, a wide slip zone)"),
+    Param("mu", 0.3, "", 0.0, doc="Coulomb coefficient for law=coulomb (ours, not the paper's: 0.3, a wide slip zone)"),
     Param("g_N0", -1.0e-12, "L", -1e-3, 0.0, high_open=True,
           doc="initial gap of the bottom nodes. Chosen: a touch (-1e-12) so the first Newton iterate has "
               "contact stiffness (at g_N = 0 the contact is inactive and the tangent singular)"),

@@ -1,4 +1,4 @@
-"""`contactfem bench`: speed against accuracy, measured (issue 6).
+"""`contactfem bench`: speed against accuracy, measured.
 
 Four studies, each a function returning a JSON-able dict; ``run_bench`` runs them all
 and ``write_markdown`` turns the result into the tables of BENCHMARKS.md.
@@ -21,7 +21,7 @@ and ``write_markdown`` turns the result into the tables of BENCHMARKS.md.
                    paper sizes and for the block refined to about 1e5 unknowns; contact
                    time against the number of contact nodes (slope ~1: linear).
 4. targets         every paper scene at the paper preset (wall time of the solve and of
-                   the whole `contactfem run` process), against the issue's targets.
+                   the whole `contactfem run` process), against the targets.
 
 ``quick`` shrinks every study (fast presets, fewer points) to about a minute in all.
 No timing enters a test: times depend on the machine and its load.
@@ -485,10 +485,10 @@ def _f(x, fmt="{:.3g}"):
     return fmt.format(x) if isinstance(x, (int, float)) else str(x)
 
 
-# Measured on this machine while working on issue 6 (same scene, same preset, before and
+# Measured on this machine during development (same scene, same preset, before and
 # after each change; the tables above are from the current code).
 OPTIMISATIONS = [
-    "### Optimisations (before -> after, measured during issue 6)", "",
+    "### Optimisations (before -> after, measured during development)", "",
     "| change | where | before | after |", "|---|---|---|---|",
     "| quadrature-point fields read as plain arrays in the weak forms (indexing a scikit-fem "
     "DiscreteField copies the whole field, once per basis-function pair) | bodies/continuum.py | "
