@@ -38,7 +38,8 @@ def draw_mesh(ax, X, t, **kw):
 @figure("fig06_block_mesh_deformed", "Fig 6")
 def fig06(preset="fast", outdir=None, law="conical"):
     plt = pyplot()
-    s = solve(SCENE.resolve(preset, {"law": law}))
+    params = SCENE.resolve(preset, {"law": law})
+    s = solve(params)
     body, u, rep = s["body"], s["u"], s["report"]
     X, t = body.X, body.mesh.t
     x = X + u[body.xdofs]
@@ -48,13 +49,19 @@ def fig06(preset="fast", outdir=None, law="conical"):
     draw_mesh(ax, X, t, edgecolors="k", linewidths=0.6)
     for xi in np.linspace(0, W, 9):                               # pressure p_y on the top
         ax.annotate("", (xi, H), (xi, H + 0.5), arrowprops=dict(arrowstyle="->", color="tab:green"))
-    for yi in np.linspace(0, H, 8):                               # traction p_x on the right side
-        ax.annotate("", (W + 0.5, yi), (W, yi), arrowprops=dict(arrowstyle="->", color="tab:purple"))
-    ax.text(W / 2, H + 0.6, "p_y = 200", ha="center", color="tab:green")
-    ax.text(W + 0.55, H / 2, "p_x = 60", va="center", color="tab:purple")
+    right = params["p_x_face"] == "right"                          # traction p_x on a lateral side
+    x0 = W if right else 0.0
+    for yi in np.linspace(0, H, 8):
+        tail = (x0, yi) if right else (x0 - 0.5, yi)
+        ax.annotate("", (tail[0] + 0.5, yi), tail, arrowprops=dict(arrowstyle="->", color="tab:purple"))
+    ax.text(W / 2, H + 0.6, f"p_y = {params['p_y']:g}", ha="center", color="tab:green")
+    ax.text(W + 0.55 if right else -0.55, H / 2, f"p_x = {params['p_x']:g}", va="center",
+            ha="left" if right else "right", color="tab:purple")
     Xs = rep["X"]
-    ax.plot(Xs[:, 0], Xs[:, 1], "o", ms=4, color="tab:orange", label="contact nodes (17)")
-    ax.set_title("system and discretisation: 20 x 10 quads, width 4, height 3.5", fontsize=9)
+    ax.plot(Xs[:, 0], Xs[:, 1], "o", ms=4, color="tab:orange", label=f"contact nodes ({len(Xs)})")
+    fitted = " (FITTED to Table 1)" if preset in ("fast", "paper") else ""
+    ax.set_title(f"system and discretisation: {params['nx']} x {params['ny']} quads, width {W:g},\n"
+                 f"height {H:g}, plane {params['plane']}{fitted}", fontsize=9)
     ax.legend(loc="lower left", fontsize=8)
     ax = axes[1]
     draw_mesh(ax, X, t, edgecolors="0.8", linewidths=0.5)
@@ -63,13 +70,13 @@ def fig06(preset="fast", outdir=None, law="conical"):
         sel = rep["state"] == state
         if sel.any():
             ax.plot(rep["x"][sel, 0], rep["x"][sel, 1], "o", ms=4, color=color, label=state)
-    ax.set_title(f"deformed ({law} law), displacements at true scale (x1): max |u| = "
+    ax.set_title(f"deformed ({law} law), displacements at true scale (x1):\nmax |u| = "
                  f"{np.linalg.norm(u[body.xdofs], axis=1).max():.2f}; grey: undeformed", fontsize=9)
     ax.legend(loc="lower left", fontsize=8)
     for ax in axes:
         ax.axhline(0.0, color="k", lw=2.5)
-        ax.fill_between([-0.5, W + 1.5], -0.4, 0.0, color="0.85", alpha=0.5, lw=0, zorder=0)
-        ax.set_xlim(-0.5, W + 1.5)
+        ax.fill_between([-1.5, W + 1.5], -0.4, 0.0, color="0.85", alpha=0.5, lw=0, zorder=0)
+        ax.set_xlim(-1.5, W + 1.5)
         ax.set_ylim(-0.45, H + 1.0)
         ax.set_aspect("equal")
     fig.suptitle("Fig 6: elastic block on a rigid rough foundation, whole load in one step", fontsize=10)
@@ -114,7 +121,7 @@ def fig07(preset="fast", outdir=None):
     draw_stresses(ax, r, "(conical)")
     _stress_axes(ax, "Fig 7: stresses on the contact area, conical slip surface (n = 1, alpha + beta = 0.5)\n"
                      f"sum |t_N| w = {-r['total_normal']:.6g}, sum t_T w = {r['total_tangential']:.6g}; "
-                     "no node reaches the slip bound on this block")
+                     f"{r['n_slip']} of {len(r['contact']['state'])} nodes slip")
     return [savefig(fig, outdir or default_outdir(), "fig07_block_conical_stresses")]
 
 
@@ -143,8 +150,9 @@ def residual_histories(preset="fast"):
     return out
 
 
-def table1_markdown(hist):
+def table1_markdown(hist, params=None):
     """Table 1 as markdown: the paper's values beside ours (linear solves = rows - 1)."""
+    p = params or SCENE.resolve("paper")
     def cell(values, k, law=None):
         if k >= len(values):
             return ""
@@ -155,11 +163,13 @@ def table1_markdown(hist):
     n = max(len(PAPER_TABLE1["parabolic"]), len(hist["conical"]), len(hist["parabolic"]), len(hist["coulomb"]))
     lines = ["# Table 1: norm of the residual ||G|| per Newton iteration, whole load in one step",
              "",
-             "Block of Sec. 5.1 (canonical data, chosen: width 4, height 3.5, 20 x 10 quads, E = 1000, "
-             "nu = 0.3, c_N = 1e5 chosen, c_T = 5e4 per unit length). Iteration 1 is the initial state u = 0: its "
-             "residual is the nodal load vector (top pressure and right traction; the contact forces at "
-             "g_N0 = -1e-12 are ~1e-8). The paper's block dimensions are not known, hence its different "
-             "first value. (scan?): exponent garbled in the scan, value uncertain.",
+             f"Block of Sec. 5.1: E = {p['E']:g}, nu = {p['nu']:g}, c_T = {p['c_T']:g} ({p['penalty']}) from the scan; "
+             f"FITTED to this table (the scan lost them; `contactfem reconstruct block`): width {p['width']:g}, "
+             f"height {p['height']:g}, {p['nx']} x {p['ny']} quads, p_x on the {p['p_x_face']} side, "
+             f"{p['free_end_nodes']} free end nodes, c_N = {p['c_N']:g}, plane {p['plane']}. Iteration 1 is the "
+             "initial state u = 0: its residual is the nodal load vector (top pressure and side traction; the "
+             "contact forces at g_N0 = -1e-12 are ~1e-8); no uniform mesh reproduces the printed first value. "
+             "(scan?): exponent garbled in the scan, value uncertain.",
              "",
              "| iteration | paper conical | ours conical | paper parabolic | ours parabolic | ours Coulomb mu = 0.3 |",
              "|---:|---:|---:|---:|---:|---:|"]
@@ -182,7 +192,7 @@ def table1(preset="fast", outdir=None):
     hist = residual_histories(preset)
     md = Path(outdir) / "table1_block_newton_residuals.md"
     md.parent.mkdir(parents=True, exist_ok=True)
-    md.write_text(table1_markdown(hist))
+    md.write_text(table1_markdown(hist, SCENE.resolve(preset)))
     fig, ax = plt.subplots(figsize=(7.5, 5))
     colors = {"conical": "tab:blue", "parabolic": "tab:red"}
     for law, color in colors.items():
