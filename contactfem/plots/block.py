@@ -18,7 +18,7 @@ import numpy as np
 
 from ..scenes.block import PAPER_TABLE1, PAPER_TABLE1_UNCERTAIN, SCENE, solve
 from ..solver.newton import NewtonError
-from . import cached_run, default_outdir, figure, pyplot, savefig
+from . import cached_run, default_outdir, describe_newton, figure, pyplot, savefig
 
 STATE_COLORS = {"stick": "tab:blue", "slip": "tab:red", "open": "0.6"}
 
@@ -38,8 +38,8 @@ def draw_mesh(ax, X, t, **kw):
 @figure("fig06_block_mesh_deformed", "Fig 6")
 def fig06(preset="fast", outdir=None, law="conical"):
     plt = pyplot()
-    params = SCENE.resolve(preset, {"law": law})
-    s = solve(params)
+    P = SCENE.resolve(preset, {"law": law})
+    s = solve(P)
     body, u, rep = s["body"], s["u"], s["report"]
     X, t = body.X, body.mesh.t
     x = X + u[body.xdofs]
@@ -49,19 +49,19 @@ def fig06(preset="fast", outdir=None, law="conical"):
     draw_mesh(ax, X, t, edgecolors="k", linewidths=0.6)
     for xi in np.linspace(0, W, 9):                               # pressure p_y on the top
         ax.annotate("", (xi, H), (xi, H + 0.5), arrowprops=dict(arrowstyle="->", color="tab:green"))
-    right = params["p_x_face"] == "right"                          # traction p_x on a lateral side
+    right = P["p_x_face"] == "right"                          # traction p_x on a lateral side
     x0 = W if right else 0.0
     for yi in np.linspace(0, H, 8):
         tail = (x0, yi) if right else (x0 - 0.5, yi)
         ax.annotate("", (tail[0] + 0.5, yi), tail, arrowprops=dict(arrowstyle="->", color="tab:purple"))
-    ax.text(W / 2, H + 0.6, f"p_y = {params['p_y']:g}", ha="center", color="tab:green")
-    ax.text(W + 0.55 if right else -0.55, H / 2, f"p_x = {params['p_x']:g}", va="center",
+    ax.text(W / 2, H + 0.6, f"p_y = {P['p_y']:g}", ha="center", color="tab:green")
+    ax.text(W + 0.55 if right else -0.55, H / 2, f"p_x = {P['p_x']:g}", va="center",
             ha="left" if right else "right", color="tab:purple")
     Xs = rep["X"]
     ax.plot(Xs[:, 0], Xs[:, 1], "o", ms=4, color="tab:orange", label=f"contact nodes ({len(Xs)})")
     fitted = " (FITTED to Table 1)" if preset in ("fast", "paper") else ""
-    ax.set_title(f"system and discretisation: {params['nx']} x {params['ny']} quads, width {W:g},\n"
-                 f"height {H:g}, plane {params['plane']}{fitted}", fontsize=9)
+    ax.set_title(f"system and discretisation: {P['nx']} x {P['ny']} quads, width {W:g},\n"
+                 f"height {H:g}, plane {P['plane']}{fitted}", fontsize=9)
     ax.legend(loc="lower left", fontsize=8)
     ax = axes[1]
     draw_mesh(ax, X, t, edgecolors="0.8", linewidths=0.5)
@@ -117,11 +117,13 @@ def _stress_axes(ax, title):
 def fig07(preset="fast", outdir=None):
     plt = pyplot()
     r = result(preset, law="conical")
+    P = r["parameters"]
     fig, ax = plt.subplots(figsize=(7.5, 5))
     draw_stresses(ax, r, "(conical)")
-    _stress_axes(ax, "Fig 7: stresses on the contact area, conical slip surface (n = 1, alpha + beta = 0.5)\n"
+    _stress_axes(ax, "Fig 7: stresses on the contact area, conical slip surface "
+                     f"(n = 1, alpha + beta = {P['alpha'] + P['beta']:g})\n"
                      f"sum |t_N| w = {-r['total_normal']:.6g}, sum t_T w = {r['total_tangential']:.6g}; "
-                     f"{r['n_slip']} of {len(r['contact']['state'])} nodes slip")
+                     + slip_words(r))
     return [savefig(fig, outdir or default_outdir(), "fig07_block_conical_stresses")]
 
 
@@ -133,9 +135,18 @@ def fig08(preset="fast", outdir=None):
     fig, ax = plt.subplots(figsize=(7.5, 5))
     draw_stresses(ax, rc, "conical", style=":", faint=True)
     draw_stresses(ax, r, "(parabolic)")
-    _stress_axes(ax, "Fig 8: stresses on the contact area, parabolic slip surface (n = 0.5, alpha = 0.2, beta = 0.3)\n"
-                     "grey: the conical case (Fig 7)")
+    P = r["parameters"]
+    _stress_axes(ax, "Fig 8: stresses on the contact area, parabolic slip surface "
+                     f"(n = {P['n']:g}, alpha = {P['alpha']:g}, beta = {P['beta']:g})\n"
+                     f"{slip_words(r)}; grey: the conical case (Fig 7)")
     return [savefig(fig, outdir or default_outdir(), "fig08_block_parabolic_stresses")]
+
+
+def slip_words(r):
+    """How many contact nodes slip, stick and are open in a block run, in words."""
+    n_slip = r["n_slip"]
+    text = "no node reaches the slip bound" if n_slip == 0 else f"{n_slip} of {len(r['contact']['x'])} nodes slip"
+    return text + f" ({r['n_stick']} stick, {r['n_open']} open)"
 
 
 def residual_histories(preset="fast"):
@@ -143,16 +154,19 @@ def residual_histories(preset="fast"):
     Coulomb case with the tangent without the c_N^s coupling ('frozen')."""
     out = {law: result(preset, law=law)["newton_residuals"] for law in ("conical", "parabolic", "coulomb")}
     out["coulomb, frozen tangent"] = result(preset, law="coulomb", tangent="frozen")["newton_residuals"]
+    out["verdict"] = {key: describe_newton(hist, True) for key, hist in out.items()}
     try:
         out["coulomb, symmetric tangent"] = result(preset, law="coulomb", tangent="symmetric", maxit=12)["newton_residuals"]
+        out["verdict"]["coulomb, symmetric tangent"] = describe_newton(out["coulomb, symmetric tangent"], True)
     except NewtonError as err:
         out["coulomb, symmetric tangent"] = err.history
+        out["verdict"]["coulomb, symmetric tangent"] = describe_newton(err.history, False)
+    out["parameters"] = result(preset, law="conical")["parameters"]
     return out
 
 
-def table1_markdown(hist, params=None):
+def table1_markdown(hist):
     """Table 1 as markdown: the paper's values beside ours (linear solves = rows - 1)."""
-    p = params or SCENE.resolve("paper")
     def cell(values, k, law=None):
         if k >= len(values):
             return ""
@@ -161,27 +175,29 @@ def table1_markdown(hist, params=None):
             text += " (scan?)"
         return text
     n = max(len(PAPER_TABLE1["parabolic"]), len(hist["conical"]), len(hist["parabolic"]), len(hist["coulomb"]))
+    P = hist["parameters"]
     lines = ["# Table 1: norm of the residual ||G|| per Newton iteration, whole load in one step",
              "",
-             f"Block of Sec. 5.1: E = {p['E']:g}, nu = {p['nu']:g}, c_T = {p['c_T']:g} ({p['penalty']}) from the scan; "
-             f"FITTED to this table (the scan lost them; `contactfem reconstruct block`): width {p['width']:g}, "
-             f"height {p['height']:g}, {p['nx']} x {p['ny']} quads, p_x on the {p['p_x_face']} side, "
-             f"{p['free_end_nodes']} free end nodes, c_N = {p['c_N']:g}, plane {p['plane']}. Iteration 1 is the "
+             f"Block of Sec. 5.1: E = {P['E']:g}, nu = {P['nu']:g}, c_T = {P['c_T']:g} ({P['penalty']}) from the scan; "
+             f"FITTED to this table (the scan lost them; `contactfem reconstruct block`): width {P['width']:g}, "
+             f"height {P['height']:g}, {P['nx']} x {P['ny']} quads, p_x on the {P['p_x_face']} side, "
+             f"{P['free_end_nodes']} free end nodes, c_N = {P['c_N']:g}, plane {P['plane']}. Iteration 1 is the "
              "initial state u = 0: its residual is the nodal load vector (top pressure and side traction; the "
              "contact forces at g_N0 = -1e-12 are ~1e-8); no uniform mesh reproduces the printed first value. "
              "(scan?): exponent garbled in the scan, value uncertain.",
              "",
-             "| iteration | paper conical | ours conical | paper parabolic | ours parabolic | ours Coulomb mu = 0.3 |",
+             f"| iteration | paper conical | ours conical | paper parabolic | ours parabolic | ours Coulomb mu = {P['mu']:g} |",
              "|---:|---:|---:|---:|---:|---:|"]
     for k in range(n):
         lines.append(f"| {k + 1} | {cell(PAPER_TABLE1['conical'], k, 'conical')} | {cell(hist['conical'], k)} | "
                      f"{cell(PAPER_TABLE1['parabolic'], k, 'parabolic')} | {cell(hist['parabolic'], k)} | "
                      f"{cell(hist['coulomb'], k)} |")
-    lines += ["", "Linear solves: paper conical 3, parabolic 6; ours conical "
+    lines += ["", f"Linear solves: paper conical {len(PAPER_TABLE1['conical']) - 1}, "
+              f"parabolic {len(PAPER_TABLE1['parabolic']) - 1}; ours conical "
               f"{len(hist['conical']) - 1}, parabolic {len(hist['parabolic']) - 1}, Coulomb {len(hist['coulomb']) - 1}; "
               f"Coulomb with the tangent without the c_N^s coupling (frozen): {len(hist['coulomb, frozen tangent']) - 1}; "
-              f"with the symmetrised tangent: diverges (residuals "
-              + ", ".join(f"{v:.2e}" for v in hist["coulomb, symmetric tangent"][:6]) + ", ...).", ""]
+              f"with the symmetrised tangent: {hist['verdict']['coulomb, symmetric tangent']}; residuals "
+              + ", ".join(f"{v:.2e}" for v in hist["coulomb, symmetric tangent"][:6]) + ", ...", ""]
     return "\n".join(lines)
 
 
@@ -192,7 +208,7 @@ def table1(preset="fast", outdir=None):
     hist = residual_histories(preset)
     md = Path(outdir) / "table1_block_newton_residuals.md"
     md.parent.mkdir(parents=True, exist_ok=True)
-    md.write_text(table1_markdown(hist, SCENE.resolve(preset)))
+    md.write_text(table1_markdown(hist))
     fig, ax = plt.subplots(figsize=(7.5, 5))
     colors = {"conical": "tab:blue", "parabolic": "tab:red"}
     for law, color in colors.items():
@@ -209,7 +225,7 @@ def table1(preset="fast", outdir=None):
     for key, style in (("coulomb", "-^"), ("coulomb, frozen tangent", "--v")):
         ours = hist[key]
         ax.semilogy(np.arange(1, len(ours) + 1), ours, style, color="tab:green" if key == "coulomb" else "0.5",
-                    label=f"ours, {key} (mu = 0.3)")
+                    label=f"ours, {key} (mu = {hist['parameters']['mu']:g})")
     ax.set_xlabel("iteration (1 = initial state)")
     ax.set_ylabel("||G||")
     ax.grid(alpha=0.3, which="both")

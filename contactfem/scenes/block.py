@@ -61,11 +61,13 @@ from skfem import MeshQuad
 
 from ..bodies.continuum import MATERIALS, Continuum
 from ..bodies.loads import Pressure, Traction
-from ..contact import NodeToSegment, RigidLine, to_coo, tributary_lengths
+from ..contact import RigidLine, to_coo, tributary_lengths
+from ..contact.augmented import make_interface
 from ..contact.kinematics import outer
 from ..laws.friction import Coulomb, ParabolicSlip
 from ..laws.normal import PowerLaw
 from ..solver import Static, System
+from . import enforcement
 from .base import Param, Scene
 
 # Table 1 of the paper: norm of the residual ||G|| per Newton iteration (the first
@@ -113,8 +115,8 @@ PARAMS = (
               "p_x > 0 the right side is pulled, the left side pushed"),
     Param("c_N", 1.0e5, "F/L^2", 0.0, low_open=True,
           doc="normal penalty per unit length (eq 4). The scan lost it (it reads 'lo*', 10^2 if '*' is a garbled "
-              "superscript 2); 1e5 FITTED to Table 1 (contactfem reconstruct block: 1e2..1e6 move the conical "
-              "residuals little, the parabolic ones more)"),
+              "superscript 2); 1e5 FITTED to Table 1 (contactfem reconstruct block). The run reports "
+              "max_penetration"),
     Param("penalty", "per_length", choices=("per_length", "per_node"),
           doc="unit of c_N and c_T: per_length (tractions per unit gap) or per_node (nodal stiffnesses, "
               "converted to per length by the bottom element length width/nx; the scan gives no unit)"),
@@ -136,6 +138,7 @@ PARAMS = (
     Param("rtol", 1e-10, "", 0.0, 1e-3, low_open=True, doc="Newton: ||G_k|| <= atol + rtol ||G_0||"),
     Param("atol", 1e-12, "F", 0.0, doc="Newton absolute tolerance"),
     Param("maxit", 40, "", 1, 500, doc="Newton: maximal number of linear solves"),
+    *enforcement.ENFORCEMENT_PARAMS,
 )
 
 
@@ -215,9 +218,9 @@ def build(params, friction=None):
         raise ValueError(f"parameter free_end_nodes = {k} is out of range: allowed [1, {(len(bottom) - 2) // 2}] for nx = {params['nx']}")
     weights = tributary_lengths(body.X[bottom])[k:-k]        # tractions per unit length of the bottom
     slaves = bottom[k:-k]                                   # the first and last element never touch
-    contact = NodeToSegment(body, slaves, RigidLine((0.0, 0.0), (0.0, 1.0)),
-                            PowerLaw(c_N=params["c_N"] * per_length(params), m=params["m"]), friction or friction_law(params),
-                            weights=weights, offset=-params["g_N0"], name="foundation")
+    contact = make_interface(params.get("enforcement", "penalty"), body, slaves, RigidLine((0.0, 0.0), (0.0, 1.0)),
+                             PowerLaw(c_N=params["c_N"] * per_length(params), m=params["m"]),
+                             friction or friction_law(params), weights=weights, offset=-params["g_N0"], name="foundation")
     p_y, p_x = params["p_y"], params["p_x"]
     loads = [Pressure(body, "top", lambda t: p_y * t),                # dead loads, ramped over the
              Traction(body, params["p_x_face"], lambda t: (p_x * t, 0.0))]   # pseudo-time t in [0, 1]
@@ -235,6 +238,9 @@ def solve(params, friction=None):
     system, contact = sc["system"], sc["contact"]
     n = params["n_steps"]
     stepper = Static(system, dt=1.0 / n, atol=params["atol"], rtol=params["rtol"], maxit=params["maxit"])
+    h = params["width"] / params["nx"]                        # gap_violation: penetration / element size
+    stepper = enforcement.wrap(dict(params, enforcement=params.get("enforcement", "penalty")), stepper,
+                               [contact], length=h)
     u = np.zeros(system.ndof)
     contact.initialize(u)
     results = []
@@ -244,7 +250,8 @@ def solve(params, friction=None):
         if k == n - 1:
             report, R_c = contact.report(u), contact.assemble(u)[0]
         system.commit(u)
-    return dict(sc, u=u, result=results[-1], results=results, report=report, R_c=R_c)
+    return dict(sc, u=u, result=results[-1], results=results, report=report, R_c=R_c, stepper=stepper,
+                element_size=h)
 
 
 def slip_bound(params, t_N):
@@ -290,6 +297,7 @@ def run(params):
         "n_slip": int(np.sum(slipping)),
         "n_open": int(np.sum(rep["state"] == "open")),
         "max_displacement": float(np.max(np.linalg.norm(u[dofs], axis=1))),
+        "max_penetration": float(max(-np.min(rep["g_N"]), 0.0)),
         "contact": {"x": rep["X"][:, 0], "x_current": rep["x"][:, 0], "t_N": rep["t_N"], "t_T": rep["t_T"],
                     "state": [str(v) for v in rep["state"]], "g_N": rep["g_N"], "slip_bound": Y,
                     "weights": rep["weights"]},
@@ -298,6 +306,8 @@ def run(params):
         "fitted": {k: params[k] for k in FITTED},
         "fitted_to": "Table 1 (first residual, number and pattern of the residuals, conical slip); "
                      "see contactfem reconstruct block",
+        **enforcement.report(params, s["stepper"], [r.iterations for r in s["results"]],
+                             enforcement.penetration(s["contact"], u), s["element_size"], "the element size width / nx"),
     }
 
 
