@@ -165,7 +165,6 @@ def build_parser():
     sw.add_argument("--scheduler", default=None, help="Dask scheduler address: run on that cluster instead")
     sw.add_argument("--out", default="sweep.csv", help="table of results (.csv or .json)")
     sw.set_defaults(func=cmd_sweep)
-<<<<<<< HEAD
     st = sub.add_parser("site", help="build the course website (lectures executed, gallery, equation index, API)")
     st.add_argument("--out", default=None, metavar="DIR", help="output folder, DIR/index.html (default: build/site)")
     st.set_defaults(func=cmd_site)

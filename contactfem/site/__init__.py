@@ -38,7 +38,8 @@ def code_hash(package_dir=None):
 
 
 def _prepare_cache(cache):
-    """Empty the notebook cache if it was made by different package code."""
+    """Empty the cache (executed notebooks, and Sphinx's read pages that hold their
+    outputs) if it was made by different package code."""
     stamp = cache / "contactfem-code.txt"
     digest = code_hash()
     if cache.exists() and (not stamp.exists() or stamp.read_text().strip() != digest):
@@ -76,9 +77,9 @@ def build(out=None, repo=None, quiet=True):
     env = dict(os.environ)
     _kernel_env(work / "site-kernel", env)
     env.update(CONTACTFEM_PRESET="fast", CONTACTFEM_FIGURES=str(work / "site-figures"),
-               CONTACTFEM_SITE_CACHE=str(cache), MPLBACKEND="module://matplotlib_inline.backend_inline")
+               CONTACTFEM_SITE_CACHE=str(cache / "notebooks"), MPLBACKEND="module://matplotlib_inline.backend_inline")
     cmd = [sys.executable, "-m", "sphinx", "-b", "html", "-W", "--keep-going", "-q",
-           "-d", str(work / "site-doctrees"), str(src), str(out)]
+           "-d", str(cache / "doctrees"), str(src), str(out)]   # read pages live with the cache
     proc = subprocess.run(cmd, env=env, cwd=str(src), capture_output=quiet, text=True)
     if proc.returncode != 0:
         msg = (proc.stdout or "")[-6000:] + (proc.stderr or "")[-6000:] if quiet else ""
