@@ -49,7 +49,7 @@ BAD_BEFORE_THE_RUN = [
     (["run", "block", "--set", "law=parabolic", "--set", "alpha=0.01", "--set", "beta=0.01"], "no static equilibrium"),
     (["run", "hertz", "--set", "n_el=2000"], "add --force"),
     (["run", "rolling_ring", "--set", "dt=1e-9"], "steps"),
-    (["run", "block", "--preset", "nonsense"], "invalid choice: 'nonsense'"),
+    (["run", "block", "--preset", "nonsense"], "nonsense"),
     (["run"], "required: scene"),
     (["figures", "--only", "nomatch"], "matches no figure"),
     (["run", "sloping_impact", "--set", "variant=viscoplastic", "--set", "kind=continuum"], "needs kind = 'beam'"),
