@@ -96,7 +96,7 @@ class NodeToSegment:
         t_N, dt_N = self.normal.traction(np.where(active, g_N, 1.0))
         dofs = np.concatenate([self.slave_dofs(), k["master_dofs"]], axis=1)
         travel = k["s"] - self.s_bar
-        r, ddg_T = np.ones_like(g_N), k["ds"]
+        r, dr, ddg_T = np.ones_like(g_N), np.zeros_like(g_N), k["ds"]
         if self.g_bar is not None:                          # the closing step (module docstring)
             closing = active & (self.g_bar > 0.0)
             if np.any(closing):
@@ -105,7 +105,7 @@ class NodeToSegment:
                 dr = np.where(closing, -gb / (gb - g_N) ** 2, 0.0)
                 ddg_T = r[:, None] * k["ds"] + (travel * dr)[:, None] * k["dg_N"]
         return dict(k, x_s=x_s, g_N=g_N, active=active, t_N=t_N, dt_N=dt_N, dg_T=r * travel, travel=travel,
-                    r=r, ddg_T=ddg_T, dofs=dofs)
+                    r=r, dr=dr, ddg_T=ddg_T, dofs=dofs)
 
     def evaluate(self, u):
         """Everything at displacement u with the committed history: kinematics,
