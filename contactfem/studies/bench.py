@@ -1,6 +1,6 @@
 """`contactfem bench`: speed against accuracy, measured.
 
-Four studies, each a function returning a JSON-able dict; ``run_bench`` runs them all
+Five studies, each a function returning a JSON-able dict; ``run_bench`` runs them all
 and ``write_markdown`` turns the result into the tables of BENCHMARKS.md.
 
 1. tangents        the paper's central claim (Sec. 4.2): Newton with the consistent
@@ -22,6 +22,8 @@ and ``write_markdown`` turns the result into the tables of BENCHMARKS.md.
                    time against the number of contact nodes (slope ~1: linear).
 4. targets         every paper scene at the paper preset (wall time of the solve and of
                    the whole `contactfem run` process), against the targets.
+5. enforcement     Newton solves to reach a gap violation of 1e-8, penalty against
+                   augmented Lagrangian, at three penalties (studies/enforcement.py).
 
 ``quick`` shrinks every study (fast presets, fewer points) to about a minute in all.
 No timing enters a test: times depend on the machine and its load.
@@ -38,6 +40,7 @@ from pathlib import Path
 import numpy as np
 
 from ..scenes import get_scene, jsonable, run_scene
+from .enforcement import enforcement_markdown, enforcement_study
 
 TARGETS = dict(scene_s=10.0, all_s=60.0, hertz_process_s=1.5, hertz_p0_error=0.005, hertz_quads=4000)
 PAPER_SCENES = ("block", "rolling_ring", "sloping_impact", "funnel", "cork")
@@ -452,7 +455,7 @@ def targets_study(quick=False):
 # ---------------------------------------------------------------------------
 
 STUDIES = {"tangents": tangent_study, "work_precision": work_precision, "cost": cost_study,
-           "targets": targets_study}
+           "targets": targets_study, "enforcement": enforcement_study}
 
 
 def machine():
@@ -618,6 +621,8 @@ def write_markdown(res):
               f"Hertz on {h['n_quads']} quads: p0 error {h['error_p0']:+.2%} (target 0.5 %: {_f(h['p0_within'])}), "
               f"solve {_f(h['solve_s'])} s, whole process {_f(h['process_s'])} s wall, "
               f"{_f(h.get('process_cpu_s'))} s CPU (best of 3; target 1.5 s wall: {_f(h['under_1p5s'])}).", ""]
+    if "enforcement" in res:
+        L += enforcement_markdown(res["enforcement"])
     return "\n".join(L) + "\n"
 
 
