@@ -165,3 +165,11 @@ def test_sloping_impact_friction_only_dissipates():
 def test_viscoplastic_ring_refuses_energy_consistent():
     with pytest.raises(ValueError, match="contact_integration"):
         run_scene("sloping_impact", "fast", {"contact_integration": "energy_consistent", "variant": "viscoplastic"})
+
+
+@pytest.mark.parametrize("scene, over", [("funnel", {"n_steps": 40}), ("rolling_ring", {"t_end": 0.3})])
+def test_other_ring_scenes_balance_energy(scene, over):
+    """The funnel (rigid polyline, symmetry supports) and the rolling ring (gravity, Coulomb
+    friction): energy + dissipation - work of the loads stays the initial energy."""
+    r = run_scene(scene, "fast", dict(over, contact_integration="energy_consistent"))
+    assert abs(r["energy_error"]) < 1e-6, r["energy_error"]
