@@ -28,14 +28,16 @@ def get_scene(name):
     return scenes[name]
 
 
-def run_scene(name, preset="fast", overrides=None):
-    """Run a scene and return its results with wall time, Newton iteration count and parameters."""
+def run_scene(name, preset="fast", overrides=None, progress=None):
+    """Run a scene and return its results with wall time, Newton iteration count and parameters.
+    ``progress(t0, t_end, label)``: a progress-callback factory handed to the scene's time
+    loops (e.g. ``contactfem.io.progress_bar``); None shows nothing."""
     import time
 
     scene = get_scene(name)
     params = scene.resolve(preset, overrides)
     t0 = time.perf_counter()
-    results = scene.run(params)
+    results = scene.run(params) if progress is None else scene.run(params, progress=progress)
     results = dict(results)
     results["wall_time_s"] = time.perf_counter() - t0
     results.setdefault("newton_iterations_total", 0)
