@@ -52,6 +52,7 @@ differences in tests/test_conserving.py).
 
 import numpy as np
 
+from .element import to_coo
 from .kinematics import outer
 
 
@@ -133,7 +134,6 @@ def conserving_force(contact, u0, u1):
 
 def assemble_conserving(contact, u0, u1):
     """Global residual and COO triplets of conserving_force."""
-    from .element import to_coo
     R, K, dofs, _ = conserving_force(contact, u0, u1)
     R_c = np.zeros(len(u1))
     np.add.at(R_c, dofs.ravel(), R.ravel())
