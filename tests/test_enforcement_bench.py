@@ -3,7 +3,7 @@ each of three penalties; the penalty meets it at none of them (its gap falls lik
 import pytest
 
 from contactfem.studies.bench import STUDIES, write_markdown
-from contactfem.studies.enforcement import TARGET, enforcement_markdown, enforcement_study
+from contactfem.studies.bench.enforcement import TARGET, enforcement_markdown, enforcement_study
 
 
 @pytest.fixture(scope="module")

@@ -10,7 +10,7 @@ time of the scene's run().
 """
 import time
 
-from ..scenes import get_scene, run_scene
+from ...scenes import get_scene, run_scene
 
 TARGET = 1e-8
 CASES = {"hertz": {}, "block": {"law": "parabolic"}}
