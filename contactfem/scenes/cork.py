@@ -32,7 +32,7 @@ Reconstructed (the scan lost them; each is a Param with "chosen: ..." in its doc
   breakaway pressure mu N / (pi R_neck^2) is 0.786 MPa against the 0.8 MPa applied
   (``breakaway_margin_MPa`` = applied - static breakaway, +0.014 MPa); R_tip + 0.1 mm
   or mu = 0.105 and the cork stays in (figure ``cork_knife_edge``, lecture 08).
-* The neck (``Neck``, a smooth rigid master defined here) has three pieces: the
+* The neck (``Neck``, a ``RigidComposite`` of contact/masters.py) has three pieces: the
   straight wall r = 10 mm up to z = 24 mm (traversed upwards, so that its normal
   n = e3 x t of eq 18 points into the neck, towards the cork), a rounded mouth
   (quarter circle of radius 2 mm, exact curvature) and the flat top of the bottle
@@ -311,7 +311,7 @@ def press_fit(model, P, log=None, progress=None):
     hist = integrate(stepper, 0.0, u, t_end=1.0, dt_rule=lambda t, u, v, a: ds, growth=1.0,
                      cutback=True, max_cuts=P["max_cuts"], min_dt=ds / 2**P["max_cuts"],
                      motion=lambda t1: neck.set_shift(shift0 * (1.0 - t1)),
-                     label=lambda k, t1, h: f"press fit {t1:.3f}", progress=progress)
+                     label=lambda k, t1, h: f"press fit {t1:.3f}", progress=progress, name="cork: press fit")
     # the axial hold's reaction: released at the start of stage 2 (the dynamic run
     # absorbs this small imbalance; it is reported, not hidden)
     reaction = float(hist.result.G[cork.xdofs[hold, 1]])
@@ -386,7 +386,7 @@ def pop(model, P, u0, log=None, progress=None):
     zero = np.zeros(system.ndof)
     hist = integrate(stepper, 0.0, u0.copy(), zero, t_end=P["t_end"], a0=zero, dt_rule=dt_rule,
                      cutback=True, max_cuts=P["max_cuts"], before_step=lambda t, u, v, a: gas.update(u, t),
-                     stop=flown, recorder=record, progress=progress,
+                     stop=flown, recorder=record, progress=progress, name="cork: pop",
                      label=lambda k, t1, h: f"cork t = {t1 * 1e3:.5f} ms, dt = {h:.2e}")
     H = {k: np.asarray(x) for k, x in H.items()}
     exited = bool(gas.released and H["n_contact"][-1] == 0)
