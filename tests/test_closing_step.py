@@ -53,3 +53,15 @@ def test_closing_tangent_deformable_master(rng, mu):
     e = iface.evaluate(u1)
     assert np.all(e["active"]) and np.all(e["r"] < 1.0)
     check_tangent(iface, u1)
+
+
+@pytest.mark.parametrize("phase", ["normal", "friction"])
+def test_closing_tangent_staggered_phases(phase):
+    """The two phases of the staggered algorithm at a closing node: the normal phase's stick
+    about the frozen state varies with s alone, the friction phase's slip with r (s - s_bar)."""
+    from contactfem.contact.tangents import SplitContact
+    iface, u1 = closing_node(mu=0.3)
+    split = SplitContact(iface)
+    split.freeze(u1)
+    split.set_phase(phase)
+    check_tangent(split, u1)
