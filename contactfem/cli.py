@@ -89,6 +89,12 @@ def cmd_equations(args):
     print(markdown_table())
 
 
+def cmd_site(args):
+    from .site import build
+
+    print(f"site -> {build(args.out)}")
+
+
 def cmd_reconstruct(args):
     from .studies.reconstruct import main as reconstruct
 
@@ -159,6 +165,9 @@ def build_parser():
     sw.add_argument("--scheduler", default=None, help="Dask scheduler address: run on that cluster instead")
     sw.add_argument("--out", default="sweep.csv", help="table of results (.csv or .json)")
     sw.set_defaults(func=cmd_sweep)
+    st = sub.add_parser("site", help="build the course website (lectures executed, gallery, equation index, API)")
+    st.add_argument("--out", default=None, metavar="DIR", help="output folder, DIR/index.html (default: build/site)")
+    st.set_defaults(func=cmd_site)
     rc = sub.add_parser("reconstruct", help="the scan's lost values as an inverse problem: run every reading "
                         "the scan allows, score it against what the paper prints, print the ranked table")
     rc.add_argument("scene", help="block | sloping_impact")
