@@ -219,7 +219,7 @@ def cmd_reconstruct(args):
     reconstruct(args.scene, quick=args.quick, top=args.top, json_path=args.json, cache=not args.no_cache)
 
 
-BENCH_STUDIES = ("tangents", "work_precision", "cost", "targets")    # contactfem.studies.bench.STUDIES
+BENCH_STUDIES = ("tangents", "work_precision", "cost", "targets", "enforcement")  # = studies.bench.STUDIES
 
 
 def cmd_bench(args):
@@ -302,7 +302,7 @@ def build_parser():
     rc.add_argument("--no-cache", action="store_true", help="recompute every reading (default: reuse the "
                     "results of earlier runs of the same code, in $CONTACTFEM_CACHE or ~/.cache/contactfem)")
     rc.set_defaults(func=cmd_reconstruct)
-    bp = sub.add_parser("bench", help="speed against accuracy: tangents, work-precision, cost, targets "
+    bp = sub.add_parser("bench", help="speed against accuracy: tangents, work-precision, cost, targets, enforcement "
                                       "(writes bench.json and BENCHMARKS.md)")
     bp.add_argument("--quick", action="store_true", help="fast presets and fewer points (about a minute)")
     bp.add_argument("--out", default=".", help="folder for bench.json and BENCHMARKS.md (default: .)")
