@@ -1,6 +1,10 @@
 """Scenes: each module composes bodies, obstacles, laws and loads into one of the
 paper's examples (or a verification problem with a closed form) and declares its
-parameters. A module becomes a scene by defining ``SCENE = Scene(...)``."""
+parameters. A module becomes a scene by defining ``SCENE = Scene(...)``.
+
+Listing the scenes imports every scene module, so a scene module imports scikit-fem
+(and the continuum bodies built on it) inside the functions that build the model:
+``contactfem list`` and ``show`` then load neither scikit-fem nor scipy nor matplotlib."""
 
 import importlib
 import pkgutil

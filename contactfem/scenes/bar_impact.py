@@ -33,9 +33,7 @@ rebound velocity (momentum / mass at the end) and the energy error.
 """
 
 import numpy as np
-from skfem import MeshQuad
 
-from ..bodies.continuum import Continuum
 from ..contact import NodeToSegment, RigidLine, tributary_lengths
 from ..laws import PowerLaw
 from ..solver import Newmark, System, integrate
@@ -49,6 +47,10 @@ def bar_exact(L, E, rho, v0):
 
 
 def build(params):
+    from skfem import MeshQuad
+
+    from ..bodies.continuum import Continuum
+
     L, H = params["L"], params["h"]
     n = params["n_el"]
     mesh = MeshQuad.init_tensor(np.linspace(0.0, L, n + 1), np.linspace(0.0, H, 2))

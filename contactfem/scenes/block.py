@@ -41,10 +41,8 @@ its shear-buckling load G A, and elements invert (p_y <= 50 converges).
 """
 
 import numpy as np
-from skfem import MeshQuad
 
-from ..bodies.continuum import MATERIALS, Continuum
-from ..bodies.loads import Pressure, Traction
+from ..bodies.materials import MATERIALS
 from ..contact import NodeToSegment, RigidLine, to_coo, tributary_lengths
 from ..contact.kinematics import outer
 from ..laws.friction import Coulomb, ParabolicSlip
@@ -111,6 +109,8 @@ PARAMS = (
 
 def block_mesh(width, height, nx, ny):
     """MeshQuad of the block [0, width] x [0, height] with boundaries bottom/top/left/right."""
+    from skfem import MeshQuad
+
     mesh = MeshQuad.init_tensor(np.linspace(0.0, width, nx + 1), np.linspace(0.0, height, ny + 1))
     tx, ty = 1e-9 * width, 1e-9 * height
     return mesh.with_boundaries({
@@ -166,6 +166,9 @@ class ContactTangent:
 def build(params, friction=None):
     """Body, contact, loads and System of the block (no solve). Returns a dict.
     ``friction``: a friction law object to use instead of params["law"] (a student's law)."""
+    from ..bodies.continuum import Continuum
+    from ..bodies.loads import Pressure, Traction
+
     W, H = params["width"], params["height"]
     mesh = block_mesh(W, H, params["nx"], params["ny"])
     body = Continuum(mesh, E=params["E"], nu=params["nu"], rho=0.0, kind="plane_strain",

@@ -72,10 +72,7 @@ which the centre of mass moves faster than 1 m/s (before, the cork only creeps);
 """
 
 import numpy as np
-from skfem import MeshQuad
 
-from ..bodies.continuum import Continuum
-from ..bodies.loads import Pressure
 from ..contact import NodeToSegment, tributary_lengths
 from ..contact.kinematics import arc_variations, line_variations
 from ..io.animate import boundary_loop
@@ -159,6 +156,8 @@ def cork_radius(z, R_tip, R_cork, L_taper):
 def cork_mesh(R_tip, R_cork, L_taper, length, n_r, n_z):
     """MeshQuad of the cork's meridian (x = r, y = z): n_r x n_z elements, radius
     ``cork_radius(z)``, with boundaries axis, outer, bottom, top."""
+    from skfem import MeshQuad
+
     mesh = MeshQuad.init_tensor(np.linspace(0.0, 1.0, n_r + 1), np.linspace(0.0, length, n_z + 1))
     tr, tz = 1e-9, 1e-9 * length
     mesh = mesh.with_boundaries({
@@ -346,6 +345,8 @@ def centre_of_mass_velocity(body, v):
 
 def build(params):
     """Cork, neck, contact, gas: everything both stages share."""
+    from ..bodies.continuum import Continuum
+
     P = params
     if not P["R_cork"] > P["R_neck"]:
         raise ValueError(f"parameter R_cork = {P['R_cork']} must exceed R_neck = {P['R_neck']} (a press fit)")
@@ -430,6 +431,8 @@ def pop(model, P, u0, log=None):
     """Stage 2: the gas drives the cork out (Newmark, explicit Boyle coupling,
     adaptive dt with cutback). Runs to t_end, or t_flight after the exit.
     Returns the histories (numpy arrays), the states u of every step and the events."""
+    from ..bodies.loads import Pressure
+
     cork, contacts, gas = model["cork"], model["contacts"], model["gas"]
     t_ramp = P["n_ramp"] * P["dt"]
 

@@ -34,10 +34,7 @@ iteration: the initial overlap a^2 / 2R guesses the active set.
 """
 
 import numpy as np
-from skfem import MeshQuad
 
-from ..bodies.continuum import Continuum
-from ..bodies.loads import Pressure
 from ..contact import NodeToSegment, RigidLine, tributary_lengths
 from ..laws import PowerLaw
 from ..solver import Dirichlet, Static, System, integrate
@@ -80,6 +77,8 @@ def quarter_disk(R, n_el, k):
     xi = 0 -> symmetry line x = 0, xi = 1 -> arc from -45 deg to A = (R, 0).
     Both coordinates are stretched with sinh(k s)/sinh(k), so the mesh is finest at B.
     Boundaries: 'symmetry' (x = 0), 'top' (y = 0), 'arc'."""
+    from skfem import MeshQuad
+
     xi = stretching(n_el, k)
     XI, ETA = np.meshgrid(xi, xi, indexing="ij")               # (n+1, n+1)
 
@@ -125,6 +124,9 @@ def fit_hertz(x, p):
 
 def build(params):
     """Body, contact, load and supports of the quarter cylinder; returns a dict."""
+    from ..bodies.continuum import Continuum
+    from ..bodies.loads import Pressure
+
     R, E, nu, P = params["R"], params["E"], params["nu"], params["P"]
     a_ex, p0_ex = hertz_exact(P, R, E, nu)
     n = params["n_el"]

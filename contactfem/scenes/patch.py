@@ -46,10 +46,7 @@ p): only the sum is meaningful.
 """
 
 import numpy as np
-from skfem import MeshQuad
 
-from ..bodies.continuum import Continuum
-from ..bodies.loads import Pressure
 from ..contact import BodySurface, NodeToSegment, tributary_lengths
 from ..laws import PowerLaw
 from ..solver import Dirichlet, Static, System, integrate
@@ -58,6 +55,10 @@ from .base import Param, Scene
 
 def block(xs, y0, y1, ny, name, E, nu):
     """A block of quads on the grid xs x linspace(y0, y1, ny + 1); boundaries bottom, top."""
+    from skfem import MeshQuad
+
+    from ..bodies.continuum import Continuum
+
     mesh = MeshQuad.init_tensor(np.asarray(xs, dtype=float), np.linspace(y0, y1, ny + 1))
     tol = 1e-9 * (xs[-1] - xs[0])
     mesh = mesh.with_boundaries({"bottom": lambda x: np.abs(x[1] - y0) < tol,
@@ -94,6 +95,8 @@ class OverhangPressure:
 
 
 def build(params):
+    from ..bodies.loads import Pressure
+
     W, H, E, nu = params["W"], params["H"], params["E"], params["nu"]
     e = W / params["nx_lower"]
     xs_lower = -0.5 * e + e * np.arange(params["nx_lower"] + 2)      # [-e/2, W + e/2], shifted
