@@ -121,3 +121,30 @@ def test_results_match_the_recorded_run_before_the_fast_paths():
         assert res["newton_iterations_total"] == iters
         for got, want in ((res["rebound_vx"], vx), (res["rebound_vy"], vy), (res["rebound_spin"], spin)):
             assert abs(got - want) <= 1e-12 * max(1.0, abs(want)), variant
+
+
+# -- the bench's split of a Newton iteration -----------------------------------------------
+
+def test_iteration_cost_splits_the_newton_time_of_a_real_run():
+    """The parts add up to the measured Newton time, each part is non-negative, and the
+    solves counted are the run's linear solves (times themselves are not asserted)."""
+    from contactfem.scenes import run_scene
+    from contactfem.studies.speed import PARTS, iteration_cost
+
+    over = {"variant": "frictional", "n_steps": 30}
+    cost = iteration_cost("sloping_impact", "paper", over)
+    assert cost["solves"] == run_scene("sloping_impact", "paper", over)["newton_iterations_total"]
+    assert (cost["linear_algebra"], cost["ndof"]) == ("dense", 48)
+    parts = [cost[f"{p}_s"] for p in PARTS]
+    assert min(parts) >= 0.0
+    assert sum(parts) == pytest.approx(cost["iteration_s"], rel=1e-9)
+
+
+def test_run_json_reports_the_linear_algebra():
+    from contactfem.scenes import run_scene
+
+    small = run_scene("sloping_impact", "fast", {"n_steps": 2})
+    big = run_scene("block", "fast", {})
+    assert (small["linear_algebra"], small["unknowns"]) == ("dense", 48)
+    assert small["ordering"].startswith("natural")
+    assert (big["linear_algebra"], big["ordering"]) == ("sparse", "MMD_AT_PLUS_A")

@@ -68,17 +68,17 @@ def return_map(law, t_N, dt_N, dg_T, t_T_bar, q_bar, tol=1e-12, maxit=50):
     lam = np.zeros_like(p)
     q = q_bar.copy()
 
-    if np.any(slip):
+    if slip.any():
         i = np.flatnonzero(slip)
         a_tr, s, pi, qi = np.abs(t_tr[i]), np.sign(t_tr[i]), p[i], q_bar[i]
         lam_i = f_tr[i] / c_T                                     # exact if Y_q = 0
         for _ in range(maxit):                                     # eq (44): local Newton
             Y, Y_p, Y_q = law.slip_bound(pi, qi + lam_i)
             phi = a_tr - c_T * lam_i - Y
-            if np.all(np.abs(phi) <= tol * np.maximum(1.0, a_tr)):
+            if (np.abs(phi) <= tol * np.maximum(1.0, a_tr)).all():
                 break
             dphi = -(c_T + Y_q)
-            if np.any(dphi >= 0.0):
+            if (dphi >= 0.0).any():
                 raise ReturnMapError("return map: slip softening faster than the stick stiffness c_T (c_T + dY/dq <= 0)")
             lam_i = np.maximum(lam_i - phi / dphi, 0.0)
         else:
@@ -92,6 +92,6 @@ def return_map(law, t_N, dt_N, dg_T, t_T_bar, q_bar, tol=1e-12, maxit=50):
         q[i] = qi + lam_i
 
     state = np.where(slip, SLIP, np.where(stick, STICK, OPEN))
-    if not (np.all(np.isfinite(t_T)) and np.all(np.isfinite(c_T_s)) and np.all(np.isfinite(c_N_s))):
+    if not (np.isfinite(t_T).all() and np.isfinite(c_T_s).all() and np.isfinite(c_N_s).all()):
         raise ReturnMapError("return map produced a non-finite traction or modulus")
     return FrictionState(t_T=t_T, c_T_s=c_T_s, c_N_s=c_N_s, state=state, lam=lam, q=q)

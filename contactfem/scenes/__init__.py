@@ -33,15 +33,26 @@ def get_scene(name):
 
 
 def run_scene(name, preset="fast", overrides=None):
-    """Run a scene and return its results with wall time, Newton iteration count and parameters."""
+    """Run a scene and return its results with wall time, Newton iteration count, parameters and
+    the linear algebra of its Systems (``linear_algebra``: dense|sparse, ``ordering``, ``unknowns``)."""
     import time
+
+    from ..solver.system import System
 
     scene = get_scene(name)
     params = scene.resolve(preset, overrides)
+    outer, System.built = System.built, []          # record the Systems the scene builds
     t0 = time.perf_counter()
-    results = scene.run(params)
+    try:
+        results = scene.run(params)
+    finally:
+        systems, System.built = System.built, outer
     results = dict(results)
     results["wall_time_s"] = time.perf_counter() - t0
+    # how K was assembled and factorised: dense or sparse (by size), and the ordering
+    results["linear_algebra"] = "+".join(dict.fromkeys(s.linear_algebra for s in systems)) or None
+    results["ordering"] = "+".join(dict.fromkeys(s.ordering for s in systems)) or None
+    results["unknowns"] = max((s.ndof for s in systems), default=None)
     results.setdefault("newton_iterations_total", 0)
     results["scene"] = name
     results["preset"] = preset

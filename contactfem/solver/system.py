@@ -70,6 +70,8 @@ class System:
     ``linear_algebra`` ("dense" or "sparse") and ``ordering`` (of the factorisation).
     """
 
+    built = None     # a list while contactfem.scenes.run_scene records the Systems a scene builds
+
     def __init__(self, bodies, contacts=(), loads=(), fixed=(), linear_algebra="auto"):
         self.bodies = list(bodies)
         self.contacts = list(contacts)
@@ -99,6 +101,8 @@ class System:
         self.ordering = DENSE_ORDERING if self.linear_algebra == "dense" else ORDERING
         self._tangent = TangentAssembler(self.ndof, self.linear_algebra)
         self._body_coo = {}          # body -> (K, rows, cols) of its last sparse tangent
+        if System.built is not None:
+            System.built.append(self)
 
     def global_dofs(self, body, local):
         """Global numbers of a body's local dofs."""
