@@ -8,7 +8,8 @@ from conftest import PointCloud
 from fd import fd_jacobian, rel_error
 
 from contactfem.contact import BodySurface, NodeToSegment, RigidArc, RigidLine, RigidPolyline, SLIP, STICK, OPEN
-from contactfem.laws import Coulomb, ExponentialLaw, ParabolicSlip, PowerLaw, SlipHardening
+from contactfem.laws import (ArchardWear, Coulomb, DieterichRuina, ExponentialLaw, ParabolicSlip, PowerLaw,
+                             SlipHardening, Stribeck)
 
 NORMALS = {"penalty": PowerLaw(c_N=50.0, m=1.0), "power2.5": PowerLaw(c_N=80.0, m=2.5),
            "exp": ExponentialLaw(a=20.0, b=8.0)}
@@ -16,7 +17,12 @@ FRICTIONS = {"none": None, "coulomb": Coulomb(c_T=30.0, mu=0.3),
              "parabolic": ParabolicSlip(c_T=30.0, alpha=0.2, beta=0.3, n=0.5),
              "parabolic08": ParabolicSlip(c_T=30.0, alpha=0.2, beta=0.3, n=0.8),
              "hardening": SlipHardening(c_T=30.0, mu=0.2, h=0.5),
-             "softening": SlipHardening(c_T=30.0, mu=0.4, h=-0.3)}
+             "softening": SlipHardening(c_T=30.0, mu=0.4, h=-0.3),
+             # laws with a slip rate and internal variables (time step DT, states advanced in set_history)
+             "stribeck": Stribeck(c_T=30.0, mu_s=0.5, mu_d=0.3, v_s=0.5, mu_v=0.05),
+             "rate_state": DieterichRuina(c_T=30.0, mu_0=0.3, a=0.02, b=0.03, d_c=0.05),
+             "wear": ArchardWear(c_T=30.0, mu=0.3, k_w=0.2)}
+DT = 0.1
 
 
 def check_tangent(iface, u, tol=1e-6):
@@ -45,6 +51,10 @@ def set_history(iface, u, t_T_bar, dg):
     iface.initialize(u)
     iface.s_bar = iface.s_bar - dg
     iface.t_T_bar = np.full(len(iface.nodes), t_T_bar)
+    iface.set_dt(DT)
+    if iface.friction is not None and iface._law.n_state:     # a state reached by earlier slip (wear: 0.01 deep)
+        n = len(iface.nodes)
+        iface.z_bar = iface._law.evolve(iface.z_bar, np.ones(n), np.full(n, 0.05), DT)[0]
 
 
 MASTERS = ["line", "tilted_polyline", "arc_outside", "arc_inside"]

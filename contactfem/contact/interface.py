@@ -2,12 +2,14 @@
 friction history (paper Sec. 4.3, step 4: per slave node, check the gap -> normal
 force -> trial friction -> slip check -> stick or return map -> tangents).
 
-History (s_bar, t_T_bar, q_bar) is committed only on a converged step (commit)."""
+History (s_bar, t_T_bar, q_bar and the friction law's internal variables z_bar) is
+committed only on a converged step (commit)."""
 
 import numpy as np
 
 from .element import contact_element, to_coo
 from ..laws.friction import Frictionless
+from ..laws.protocol import as_friction_law
 from .return_map import STATE_NAMES, return_map
 
 FRICTIONLESS = Frictionless()
@@ -32,6 +34,11 @@ class NodeToSegment:
               (the block, Sec. 5.1), 1 when c_N, c_T are nodal stiffnesses (rings, cork)
     offset:   the slave surface lies `offset` beyond the node along the master normal
               (half the thickness of a beam whose centreline nodes are the slaves)
+
+    A friction law with a slip rate or internal variables (contactfem.laws.protocol)
+    gets the time step from ``set_dt`` (called by every stepper) and keeps its
+    variables z_bar per slave node; a law with ``gap_offset(z)`` (wear) moves the
+    surface by the committed z_bar (the wear of a step acts from the next step on).
     """
 
     def __init__(self, slave, nodes, master, normal, friction=None, weights=1.0, offset=0.0, name="contact"):
@@ -45,8 +52,15 @@ class NodeToSegment:
         self.s_bar = None                   # set at the first evaluation (or initialize)
         self.t_T_bar = np.zeros(nc)
         self.q_bar = np.zeros(nc)
+        self._law = None if friction is None else as_friction_law(friction)
+        self.z_bar = self._law.initial_state(nc) if self._law is not None else np.zeros((nc, 0))
+        self.dt = None                      # time step, for rate- and state-dependent laws
         self.dissipation = 0.0              # of the last committed step
         self.dissipation_total = 0.0
+
+    def set_dt(self, dt):
+        """The step size of the coming step (slip rate = slip increment / dt)."""
+        self.dt = float(dt)
 
     # -- kinematics -------------------------------------------------------------
     def slave_dofs(self):
@@ -75,6 +89,8 @@ class NodeToSegment:
         x_s = self.slave_positions(u)
         k = self.master.locate(x_s, self.s_bar, u)
         g_N = k["g_N"] - self.offset
+        if self._law is not None and self._law.n_state:
+            g_N = g_N + self._law.gap_offset(self.z_bar)    # worn surface: the gap opens
         active = k["inside"] & (g_N < 0.0)
         t_N, dt_N = self.normal.traction(np.where(active, g_N, 1.0))
         dofs = np.concatenate([self.slave_dofs(), k["master_dofs"]], axis=1) if k["master_dofs"].size else self._dofs
@@ -88,7 +104,8 @@ class NodeToSegment:
             z = np.zeros_like(e["t_N"])
             fr = return_map(FRICTIONLESS, e["t_N"], e["dt_N"], z, z, self.q_bar)
         else:
-            fr = return_map(self.friction, e["t_N"], e["dt_N"], e["dg_T"], self.t_T_bar, self.q_bar)
+            fr = return_map(self._law, e["t_N"], e["dt_N"], e["dg_T"], self.t_T_bar, self.q_bar,
+                            z_bar=self.z_bar, dt=self.dt)
         return self.element(e, fr.t_T, fr.c_T_s, fr.c_N_s, friction=fr)
 
     def element(self, e, t_T, c_T_s, c_N_s, **extra):
@@ -125,6 +142,8 @@ class NodeToSegment:
         self.dissipation_total += self.dissipation
         self.t_T_bar = np.where(e["active"], fr.t_T, 0.0)
         self.q_bar = fr.q
+        if fr.z is not None and self._law is not None:
+            self.z_bar = fr.z
         if hasattr(self.master, "commit"):
             self.master.commit(u)           # new converged metric l_bar of a deformable master
         self.s_bar = self.master.locate(e["x_s"], self.s_bar, u)["s"]

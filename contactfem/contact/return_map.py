@@ -1,12 +1,16 @@
 """Return mapping of the frictional interface law (paper Sec. 4.2.3, eqs 40-48).
 
 Plane case: the tangential traction t_T is a scalar along the master tangent.
-Everything is vectorised over contact nodes.
+Everything is vectorised over contact nodes. Beyond the paper's laws Y(p, q), the
+return map integrates laws that depend on the slip rate and on internal variables of
+their own (the protocol of ``contactfem.laws.protocol``).
 """
 
 from dataclasses import dataclass
 
 import numpy as np
+
+from ..laws.protocol import as_friction_law
 
 OPEN, STICK, SLIP = 0, 1, 2
 STATE_NAMES = np.array(["open", "stick", "slip"])
@@ -26,6 +30,8 @@ class FrictionState:
     state: np.ndarray  # OPEN, STICK or SLIP
     lam: np.ndarray    # slip increment lambda >= 0 (eq 45)
     q: np.ndarray      # accumulated slip after the step
+    z: np.ndarray = None   # the law's internal variables after the step (n, k)
+    v: np.ndarray = None   # slip rate lambda / dt of the step
 
     @property
     def dissipation(self):
@@ -33,29 +39,45 @@ class FrictionState:
         return self.lam * np.abs(self.t_T)
 
 
-def return_map(law, t_N, dt_N, dg_T, t_T_bar, q_bar, tol=1e-12, maxit=50):
+def return_map(law, t_N, dt_N, dg_T, t_T_bar, q_bar, z_bar=None, dt=None, tol=1e-12, maxit=100):
     """Integrate the friction law over one step by elastic predictor / return map.
 
-    law      : friction law (c_T, slip_bound(p, q) -> (Y, dY/dp, dY/dq))
+    law      : friction law (c_T and slip_bound, see contactfem.laws.protocol)
     t_N      : signed normal traction (<= 0 in contact), dt_N = dt_N/dg_N
     dg_T     : tangential slip increment Delta g_T = s - s_bar (eq 20)
     t_T_bar  : converged tangential traction, q_bar: converged accumulated slip
+    z_bar    : converged internal variables of the law (n, k); default its initial state
+    dt       : time step (needed by laws with a slip rate or internal variables)
 
     Eq (42), the elastic predictor:  t_tr = t_T_bar + c_T dg_T.
-    Eq (40), the slip check:         f_tr = |t_tr| - Y(p, q_bar), p = |t_N|.
+    Eq (40), the slip check:         f_tr = |t_tr| - Y(p, q_bar, 0, z(0)), p = |t_N|.
     Eqs (43)-(44), the return:       t_T = t_tr - c_T lam sign(t_tr), with lam from
-                                     phi(lam) = |t_tr| - c_T lam - Y(p, q_bar + lam) = 0
-                                     (closed form when Y does not depend on q,
-                                     otherwise a local Newton iteration).
-    Eqs (47)-(48), the consistent moduli, by implicit differentiation of phi = 0:
-        c_T^s = dt_T/dg_T = c_T Y_q / (c_T + Y_q),
-        c_N^s = dt_T/dg_N = sign(t_tr) Y_p dp/dg_N c_T / (c_T + Y_q),  dp/dg_N = -dt_N.
+                                     phi(lam) = |t_tr| - c_T lam - Y(p, q_bar + lam, lam/dt, z(lam)) = 0,
+                                     z(lam) = evolve(z_bar, p, lam, dt) (a local Newton iteration,
+                                     safeguarded by bisection on [0, |t_tr|/c_T], where phi
+                                     changes sign; closed form when Y is Y(p) alone).
+    Eqs (47)-(48), the consistent moduli, by implicit differentiation of phi = 0, with the
+    total derivatives Y_lam = Y_q + Y_v/dt + Y_z . dz/dlam and Y_P = Y_p + Y_z . dz/dp:
+        c_T^s = dt_T/dg_T = c_T Y_lam / (c_T + Y_lam),
+        c_N^s = dt_T/dg_N = sign(t_tr) Y_P dp/dg_N c_T / (c_T + Y_lam),  dp/dg_N = -dt_N.
+    (For the paper's Y(p, q): Y_lam = dY/dq, Y_P = dY/dp, eq 48 as printed.)
     """
+    L = as_friction_law(law)
     t_N, dt_N, dg_T, t_T_bar, q_bar = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (t_N, dt_N, dg_T, t_T_bar, q_bar)))
     p = -t_N
-    c_T = float(law.c_T)
+    n = p.size
+    c_T = L.c_T
+    if L.needs_dt:
+        if dt is None or not (np.isfinite(dt) and dt > 0):
+            raise ValueError(f"the friction law {L.name} depends on the slip rate or on internal variables: "
+                             f"the return map needs the time step dt > 0, got {dt!r}")
+    else:
+        dt = 1.0 if dt is None else dt
+    z_bar = L.initial_state(n) if z_bar is None else np.broadcast_to(np.asarray(z_bar, dtype=float), (n, L.n_state))
     t_tr = t_T_bar + c_T * dg_T                                   # eq (42)
-    Y0, _, _ = law.slip_bound(p, q_bar)
+    zero = np.zeros(n)
+    z0 = L.evolve(z_bar, p, zero, dt)[0]
+    Y0 = L.slip_bound(p, q_bar, zero, z0)[0]
     f_tr = np.abs(t_tr) - Y0                                      # eq (40)
 
     in_contact = p > 0.0
@@ -67,31 +89,48 @@ def return_map(law, t_N, dt_N, dg_T, t_T_bar, q_bar, tol=1e-12, maxit=50):
     c_N_s = np.zeros_like(p)
     lam = np.zeros_like(p)
     q = q_bar.copy()
+    z = np.array(np.where(in_contact[:, None], z0, z_bar), dtype=float)
 
-    if slip.any():
+    if np.any(slip):
         i = np.flatnonzero(slip)
-        a_tr, s, pi, qi = np.abs(t_tr[i]), np.sign(t_tr[i]), p[i], q_bar[i]
-        lam_i = f_tr[i] / c_T                                     # exact if Y_q = 0
+        a_tr, s, pi, qi, zi = np.abs(t_tr[i]), np.sign(t_tr[i]), p[i], q_bar[i], z_bar[i]
+        lo, hi = np.zeros(len(i)), a_tr / c_T                     # phi(lo) > 0 >= phi(hi) (Y >= 0)
+        lam_i = f_tr[i] / c_T                                     # exact if Y depends on p alone
+
+        def local(lam_i):
+            zz, z_p, z_lam = L.evolve(zi, pi, lam_i, dt)
+            Y, Y_p, Y_q, Y_v, Y_z = L.slip_bound(pi, qi + lam_i, lam_i / dt, zz)
+            Y_lam = Y_q + Y_v / dt + np.einsum("ij,ij->i", Y_z, z_lam)
+            Y_P = Y_p + np.einsum("ij,ij->i", Y_z, z_p)
+            return a_tr - c_T * lam_i - Y, Y_lam, Y_P, zz
+
         for _ in range(maxit):                                     # eq (44): local Newton
-            Y, Y_p, Y_q = law.slip_bound(pi, qi + lam_i)
-            phi = a_tr - c_T * lam_i - Y
-            if (np.abs(phi) <= tol * np.maximum(1.0, a_tr)).all():
+            phi, Y_lam, Y_P, zz = local(lam_i)
+            if not np.all(np.isfinite(phi)):
+                raise ReturnMapError(f"return map: the slip bound of {L.name} is not finite at p = {pi[~np.isfinite(phi)][:3]}")
+            if np.all(np.abs(phi) <= tol * np.maximum(1.0, a_tr)):
                 break
-            dphi = -(c_T + Y_q)
-            if (dphi >= 0.0).any():
-                raise ReturnMapError("return map: slip softening faster than the stick stiffness c_T (c_T + dY/dq <= 0)")
-            lam_i = np.maximum(lam_i - phi / dphi, 0.0)
+            lo = np.where(phi > 0.0, lam_i, lo)
+            hi = np.where(phi < 0.0, lam_i, hi)
+            dphi = -(c_T + Y_lam)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                trial = lam_i - phi / dphi
+            bad = ~np.isfinite(trial) | (trial < lo) | (trial > hi) | (dphi >= 0.0)
+            lam_i = np.where(bad, 0.5 * (lo + hi), trial)          # bisection where Newton leaves the bracket
         else:
             raise ReturnMapError(f"return map: local Newton for lambda did not converge in {maxit} iterations (max |phi| = {np.max(np.abs(phi)):.3e})")
-        Y, Y_p, Y_q = law.slip_bound(pi, qi + lam_i)
-        D = c_T + Y_q
+        D = c_T + Y_lam
+        if np.any(D == 0.0):
+            raise ReturnMapError(f"return map: the slip bound of {L.name} softens exactly as fast as the stick stiffness "
+                                 "(c_T + dY/dlambda = 0): the slip is not unique")
         t_T[i] = s * (a_tr - c_T * lam_i)                          # eq (43)
-        c_T_s[i] = c_T * Y_q / D                                  # eq (48)
-        c_N_s[i] = s * Y_p * (-dt_N[i]) * c_T / D                 # eq (48)
+        c_T_s[i] = c_T * Y_lam / D                                # eq (48)
+        c_N_s[i] = s * Y_P * (-dt_N[i]) * c_T / D                 # eq (48)
         lam[i] = lam_i
         q[i] = qi + lam_i
+        z[i] = zz
 
     state = np.where(slip, SLIP, np.where(stick, STICK, OPEN))
-    if not (np.isfinite(t_T).all() and np.isfinite(c_T_s).all() and np.isfinite(c_N_s).all()):
+    if not (np.all(np.isfinite(t_T)) and np.all(np.isfinite(c_T_s)) and np.all(np.isfinite(c_N_s))):
         raise ReturnMapError("return map produced a non-finite traction or modulus")
-    return FrictionState(t_T=t_T, c_T_s=c_T_s, c_N_s=c_N_s, state=state, lam=lam, q=q)
+    return FrictionState(t_T=t_T, c_T_s=c_T_s, c_N_s=c_N_s, state=state, lam=lam, q=q, z=z, v=lam / dt)

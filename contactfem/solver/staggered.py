@@ -86,7 +86,8 @@ class SplitContact:
             t_T = self.t_T_star + c_T * (e["s"] - self.s_star)
             c_T_s, c_N_s = np.full_like(zero, c_T), zero
         else:                              # eqs 40-45 at the frozen pressure p*: c_N^s = 0
-            fr = return_map(c.friction, -self.p_star, zero, e["dg_T"], c.t_T_bar, c.q_bar)
+            fr = return_map(c.friction, -self.p_star, zero, e["dg_T"], c.t_T_bar, c.q_bar,
+                            z_bar=c.z_bar, dt=c.dt)
             t_T, c_T_s, c_N_s = fr.t_T, fr.c_T_s, fr.c_N_s
         return c.scatter(c.element(e, t_T, c_T_s, c_N_s), len(u))
 

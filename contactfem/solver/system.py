@@ -196,10 +196,11 @@ class System:
         return G, K
 
     def set_dt(self, dt):
-        """Tell rate-dependent bodies (viscoplastic beam: ``set_dt``) the step size."""
-        for body in self.bodies:
-            if hasattr(body, "set_dt"):
-                body.set_dt(dt)
+        """Tell rate-dependent bodies (viscoplastic beam) and contacts (friction laws with
+        a slip rate or internal variables) the step size: their ``set_dt``."""
+        for part in self.bodies + self.contacts:
+            if hasattr(part, "set_dt"):
+                part.set_dt(dt)
 
     # -- history and energies ---------------------------------------------------
 
