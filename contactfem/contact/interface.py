@@ -12,7 +12,7 @@ from ..laws.friction import Frictionless
 from ..laws.protocol import as_friction_law
 from .return_map import STATE_NAMES, return_map
 
-FRICTIONLESS = Frictionless()
+FRICTIONLESS = as_friction_law(Frictionless())
 
 
 def tributary_lengths(X):
