@@ -32,9 +32,11 @@ def get_scene(name):
     return scenes[name]
 
 
-def run_scene(name, preset="fast", overrides=None):
+def run_scene(name, preset="fast", overrides=None, progress=None):
     """Run a scene and return its results with wall time, Newton iteration count, parameters and
-    the linear algebra of its Systems (``linear_algebra``: dense|sparse, ``ordering``, ``unknowns``)."""
+    the linear algebra of its Systems (``linear_algebra``: dense|sparse, ``ordering``, ``unknowns``).
+    ``progress(t0, t_end, label)``: a progress-callback factory handed to the scene's time
+    loops (e.g. ``contactfem.io.progress_bar``); None shows nothing."""
     import time
 
     from ..solver.system import System
@@ -44,7 +46,7 @@ def run_scene(name, preset="fast", overrides=None):
     outer, System.built = System.built, []          # record the Systems the scene builds
     t0 = time.perf_counter()
     try:
-        results = scene.run(params)
+        results = scene.run(params) if progress is None else scene.run(params, progress=progress)
     finally:
         systems, System.built = System.built, outer
     results = dict(results)

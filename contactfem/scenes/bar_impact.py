@@ -75,7 +75,7 @@ def build(params):
     return dict(body=body, contact=contact, system=system, nodes=nodes, w=w, c_N=c_N)
 
 
-def run(params):
+def run(params, progress=None):
     m = build(params)
     body, contact, system = m["body"], m["contact"], m["system"]
     L, H, v0 = params["L"], params["h"], params["v0"]
@@ -95,7 +95,7 @@ def run(params):
     def record(t, u, v, a):
         force.append(float(-contact.report(u)["f_N"].sum()))
 
-    hist = integrate(stepper, 0.0, u0, v0_vec, t_end=t_end, callback=record, cutback=True)
+    hist = integrate(stepper, 0.0, u0, v0_vec, t_end=t_end, callback=record, cutback=True, progress=progress)
     t, F = hist.t, np.asarray(force)
     stress = F / H
     on = np.flatnonzero(F > 0.0)

@@ -31,7 +31,7 @@ vibrating in place, so the mean, not the instantaneous, velocity is tested).
 
 import numpy as np
 
-from ..bodies.ring import make_ring
+from ..bodies.ring import RingRecorder, make_ring
 from ..contact import NodeToSegment, RigidPolyline
 from ..laws import ParabolicSlip, PowerLaw
 from ..solver import Dirichlet, Newmark, System, integrate
@@ -75,39 +75,20 @@ def radial_deviation(ring, u, center):
     return float(np.max(np.abs(r - ring.R)) / ring.R)
 
 
-def run(params):
+def run(params, progress=None):
     m = build(params)
     ring, contact, system = m["ring"], m["contact"], m["system"]
     u0 = np.zeros(ring.body.ndof)
     v0 = ring.initial_velocity((0.0, -params["v0"]))
     contact.initialize(u0)
-    every = params["outline_every"]
-    rec = dict(t=[], y_c=[], v_c=[], n_contact=[], n_slip=[], deformation=[], outlines=[], outline_t=[])
-    body = ring.body
-    mass = body.mass()[body.xdofs[:, 1]]          # lumped nodal masses, assembled once
-    mass = mass / mass.sum()
-
-    def record(t, u, v):
-        # centre of mass of the mirrored ring: (0, sum m_i y_i / sum m_i), as RingModel.center_of_mass
-        c = np.array([0.0, mass @ (body.X[:, 1] + u[body.xdofs[:, 1]])])
-        state = contact.report(u)["state"]
-        rec["t"].append(t)
-        rec["y_c"].append(c[1])
-        rec["v_c"].append(mass @ v[body.xdofs[:, 1]])
-        rec["n_contact"].append(int(np.count_nonzero(state != "open")))
-        rec["n_slip"].append(int(np.count_nonzero(state == "slip")))
-        rec["deformation"].append(radial_deviation(ring, u, c))
-        if (len(rec["t"]) - 1) % every == 0:
-            rec["outlines"].append(ring.outline(u, mirror=True))
-            rec["outline_t"].append(t)
-
-    record(0.0, u0, v0)
+    rec = RingRecorder(ring, contact, every=params["outline_every"], mirror=True,
+                       measures=dict(deformation=lambda u, v: radial_deviation(ring, u, ring.center_of_mass(u))))
     stepper = Newmark(system, params["dt"], params["delta"], params["beta_newmark"],
                       atol=1e-10, rtol=1e-10, maxit=30)
-    hist = integrate(stepper, 0.0, u0, v0, n_steps=params["n_steps"],
-                     callback=lambda t, u, v, a: record(t, u, v), cutback=True, max_cuts=6)
-
-    t, y_c, v_c = (np.asarray(rec[k]) for k in ("t", "y_c", "v_c"))
+    hist = integrate(stepper, 0.0, u0, v0, n_steps=params["n_steps"], recorder=rec, cutback=True, max_cuts=6,
+                     progress=progress)
+    rec = rec.arrays()
+    t, y_c, v_c = rec["t"], rec["x_c"][:, 1], rec["v_c"][:, 1]   # the mirrored ring: centre on x = 0
     n_contact = np.asarray(rec["n_contact"])
     k0 = len(t) - max(2, len(t) // 4)                           # the last quarter of the run
     T_win = t[-1] - t[k0]

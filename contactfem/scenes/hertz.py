@@ -158,7 +158,7 @@ def build(params):
                 grading_k=k)
 
 
-def run(params):
+def run(params, progress=None):
     m = build(params)
     body, contact, system, w = m["body"], m["contact"], m["system"], m["w"]
     R, P = params["R"], params["P"]
@@ -175,7 +175,7 @@ def run(params):
     atol = max(1e-10 * scale, 1e-15 * k_c * R)
     stepper = Static(system, dt=1.0 / params["n_steps"], atol=atol, rtol=1e-12, maxit=40)
     stepper = enforcement.wrap(params, stepper, [contact], length=a_ex)   # gap_violation: penetration / a
-    hist = integrate(stepper, 0.0, u0, n_steps=params["n_steps"], cutback=True, max_cuts=6)
+    hist = integrate(stepper, 0.0, u0, n_steps=params["n_steps"], cutback=True, max_cuts=6, progress=progress)
     u = hist.u
 
     rep = contact.report(u)

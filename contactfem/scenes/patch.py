@@ -140,7 +140,7 @@ def build(params):
     return dict(lower=lower, upper=upper, contacts=contacts, system=system, bottom_upper=bottom_upper)
 
 
-def run(params):
+def run(params, progress=None):
     m = build(params)
     lower, upper, system = m["lower"], m["upper"], m["system"]
     p = params["p"]
@@ -151,7 +151,7 @@ def run(params):
     for c in m["contacts"]:
         c.initialize(u0)
     stepper = Static(system, dt=1.0, atol=1e-10 * p * params["W"], rtol=1e-12, maxit=30)
-    hist = integrate(stepper, 0.0, u0, n_steps=1)
+    hist = integrate(stepper, 0.0, u0, n_steps=1, progress=progress)
     u = hist.u
 
     result = dict(newton_iterations_total=int(np.sum(hist.iterations)), passes=params["passes"])
