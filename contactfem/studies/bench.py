@@ -451,14 +451,8 @@ def targets_study(quick=False):
 # Driver, JSON and markdown
 # ---------------------------------------------------------------------------
 
-def _speed_study(quick=False):
-    from .speed import speed_study
-
-    return speed_study(quick)
-
-
 STUDIES = {"tangents": tangent_study, "work_precision": work_precision, "cost": cost_study,
-           "targets": targets_study, "speed": _speed_study}
+           "targets": targets_study}
 
 
 def machine():
@@ -624,10 +618,6 @@ def write_markdown(res):
               f"Hertz on {h['n_quads']} quads: p0 error {h['error_p0']:+.2%} (target 0.5 %: {_f(h['p0_within'])}), "
               f"solve {_f(h['solve_s'])} s, whole process {_f(h['process_s'])} s wall, "
               f"{_f(h.get('process_cpu_s'))} s CPU (best of 3; target 1.5 s wall: {_f(h['under_1p5s'])}).", ""]
-    if "speed" in res:
-        from .speed import markdown
-
-        L += [markdown(res["speed"])]
     return "\n".join(L) + "\n"
 
 
