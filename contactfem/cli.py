@@ -84,7 +84,7 @@ def cmd_equations(args):
     print(markdown_table())
 
 
-BENCH_STUDIES = ("tangents", "work_precision", "cost", "targets")    # contactfem.studies.bench.STUDIES
+BENCH_STUDIES = ("tangents", "work_precision", "cost", "targets", "speed")    # contactfem.studies.bench.STUDIES
 
 
 def cmd_bench(args):
@@ -147,7 +147,7 @@ def build_parser():
     sw.add_argument("--scheduler", default=None, help="Dask scheduler address: run on that cluster instead")
     sw.add_argument("--out", default="sweep.csv", help="table of results (.csv or .json)")
     sw.set_defaults(func=cmd_sweep)
-    bp = sub.add_parser("bench", help="speed against accuracy: tangents, work-precision, cost, targets "
+    bp = sub.add_parser("bench", help="speed against accuracy: tangents, work-precision, cost, targets, speed "
                                       "(writes bench.json and BENCHMARKS.md)")
     bp.add_argument("--quick", action="store_true", help="fast presets and fewer points (about a minute)")
     bp.add_argument("--out", default=".", help="folder for bench.json and BENCHMARKS.md (default: .)")

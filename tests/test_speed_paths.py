@@ -129,10 +129,10 @@ def test_iteration_cost_splits_the_newton_time_of_a_real_run():
     """The parts add up to the measured Newton time, each part is non-negative, and the
     solves counted are the run's linear solves (times themselves are not asserted)."""
     from contactfem.scenes import run_scene
-    from contactfem.studies.speed import PARTS, iteration_cost
+    from contactfem.studies.bench.speed import PARTS, iteration_split
 
     over = {"variant": "frictional", "n_steps": 30}
-    cost = iteration_cost("sloping_impact", "paper", over)
+    cost = iteration_split("sloping_impact", "paper", over)
     assert cost["solves"] == run_scene("sloping_impact", "paper", over)["newton_iterations_total"]
     assert (cost["linear_algebra"], cost["ndof"]) == ("dense", 48)
     parts = [cost[f"{p}_s"] for p in PARTS]

@@ -6,6 +6,7 @@ from pathlib import Path
 import numpy as np
 
 from .common import TARGETS
+from .speed import PARTS, SPEED_TARGETS
 
 def _f(x, fmt="{:.3g}"):
     if x is None:
@@ -34,6 +35,64 @@ OPTIMISATIONS = [
     "download): at 1e5 unknowns 1.0-1.4 s against 1.3-1.4 s for SuperLU with MMD_AT_PLUS_A, slower "
     "at the paper sizes; not a clear win. scikit-umfpack does not install from PyPI here (needs swig and "
     "SuiteSparse to build).", ""]
+
+
+def _ms(x):
+    return "-" if x is None else f"{1e3 * x:.3f}"
+
+
+def speed_section(sp):
+    """Study 5 (speed): start-up, the split of one Newton iteration, the Table 2 sweep."""
+    T = SPEED_TARGETS
+    s = sp["startup"]
+    L = ["## Start-up and the cost of one Newton iteration", "",
+         f"Start-up: whole processes, median of {len(s['python']['walls_s'])} runs (wall and CPU seconds).", "",
+         "| process | wall [s] | CPU [s] |", "|---|---|---|"]
+    names = {"python": "`python -c pass`", "list": "`contactfem list`",
+             "scipy_skfem": "`python -c \"import scipy.sparse.linalg, skfem\"`",
+             "run_block": "`contactfem run block --preset paper`"}
+    for key, label in names.items():
+        L.append(f"| {label} | {s[key]['wall_s']:.3f} | {s[key]['cpu_s']:.3f} |")
+    L += ["", f"`contactfem list`: {s['list']['wall_s']:.3f} s, {s['list_over_python']:.1f} x `python -c pass` "
+              f"(target {T['list_s']} s: {_f(s['list']['wall_s'] < T['list_s'])}). "
+              f"`contactfem run block --preset paper`: {s['run_block_over_scipy_skfem']:.2f} x an interpreter that "
+              f"imports scipy.sparse.linalg and scikit-fem (target {T['run_block_over_scipy_skfem']}: "
+              f"{_f(s['run_block_over_scipy_skfem'] <= T['run_block_over_scipy_skfem'])}).", "",
+          "One Newton iteration, CPU milliseconds: the run's totals divided by its linear solves "
+          "(contactfem/studies/bench/speed.py). bulk: the bodies' internal forces and tangents; contact: every "
+          "contact's residual and tangent; assembly: summing them into K, loads included; solve: factorisation "
+          "and solve; overhead: the rest of newton() and the time stepper's effective residual. K: dense "
+          "(LAPACK) up to 100 unknowns, sparse (fixed pattern, SuperLU) above.", "",
+          "| scene | unknowns | K | iteration [ms] | bulk | contact | assembly | solve | overhead | solves | run [s] |",
+          "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in sp["iterations"]:
+        label = r["scene"] + "".join(f", {v}" for v in r["overrides"].values())
+        L.append(f"| {label} | {r['ndof'] or '-'} | {r['linear_algebra'] or '-'} | {_ms(r['iteration_s'])} | "
+                 + " | ".join(_ms(r[f'{p}_s']) for p in PARTS) + f" | {r['solves']} | {r['run_wall_s']:.2f} |")
+    goals = {("sloping_impact", "frictional"): "sloping_impact_iteration_s", ("rolling_ring", None): "rolling_ring_iteration_s"}
+    for r in sp["iterations"]:
+        key = goals.get((r["scene"], r["overrides"].get("variant")))
+        if key and r["preset"] == "paper":
+            L.append(f"\n{r['scene']}: {_ms(r['iteration_s'])} ms per iteration "
+                     f"(target {1e3 * T[key]:g} ms: {_f(r['iteration_s'] <= T[key])}).")
+    t2 = sp.get("table2")
+    if t2:
+        L += ["", "### Table 2: convergence of the rebound under refinement", "",
+              "Each line is one run of the two sweeps below (paper data, Newmark 0.7/0.4; the paper prints two "
+              "digits). Wall time: " + "; ".join(f"`{sw['command']}` {sw['wall_s']:.1f} s" for sw in t2["sweeps"])
+              + f"; together {t2['total_wall_s']:.1f} s (target {T['table2_s']:g} s: "
+              f"{_f(t2['total_wall_s'] < T['table2_s'])}).", "",
+              "| variant | elements | dt | v_x | v_y | angle [deg] | spin | linear solves | paper v_x, v_y, angle |",
+              "|---|---|---|---|---|---|---|---|---|"]
+        for r in t2["rows"]:
+            p = r["paper"]
+            ref = f"{p['vx']}, {p['vy']}, {p['angle_deg']}" if p else "-"
+            if r["error"]:
+                L.append(f"| {r['variant']} | {r['n_el']} | {r['dt']:g} | failed: {r['error'][:60]} | | | | | {ref} |")
+                continue
+            L.append(f"| {r['variant']} | {r['n_el']} | {r['dt']:g} | {r['rebound_vx']:.3f} | {r['rebound_vy']:.3f} | "
+                     f"{r['rebound_angle_deg']:.1f} | {r['rebound_spin']:.4f} | {int(r['newton_iterations_total'])} | {ref} |")
+    return L + [""]
 
 
 def write_markdown(res):
@@ -148,6 +207,8 @@ def write_markdown(res):
               f"Hertz on {h['n_quads']} quads: p0 error {h['error_p0']:+.2%} (target 0.5 %: {_f(h['p0_within'])}), "
               f"solve {_f(h['solve_s'])} s, whole process {_f(h['process_s'])} s wall, "
               f"{_f(h.get('process_cpu_s'))} s CPU (best of 3; target 1.5 s wall: {_f(h['under_1p5s'])}).", ""]
+    if "speed" in res:
+        L += speed_section(res["speed"])
     return "\n".join(L) + "\n"
 
 

@@ -1,5 +1,6 @@
-"""Where the time of a run goes: start-up of the process and the cost of one Newton
-iteration, split into its parts, for every paper scene (`contactfem bench`).
+"""Study 5, speed: where the time of a run goes. Start-up of the process and the cost of one
+Newton iteration, split into its parts, for every paper scene; the Table 2 refinement
+study as `contactfem sweep` runs it (report: report.py).
 
 One Newton iteration is what ``newton()`` does between two linear solves: evaluate the
 residual and tangent (bulk: the bodies' internal forces and tangents; contact: every
@@ -23,6 +24,9 @@ import time
 from contextlib import contextmanager
 
 PARTS = ("bulk", "contact", "assembly", "solve", "overhead")
+# what the speed work aims at (whole-process and per-iteration times on 2 cores)
+SPEED_TARGETS = dict(list_s=0.25, sloping_impact_iteration_s=0.5e-3, rolling_ring_iteration_s=0.8e-3,
+                     table2_s=60.0, run_block_over_scipy_skfem=1.3)
 
 
 def _process(args, repeat=5):
@@ -59,11 +63,11 @@ def _timers():
     """Wrap the parts of a Newton iteration with CPU timers while inside newton().
 
     Yields a dict: seconds per part and the number of linear solves, summed over the run."""
-    from ..bodies.beam import Beam
-    from ..bodies.continuum import Continuum
-    from ..contact.interface import NodeToSegment
-    from ..solver import newmark, staggered
-    from ..solver.system import System
+    from ...bodies.beam import Beam
+    from ...bodies.continuum import Continuum
+    from ...contact.interface import NodeToSegment
+    from ...solver import newmark, staggered
+    from ...solver.system import System
 
     newton_module = sys.modules["contactfem.solver.newton"]     # (the package exports the function newton)
     acc = dict.fromkeys(("newton", "residual_tangent", "bulk", "contact", "solve"), 0.0)
@@ -112,9 +116,9 @@ def _timers():
             setattr(owner, name, fn)
 
 
-def iteration_cost(scene, preset="paper", overrides=None):
+def iteration_split(scene, preset="paper", overrides=None):
     """Run a scene with timers; per-iteration cost of each part (seconds, CPU) and the run's totals."""
-    from ..scenes import run_scene
+    from ...scenes import run_scene
 
     t0, c0 = time.perf_counter(), time.process_time()
     with _timers() as acc:
@@ -145,7 +149,7 @@ def table2_study(n_els=(16, 32, 64, 128), jobs=2, refine=8):
     import tempfile
     from pathlib import Path
 
-    from ..scenes.sloping_impact import PAPER_TABLE2
+    from ...scenes.sloping_impact import PAPER_TABLE2
 
     out = dict(n_el=list(n_els), jobs=jobs, sweeps=[], rows=[])
     with tempfile.TemporaryDirectory() as tmp:
@@ -177,64 +181,14 @@ def table2_study(n_els=(16, 32, 64, 128), jobs=2, refine=8):
 
 
 def speed_study(quick=False):
-    """Start-up times, the per-iteration cost of every paper scene and the Table 2 sweep."""
+    """Start-up times, the per-iteration cost of every paper scene and the Table 2 sweep.
+    Quick: two scenes at the fast preset, one run of each process, no sweep."""
     preset = "fast" if quick else "paper"
+    scenes = SCENES[:1] + SCENES[2:3] if quick else SCENES
     rows = []
-    for scene, over in SCENES:
+    for scene, over in scenes:
         row = dict(scene=scene, overrides=over, preset=preset)
-        row.update(iteration_cost(scene, preset, over))
+        row.update(iteration_split(scene, preset, over))
         rows.append(row)
-    return dict(preset=preset, iterations=rows, startup=startup_study(repeat=2 if quick else 5),
-                table2=table2_study(n_els=(16, 32) if quick else (16, 32, 64, 128), refine=2 if quick else 8))
-
-
-def _ms(x):
-    return "-" if x is None else f"{1e3 * x:.3f}"
-
-
-def markdown(res):
-    """The section of BENCHMARKS.md for this study."""
-    s = res["startup"]
-    lines = ["## Start-up and the cost of one Newton iteration", "",
-             "Start-up: whole processes, median of "
-             f"{len(s['python']['walls_s'])} runs (wall and CPU seconds).", "",
-             "| process | wall [s] | CPU [s] |", "|---|---|---|"]
-    names = {"python": "`python -c pass`", "list": "`contactfem list`",
-             "scipy_skfem": "`python -c \"import scipy.sparse.linalg, skfem\"`",
-             "run_block": "`contactfem run block --preset paper`"}
-    for key, label in names.items():
-        lines.append(f"| {label} | {s[key]['wall_s']:.3f} | {s[key]['cpu_s']:.3f} |")
-    lines += ["", f"`contactfem list` / `python -c pass`: {s['list_over_python']:.2f} (wall); "
-                  f"`contactfem run block --preset paper` / the scipy + scikit-fem import: "
-                  f"{s['run_block_over_scipy_skfem']:.2f} (wall).", "",
-              "One Newton iteration (CPU milliseconds, the run's totals divided by its linear solves; "
-              "module docstring of contactfem/studies/speed.py): bulk = the bodies' internal forces and "
-              "tangents, contact = every contact's residual and tangent, assembly = summing into K "
-              "(loads included), solve = the factorisation and solve, overhead = the rest of newton().", "",
-              "| scene | unknowns | K | iteration [ms] | bulk | contact | assembly | solve | overhead "
-              "| solves | run [s] |",
-              "|---|---|---|---|---|---|---|---|---|---|---|"]
-    for r in res["iterations"]:
-        label = r["scene"] + "".join(f", {v}" for v in r["overrides"].values())
-        lines.append(f"| {label} | {r['ndof'] or '-'} | {r['linear_algebra'] or '-'} | {_ms(r['iteration_s'])} | "
-                     + " | ".join(_ms(r[f'{p}_s']) for p in PARTS)
-                     + f" | {r['solves']} | {r['run_wall_s']:.2f} |")
-    t2 = res.get("table2")
-    if t2:
-        lines += ["", "### Table 2: convergence of the rebound under refinement", "",
-                  "Each line of the table is one run of the sweeps below (paper data, Newmark 0.7/0.4; the "
-                  "paper's values are printed to two digits). Wall time of the sweeps: "
-                  + "; ".join(f"`{sw['command']}` {sw['wall_s']:.1f} s" for sw in t2["sweeps"])
-                  + f"; together {t2['total_wall_s']:.1f} s.", "",
-                  "| variant | elements | dt | v_x | v_y | angle [deg] | spin | linear solves | paper v_x, v_y, angle |",
-                  "|---|---|---|---|---|---|---|---|---|"]
-        for r in t2["rows"]:
-            paper = r["paper"]
-            ref = f"{paper['vx']}, {paper['vy']}, {paper['angle_deg']}" if paper else "-"
-            if r["error"]:
-                lines.append(f"| {r['variant']} | {r['n_el']} | {r['dt']:g} | failed: {r['error'][:60]} | | | | | {ref} |")
-                continue
-            lines.append(f"| {r['variant']} | {r['n_el']} | {r['dt']:g} | {r['rebound_vx']:.3f} | {r['rebound_vy']:.3f} | "
-                         f"{r['rebound_angle_deg']:.1f} | {r['rebound_spin']:.4f} | "
-                         f"{int(r['newton_iterations_total'])} | {ref} |")
-    return "\n".join(lines) + "\n"
+    return dict(preset=preset, iterations=rows, startup=startup_study(repeat=1 if quick else 5),
+                table2=None if quick else table2_study())
