@@ -109,15 +109,16 @@ def test_effective_tangent_is_the_same_matrix_dense_and_sparse():
 
 
 def test_results_match_the_recorded_run_before_the_fast_paths():
-    """Rebound of the paper's frictional and frictionless runs, recorded with the COO -> CSR
-    assembly and SuperLU of every Newton iteration (before the dense and fixed-pattern
-    paths): unchanged to 1e-12."""
+    """Rebound of the paper's frictional and frictionless runs (midpoint beam integration),
+    recorded with the COO -> CSR assembly and SuperLU of every Newton iteration (before the
+    dense and fixed-pattern paths): unchanged to 1e-12."""
     recorded = {   # rebound_vx, rebound_vy, rebound_spin, newton_iterations_total
         "frictional": (0.982357236644071, 1.3520089784366212, -0.0910290788696532, 455),
         "frictionless": (2.000000000000146, 1.3125149198268813, -1.570706901749704e-14, 445),
     }
     for variant, (vx, vy, spin, iters) in recorded.items():
-        res = sloping_impact.run(get_scene("sloping_impact").resolve("paper", {"variant": variant}))
+        # the recorded runs used one (midpoint) integration point per beam element
+        res = sloping_impact.run(get_scene("sloping_impact").resolve("paper", {"variant": variant, "integration": "1"}))
         assert res["newton_iterations_total"] == iters
         for got, want in ((res["rebound_vx"], vx), (res["rebound_vy"], vy), (res["rebound_spin"], spin)):
             assert abs(got - want) <= 1e-12 * max(1.0, abs(want)), variant

@@ -15,9 +15,10 @@ Kinematics (exact under large rotations; textbook: Simo & Vu-Quoc 1986, Crisfiel
 
 Discretisation: straight two-node elements (a polygon in the reference state), linear
 interpolation in the reference arc length s, ONE-point (midpoint) integration against
-shear locking. The element kernel is vectorised numpy over all elements; K comes as
-COO triplets on the constant element connectivity (``internal_coo``, what the solver's
-System assembles) or as a CSR matrix (``internal``).
+shear locking (``integration=2``: two-point Gauss, which locks in shear). The element
+kernel is vectorised numpy over all elements; K comes as COO triplets on the constant
+element connectivity (``internal_coo``, what the solver's System assembles) or as a CSR
+matrix (``internal``).
 
 What scikit-fem does here: the 1D mesh in the arc length s (``MeshLine``; its
 element lengths are the reference chord lengths), and the lumped mass (row sums of
@@ -96,10 +97,12 @@ class Beam:
     kappa_s  shear correction factor (default 5/6, rectangle)
     plastic  None (elastic) or dict(N0=, Q0=, M0=, eta=0.1): Perzyna viscoplasticity;
              then set the step with ``beam.set_dt(dt)`` before calling internal().
+    integration     1 (midpoint, default) or 2 (two-point Gauss: stiffer, shear locking)
+    rotary_inertia  True (default): rho I on the rotation dofs of the lumped mass; False: 0
     """
 
     def __init__(self, X, closed, E, A, I, rho, G=None, nu=0.0, kappa_s=5 / 6,
-                 name="beam", plastic=None):
+                 name="beam", plastic=None, integration=1, rotary_inertia=True):
         X = np.asarray(X, dtype=float)
         if X.ndim != 2 or X.shape[1] != 2 or not np.all(np.isfinite(X)):
             raise ValueError(f"parameter X must be a finite (nn, 2) array, got shape {X.shape}")
@@ -156,7 +159,15 @@ class Beam:
             self.S0 = np.array([_check(k, plastic.get(k, d), 0.0)
                                 for k, d in (("N0", 1.0), ("Q0", 0.5), ("M0", 0.25))])
             self.eta = _check("eta", plastic.get("eta", 0.1), 0.0)
-        self.ep = np.zeros((ne, 3))   # committed plastic strains (eps_p, gam_p, kap_p)
+        if integration not in (1, 2):
+            raise ValueError(f"parameter integration = {integration!r} is not allowed: one of 1|2")
+        g = 1 / np.sqrt(3.0)
+        # (natural coordinate xi in [-1, 1], weight as a fraction of L0)
+        self.points = ((0.0, 1.0),) if integration == 1 else ((-g, 0.5), (g, 0.5))
+        # committed plastic strains (eps_p, gam_p, kap_p) per integration point: rows k ne .. (k+1) ne - 1
+        # belong to point k
+        self.ep = np.zeros((len(self.points) * ne, 3))
+        self.rotary_inertia = bool(rotary_inertia)
 
     # ---- time step for the viscoplastic update ---------------------------------
     def set_dt(self, dt):
@@ -168,12 +179,13 @@ class Beam:
         """Current centreline node positions x = X + u, (nn, 2)."""
         return self.X + np.asarray(u).reshape(-1, 3)[:, :2]
 
-    def strains(self, u):
-        """Midpoint strains (eps, gam, kap) per element, (ne, 3), and t, n of the total angle."""
+    def strains(self, u, xi=0.0):
+        """Strains (eps, gam, kap) per element at the natural coordinate xi (0: midpoint),
+        (ne, 3), and t, n of the total angle there."""
         U = np.asarray(u, float).reshape(-1, 3)
         a, b = self.conn.T
         xp = (self._dX + U[b, :2] - U[a, :2]) / self.L0[:, None]          # x'
-        phi = self.theta0 + 0.5 * (U[a, 2] + U[b, 2])
+        phi = self.theta0 + 0.5 * (1 - xi) * U[a, 2] + 0.5 * (1 + xi) * U[b, 2]
         cos, sin = np.cos(phi), np.sin(phi)
         t = np.stack([cos, sin], axis=1)
         n = np.stack([-sin, cos], axis=1)
@@ -183,14 +195,15 @@ class Beam:
         E[:, 2] = (U[b, 2] - U[a, 2]) / self.L0                           # kap = theta'
         return E, t, n
 
-    def resultants(self, u, E=None):
-        """(N, Q, M) per element, (ne, 3), with the algorithmic moduli dS/dE and new plastic
-        strains (E: the strains at u, if already computed)."""
+    def resultants(self, u, xi=0.0, k=0, E=None):
+        """(N, Q, M) per element at xi (integration point k), (ne, 3), with the algorithmic
+        moduli dS/dE and new plastic strains (E: the strains there, if already computed)."""
         if E is None:
-            E = self.strains(u)[0]
+            E = self.strains(u, xi)[0]
         if self.S0 is not None and self.dt is None:
             raise RuntimeError("viscoplastic beam: call beam.set_dt(dt) before evaluating it")
-        return return_map(E, self.ep, self.D, self.S0, self.eta, self.dt)
+        ne = len(self.L0)
+        return return_map(E, self.ep[k * ne:(k + 1) * ne], self.D, self.S0, self.eta, self.dt)
 
     # ---- body interface ------------------------------------------------------------
     def internal(self, u):
@@ -201,54 +214,58 @@ class Beam:
         return R, coo_matrix((vals, (rows, cols)), shape=(self.ndof, self.ndof)).tocsr()
 
     def internal_coo(self, u):
-        """Internal force R = dW/du and consistent tangent K = dR/du (virtual work, midpoint
-        rule), K as COO triplets (rows, cols, vals) on the fixed element connectivity.
+        """Internal force R = dW/du and consistent tangent K = dR/du (virtual work, midpoint rule,
+        or two-point Gauss with ``integration=2``), K as COO triplets (rows, cols, vals) on the
+        fixed element connectivity.
 
-        Per element, with q = (u_a, theta_a, u_b, theta_b) and B = dE/dq (3 x 6):
-            r_e = L0 B^T S,     K_e = L0 (B^T C B + N d2eps/dq2 + Q d2gam/dq2)
-        deps/dphi = gam, dgam/dphi = -(1 + eps), phi = theta0 + (theta_a + theta_b)/2.
+        Per element and point, with q = (u_a, theta_a, u_b, theta_b) and B = dE/dq (3 x 6):
+            r_e = w L0 B^T S,     K_e = w L0 (B^T C B + N d2eps/dq2 + Q d2gam/dq2)
+        deps/dphi = gam, dgam/dphi = -(1 + eps), phi = theta0 + N_a theta_a + N_b theta_b.
         With a_t = d(x'.t)/dq, a_n = d(x'.n)/dq (phi fixed) and p = dphi/dq:
             B = [a_t + gam p,  a_n - (1 + eps) p,  dkap/dq],
             d2eps/dq2 = a_n p^T + p a_n^T - (1 + eps) p p^T,
             d2gam/dq2 = -(a_t p^T + p a_t^T) - gam p p^T,
         so the geometric part is w p^T + p w^T - (N (1 + eps) + Q gam) p p^T, w = N a_n - Q a_t.
         """
-        E, t, n = self.strains(u)
-        S, C, _ = self.resultants(u, E)
-        eps, gam = E[:, 0], E[:, 1]
-        N, Q = S[:, 0], S[:, 1]
         ne = len(self.L0)
         L0 = self.L0[:, None]
-        p = np.array([0, 0, 0.5, 0, 0, 0.5])                       # dphi/dq
-        a_t = np.zeros((ne, 6))
-        a_t[:, 0:2], a_t[:, 3:5] = -t / L0, t / L0                  # d(x' . t)/dq
-        a_n = np.zeros((ne, 6))
-        a_n[:, 0:2], a_n[:, 3:5] = -n / L0, n / L0                  # d(x' . n)/dq
-        B = np.empty((ne, 3, 6))
-        B[:, 0] = a_t + gam[:, None] * p
-        B[:, 1] = a_n - (1 + eps)[:, None] * p
-        B[:, 2] = self._dkap
-        w = N[:, None] * a_n - Q[:, None] * a_t
-        wp = w[:, :, None] * p                                     # w p^T
-        Ke = np.matmul(B.transpose(0, 2, 1) * C[:, None, :], B)   # B^T C B (C diagonal)
-        Ke += wp + wp.transpose(0, 2, 1) - (N * (1 + eps) + Q * gam)[:, None, None] * np.outer(p, p)
-        Ke *= L0[:, :, None]
-        re = L0 * np.matmul(S[:, None, :], B)[:, 0]                # L0 B^T S
+        re, Ke = 0.0, 0.0
+        for k, (xi, weight) in enumerate(self.points):
+            E, t, n = self.strains(u, xi)
+            S, C, _ = self.resultants(u, xi, k, E)
+            eps, gam = E[:, 0], E[:, 1]
+            N, Q = S[:, 0], S[:, 1]
+            p = np.array([0, 0, 0.5 * (1 - xi), 0, 0, 0.5 * (1 + xi)])   # dphi/dq
+            a_t = np.zeros((ne, 6))
+            a_t[:, 0:2], a_t[:, 3:5] = -t / L0, t / L0                  # d(x' . t)/dq
+            a_n = np.zeros((ne, 6))
+            a_n[:, 0:2], a_n[:, 3:5] = -n / L0, n / L0                  # d(x' . n)/dq
+            B = np.empty((ne, 3, 6))
+            B[:, 0] = a_t + gam[:, None] * p
+            B[:, 1] = a_n - (1 + eps)[:, None] * p
+            B[:, 2] = self._dkap
+            w = N[:, None] * a_n - Q[:, None] * a_t
+            wp = w[:, :, None] * p                                     # w p^T
+            K = np.matmul(B.transpose(0, 2, 1) * C[:, None, :], B)    # B^T C B (C diagonal)
+            K += wp + wp.transpose(0, 2, 1) - (N * (1 + eps) + Q * gam)[:, None, None] * np.outer(p, p)
+            Ke = Ke + weight * L0[:, :, None] * K
+            re = re + weight * L0 * np.matmul(S[:, None, :], B)[:, 0]   # w L0 B^T S
         R = np.bincount(self._edofs_flat, re.ravel(), minlength=self.ndof)
         return R, self._rows, self._cols, Ke.ravel()
 
     def strain_energy(self, u):
         """Stored (elastic) energy sum_e L0 sum_k S_k^2 / (2 D_k); elastic case: L0 D E^2 / 2."""
-        S, _, _ = self.resultants(u)
-        return float(np.sum(self.L0[:, None] * S**2 / (2 * self.D)))
+        return float(sum(w * np.sum(self.L0[:, None] * self.resultants(u, xi, k)[0] ** 2 / (2 * self.D))
+                         for k, (xi, w) in enumerate(self.points)))
 
     def commit(self, u):
         """Accept u as converged: store the plastic strains (no-op if elastic)."""
         if self.S0 is not None:
-            self.ep = self.resultants(u)[2]
+            self.ep = np.concatenate([self.resultants(u, xi, k)[2] for k, (xi, _) in enumerate(self.points)])
 
     def mass(self):
-        """Lumped mass: rho A per length on u_x, u_y and rho I per length on theta (half to each node).
+        """Lumped mass: rho A per length on u_x, u_y and rho I per length on theta (half to each node;
+        0 on theta without rotary inertia).
 
         scikit-fem: row sums of the P1 mass matrix on the arc-length mesh = L0/2 per element end.
         """
@@ -258,7 +275,8 @@ class Beam:
 
             lumped_mesh = np.asarray(asm(mass_form, Basis(self.mesh, ElementLineP1())).sum(axis=1)).ravel()
             length = np.bincount(self.fold, lumped_mesh, minlength=self.X.shape[0])   # fold s = L onto s = 0
-            self._mass = (self.rho * np.column_stack([self.A * length, self.A * length, self.I * length])).ravel()
+            J = self.I * length if self.rotary_inertia else 0.0 * length
+            self._mass = (self.rho * np.column_stack([self.A * length, self.A * length, J])).ravel()
         return self._mass.copy()
 
     # ---- surface offset (for contact on the outer face of a ring) -------------------

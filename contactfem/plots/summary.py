@@ -39,7 +39,10 @@ def row_block_equilibrium(preset):
     r = cached_run("block", preset, law="conical")
     ours = (f"equilibrium to {r['equilibrium_error']:.0e} ({-r['total_normal']:.0f} down, "
             f"{r['total_tangential']:.0f} along)")
-    return ("Sec. 5.1, Fig 6", "block on a rough foundation, whole load in one step", "-", ours,
+    what = "block on a rough foundation, whole load in one step"
+    if r.get("fitted"):
+        what += " (" + ", ".join(r["fitted"]) + " FITTED to Table 1)"
+    return ("Sec. 5.1, Fig 6", what, "-", ours,
             _links(("6", "fig06_block_mesh_deformed.png")))
 
 
@@ -71,7 +74,7 @@ def row_table1(preset):
     rc, rp = c["newton_residuals"], p["newton_residuals"]
     ours = (f"conical {len(rc)} ({c['n_slip']} nodes slip), parabolic {len(rp)}; "
             f"first {rc[0]:.2f}; last {rc[-1]:.0e} and {rp[-1]:.0e}")
-    return ("Table 1", "residual norms of Newton, one load step",
+    return ("Table 1", "residual norms of Newton, one load step" + (" (reading FITTED to this table)" if c.get("fitted") else ""),
             f"conical {len(PAPER_TABLE1['conical'])} residuals, parabolic {len(PAPER_TABLE1['parabolic'])}; "
             f"first {PAPER_TABLE1['conical'][0]:.2f}", ours,
             _links(("table", "table1_block_newton_residuals.md")))
@@ -93,7 +96,10 @@ def row_sloping_impact(preset):
         parts.append(f"{variant} ({r['rebound_vx']:.2f}, {r['rebound_vy']:.2f}), {r['rebound_angle_deg']:.1f} deg")
     n_el = cached_run("sloping_impact", preset, variant="frictionless")["parameters"]["n_el"]
     ours = "; ".join(parts) + f" ({n_el} elements)"
-    return ("Sec. 5.3, Table 2", "sloping impact, rebound",
+    fitted = cached_run("sloping_impact", preset, variant="frictionless").get("fitted") or {}
+    what = "sloping impact, rebound" + (f" (beam integration FITTED to this table: {fitted['integration']} points)"
+                                        if "integration" in fitted else "")
+    return ("Sec. 5.3, Table 2", what,
             "frictionless (2, 1.7), 50 deg; frictional (1.2, 1.7), 35 deg", ours,
             _links(("10", "fig10_sloping_impact_frictionless.png"), ("11a", "fig11a_sloping_impact_frictional.png"),
                    ("11b", "fig11b_sloping_impact_viscoplastic.png"), ("table", "table2_sloping_impact.md")))
