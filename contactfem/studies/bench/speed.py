@@ -16,6 +16,7 @@ interpreter, `contactfem list`, an interpreter that imports scipy.sparse.linalg 
 scikit-fem (what any scikit-fem program pays), and `contactfem run block --preset paper`.
 """
 
+import os
 import resource
 import statistics
 import subprocess
@@ -158,12 +159,17 @@ def table2_study(n_els=(16, 32, 64, 128), jobs=2, refine=8):
             args = [sys.executable, "-m", "contactfem", "sweep", "sloping_impact", "--preset", "paper",
                     "--set", "variant=frictionless,frictional", "--set", "n_el=" + ",".join(map(str, n_els)),
                     "--set", f"dt={dt:g}", "--set", f"n_steps={n_steps}", "--jobs", str(jobs), "--out", str(table)]
+            r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
             t0 = time.perf_counter()
             proc = subprocess.run(args, capture_output=True, text=True)
             wall = time.perf_counter() - t0
+            r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
             if proc.returncode != 0:
                 raise RuntimeError(f"bench: the Table 2 sweep failed: {proc.stderr.strip()[-500:]}")
-            out["sweeps"].append(dict(command="contactfem " + " ".join(args[3:-2]), wall_s=wall))
+            # CPU of the sweep and of its worker processes (user + sys): on a loaded machine the
+            # wall time is mostly waiting for a core
+            cpu = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
+            out["sweeps"].append(dict(command="contactfem " + " ".join(args[3:-2]), wall_s=wall, cpu_s=cpu))
             with open(table, newline="") as fh:
                 for row in csv.DictReader(fh):
                     variant = row["param.variant"]
@@ -177,6 +183,7 @@ def table2_study(n_els=(16, 32, 64, 128), jobs=2, refine=8):
                                             paper=PAPER_TABLE2.get(variant)))
     out["rows"].sort(key=lambda r: (r["variant"], r["dt"] < 0.1, r["n_el"]))
     out["total_wall_s"] = sum(sw["wall_s"] for sw in out["sweeps"])
+    out["total_cpu_s"] = sum(sw["cpu_s"] for sw in out["sweeps"])
     return out
 
 
@@ -190,5 +197,6 @@ def speed_study(quick=False):
         row = dict(scene=scene, overrides=over, preset=preset)
         row.update(iteration_split(scene, preset, over))
         rows.append(row)
+    load = list(os.getloadavg()) if hasattr(os, "getloadavg") else None
     return dict(preset=preset, iterations=rows, startup=startup_study(repeat=1 if quick else 5),
-                table2=None if quick else table2_study())
+                table2=None if quick else table2_study(), load_average=load)
