@@ -89,13 +89,19 @@ def cmd_equations(args):
     print(markdown_table())
 
 
+def cmd_site(args):
+    from .site import build
+
+    print(f"site -> {build(args.out)}")
+
+
 def cmd_reconstruct(args):
     from .studies.reconstruct import main as reconstruct
 
     reconstruct(args.scene, quick=args.quick, top=args.top, json_path=args.json, cache=not args.no_cache)
 
 
-BENCH_STUDIES = ("tangents", "work_precision", "cost", "targets", "speed")    # contactfem.studies.bench.STUDIES
+BENCH_STUDIES = ("tangents", "work_precision", "cost", "targets", "enforcement", "speed")  # = studies.bench.STUDIES
 
 
 def cmd_bench(args):
@@ -159,6 +165,9 @@ def build_parser():
     sw.add_argument("--scheduler", default=None, help="Dask scheduler address: run on that cluster instead")
     sw.add_argument("--out", default="sweep.csv", help="table of results (.csv or .json)")
     sw.set_defaults(func=cmd_sweep)
+    st = sub.add_parser("site", help="build the course website (lectures executed, gallery, equation index, API)")
+    st.add_argument("--out", default=None, metavar="DIR", help="output folder, DIR/index.html (default: build/site)")
+    st.set_defaults(func=cmd_site)
     rc = sub.add_parser("reconstruct", help="the scan's lost values as an inverse problem: run every reading "
                         "the scan allows, score it against what the paper prints, print the ranked table")
     rc.add_argument("scene", help="block | sloping_impact")
@@ -168,7 +177,8 @@ def build_parser():
     rc.add_argument("--no-cache", action="store_true", help="recompute every reading (default: reuse the "
                     "results of earlier runs of the same code, in $CONTACTFEM_CACHE or ~/.cache/contactfem)")
     rc.set_defaults(func=cmd_reconstruct)
-    bp = sub.add_parser("bench", help="speed against accuracy: tangents, work-precision, cost, targets, speed "
+    bp = sub.add_parser("bench", help="speed against accuracy: tangents, work-precision, cost, targets, "
+                                      "enforcement, speed "
                                       "(writes bench.json and BENCHMARKS.md)")
     bp.add_argument("--quick", action="store_true", help="fast presets and fewer points (about a minute)")
     bp.add_argument("--out", default=".", help="folder for bench.json and BENCHMARKS.md (default: .)")

@@ -3,7 +3,14 @@ friction history (paper Sec. 4.3, step 4: per slave node, check the gap -> norma
 force -> trial friction -> slip check -> stick or return map -> tangents).
 
 History (s_bar, t_T_bar, q_bar and the friction law's internal variables z_bar) is
-committed only on a converged step (commit)."""
+committed only on a converged step (commit).
+
+The closing step: a node open at the start of a step (committed gap g_bar > 0) that is in
+contact at its end touched the master at the fraction theta = g_bar / (g_bar - g_N) of the
+step (the gap interpolated linearly). Its stick spring starts there: the slip increment is
+the travel after touching, Delta g_T = r (s - s_bar) with r = 1 - theta = -g_N / (g_bar - g_N),
+not the whole travel of the step (which would load the spring with the tangential motion
+made while still open)."""
 
 import numpy as np
 
@@ -50,6 +57,7 @@ class NodeToSegment:
         self.offset = float(offset)
         nc = len(self.nodes)
         self.s_bar = None                   # set at the first evaluation (or initialize)
+        self.g_bar = None                   # committed gap (the closing step, module docstring)
         self.t_T_bar = np.zeros(nc)
         self.q_bar = np.zeros(nc)
         self._law = None if friction is None else as_friction_law(friction)
@@ -81,6 +89,8 @@ class NodeToSegment:
         x_s = self.slave_positions(u)
         s0 = np.zeros(len(self.nodes))
         self.s_bar = self.master.locate(x_s, s0, u)["s"]
+        self.g_bar = None
+        self.g_bar = self.kinematics(u)["g_N"]
 
     def kinematics(self, u):
         """Gap, normal traction and variations at u (step 4a-b of Sec. 4.3), before friction."""
@@ -94,7 +104,17 @@ class NodeToSegment:
         active = k["inside"] & (g_N < 0.0)
         t_N, dt_N = self.normal.traction(np.where(active, g_N, 1.0))
         dofs = np.concatenate([self.slave_dofs(), k["master_dofs"]], axis=1) if k["master_dofs"].size else self._dofs
-        return dict(k, x_s=x_s, g_N=g_N, active=active, t_N=t_N, dt_N=dt_N, dg_T=k["s"] - self.s_bar, dofs=dofs)
+        travel = k["s"] - self.s_bar
+        r, dr, ddg_T = np.ones_like(g_N), np.zeros_like(g_N), k["ds"]
+        if self.g_bar is not None:                          # the closing step (module docstring)
+            closing = active & (self.g_bar > 0.0)
+            if np.any(closing):
+                gb = np.where(closing, self.g_bar, 1.0)
+                r = np.where(closing, -g_N / (gb - g_N), 1.0)
+                dr = np.where(closing, -gb / (gb - g_N) ** 2, 0.0)
+                ddg_T = r[:, None] * k["ds"] + (travel * dr)[:, None] * k["dg_N"]
+        return dict(k, x_s=x_s, g_N=g_N, active=active, t_N=t_N, dt_N=dt_N, dg_T=r * travel, travel=travel,
+                    r=r, dr=dr, ddg_T=ddg_T, dofs=dofs)
 
     def evaluate(self, u):
         """Everything at displacement u with the committed history: kinematics,
@@ -112,8 +132,10 @@ class NodeToSegment:
         """Add the element residuals and tangents (eqs 28, 33, 39, 49) of the active pairs
         to the kinematics e (an open pair contributes nothing: R and K hold active pairs only)."""
         on = e["active"]
+        ddg_T = e.get("ddg_T")
         R, K = contact_element(self.weights[on], e["t_N"][on], e["dt_N"][on], t_T[on], c_T_s[on], c_N_s[on],
-                               e["dg_N"][on], e["d2g_N"][on], e["ds"][on], e["d2s"][on])
+                               e["dg_N"][on], e["d2g_N"][on], e["ds"][on], e["d2s"][on],
+                               None if ddg_T is None else ddg_T[on])
         return dict(e, R=R, K=K, **extra)
 
     @staticmethod
@@ -147,6 +169,7 @@ class NodeToSegment:
         if hasattr(self.master, "commit"):
             self.master.commit(u)           # new converged metric l_bar of a deformable master
         self.s_bar = self.master.locate(e["x_s"], self.s_bar, u)["s"]
+        self.g_bar = self.kinematics(u)["g_N"]
 
     def energy(self, u):
         """Energy stored in the interface: the normal law's potential plus the elastic

@@ -53,7 +53,8 @@ import numpy as np
 from ..bodies.ring import RingRecorder, make_ring
 from ..contact import NodeToSegment, RigidLine
 from ..laws import Coulomb, PowerLaw
-from ..solver import Newmark, System, integrate
+from ..solver import System, integrate
+from . import time_integration
 from .base import Param, Scene
 
 # Paper, Fig 9 (bracketed values are the rigid thin-ring solution)
@@ -138,8 +139,7 @@ def run(params, progress=None):
     rec = RingRecorder(ring, interval=params["outline_interval"], tol=1e-6 * params["dt"], snapshot_measures=dict(
         node_y=lambda u, v: ring.body.X[ring.contact_nodes, 1] + u[nodes[:, 1]],   # velocity profile
         node_vx=lambda u, v: v[nodes[:, 0]]))
-    stepper = Newmark(system, params["dt"], params["delta"], params["beta_newmark"],
-                      atol=1e-6, rtol=1e-10, maxit=30)
+    stepper = time_integration.make_stepper(params, system, params["dt"], atol=1e-6, rtol=1e-10, maxit=30)
     hist = integrate(stepper, 0.0, u0, vel0, t_end=params["t_end"], recorder=rec, cutback=True, max_cuts=8,
                      progress=progress)
     rec = rec.arrays()
@@ -178,6 +178,7 @@ def run(params, progress=None):
         outlines=rec["outlines"], outline_t=rec["outline_t"],
         outline_vc=vc[rec["outline_k"]], outline_omega=omega[rec["outline_k"]],
         outline_node_y=rec["outline_node_y"], outline_node_vx=rec["outline_node_vx"],
+        energy_error=time_integration.energy_error(hist)[0],
         energy_kinetic=hist.kinetic, energy_strain=hist.strain, energy_dissipation=hist.dissipation,
         newton_iterations_total=int(np.sum(hist.iterations)),
         step_cuts_total=int(np.sum(hist.cuts)),
@@ -231,6 +232,7 @@ SCENE = Scene(
               doc="duration (chosen: 2 s, where the paper's exact position is 376 cm)"),
         Param("delta", 0.7, "", 0.5, 1.0, doc="Newmark delta (paper: 0.7)"),
         Param("beta_newmark", 0.4, "", 0.0, 0.5, low_open=True, doc="Newmark beta (paper: 0.4)"),
+        time_integration.CONTACT_INTEGRATION_PARAM,
         Param("outline_interval", 0.25, "s", 0.0, None, low_open=True,
               doc="store the ring outline this often (figures)"),
     ),

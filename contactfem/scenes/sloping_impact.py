@@ -33,7 +33,8 @@ import numpy as np
 from ..bodies.ring import RingRecorder, make_ring
 from ..contact import NodeToSegment, RigidLine, tributary_lengths
 from ..laws import ParabolicSlip, PowerLaw
-from ..solver import Newmark, System, integrate
+from ..solver import System, integrate
+from . import time_integration
 from .base import Param, Scene
 
 VARIANTS = ("frictionless", "frictional", "viscoplastic")
@@ -97,8 +98,7 @@ def run(params, progress=None):
     contact.initialize(u0)
     rec = RingRecorder(ring, contact, every=params["outline_every"])
     system.set_dt(params["dt"])            # the viscoplastic beam needs dt before the first evaluation
-    stepper = Newmark(system, params["dt"], params["delta"], params["beta_newmark"],
-                      atol=1e-10, rtol=1e-10, maxit=30)
+    stepper = time_integration.make_stepper(params, system, params["dt"], atol=1e-10, rtol=1e-10, maxit=30)
     hist = integrate(stepper, 0.0, u0, v0, n_steps=params["n_steps"], recorder=rec, cutback=True, max_cuts=6,
                      progress=progress)
     rec = rec.arrays()
@@ -125,6 +125,8 @@ def run(params, progress=None):
         energy_total_max_rel_change_impact=float(np.max(np.abs(mech[window] - E0)) / E0),
         energy_total_max_rel_increase_per_step=float(np.max(np.diff(mech)) / E0),
         energy_total_final_rel=float(mech[-1] / E0),
+        energy_error=time_integration.energy_error(hist)[0], energy_error_max=time_integration.energy_error(hist)[1],
+        energy_after_rebound_rel=float(mech[-1] / E0 - 1.0) if rebounded else None,
         outlines=rec["outlines"], outline_t=rec["outline_t"], outline_spin=omega,
         mass=ring.total_mass(),
         # committed plastic strains of the beam (eps_p, gam_p, kap_p): the permanent deformation
@@ -195,6 +197,7 @@ SCENE = Scene(
         Param("n_steps", 200, "", 1, 100000, doc="number of steps (paper: 200)"),
         Param("delta", 0.7, "", 0.5, 1.0, doc="Newmark delta (paper: 0.7; 0.5 with beta 0.25 conserves energy)"),
         Param("beta_newmark", 0.4, "", 0.0, 0.5, low_open=True, doc="Newmark beta (paper: 0.4)"),
+        time_integration.CONTACT_INTEGRATION_PARAM,
         Param("outline_every", 20, "", 1, 100000, doc="store the ring outline every this many steps (figures)"),
     ),
     run=run,
