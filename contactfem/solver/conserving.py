@@ -48,9 +48,9 @@ class EnergyConsistent:
                                  "(use contact_integration=standard for the viscoplastic ring)")
 
     def _bodies(self, u0, u1):
+        """Discrete-gradient internal forces of every body, as (G, rows, cols, vals)."""
         import scipy.sparse as sp     # (imported here: listing the scenes loads no scipy)
 
-        """Discrete-gradient internal forces of every body, as (G, rows, cols, vals)."""
         s = self.system
         G = np.zeros(s.ndof)
         rows, cols, vals = [], [], []
