@@ -165,6 +165,9 @@ SCENE = Scene(
     ),
     run=run,
     presets={"fast": {"n_el": 40}, "paper": {"n_el": 100}},
+    size=lambda p: dict(elements=p["n_el"], unknowns=4 * (p["n_el"] + 1),
+                        steps=(2 * p["t_end"] + p["gap"] / p["L"] * (p["E"] / p["rho"]) ** 0.5 / p["v0"])
+                        * p["n_el"] / p["courant"]),
     reports=("duration", "duration_exact", "stress_mean", "stress_peak", "stress_exact",
              "rebound_velocity", "energy_error"),
 )
