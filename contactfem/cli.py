@@ -45,7 +45,8 @@ def cmd_show(args):
 def cmd_run(args):
     if args.progress:
         os.environ["CONTACTFEM_PROGRESS"] = "1"
-    res = scenes.run_scene(args.scene, args.preset, parse_sets(args.set))
+    overrides, laws = laws_from_args(args)
+    res = scenes.run_scene(args.scene, args.preset, overrides, **laws)
     text = json.dumps(res, indent=1)
     if args.json:
         with open(args.json, "w") as fh:
@@ -59,6 +60,17 @@ def cmd_run(args):
     summary = {k: v for k, v in res.items() if not isinstance(v, (list, dict))}
     for k, v in summary.items():
         print(f"{k}: {v}")
+
+
+def laws_from_args(args):
+    """Scene overrides and the --friction / --normal law objects (fields from --set law.NAME=...)."""
+    from .laws.lawfile import laws_from_options, split_sets
+
+    overrides, law_sets = split_sets(parse_sets(args.set))
+    if not (args.friction or args.normal or any(law_sets.values())):
+        return overrides, {}
+    params = scenes.get_scene(args.scene).resolve(args.preset, overrides)
+    return overrides, laws_from_options(args.friction, args.normal, law_sets, params)
 
 
 def cmd_figures(args):
@@ -108,7 +120,10 @@ def build_parser():
     rp = sub.add_parser("run", help="run a scene")
     rp.add_argument("scene")
     rp.add_argument("--preset", default="fast", choices=["fast", "paper"])
-    rp.add_argument("--set", action="append", metavar="NAME=VALUE", help="override a parameter (repeatable)")
+    rp.add_argument("--set", action="append", metavar="NAME=VALUE",
+                    help="override a parameter, or a field of a law file's law as law.NAME=VALUE (repeatable)")
+    rp.add_argument("--friction", metavar="FILE.py:CLASS", help="use the friction law CLASS defined in FILE.py")
+    rp.add_argument("--normal", metavar="FILE.py:CLASS", help="use the normal law CLASS defined in FILE.py")
     rp.add_argument("--json", metavar="FILE", help="write all results to FILE as JSON")
     rp.add_argument("--gif", metavar="FILE", help="animate the recorded outlines (.gif, or .mp4 with ffmpeg)")
     rp.add_argument("--progress", action="store_true", help="show a progress bar on stderr during the time loop")

@@ -28,15 +28,22 @@ def get_scene(name):
     return scenes[name]
 
 
-def run_scene(name, preset="fast", overrides=None):
-    """Run a scene and return its results with wall time, Newton iteration count and parameters."""
+def run_scene(name, preset="fast", overrides=None, friction=None, normal=None):
+    """Run a scene and return its results with wall time, Newton iteration count and parameters.
+    ``friction`` / ``normal``: law objects replacing the laws the scene's parameters build
+    (recorded as ``friction_law`` / ``normal_law``: class, file, fields)."""
     import time
+
+    from ..laws.lawfile import describe
 
     scene = get_scene(name)
     params = scene.resolve(preset, overrides)
+    laws = {k: v for k, v in (("friction", friction), ("normal", normal)) if v is not None}
     t0 = time.perf_counter()
-    results = scene.run(params)
+    results = scene.run(params, **laws)
     results = dict(results)
+    for kind, law in laws.items():
+        results[f"{kind}_law"] = describe(law)
     results["wall_time_s"] = time.perf_counter() - t0
     results.setdefault("newton_iterations_total", 0)
     results["scene"] = name

@@ -215,6 +215,7 @@ def integrate(stepper, t0, u0, v0=None, n_steps=None, t_end=None, callback=None,
         raise ValueError(f"max_cuts must be an integer >= 0, got {max_cuts}")
 
     fixed = s.fixed_dofs
+    s.set_dt(DT)                                      # rate-dependent parts see dt from the start
     u = s.apply_dirichlet(u0, t0)
     v = np.zeros(s.ndof) if v0 is None else np.array(v0, dtype=float)
     G, _ = s.residual_tangent(u, t0)
