@@ -45,11 +45,13 @@ from skfem import MeshQuad
 
 from ..bodies.continuum import MATERIALS, Continuum
 from ..bodies.loads import Pressure, Traction
-from ..contact import NodeToSegment, RigidLine, to_coo, tributary_lengths
+from ..contact import RigidLine, to_coo, tributary_lengths
+from ..contact.augmented import make_interface
 from ..contact.kinematics import outer
 from ..laws.friction import Coulomb, ParabolicSlip
 from ..laws.normal import PowerLaw
 from ..solver import Static, System
+from . import enforcement
 from .base import Param, Scene
 
 # Table 1 of the paper: norm of the residual ||G|| per Newton iteration (the first
@@ -106,6 +108,7 @@ PARAMS = (
     Param("rtol", 1e-10, "", 0.0, 1e-3, low_open=True, doc="Newton: ||G_k|| <= atol + rtol ||G_0||"),
     Param("atol", 1e-12, "F", 0.0, doc="Newton absolute tolerance"),
     Param("maxit", 40, "", 1, 500, doc="Newton: maximal number of linear solves"),
+    *enforcement.ENFORCEMENT_PARAMS,
 )
 
 
@@ -177,9 +180,9 @@ def build(params, friction=None):
         raise ValueError(f"parameter free_end_nodes = {k} is out of range: allowed [1, {(len(bottom) - 2) // 2}] for nx = {params['nx']}")
     weights = tributary_lengths(body.X[bottom])[k:-k]        # tractions per unit length of the bottom
     slaves = bottom[k:-k]                                   # the first and last element never touch
-    contact = NodeToSegment(body, slaves, RigidLine((0.0, 0.0), (0.0, 1.0)),
-                            PowerLaw(c_N=params["c_N"], m=params["m"]), friction or friction_law(params),
-                            weights=weights, offset=-params["g_N0"], name="foundation")
+    contact = make_interface(params.get("enforcement", "penalty"), body, slaves, RigidLine((0.0, 0.0), (0.0, 1.0)),
+                             PowerLaw(c_N=params["c_N"], m=params["m"]), friction or friction_law(params),
+                             weights=weights, offset=-params["g_N0"], name="foundation")
     p_y, p_x = params["p_y"], params["p_x"]
     loads = [Pressure(body, "top", lambda t: p_y * t),                # dead loads, ramped over the
              Traction(body, "right", lambda t: (p_x * t, 0.0))]      # pseudo-time t in [0, 1]
@@ -197,6 +200,9 @@ def solve(params, friction=None):
     system, contact = sc["system"], sc["contact"]
     n = params["n_steps"]
     stepper = Static(system, dt=1.0 / n, atol=params["atol"], rtol=params["rtol"], maxit=params["maxit"])
+    h = params["width"] / params["nx"]                        # gap_violation: penetration / element size
+    stepper = enforcement.wrap(dict(params, enforcement=params.get("enforcement", "penalty")), stepper,
+                               [contact], length=h)
     u = np.zeros(system.ndof)
     contact.initialize(u)
     results = []
@@ -206,7 +212,8 @@ def solve(params, friction=None):
         if k == n - 1:
             report, R_c = contact.report(u), contact.assemble(u)[0]
         system.commit(u)
-    return dict(sc, u=u, result=results[-1], results=results, report=report, R_c=R_c)
+    return dict(sc, u=u, result=results[-1], results=results, report=report, R_c=R_c, stepper=stepper,
+                element_size=h)
 
 
 def slip_bound(params, t_N):
@@ -256,6 +263,8 @@ def run(params):
                     "state": [str(v) for v in rep["state"]], "g_N": rep["g_N"], "slip_bound": Y,
                     "weights": rep["weights"]},
         "paper_table1": PAPER_TABLE1.get(params["law"], []),
+        **enforcement.report(params, s["stepper"], [r.iterations for r in s["results"]],
+                             enforcement.penetration(s["contact"], u), s["element_size"], "the element size width / nx"),
     }
 
 

@@ -38,9 +38,11 @@ from skfem import MeshQuad
 
 from ..bodies.continuum import Continuum
 from ..bodies.loads import Pressure
-from ..contact import NodeToSegment, RigidLine, tributary_lengths
+from ..contact import RigidLine, tributary_lengths
+from ..contact.augmented import make_interface
 from ..laws import PowerLaw
 from ..solver import Dirichlet, Static, System, integrate
+from . import enforcement
 from .base import Param, Scene
 
 
@@ -140,8 +142,8 @@ def build(params):
     nodes = nodes[np.argsort(body.X[nodes, 0])]                # chain from B outwards
     w = tributary_lengths(body.X[nodes])
     weights = w if params["penalty"] == "per_length" else 1.0
-    contact = NodeToSegment(body, nodes, RigidLine((0.0, -R), (0.0, 1.0)), PowerLaw(params["c_N"], 1.0),
-                            weights=weights, name="plane")
+    contact = make_interface(params.get("enforcement", "penalty"), body, nodes, RigidLine((0.0, -R), (0.0, 1.0)),
+                             PowerLaw(params["c_N"], 1.0), weights=weights, name="plane")
     sym = np.flatnonzero(np.abs(body.X[:, 0]) < 1e-9 * R)
     fixed = [Dirichlet(body, body.xdofs[sym, 0], 0.0)]
     q = P / (2.0 * R)
@@ -162,7 +164,12 @@ def run(params):
     u0[body.xdofs[:, 1]] = -a_ex**2 / (2.0 * R)
     contact.initialize(u0)
     scale = P                                               # force scale of the residual
-    stepper = Static(system, dt=1.0 / params["n_steps"], atol=1e-10 * scale, rtol=1e-12, maxit=40)
+    # the residual cannot fall below roundoff of the stiffest contact spring (c_N w, nodal
+    # force per unit gap) times the displacement scale R: a floor for very stiff penalties
+    k_c = params["c_N"] * (np.max(w) if params["penalty"] == "per_length" else 1.0)
+    atol = max(1e-10 * scale, 1e-15 * k_c * R)
+    stepper = Static(system, dt=1.0 / params["n_steps"], atol=atol, rtol=1e-12, maxit=40)
+    stepper = enforcement.wrap(params, stepper, [contact], length=a_ex)   # gap_violation: penetration / a
     hist = integrate(stepper, 0.0, u0, n_steps=params["n_steps"], cutback=True, max_cuts=6)
     u = hist.u
 
@@ -186,6 +193,8 @@ def run(params):
         profile_x=x, profile_p=p, profile_p_exact=p0_ex * np.sqrt(np.clip(1 - (x / a_ex) ** 2, 0, None)),
         newton_iterations_total=int(np.sum(hist.iterations)),
         newton_residuals=[list(r) for r in hist.residuals[1:]],
+        **enforcement.report(params, stepper, hist.iterations[1:],
+                             enforcement.penetration(contact, u), a_ex, "the exact contact half-width a"),
     )
 
 
@@ -208,6 +217,7 @@ SCENE = Scene(
         Param("c_N", 1.0e9, "MPa/mm or N/mm", 0.0, None, low_open=True,
               doc="penalty stiffness (eq 4, m = 1); chosen: stiff enough that the penalty error is < 0.1 %"),
         Param("n_steps", 1, "", 1, 1000, doc="load steps (the whole load in one step by default)"),
+        *enforcement.ENFORCEMENT_PARAMS,
     ),
     run=run,
     presets={"fast": {"n_el": 32}, "paper": {"n_el": 64}},

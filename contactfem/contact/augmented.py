@@ -1,0 +1,146 @@
+"""Augmented-Lagrangian contact: the penalty interface of the paper with Lagrange
+multipliers updated in an outer (Uzawa) loop, so that the converged solution meets the
+contact conditions to a tolerance whatever the penalty (Simo & Laursen 1992, "An
+augmented Lagrangian treatment of contact problems involving friction", Computers &
+Structures 42, 97-116).
+
+Per slave node two multipliers, both tractions (per unit length or per node, like the
+interface's laws): lam_N <= 0 for the normal and lam_T for the tangential traction. They
+are held FIXED during a Newton solve and updated after it (solver/uzawa.py).
+
+Normal (penalty law eq 4 with m = 1, c_N the penalty):
+
+    t_N = min(0, lam_N + c_N g_N) = t_N^law(g_N + lam_N / c_N),   dt_N/dg_N = c_N where active,
+
+i.e. the penalty law evaluated at the gap shifted by lam_N / c_N. The update
+lam_N <- t_N converges to g_N = 0 where lam_N < 0: no penetration, whatever c_N.
+
+Friction (the stick law eq 5 becomes the penalty of exact stick): the elastic predictor of
+the return mapping starts from lam_T instead of the converged traction (eqs 40-44),
+
+    t_T^tr = lam_T + c_T (s - s_bar),   t_T = return_map(t_T^tr, Y(|t_N|)),   lam_T <- t_T.
+
+At the fixed point a sticking node has s = s_bar (no elastic micro-slip) and carries
+t_T = lam_T, |lam_T| <= Y; a slipping one carries t_T = Y sign(t_T^tr) and slips by
+|s - s_bar| (the return map's lambda). The tangent is the penalty interface's (eqs 33,
+39, 49-50) at the shifted state: the multipliers do not depend on u.
+
+Laws other than the penalty: a power law with m != 1 (or the exponential law) is a
+constitutive law of a rough interface, its approach g_N < 0 is physical (the asperities
+flatten), not an error to remove. Such a normal law is used AS IS (no normal multiplier,
+lam_N stays 0) while the friction is still augmented: only the stick spring c_T is
+treated as a penalty. ``gap_violation`` counts the augmented normal interfaces only.
+
+Step history: at the start of a step lam_T is the converged t_T (warm start: the first
+outer iteration is exactly the penalty step); lam_N carries over from the last step.
+"""
+
+import numpy as np
+
+from ..laws.friction import Frictionless
+from ..laws.normal import PowerLaw
+from .interface import NodeToSegment
+from .return_map import return_map
+
+ENFORCEMENTS = ("penalty", "augmented")
+
+
+def augments_normal(law):
+    """True when the normal law is the penalty method (eq 4 with m = 1), whose c_N is a
+    numerical parameter the multiplier removes; False for constitutive laws."""
+    return isinstance(law, PowerLaw) and law.m == 1.0
+
+
+class AugmentedNodeToSegment(NodeToSegment):
+    """NodeToSegment (same arguments) with normal and tangential multipliers (module
+    docstring). ``update_multipliers(u)`` is the Uzawa update; everything else is used
+    by the solver exactly like the penalty interface."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        nc = len(self.nodes)
+        self.lam_N = np.zeros(nc)
+        self.lam_T = np.zeros(nc)
+        self.augment_normal = augments_normal(self.normal)
+        self.updates = 0                    # multiplier updates since construction
+
+    def start_step(self):
+        """lam_T = the converged traction t_T_bar (called at the start of every step, so a
+        step retried after a cut-back starts again from the committed state)."""
+        self.lam_T = self.t_T_bar.copy()
+
+    def kinematics(self, u):
+        """As NodeToSegment.kinematics, with the penalty law evaluated at the shifted gap
+        g_N + lam_N / c_N (eq 4, m = 1; module docstring)."""
+        e = super().kinematics(u)
+        if not self.augment_normal:
+            return e
+        g_eff = e["g_N"] + self.lam_N / self.normal.c_N
+        active = e["inside"] & (g_eff < 0.0)
+        t_N, dt_N = self.normal.traction(np.where(active, g_eff, 1.0))
+        return dict(e, active=active, t_N=t_N, dt_N=dt_N, g_eff=g_eff)
+
+    def evaluate(self, u):
+        """Tractions with the return mapping (eqs 40-44) started from lam_T, element
+        residual and tangent (eqs 28, 33, 39, 49)."""
+        e = self.kinematics(u)
+        if self.friction is None:
+            z = np.zeros_like(e["t_N"])
+            fr = return_map(Frictionless(), e["t_N"], e["dt_N"], z, z, self.q_bar)
+        else:
+            fr = return_map(self.friction, e["t_N"], e["dt_N"], e["dg_T"], self.lam_T, self.q_bar)
+        return self.element(e, fr.t_T, fr.c_T_s, fr.c_N_s, friction=fr)
+
+    def violation(self, u):
+        """What the next update would change, in length units: max |t - lam| / c over the
+        slave nodes, normal (= the penetration of an active node) and tangential (= the
+        stick creep |s - s_bar| of a sticking node); and the largest penetration
+        (augmented normal only; 0 otherwise)."""
+        e = self.evaluate(u)
+        on = e["active"]
+        dN = 0.0
+        pen = 0.0
+        if self.augment_normal:
+            t_N = np.where(on, e["t_N"], 0.0)
+            dN = float(np.max(np.abs(t_N - self.lam_N), initial=0.0)) / self.normal.c_N
+            inside = e["inside"]
+            pen = float(np.max(np.where(inside, -e["g_N"], 0.0), initial=0.0))
+        dT = 0.0
+        if self.friction is not None:
+            t_T = np.where(on, e["friction"].t_T, 0.0)
+            dT = float(np.max(np.abs(t_T - self.lam_T), initial=0.0)) / self.friction.c_T
+        return dict(change=max(dN, dT, 0.0), normal=dN, tangential=dT, penetration=max(pen, 0.0), e=e)
+
+    def update_multipliers(self, u):
+        """The Uzawa update lam <- t at u (module docstring). Returns ``violation(u)``
+        (before the update)."""
+        v = self.violation(u)
+        e = v.pop("e")
+        on = e["active"]
+        if self.augment_normal:
+            self.lam_N = np.where(on, e["t_N"], 0.0)
+        if self.friction is not None:
+            self.lam_T = np.where(on, e["friction"].t_T, 0.0)
+        self.updates += 1
+        return v
+
+    def commit(self, u):
+        """The penalty interface's commit (t_T_bar = t_T, accumulated slip, projection);
+        then lam_T = t_T_bar so the next step starts from the converged traction, and
+        lam_N = t_N (warm start of the next step)."""
+        e = self.evaluate(u)
+        t_N = np.where(e["active"], e["t_N"], 0.0)
+        super().commit(u)
+        self.lam_T = self.t_T_bar.copy()
+        if self.augment_normal:
+            self.lam_N = t_N
+
+
+def make_interface(enforcement, *args, **kwargs):
+    """A NodeToSegment (enforcement = 'penalty') or an AugmentedNodeToSegment
+    ('augmented') with the same arguments."""
+    if enforcement == "penalty":
+        return NodeToSegment(*args, **kwargs)
+    if enforcement == "augmented":
+        return AugmentedNodeToSegment(*args, **kwargs)
+    raise ValueError(f"parameter enforcement = {enforcement!r} is not allowed: one of {'|'.join(ENFORCEMENTS)}")

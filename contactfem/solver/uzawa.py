@@ -1,0 +1,128 @@
+"""The Uzawa (outer) loop of augmented-Lagrangian contact (contact/augmented.py).
+
+    stepper = Uzawa(Static(system, ...), contacts, length=a, tol=1e-9)
+    u1, v1, a1, result = stepper.step(t, u, v, a)    # works with integrate like any stepper
+
+One step: solve the step equation by the wrapped stepper's Newton method (the same
+consistent tangent as the penalty method) with the multipliers held fixed; measure what
+the multiplier update lam <- t would change, in length units, divided by the scene's
+``length`` (the contact half-width of Hertz, the element size of the block);
+if that is <= tol, stop; otherwise update the multipliers and solve again.
+
+    outer iteration k:  Newton solve at lam_k  ->  u_k
+                        violation_k = max |t(u_k) - lam_k| / c / length
+                        stop if violation_k <= tol, else lam_{k+1} = t(u_k)
+
+At an active node the normal part of the violation is the penetration itself, at a
+sticking node the tangential part is the stick creep |s - s_bar|. Each update shrinks the
+violation by about k / (k + c), k the stiffness of the structure behind the contact: a
+stiff penalty converges in few updates (with a worse-conditioned Newton), a soft one in
+many (with an easy Newton): the speed/accuracy trade, now between outer and inner
+iterations instead of between accuracy and conditioning.
+
+A static step restarts Newton from the last outer iterate; a dynamic step (Newmark) from
+its own predictor (its equation depends on the start of the step). The interfaces'
+histories are committed by ``integrate`` after the last outer iteration, as for any
+stepper.
+"""
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .newton import NewtonError
+
+
+@dataclass
+class UzawaResult:
+    """Like NewtonResult: ``residuals`` and ``iterations`` cover all Newton solves of the
+    step. ``uzawa_iterations``: Newton solves (outer iterations); ``updates`` =
+    uzawa_iterations - 1 multiplier updates; ``newton_per_outer``: linear solves of each;
+    ``violations``: the violation after each; ``gap_violations``: the largest penetration /
+    length after each; ``gap_violation``: its last value (the converged state)."""
+    u: np.ndarray
+    residuals: list = field(default_factory=list)
+    iterations: int = 0
+    G: np.ndarray = None
+    uzawa_iterations: int = 0
+    updates: int = 0
+    newton_per_outer: list = field(default_factory=list)
+    violations: list = field(default_factory=list)
+    gap_violation: float = 0.0
+    gap_violations: list = field(default_factory=list)
+
+
+def _check(name, value, low, high=None):
+    if not (np.isfinite(value) and value >= low and (high is None or value <= high)):
+        hi = "inf" if high is None else f"{high:g}"
+        raise ValueError(f"parameter {name} = {value!r} is out of range: allowed [{low:g}, {hi})")
+
+
+class Uzawa:
+    """Wraps a stepper (Static or Newmark) with the outer loop (module docstring).
+
+    contacts: the AugmentedNodeToSegment interfaces of the system (others are left alone);
+    length: the length the violation is divided by (the scene states it);
+    tol: stop when the relative violation is <= tol; max_updates: multiplier updates
+    allowed per step before a NewtonError (carrying the violation history) is raised.
+    """
+
+    def __init__(self, stepper, contacts, length, tol=1e-9, max_updates=50):
+        _check("uzawa_tol", tol, 0.0)
+        _check("length", length, 0.0)
+        if not length > 0:
+            raise ValueError(f"parameter length = {length!r} is out of range: allowed (0, inf)")
+        if int(max_updates) != max_updates or max_updates < 0:
+            raise ValueError(f"parameter uzawa_max_updates = {max_updates!r} is out of range: allowed integers >= 0")
+        self.stepper, self.length, self.tol, self.max_updates = stepper, float(length), float(tol), int(max_updates)
+        self.contacts = [c for c in contacts if hasattr(c, "update_multipliers")]
+        if not self.contacts:
+            raise ValueError("Uzawa needs at least one augmented interface (enforcement = 'augmented')")
+        self.system, self.dt, self.dynamic = stepper.system, stepper.dt, stepper.dynamic
+        self.results = []                # UzawaResult of every converged step
+
+    def step(self, t, u, v, a, dt=None, label=""):
+        for c in self.contacts:
+            c.start_step()                # a retried (cut back) step starts from the committed state
+        start = u
+        residuals, per_outer, viols, self._gaps = [], [], [], []
+        opts = getattr(self.stepper, "newton_options", None)
+        saved = dict(opts) if opts is not None else None
+        try:
+            for k in range(self.max_updates + 1):
+                u1, v1, a1, res = self.stepper.step(t, start, v, a, dt=dt,
+                                                    label=f"{label} (outer iteration {k + 1})" if label else "")
+                if k == 0 and opts is not None and res.residuals:
+                    # later solves start close to the solution: keep the tolerance of the first
+                    # (atol + rtol ||G_0|| with the step's own G_0), not one relative to a tiny G_0
+                    opts.update(atol=saved.get("atol", 1e-10) + saved.get("rtol", 1e-10) * res.residuals[0], rtol=0.0)
+                out = self._outer(k, u1, v1, a1, res, residuals, per_outer, viols)
+                if out is not None:
+                    return out
+                if not self.dynamic:
+                    start = u1                # warm start of the next static solve
+        finally:
+            if opts is not None:
+                opts.clear()
+                opts.update(saved)
+        raise NewtonError(f"Uzawa: contact violation {viols[-1]:.3e} > uzawa_tol = {self.tol:.1e} after "
+                          f"{self.max_updates} multiplier updates ({label}); violations "
+                          f"{', '.join(f'{x:.2e}' for x in viols[-5:])} (last 5)", residuals, label)
+
+    def _outer(self, k, u1, v1, a1, res, residuals, per_outer, viols):
+        """Book-keeping of outer iteration k: the step's result if converged, else update."""
+        residuals += list(res.residuals)
+        per_outer.append(res.iterations)
+        checks = [c.violation(u1) for c in self.contacts]
+        viol = max(c["change"] for c in checks) / self.length
+        gap = max(c["penetration"] for c in checks) / self.length
+        viols.append(viol)
+        self._gaps.append(gap)
+        if viol <= self.tol:
+            result = UzawaResult(u=u1, residuals=residuals, iterations=sum(per_outer), G=res.G,
+                                 uzawa_iterations=k + 1, updates=k, newton_per_outer=per_outer,
+                                 violations=viols, gap_violation=gap, gap_violations=list(self._gaps))
+            self.results.append(result)
+            return u1, v1, a1, result
+        for c in self.contacts:
+            c.update_multipliers(u1)
+        return None
