@@ -88,7 +88,8 @@ class AugmentedNodeToSegment(NodeToSegment):
             z = np.zeros_like(e["t_N"])
             fr = return_map(Frictionless(), e["t_N"], e["dt_N"], z, z, self.q_bar)
         else:
-            fr = return_map(self.friction, e["t_N"], e["dt_N"], e["dg_T"], self.lam_T, self.q_bar)
+            fr = return_map(self._law, e["t_N"], e["dt_N"], e["dg_T"], self.lam_T, self.q_bar,
+                            z_bar=self.z_bar, dt=self.dt)
         return self.element(e, fr.t_T, fr.c_T_s, fr.c_N_s, friction=fr)
 
     def violation(self, u):
