@@ -25,9 +25,29 @@ def test_contact_stress(fast):
 
 def test_rebound_and_energy(fast):
     # exact: rebound at v0, energy conserved. Ours: rebound within 3 % (the rest stays as
-    # vibration), total energy within 1e-3
+    # vibration: measured -1.8 % with 40 elements, -1.2 % with 100). With gap = 0 the
+    # contact starts ON a step boundary, where the trapezoidal rule is exact for the
+    # penalty's quadratic potential: measured 9.5e-5 with 40 elements; bound 1e-3, the
+    # size of the error of a contact starting within a step (next test), which this case avoids
     assert abs(fast["error_rebound"]) < 0.03, fast["rebound_velocity"]
     assert abs(fast["energy_error_max"]) < 1e-3, fast["energy_error_max"]
+
+
+@pytest.mark.parametrize("fraction", [1 / 3, 1 / 2])
+def test_energy_when_contact_starts_between_steps(fast, fraction):
+    # gap = fraction * v0 dt: the contact closes inside a step, whose kinked potential the
+    # trapezoidal rule does not integrate exactly. Measured (40 elements, Courant 1) over
+    # start fractions 0.1, 1/3, 1/2, 0.9 of a step: -1.5e-3, -3.9e-3, -4.5e-3, -1.6e-3, the
+    # worst at 1/2; 100 elements: -0.7e-3 ... -1.8e-3. The bound 5e-3 is that worst case over
+    # the start position, not today's value; the property checked is that energy is lost,
+    # never gained, and that the loss is first order in dt (halved with dt and h below)
+    gap = fraction * fast["parameters"]["v0"] * fast["dt"]
+    r = run_scene("bar_impact", "fast", {"gap": gap})
+    assert -5e-3 < r["energy_error"] < -1e-4, r["energy_error"]
+    assert r["energy_error_max"] < 5e-3
+    finer = run_scene("bar_impact", "fast", {"n_el": 80, "gap": fraction * r["parameters"]["v0"] * r["dt"] / 2})
+    ratio = r["energy_error"] / finer["energy_error"]
+    assert 1.6 < ratio < 2.6, (r["energy_error"], finer["energy_error"])     # first order in dt
 
 
 def test_dissipative_newmark_loses_energy():

@@ -173,3 +173,17 @@ def test_cli_json(tmp_path):
     for key in ("newton_residuals", "iterations", "total_normal", "total_tangential", "contact"):
         assert key in r
     assert r["contact"]["state"].count("slip") == 11
+
+
+def test_c_N_documentation_states_the_measured_penetration():
+    # the c_N parameter's text quotes the largest penetration of the 4 x 3.5 block; the run
+    # measures it (max_penetration = -min g_N over the contact nodes): to the 2 digits printed
+    import re
+
+    from contactfem.scenes.block import SCENE
+
+    doc = SCENE.param("c_N").doc
+    stated = float(re.search(r"largest penetration of ([0-9.]+e-?[0-9]+)", doc).group(1))
+    r = run_scene("block", "fast", {"width": 4.0, "height": 3.5, "c_N": 1e5})
+    assert r["max_penetration"] == pytest.approx(-min(r["contact"]["g_N"]), rel=1e-12)
+    assert r["max_penetration"] == pytest.approx(stated, rel=0.05 / 7.6), (stated, r["max_penetration"])

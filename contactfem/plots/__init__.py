@@ -90,3 +90,17 @@ def savefig(fig, outdir, stem):
     fig.savefig(path, dpi=110, bbox_inches="tight")
     plt.close(fig)
     return str(path)
+
+
+def describe_newton(history, converged):
+    """What a Newton residual history shows, in words computed from the numbers (for
+    figure titles and table notes): "converges in k linear solves", "diverges (||G||
+    grows from a to b in k solves)" when the last residuals exceed the first tenfold,
+    else "does not converge in k solves (||G|| = b)"."""
+    h = [float(v) for v in history]
+    k = len(h) - 1
+    if converged:
+        return f"converges in {k} linear solves"
+    if max(h[-3:]) > 10.0 * h[0]:
+        return f"diverges (||G|| grows from {h[0]:.2e} to {max(h[-3:]):.2e} in {k} solves)"
+    return f"does not converge in {k} solves (||G|| = {h[-1]:.2e})"

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..scenes.block import PAPER_TABLE1, PAPER_TABLE1_UNCERTAIN, SCENE, solve
 from ..solver.newton import NewtonError
-from . import cached_run, default_outdir, figure, pyplot, savefig
+from . import cached_run, default_outdir, describe_newton, figure, pyplot, savefig
 
 STATE_COLORS = {"stick": "tab:blue", "slip": "tab:red", "open": "0.6"}
 
@@ -38,7 +38,8 @@ def draw_mesh(ax, X, t, **kw):
 @figure("fig06_block_mesh_deformed", "Fig 6")
 def fig06(preset="fast", outdir=None, law="conical"):
     plt = pyplot()
-    s = solve(SCENE.resolve(preset, {"law": law}))
+    P = SCENE.resolve(preset, {"law": law})
+    s = solve(P)
     body, u, rep = s["body"], s["u"], s["report"]
     X, t = body.X, body.mesh.t
     x = X + u[body.xdofs]
@@ -50,11 +51,11 @@ def fig06(preset="fast", outdir=None, law="conical"):
         ax.annotate("", (xi, H), (xi, H + 0.5), arrowprops=dict(arrowstyle="->", color="tab:green"))
     for yi in np.linspace(0, H, 8):                               # traction p_x on the right side
         ax.annotate("", (W + 0.5, yi), (W, yi), arrowprops=dict(arrowstyle="->", color="tab:purple"))
-    ax.text(W / 2, H + 0.6, "p_y = 200", ha="center", color="tab:green")
-    ax.text(W + 0.55, H / 2, "p_x = 60", va="center", color="tab:purple")
+    ax.text(W / 2, H + 0.6, f"p_y = {P['p_y']:g}", ha="center", color="tab:green")
+    ax.text(W + 0.55, H / 2, f"p_x = {P['p_x']:g}", va="center", color="tab:purple")
     Xs = rep["X"]
-    ax.plot(Xs[:, 0], Xs[:, 1], "o", ms=4, color="tab:orange", label="contact nodes (17)")
-    ax.set_title("system and discretisation: 20 x 10 quads, width 4, height 3.5", fontsize=9)
+    ax.plot(Xs[:, 0], Xs[:, 1], "o", ms=4, color="tab:orange", label=f"contact nodes ({len(Xs)})")
+    ax.set_title(f"system and discretisation: {P['nx']} x {P['ny']} quads, width {W:g}, height {H:g}", fontsize=9)
     ax.legend(loc="lower left", fontsize=8)
     ax = axes[1]
     draw_mesh(ax, X, t, edgecolors="0.8", linewidths=0.5)
@@ -110,11 +111,13 @@ def _stress_axes(ax, title):
 def fig07(preset="fast", outdir=None):
     plt = pyplot()
     r = result(preset, law="conical")
+    P = r["parameters"]
     fig, ax = plt.subplots(figsize=(7.5, 5))
     draw_stresses(ax, r, "(conical)")
-    _stress_axes(ax, "Fig 7: stresses on the contact area, conical slip surface (n = 1, alpha + beta = 0.5)\n"
+    _stress_axes(ax, "Fig 7: stresses on the contact area, conical slip surface "
+                     f"(n = 1, alpha + beta = {P['alpha'] + P['beta']:g})\n"
                      f"sum |t_N| w = {-r['total_normal']:.6g}, sum t_T w = {r['total_tangential']:.6g}; "
-                     "no node reaches the slip bound on this block")
+                     + slip_words(r))
     return [savefig(fig, outdir or default_outdir(), "fig07_block_conical_stresses")]
 
 
@@ -126,9 +129,18 @@ def fig08(preset="fast", outdir=None):
     fig, ax = plt.subplots(figsize=(7.5, 5))
     draw_stresses(ax, rc, "conical", style=":", faint=True)
     draw_stresses(ax, r, "(parabolic)")
-    _stress_axes(ax, "Fig 8: stresses on the contact area, parabolic slip surface (n = 0.5, alpha = 0.2, beta = 0.3)\n"
-                     "grey: the conical case (Fig 7)")
+    P = r["parameters"]
+    _stress_axes(ax, "Fig 8: stresses on the contact area, parabolic slip surface "
+                     f"(n = {P['n']:g}, alpha = {P['alpha']:g}, beta = {P['beta']:g})\n"
+                     f"{slip_words(r)}; grey: the conical case (Fig 7)")
     return [savefig(fig, outdir or default_outdir(), "fig08_block_parabolic_stresses")]
+
+
+def slip_words(r):
+    """How many contact nodes slip, stick and are open in a block run, in words."""
+    n_slip = r["n_slip"]
+    text = "no node reaches the slip bound" if n_slip == 0 else f"{n_slip} of {len(r['contact']['x'])} nodes slip"
+    return text + f" ({r['n_stick']} stick, {r['n_open']} open)"
 
 
 def residual_histories(preset="fast"):
@@ -136,10 +148,14 @@ def residual_histories(preset="fast"):
     Coulomb case with the tangent without the c_N^s coupling ('frozen')."""
     out = {law: result(preset, law=law)["newton_residuals"] for law in ("conical", "parabolic", "coulomb")}
     out["coulomb, frozen tangent"] = result(preset, law="coulomb", tangent="frozen")["newton_residuals"]
+    out["verdict"] = {key: describe_newton(hist, True) for key, hist in out.items()}
     try:
         out["coulomb, symmetric tangent"] = result(preset, law="coulomb", tangent="symmetric", maxit=12)["newton_residuals"]
+        out["verdict"]["coulomb, symmetric tangent"] = describe_newton(out["coulomb, symmetric tangent"], True)
     except NewtonError as err:
         out["coulomb, symmetric tangent"] = err.history
+        out["verdict"]["coulomb, symmetric tangent"] = describe_newton(err.history, False)
+    out["parameters"] = result(preset, law="conical")["parameters"]
     return out
 
 
@@ -153,25 +169,28 @@ def table1_markdown(hist):
             text += " (scan?)"
         return text
     n = max(len(PAPER_TABLE1["parabolic"]), len(hist["conical"]), len(hist["parabolic"]), len(hist["coulomb"]))
+    P = hist["parameters"]
     lines = ["# Table 1: norm of the residual ||G|| per Newton iteration, whole load in one step",
              "",
-             "Block of Sec. 5.1 (canonical data, chosen: width 4, height 3.5, 20 x 10 quads, E = 1000, "
-             "nu = 0.3, c_N = 1e5 chosen, c_T = 5e4 per unit length). Iteration 1 is the initial state u = 0: its "
+             f"Block of Sec. 5.1 (canonical data, chosen: width {P['width']:g}, height {P['height']:g}, "
+             f"{P['nx']} x {P['ny']} quads, E = {P['E']:g}, nu = {P['nu']:g}, c_N = {P['c_N']:.3g} chosen, "
+             f"c_T = {P['c_T']:.3g} per unit length). Iteration 1 is the initial state u = 0: its "
              "residual is the nodal load vector (top pressure and right traction; the contact forces at "
              "g_N0 = -1e-12 are ~1e-8). The paper's block dimensions are not known, hence its different "
              "first value. (scan?): exponent garbled in the scan, value uncertain.",
              "",
-             "| iteration | paper conical | ours conical | paper parabolic | ours parabolic | ours Coulomb mu = 0.3 |",
+             f"| iteration | paper conical | ours conical | paper parabolic | ours parabolic | ours Coulomb mu = {P['mu']:g} |",
              "|---:|---:|---:|---:|---:|---:|"]
     for k in range(n):
         lines.append(f"| {k + 1} | {cell(PAPER_TABLE1['conical'], k, 'conical')} | {cell(hist['conical'], k)} | "
                      f"{cell(PAPER_TABLE1['parabolic'], k, 'parabolic')} | {cell(hist['parabolic'], k)} | "
                      f"{cell(hist['coulomb'], k)} |")
-    lines += ["", "Linear solves: paper conical 3, parabolic 6; ours conical "
+    lines += ["", f"Linear solves: paper conical {len(PAPER_TABLE1['conical']) - 1}, "
+              f"parabolic {len(PAPER_TABLE1['parabolic']) - 1}; ours conical "
               f"{len(hist['conical']) - 1}, parabolic {len(hist['parabolic']) - 1}, Coulomb {len(hist['coulomb']) - 1}; "
               f"Coulomb with the tangent without the c_N^s coupling (frozen): {len(hist['coulomb, frozen tangent']) - 1}; "
-              f"with the symmetrised tangent: diverges (residuals "
-              + ", ".join(f"{v:.2e}" for v in hist["coulomb, symmetric tangent"][:6]) + ", ...).", ""]
+              f"with the symmetrised tangent: {hist['verdict']['coulomb, symmetric tangent']}; residuals "
+              + ", ".join(f"{v:.2e}" for v in hist["coulomb, symmetric tangent"][:6]) + ", ...", ""]
     return "\n".join(lines)
 
 
@@ -199,7 +218,7 @@ def table1(preset="fast", outdir=None):
     for key, style in (("coulomb", "-^"), ("coulomb, frozen tangent", "--v")):
         ours = hist[key]
         ax.semilogy(np.arange(1, len(ours) + 1), ours, style, color="tab:green" if key == "coulomb" else "0.5",
-                    label=f"ours, {key} (mu = 0.3)")
+                    label=f"ours, {key} (mu = {hist['parameters']['mu']:g})")
     ax.set_xlabel("iteration (1 = initial state)")
     ax.set_ylabel("||G||")
     ax.grid(alpha=0.3, which="both")

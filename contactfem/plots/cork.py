@@ -97,7 +97,11 @@ def fig16_cork_pressure(preset="fast", outdir=None):
     ax.step(r["time_ms"], r["pressure_MPa"], where="pre", color="C0", label="gas pressure (used in the step)")
     if r["gas_release_time_ms"] is not None:
         ax.axvline(r["gas_release_time_ms"], color="0.5", ls="--", lw=0.8, label="bottom passes the mouth")
-    ax.axhline(0.8 * 30 / 54, color="C3", ls=":", lw=1, label="Boyle at 24 mm travel: 0.8 * 30/54")
+    P = r["parameters"]
+    p0 = P["p_step"] * P["n_ramp"]
+    L, gas = P["L_neck"], P["gas_column"]
+    ax.axhline(p0 * gas / (gas + L), color="C3", ls=":", lw=1,
+               label=f"Boyle at {L:g} mm travel: {p0:g} * {gas:g}/{gas + L:g} = {p0 * gas / (gas + L):.3g} MPa")
     ax.set_xlabel("time (ms)")
     ax.set_ylabel("p (MPa)")
     ax.set_title("Fig 16: the pressure on the cork")

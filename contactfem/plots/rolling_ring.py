@@ -115,7 +115,13 @@ def draw_rolling(r, title):
     ap.set_ylabel("height y [cm]")
     ap.legend(fontsize=7)
     ap.grid(alpha=0.3)
-    ap.set_title("velocity profiles across the ring: bottom point at rest once rolling", fontsize=9)
+    if r["rolled"]:
+        late = np.asarray(r["t"]) > r["t_roll"] + 0.1
+        s_late = np.max(np.abs(np.asarray(r["slip_velocity"])[late]), initial=0.0)
+        verdict = f"once rolling, the contact point slips at most {s_late:.2g} cm/s ({100 * s_late / prm['v0']:.1g} % of v0)"
+    else:
+        verdict = "the ring did not start rolling"
+    ap.set_title("velocity profiles across the ring; " + verdict, fontsize=9)
 
     ah.plot(t, r["vx_c"], "C0", label="centre v_x")
     ah.plot(t, -np.asarray(r["omega"]) * a, "C1", label="-omega a (a = rolling radius)")

@@ -59,14 +59,18 @@ def draw_impact(r, title):
 @figure("fig10_sloping_impact_frictionless", "Fig 10")
 def fig10(preset="fast", outdir=None):
     r = result("frictionless", preset)
-    fig = draw_impact(r, "Fig 10: sloping impact, frictionless contact (Newmark 0.7/0.4, dt = 0.1)")
+    p = r["parameters"]
+    fig = draw_impact(r, f"Fig 10: sloping impact, frictionless contact (Newmark {p['delta']:g}/{p['beta_newmark']:g}, "
+                         f"dt = {p['dt']:g})")
     return [savefig(fig, outdir or default_outdir(), "fig10_sloping_impact_frictionless")]
 
 
 @figure("fig11a_sloping_impact_frictional", "Fig 11a")
 def fig11a(preset="fast", outdir=None):
     r = result("frictional", preset)
-    fig = draw_impact(r, "Fig 11a: sloping impact, frictional contact (eq 10: n = 0.8, alpha = 0.2, beta = 0.3)")
+    p = r["parameters"]
+    fig = draw_impact(r, f"Fig 11a: sloping impact, frictional contact (eq 10: n = {p['n']:g}, alpha = {p['alpha']:g}, "
+                         f"beta = {p['beta']:g})")
     return [savefig(fig, outdir or default_outdir(), "fig11a_sloping_impact_frictional")]
 
 

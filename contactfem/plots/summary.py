@@ -1,0 +1,191 @@
+"""The README's table of the paper's examples, ours beside the paper's: every "ours"
+cell is computed here from the runs the figures use (``cached_run``), never typed.
+
+    summary     figures/summary.md: one row per example of the paper
+
+``contactfem figures --preset paper`` writes it with the other figures; the README
+carries the same table between the markers ``<!-- summary:start -->`` and
+``<!-- summary:end -->`` (``python -m contactfem.plots.summary`` copies it there), and
+``tests/test_summary.py`` fails when the two disagree.
+
+The "paper's value" column quotes the paper (NOTES.md); where the scan lost a digit it
+says so. Which rows depend on which scene and preset: ``ROWS`` below (one function a row).
+"""
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from ..scenes.block import PAPER_TABLE1
+from . import cached_run, default_outdir, figure
+
+START, END = "<!-- summary:start -->", "<!-- summary:end -->"
+HEAD = ["| paper | what | paper's value | ours | figure |", "|---|---|---|---|---|"]
+
+
+def _links(*pairs):
+    """Links to figures, relative to summary.md's folder (the README adds "figures/")."""
+    return " ".join(f"[{label}]({stem})" for label, stem in pairs)
+
+
+def row_laws(preset):
+    return ("Figs 1-4", "interface laws, slip surface, return-mapping geometry", "-", "-",
+            _links(("1", "fig01_true_contact_area.png"), ("2", "fig02_force_vs_microdisplacement.png"),
+                   ("3", "fig03_shear_vs_normal.png"), ("4", "fig04_parabolic_slip_surface.png")))
+
+
+def row_block_equilibrium(preset):
+    r = cached_run("block", preset, law="conical")
+    ours = (f"equilibrium to {r['equilibrium_error']:.0e} ({-r['total_normal']:.0f} down, "
+            f"{r['total_tangential']:.0f} along)")
+    return ("Sec. 5.1, Fig 6", "block on a rough foundation, whole load in one step", "-", ours,
+            _links(("6", "fig06_block_mesh_deformed.png")))
+
+
+def fig8_remark(preset):
+    """The paper's Fig 8 remark, measured: at the contact nodes in the top quartile of
+    normal pressure (parabolic run), the parabolic |t_T| relative to the conical one."""
+    par, con = cached_run("block", preset, law="parabolic"), cached_run("block", preset, law="conical")
+    p = -np.asarray(par["contact"]["t_N"])
+    top = p >= np.quantile(p[p > 0], 0.75) if np.any(p > 0) else np.zeros_like(p, bool)
+    tp, tc = (np.abs(np.asarray(r["contact"]["t_T"]))[top] for r in (par, con))
+    change = (tp - tc) / np.where(tc > 0, tc, np.inf)
+    return dict(n_top=int(top.sum()), change_min=float(change.min(initial=0.0)),
+                change_max=float(change.max(initial=0.0)), n_slip_parabolic=par["n_slip"],
+                n_slip_conical=con["n_slip"])
+
+
+def row_block_stresses(preset):
+    f = fig8_remark(preset)
+    ours = (f"at the {f['n_top']} nodes of highest pressure (top quartile) the parabolic friction stress "
+            f"differs from the conical by {100 * f['change_min']:+.0f} % to {100 * f['change_max']:+.0f} %; nodes slipping: "
+            f"conical {f['n_slip_conical']}, parabolic {f['n_slip_parabolic']}")
+    return ("Figs 7-8", "contact stresses, conical and parabolic slip surface",
+            "parabolic lowers friction where pressure is high", ours,
+            _links(("7", "fig07_block_conical_stresses.png"), ("8", "fig08_block_parabolic_stresses.png")))
+
+
+def row_table1(preset):
+    c, p = (cached_run("block", preset, law=law) for law in ("conical", "parabolic"))
+    rc, rp = c["newton_residuals"], p["newton_residuals"]
+    ours = (f"conical {len(rc)} ({c['n_slip']} nodes slip), parabolic {len(rp)}; "
+            f"first {rc[0]:.2f}; last {rc[-1]:.0e} and {rp[-1]:.0e}")
+    return ("Table 1", "residual norms of Newton, one load step",
+            f"conical {len(PAPER_TABLE1['conical'])} residuals, parabolic {len(PAPER_TABLE1['parabolic'])}; "
+            f"first {PAPER_TABLE1['conical'][0]:.2f}", ours,
+            _links(("table", "table1_block_newton_residuals.md")))
+
+
+def row_rolling_ring(preset):
+    r = cached_run("rolling_ring", preset)
+    x_roll = "did not roll" if not r["rolled"] else f"x_roll = {r['x_roll']:.1f} cm"
+    ours = f"{x_roll}, x(2 s) = {r['x_end']:.1f} cm, v = {r['v_final']:.1f} cm/s"
+    return ("Sec. 5.2, Fig 9", "ring sliding, then rolling (exact: rigid thin ring)",
+            "rolling at x = 23x (229), later 382 (376), 149 (150) cm/s", ours,
+            _links(("9", "fig09_rolling_ring.png"), ("conv.", "fig09b_rolling_ring_convergence.png")))
+
+
+def row_sloping_impact(preset):
+    parts = []
+    for variant in ("frictionless", "frictional"):
+        r = cached_run("sloping_impact", preset, variant=variant)
+        parts.append(f"{variant} ({r['rebound_vx']:.2f}, {r['rebound_vy']:.2f}), {r['rebound_angle_deg']:.1f} deg")
+    n_el = cached_run("sloping_impact", preset, variant="frictionless")["parameters"]["n_el"]
+    ours = "; ".join(parts) + f" ({n_el} elements)"
+    return ("Sec. 5.3, Table 2", "sloping impact, rebound",
+            "frictionless (2, 1.7), 50 deg; frictional (1.2, 1.7), 35 deg", ours,
+            _links(("10", "fig10_sloping_impact_frictionless.png"), ("11a", "fig11a_sloping_impact_frictional.png"),
+                   ("11b", "fig11b_sloping_impact_viscoplastic.png"), ("table", "table2_sloping_impact.md")))
+
+
+def row_funnel(preset):
+    f, g = (cached_run("funnel", preset, variant=v) for v in ("frictionless", "frictional"))
+    phi = f["parameters"]["phi_deg"]
+
+    def verdict(r):
+        if r["stuck"]:
+            return "sticks"
+        return f"rebounds at {r['v_c_final'] / r['parameters']['v0']:.2f} v0"
+    return ("Sec. 5.4, Figs 12-13", f"ring into a funnel (angle chosen: {phi:g} deg)",
+            "frictionless rebounds, frictional sticks", f"{verdict(f)}; {verdict(g)}",
+            _links(("12", "fig12_funnel_frictionless.png"), ("13", "fig13_funnel_frictional.png")))
+
+
+def row_cork(preset):
+    r = cached_run("cork", preset)
+    exit_text = (f"exit {r['exit_time_ms']:.2f} ms at {r['exit_velocity_m_s']:.1f} m/s" if r["exited"]
+                 else "the cork stays in")
+    ours = f"{r['press_fit_normal_force_N']:.0f} N"
+    if r.get("press_fit_calibrated"):
+        ours += " (fitted: R_tip chosen to give ~2500 N)"
+    ours += f", {exit_text}"
+    if r.get("breakaway_margin_MPa") is not None:
+        ours += f"; breakaway margin {r['breakaway_margin_MPa']:+.3f} MPa"
+    return ("Sec. 5.5, Figs 14-17", "champagne cork (dimensions reconstructed)",
+            "press fit ~2500 N, exit ~2.6-2.7 ms at ~28 m/s", ours,
+            _links(("14", "fig14_cork_mesh.png"), ("15", "fig15_cork_configurations.png"),
+                   ("16", "fig16_cork_pressure.png"), ("17", "fig17_cork_displacement.png")))
+
+
+# row function -> the scenes (and variants) it runs
+ROWS = (
+    (row_laws, ()),
+    (row_block_equilibrium, ("block",)),
+    (row_block_stresses, ("block",)),
+    (row_table1, ("block",)),
+    (row_rolling_ring, ("rolling_ring",)),
+    (row_sloping_impact, ("sloping_impact",)),
+    (row_funnel, ("funnel",)),
+    (row_cork, ("cork",)),
+)
+
+
+def summary_table(preset="paper"):
+    """The table's lines (head and one row per example), every "ours" cell from a run."""
+    lines = list(HEAD)
+    for fn, _ in ROWS:
+        cells = [str(c).replace("|", "/") for c in fn(preset)]
+        lines.append("| " + " | ".join(cells) + " |")
+    return lines
+
+
+def summary_markdown(preset="paper"):
+    return "\n".join(["# The paper's examples: ours beside the paper's", "",
+                      f"Written by `contactfem figures --preset {preset}` (contactfem/plots/summary.py): "
+                      "every value in the column 'ours' is computed by the run behind the figures.", "",
+                      *summary_table(preset), ""])
+
+
+def table_lines(text, prefix=""):
+    """The markdown table lines of summary.md, or of the README's marked block with the
+    link prefix `prefix` ("figures/") removed, so that the two compare equal."""
+    if START in text:
+        text = text.split(START, 1)[1].split(END, 1)[0]
+    lines = [ln.strip() for ln in text.splitlines() if ln.strip().startswith("|")]
+    return [ln.replace(f"]({prefix}", "](") for ln in lines] if prefix else lines
+
+
+@figure("summary", "README table")
+def summary(preset="fast", outdir=None):
+    path = Path(outdir or default_outdir()) / "summary.md"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(summary_markdown(preset))
+    return [str(path)]
+
+
+def update_readme(readme="README.md", summary_md="figures/summary.md"):
+    """Copy the table of summary.md into the README between the markers."""
+    text = Path(readme).read_text()
+    if START not in text or END not in text:
+        raise ValueError(f"{readme} has no {START} ... {END} block")
+    table = "\n".join(ln.replace("](", "](figures/") for ln in table_lines(Path(summary_md).read_text()))
+    head, rest = text.split(START, 1)
+    tail = rest.split(END, 1)[1]
+    Path(readme).write_text(f"{head}{START}\n{table}\n{END}{tail}")
+
+
+if __name__ == "__main__":
+    repo = Path(__file__).resolve().parents[2]
+    update_readme(sys.argv[1] if len(sys.argv) > 1 else repo / "README.md",
+                  sys.argv[2] if len(sys.argv) > 2 else repo / "figures" / "summary.md")

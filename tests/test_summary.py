@@ -1,0 +1,69 @@
+"""figures/summary.md (written by `contactfem figures --preset paper`) is the README's
+table of the paper's examples: the two must agree, and every "ours" cell comes from a run."""
+
+from pathlib import Path
+
+import pytest
+
+from contactfem.plots import summary as S
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+def test_readme_table_is_figures_summary():
+    readme = S.table_lines((REPO / "README.md").read_text(), prefix="figures/")
+    written = S.table_lines((REPO / "figures" / "summary.md").read_text())
+    assert readme, "README.md has no table between " + S.START + " and " + S.END
+    assert readme == written, ("README.md and figures/summary.md disagree: regenerate with "
+                               "`contactfem figures --only summary --preset paper` and copy it with "
+                               "`python -m contactfem.plots.summary`")
+
+
+def test_summary_has_one_row_per_example():
+    written = S.table_lines((REPO / "figures" / "summary.md").read_text())
+    assert written[:2] == S.HEAD
+    assert len(written) == len(S.HEAD) + len(S.ROWS)
+    assert "--preset paper" in (REPO / "figures" / "summary.md").read_text()
+
+
+def test_ours_is_computed_from_the_run(monkeypatch):
+    # change what the block run returns: the row changes with it (nothing typed)
+    def fake(scene, preset="fast", law="conical", **kw):
+        assert scene == "block"
+        return dict(newton_residuals=[171.37, 3.2, 4e-12] if law == "conical" else [171.37] + [1.0] * 6,
+                    n_slip=7 if law == "conical" else 9, equilibrium_error=3e-13, total_normal=-123.0,
+                    total_tangential=45.0)
+    monkeypatch.setattr(S, "cached_run", fake)
+    row = S.row_table1("paper")
+    assert "conical 3 (7 nodes slip), parabolic 7" in row[3] and "first 171.37" in row[3]
+    assert "(123 down, 45 along)" in S.row_block_equilibrium("paper")[3]
+
+
+def test_update_readme_round_trip(tmp_path):
+    readme = tmp_path / "README.md"
+    readme.write_text(f"intro\n\n{S.START}\n| old |\n{S.END}\n\nafter\n")
+    md = tmp_path / "summary.md"
+    md.write_text("# t\n\n" + "\n".join(S.HEAD + ["| a | b | c | d | [1](fig.png) |"]) + "\n")
+    S.update_readme(readme, md)
+    text = readme.read_text()
+    assert "[1](figures/fig.png)" in text and "| old |" not in text and text.endswith("after\n")
+    assert S.table_lines(text, prefix="figures/") == S.table_lines(md.read_text())
+    readme.write_text("no markers")
+    with pytest.raises(ValueError, match="summary:start"):
+        S.update_readme(readme, md)
+
+
+def test_describe_newton_reads_the_history():
+    from contactfem.plots import describe_newton
+
+    assert describe_newton([10.0, 1.0, 1e-3, 1e-9], True) == "converges in 3 linear solves"
+    assert describe_newton([10.0, 9.0, 200.0, 5e3], False).startswith("diverges")
+    assert describe_newton([10.0, 5.0, 4.0, 3.0], False).startswith("does not converge in 3 solves")
+
+
+def test_block_titles_say_what_the_run_found():
+    from contactfem.plots.block import slip_words
+
+    base = dict(contact=dict(x=[0.0] * 17), n_stick=17, n_open=0)
+    assert slip_words(dict(base, n_slip=0)).startswith("no node reaches the slip bound")
+    assert slip_words(dict(base, n_slip=4, n_stick=13)).startswith("4 of 17 nodes slip")
