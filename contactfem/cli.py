@@ -7,7 +7,6 @@ with code 1 and prints the residual history."""
 
 import argparse
 import json
-import os
 import sys
 
 from . import scenes
@@ -43,10 +42,11 @@ def cmd_show(args):
 
 
 def cmd_run(args):
+    progress = None
     if args.progress:
-        os.environ["CONTACTFEM_PROGRESS"] = "1"
+        from .io import progress_bar as progress
     overrides, laws = laws_from_args(args)
-    res = scenes.run_scene(args.scene, args.preset, overrides, **laws)
+    res = scenes.run_scene(args.scene, args.preset, overrides, progress=progress, **laws)
     text = json.dumps(res, indent=1)
     if args.json:
         with open(args.json, "w") as fh:

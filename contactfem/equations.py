@@ -30,7 +30,7 @@ class Equation:
 
 _K = "contactfem.contact.kinematics"
 _E = "contactfem.contact.element.contact_element"
-_R = "contactfem.contact.return_map.return_map"
+_R = "contactfem.laws.return_map.return_map"
 _P = "contactfem.plots.laws"
 
 INDEX = {e.number: e for e in [

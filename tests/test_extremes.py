@@ -18,7 +18,7 @@ from skfem import MeshQuad
 
 from contactfem.bodies.continuum import Continuum
 from contactfem.contact import BodySurface, NodeToSegment, RigidArc, RigidLine, RigidPolyline
-from contactfem.contact.return_map import return_map
+from contactfem.laws.return_map import return_map
 from contactfem.laws import Coulomb, ParabolicSlip, PowerLaw
 from contactfem.solver import Dirichlet, Newmark, NewtonError, System, integrate
 

@@ -160,6 +160,24 @@ def _energy_form(w):
 # Boundary helper
 # ---------------------------------------------------------------------------
 
+def boundary_loop(mesh):
+    """Node indices of the boundary of a 2D scikit-fem mesh, in order around it (the outer
+    loop of a simply connected mesh): to draw a continuum's outline as one polyline."""
+    edges = mesh.facets[:, mesh.boundary_facets()].T
+    nxt = {}
+    for a, b in edges:
+        nxt.setdefault(a, []).append(b)
+        nxt.setdefault(b, []).append(a)
+    start = edges[0, 0]
+    loop, prev, cur = [start], None, start
+    while True:
+        step = [n for n in nxt[cur] if n != prev][0]
+        if step == start:
+            return np.array(loop)
+        loop.append(step)
+        prev, cur = cur, step
+
+
 def oriented_facets(mesh, facets):
     """Boundary facets as node pairs (a, b), shape (nf, 2), oriented so that the
     body lies to the RIGHT of b - a: the outward normal is e3 x (x_b - x_a),

@@ -138,3 +138,77 @@ class Pressure(_Load):
         rows = np.repeat(self._dofs, 4, axis=1).ravel()
         cols = np.tile(self._dofs, (1, 4)).ravel()
         return P, rows, cols, K.ravel()
+
+
+def swept_volume(x):
+    """Volume of revolution under the profile x = (r_i, z_i), ordered in r
+    (Pappus on each straight segment):  int 2 pi r z dr
+    = sum 2 pi (r2 - r1) (2 r1 z1 + r1 z2 + r2 z1 + 2 r2 z2) / 6.
+    For a flat face at height z and radius r it is pi r^2 z."""
+    r, z = x[:, 0], x[:, 1]
+    r1, r2, z1, z2 = r[:-1], r[1:], z[:-1], z[1:]
+    return float(np.sum(2.0 * np.pi * (r2 - r1) * (2 * r1 * z1 + r1 * z2 + r2 * z1 + 2 * r2 * z2) / 6.0))
+
+
+class GasPressure(Pressure):
+    """The pressure of a gas column under the face ``boundary_name`` of an axisymmetric
+    body (the champagne under the cork): a follower ``Pressure`` whose value is
+
+        ramp:   p = p_step * ceil(t / dt_ramp) while t <= n_ramp dt_ramp (by time)
+        Boyle:  p = p0 V0 / V after the ramp (p0 = n_ramp p_step, V0 = area * column,
+                V = V0 + the volume swept by the face since ``start``)
+        open:   p = 0 once the face's outer edge has reached z_release (the gas escapes).
+
+    Explicit coupling: ``update(u)`` sets the Boyle value and the release from the last
+    converged state, once per step (the before-step hook of ``integrate``); the pressure
+    is then constant over the step (``value``). ``face_nodes`` are the nodes of that face.
+    """
+
+    def __init__(self, body, boundary_name, face_nodes, area, column, p_step, n_ramp, dt_ramp, z_release):
+        super().__init__(body, boundary_name, self.pressure, follower=True)
+        self.face = np.asarray(face_nodes)
+        self.V0 = area * column
+        self.p_step, self.n_ramp, self.dt_ramp, self.z_release = p_step, n_ramp, dt_ramp, z_release
+        self.p0 = p_step * n_ramp
+        self.value, self.k, self.released = 0.0, 0, False
+        self.released_at = None
+        self.S0 = None
+
+    def face_positions(self, u):
+        b = self.body
+        x = b.X[self.face] + u[b.dof_offset + b.xdofs[self.face]]
+        return x[np.argsort(b.X[self.face, 0])]
+
+    def start(self, u):
+        """The state u where the gas column has its volume V0."""
+        self.S0 = swept_volume(self.face_positions(u))
+
+    def volume(self, u):
+        return self.V0 + swept_volume(self.face_positions(u)) - self.S0
+
+    def edge_z(self, u):
+        """Height of the face's outer edge (the gas escapes when it reaches z_release)."""
+        return self.face_positions(u)[-1, 1]
+
+    def update(self, u, t=None):
+        """Pressure for the next step from the converged u (explicit coupling); t, when
+        given, is recorded as ``released_at`` at the release."""
+        self.k += 1
+        if not self.released and self.edge_z(u) >= self.z_release:
+            self.released = True
+            self.released_at = t
+        if self.released:
+            self.value = 0.0
+        elif self.k <= self.n_ramp:
+            self.value = self.p_step * self.k
+        else:
+            self.value = self.p0 * self.V0 / self.volume(u)
+        return self.value
+
+    def pressure(self, t):
+        """The value at time t: the ramp by time, then the value set by ``update``."""
+        if self.released:
+            return 0.0
+        if t <= self.n_ramp * self.dt_ramp * (1 + 1e-9):
+            return self.p_step * np.ceil(t / self.dt_ramp - 1e-6)
+        return self.value

@@ -316,3 +316,69 @@ def make_ring(kind="beam", R=1.0, thickness=0.1, n_el=32, E=1.0, nu=0.0, rho=1.0
                      name=name, thickness=b)
     outer = n_radial * n_ang + np.arange(n_ang)
     return RingModel(body, kind, R, h, b, center, bool(half), outer, 0.0)
+
+
+class RingRecorder:
+    """What the ring scenes record over a run: an ``integrate`` recorder,
+    ``integrate(..., recorder=RingRecorder(ring, ...))``, called with the initial state
+    and after every accepted step.
+
+    Every step: t, the centre of mass x_c and its velocity v_c (2-vectors, of the whole
+    mirrored ring for a half ring), the spin omega; with ``contact`` (anything whose
+    ``report(u)["state"]`` lists "open" / "stick" / "slip" per node) the numbers of
+    touching (n_contact) and slipping (n_slip) nodes; ``measures``, name -> f(u, v),
+    more numbers per step. Snapshots every ``every`` steps, or every ``interval`` of
+    time (a snapshot is due when t >= the next snapshot time - ``tol``): the outline
+    (``mirror``: the whole ring for a half ring), its time and step index, and
+    ``snapshot_measures``, name -> f(u, v). ``arrays()`` returns everything as numpy
+    arrays; per-snapshot entries are prefixed ``outline_`` (outline_t, outline_k, ...).
+    """
+
+    def __init__(self, ring, contact=None, every=None, interval=None, tol=0.0, mirror=False,
+                 measures=None, snapshot_measures=None):
+        if (every is None) == (interval is None):
+            raise ValueError("give exactly one of every (steps) and interval (time) for the snapshots")
+        if every is not None and (int(every) != every or every < 1):
+            raise ValueError(f"parameter every = {every!r} is out of range: an integer >= 1")
+        if interval is not None and not interval > 0:
+            raise ValueError(f"parameter interval = {interval!r} is out of range: allowed (0, inf)")
+        self.ring, self.contact, self.every, self.interval, self.tol = ring, contact, every, interval, tol
+        self.mirror = mirror
+        self.measures, self.snapshot_measures = dict(measures or {}), dict(snapshot_measures or {})
+        self.next_snapshot = 0.0
+        keys = ["t", "x_c", "v_c", "omega"] + (["n_contact", "n_slip"] if contact is not None else [])
+        self.data = {k: [] for k in keys + list(self.measures)}
+        self.snapshots = {k: [] for k in ["outlines", "outline_t", "outline_k"] +
+                          [f"outline_{k}" for k in self.snapshot_measures]}
+
+    def __call__(self, t, u, v, a=None, step=None):
+        ring, d = self.ring, self.data
+        k = len(d["t"])
+        d["t"].append(t)
+        d["x_c"].append(ring.center_of_mass(u))
+        d["v_c"].append(ring.velocity_of_mass(v))
+        d["omega"].append(ring.angular_velocity(u, v))
+        if self.contact is not None:
+            state = self.contact.report(u)["state"]
+            d["n_contact"].append(int(np.count_nonzero(state != "open")))
+            d["n_slip"].append(int(np.count_nonzero(state == "slip")))
+        for name, f in self.measures.items():
+            d[name].append(f(u, v))
+        if self.every is not None:
+            due = k % self.every == 0
+        else:
+            due = t >= self.next_snapshot - self.tol
+            if due:
+                self.next_snapshot += self.interval
+        if due:
+            s = self.snapshots
+            s["outlines"].append(ring.outline(u, mirror=self.mirror) if ring.half else ring.outline(u))
+            s["outline_t"].append(t)
+            s["outline_k"].append(k)
+            for name, f in self.snapshot_measures.items():
+                s[f"outline_{name}"].append(f(u, v))
+
+    def arrays(self):
+        out = {k: np.asarray(x) for k, x in self.data.items()}
+        out.update({k: np.asarray(x) for k, x in self.snapshots.items()})
+        return out

@@ -40,7 +40,7 @@ import numpy as np
 from ..laws.friction import Frictionless
 from ..laws.normal import PowerLaw
 from .interface import NodeToSegment
-from .return_map import return_map
+from ..laws.return_map import return_map
 
 ENFORCEMENTS = ("penalty", "augmented")
 

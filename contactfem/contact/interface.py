@@ -10,7 +10,7 @@ import numpy as np
 from .element import contact_element, to_coo
 from ..laws.friction import Frictionless
 from ..laws.protocol import as_friction_law
-from .return_map import STATE_NAMES, return_map
+from ..laws.return_map import STATE_NAMES, return_map
 
 
 def tributary_lengths(X):

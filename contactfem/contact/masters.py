@@ -171,3 +171,107 @@ class BodySurface:
 
     def outline(self, u=None):
         return self.x_bar if u is None else self.positions(u)
+
+
+def _expand(mask, like):
+    """A boolean mask (nc,) broadcast against an array (nc, ...)."""
+    return mask.reshape((-1,) + (1,) * (np.ndim(like) - 1))
+
+
+class RigidComposite:
+    """A smooth rigid master made of straight lines and circular arcs joined end to end
+    (e.g. a bottle neck: wall, rounded mouth, flat top). ``pieces`` in order of travel:
+
+        ("line", start, end)                  n = e3 x t (eq 18), t = (end - start) / length
+        ("arc", center, R, theta0, theta1)    from angle theta0 to theta1 (radians); n = e3 x t,
+                                              so clockwise (theta1 < theta0) is touched from
+                                              outside, counter-clockwise from inside
+
+    Exact curvature on the arcs (``arc_variations``). The arc coordinate s runs on
+    continuously from piece to piece (s = S_i + the length travelled on piece i), so a
+    node keeps its friction history (Delta g_T = s - s_bar, eq 20) when it passes from
+    one piece to the next; with equal tangents at the joints the normal is continuous.
+    A node belongs to the first piece whose end it has not passed (its coordinate on the
+    piece is below the piece's length), the last piece otherwise; a node exactly at a
+    joint belongs to the line piece there. ``translate(offset)``
+    moves the whole master rigidly (a prescribed obstacle motion; s is unchanged).
+    """
+
+    rigid = True
+
+    def __init__(self, pieces, offset=(0.0, 0.0)):
+        self.pieces = []
+        for p in pieces:
+            kind = p[0]
+            if kind == "line":
+                A, B = np.asarray(p[1], float), np.asarray(p[2], float)
+                L = float(np.linalg.norm(B - A))
+                if not L > 0:
+                    raise ValueError("a line piece of a composite master has zero length")
+                self.pieces.append(dict(kind="line", A=A, t=(B - A) / L, length=L))
+            elif kind == "arc":
+                c, R, th0, th1 = np.asarray(p[1], float), float(p[2]), float(p[3]), float(p[4])
+                if not R > 0 or th0 == th1:
+                    raise ValueError("an arc piece of a composite master needs R > 0 and theta0 != theta1")
+                self.pieces.append(dict(kind="arc", c=c, R=R, th0=th0, th1=th1, length=R * abs(th1 - th0),
+                                        cw=th1 < th0))
+            else:
+                raise ValueError(f"piece kind {kind!r} is not allowed: one of line|arc")
+        self.S = np.concatenate([[0.0], np.cumsum([p["length"] for p in self.pieces])])
+        self.translate(offset)
+
+    def translate(self, offset):
+        """Move the master rigidly to ``offset`` (from its defining position)."""
+        self.offset = np.asarray(offset, dtype=float)
+
+    def _piece(self, i, x_s):
+        """Kinematics of every slave with piece i and its coordinate along it."""
+        p, nc = self.pieces[i], len(x_s)
+        if p["kind"] == "line":
+            t = p["t"]
+            k = line_variations(x_s, p["A"] + self.offset, np.array([-t[1], t[0]]))
+            return k, k["s"]
+        c = p["c"] + self.offset
+        k = arc_variations(x_s, c, p["R"], not p["cw"], np.full(nc, 0.5 * (p["th0"] + p["th1"])))
+        if p["cw"]:                        # travelled clockwise: t = -e_theta, s = R (theta0 - theta)
+            k = dict(k, t=-k["t"], ds=-k["ds"], d2s=-k["d2s"])
+            return k, p["R"] * p["th0"] - k["s"]
+        return k, k["s"] - p["R"] * p["th0"]
+
+    def locate(self, x_s, s_bar, u):
+        nc, m = len(x_s), len(self.pieces)
+        own = np.full(nc, m - 1)
+        local = []
+        for i in range(m):
+            k, s_loc = self._piece(i, x_s)
+            local.append((k, s_loc))
+        for i in reversed(range(m - 1)):         # a joint belongs to the line beside it
+            L_i = self.pieces[i]["length"]
+            before_end = local[i][1] <= L_i if self.pieces[i]["kind"] == "line" else local[i][1] < L_i
+            own = np.where(before_end, i, own)
+        out = {}
+        for key in ("g_N", "t", "n", "dg_N", "d2g_N", "ds", "d2s"):
+            val = local[m - 1][0][key]
+            for i in reversed(range(m - 1)):
+                val = np.where(_expand(own == i, val), local[i][0][key], val)
+            out[key] = val
+        s = local[m - 1][1] + self.S[m - 1]
+        for i in reversed(range(m - 1)):
+            s = np.where(own == i, local[i][1] + self.S[i], s)
+        out["s"] = s
+        inside = ~(((own == 0) & (local[0][1] < 0.0)) | ((own == m - 1) & (local[-1][1] > self.pieces[-1]["length"])))
+        return dict(out, master_dofs=np.zeros((nc, 0), dtype=int), inside=inside, seg=own)
+
+    def outline(self, n=32):
+        """Points along the master (n per arc), for drawing."""
+        pts = []
+        for p in self.pieces:
+            if p["kind"] == "line":
+                pts += [p["A"] + self.offset, p["A"] + p["length"] * p["t"] + self.offset]
+            else:
+                th = np.linspace(p["th0"], p["th1"], n)
+                pts += list(p["c"] + self.offset + p["R"] * np.column_stack([np.cos(th), np.sin(th)]))
+        pts = np.array(pts)
+        scale = max(float(np.max(np.abs(pts))), 1.0)
+        keep = np.concatenate([[True], np.linalg.norm(np.diff(pts, axis=0), axis=1) > 1e-9 * scale])
+        return pts[keep]

@@ -8,13 +8,14 @@
     animate.py   animate_outlines(frames, "motion.gif"): body outlines over time with
                  matplotlib's PillowWriter (GIF) or FFMpegWriter (MP4)
     progress.py  ProgressBar: a progress bar on stderr for integrate(..., callback=bar);
-                 chain(...) to give integrate several callbacks
+                 chain(...) to give integrate several callbacks; progress_bar, the factory
+                 for integrate(..., progress=) and run_scene(..., progress=)
 """
 
 from .animate import animate_outlines, boundary_loop
 from .paraview import export_continuum, export_polyline, export_series
-from .progress import ProgressBar, chain
+from .progress import ProgressBar, chain, progress_bar
 from .runs import Recorder, load_run, save_run
 
 __all__ = ["save_run", "load_run", "Recorder", "boundary_loop", "export_series", "export_continuum", "export_polyline",
-           "animate_outlines", "ProgressBar", "chain"]
+           "animate_outlines", "ProgressBar", "chain", "progress_bar"]

@@ -11,6 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..bodies.continuum import boundary_loop  # noqa: F401  (public here too)
+
 
 def _polylines(frame):
     """A frame is one (n, 2) polyline or a list of them; return a list of (n, 2) arrays."""
@@ -20,24 +22,6 @@ def _polylines(frame):
         if p.ndim != 2 or p.shape[1] != 2:
             raise ValueError(f"parameter frames: each polyline must have shape (n, 2), got {p.shape}")
     return out
-
-
-def boundary_loop(mesh):
-    """Node indices of the boundary of a 2D scikit-fem mesh, in order around it (the outer
-    loop of a simply connected mesh): to draw a continuum's outline as one polyline."""
-    edges = mesh.facets[:, mesh.boundary_facets()].T
-    nxt = {}
-    for a, b in edges:
-        nxt.setdefault(a, []).append(b)
-        nxt.setdefault(b, []).append(a)
-    start = edges[0, 0]
-    loop, prev, cur = [start], None, start
-    while True:
-        step = [n for n in nxt[cur] if n != prev][0]
-        if step == start:
-            return np.array(loop)
-        loop.append(step)
-        prev, cur = cur, step
 
 
 def animate_outlines(frames, path, times=None, obstacles=(), closed=False, fps=20, title="",

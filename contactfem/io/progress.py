@@ -5,10 +5,10 @@
     bar.close()
 
 or, counting steps: ``bar = ProgressBar(total=200)`` and ``bar.update()`` per step.
-Several callbacks at once: ``integrate(..., callback=chain(bar, recorder))``.
+Several callbacks at once: ``integrate(..., callback=chain(bar, recorder))``. A scene or
+``integrate`` makes its own bars with ``progress=progress_bar`` (one per time loop).
 """
 
-import os
 import sys
 import time
 
@@ -93,9 +93,7 @@ def chain(*callbacks):
     return call
 
 
-def progress_from_env(t0, t_end, label=""):
-    """A ProgressBar when CONTACTFEM_PROGRESS=1 (set by `contactfem run --progress`), else None:
-    the scenes' time loops call this, so any long run can show its progress."""
-    if os.environ.get("CONTACTFEM_PROGRESS") == "1" and t_end > t0:
-        return ProgressBar(t0=t0, t_end=t_end, label=label)
-    return None
+def progress_bar(t0, t_end, label=""):
+    """A ProgressBar over [t0, t_end]: what ``integrate(..., progress=progress_bar)`` and
+    ``run_scene(..., progress=progress_bar)`` (``contactfem run --progress``) expect."""
+    return ProgressBar(t0=t0, t_end=t_end, label=label)

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..contact.return_map import SLIP, STICK, return_map
+from .return_map import SLIP, STICK, return_map
 from .normal import PowerLaw
 from .protocol import FrictionLaw, LawError, explain_call_error
 

@@ -9,7 +9,7 @@ A friction law is two things (eqs 5 and 10):
   that the slip condition reads ``f = ||t_T|| - Y(p, q) <= 0`` (eqs 10, 11).
 
 ``slip_bound(p, q)`` returns ``(Y, dY/dp, dY/dq)`` vectorised over contact nodes.
-That is the whole interface: :func:`contactfem.contact.return_map` integrates any
+That is the whole interface: :func:`contactfem.laws.return_map` integrates any
 such law (eqs 40-48), and :func:`contactfem.check_law` verifies a new one.
 Slip follows the non-associated rule of eq (14): it is tangential only.
 """

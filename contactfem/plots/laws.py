@@ -11,7 +11,7 @@ need (eqs 3, 6-9, 13); the laws used in computations live in contactfem.laws.
 
 import numpy as np
 
-from ..contact.return_map import return_map
+from ..laws.return_map import return_map
 from ..laws import Coulomb, ParabolicSlip, SlipHardening
 from ..laws.validation import require
 from . import default_outdir, figure, pyplot, savefig

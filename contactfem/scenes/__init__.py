@@ -28,8 +28,10 @@ def get_scene(name):
     return scenes[name]
 
 
-def run_scene(name, preset="fast", overrides=None, friction=None, normal=None):
+def run_scene(name, preset="fast", overrides=None, progress=None, friction=None, normal=None):
     """Run a scene and return its results with wall time, Newton iteration count and parameters.
+    ``progress(t0, t_end, label)``: a progress-callback factory handed to the scene's time
+    loops (e.g. ``contactfem.io.progress_bar``); None shows nothing.
     ``friction`` / ``normal``: law objects replacing the laws the scene's parameters build
     (recorded as ``friction_law`` / ``normal_law``: class, file, fields)."""
     import time
@@ -40,7 +42,8 @@ def run_scene(name, preset="fast", overrides=None, friction=None, normal=None):
     params = scene.resolve(preset, overrides)
     laws = {k: v for k, v in (("friction", friction), ("normal", normal)) if v is not None}
     t0 = time.perf_counter()
-    results = scene.run(params, **laws)
+    kwargs = dict(laws, progress=progress) if progress is not None else laws
+    results = scene.run(params, **kwargs)
     results = dict(results)
     for kind, law in laws.items():
         results[f"{kind}_law"] = describe(law)

@@ -57,7 +57,8 @@ def bar_exact(L, E, rho, v0):
     return dict(c=c, stress=rho * c * v0, duration=2.0 * L / c, rebound_velocity=v0)
 
 
-def build(params):
+def build(params, normal=None, friction=None):
+    """``normal`` / ``friction``: law objects instead of the parameters' (frictionless by default)."""
     L, H = params["L"], params["h"]
     n = params["n_el"]
     mesh = MeshQuad.init_tensor(np.linspace(0.0, L, n + 1), np.linspace(0.0, H, 2))
@@ -67,14 +68,14 @@ def build(params):
     nodes = nodes[np.argsort(body.X[nodes, 1])]
     w = tributary_lengths(body.X[nodes])
     c_N = params["c_N_factor"] * params["E"] / (L / n)
-    contact = NodeToSegment(body, nodes, RigidLine((0.0, 0.0), (1.0, 0.0)), PowerLaw(c_N, 1.0),
+    contact = NodeToSegment(body, nodes, RigidLine((0.0, 0.0), (1.0, 0.0)), normal or PowerLaw(c_N, 1.0), friction,
                             weights=w, name="wall")
     system = System([body], [contact])
     return dict(body=body, contact=contact, system=system, nodes=nodes, w=w, c_N=c_N)
 
 
-def run(params):
-    m = build(params)
+def run(params, progress=None, normal=None, friction=None):
+    m = build(params, normal, friction)
     body, contact, system = m["body"], m["contact"], m["system"]
     L, H, v0 = params["L"], params["h"], params["v0"]
     ex = bar_exact(L, params["E"], params["rho"], v0)
@@ -93,7 +94,7 @@ def run(params):
     def record(t, u, v, a):
         force.append(float(-contact.report(u)["f_N"].sum()))
 
-    hist = integrate(stepper, 0.0, u0, v0_vec, t_end=t_end, callback=record, cutback=True)
+    hist = integrate(stepper, 0.0, u0, v0_vec, t_end=t_end, callback=record, cutback=True, progress=progress)
     t, F = hist.t, np.asarray(force)
     stress = F / H
     on = np.flatnonzero(F > 0.0)

@@ -45,12 +45,13 @@ from skfem import MeshQuad
 
 from ..bodies.continuum import MATERIALS, Continuum
 from ..bodies.loads import Pressure, Traction
-from ..contact import RigidLine, to_coo, tributary_lengths
+from ..contact import RigidLine, tributary_lengths
 from ..contact.augmented import make_interface
-from ..contact.kinematics import outer
+from ..contact.tangents import TANGENTS, ContactTangent  # noqa: F401  (ContactTangent: public here too)
 from ..laws.friction import Coulomb, ParabolicSlip
 from ..laws.normal import PowerLaw
-from ..solver import Static, System
+from ..laws.protocol import FrictionLaw
+from ..solver import Static, System, integrate
 from . import enforcement
 from .base import Param, Scene
 
@@ -65,7 +66,6 @@ PAPER_TABLE1 = {
 PAPER_TABLE1_UNCERTAIN = {"conical": (2, 3), "parabolic": ()}
 
 LAWS = ("conical", "parabolic", "coulomb")
-TANGENTS = ("consistent", "symmetric", "frozen")
 
 PARAMS = (
     Param("law", "conical", choices=LAWS,
@@ -138,39 +138,10 @@ def friction_law(params):
     raise ValueError(f"parameter law = {law!r} is not allowed: one of {'|'.join(LAWS)}")
 
 
-class ContactTangent:
-    """A contact with the same residual (eq 28) but a modified tangent, to compare
-    Newton's convergence (the point of paper Sec. 4.2):
-
-    symmetric:  (K_c + K_c^T) / 2
-    frozen:     K_c - w c_N^s C,  C = ds dg_N^T (eq 50): the slip bound is treated
-                as independent of the normal gap in the tangent.
-    Everything else is delegated to the wrapped contact."""
-
-    def __init__(self, contact, kind):
-        if kind not in TANGENTS:
-            raise ValueError(f"parameter tangent = {kind!r} is not allowed: one of {'|'.join(TANGENTS)}")
-        self.contact, self.kind = contact, kind
-
-    def __getattr__(self, name):
-        return getattr(self.contact, name)
-
-    def assemble(self, u):
-        R_c, rows, cols, vals = self.contact.assemble(u)
-        if self.kind == "symmetric":
-            return R_c, np.concatenate([rows, cols]), np.concatenate([cols, rows]), np.concatenate([vals, vals]) / 2
-        if self.kind == "frozen":
-            e = self.contact.evaluate(u)
-            on = e["active"]
-            C = (self.contact.weights * e["friction"].c_N_s)[on, None, None] * outer(e["ds"][on], e["dg_N"][on])
-            r, c, v = to_coo(e["dofs"][on], -C)
-            return R_c, np.concatenate([rows, r]), np.concatenate([cols, c]), np.concatenate([vals, v])
-        return R_c, rows, cols, vals
-
-
-def build(params, friction=None):
+def build(params, friction=None, normal=None):
     """Body, contact, loads and System of the block (no solve). Returns a dict.
-    ``friction``: a friction law object to use instead of params["law"] (a student's law)."""
+    ``friction`` / ``normal``: law objects to use instead of the ones params build
+    (params["law"] and the penalty law of c_N, m): a student's law."""
     W, H = params["width"], params["height"]
     mesh = block_mesh(W, H, params["nx"], params["ny"])
     body = Continuum(mesh, E=params["E"], nu=params["nu"], rho=0.0, kind="plane_strain",
@@ -183,7 +154,7 @@ def build(params, friction=None):
     weights = tributary_lengths(body.X[bottom])[k:-k]        # tractions per unit length of the bottom
     slaves = bottom[k:-k]                                   # the first and last element never touch
     contact = make_interface(params.get("enforcement", "penalty"), body, slaves, RigidLine((0.0, 0.0), (0.0, 1.0)),
-                             PowerLaw(c_N=params["c_N"], m=params["m"]), friction or friction_law(params),
+                             normal or PowerLaw(c_N=params["c_N"], m=params["m"]), friction or friction_law(params),
                              weights=weights, offset=-params["g_N0"], name="foundation")
     p_y, p_x = params["p_y"], params["p_x"]
     loads = [Pressure(body, "top", lambda t: p_y * t),                # dead loads, ramped over the
@@ -193,12 +164,12 @@ def build(params, friction=None):
     return dict(body=body, contact=contact, loads=loads, system=system, slaves=slaves)
 
 
-def solve(params, friction=None):
+def solve(params, friction=None, progress=None, normal=None):
     """Build the block and apply the load in ``n_steps`` static steps of the pseudo-time
     (default: the whole load in ONE step, Newton from u = 0). Returns build()'s dict plus
     u, the NewtonResult of every step and the contact report and contact forces R_c at
     the converged final state (taken before the friction history is committed)."""
-    sc = build(params, friction)
+    sc = build(params, friction, normal)
     system, contact = sc["system"], sc["contact"]
     n = params["n_steps"]
     stepper = Static(system, dt=1.0 / n, atol=params["atol"], rtol=params["rtol"], maxit=params["maxit"])
@@ -207,15 +178,18 @@ def solve(params, friction=None):
                                [contact], length=h)
     u = np.zeros(system.ndof)
     contact.initialize(u)
-    results = []
-    for k in range(n):
-        u, _, _, result = stepper.step(k / n, u, u, u, label=f"block, load step {k + 1} of {n}")
-        results.append(result)
-        if k == n - 1:
-            report, R_c = contact.report(u), contact.assemble(u)[0]
-        system.commit(u)
-    return dict(sc, u=u, result=results[-1], results=results, report=report, R_c=R_c, stepper=stepper,
-                element_size=h)
+    results, last = [], {}
+
+    def converged(t, u, v, a, step):                 # before the friction history is committed
+        results.append(step.result)
+        if step.k == n:
+            rep, fr = contact.report(u), contact.evaluate(u)["friction"]
+            Y = FrictionLaw(contact.friction).slip_bound(-rep["t_N"], fr.q, fr.v, fr.z)[0]    # after the step
+            last.update(report=rep, R_c=contact.assemble(u)[0], slip_bound=Y)
+
+    hist = integrate(stepper, 0.0, u, n_steps=n, before_commit=converged, progress=progress,
+                     label=lambda k, t1, dt: f"block, load step {k} of {n}")
+    return dict(sc, u=hist.u, result=results[-1], results=results, stepper=stepper, element_size=h, **last)
 
 
 def slip_bound(params, t_N):
@@ -231,15 +205,15 @@ def load_norms(body, loads):
     return [float(np.linalg.norm(ld.assemble(u, 1.0)[0])) for ld in loads]
 
 
-def run(params):
-    s = solve(params)
+def run(params, progress=None, normal=None, friction=None):
+    s = solve(params, friction, progress, normal)
     body, rep, res = s["body"], s["report"], s["result"]
     dofs = body.xdofs
     total_normal = float(s["R_c"][dofs[:, 1]].sum())          # = sum w t_N (signed, < 0 compressive)
     total_tangential = float(s["R_c"][dofs[:, 0]].sum())      # = sum w t_T
     W, H = params["width"], params["height"]
     applied_normal, applied_tangential = -params["p_y"] * W, params["p_x"] * H
-    Y = slip_bound(params, rep["t_N"])
+    Y = s["slip_bound"]                                       # of the law in use, after the step
     excess = np.abs(rep["t_T"]) - Y                           # <= 0 everywhere, = 0 on slipping nodes
     slipping = rep["state"] == "slip"
     top, right = load_norms(body, s["loads"])

@@ -74,14 +74,13 @@ which the centre of mass moves faster than 1 m/s (before, the cork only creeps);
 import numpy as np
 from skfem import MeshQuad
 
-from ..bodies.continuum import Continuum
-from ..bodies.loads import Pressure
+from ..bodies.continuum import Continuum, boundary_loop
+from ..bodies.loads import GasPressure, swept_volume  # noqa: F401  (swept_volume: public here too)
 from ..contact import NodeToSegment, tributary_lengths
-from ..contact.kinematics import arc_variations, line_variations
-from ..io.animate import boundary_loop
+from ..contact.masters import RigidComposite
 from ..laws.friction import SlipHardening
 from ..laws.normal import PowerLaw
-from ..solver import Dirichlet, Newmark, NewtonError, Static, System
+from ..solver import Dirichlet, Newmark, Static, System, integrate
 from .base import Param, Scene
 
 # The paper's numbers (Sec. 5.5) the run is compared with.
@@ -172,7 +171,7 @@ def cork_mesh(R_tip, R_cork, L_taper, length, n_r, n_z):
     return MeshQuad(p, mesh.t, _boundaries=mesh.boundaries)
 
 
-class Neck:
+class Neck(RigidComposite):
     """The rigid bottle neck: one smooth master made of three pieces,
 
         wall   the line r = R_neck for z <= L_neck, traversed upwards, so that its
@@ -182,124 +181,28 @@ class Neck:
                outside, n = e_r of the circle (exact curvature, ``arc_variations``);
         top    the flat top of the bottle z = L_neck + r_mouth, traversed outwards (n = +e_z).
 
-    The pieces meet with equal tangents, so the normal is continuous, and the arc
-    coordinate s runs on continuously from piece to piece (wall: z - z_low; mouth:
-    + r_mouth (pi - theta); top: + (r - R_neck - r_mouth)), so a node keeps its
-    friction history (Delta g_T = s - s_bar, eq 20) when it passes from one piece to
-    the next. (A polyline mouth with facets, or separate masters that lose the
-    friction history at the junction, made Newton's iteration cycle.)
-    A node belongs to the piece its position lies in front of. ``set_shift``
-    translates the neck radially (the press fit); that leaves s unchanged.
+    A ``RigidComposite`` (contact/masters.py): the pieces meet with equal tangents, so
+    the normal is continuous, and the arc coordinate s runs on continuously from piece
+    to piece (wall: z - z_low; mouth: + r_mouth (pi - theta); top: + (r - R_neck -
+    r_mouth)), so a node keeps its friction history (Delta g_T = s - s_bar, eq 20) when
+    it passes from one piece to the next. (A polyline mouth with facets, or separate
+    masters that lose the friction history at the junction, made Newton's iteration
+    cycle.) ``set_shift`` translates the neck radially (the press fit); that leaves s
+    unchanged.
     """
-
-    rigid = True
 
     def __init__(self, R_neck, L_neck, r_mouth, z_low=-10.0, shift=0.0):
         self.R_neck, self.L_neck, self.r_mouth, self.z_low = R_neck, L_neck, r_mouth, z_low
         self.r_top = R_neck + r_mouth + 6.0
-        self.S_mouth = L_neck - z_low                        # s at the start of the mouth
-        self.S_top = self.S_mouth + r_mouth * np.pi / 2      # s at the start of the top
+        super().__init__([("line", (R_neck, z_low), (R_neck, L_neck)),
+                          ("arc", (R_neck + r_mouth, L_neck), r_mouth, np.pi, np.pi / 2),
+                          ("line", (R_neck + r_mouth, L_neck + r_mouth), (self.r_top, L_neck + r_mouth))])
         self.set_shift(shift)
 
     def set_shift(self, shift):
+        """Move the neck radially by ``shift`` (the press fit: from R_cork - R_neck to 0)."""
         self.shift = float(shift)
-        self.center = np.array([self.R_neck + self.r_mouth + self.shift, self.L_neck])
-
-    def locate(self, x_s, s_bar, u):
-        """Contact kinematics of each slave with its piece (see masters.py)."""
-        nc = len(x_s)
-        c, rm = self.center, self.r_mouth
-        on_wall = x_s[:, 1] <= self.L_neck
-        on_top = ~on_wall & (x_s[:, 0] >= c[0])
-        on_mouth = ~on_wall & ~on_top
-        wall = line_variations(x_s, np.array([c[0] - rm, self.z_low]), np.array([-1.0, 0.0]))
-        top = line_variations(x_s, np.array([c[0], self.L_neck + rm]), np.array([0.0, 1.0]))
-        arc = arc_variations(x_s, c, rm, False, np.full(nc, 0.75 * np.pi))
-        k = {}
-        for key in ("g_N", "t", "n", "dg_N", "d2g_N"):
-            k[key] = np.where(_expand(on_wall, wall[key]), wall[key],
-                              np.where(_expand(on_top, top[key]), top[key], arc[key]))
-        # the mouth is traversed clockwise: t = -e_theta, s = S_mouth + r_mouth (pi - theta)
-        s_arc = self.S_mouth + rm * np.pi - arc["s"]
-        k["t"] = np.where(_expand(on_mouth, arc["t"]), -arc["t"], k["t"])
-        k["s"] = np.where(on_wall, wall["s"], np.where(on_top, self.S_top + top["s"], s_arc))
-        k["ds"] = np.where(_expand(on_mouth, arc["ds"]), -arc["ds"], np.where(_expand(on_wall, wall["ds"]), wall["ds"], top["ds"]))
-        k["d2s"] = np.where(_expand(on_mouth, arc["d2s"]), -arc["d2s"],
-                            np.where(_expand(on_wall, wall["d2s"]), wall["d2s"], top["d2s"]))
-        inside = (x_s[:, 1] >= self.z_low) & (x_s[:, 0] <= self.r_top + self.shift)
-        return dict(k, master_dofs=np.zeros((nc, 0), dtype=int), inside=inside,
-                    seg=np.where(on_wall, 0, np.where(on_mouth, 1, 2)))
-
-    def outline(self, n=32):
-        """Points of the neck's profile (for drawing)."""
-        th = np.linspace(np.pi, np.pi / 2, n)
-        arc = self.center + self.r_mouth * np.column_stack([np.cos(th), np.sin(th)])
-        return np.vstack([[self.center[0] - self.r_mouth, self.z_low], arc,
-                          [self.r_top + self.shift, self.L_neck + self.r_mouth]])
-
-
-def _expand(mask, like):
-    """A boolean mask (nc,) broadcast against an array (nc, ...)."""
-    return mask.reshape((-1,) + (1,) * (np.ndim(like) - 1))
-
-
-# ---------------------------------------------------------------------------
-# The gas under the cork (Boyle, explicit coupling)
-# ---------------------------------------------------------------------------
-
-def swept_volume(x):
-    """Volume of revolution under the profile x = (r_i, z_i), ordered in r
-    (Pappus on each straight segment):  int 2 pi r z dr
-    = sum 2 pi (r2 - r1) (2 r1 z1 + r1 z2 + r2 z1 + 2 r2 z2) / 6.
-    For a flat face at height z and radius r it is pi r^2 z."""
-    r, z = x[:, 0], x[:, 1]
-    r1, r2, z1, z2 = r[:-1], r[1:], z[:-1], z[1:]
-    return float(np.sum(2.0 * np.pi * (r2 - r1) * (2 * r1 * z1 + r1 * z2 + r2 * z1 + 2 * r2 * z2) / 6.0))
-
-
-class GasColumn:
-    """The gas under the cork. ``p`` is the pressure used by the next step (the load
-    callable returns it); ``update`` sets it from the last converged state:
-
-        ramp:   p = p_step * k for the first n_ramp steps k = 1 .. n_ramp
-        Boyle:  p = p0 V0 / V  (p0 = n_ramp p_step, V0 = pi R_neck^2 gas_column,
-                V = V0 + swept volume of the bottom face since the start)
-        open:   p = 0 once the cork's bottom edge has reached the mouth.
-    """
-
-    def __init__(self, body, face_nodes, R_neck, gas_column, p_step, n_ramp, z_mouth):
-        self.body, self.face = body, np.asarray(face_nodes)
-        self.V0 = np.pi * R_neck**2 * gas_column
-        self.p_step, self.n_ramp, self.z_mouth = p_step, n_ramp, z_mouth
-        self.p0 = p_step * n_ramp
-        self.p, self.k, self.released = 0.0, 0, False
-        self.S0 = None
-
-    def face_positions(self, u):
-        x = self.body.X[self.face] + u[self.body.dof_offset + self.body.xdofs[self.face]]
-        return x[np.argsort(self.body.X[self.face, 0])]
-
-    def start(self, u):
-        self.S0 = swept_volume(self.face_positions(u))
-
-    def volume(self, u):
-        return self.V0 + swept_volume(self.face_positions(u)) - self.S0
-
-    def bottom_edge_z(self, u):
-        return self.face_positions(u)[-1, 1]
-
-    def update(self, u):
-        """Pressure for the next step from the converged u (explicit coupling)."""
-        self.k += 1
-        if not self.released and self.bottom_edge_z(u) >= self.z_mouth:
-            self.released = True
-        if self.released:
-            self.p = 0.0
-        elif self.k <= self.n_ramp:
-            self.p = self.p_step * self.k
-        else:
-            self.p = self.p0 * self.V0 / self.volume(u)
-        return self.p
+        self.translate((self.shift, 0.0))
 
 
 # ---------------------------------------------------------------------------
@@ -344,8 +247,9 @@ def centre_of_mass_velocity(body, v):
 # The model
 # ---------------------------------------------------------------------------
 
-def build(params):
-    """Cork, neck, contact, gas: everything both stages share."""
+def build(params, normal=None, friction=None):
+    """Cork, neck, contact, gas: everything both stages share.
+    ``normal`` / ``friction``: law objects instead of the ones the parameters build."""
     P = params
     if not P["R_cork"] > P["R_neck"]:
         raise ValueError(f"parameter R_cork = {P['R_cork']} must exceed R_neck = {P['R_neck']} (a press fit)")
@@ -363,11 +267,12 @@ def build(params):
         w = np.full(len(side), 2.0 * np.pi * P["R_neck"])
     else:
         w = np.ones(len(side))
-    friction = SlipHardening(c_T=P["c_T"], mu=P["mu"], h=P["h"])
-    contacts = [NodeToSegment(cork, side, neck, PowerLaw(P["c_N"], P["m"]), friction, weights=w, name="neck")]
+    friction = friction or SlipHardening(c_T=P["c_T"], mu=P["mu"], h=P["h"])
+    contacts = [NodeToSegment(cork, side, neck, normal or PowerLaw(P["c_N"], P["m"]), friction, weights=w, name="neck")]
     axis = cork.boundary_nodes("axis")
     bottom = cork.boundary_nodes("bottom")
-    gas = GasColumn(cork, bottom, P["R_neck"], P["gas_column"], P["p_step"], P["n_ramp"], P["L_neck"])
+    gas = GasPressure(cork, "bottom", bottom, np.pi * P["R_neck"]**2, P["gas_column"], P["p_step"], P["n_ramp"],
+                      P["dt"], P["L_neck"])
     return dict(cork=cork, neck=neck, contacts=contacts, gas=gas, axis=axis, side=side, bottom=bottom,
                 length=length)
 
@@ -376,10 +281,12 @@ def _newton_options(P):
     return dict(atol=P["atol"], rtol=P["rtol"], maxit=P["maxit"])
 
 
-def press_fit(model, P, log=None):
+def press_fit(model, P, log=None, progress=None):
     """Stage 1: move the neck from r = R_cork to r = R_neck in n_press static
-    increments (axial position held at the axis node at mouth level), then release
-    that node at the start of stage 2. Returns u and the step record."""
+    increments of the pseudo-time t in [0, 1] (the neck's shift is the prescribed
+    motion; a failed increment is halved and the smaller increment kept), axial
+    position held at one axis node, released at the start of stage 2.
+    Returns u and the step record."""
     cork, neck, contacts = model["cork"], model["neck"], model["contacts"]
     axis = model["axis"]
     hold = axis[np.argmin(np.abs(cork.X[axis, 1] - P["z_hold"] * P["L_neck"]))]
@@ -388,29 +295,18 @@ def press_fit(model, P, log=None):
     u = np.zeros(system.ndof)
     for contact in contacts:
         contact.initialize(u)
-    stepper = Static(system, **_newton_options(P))
+    ds = 1.0 / P["n_press"]
+    stepper = Static(system, dt=ds, **_newton_options(P))
     shift0 = P["R_cork"] - P["R_neck"]
-    iterations, failures = 0, 0
-    s, ds = 0.0, 1.0 / P["n_press"]
-    ds_min = ds / 2**P["max_cuts"]
-    while s < 1.0 - 1e-12:
-        h = min(ds, 1.0 - s)
-        neck.set_shift(shift0 * (1.0 - (s + h)))
-        try:
-            u1, _, _, res = stepper.step(0.0, u, None, None, label=f"press fit {s + h:.3f}")
-        except NewtonError:
-            failures += 1
-            if h / 2 < ds_min * (1 - 1e-9):
-                raise
-            ds = h / 2
-            continue
-        system.commit(u1)
-        u, s = u1, s + h
-        iterations += res.iterations
+    hist = integrate(stepper, 0.0, u, t_end=1.0, dt_rule=lambda t, u, v, a: ds, growth=1.0,
+                     cutback=True, max_cuts=P["max_cuts"], min_dt=ds / 2**P["max_cuts"],
+                     motion=lambda t1: neck.set_shift(shift0 * (1.0 - t1)),
+                     label=lambda k, t1, h: f"press fit {t1:.3f}", progress=progress)
     # the axial hold's reaction: released at the start of stage 2 (the dynamic run
     # absorbs this small imbalance; it is reported, not hidden)
-    reaction = float(res.G[cork.xdofs[hold, 1]])
-    return u, dict(iterations=iterations, failures=failures, hold_reaction=reaction)
+    reaction = float(hist.result.G[cork.xdofs[hold, 1]])
+    return hist.u, dict(iterations=int(np.sum(hist.iterations)), failures=int(np.sum(hist.cuts)),
+                        hold_reaction=reaction)
 
 
 def choose_dt(P, t, gap_to_mouth, released_at, v_cm):
@@ -426,22 +322,14 @@ def choose_dt(P, t, gap_to_mouth, released_at, v_cm):
     return max(dt, P["dt_fine"])
 
 
-def pop(model, P, u0, log=None):
-    """Stage 2: the gas drives the cork out (Newmark, explicit Boyle coupling,
-    adaptive dt with cutback). Runs to t_end, or t_flight after the exit.
-    Returns the histories (numpy arrays), the states u of every step and the events."""
+def pop(model, P, u0, log=None, progress=None):
+    """Stage 2: the gas drives the cork out (Newmark; explicit Boyle coupling: the gas
+    pressure is updated before each step; adaptive dt with cutback). Runs to t_end, or
+    t_flight after the exit. Returns the histories (numpy arrays), the states u of every
+    step and the events."""
     cork, contacts, gas = model["cork"], model["contacts"], model["gas"]
     t_ramp = P["n_ramp"] * P["dt"]
-
-    def pressure(t):                       # ramp by time, then the value set by gas.update
-        if gas.released:
-            return 0.0
-        if t <= t_ramp * (1 + 1e-9):
-            return P["p_step"] * np.ceil(t / P["dt"] - 1e-6)
-        return gas.p
-
-    load = Pressure(cork, "bottom", pressure, follower=True)
-    system = System([cork], contacts, [load], [Dirichlet(cork, cork.xdofs[model["axis"], 0], 0.0)])
+    system = System([cork], contacts, [gas], [Dirichlet(cork, cork.xdofs[model["axis"], 0], 0.0)])
     stepper = Newmark(system, P["dt"], delta=P["delta"], beta=P["beta_newmark"], **_newton_options(P))
     gas.start(u0)
     centre = model["bottom"][np.argmin(cork.X[model["bottom"], 0])]
@@ -454,58 +342,46 @@ def pop(model, P, u0, log=None):
                          "friction_force", "n_contact", "n_slip", "min_gap", "min_area_ratio",
                          "iterations", "cuts", "kinetic", "strain")}
     states = []
+    exit_time = None
 
-    def record(t, dt, p, u, v, iterations, cuts):
+    def record(t, u, v, a, step):
+        nonlocal exit_time
         f = contact_forces(contacts, u)
-        row = dict(t=t, dt=dt, p=p, volume=gas.volume(u), u_bottom=u[uz[centre]] - u0[uz[centre]],
+        row = dict(t=t, dt=step.dt, p=gas.pressure(t) if step.k else 0.0, volume=gas.volume(u),
+                   u_bottom=u[uz[centre]] - u0[uz[centre]],
                    u_top=u[uz[top]] - u0[uz[top]], u_cm=float(np.sum(M * (u - u0)[uz]) / np.sum(M)),
                    v_cm=centre_of_mass_velocity(cork, v) / 1e3, normal_force=f["normal"],
                    friction_force=f["tangential"], n_contact=f["n_active"], n_slip=f["n_slip"],
                    min_gap=f["min_gap"], min_area_ratio=float(np.min(quad_areas(cork, u) / A0)),
-                   iterations=iterations, cuts=cuts, kinetic=0.5 * float(np.sum(system.mass() * v * v)),
-                   strain=cork.strain_energy(u))
+                   iterations=step.iterations, cuts=step.cuts,
+                   kinetic=0.5 * float(np.sum(system.mass() * v * v)), strain=cork.strain_energy(u))
         for k, x in row.items():
             H[k].append(x)
         states.append(u.copy())
+        if step.k and gas.released and H["n_contact"][-1] == 0 and (exit_time is None or H["n_contact"][-2] > 0):
+            exit_time = t                               # the last time the contact opened
+        if log and step.k:
+            log(f"t = {t * 1e3:.4f} ms dt = {step.dt:.1e} p = {row['p']:.3f} u = {H['u_bottom'][-1]:.3f} "
+                f"v = {H['v_cm'][-1]:.2f} m/s contact {H['n_contact'][-1]} it {step.iterations}")
+
+    def dt_rule(t, u, v, a):
+        h = choose_dt(P, t, P["L_neck"] - gas.edge_z(u), gas.released_at, H["v_cm"][-1])
+        return min(h, t_ramp - t) if t < t_ramp * (1 - 1e-9) else h
+
+    def flown(t, u, v, a):                                # t_flight after the exit: stop
+        return exit_time is not None and t >= exit_time + P["t_flight"] * (1 - 1e-9)
 
     # the press fit is a static state: start at rest with a0 = 0 (M^-1 G would put the
     # hold's reaction on one light axis node as a spurious acceleration spike)
-    t, u, v, a = 0.0, u0.copy(), np.zeros(system.ndof), np.zeros(system.ndof)
-    record(t, 0.0, 0.0, u, v, 0, 0)
-    released_at, exit_time, failures = None, None, []
-    while t < P["t_end"] * (1 - 1e-9):
-        if exit_time is not None and t >= exit_time + P["t_flight"] * (1 - 1e-9):
-            break
-        gas.update(u)                                   # explicit coupling: once per step
-        if gas.released and released_at is None:
-            released_at = t
-        h = choose_dt(P, t, P["L_neck"] - gas.bottom_edge_z(u), released_at, H["v_cm"][-1])
-        if t < t_ramp * (1 - 1e-9):
-            h = min(h, t_ramp - t)
-        h = min(h, P["t_end"] - t)
-        cuts = 0
-        while True:
-            try:
-                u1, v1, a1, res = stepper.step(t, u, v, a, dt=h, label=f"cork t = {(t + h) * 1e3:.5f} ms, dt = {h:.2e}")
-                break
-            except NewtonError as err:
-                failures.append(str(err).splitlines()[0][:200])
-                if cuts >= P["max_cuts"]:
-                    raise
-                h, cuts = h / 2, cuts + 1
-        p_used = pressure(t + h)
-        system.commit(u1)
-        t, u, v, a = t + h, u1, v1, a1
-        record(t, h, p_used, u, v, res.iterations, cuts)
-        if gas.released and H["n_contact"][-1] == 0 and (exit_time is None or H["n_contact"][-2] > 0):
-            exit_time = t                               # the last time the contact opened
-        if log:
-            log(f"t = {t * 1e3:.4f} ms dt = {h:.1e} p = {p_used:.3f} u = {H['u_bottom'][-1]:.3f} "
-                f"v = {H['v_cm'][-1]:.2f} m/s contact {H['n_contact'][-1]} it {res.iterations}")
-    hist = {k: np.asarray(x) for k, x in H.items()}
-    exited = bool(gas.released and hist["n_contact"][-1] == 0)
-    return dict(history=hist, states=states, exited=exited, exit_time=exit_time if exited else None,
-                released_at=released_at, failures=failures)
+    zero = np.zeros(system.ndof)
+    hist = integrate(stepper, 0.0, u0.copy(), zero, t_end=P["t_end"], a0=zero, dt_rule=dt_rule,
+                     cutback=True, max_cuts=P["max_cuts"], before_step=lambda t, u, v, a: gas.update(u, t),
+                     stop=flown, recorder=record, progress=progress,
+                     label=lambda k, t1, h: f"cork t = {t1 * 1e3:.5f} ms, dt = {h:.2e}")
+    H = {k: np.asarray(x) for k, x in H.items()}
+    exited = bool(gas.released and H["n_contact"][-1] == 0)
+    return dict(history=H, states=states, exited=exited, exit_time=exit_time if exited else None,
+                released_at=gas.released_at, failures=hist.failures)
 
 
 V_BREAK = 1.0    # m/s: the cork "slides" (not just creeps) once its centre of mass is this fast
@@ -532,20 +408,20 @@ def snapshot_times(t_ramp, t_exit, t_last):
     return np.minimum(ours, t_last)
 
 
-def simulate(params, log=None):
+def simulate(params, log=None, progress=None, normal=None, friction=None):
     """Both stages; returns the model, the press-fit state and record, and the pop
     record (for the figures and the lecture; ``run`` reduces it to JSON-able results)."""
-    model = build(params)
-    u_fit, fit = press_fit(model, params, log)
+    model = build(params, normal, friction)
+    u_fit, fit = press_fit(model, params, log, progress)
     fit.update(contact_forces(model["contacts"], u_fit))
     fit["min_area_ratio"] = float(np.min(quad_areas(model["cork"], u_fit) / quad_areas(model["cork"], 0 * u_fit)))
-    out = pop(model, params, u_fit, log)
+    out = pop(model, params, u_fit, log, progress)
     return model, u_fit, fit, out
 
 
-def run(params):
+def run(params, progress=None, normal=None, friction=None):
     P = params
-    model, u_fit, fit, out = simulate(P)
+    model, u_fit, fit, out = simulate(P, progress=progress, normal=normal, friction=friction)
     h = out["history"]
     t_ramp = P["n_ramp"] * P["dt"]
     p_break = breakaway(h)

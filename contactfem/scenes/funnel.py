@@ -31,7 +31,7 @@ vibrating in place, so the mean, not the instantaneous, velocity is tested).
 
 import numpy as np
 
-from ..bodies.ring import make_ring
+from ..bodies.ring import RingRecorder, make_ring
 from ..contact import NodeToSegment, RigidPolyline
 from ..laws import ParabolicSlip, PowerLaw
 from ..solver import Dirichlet, Newmark, System, integrate
@@ -49,8 +49,10 @@ def funnel_wall(phi_deg, length):
     return np.array([[-length * np.sin(phi), length * np.cos(phi)], [0.0, 0.0]])
 
 
-def build(params):
-    """Half ring, funnel wall, contact and symmetry conditions; returns a dict."""
+def build(params, normal=None, friction=None):
+    """Half ring, funnel wall, contact and symmetry conditions; returns a dict.
+    ``normal`` / ``friction``: law objects instead of the ones the parameters build
+    (a friction law given makes the run frictional)."""
     R, h = params["R"], params["thickness"]
     phi = np.radians(params["phi_deg"])
     yc0 = (R + h / 2) / np.sin(phi) + params["gap0"]      # wall distance of the centre = R + h/2 + gap
@@ -58,10 +60,9 @@ def build(params):
                      E=params["E"], nu=params["nu"], rho=params["rho"], center=(0.0, yc0), half=True,
                      name="half ring")
     wall = RigidPolyline(funnel_wall(params["phi_deg"], params["wall_length"]))
-    friction = None
-    if params["variant"] == "frictional":
+    if friction is None and params["variant"] == "frictional":
         friction = ParabolicSlip(params["c_T"], params["alpha"], params["beta"], params["n"])
-    contact = NodeToSegment(ring.body, ring.contact_nodes, wall, PowerLaw(params["c_N"], params["m"]),
+    contact = NodeToSegment(ring.body, ring.contact_nodes, wall, normal or PowerLaw(params["c_N"], params["m"]),
                             friction, weights=1.0, offset=ring.offset, name="funnel")
     symmetry = Dirichlet(ring.body, ring.symmetry_dofs(), 0.0)
     system = System([ring.body], [contact], fixed=[symmetry])
@@ -75,39 +76,20 @@ def radial_deviation(ring, u, center):
     return float(np.max(np.abs(r - ring.R)) / ring.R)
 
 
-def run(params):
-    m = build(params)
+def run(params, progress=None, normal=None, friction=None):
+    m = build(params, normal, friction)
     ring, contact, system = m["ring"], m["contact"], m["system"]
     u0 = np.zeros(ring.body.ndof)
     v0 = ring.initial_velocity((0.0, -params["v0"]))
     contact.initialize(u0)
-    every = params["outline_every"]
-    rec = dict(t=[], y_c=[], v_c=[], n_contact=[], n_slip=[], deformation=[], outlines=[], outline_t=[])
-    body = ring.body
-    mass = body.mass()[body.xdofs[:, 1]]          # lumped nodal masses, assembled once
-    mass = mass / mass.sum()
-
-    def record(t, u, v):
-        # centre of mass of the mirrored ring: (0, sum m_i y_i / sum m_i), as RingModel.center_of_mass
-        c = np.array([0.0, mass @ (body.X[:, 1] + u[body.xdofs[:, 1]])])
-        state = contact.report(u)["state"]
-        rec["t"].append(t)
-        rec["y_c"].append(c[1])
-        rec["v_c"].append(mass @ v[body.xdofs[:, 1]])
-        rec["n_contact"].append(int(np.count_nonzero(state != "open")))
-        rec["n_slip"].append(int(np.count_nonzero(state == "slip")))
-        rec["deformation"].append(radial_deviation(ring, u, c))
-        if (len(rec["t"]) - 1) % every == 0:
-            rec["outlines"].append(ring.outline(u, mirror=True))
-            rec["outline_t"].append(t)
-
-    record(0.0, u0, v0)
+    rec = RingRecorder(ring, contact, every=params["outline_every"], mirror=True,
+                       measures=dict(deformation=lambda u, v: radial_deviation(ring, u, ring.center_of_mass(u))))
     stepper = Newmark(system, params["dt"], params["delta"], params["beta_newmark"],
                       atol=1e-10, rtol=1e-10, maxit=30)
-    hist = integrate(stepper, 0.0, u0, v0, n_steps=params["n_steps"],
-                     callback=lambda t, u, v, a: record(t, u, v), cutback=True, max_cuts=6)
-
-    t, y_c, v_c = (np.asarray(rec[k]) for k in ("t", "y_c", "v_c"))
+    hist = integrate(stepper, 0.0, u0, v0, n_steps=params["n_steps"], recorder=rec, cutback=True, max_cuts=6,
+                     progress=progress)
+    rec = rec.arrays()
+    t, y_c, v_c = rec["t"], rec["x_c"][:, 1], rec["v_c"][:, 1]   # the mirrored ring: centre on x = 0
     n_contact = np.asarray(rec["n_contact"])
     k0 = len(t) - max(2, len(t) // 4)                           # the last quarter of the run
     T_win = t[-1] - t[k0]

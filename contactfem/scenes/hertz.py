@@ -128,8 +128,9 @@ def fit_hertz(x, p):
     return float(np.sqrt(-c0 / c1)), float(np.sqrt(c0))
 
 
-def build(params):
-    """Body, contact, load and supports of the quarter cylinder; returns a dict."""
+def build(params, normal=None, friction=None):
+    """Body, contact, load and supports of the quarter cylinder; returns a dict.
+    ``normal`` / ``friction``: law objects instead of the parameters' (frictionless by default)."""
     R, E, nu, P = params["R"], params["E"], params["nu"], params["P"]
     a_ex, p0_ex = hertz_exact(P, R, E, nu)
     n = params["n_el"]
@@ -146,7 +147,7 @@ def build(params):
     w = tributary_lengths(body.X[nodes])
     weights = w if params["penalty"] == "per_length" else 1.0
     contact = make_interface(params.get("enforcement", "penalty"), body, nodes, RigidLine((0.0, -R), (0.0, 1.0)),
-                             PowerLaw(params["c_N"], 1.0), weights=weights, name="plane")
+                             normal or PowerLaw(params["c_N"], 1.0), friction, weights=weights, name="plane")
     sym = np.flatnonzero(np.abs(body.X[:, 0]) < 1e-9 * R)
     fixed = [Dirichlet(body, body.xdofs[sym, 0], 0.0)]
     q = P / (2.0 * R)
@@ -156,8 +157,8 @@ def build(params):
                 grading_k=k)
 
 
-def run(params):
-    m = build(params)
+def run(params, progress=None, normal=None, friction=None):
+    m = build(params, normal, friction)
     body, contact, system, w = m["body"], m["contact"], m["system"], m["w"]
     R, P = params["R"], params["P"]
     a_ex = m["a_exact"]
@@ -173,7 +174,7 @@ def run(params):
     atol = max(1e-10 * scale, 1e-15 * k_c * R)
     stepper = Static(system, dt=1.0 / params["n_steps"], atol=atol, rtol=1e-12, maxit=40)
     stepper = enforcement.wrap(params, stepper, [contact], length=a_ex)   # gap_violation: penetration / a
-    hist = integrate(stepper, 0.0, u0, n_steps=params["n_steps"], cutback=True, max_cuts=6)
+    hist = integrate(stepper, 0.0, u0, n_steps=params["n_steps"], cutback=True, max_cuts=6, progress=progress)
     u = hist.u
 
     rep = contact.report(u)

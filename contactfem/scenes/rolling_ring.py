@@ -50,7 +50,7 @@ Measured from the simulation (all centre-of-mass quantities of RingModel):
 
 import numpy as np
 
-from ..bodies.ring import make_ring
+from ..bodies.ring import RingRecorder, make_ring
 from ..contact import NodeToSegment, RigidLine
 from ..laws import Coulomb, PowerLaw
 from ..solver import Newmark, System, integrate
@@ -110,8 +110,9 @@ def detect_rolling(t, slip, v0, lo=0.1, hi=0.9, roll=0.02):
     return float(-icpt / slope)
 
 
-def build(params):
-    """The ring touching the plane y = 0 (lowest outer point at y = 0), contact, gravity."""
+def build(params, normal=None, friction=None):
+    """The ring touching the plane y = 0 (lowest outer point at y = 0), contact, gravity.
+    ``normal`` / ``friction``: law objects instead of the ones the parameters build."""
     R, h = params["R"], params["thickness"]
     args = dict(kind=params["kind"], R=R, thickness=h, width=params["width"], n_el=params["n_el"],
                 E=params["E"], nu=params["nu"], rho=params["rho"], n_radial=params["n_radial"], name="ring")
@@ -119,49 +120,32 @@ def build(params):
     y0 = -probe.outline(np.zeros(probe.body.ndof))[:, 1].min()   # R + h/2 if a node sits at the bottom
     ring = make_ring(center=(0.0, y0), **args)
     plane = RigidLine((0.0, 0.0), (0.0, 1.0))
-    contact = NodeToSegment(ring.body, ring.contact_nodes, plane, PowerLaw(params["c_N"], params["m"]),
-                            Coulomb(params["c_T"], params["mu"]), weights=1.0, offset=ring.offset,
+    contact = NodeToSegment(ring.body, ring.contact_nodes, plane, normal or PowerLaw(params["c_N"], params["m"]),
+                            friction or Coulomb(params["c_T"], params["mu"]), weights=1.0, offset=ring.offset,
                             name="plane")
     system = System([ring.body], [contact], [ring.gravity(params["g"])])
     return dict(ring=ring, contact=contact, system=system, plane=plane)
 
 
-def run(params):
-    m = build(params)
+def run(params, progress=None, normal=None, friction=None):
+    m = build(params, normal, friction)
     ring, contact, system = m["ring"], m["contact"], m["system"]
     v0 = params["v0"]
     u0 = np.zeros(ring.body.ndof)
     vel0 = ring.initial_velocity((v0, 0.0))
     contact.initialize(u0)
 
-    interval = params["outline_interval"]
-    next_snap = [0.0]                                     # next outline time
-    rec = dict(t=[], xc=[], vc=[], omega=[], outlines=[], outline_t=[], outline_vc=[], outline_omega=[],
-               node_y=[], node_vx=[])
     nodes = ring.body.xdofs[ring.contact_nodes]          # (u_x, u_y) dofs of the contact nodes
-
-    def record(t, u, v):
-        rec["t"].append(t)
-        rec["xc"].append(ring.center_of_mass(u))
-        rec["vc"].append(ring.velocity_of_mass(v))
-        rec["omega"].append(ring.angular_velocity(u, v))
-        if t >= next_snap[0] - 1e-6 * params["dt"]:
-            next_snap[0] += interval
-            rec["outlines"].append(ring.outline(u))
-            rec["outline_t"].append(t)
-            rec["outline_vc"].append(rec["vc"][-1])
-            rec["outline_omega"].append(rec["omega"][-1])
-            rec["node_y"].append(ring.body.X[ring.contact_nodes, 1] + u[nodes[:, 1]])   # velocity profile
-            rec["node_vx"].append(v[nodes[:, 0]])
-
-    record(0.0, u0, vel0)
+    rec = RingRecorder(ring, interval=params["outline_interval"], tol=1e-6 * params["dt"], snapshot_measures=dict(
+        node_y=lambda u, v: ring.body.X[ring.contact_nodes, 1] + u[nodes[:, 1]],   # velocity profile
+        node_vx=lambda u, v: v[nodes[:, 0]]))
     stepper = Newmark(system, params["dt"], params["delta"], params["beta_newmark"],
                       atol=1e-6, rtol=1e-10, maxit=30)
-    hist = integrate(stepper, 0.0, u0, vel0, t_end=params["t_end"],
-                     callback=lambda t, u, v, a: record(t, u, v), cutback=True, max_cuts=8)
+    hist = integrate(stepper, 0.0, u0, vel0, t_end=params["t_end"], recorder=rec, cutback=True, max_cuts=8,
+                     progress=progress)
+    rec = rec.arrays()
 
-    t = np.array(rec["t"])
-    xc, vc, omega = np.array(rec["xc"]), np.array(rec["vc"]), np.array(rec["omega"])
+    t, xc, vc, omega = rec["t"], rec["x_c"], rec["v_c"], rec["omega"]
     a = ring.rolling_radius
     slip = vc[:, 0] + omega * a
     t_roll = detect_rolling(t, slip, v0)
@@ -192,9 +176,9 @@ def run(params):
         paper=PAPER,
         t=t, x_c=xc[:, 0], y_c=xc[:, 1], vx_c=vc[:, 0], vy_c=vc[:, 1], omega=omega, slip_velocity=slip,
         x_exact=hoop["x"], vx_exact=hoop["v"], omega_exact=hoop["omega"],
-        outlines=np.array(rec["outlines"]), outline_t=np.array(rec["outline_t"]),
-        outline_vc=np.array(rec["outline_vc"]), outline_omega=np.array(rec["outline_omega"]),
-        outline_node_y=np.array(rec["node_y"]), outline_node_vx=np.array(rec["node_vx"]),
+        outlines=rec["outlines"], outline_t=rec["outline_t"],
+        outline_vc=vc[rec["outline_k"]], outline_omega=omega[rec["outline_k"]],
+        outline_node_y=rec["outline_node_y"], outline_node_vx=rec["outline_node_vx"],
         energy_kinetic=hist.kinetic, energy_strain=hist.strain, energy_dissipation=hist.dissipation,
         newton_iterations_total=int(np.sum(hist.iterations)),
         step_cuts_total=int(np.sum(hist.cuts)),

@@ -30,7 +30,7 @@ the spin after rebound is the angular velocity about the centre of mass
 
 import numpy as np
 
-from ..bodies.ring import make_ring
+from ..bodies.ring import RingRecorder, make_ring
 from ..contact import NodeToSegment, RigidLine
 from ..laws import ParabolicSlip, PowerLaw
 from ..solver import Newmark, System, integrate
@@ -50,8 +50,10 @@ def rebound_angle(vx, vy):
     return float(np.degrees(np.arctan2(abs(vx), abs(vy))))
 
 
-def build(params):
-    """The ring (make_ring), the plane y = 0 and the contact; returns a dict."""
+def build(params, normal=None, friction=None):
+    """The ring (make_ring), the plane y = 0 and the contact; returns a dict.
+    ``normal`` / ``friction``: law objects instead of the ones the parameters build
+    (a friction law given makes any variant frictional)."""
     h = params["thickness"]
     plastic = None
     if params["variant"] == "viscoplastic":
@@ -63,57 +65,30 @@ def build(params):
     ring = make_ring(kind=params["kind"], R=R, thickness=h, width=params["width"], n_el=params["n_el"],
                      E=params["E"], nu=params["nu"], rho=params["rho"], center=center, plastic=plastic,
                      name="ring")
-    friction = None
-    if params["variant"] != "frictionless":
+    if friction is None and params["variant"] != "frictionless":
         friction = ParabolicSlip(params["c_T"], params["alpha"], params["beta"], params["n"])
     plane = RigidLine((0.0, 0.0), (0.0, 1.0))
-    contact = NodeToSegment(ring.body, ring.contact_nodes, plane, PowerLaw(params["c_N"], params["m"]),
+    contact = NodeToSegment(ring.body, ring.contact_nodes, plane, normal or PowerLaw(params["c_N"], params["m"]),
                             friction, weights=1.0, offset=ring.offset, name="plane")
     system = System([ring.body], [contact])
     return dict(ring=ring, contact=contact, system=system, plane=plane)
 
 
-def run(params):
-    m = build(params)
+def run(params, progress=None, normal=None, friction=None):
+    m = build(params, normal, friction)
     ring, contact, system = m["ring"], m["contact"], m["system"]
     u0 = np.zeros(ring.body.ndof)
     v0 = ring.initial_velocity((params["vx0"], params["vy0"]))
     contact.initialize(u0)
-    every = params["outline_every"]
-
-    rec = dict(t=[0.0], x_c=[], v_c=[], omega=[], n_contact=[], outlines=[], outline_t=[])
-
-    body = ring.body
-    mass = body.mass()[body.xdofs[:, 0]]          # lumped nodal masses, assembled once
-    mass = mass / mass.sum()
-
-    def record(t, u, v, k):
-        # centre of mass and its velocity, sum m_i x_i / sum m_i (as RingModel.center_of_mass)
-        rec["x_c"].append(mass @ (body.X + u[body.xdofs]))
-        rec["v_c"].append(mass @ v[body.xdofs])
-        rec["n_contact"].append(int(np.count_nonzero(contact.report(u)["state"] != "open")))
-        if k % every == 0:
-            rec["omega"].append(ring.angular_velocity(u, v))
-            rec["outlines"].append(ring.outline(u))
-            rec["outline_t"].append(t)
-
-    record(0.0, u0, v0, 0)
-    step = [0]
-
-    def callback(t, u, v, a):
-        step[0] += 1
-        rec["t"].append(t)
-        record(t, u, v, step[0])
-
+    rec = RingRecorder(ring, contact, every=params["outline_every"])
     system.set_dt(params["dt"])            # the viscoplastic beam needs dt before the first evaluation
     stepper = Newmark(system, params["dt"], params["delta"], params["beta_newmark"],
                       atol=1e-10, rtol=1e-10, maxit=30)
-    hist = integrate(stepper, 0.0, u0, v0, n_steps=params["n_steps"], callback=callback,
-                     cutback=True, max_cuts=6)
-
-    t = np.asarray(rec["t"])
-    x_c, v_c, omega = np.array(rec["x_c"]), np.array(rec["v_c"]), np.array(rec["omega"])
-    n_contact = np.array(rec["n_contact"])
+    hist = integrate(stepper, 0.0, u0, v0, n_steps=params["n_steps"], recorder=rec, cutback=True, max_cuts=6,
+                     progress=progress)
+    rec = rec.arrays()
+    t, x_c, v_c, omega = rec["t"], rec["x_c"], rec["v_c"], rec["omega"][rec["outline_k"]]
+    n_contact = rec["n_contact"]
     touched = np.flatnonzero(n_contact > 0)
     rebounded = bool(touched.size and touched[-1] < len(t) - 1)
     t_first = float(t[touched[0]]) if touched.size else None
@@ -135,7 +110,7 @@ def run(params):
         energy_total_max_rel_change_impact=float(np.max(np.abs(mech[window] - E0)) / E0),
         energy_total_max_rel_increase_per_step=float(np.max(np.diff(mech)) / E0),
         energy_total_final_rel=float(mech[-1] / E0),
-        outlines=np.array(rec["outlines"]), outline_t=np.array(rec["outline_t"]), outline_spin=omega,
+        outlines=rec["outlines"], outline_t=rec["outline_t"], outline_spin=omega,
         mass=ring.total_mass(),
         # committed plastic strains of the beam (eps_p, gam_p, kap_p): the permanent deformation
         plastic_strain_max=np.max(np.abs(getattr(ring.body, "ep", np.zeros((1, 3)))), axis=0),

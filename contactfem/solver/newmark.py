@@ -25,7 +25,6 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from ..io.progress import chain, progress_from_env
 from .newton import NewtonError, NewtonResult, newton
 
 
@@ -161,9 +160,11 @@ class History:
     contact: list = field(default_factory=list)
     dissipation: list = field(default_factory=list)    # cumulative frictional dissipation
     external_work: list = field(default_factory=list)  # cumulative work of loads and supports
+    failures: list = field(default_factory=list)       # first line of each failed Newton solve
     u: np.ndarray = None                               # final state
     v: np.ndarray = None
     a: np.ndarray = None
+    result: object = None                              # NewtonResult of the last step
 
     def append(self, t, dt, result, cuts, energies, work):
         self.t.append(t)
@@ -174,6 +175,7 @@ class History:
         for key in ("kinetic", "strain", "contact", "dissipation"):
             getattr(self, key).append(energies[key])
         self.external_work.append(work)
+        self.result = result
 
     def finish(self, u, v, a):
         for key in ("t", "dt", "iterations", "cuts", "kinetic", "strain", "contact",
@@ -183,25 +185,66 @@ class History:
         return self
 
 
+@dataclass(frozen=True)
+class Step:
+    """What a ``recorder`` learns about a step besides the state: its number k (0: the
+    initial state), size dt, Newton result (None at k = 0) and step halvings."""
+    k: int
+    dt: float
+    result: object = None
+    cuts: int = 0
+
+    @property
+    def iterations(self):
+        return self.result.iterations if self.result is not None else 0
+
+
 def integrate(stepper, t0, u0, v0=None, n_steps=None, t_end=None, callback=None,
-              cutback=False, max_cuts=4):
+              cutback=False, max_cuts=4, *, a0=None, dt_rule=None, min_dt=None, growth=None,
+              before_step=None, motion=None, stop=None, before_commit=None, recorder=None, progress=None,
+              label=None):
     """Step from t0 over n_steps steps of stepper.dt, or up to t_end (algorithm of Sec. 4.3).
 
     Each step: Newton on the stepper's equation; on convergence the System commits
     (history variables, friction state, dissipation) and energies are recorded.
-    With ``cutback``, a step whose Newton fails is halved (up to ``max_cuts`` times)
-    and the remainder of the step is covered with the smaller dt; the next step starts
-    again with stepper.dt. ``callback(t, u, v, a)`` is called after each accepted step.
+    With ``cutback``, a step whose Newton fails is halved (up to ``max_cuts`` times, and
+    never below ``min_dt``) and the remainder of the step is covered with the smaller dt;
+    the next step starts again with stepper.dt. ``callback(t, u, v, a)`` is called after
+    each accepted step.
+
+    Hooks for scenes with more than a fixed step (all optional, keyword only):
+
+    a0                      initial acceleration (default: from eq 29 at t0, M a0 = -G;
+                            0 for a Static stepper)
+    dt_rule(t, u, v, a)     the size of the next step (adaptive stepping; needs t_end):
+                            the step ends at min(t + dt_rule(...), t_end); a failed step
+                            is halved as with cutback
+    growth                  with dt_rule: a step may be at most ``growth`` times the last
+                            accepted one (growth = 1: a cut step size is kept)
+    before_step(t, u, v, a) called once before each step, from the last converged state
+                            (explicit coupling, e.g. the gas pressure under the cork)
+    motion(t1)              called before each attempt with its end time t1 (prescribed
+                            motion of a rigid obstacle)
+    stop(t, u, v, a)        ends the run early when it returns True (checked before a step)
+    before_commit(t, u, v, a, step)  called with each converged step before the System
+                            commits it (what the step did: e.g. which nodes slipped in it)
+    recorder(t, u, v, a, step)  called for the initial state and each accepted step with a
+                            ``Step`` (k, dt, Newton result, cuts)
+    progress(t0, t_end, label)  makes a callback (e.g. ``contactfem.io.ProgressBar``)
+                            called after each step and closed (its ``close()``) at the end
+    label(k, t1, dt)        the text naming a step in a NewtonError (default: step k, t, dt)
 
     External work is summed with the trapezoidal rule, 1/2 (F_n + F_n+1) . (u_n+1 - u_n),
     over the loads P and the support reactions (the prescribed-dof part of G).
-    Returns a History; a NewtonError that ends the run carries the History so far as
-    ``error.partial``.
+    Returns a History (``failures`` lists the first line of every failed Newton solve);
+    a NewtonError that ends the run carries the History so far as ``error.partial``.
     """
     s = stepper.system
     if (n_steps is None) == (t_end is None):
         raise ValueError("give exactly one of n_steps and t_end")
     DT = stepper.dt
+    if dt_rule is not None and t_end is None:
+        raise ValueError("an adaptive step (dt_rule) needs t_end, not n_steps")
     if t_end is not None:
         if not t_end > t0:
             raise ValueError(f"t_end must be > t0 = {t0}, got {t_end}")
@@ -213,44 +256,97 @@ def integrate(stepper, t0, u0, v0=None, n_steps=None, t_end=None, callback=None,
         t_end = t0 + n_steps * DT
     if int(max_cuts) != max_cuts or max_cuts < 0:
         raise ValueError(f"max_cuts must be an integer >= 0, got {max_cuts}")
+    if growth is not None and not growth >= 1:
+        raise ValueError(f"parameter growth = {growth!r} is out of range: allowed [1, inf)")
 
     fixed = s.fixed_dofs
-    s.set_dt(DT)                                      # rate-dependent parts see dt from the start
+    s.set_dt(DT)                    # rate-dependent bodies and laws evaluate the initial state too
     u = s.apply_dirichlet(u0, t0)
     v = np.zeros(s.ndof) if v0 is None else np.array(v0, dtype=float)
     G, _ = s.residual_tangent(u, t0)
-    a = _acceleration(s, G) if stepper.dynamic else np.zeros(s.ndof)
+    if a0 is not None:
+        a = np.array(a0, dtype=float)
+    else:
+        a = _acceleration(s, G) if stepper.dynamic else np.zeros(s.ndof)
     P, F = s.external_force(u, t0), G[fixed]          # loads and support reactions at t0
     work = 0.0
 
-    bar = progress_from_env(t0, t_end, label=type(stepper).__name__)
-    callback = chain(callback, bar)
+    bar = progress(t0, t_end, type(stepper).__name__) if progress is not None else None
+    after = [c for c in (callback, bar) if c is not None]
     hist = History()
     hist.append(t0, 0.0, None, 0, s.energies(u, v), work)
+    if recorder is not None:
+        recorder(t0, u, v, a, Step(0, 0.0))
+
+    def close():
+        if bar is not None and hasattr(bar, "close"):
+            bar.close()
+
+    def attempt(t, h, k, cuts):
+        """One step of size h from t (None if Newton failed and it may be cut)."""
+        if motion is not None:
+            motion(t + h)
+        name = label(k, t + h, h) if label is not None else f"step {k}, t = {t + h:.6g}, dt = {h:.3g}"
+        try:
+            return stepper.step(t, u, v, a, dt=h, label=name)
+        except NewtonError as err:
+            hist.failures.append(str(err).splitlines()[0][:200] if str(err) else "Newton failed")
+            if cutback and cuts < max_cuts and (min_dt is None or h / 2 >= min_dt * (1 - 1e-9)):
+                return None
+            err.partial = hist.finish(u, v, a)
+            close()
+            raise
+
+    def accept(t, h, k, cuts, step):
+        nonlocal u, v, a, P, F, work
+        u1, v1, a1, result = step
+        if before_commit is not None:
+            before_commit(t, u1, v1, a1, Step(k, h, result, cuts))
+        s.commit(u1)
+        P1, F1 = s.external_force(u1, t), result.G[fixed]
+        work += 0.5 * (P + P1) @ (u1 - u) + 0.5 * (F + F1) @ (u1 - u)[fixed]
+        u, v, a, P, F = u1, v1, a1, P1, F1
+        hist.append(t, h, result, cuts, s.energies(u, v), work)
+        for fn in after:
+            fn(t, u, v, a)
+        if recorder is not None:
+            recorder(t, u, v, a, Step(k, h, result, cuts))
+
     t = t0
-    for k in range(1, n_steps + 1):
-        t_target = min(t0 + k * DT, t_end)
-        h, cuts = t_target - t, 0
-        while t < t_target - 1e-12 * DT:
-            h = min(h, t_target - t)
-            try:
-                u1, v1, a1, result = stepper.step(t, u, v, a, dt=h,
-                                                  label=f"step {k}, t = {t + h:.6g}, dt = {h:.3g}")
-            except NewtonError as err:
-                if cutback and cuts < max_cuts:
+    if dt_rule is None:
+        for k in range(1, n_steps + 1):
+            if stop is not None and stop(t, u, v, a):
+                break
+            if before_step is not None:
+                before_step(t, u, v, a)
+            t_target = min(t0 + k * DT, t_end)
+            h, cuts = t_target - t, 0
+            while t < t_target - 1e-12 * DT:
+                h = min(h, t_target - t)
+                step = attempt(t, h, k, cuts)
+                if step is None:
                     h, cuts = h / 2, cuts + 1
                     continue
-                err.partial = hist.finish(u, v, a)
-                if bar is not None:
-                    bar.close()
-                raise
-            s.commit(u1)
-            t = t_target if t_target - (t + h) < 1e-12 * DT else t + h
-            P1, F1 = s.external_force(u1, t), result.G[fixed]
-            work += 0.5 * (P + P1) @ (u1 - u) + 0.5 * (F + F1) @ (u1 - u)[fixed]
-            u, v, a, P, F = u1, v1, a1, P1, F1
-            hist.append(t, h, result, cuts, s.energies(u, v), work)
-            callback(t, u, v, a)
-    if bar is not None:
-        bar.close()
+                t = t_target if t_target - (t + h) < 1e-12 * DT else t + h
+                accept(t, h, k, cuts, step)
+    else:
+        k, last = 0, None
+        while t < t_end - 1e-9 * (t_end - t0):
+            if stop is not None and stop(t, u, v, a):
+                break
+            if before_step is not None:
+                before_step(t, u, v, a)
+            h = float(dt_rule(t, u, v, a))
+            _check_dt(h)
+            if growth is not None and last is not None:
+                h = min(h, growth * last)
+            h, cuts, k = min(h, t_end - t), 0, k + 1
+            while True:
+                step = attempt(t, h, k, cuts)
+                if step is not None:
+                    break
+                h, cuts = h / 2, cuts + 1
+            t, last = t + h, h
+            accept(t, h, k, cuts, step)
+    close()
     return hist.finish(u, v, a)

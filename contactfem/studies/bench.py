@@ -97,7 +97,7 @@ def _impact_variant(params, variant):
     """The frictional sloping impact (Sec. 5.3) with a tangent variant or the staggered
     algorithm: total linear solves, step cutbacks, rebound velocity."""
     from ..scenes import sloping_impact
-    from ..scenes.block import ContactTangent
+    from ..contact.tangents import ContactTangent
     from ..solver import Newmark, System, integrate
     from ..solver.newton import NewtonError
     from ..solver.staggered import SplitContact, Staggered
