@@ -18,7 +18,7 @@ def test_load_and_set_fields():
     assert type(law).__name__ == "Saturating" and law.mu0 == 0.6 and law.c_T == 30.0
     rec = describe(law)
     assert rec["class"] == "Saturating" and rec["file"].endswith("saturating.py")
-    assert rec["fields"] == {"c_T": 30.0, "mu0": 0.6, "p0": 10.0}
+    assert rec["fields"] == {"c_T": 30.0, "mu0": 0.6, "p0": 1000.0}
 
 
 def test_fields_default_to_the_scene_parameters_of_the_same_name():

@@ -25,8 +25,8 @@ COULOMB_SETUPS = {
     "block": ({"law": "coulomb"}, "mu"),
     "rolling_ring": ({"t_end": 0.4}, "mu"),
     "sloping_impact": ({"variant": "frictional", "n": 1.0, "n_steps": 60}, "alpha+beta"),
-    "funnel": ({"variant": "frictional", "n": 1.0, "t_end": 1.0}, "alpha+beta"),
-    "cork": ({"h": 0.0}, "mu"),
+    "funnel": ({"variant": "frictional", "n": 1.0, "n_steps": 40}, "alpha+beta"),
+    "cork": ({"h": 0.0, "t_end": 0.001}, "mu"),
 }
 
 
@@ -58,7 +58,7 @@ def test_cli_runs_every_scene_with_a_law_file(scene, tmp_path):
     assert proc.returncode == 0, proc.stderr
     rec = json.loads(out.read_text())["friction_law"]
     assert rec["class"] == "Saturating" and rec["file"] == "tests/data/saturating.py"
-    assert set(rec["fields"]) == {"c_T", "mu0", "p0"} and rec["fields"]["mu0"] == 0.3
+    assert rec["fields"]["mu0"] == 0.3 and rec["fields"]["p0"] == 1000.0
     assert rec["fields"]["c_T"] == get_scene(scene).resolve("fast")["c_T"]     # the scene's c_T
 
 
@@ -76,8 +76,10 @@ def test_a_coulomb_law_file_equals_the_built_in_law(scene):
     assert a.keys() == b.keys() and len(a) > 3
     for key in b:
         assert a[key].shape == b[key].shape, key
-        scale = max(float(np.max(np.abs(b[key]), initial=0.0)), 1e-300)
-        assert np.all(np.abs(a[key] - b[key]) <= 1e-10 * scale), (key, np.max(np.abs(a[key] - b[key])))
+        assert np.array_equal(np.isnan(a[key]), np.isnan(b[key])), key        # None (not reached) in both
+        x, y = a[key][~np.isnan(b[key])], b[key][~np.isnan(b[key])]
+        scale = max(float(np.max(np.abs(y), initial=0.0)), 1e-300)
+        assert np.all(np.abs(x - y) <= 1e-10 * scale), (key, np.max(np.abs(x - y)))
 
 
 def test_a_shipped_law_object_from_python():
@@ -96,9 +98,9 @@ def test_a_shipped_law_object_from_python():
 def test_cli_law_fields_and_errors(tmp_path):
     out = tmp_path / "b.json"
     ok = _cli("run", "block", "--friction", "tests/data/saturating.py:Saturating", "--set", "law.mu0=0.6",
-              "--set", "law.p0=50", "--json", str(out))
+              "--set", "law.p0=500", "--json", str(out))
     assert ok.returncode == 0, ok.stderr
-    assert json.loads(out.read_text())["friction_law"]["fields"] == {"c_T": 5.0e4, "mu0": 0.6, "p0": 50.0}
+    assert json.loads(out.read_text())["friction_law"]["fields"] == {"c_T": 5.0e4, "mu0": 0.6, "p0": 500.0}
     for args, pattern in [
         (("--friction", "tests/data/saturating.py:Saturating", "--set", "law.mu0=-1"), "parameter mu0 = -1.0 is out of range"),
         (("--friction", "tests/data/broken_syntax.py:Broken"), "law file broken_syntax.py, line 8: SyntaxError"),

@@ -1,5 +1,6 @@
 """A student's friction law: the coefficient saturates with pressure,
-Y(p) = mu0 p0 tanh(p / p0) (Coulomb mu0 at low pressure, a cap mu0 p0 at high).
+Y(p) = mu0 p0 tanh(p / p0) (Coulomb mu0 at low pressure, a cap mu0 p0 at high; the
+default p0 lies above the pressures of the paper's scenes, so it runs in all of them).
 
     contactfem run rolling_ring --friction tests/data/saturating.py:Saturating --set law.mu0=0.6
 
@@ -16,7 +17,7 @@ from contactfem.laws.validation import require
 class Saturating:
     c_T: float = 30.0
     mu0: float = 0.3
-    p0: float = 10.0
+    p0: float = 1000.0
 
     def __post_init__(self):
         require("c_T", self.c_T, 0.0, low_open=True)
