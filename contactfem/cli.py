@@ -96,6 +96,24 @@ def cmd_equations(args):
     print(markdown_table())
 
 
+BENCH_STUDIES = ("tangents", "work_precision", "cost", "targets")    # contactfem.studies.bench.STUDIES
+
+
+def cmd_bench(args):
+    """`contactfem bench [--quick] [--out DIR] [--only NAME ...]`: bench.json and BENCHMARKS.md."""
+    from pathlib import Path
+
+    from .studies.bench import run_bench, write_outputs
+
+    res = run_bench(quick=args.quick, only=args.only,
+                    progress=lambda m: print(m, file=sys.stderr, flush=True))
+    old = Path(args.out) / "bench.json"
+    if args.only and old.exists():                  # keep the other studies of an earlier run
+        res = dict(json.loads(old.read_text()), **res)
+    for path in write_outputs(res, args.out):
+        print(path)
+
+
 def write_animation(res, path):
     """Animate the outlines a scene recorded (rings, the cork) into a GIF or MP4."""
     from .io import animate_outlines
@@ -144,8 +162,13 @@ def build_parser():
     sw.add_argument("--scheduler", default=None, help="Dask scheduler address: run on that cluster instead")
     sw.add_argument("--out", default="sweep.csv", help="table of results (.csv or .json)")
     sw.set_defaults(func=cmd_sweep)
-    from .studies.bench import add_bench_parser
-    add_bench_parser(sub)
+    bp = sub.add_parser("bench", help="speed against accuracy: tangents, work-precision, cost, targets "
+                                      "(writes bench.json and BENCHMARKS.md)")
+    bp.add_argument("--quick", action="store_true", help="fast presets and fewer points (about a minute)")
+    bp.add_argument("--out", default=".", help="folder for bench.json and BENCHMARKS.md (default: .)")
+    bp.add_argument("--only", action="append", choices=list(BENCH_STUDIES),
+                    help="run only this study (repeatable); the other studies of DIR/bench.json are kept")
+    bp.set_defaults(func=cmd_bench)
     return ap
 
 

@@ -153,3 +153,10 @@ def test_quick_bench_writes_json_and_markdown(tmp_path):
     assert all(r["ok"] for r in wp["hertz_mesh"]["rows"])
     assert abs(wp["hertz_mesh"]["rows"][-1]["error_p0"]) < 0.005        # 32^2 quads: p0 within 0.5 %
     assert res["targets"]["hertz"]["p0_within"]
+
+
+def test_bench_cli_names_every_study():
+    """`contactfem bench --only NAME` offers exactly the studies run_bench knows."""
+    from contactfem.cli import BENCH_STUDIES
+    from contactfem.studies.bench import STUDIES
+    assert tuple(STUDIES) == BENCH_STUDIES

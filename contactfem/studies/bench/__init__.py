@@ -1,0 +1,73 @@
+"""`contactfem bench`: speed against accuracy, measured.
+
+Four studies, each a module with a function returning a JSON-able dict; ``run_bench``
+runs them all and ``write_markdown`` (report.py, the one report writer) turns the result
+into the tables of BENCHMARKS.md. Files: common.py (targets, timing, observed order),
+tangents.py, work_precision.py, cost.py, targets.py, report.py.
+
+1. tangents        the paper's central claim (Sec. 4.2): Newton with the consistent
+                   non-symmetric tangent (eqs 49-50) against a symmetrised tangent, the
+                   tangent without the coupling c_N^s C ("frozen") and the staggered
+                   normal-then-friction algorithm of Sec. 2.2 (contactfem.solver.staggered),
+                   on the block (Sec. 5.1) and the frictional sloping impact (Sec. 5.3):
+                   linear solves and time to the same tolerance; divergence is recorded.
+2. work_precision  error against wall time under refinement: hertz (mesh; exact a, p0),
+                   rolling ring (dt and mesh; exact rolling point of the rigid ring),
+                   Newmark 0.7/0.4 against 0.5/0.25, implicit Newmark against explicit
+                   central differences on bar_impact (exact contact duration), beam ring
+                   against continuum ring. Observed orders: slope of log(error) against
+                   log(h) by least squares.
+3. cost            time of one Newton iteration split into bulk assembly (body.internal),
+                   contact (contact.assemble), global assembly (COO -> CSR) and linear
+                   solve (SuperLU with two orderings, and pypardiso if installed), at the
+                   paper sizes and for the block refined to about 1e5 unknowns; contact
+                   time against the number of contact nodes (slope ~1: linear).
+4. targets         every paper scene at the paper preset (wall time of the solve and of
+                   the whole `contactfem run` process), against the targets.
+
+``quick`` shrinks every study (fast presets, fewer points) to about a minute in all.
+No timing enters a test: times depend on the machine and its load.
+"""
+
+import os
+import platform
+
+import numpy as np
+
+from ...scenes import jsonable
+from .common import PAPER_SCENES, TARGETS, observed_order, timed
+from .cost import cost_study, iteration_cost
+from .report import write_markdown, write_outputs
+from .tangents import VARIANTS, tangent_study
+from .targets import targets_study
+from .work_precision import work_precision
+
+STUDIES = {"tangents": tangent_study, "work_precision": work_precision, "cost": cost_study,
+           "targets": targets_study}
+
+
+def machine():
+    import scipy
+
+    return dict(python=platform.python_version(), numpy=np.__version__, scipy=scipy.__version__,
+                cpus=os.cpu_count(), platform=platform.platform(),
+                load_average=list(os.getloadavg()) if hasattr(os, "getloadavg") else None)
+
+
+def run_bench(quick=False, only=None, progress=print):
+    """Run the studies (all, or those named in `only`); returns the JSON-able dict."""
+    out = dict(quick=bool(quick), machine=machine(), target_values=TARGETS)
+    for name, fn in STUDIES.items():
+        if only and name not in only:
+            continue
+        if progress:
+            progress(f"bench: {name} ...")
+        res, dt = timed(fn, quick)
+        out[name] = res
+        out[f"{name}_bench_s"] = dt
+    return jsonable(out)
+
+
+__all__ = ["run_bench", "STUDIES", "TARGETS", "PAPER_SCENES", "VARIANTS", "observed_order", "machine",
+           "write_markdown", "write_outputs", "tangent_study", "work_precision", "cost_study",
+           "iteration_cost", "targets_study"]

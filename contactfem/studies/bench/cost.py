@@ -1,0 +1,97 @@
+"""Study 3, cost: the time of one Newton iteration split into bulk assembly
+(body.internal), contact (contact.assemble), global assembly (COO -> CSR) and linear
+solve (SuperLU with two orderings, and pypardiso if installed), at the paper sizes and
+for the block refined to about 1e5 unknowns; contact time against the number of contact
+nodes (slope ~1: linear)."""
+
+import numpy as np
+
+from ...scenes import get_scene
+from .common import best_of
+
+def iteration_cost(system, u, t=1.0, repeat=3, solvers=True):
+    """Wall times (best of `repeat`) of the parts of one Newton iteration at u:
+    bulk (every body.internal), contact (every contact.assemble), assembly (the whole
+    System.residual_tangent minus those two: loads, COO -> CSR), solve (splu factor +
+    solve of the free block with the default COLAMD and with MMD_AT_PLUS_A ordering,
+    and pypardiso if installed)."""
+    import scipy.sparse as sp
+    from scipy.sparse.linalg import splu
+
+    out = dict(ndof=int(system.ndof))
+    _, out["bulk_s"] = best_of(lambda: [b.internal(system.local(b, u)) for b in system.bodies], repeat)
+    _, out["contact_s"] = best_of(lambda: [c.assemble(u) for c in system.contacts], repeat)
+    (G, K), total = best_of(lambda: system.residual_tangent(u, t), repeat)
+    out["assembly_s"] = max(total - out["bulk_s"] - out["contact_s"], 0.0)
+    out["residual_tangent_s"] = total
+    free = system.free_dofs
+    Kff = sp.csr_matrix(K)[free][:, free].tocsc()
+    b = -G[free]
+    out["n_contact_nodes"] = int(sum(len(c.nodes) for c in system.contacts))
+    if not solvers:
+        return out
+    for spec in ("COLAMD", "MMD_AT_PLUS_A"):
+        _, out[f"solve_splu_{spec}_s"] = best_of(lambda: splu(Kff, permc_spec=spec).solve(b), repeat)
+    try:
+        import pypardiso
+        A = Kff.tocsr()
+        pypardiso.spsolve(A, b)                      # first call: library initialisation
+        # spsolve would reuse the factors of the same matrix: factorise explicitly each time
+        ps = pypardiso.PyPardisoSolver()
+        ps.solve(A, b)
+        _, out["solve_pypardiso_s"] = best_of(lambda: (ps.factorize(A), ps.solve(A, b)), repeat)
+    except ImportError:
+        out["solve_pypardiso_s"] = None
+    out["solve_s"] = out["solve_splu_MMD_AT_PLUS_A_s"]           # what newton() uses
+    return out
+
+
+def _block_system(nx, ny, material="linear", width=None):
+    from ...scenes import block
+
+    p = get_scene("block").resolve("paper", {"law": "coulomb", "material": material})
+    p = dict(p, nx=nx, ny=ny)                       # past the scene's nx <= 400 for the scaling study
+    if width is not None:
+        p.update(width=width, height=width * ny / nx)  # square elements
+    b = block.build(p)
+    u = np.zeros(b["system"].ndof)
+    b["contact"].initialize(u)
+    # a state with every slave in contact: the block pushed down by 1e-3 (stick)
+    u[b["body"].xdofs[:, 1]] = -1e-3
+    return b["system"], u
+
+
+def cost_study(quick=False):
+    """Study 3 (module docstring)."""
+    from ...scenes import hertz, rolling_ring
+
+    cases = {}
+    for material in ("linear", "svk"):
+        system, u = _block_system(20, 10, material)
+        cases[f"block 20x10 ({material})"] = iteration_cost(system, u)
+    hz = get_scene("hertz")
+    m = hertz.build(hz.resolve("paper", {"n_el": 32 if quick else 64}))
+    u = np.zeros(m["system"].ndof)
+    u[m["body"].xdofs[:, 1]] = -m["a_exact"] ** 2 / (2 * 10.0)
+    m["contact"].initialize(u)
+    cases[f"hertz {m['body'].mesh.t.shape[1]} quads"] = iteration_cost(m["system"], u)
+    ring = rolling_ring.build(get_scene("rolling_ring").resolve("paper"))
+    u = np.zeros(ring["system"].ndof)
+    ring["contact"].initialize(u)
+    cases["rolling ring 120 beams"] = iteration_cost(ring["system"], u, t=0.0)
+    n_big = 64 if quick else 223                        # 2 (n + 1)^2 = 100352 unknowns
+    for material in ("linear",) if quick else ("linear", "svk"):
+        system, u = _block_system(n_big, n_big, material)
+        system.residual_tangent(u, 1.0)                 # the linear body caches its K
+        cases[f"block {n_big}x{n_big} ({material})"] = iteration_cost(system, u, repeat=1 if not quick else 2)
+
+    # contact cost against the number of contact nodes (a one-element-high strip)
+    scaling = []
+    for nx in ((50, 200, 800) if quick else (50, 200, 800, 1600, 3200)):
+        system, u = _block_system(nx, 1, width=4.0)
+        c = system.contacts[0]
+        _, t_c = best_of(lambda: c.assemble(u), 5)
+        scaling.append(dict(n_contact_nodes=int(len(c.nodes)), contact_s=t_c))
+    slope = float(np.polyfit(np.log([r["n_contact_nodes"] for r in scaling[1:]]),
+                             np.log([r["contact_s"] for r in scaling[1:]]), 1)[0])
+    return dict(cases=cases, contact_scaling=scaling, contact_scaling_slope=slope)
