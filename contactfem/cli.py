@@ -37,6 +37,11 @@ def cmd_show(args):
         paper = sc.presets.get("paper", {}).get(p.name, "")
         print(f"{p.name:14s} {str(p.default):>12s} {str(fast):>10s} {str(paper):>10s}  {p.unit:10s} {p.range_text()}"
               + (f"  -- {p.doc}" if p.doc else ""))
+    for name, values in sc.presets.items():
+        if name not in ("fast", "paper"):
+            print(f"preset {name}: " + ", ".join(f"{k}={v}" for k, v in values.items()))
+    if sc.notes:
+        print(sc.notes)
     if sc.reports:
         print("reports: " + ", ".join(sc.reports))
 
@@ -96,6 +101,12 @@ def cmd_equations(args):
     print(markdown_table())
 
 
+def cmd_reconstruct(args):
+    from .studies.reconstruct import main as reconstruct
+
+    reconstruct(args.scene, quick=args.quick, top=args.top, json_path=args.json, cache=not args.no_cache)
+
+
 BENCH_STUDIES = ("tangents", "work_precision", "cost", "targets")    # contactfem.studies.bench.STUDIES
 
 
@@ -137,7 +148,8 @@ def build_parser():
     sp.set_defaults(func=cmd_show)
     rp = sub.add_parser("run", help="run a scene")
     rp.add_argument("scene")
-    rp.add_argument("--preset", default="fast", choices=["fast", "paper"])
+    rp.add_argument("--preset", default="fast",
+                    help="fast (default), paper, or a named variant of the scene (listed by show)")
     rp.add_argument("--set", action="append", metavar="NAME=VALUE",
                     help="override a parameter, or a field of a law file's law as law.NAME=VALUE (repeatable)")
     rp.add_argument("--friction", metavar="FILE.py:CLASS", help="use the friction law CLASS defined in FILE.py")
@@ -162,6 +174,15 @@ def build_parser():
     sw.add_argument("--scheduler", default=None, help="Dask scheduler address: run on that cluster instead")
     sw.add_argument("--out", default="sweep.csv", help="table of results (.csv or .json)")
     sw.set_defaults(func=cmd_sweep)
+    rc = sub.add_parser("reconstruct", help="the scan's lost values as an inverse problem: run every reading "
+                        "the scan allows, score it against what the paper prints, print the ranked table")
+    rc.add_argument("scene", help="block | sloping_impact")
+    rc.add_argument("--quick", action="store_true", help="a small profile of the search (seconds)")
+    rc.add_argument("--top", type=int, default=25, help="rows of the ranked table to print")
+    rc.add_argument("--json", metavar="FILE", help="write every reading and its scores to FILE")
+    rc.add_argument("--no-cache", action="store_true", help="recompute every reading (default: reuse the "
+                    "results of earlier runs of the same code, in $CONTACTFEM_CACHE or ~/.cache/contactfem)")
+    rc.set_defaults(func=cmd_reconstruct)
     bp = sub.add_parser("bench", help="speed against accuracy: tangents, work-precision, cost, targets "
                                       "(writes bench.json and BENCHMARKS.md)")
     bp.add_argument("--quick", action="store_true", help="fast presets and fewer points (about a minute)")

@@ -33,10 +33,11 @@ def newton(beam, P, free, u, tol=1e-10, maxit=30):
 
 @pytest.mark.parametrize("closed", [False, True])
 @pytest.mark.parametrize("plastic", [None, dict(N0=20.0, Q0=10.0, M0=5.0, eta=0.1)])
-def test_tangent_matches_finite_differences(closed, plastic):
+@pytest.mark.parametrize("integration", [1, 2])
+def test_tangent_matches_finite_differences(closed, plastic, integration):
     rng = np.random.default_rng(1)
     X = ring(2.0, 7) if closed else np.column_stack([np.linspace(0, 3, 6), 0.2 * np.linspace(0, 3, 6) ** 2])
-    beam = Beam(X, closed, E=100.0, A=1.0, I=0.1, rho=1.0, plastic=plastic)
+    beam = Beam(X, closed, E=100.0, A=1.0, I=0.1, rho=1.0, plastic=plastic, integration=integration)
     u = 0.1 * rng.standard_normal(beam.ndof)
     u[2::3] = 1.5 * rng.standard_normal(X.shape[0])          # large rotations
     if plastic:
@@ -112,6 +113,7 @@ def test_lumped_mass_and_gravity(closed):
     assert m[:, 0].sum() == pytest.approx(rho * A * L)
     assert m[:, 1].sum() == pytest.approx(rho * A * L)
     assert m[:, 2].sum() == pytest.approx(rho * I * L)
+    assert np.all(Beam(X, closed, E=1.0, A=A, I=I, rho=rho, rotary_inertia=False).mass()[2::3] == 0)
     beam.dof_offset = 4
     P, rows, *_ = BeamGravity(beam, 9.81).assemble(np.zeros(beam.ndof + 6), 0.0)
     assert P[4 + beam.xdofs[:, 1]].sum() == pytest.approx(-9.81 * rho * A * L)
@@ -156,6 +158,25 @@ def test_bad_input_names_the_parameter(kwargs, name):
     args = dict(X=straight(1.0, 4), closed=False, E=1.0, A=1.0, I=1.0, rho=1.0) | kwargs
     with pytest.raises(ValueError, match=name):
         Beam(**args)
+
+
+def test_two_point_integration_is_exact_for_a_rigid_motion_and_stiffer_in_bending():
+    """Two-point Gauss: no force under a rigid rotation; a cantilever tip deflection smaller
+    than the midpoint rule's (the two-point element locks in shear)."""
+    X = straight(2.0, 4)
+    deflection = {}
+    for n in (1, 2):
+        beam = Beam(X, False, E=100.0, A=1.0, I=0.01, rho=0.0, integration=n)
+        c, s_ = np.cos(0.7), np.sin(0.7)
+        u = np.zeros(beam.ndof).reshape(-1, 3)
+        u[:, 0], u[:, 1], u[:, 2] = c * X[:, 0] - s_ * X[:, 1] - X[:, 0], s_ * X[:, 0] + c * X[:, 1] - X[:, 1], 0.7
+        assert np.abs(beam.internal(u.ravel())[0]).max() < 1e-10
+        R, K = beam.internal(np.zeros(beam.ndof))
+        free = np.arange(3, beam.ndof)
+        f = np.zeros(beam.ndof)
+        f[-2] = -1e-3
+        deflection[n] = -spsolve(K[free][:, free].tocsc(), f[free])[-2]
+    assert 0 < deflection[2] < 0.75 * deflection[1], deflection   # 4 elements: 0.54 of the midpoint rule
 
 
 def test_bad_helper_input():

@@ -1,7 +1,13 @@
 """The champagne cork (paper Sec. 5.5): one fast run shared by the tests, the
-neck's kinematics against finite differences, Boyle's law, failures reported."""
+paper preset (about half a minute), the static breakaway mechanism and its knife's edge,
+the neck's kinematics against finite differences, Boyle's law, failures reported.
 
-import os
+Where the tolerances come from. The paper prints "about 2500 N", "about 250 N",
+"about 0.8 MPa" and "about 28 m/s": one or two significant digits, i.e. +-2 % to
++-20 %. Our press-fit force is FITTED (R_tip chosen to give ~2500 N), so agreement there
+is by construction; the exit velocity sits on a knife's edge (the static breakaway
+margin is +0.014 MPa of 0.8), so it is tested against the paper only with tolerances
+argued below, and the mechanism (margin > 0) is asserted for both presets."""
 
 import numpy as np
 import pytest
@@ -32,16 +38,54 @@ def test_penetration_stays_below_two_percent_of_the_radius(fast):
 
 
 def test_fast_preset_exit_velocity_is_near_the_paper(fast):
-    # paper 28 m/s; the coarse fast mesh (36 elements) within 25 % (paper preset: 15 %, below)
+    # paper "about 28 m/s" (two digits: +-2 %). The fast preset differs from the paper preset
+    # only by its coarser steps around the exit (dt_fine 2e-5 instead of 5e-6 s, 1 mm of travel
+    # per step instead of 0.5): measured 30.7 against 28.6 m/s, a time discretisation error of
+    # +7 %. Tolerance 15 %: that error twice, plus the paper's rounding
     v = fast["exit_velocity_m_s"]
-    assert abs(v - PAPER_V) / PAPER_V < 0.25, f"paper {PAPER_V} m/s, ours {v:.2f} m/s, tolerance 25 %"
+    assert abs(v - PAPER_V) / PAPER_V < 0.15, f"paper {PAPER_V} m/s, ours {v:.2f} m/s, tolerance 15 %"
 
 
 def test_press_fit_force_and_breakaway(fast):
-    # paper: normal force ~2500 N, sliding at ~250 N, ~0.8 MPa; coarse mesh within 20 %
-    assert abs(fast["press_fit_normal_force_N"] - 2500) / 2500 < 0.2, fast["press_fit_normal_force_N"]
-    assert abs(fast["breakaway_pressure_static_MPa"] - 0.8) / 0.8 < 0.2, fast["breakaway_pressure_static_MPa"]
+    # paper: normal force "about 2500 N" (one to two digits: the scan prints no more). Ours is
+    # fitted through R_tip, so this checks the calibration holds (2 %: the rounding of "2500"),
+    # not a prediction; the JSON says so
+    assert fast["press_fit_calibrated"] is True
+    assert abs(fast["press_fit_normal_force_N"] - 2500) / 2500 < 0.02, fast["press_fit_normal_force_N"]
     assert fast["breakaway_pressure_MPa"] is not None and fast["breakaway_pressure_MPa"] <= 0.8 + 1e-9
+
+
+def test_breakaway_margin_is_applied_minus_static_breakaway(fast):
+    P = fast["parameters"]
+    p0 = P["p_step"] * P["n_ramp"]
+    static = P["mu"] * fast["press_fit_normal_force_N"] / (np.pi * P["R_neck"] ** 2)
+    assert fast["applied_pressure_MPa"] == pytest.approx(p0, rel=1e-12)
+    assert fast["breakaway_pressure_static_MPa"] == pytest.approx(static, rel=1e-12)
+    assert fast["breakaway_margin_MPa"] == pytest.approx(p0 - static, rel=1e-12)
+
+
+def test_fast_preset_leaves_by_static_breakaway(fast):
+    # the mechanism of the paper preset (test below): the applied pressure exceeds the static
+    # friction reserve mu N / (pi R^2), so the cork leaves; a coarser mesh would overestimate
+    # the press fit and leave only by dynamic overshoot (margin < 0), a different mechanism
+    assert fast["breakaway_margin_MPa"] > 0, fast["breakaway_margin_MPa"]
+    assert fast["exited"]
+
+
+def test_the_knife_edge_more_friction_and_the_cork_stays_in():
+    # mu = 0.105 instead of 0.1: the static breakaway rises above 0.8 MPa (margin < 0) and
+    # the whole run confirms it: the cork does not leave
+    r = run_scene("cork", "fast", {"mu": 0.105})
+    assert r["breakaway_margin_MPa"] < 0, r["breakaway_margin_MPa"]
+    assert not r["exited"] and r["exit_velocity_m_s"] is None
+
+
+def test_press_fit_only_gives_the_same_margin(fast):
+    from contactfem.scenes.cork import SCENE, press_fit_only
+
+    m = press_fit_only(SCENE.resolve("fast"))
+    assert m["breakaway_margin_MPa"] == pytest.approx(fast["breakaway_margin_MPa"], rel=1e-9)
+    assert not press_fit_only(SCENE.resolve("fast", {"R_tip": 10.05}))["press_fit_calibrated"]
 
 
 def test_boyle_pressure_is_explicit_in_the_volume(fast):
@@ -54,7 +98,10 @@ def test_boyle_pressure_is_explicit_in_the_volume(fast):
     boyle = np.flatnonzero((t > t_ramp + 1e-9) & (p > 0))
     assert len(boyle) > 5
     assert np.allclose(p[boyle], p0 * V0 / V[boyle - 1], rtol=1e-12)
-    # just before the exit: close to 0.8 * 30 / 54 (24 mm of travel)
+    # just before the exit: Boyle at 24 mm of travel, p0 * 30 / 54 = 0.444 MPa. Measured 0.005
+    # below on both presets (the volume is taken one step late, explicit coupling, and the
+    # bottom face is not flat). 0.03 MPa is the pressure change over ~4 mm of travel
+    # (p0 V0 / V^2 dV = 0.8 * 30 / 54^2 = 0.008 MPa per mm): the exit located within 4 mm
     assert abs(fast["pressure_before_exit_MPa"] - 0.8 * 30 / 54) < 0.03, fast["pressure_before_exit_MPa"]
     assert p[-1] == 0.0                      # the gas escaped
 
@@ -112,10 +159,38 @@ def test_bad_input_names_the_parameter():
         run_scene("cork", "fast", {"dt": -1.0})
 
 
-@pytest.mark.skipif(not os.environ.get("CONTACTFEM_SLOW"), reason="paper preset (~15-45 s): set CONTACTFEM_SLOW=1")
-def test_paper_preset_exit_velocity_within_15_percent():
+def test_paper_preset_leaves_by_static_breakaway_near_28_m_s():
+    # the paper preset runs in CI (about 10 s of CPU, half a minute on a busy machine)
     r = run_scene("cork", "paper")
+    assert r["press_fit_calibrated"] is True
+    assert r["breakaway_margin_MPa"] > 0, r["breakaway_margin_MPa"]        # the mechanism
+    assert r["exited"]
     v = r["exit_velocity_m_s"]
-    # paper 28 m/s; ours 28.6 m/s when written; tolerance 15 %
-    assert abs(v - PAPER_V) / PAPER_V < 0.15, f"paper {PAPER_V} m/s, ours {v:.2f} m/s, tolerance 15 %"
+    # paper "about 28 m/s" (two digits, +-2 %); ours 28.6. Tolerance 10 %: on the knife's edge
+    # (margin +0.014 MPa) the exit velocity moves by ~1 m/s over the neighbouring exiting
+    # points of the knife-edge study (mu 0.095: 30.4, p0 0.84: 30.9, fast preset), i.e. 3-4 %;
+    # that twice, plus the rounding
+    assert abs(v - PAPER_V) / PAPER_V < 0.10, f"paper {PAPER_V} m/s, ours {v:.2f} m/s, tolerance 10 %"
     assert r["max_penetration_ratio"] < 0.02
+
+
+def test_knife_edge_figure_draws_from_its_data(tmp_path, monkeypatch):
+    # the figure is computed by `contactfem figures` (minutes); here it is drawn from data of
+    # the same shape, and the grid switches to the full one with CONTACTFEM_SLOW
+    import matplotlib
+    matplotlib.use("Agg")
+    from contactfem.plots import cork as F
+
+    field = [dict(mu=m, R_tip=R, breakaway_margin_MPa=0.8 - m * 2470 * (1 + (R - 10)) / (np.pi * 100), error=None)
+             for m in (0.095, 0.1, 0.105) for R in (10.0, 10.1)]
+    runs = [dict(mu=0.1, R_tip=10.0, exited=True, v=30.7, margin=0.014, error=None),
+            dict(mu=0.105, R_tip=10.0, exited=False, v=None, margin=-0.028, error=None),
+            dict(mu=0.1, R_tip=10.1, exited=None, v=None, margin=None, error="NewtonError")]
+    line = [dict(p0=p, p_step=p / 8, n_ramp=8, exited=p > 0.79, v=30.0 if p > 0.79 else None,
+                 margin=p - 0.786, error=None) for p in (0.78, 0.8)]
+    files = F.cork_knife_edge(outdir=str(tmp_path), data=dict(field=field, runs=runs, p0=line, preset="fast"))
+    assert all((tmp_path / f).exists() for f in ("cork_knife_edge.png", "cork_knife_edge.json")), files
+    monkeypatch.delenv("CONTACTFEM_SLOW", raising=False)
+    assert F.knife_grid() is F.KNIFE_GRID
+    monkeypatch.setenv("CONTACTFEM_SLOW", "1")
+    assert F.knife_grid() is F.KNIFE_GRID_SLOW

@@ -108,7 +108,8 @@ def test_block_newton_quadratic_with_rate_and_state_laws(name, n_steps):
     on a linear block: piecewise linear, so the last step is exact once the stick/slip
     pattern is settled (one reduction checked, as for Coulomb in test_block.py).
     The contact forces balance the loads."""
-    params = block.SCENE.resolve("fast", {"law": "coulomb", "n_steps": n_steps})
+    # the canonical block (4 x 3.5, 20 x 10) on which these laws were studied
+    params = block.SCENE.resolve("canonical", {"law": "coulomb", "n_steps": n_steps})
     s = block.solve(params, friction=RATE_LAWS[name])
     n_last = 1 if name == "wear" else 2
     for res in s["results"]:
@@ -121,7 +122,8 @@ def test_block_newton_quadratic_with_rate_and_state_laws(name, n_steps):
             order = np.log(above[-1] / above[-2]) / np.log(above[-2] / above[-3])
             assert order > 1.7, (name, order, e)
     R = s["R_c"][s["body"].xdofs]
-    assert abs(R[:, 0].sum() - 210.0) < 1e-6 and abs(R[:, 1].sum() + 800.0) < 1e-6
+    applied_x, applied_y = params["p_x"] * params["height"], params["p_y"] * params["width"]   # 60 H, 200 W
+    assert abs(R[:, 0].sum() - applied_x) < 1e-6 and abs(R[:, 1].sum() + applied_y) < 1e-6
     assert np.sum(s["report"]["state"] == "slip") >= 2
 
 

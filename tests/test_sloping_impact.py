@@ -5,6 +5,7 @@ about two seconds. Paper values (Table 2) are stated in the assert messages with
 tolerance. The runs are shared with the figure code through its cache."""
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,6 +13,7 @@ import pytest
 from contactfem.plots import sloping_impact as plots
 from contactfem.scenes import run_scene
 from contactfem.scenes.sloping_impact import PAPER_TABLE2, SCENE, rebound_angle
+from contactfem.studies import reconstruct as rc
 
 R_OUTER = 10.5
 
@@ -38,25 +40,44 @@ def test_rebound_angle_definition():
     assert rebound_angle(1.2, -1.7) == pytest.approx(35.22, abs=0.01)   # Table 2: 35 deg
 
 
-def test_frictional_rebound_angle_matches_table2(res):
-    """Table 2, frictional: angle 35 deg; ours within 5 deg (we get about 36.0)."""
-    r, p = res["frictional"], PAPER_TABLE2["frictional"]
-    assert abs(r["rebound_angle_deg"] - p["angle_deg"]) <= 5.0, \
-        f"frictional rebound angle: ours {r['rebound_angle_deg']:.1f}, paper {p['angle_deg']}, tol 5 deg"
+# Table 2 prints the velocities to two digits (1.7, 1.2: +-0.05, 3-4 %) and the angles as
+# multiples of 5 deg (+-2.5 deg). A number is reproduced when ours is within 10 % (velocities)
+# or 5 deg (angles): twice the printing uncertainty, the rest for the paper's own
+# time-discretisation error at dt = 0.1, which for ours is of that size (lecture 06: v_y moves
+# by 0.1-0.3 from dt = 0.1 to 0.0125). Same criterion as `contactfem reconstruct sloping_impact`.
+VELOCITY_TOL, ANGLE_TOL = rc.TABLE2_VELOCITY_TOL, rc.TABLE2_ANGLE_TOL_DEG
 
 
-def test_frictionless_rebound_angle_vs_table2(res):
-    """Table 2, frictionless: v = (2, 1.7), angle 50 deg. On the paper's 16-element mesh we
-    get v_y = 1.31, 56.7 deg: 6.7 deg off (a documented deviation: the flexible ring keeps
-    more vibration energy in our model; continuum and refined beam rings give 54 deg).
-    Asserted: within 7 deg on the paper's mesh, within 5 deg on a 32-element ring."""
-    r, p = res["frictionless"], PAPER_TABLE2["frictionless"]
-    assert r["rebound_vx"] == pytest.approx(2.0, abs=1e-8), "frictionless: v_x is kept (paper: 2)"
-    assert abs(r["rebound_angle_deg"] - p["angle_deg"]) <= 7.0, \
-        f"frictionless, 16 elements: ours {r['rebound_angle_deg']:.1f}, paper {p['angle_deg']}, tol 7 deg"
-    fine = plots.result("frictionless", "fast", n_el=32)
-    assert abs(fine["rebound_angle_deg"] - p["angle_deg"]) <= 5.0, \
-        f"frictionless, 32 elements: ours {fine['rebound_angle_deg']:.1f}, paper {p['angle_deg']}, tol 5 deg"
+def test_table2_numbers_reproduced(res):
+    """Table 2 at the paper's 16 elements, dt = 0.1, Newmark 0.7/0.4: the frictionless v_x
+    (exact: a frictionless plane exerts no tangential force) and both angles."""
+    fl, fr = res["frictionless"], res["frictional"]
+    assert fl["rebound_vx"] == pytest.approx(2.0, abs=1e-8), "frictionless: v_x is kept (paper: 2)"
+    for r, v in ((fl, "frictionless"), (fr, "frictional")):
+        p = PAPER_TABLE2[v]["angle_deg"]
+        assert abs(r["rebound_angle_deg"] - p) <= ANGLE_TOL, \
+            f"{v} rebound angle: ours {r['rebound_angle_deg']:.1f}, paper {p}, tol {ANGLE_TOL} deg"
+
+
+def test_table2_velocities_out_of_reach_are_documented(res):
+    """The frictionless v_y and the frictional v_x, v_y are 14-18 % below the paper's 1.7,
+    1.2, 1.7 (outside the 10 % above) with every reading `contactfem reconstruct
+    sloping_impact` tries; the README states this with the study's numbers. Checked: each
+    velocity against the paper with the 10 % criterion, and the README's numbers against
+    this run (to the two printed decimals), so that neither can drift silently."""
+    readme = (Path(__file__).parents[1] / "README.md").read_text()
+    section = readme[readme.index("### Table 2"):]
+    section = section[:section.index("\n## ")] if "\n## " in section else section
+    for v in ("frictionless", "frictional"):
+        r, p = res[v], PAPER_TABLE2[v]
+        for q in ("vx", "vy"):
+            ours = abs(r[f"rebound_{q}"])
+            within = abs(ours / p[q] - 1) <= VELOCITY_TOL
+            if v == "frictionless" and q == "vx":
+                assert within
+                continue
+            assert not within, f"{v} {q} = {ours:.3f} now within 10 % of {p[q]}: update the README"
+            assert f"{ours:.2f}" in section, f"README Table 2 section lacks {v} {q} = {ours:.2f}"
 
 
 def test_friction_slows_and_spins_the_ring(res):

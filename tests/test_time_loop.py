@@ -125,4 +125,4 @@ def test_run_cork_progress_shows_a_bar(capsys):
     from contactfem.cli import main
     assert main(["run", "cork", "--progress", "--set", "t_end=0.0004", "--set", "n_press=2"]) == 0
     err = capsys.readouterr().err
-    assert "Static [" in err and "Newmark [" in err and "100%" in err
+    assert "cork: press fit [" in err and "cork: pop [" in err and "100%" in err

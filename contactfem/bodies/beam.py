@@ -15,7 +15,7 @@ Kinematics (exact under large rotations; textbook: Simo & Vu-Quoc 1986, Crisfiel
 
 Discretisation: straight two-node elements (a polygon in the reference state), linear
 interpolation in the reference arc length s, ONE-point (midpoint) integration against
-shear locking. The element kernel is vectorised numpy over all elements; K is
+shear locking (``integration=2``: two-point Gauss, which locks in shear). The element kernel is vectorised numpy over all elements; K is
 assembled from COO triplets with one ``coo_matrix(...).tocsr()``.
 
 What scikit-fem does here: the 1D mesh in the arc length s (``MeshLine``; its
@@ -98,10 +98,12 @@ class Beam:
     kappa_s  shear correction factor (default 5/6, rectangle)
     plastic  None (elastic) or dict(N0=, Q0=, M0=, eta=0.1): Perzyna viscoplasticity;
              then set the step with ``beam.set_dt(dt)`` before calling internal().
+    integration     1 (midpoint, default) or 2 (two-point Gauss: stiffer, shear locking)
+    rotary_inertia  True (default): rho I on the rotation dofs of the lumped mass; False: 0
     """
 
     def __init__(self, X, closed, E, A, I, rho, G=None, nu=0.0, kappa_s=5 / 6,
-                 name="beam", plastic=None):
+                 name="beam", plastic=None, integration=1, rotary_inertia=True):
         X = np.asarray(X, dtype=float)
         if X.ndim != 2 or X.shape[1] != 2 or not np.all(np.isfinite(X)):
             raise ValueError(f"parameter X must be a finite (nn, 2) array, got shape {X.shape}")
@@ -151,7 +153,15 @@ class Beam:
             self.S0 = np.array([_check(k, plastic.get(k, d), 0.0)
                                 for k, d in (("N0", 1.0), ("Q0", 0.5), ("M0", 0.25))])
             self.eta = _check("eta", plastic.get("eta", 0.1), 0.0)
-        self.ep = np.zeros((ne, 3))   # committed plastic strains (eps_p, gam_p, kap_p)
+        if integration not in (1, 2):
+            raise ValueError(f"parameter integration = {integration!r} is not allowed: one of 1|2")
+        g = 1 / np.sqrt(3.0)
+        # (natural coordinate xi in [-1, 1], weight as a fraction of L0)
+        self.points = ((0.0, 1.0),) if integration == 1 else ((-g, 0.5), (g, 0.5))
+        # committed plastic strains (eps_p, gam_p, kap_p) per integration point: rows k ne .. (k+1) ne - 1
+        # belong to point k
+        self.ep = np.zeros((len(self.points) * ne, 3))
+        self.rotary_inertia = bool(rotary_inertia)
 
     # ---- time step for the viscoplastic update ---------------------------------
     def set_dt(self, dt):
@@ -163,50 +173,56 @@ class Beam:
         """Current centreline node positions x = X + u, (nn, 2)."""
         return self.X + np.asarray(u).reshape(-1, 3)[:, :2]
 
-    def strains(self, u):
-        """Midpoint strains (eps, gam, kap) per element, (ne, 3), and t, n of the total angle."""
+    def strains(self, u, xi=0.0):
+        """Strains (eps, gam, kap) per element at the natural coordinate xi (0: midpoint),
+        (ne, 3), and t, n of the total angle there."""
         U = np.asarray(u, float).reshape(-1, 3)
         a, b = self.conn.T
         xp = (self.X[b] + U[b, :2] - self.X[a] - U[a, :2]) / self.L0[:, None]   # x'
-        phi = self.theta0 + 0.5 * (U[a, 2] + U[b, 2])
+        phi = self.theta0 + 0.5 * (1 - xi) * U[a, 2] + 0.5 * (1 + xi) * U[b, 2]
         t = np.column_stack([np.cos(phi), np.sin(phi)])
         n = np.column_stack([-np.sin(phi), np.cos(phi)])
         E = np.column_stack([np.sum(xp * t, 1) - 1, np.sum(xp * n, 1),
                              (U[b, 2] - U[a, 2]) / self.L0])
         return E, t, n
 
-    def resultants(self, u):
-        """(N, Q, M) per element, (ne, 3), with the algorithmic moduli dS/dE and new plastic strains."""
-        E, _, _ = self.strains(u)
+    def resultants(self, u, xi=0.0, k=0):
+        """(N, Q, M) per element at xi (integration point k), (ne, 3), with the algorithmic
+        moduli dS/dE and new plastic strains."""
+        E, _, _ = self.strains(u, xi)
         if self.S0 is not None and self.dt is None:
             raise RuntimeError("viscoplastic beam: call beam.set_dt(dt) before evaluating it")
-        return return_map(E, self.ep, self.D, self.S0, self.eta, self.dt)
+        ne = len(self.L0)
+        return return_map(E, self.ep[k * ne:(k + 1) * ne], self.D, self.S0, self.eta, self.dt)
 
     # ---- body interface ------------------------------------------------------------
     def internal(self, u):
-        """Internal force R = dW/du and consistent tangent K = dR/du (virtual work, midpoint rule).
+        """Internal force R = dW/du and consistent tangent K = dR/du (virtual work, midpoint rule,
+        or two-point Gauss with ``integration=2``).
 
-        Per element, with q = (u_a, theta_a, u_b, theta_b) and B = dE/dq (3 x 6):
-            r_e = L0 B^T S,     K_e = L0 (B^T C B + N d2eps/dq2 + Q d2gam/dq2)
-        deps/dphi = gam, dgam/dphi = -(1 + eps), phi = theta0 + (theta_a + theta_b)/2.
+        Per element and point, with q = (u_a, theta_a, u_b, theta_b) and B = dE/dq (3 x 6):
+            r_e = w L0 B^T S,     K_e = w L0 (B^T C B + N d2eps/dq2 + Q d2gam/dq2)
+        deps/dphi = gam, dgam/dphi = -(1 + eps), phi = theta0 + N_a theta_a + N_b theta_b.
         """
-        E, t, n = self.strains(u)
-        S, C, _ = self.resultants(u)
-        eps, gam = E[:, 0], E[:, 1]
         L0 = self.L0[:, None]
         z = np.zeros_like(self.L0)
-        p = np.array([0, 0, 0.5, 0, 0, 0.5])                       # dphi/dq
-        a_t = np.column_stack([-t / L0, z, t / L0, z])              # (x' . t) derivative
-        a_n = np.column_stack([-n / L0, z, n / L0, z])              # (x' . n) derivative
-        B = np.stack([a_t + gam[:, None] * p,
-                      a_n - (1 + eps)[:, None] * p,
-                      np.outer(1 / self.L0, [0, 0, -1, 0, 0, 1])], axis=1)   # (ne, 3, 6)
-        pp = np.outer(p, p)
-        G_eps = np.einsum("ei,j->eij", a_n, p) + np.einsum("i,ej->eij", p, a_n) - (1 + eps)[:, None, None] * pp
-        G_gam = -np.einsum("ei,j->eij", a_t, p) - np.einsum("i,ej->eij", p, a_t) - gam[:, None, None] * pp
-        re = L0 * np.einsum("eki,ek->ei", B, S)
-        Ke = L0[:, :, None] * (np.einsum("eki,ek,ekj->eij", B, C, B)
-                               + S[:, 0, None, None] * G_eps + S[:, 1, None, None] * G_gam)
+        re, Ke = 0.0, 0.0
+        for k, (xi, w) in enumerate(self.points):
+            E, t, n = self.strains(u, xi)
+            S, C, _ = self.resultants(u, xi, k)
+            eps, gam = E[:, 0], E[:, 1]
+            p = np.array([0, 0, 0.5 * (1 - xi), 0, 0, 0.5 * (1 + xi)])   # dphi/dq
+            a_t = np.column_stack([-t / L0, z, t / L0, z])              # (x' . t) derivative
+            a_n = np.column_stack([-n / L0, z, n / L0, z])              # (x' . n) derivative
+            B = np.stack([a_t + gam[:, None] * p,
+                          a_n - (1 + eps)[:, None] * p,
+                          np.outer(1 / self.L0, [0, 0, -1, 0, 0, 1])], axis=1)   # (ne, 3, 6)
+            pp = np.outer(p, p)
+            G_eps = np.einsum("ei,j->eij", a_n, p) + np.einsum("i,ej->eij", p, a_n) - (1 + eps)[:, None, None] * pp
+            G_gam = -np.einsum("ei,j->eij", a_t, p) - np.einsum("i,ej->eij", p, a_t) - gam[:, None, None] * pp
+            re = re + w * L0 * np.einsum("eki,ek->ei", B, S)
+            Ke = Ke + w * L0[:, :, None] * (np.einsum("eki,ek,ekj->eij", B, C, B)
+                                            + S[:, 0, None, None] * G_eps + S[:, 1, None, None] * G_gam)
         R = np.bincount(self.edofs.ravel(), re.ravel(), minlength=self.ndof)
         rows = np.repeat(self.edofs, 6, axis=1).ravel()
         cols = np.tile(self.edofs, (1, 6)).ravel()
@@ -215,23 +231,25 @@ class Beam:
 
     def strain_energy(self, u):
         """Stored (elastic) energy sum_e L0 sum_k S_k^2 / (2 D_k); elastic case: L0 D E^2 / 2."""
-        S, _, _ = self.resultants(u)
-        return float(np.sum(self.L0[:, None] * S**2 / (2 * self.D)))
+        return float(sum(w * np.sum(self.L0[:, None] * self.resultants(u, xi, k)[0] ** 2 / (2 * self.D))
+                         for k, (xi, w) in enumerate(self.points)))
 
     def commit(self, u):
         """Accept u as converged: store the plastic strains (no-op if elastic)."""
         if self.S0 is not None:
-            self.ep = self.resultants(u)[2]
+            self.ep = np.concatenate([self.resultants(u, xi, k)[2] for k, (xi, _) in enumerate(self.points)])
 
     def mass(self):
-        """Lumped mass: rho A per length on u_x, u_y and rho I per length on theta (half to each node).
+        """Lumped mass: rho A per length on u_x, u_y and rho I per length on theta (half to each node;
+        0 on theta without rotary inertia).
 
         scikit-fem: row sums of the P1 mass matrix on the arc-length mesh = L0/2 per element end.
         """
         if getattr(self, "_mass", None) is None:   # assembled once, then reused
             lumped_mesh = np.asarray(asm(mass_form, Basis(self.mesh, ElementLineP1())).sum(axis=1)).ravel()
             length = np.bincount(self.fold, lumped_mesh, minlength=self.X.shape[0])   # fold s = L onto s = 0
-            self._mass = (self.rho * np.column_stack([self.A * length, self.A * length, self.I * length])).ravel()
+            J = self.I * length if self.rotary_inertia else 0.0 * length
+            self._mass = (self.rho * np.column_stack([self.A * length, self.A * length, J])).ravel()
         return self._mass.copy()
 
     # ---- surface offset (for contact on the outer face of a ring) -------------------

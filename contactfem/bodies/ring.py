@@ -268,7 +268,7 @@ class RingModel:
 
 def make_ring(kind="beam", R=1.0, thickness=0.1, n_el=32, E=1.0, nu=0.0, rho=1.0,
               center=(0.0, 0.0), n_radial=2, plastic=None, width=1.0, half=False,
-              name="ring", material="svk"):
+              name="ring", material="svk", integration=1, rotary_inertia=True):
     """Build a beam or continuum ring (see the module docstring); returns a RingModel.
 
     R          mean radius > 0;  thickness h in (0, 2R): radial wall thickness
@@ -279,6 +279,7 @@ def make_ring(kind="beam", R=1.0, thickness=0.1, n_el=32, E=1.0, nu=0.0, rho=1.0
     plastic    beam only: None or the Perzyna dict of Beam (N0, Q0, M0, eta)
     half       the half ring x <= center_x (symmetry plane x = center_x)
     material   continuum only: "svk" (default) or "neohooke" (plane strain)
+    integration, rotary_inertia   beam only: see Beam (1 or 2 points; rho I on the rotations or not)
     """
     if kind not in KINDS:
         raise ValueError(f"parameter kind = {kind!r} is not allowed: one of {'|'.join(KINDS)}")
@@ -303,7 +304,7 @@ def make_ring(kind="beam", R=1.0, thickness=0.1, n_el=32, E=1.0, nu=0.0, rho=1.0
         else:
             X = ring_nodes(R, n_el, center)
         body = Beam(X, closed=not half, E=E, A=h * b, I=b * h**3 / 12, rho=rho, nu=nu,
-                    name=name, plastic=plastic)
+                    name=name, plastic=plastic, integration=integration, rotary_inertia=rotary_inertia)
         return RingModel(body, kind, R, h, b, center, bool(half), np.arange(X.shape[0]), 0.5 * h)
 
     if plastic is not None:

@@ -49,13 +49,19 @@ def fig06(preset="fast", outdir=None, law="conical"):
     draw_mesh(ax, X, t, edgecolors="k", linewidths=0.6)
     for xi in np.linspace(0, W, 9):                               # pressure p_y on the top
         ax.annotate("", (xi, H), (xi, H + 0.5), arrowprops=dict(arrowstyle="->", color="tab:green"))
-    for yi in np.linspace(0, H, 8):                               # traction p_x on the right side
-        ax.annotate("", (W + 0.5, yi), (W, yi), arrowprops=dict(arrowstyle="->", color="tab:purple"))
+    right = P["p_x_face"] == "right"                          # traction p_x on a lateral side
+    x0 = W if right else 0.0
+    for yi in np.linspace(0, H, 8):
+        tail = (x0, yi) if right else (x0 - 0.5, yi)
+        ax.annotate("", (tail[0] + 0.5, yi), tail, arrowprops=dict(arrowstyle="->", color="tab:purple"))
     ax.text(W / 2, H + 0.6, f"p_y = {P['p_y']:g}", ha="center", color="tab:green")
-    ax.text(W + 0.55, H / 2, f"p_x = {P['p_x']:g}", va="center", color="tab:purple")
+    ax.text(W + 0.55 if right else -0.55, H / 2, f"p_x = {P['p_x']:g}", va="center",
+            ha="left" if right else "right", color="tab:purple")
     Xs = rep["X"]
     ax.plot(Xs[:, 0], Xs[:, 1], "o", ms=4, color="tab:orange", label=f"contact nodes ({len(Xs)})")
-    ax.set_title(f"system and discretisation: {P['nx']} x {P['ny']} quads, width {W:g}, height {H:g}", fontsize=9)
+    fitted = " (FITTED to Table 1)" if preset in ("fast", "paper") else ""
+    ax.set_title(f"system and discretisation: {P['nx']} x {P['ny']} quads, width {W:g},\n"
+                 f"height {H:g}, plane {P['plane']}{fitted}", fontsize=9)
     ax.legend(loc="lower left", fontsize=8)
     ax = axes[1]
     draw_mesh(ax, X, t, edgecolors="0.8", linewidths=0.5)
@@ -64,13 +70,13 @@ def fig06(preset="fast", outdir=None, law="conical"):
         sel = rep["state"] == state
         if sel.any():
             ax.plot(rep["x"][sel, 0], rep["x"][sel, 1], "o", ms=4, color=color, label=state)
-    ax.set_title(f"deformed ({law} law), displacements at true scale (x1): max |u| = "
+    ax.set_title(f"deformed ({law} law), displacements at true scale (x1):\nmax |u| = "
                  f"{np.linalg.norm(u[body.xdofs], axis=1).max():.2f}; grey: undeformed", fontsize=9)
     ax.legend(loc="lower left", fontsize=8)
     for ax in axes:
         ax.axhline(0.0, color="k", lw=2.5)
-        ax.fill_between([-0.5, W + 1.5], -0.4, 0.0, color="0.85", alpha=0.5, lw=0, zorder=0)
-        ax.set_xlim(-0.5, W + 1.5)
+        ax.fill_between([-1.5, W + 1.5], -0.4, 0.0, color="0.85", alpha=0.5, lw=0, zorder=0)
+        ax.set_xlim(-1.5, W + 1.5)
         ax.set_ylim(-0.45, H + 1.0)
         ax.set_aspect("equal")
     fig.suptitle("Fig 6: elastic block on a rigid rough foundation, whole load in one step", fontsize=10)
@@ -172,12 +178,13 @@ def table1_markdown(hist):
     P = hist["parameters"]
     lines = ["# Table 1: norm of the residual ||G|| per Newton iteration, whole load in one step",
              "",
-             f"Block of Sec. 5.1 (canonical data, chosen: width {P['width']:g}, height {P['height']:g}, "
-             f"{P['nx']} x {P['ny']} quads, E = {P['E']:g}, nu = {P['nu']:g}, c_N = {P['c_N']:.3g} chosen, "
-             f"c_T = {P['c_T']:.3g} per unit length). Iteration 1 is the initial state u = 0: its "
-             "residual is the nodal load vector (top pressure and right traction; the contact forces at "
-             "g_N0 = -1e-12 are ~1e-8). The paper's block dimensions are not known, hence its different "
-             "first value. (scan?): exponent garbled in the scan, value uncertain.",
+             f"Block of Sec. 5.1: E = {P['E']:g}, nu = {P['nu']:g}, c_T = {P['c_T']:g} ({P['penalty']}) from the scan; "
+             f"FITTED to this table (the scan lost them; `contactfem reconstruct block`): width {P['width']:g}, "
+             f"height {P['height']:g}, {P['nx']} x {P['ny']} quads, p_x on the {P['p_x_face']} side, "
+             f"{P['free_end_nodes']} free end nodes, c_N = {P['c_N']:g}, plane {P['plane']}. Iteration 1 is the "
+             "initial state u = 0: its residual is the nodal load vector (top pressure and side traction; the "
+             "contact forces at g_N0 = -1e-12 are ~1e-8); no uniform mesh reproduces the printed first value. "
+             "(scan?): exponent garbled in the scan, value uncertain.",
              "",
              f"| iteration | paper conical | ours conical | paper parabolic | ours parabolic | ours Coulomb mu = {P['mu']:g} |",
              "|---:|---:|---:|---:|---:|---:|"]

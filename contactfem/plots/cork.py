@@ -6,14 +6,19 @@
     fig16_cork_pressure         Fig 16: the gas pressure on the cork against time
     fig17_cork_displacement     Fig 17: the axial displacement of the cork against time
     table_cork_sensitivity      exit velocity against the reconstructed data (lecture 08)
+    cork_knife_edge             exit velocity or "stays in" over (mu, R_tip) and over p0, with the
+                                static breakaway margin: the example sits on a knife's edge
 
 The problem is axisymmetric (x = r, y = z); the drawings mirror the meridian in the
 axis to show the whole cork and both sides of the neck.
 """
 
 
+import os
+
 import numpy as np
 
+from ..scenes.base import jsonable
 from ..scenes.cork import Neck, cork_mesh
 from . import cached_run, default_outdir, figure, pyplot, savefig
 
@@ -58,12 +63,14 @@ def fig14_cork_mesh(preset="fast", outdir=None):
     axes[0].set_title(f"free cork: {r['n_elements']} four-node elements")
     draw_neck(axes[1], neck, r["parameters"]["gas_column"])
     draw_mesh(axes[1], mesh, np.asarray(r["snapshots_x"][0]))
-    axes[1].set_title(f"pressed in: normal force {r['press_fit_normal_force_N']:.0f} N (paper ~2500 N)")
+    fitted = "fitted through R_tip" if r.get("press_fit_calibrated") else "R_tip not the fitted value"
+    axes[1].set_title(f"pressed in: normal force {r['press_fit_normal_force_N']:.0f} N (paper ~2500 N)\n"
+                      f"{fitted}; static breakaway margin {r['breakaway_margin_MPa']:+.3f} MPa", fontsize=10)
     for ax in axes:
         ax.set_aspect("equal")
         ax.set_xlabel("r (mm)")
     axes[0].set_ylabel("z (mm)")
-    fig.suptitle("Fig 14: the cork (axisymmetric, the meridian mirrored)")
+    fig.suptitle(f"Fig 14: the cork (axisymmetric, the meridian mirrored; R_tip = {r['parameters']['R_tip']:g} mm)")
     return [savefig(fig, outdir or default_outdir(), "fig14_cork_mesh")]
 
 
@@ -181,3 +188,134 @@ def table_cork_sensitivity(preset="fast", outdir=None):
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text("\n".join(lines) + "\n")
     return [str(path)]
+
+
+# The knife's edge. The static breakaway margin needs only the press fit (a few seconds a
+# point): it is drawn as a field over (mu, R_tip). The exit needs the whole run (a cork that
+# stays in is the slowest: it chatters between stick and slip until t_end), so full runs are
+# made at a few points. The runs use the fast preset: the paper's mesh and press fit (the same
+# margin) with coarser steps around the exit. CONTACTFEM_SLOW=1: the full grid.
+KNIFE_PRESET = "fast"
+KNIFE_GRID = dict(mu=(0.095, 0.1, 0.105), R_tip=(10.0, 10.05, 10.1),
+                  runs=((0.095, 10.0), (0.1, 10.0), (0.105, 10.0), (0.1, 10.05), (0.1, 10.1)),
+                  p0=(0.78, 0.8, 0.84))
+KNIFE_GRID_SLOW = dict(mu=(0.09, 0.095, 0.0975, 0.1, 0.1025, 0.105, 0.11),
+                       R_tip=(10.0, 10.025, 10.05, 10.1, 10.15, 10.2),
+                       runs="all", p0=(0.72, 0.76, 0.78, 0.79, 0.8, 0.82, 0.84, 0.88))
+
+
+def knife_grid():
+    """The coarse grid, or the full one when CONTACTFEM_SLOW is set."""
+    return KNIFE_GRID_SLOW if os.environ.get("CONTACTFEM_SLOW") else KNIFE_GRID
+
+
+def _margin_case(preset, over):
+    from ..scenes import get_scene
+    from ..scenes.cork import press_fit_only
+
+    try:
+        return dict(over, **press_fit_only(get_scene("cork").resolve(preset, over)), error=None)
+    except Exception as err:                        # a failed press fit is a point of the figure, not hidden
+        return dict(over, breakaway_margin_MPa=None, error=type(err).__name__)
+
+
+def _run_case(preset, over):
+    """Outcome of one whole run: exit velocity (None: stays in), static breakaway margin, or the error."""
+    try:
+        r = result(preset, **over)
+    except Exception as err:
+        return dict(over, exited=None, v=None, margin=None, error=type(err).__name__)
+    return dict(over, exited=bool(r["exited"]), v=r["exit_velocity_m_s"], margin=r["breakaway_margin_MPa"],
+                force=r["press_fit_normal_force_N"], error=None)
+
+
+def knife_edge_data(preset=KNIFE_PRESET, grid=None, jobs=2):
+    """Margins (press fit only) over the (mu, R_tip) grid, whole runs at grid["runs"] and over
+    p0 (n_ramp = 8, p_step = p0 / 8) at the fitted mu, R_tip. Returns dict(field, runs, p0, preset)."""
+    g = grid or knife_grid()
+    field = [dict(mu=m, R_tip=R) for m in g["mu"] for R in g["R_tip"]]
+    runs = [dict(mu=m, R_tip=R) for m, R in (g["runs"] if g["runs"] != "all" else
+                                             [(f["mu"], f["R_tip"]) for f in field])]
+    line = [dict(p_step=p0 / 8.0, n_ramp=8) for p0 in g["p0"]]
+    todo = [(_margin_case, o) for o in field] + [(_run_case, o) for o in runs + line]
+    try:
+        from joblib import Parallel, delayed
+    except ImportError:
+        out = [fn(preset, o) for fn, o in todo]
+    else:
+        out = Parallel(n_jobs=jobs)(delayed(fn)(preset, o) for fn, o in todo)
+    nf, nr = len(field), len(runs)
+    for o in out[nf + nr:]:
+        o["p0"] = o["p_step"] * o["n_ramp"]
+    return dict(field=out[:nf], runs=out[nf:nf + nr], p0=out[nf + nr:], preset=preset)
+
+
+@figure("cork_knife_edge", "Sec 5.5")
+def cork_knife_edge(preset="fast", outdir=None, data=None):
+    """Exit velocity (or "stays in") over (mu, R_tip) and over p0, on the field of the static
+    breakaway margin p0 - mu N / (pi R^2); its zero line is the knife's edge. Always computed
+    with KNIFE_PRESET (see above), whatever `preset`."""
+    plt = pyplot()
+    d = data or knife_edge_data()
+    fig, (ax, ap) = plt.subplots(1, 2, figsize=(11.5, 4.8))
+    mus = sorted({o["mu"] for o in d["field"]})
+    Rs = sorted({o["R_tip"] for o in d["field"]})
+    M = np.full((len(Rs), len(mus)), np.nan)
+    for o in d["field"]:
+        if o["breakaway_margin_MPa"] is not None:
+            M[Rs.index(o["R_tip"]), mus.index(o["mu"])] = o["breakaway_margin_MPa"]
+    if np.isfinite(M).all() and len(mus) > 1 and len(Rs) > 1:
+        lim = np.max(np.abs(M))
+        cs = ax.contourf(mus, Rs, M, levels=np.linspace(-lim, lim, 13), cmap="RdBu", alpha=0.45)
+        fig.colorbar(cs, ax=ax, label="margin p0 - mu N / (pi R^2) (MPa)")
+        if M.min() < 0 < M.max():
+            ax.contour(mus, Rs, M, levels=[0.0], colors="k", linewidths=1.5)
+    for o in d["field"]:
+        if o["error"]:
+            ax.plot(o["mu"], o["R_tip"], "k^", ms=7)
+    for o in d["runs"]:
+        if o["error"]:
+            text, style = "solver failed", dict(marker="^", color="k")
+        elif o["exited"]:
+            text, style = f"{o['v']:.1f} m/s", dict(marker="o", color="tab:green")
+        else:
+            text, style = "stays in", dict(marker="x", color="tab:red", mew=2)
+        ax.plot(o["mu"], o["R_tip"], ls="none", ms=9, **style)
+        ax.annotate(text, (o["mu"], o["R_tip"]), fontsize=8, xytext=(5, 4), textcoords="offset points")
+    ax.plot(0.1, 10.0, "s", mfc="none", mec="k", ms=18)
+    dx, dy = 0.12 * (mus[-1] - mus[0]), 0.12 * (Rs[-1] - Rs[0])
+    ax.set_xlim(mus[0] - dx, mus[-1] + 2 * dx)
+    ax.set_ylim(Rs[0] - dy, Rs[-1] + dy)
+    ax.set_xlabel("friction coefficient mu (paper: 0.1)")
+    ax.set_ylabel("R_tip (mm); 10 fitted to the paper's ~2500 N")
+    n_out = sum(1 for o in d["runs"] if o["exited"])
+    ax.set_title(f"p0 = 0.8 MPa: the cork leaves in {n_out} of {len(d['runs'])} runs; black line: margin 0\n"
+                 "(static breakaway = applied pressure); square: the fitted point", fontsize=9)
+    line = sorted(d["p0"], key=lambda o: o["p0"])
+    ok = [o for o in line if o["error"] is None]
+    ap.plot([o["p0"] for o in ok], [o["v"] if o["exited"] else 0.0 for o in ok], "o:", color="tab:green", lw=0.8)
+    for o in ok:
+        if not o["exited"]:
+            ap.annotate("stays in", (o["p0"], 0.0), fontsize=8, xytext=(0, 6), textcoords="offset points", ha="center")
+    for o in line:
+        if o["error"]:
+            ap.annotate("solver failed", (o["p0"], 0.0), fontsize=8, xytext=(0, 16), textcoords="offset points")
+    static = [o["p0"] - o["margin"] for o in ok]
+    if static:
+        ap.axvline(np.mean(static), color="k", ls="--", lw=1,
+                   label=f"static breakaway mu N / (pi R^2) = {np.mean(static):.3f} MPa")
+    ap.axhline(28.0, color="0.5", ls=":", lw=1, label="paper: ~28 m/s at 0.8 MPa")
+    ap.set_xlabel("applied pressure p0 (MPa); mu = 0.1, R_tip = 10 mm")
+    ap.set_ylabel("exit velocity (m/s); 0: stays in")
+    ap.legend(fontsize=8, loc="center right")
+    ap.set_title("over the applied pressure", fontsize=9)
+    fig.suptitle(f"The cork's knife edge (preset {d['preset']}: the paper's mesh and press fit). "
+                 "The press-fit force is fitted through R_tip", fontsize=10)
+    fig.tight_layout()
+    import json
+    from pathlib import Path
+
+    out = Path(outdir or default_outdir())
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "cork_knife_edge.json").write_text(json.dumps(jsonable(d), indent=1))   # the data, to redraw
+    return [savefig(fig, str(out), "cork_knife_edge"), str(out / "cork_knife_edge.json")]

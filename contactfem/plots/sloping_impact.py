@@ -120,7 +120,12 @@ def table2(preset="fast", outdir=None, refined_n_el=32):
              f"atan(|v_x|/|v_y|) in degrees. 'ours': the paper's mesh ({n_el} beam elements), "
              f"Newmark 0.7/0.4, dt = 0.1, 200 steps; '{refined_n_el} el.': the same on a refined ring. "
              "The paper gives no viscoplastic row (it reports a lower bounce). Spin: angular velocity "
-             "about the centre of mass after rebound (counter-clockwise positive).", "",
+             "about the centre of mass after rebound (counter-clockwise positive). Beam integration: "
+             + "; ".join(f"{v} {result(v, preset).get('integration_points', 1)} point(s)"
+                         for v in ("frictionless", "frictional", "viscoplastic"))
+             + (" (2 points FITTED to this table: `contactfem reconstruct sloping_impact`; the scan does not "
+                "say; the viscoplastic ring keeps the midpoint rule)"
+                if result("frictionless", preset).get("fitted") else "") + ".", "",
              "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     lines += ["| " + " | ".join(b) + " |" for b in body]
     out = outdir or default_outdir()

@@ -68,6 +68,7 @@ class Scene:
     run: Callable[[dict], dict]
     presets: dict = field(default_factory=dict)   # preset name -> {param: value}
     reports: tuple = ()                           # names of the main results, for `show`
+    notes: str = ""                               # what `show` says after the parameters (data read/fitted)
 
     def param(self, name):
         for p in self.params:
@@ -78,7 +79,8 @@ class Scene:
     def resolve(self, preset="fast", overrides=None):
         """Defaults, then the preset, then the user's overrides; every value validated."""
         if preset not in ("fast", "paper") and preset not in self.presets:
-            raise ValueError(f"parameter preset = {preset!r} is not allowed: one of fast|paper")
+            names = ["fast", "paper", *(k for k in self.presets if k not in ("fast", "paper"))]
+            raise ValueError(f"parameter preset = {preset!r} is not allowed: one of {'|'.join(names)}")
         known = {p.name: p for p in self.params}
         values = {p.name: p.default for p in self.params}
         values.update(self.presets.get(preset, {}))

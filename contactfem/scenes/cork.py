@@ -26,7 +26,13 @@ Reconstructed (the scan lost them; each is a Param with "chosen: ..." in its doc
   neck, the head keeps its radius: the "wider head" of Fig 14. The taper is what
   gives the paper's ~2500 N press-fit force: a 12 mm cylinder gives ~4900 N, twice
   the friction 0.8 MPa can overcome. The head length sets the mass (7 g).
-* The neck (``Neck``, a smooth rigid master defined here) has three pieces: the
+  The press-fit force is therefore FITTED, not predicted: R_tip was chosen so that it
+  lands near the paper's 2500 N (the run reports ``press_fit_calibrated: true`` while
+  R_tip has that value). And the fit puts the example on a knife's edge: the static
+  breakaway pressure mu N / (pi R_neck^2) is 0.786 MPa against the 0.8 MPa applied
+  (``breakaway_margin_MPa`` = applied - static breakaway, +0.014 MPa); R_tip + 0.1 mm
+  or mu = 0.105 and the cork stays in (figure ``cork_knife_edge``, lecture 08).
+* The neck (``Neck``, a ``RigidComposite`` of contact/masters.py) has three pieces: the
   straight wall r = 10 mm up to z = 24 mm (traversed upwards, so that its normal
   n = e3 x t of eq 18 points into the neck, towards the cork), a rounded mouth
   (quarter circle of radius 2 mm, exact curvature) and the flat top of the bottle
@@ -68,7 +74,10 @@ the neck (``exit_time_ms``: the last time the contact opened); ``exit_velocity_m
 is the axial velocity of its centre of mass at the end of the run (free flight, no
 force: constant). ``breakaway_pressure_MPa``: the pressure of the first step at
 which the centre of mass moves faster than 1 m/s (before, the cork only creeps);
-``breakaway_pressure_static_MPa`` = mu N / (pi R_neck^2), the paper's own estimate.
+``breakaway_pressure_static_MPa`` = mu N / (pi R_neck^2), the paper's own estimate;
+``breakaway_margin_MPa`` = p_step n_ramp - that: > 0 means the applied pressure exceeds
+the static friction reserve (the mechanism by which the cork leaves in the paper preset
+and the fast one, which differ only in time stepping and press-fit increments).
 """
 
 import numpy as np
@@ -89,6 +98,7 @@ PAPER = dict(exit_velocity_m_s=28.0, press_fit_normal_force_N=2500.0, sliding_fo
              snapshot_times_ms=(0.0, 0.8, 1.0, 1.5, 2.0, 2.6, 2.7, 3.0), exit_time_ms=2.65)
 
 WEIGHTS = ("area", "ring", "nodal")
+R_TIP_FITTED = 10.0     # mm: chosen so that the press fit gives the paper's ~2500 N (fitted, not predicted)
 
 PARAMS = (
     Param("E", 10.0, "MPa", 0.0, low_open=True, doc="Young's modulus (paper)"),
@@ -106,10 +116,11 @@ PARAMS = (
               "c_N per unit area); ring (w = 2 pi R_neck, per unit circumference); nodal (w = 1)"),
     Param("R_neck", 10.0, "mm", 0.0, low_open=True, doc="inner radius of the neck (paper)"),
     Param("R_cork", 12.0, "mm", 0.0, low_open=True, doc="radius of the free cork (paper: maximum radius 12)"),
-    Param("R_tip", 10.0, "mm", 0.0, low_open=True,
-          doc="radius of the cork's bottom: the shaft is conical from R_tip to R_cork at the mouth. Chosen: "
-              "scan lost the shape; R_neck (the shaft's tip fits the neck) gives the paper's ~2500 N press-fit "
-              "force, a cylinder (R_tip = 12) twice that, which 0.8 MPa could not push out"),
+    Param("R_tip", R_TIP_FITTED, "mm", 0.0, low_open=True,
+          doc="radius of the cork's bottom: the shaft is conical from R_tip to R_cork at the mouth. Fitted: "
+              "scan lost the shape; 10 (the shaft's tip fits the neck) gives the paper's ~2500 N press-fit "
+              "force (press_fit_calibrated), a cylinder (R_tip = 12) twice that, which 0.8 MPa could not push "
+              "out; 10.1 and the cork stays in (breakaway_margin_MPa < 0)"),
     Param("L_neck", 24.0, "mm", 0.0, low_open=True,
           doc="cork length in the straight neck = travel to the exit. Chosen: scan lost it; 30/54 * 0.8 "
               "MPa before the exit (paper) gives 54 - 30 = 24 mm"),
@@ -301,7 +312,7 @@ def press_fit(model, P, log=None, progress=None):
     hist = integrate(stepper, 0.0, u, t_end=1.0, dt_rule=lambda t, u, v, a: ds, growth=1.0,
                      cutback=True, max_cuts=P["max_cuts"], min_dt=ds / 2**P["max_cuts"],
                      motion=lambda t1: neck.set_shift(shift0 * (1.0 - t1)),
-                     label=lambda k, t1, h: f"press fit {t1:.3f}", progress=progress)
+                     label=lambda k, t1, h: f"press fit {t1:.3f}", progress=progress, name="cork: press fit")
     # the axial hold's reaction: released at the start of stage 2 (the dynamic run
     # absorbs this small imbalance; it is reported, not hidden)
     reaction = float(hist.result.G[cork.xdofs[hold, 1]])
@@ -376,7 +387,7 @@ def pop(model, P, u0, log=None, progress=None):
     zero = np.zeros(system.ndof)
     hist = integrate(stepper, 0.0, u0.copy(), zero, t_end=P["t_end"], a0=zero, dt_rule=dt_rule,
                      cutback=True, max_cuts=P["max_cuts"], before_step=lambda t, u, v, a: gas.update(u, t),
-                     stop=flown, recorder=record, progress=progress,
+                     stop=flown, recorder=record, progress=progress, name="cork: pop",
                      label=lambda k, t1, h: f"cork t = {t1 * 1e3:.5f} ms, dt = {h:.2e}")
     H = {k: np.asarray(x) for k, x in H.items()}
     exited = bool(gas.released and H["n_contact"][-1] == 0)
@@ -419,6 +430,24 @@ def simulate(params, log=None, progress=None, normal=None, friction=None):
     return model, u_fit, fit, out
 
 
+def static_breakaway(P, normal):
+    """The paper's estimate of the breakaway pressure, mu N / (pi R_neck^2), the applied
+    pressure p0 = p_step n_ramp and the margin p0 - estimate (> 0: the gas beats static friction)."""
+    p_static = P["mu"] * normal / (np.pi * P["R_neck"] ** 2)
+    p0 = P["p_step"] * P["n_ramp"]
+    return dict(breakaway_pressure_static_MPa=p_static, applied_pressure_MPa=p0, breakaway_margin_MPa=p0 - p_static)
+
+
+def press_fit_only(params):
+    """Stage 1 alone (a few seconds): the press-fit force and the static breakaway margin,
+    without the pop. For studies of the knife's edge over mu, R_tip and p0."""
+    model = build(params)
+    u_fit, fit = press_fit(model, params)
+    fit.update(contact_forces(model["contacts"], u_fit))
+    return dict(static_breakaway(params, fit["normal"]), press_fit_normal_force_N=fit["normal"],
+                press_fit_calibrated=bool(params["R_tip"] == R_TIP_FITTED))
+
+
 def run(params, progress=None, normal=None, friction=None):
     P = params
     model, u_fit, fit, out = simulate(P, progress=progress, normal=normal, friction=friction)
@@ -441,7 +470,12 @@ def run(params, progress=None, normal=None, friction=None):
         pressure_before_exit_MPa=float(h["p"][k_rel]) if k_rel is not None else None,
         breakaway_pressure_MPa=p_break,
         sliding_force_N=float(np.max(h["friction_force"])),
-        breakaway_pressure_static_MPa=P["mu"] * fit["normal"] / (np.pi * P["R_neck"]**2),
+        **static_breakaway(P, fit["normal"]),
+        press_fit_calibrated=bool(P["R_tip"] == R_TIP_FITTED),
+        press_fit_calibration=("R_tip fitted so that the press-fit normal force is near the paper's ~2500 N: "
+                               "the force is a calibration, not a prediction"
+                               if P["R_tip"] == R_TIP_FITTED else "R_tip set by the user: the press fit is not "
+                               "the calibrated one"),
         press_fit_normal_force_N=fit["normal"],
         press_fit_friction_force_N=fit["tangential"],
         press_fit_contact_nodes=fit["n_active"],
@@ -475,8 +509,11 @@ SCENE = Scene(
     run=run,
     presets={
         "paper": {},
-        "fast": dict(n_r=3, n_z=12, n_press=8, dt_fine=2e-5, t_after=1e-4, travel_max=1.0),
+        # the paper's mesh (a coarser one overestimates the press fit, so its static breakaway lies
+        # above the applied 0.8 MPa and it leaves by a different, dynamic mechanism); coarser in time
+        "fast": dict(n_press=8, dt_fine=2e-5, t_after=1e-4, travel_max=1.0),
     },
-    reports=("exit_velocity_m_s", "exit_time_ms", "breakaway_pressure_MPa", "press_fit_normal_force_N",
+    reports=("exit_velocity_m_s", "exit_time_ms", "breakaway_pressure_MPa", "breakaway_margin_MPa",
+             "press_fit_calibrated", "press_fit_normal_force_N",
              "max_penetration_ratio", "newton_iterations_total"),
 )

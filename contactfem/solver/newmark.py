@@ -202,7 +202,7 @@ class Step:
 def integrate(stepper, t0, u0, v0=None, n_steps=None, t_end=None, callback=None,
               cutback=False, max_cuts=4, *, a0=None, dt_rule=None, min_dt=None, growth=None,
               before_step=None, motion=None, stop=None, before_commit=None, recorder=None, progress=None,
-              label=None):
+              label=None, name=None):
     """Step from t0 over n_steps steps of stepper.dt, or up to t_end (algorithm of Sec. 4.3).
 
     Each step: Newton on the stepper's equation; on convergence the System commits
@@ -233,6 +233,7 @@ def integrate(stepper, t0, u0, v0=None, n_steps=None, t_end=None, callback=None,
     progress(t0, t_end, label)  makes a callback (e.g. ``contactfem.io.ProgressBar``)
                             called after each step and closed (its ``close()``) at the end
     label(k, t1, dt)        the text naming a step in a NewtonError (default: step k, t, dt)
+    name                    what the progress bar shows (default: the stepper's class name)
 
     External work is summed with the trapezoidal rule, 1/2 (F_n + F_n+1) . (u_n+1 - u_n),
     over the loads P and the support reactions (the prescribed-dof part of G).
@@ -271,7 +272,7 @@ def integrate(stepper, t0, u0, v0=None, n_steps=None, t_end=None, callback=None,
     P, F = s.external_force(u, t0), G[fixed]          # loads and support reactions at t0
     work = 0.0
 
-    bar = progress(t0, t_end, type(stepper).__name__) if progress is not None else None
+    bar = progress(t0, t_end, name or type(stepper).__name__) if progress is not None else None
     after = [c for c in (callback, bar) if c is not None]
     hist = History()
     hist.append(t0, 0.0, None, 0, s.energies(u, v), work)

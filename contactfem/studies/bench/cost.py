@@ -49,7 +49,8 @@ def iteration_cost(system, u, t=1.0, repeat=3, solvers=True):
 def _block_system(nx, ny, material="linear", width=None):
     from ...scenes import block
 
-    p = get_scene("block").resolve("paper", {"law": "coulomb", "material": material})
+    # plane strain: the finite-strain materials have no plane-stress form
+    p = get_scene("block").resolve("paper", {"law": "coulomb", "material": material, "plane": "strain"})
     p = dict(p, nx=nx, ny=ny)                       # past the scene's nx <= 400 for the scaling study
     if width is not None:
         p.update(width=width, height=width * ny / nx)  # square elements
