@@ -100,7 +100,7 @@ def test_cli_law_fields_and_errors(tmp_path):
     ok = _cli("run", "block", "--friction", "tests/data/saturating.py:Saturating", "--set", "law.mu0=0.6",
               "--set", "law.p0=500", "--json", str(out))
     assert ok.returncode == 0, ok.stderr
-    assert json.loads(out.read_text())["friction_law"]["fields"] == {"c_T": 5.0e4, "mu0": 0.6, "p0": 500.0}
+    assert json.loads(out.read_text())["friction_law"]["fields"] == {"c_T": get_scene("block").resolve("fast")["c_T"], "mu0": 0.6, "p0": 500.0}
     for args, pattern in [
         (("--friction", "tests/data/saturating.py:Saturating", "--set", "law.mu0=-1"), "parameter mu0 = -1.0 is out of range"),
         (("--friction", "tests/data/broken_syntax.py:Broken"), "law file broken_syntax.py, line 8: SyntaxError"),
