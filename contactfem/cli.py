@@ -1,74 +1,163 @@
 """Command line: `contactfem list | show SCENE | run SCENE [--preset fast|paper]
 [--set NAME=VALUE ...] [--json FILE] | figures | sweep | bench | equations`.
 
-Bad input (unknown scene, unknown or out-of-range parameter) prints one line on
-stderr and exits with code 2, without a traceback. A failed Newton solve exits
-with code 1 and prints the residual history."""
+Exit codes: 0 done; 2 bad input (unknown scene, unknown, repeated, out-of-range or
+inapplicable parameter, an output file that cannot be written, a run too large for this
+machine), one line on stderr, found before any solve; 1 a failed solve, its cause in one
+line and the residual history on the next; 130 interrupted (Ctrl-C): one line, and none
+of the run's output files written."""
 
 import argparse
-import json
+import os
 import sys
 
-from . import scenes
-from .solver.newton import NewtonError
+
+class UsageError(Exception):
+    """Malformed command line (argparse's complaint), reported in one line, exit 2."""
+
+
+class Parser(argparse.ArgumentParser):
+    def error(self, message):
+        raise UsageError(f"{message} (see {self.prog} --help)")
+
+
+_RUN = {}          # what `run` is doing, for the message of an interrupt: phase, progress
 
 
 def parse_sets(items):
+    """["mu=0.3", ...] -> {"mu": "0.3"}; a malformed or repeated NAME is a ValueError."""
     out = {}
     for item in items or []:
         if "=" not in item:
             raise ValueError(f"--set expects NAME=VALUE, got {item!r}")
         k, v = item.split("=", 1)
-        out[k.strip()] = v.strip()
+        k, v = k.strip(), v.strip()
+        if not k:
+            raise ValueError(f"--set expects NAME=VALUE, got {item!r}")
+        if k in out:
+            raise ValueError(f"--set {k} is given twice ({out[k]!r} and {v!r}): give each parameter once")
+        out[k] = v
     return out
 
 
 def cmd_list(args):
+    from . import scenes
+
     for name, sc in scenes.all_scenes().items():
         print(f"{name:16s} {sc.title}")
 
 
 def cmd_show(args):
+    from . import scenes
+
     sc = scenes.get_scene(args.scene)
     print(f"{sc.name}: {sc.title}")
-    print(f"{'parameter':14s} {'default':>12s} {'fast':>10s} {'paper':>10s}  {'unit':10s} allowed")
+    rows = [("parameter", "default", "fast", "paper", "unit", "allowed")]
     for p in sc.params:
         fast = sc.presets.get("fast", {}).get(p.name, "")
         paper = sc.presets.get("paper", {}).get(p.name, "")
-        print(f"{p.name:14s} {str(p.default):>12s} {str(fast):>10s} {str(paper):>10s}  {p.unit:10s} {p.range_text()}"
-              + (f"  -- {p.doc}" if p.doc else ""))
+        rows.append((p.name, _show_value(p.default), _show_value(fast), _show_value(paper), p.unit or "-",
+                     p.range_text()))
+    widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
+    right = (False, True, True, True, False, False)
+    for r, p in zip(rows, (None,) + tuple(sc.params)):
+        cells = [c.rjust(w) if rj else c.ljust(w) for c, w, rj in zip(r, widths, right)]
+        note = ""
+        if p is not None:
+            note = "; ".join(x for x in (p.doc, f"used only with {p.when_text()}" if p.when else "") if x)
+        print("  ".join(cells) + f"  -- {note}" if note else "  ".join(cells).rstrip())
     for name, values in sc.presets.items():
         if name not in ("fast", "paper"):
             print(f"preset {name}: " + ", ".join(f"{k}={v}" for k, v in values.items()))
     if sc.notes:
         print(sc.notes)
+    print("fast is the default preset; paper uses the paper's data and meshes. Values: --set NAME=VALUE.")
     if sc.reports:
         print("reports: " + ", ".join(sc.reports))
 
 
+def _show_value(v):
+    if v == "":
+        return ""
+    if isinstance(v, float):
+        return f"{v:g}"
+    return str(v)
+
+
 def cmd_run(args):
+    from . import scenes
+    from .io.outputs import Outputs
+    from .scenes.base import check_resources, describe
+
+    scene = scenes.get_scene(args.scene)
+    overrides, laws = laws_from_args(args)             # law.NAME=... go to --friction / --normal
+    params = scene.resolve(args.preset, overrides)
+    out = Outputs()                                   # every output checked before the run
+    if args.json:
+        out.add("--json", args.json, (".json",))
+    if args.save:
+        out.add("--save", args.save, (".json", ".npz"))
+    if args.gif:
+        out.add("--gif", args.gif, (".gif", ".mp4"))
+        if not scene.outlines:
+            animated = ", ".join(n for n, s in scenes.all_scenes().items() if s.outlines)
+            raise ValueError(f"--gif: scene {scene.name} records no outlines to animate (these do: {animated})")
+        if args.gif.lower().endswith(".mp4"):
+            import shutil
+
+            if shutil.which("ffmpeg") is None:
+                raise ValueError(f"--gif {args.gif}: writing .mp4 needs ffmpeg on the PATH; write a .gif instead")
+    est = check_resources(scene, params, args.force)
+    if est is not None and est.get("elements", 0) > 1e5:
+        print(f"{scene.name}: building the mesh and the system ({describe(est)}) ...", file=sys.stderr, flush=True)
     progress = None
     if args.progress:
         from .io import progress_bar as progress
-    overrides, laws = laws_from_args(args)
-    res = scenes.run_scene(args.scene, args.preset, overrides, progress=progress, **laws)
-    text = json.dumps(res, indent=1)
-    if args.json:
-        with open(args.json, "w") as fh:
-            fh.write(text)
-    if args.save:
-        from .io import save_run
+        _RUN["progress"] = True
+    _RUN["phase"] = "run"
+    res, notes = run_quietly(lambda: scenes.run_scene(args.scene, args.preset, overrides, progress=progress, **laws))
+    _RUN["phase"] = "write"
+    with out:                                         # temporaries first, then all renamed at once
+        if args.json:
+            import json
 
-        save_run(res, args.save)
-    if args.gif:
-        write_animation(res, args.gif)
+            out.temp("--json").write_text(json.dumps(res, indent=1, allow_nan=False))
+        if args.save:
+            from .io import as_arrays, save_run
+
+            save_run(as_arrays(res), out.temp("--save"))
+        if args.gif:
+            write_animation(res, out.temp("--gif"))
+        out.commit()
+    _RUN["phase"] = "done"
+    for note in notes:
+        print(f"contactfem: warning: {note}", file=sys.stderr)
     summary = {k: v for k, v in res.items() if not isinstance(v, (list, dict))}
     for k, v in summary.items():
         print(f"{k}: {v}")
+    for what, path in out.paths.items():
+        print(f"{what} -> {path}")
+
+
+def run_quietly(fn):
+    """fn() with numpy's floating-point warnings off (a non-finite value is caught by the
+    solver and reported as the cause) and other libraries' warnings dropped; returns
+    (result, contactfem's own warning messages) so they are printed once, after the run."""
+    import warnings
+
+    import numpy as np
+
+    with warnings.catch_warnings(record=True) as caught, np.errstate(all="ignore"):
+        warnings.simplefilter("always")
+        res = fn()
+    own = [str(w.message) for w in caught
+           if issubclass(w.category, UserWarning) and "contactfem" in str(w.filename)]
+    return res, list(dict.fromkeys(own))
 
 
 def laws_from_args(args):
     """Scene overrides and the --friction / --normal law objects (fields from --set law.NAME=...)."""
+    from . import scenes
     from .laws.lawfile import laws_from_options, split_sets
 
     overrides, law_sets = split_sets(parse_sets(args.set))
@@ -79,26 +168,61 @@ def laws_from_args(args):
 
 
 def cmd_figures(args):
-    from .plots import make_all
+    from .plots import load_all, make_all
 
+    if args.only and not any(args.only in stem for stem in load_all()):
+        raise ValueError(f"--only {args.only!r} matches no figure: the figures are {', '.join(sorted(load_all()))}")
     for path in make_all(args.preset, args.outdir, args.only):
         print(path)
 
 
 def cmd_sweep(args):
+    from .io.outputs import Outputs
     from .studies.sweep import parse_grid, sweep, write_table
 
     if args.jobs < 1:
         raise ValueError(f"parameter jobs = {args.jobs} is out of range: allowed [1, inf)")
+    out = Outputs()
+    out.add("--out", args.out, (".csv", ".json"))
     rows = sweep(args.scene, parse_grid(parse_sets(args.set)), args.preset, args.jobs, args.scheduler)
-    write_table(rows, args.out)
-    print(f"{len(rows)} runs -> {args.out}")
+    with out:
+        write_table(rows, out.temp("--out"))
+        out.commit()
+    failed = [r for r in rows if r.get("error")]
+    print(f"{len(rows)} runs, {len(rows) - len(failed)} succeeded, {len(failed)} failed -> {args.out}")
+    for r in failed:
+        point = ", ".join(f"{k[6:]}={v}" for k, v in r.items() if k.startswith("param."))
+        print(f"  failed: {point}: {r['error']}")
 
 
 def cmd_equations(args):
     from .equations import markdown_table
 
-    print(markdown_table())
+    table = markdown_table()
+    if args.markdown or not sys.stdout.isatty():
+        print(table)
+    else:
+        print(plain_table(table))
+
+
+def plain_table(markdown):
+    """A Markdown table as aligned plain text for a terminal: no pipes, escapes or backquotes."""
+    import re
+
+    rows = []
+    for line in markdown.splitlines():
+        if re.fullmatch(r"\|?(\s*:?-+:?\s*\|)+\s*", line):
+            continue
+        cells = re.split(r"(?<!\\)\|", line.strip().strip("|"))
+        rows.append([c.strip().replace("\\|", "|").replace("`", "") for c in cells])
+    widths = [max(len(r[i]) for r in rows if i < len(r)) for i in range(max(map(len, rows)))]
+    return "\n".join("  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows)
+
+
+def cmd_site(args):
+    from .site import build
+
+    print(f"site -> {build(args.out)}")
 
 
 def cmd_reconstruct(args):
@@ -107,7 +231,7 @@ def cmd_reconstruct(args):
     reconstruct(args.scene, quick=args.quick, top=args.top, json_path=args.json, cache=not args.no_cache)
 
 
-BENCH_STUDIES = ("tangents", "work_precision", "cost", "targets")    # contactfem.studies.bench.STUDIES
+BENCH_STUDIES = ("tangents", "work_precision", "cost", "targets", "enforcement")  # = studies.bench.STUDIES
 
 
 def cmd_bench(args):
@@ -133,14 +257,17 @@ def write_animation(res, path):
         raise ValueError(f"--gif: scene {res['scene']} records no outlines to animate")
     import numpy as np
 
-    frames = [[np.asarray(f)] if np.asarray(f).ndim == 2 else [np.asarray(p) for p in f] for f in res["outlines"]]
-    animate_outlines(frames, path, times=res.get("outline_t"), closed=True,
-                     obstacles=res.get("obstacles", ()), title=res["scene"])
-    print(f"animation -> {path}")
+    anim = res.get("animation") or {}
+    outlines = anim.get("outlines", res["outlines"])
+    frames = [[np.asarray(f)] if np.asarray(f).ndim == 2 else [np.asarray(p) for p in f] for f in outlines]
+    animate_outlines(frames, path, times=anim.get("t", res.get("outline_t")), closed=True,
+                     obstacles=anim.get("obstacles", res.get("obstacles", ())), title=res["scene"],
+                     marks=anim.get("marks"))
+    return path
 
 
 def build_parser():
-    ap = argparse.ArgumentParser(prog="contactfem", description=__doc__.split("\n\n")[0])
+    ap = Parser(prog="contactfem", description=__doc__.split("\n\n")[0])
     sub = ap.add_subparsers(dest="command", required=True)
     sub.add_parser("list", help="the scenes").set_defaults(func=cmd_list)
     sp = sub.add_parser("show", help="a scene's parameters with defaults, units and allowed ranges")
@@ -149,7 +276,8 @@ def build_parser():
     rp = sub.add_parser("run", help="run a scene")
     rp.add_argument("scene")
     rp.add_argument("--preset", default="fast",
-                    help="fast (default), paper, or a named variant of the scene (listed by show)")
+                    help="fast (default): coarse meshes and steps, seconds; paper: the paper's data; "
+                         "or a named variant of the scene (listed by show)")
     rp.add_argument("--set", action="append", metavar="NAME=VALUE",
                     help="override a parameter, or a field of a law file's law as law.NAME=VALUE (repeatable)")
     rp.add_argument("--friction", metavar="FILE.py:CLASS", help="use the friction law CLASS defined in FILE.py")
@@ -158,14 +286,17 @@ def build_parser():
     rp.add_argument("--gif", metavar="FILE", help="animate the recorded outlines (.gif, or .mp4 with ffmpeg)")
     rp.add_argument("--progress", action="store_true", help="show a progress bar on stderr during the time loop")
     rp.add_argument("--save", metavar="FILE", help="save the run (.json or .npz) for contactfem.io.load_run")
+    rp.add_argument("--force", action="store_true",
+                    help="run even if the estimated size exceeds the limits (2 GB, 1e6 unknowns, 1e6 steps)")
     rp.set_defaults(func=cmd_run)
     fp = sub.add_parser("figures", help="regenerate every figure and table of the paper into figures/")
     fp.add_argument("--preset", default="fast", choices=["fast", "paper"])
     fp.add_argument("--outdir", default=None, help="default: the repo's figures/ folder")
     fp.add_argument("--only", default=None, help="only figures whose file name contains this text")
     fp.set_defaults(func=cmd_figures)
-    sub.add_parser("equations", help="the equation index: paper equation -> implementing function"
-                   ).set_defaults(func=cmd_equations)
+    ep = sub.add_parser("equations", help="the equation index: paper equation -> implementing function")
+    ep.add_argument("--markdown", action="store_true", help="a Markdown table (the default when not on a terminal)")
+    ep.set_defaults(func=cmd_equations)
     sw = sub.add_parser("sweep", help="run a scene over a grid of parameter values, in parallel")
     sw.add_argument("scene")
     sw.add_argument("--preset", default="fast", choices=["fast", "paper"])
@@ -174,6 +305,9 @@ def build_parser():
     sw.add_argument("--scheduler", default=None, help="Dask scheduler address: run on that cluster instead")
     sw.add_argument("--out", default="sweep.csv", help="table of results (.csv or .json)")
     sw.set_defaults(func=cmd_sweep)
+    st = sub.add_parser("site", help="build the course website (lectures executed, gallery, equation index, API)")
+    st.add_argument("--out", default=None, metavar="DIR", help="output folder, DIR/index.html (default: build/site)")
+    st.set_defaults(func=cmd_site)
     rc = sub.add_parser("reconstruct", help="the scan's lost values as an inverse problem: run every reading "
                         "the scan allows, score it against what the paper prints, print the ranked table")
     rc.add_argument("scene", help="block | sloping_impact")
@@ -183,7 +317,7 @@ def build_parser():
     rc.add_argument("--no-cache", action="store_true", help="recompute every reading (default: reuse the "
                     "results of earlier runs of the same code, in $CONTACTFEM_CACHE or ~/.cache/contactfem)")
     rc.set_defaults(func=cmd_reconstruct)
-    bp = sub.add_parser("bench", help="speed against accuracy: tangents, work-precision, cost, targets "
+    bp = sub.add_parser("bench", help="speed against accuracy: tangents, work-precision, cost, targets, enforcement "
                                       "(writes bench.json and BENCHMARKS.md)")
     bp.add_argument("--quick", action="store_true", help="fast presets and fewer points (about a minute)")
     bp.add_argument("--out", default=".", help="folder for bench.json and BENCHMARKS.md (default: .)")
@@ -193,21 +327,88 @@ def build_parser():
     return ap
 
 
+def interrupted(exc):
+    """The one line of a Ctrl-C: where the run was, and what was written (nothing, unless
+    the outputs were already complete)."""
+    phase = _RUN.get("phase")
+    if phase == "done":
+        return "contactfem: interrupted after the outputs were written"
+    if getattr(exc, "step", None) is not None:
+        of = f" of {exc.n_steps}" if getattr(exc, "n_steps", None) else " (adaptive steps)"
+        where = f" at t = {exc.t:.6g}, step {exc.step}{of}"
+    elif phase == "write":
+        where = " while writing the outputs"
+    elif phase == "run":
+        where = " during the run"
+    else:
+        where = " before the run started"
+    return f"contactfem: interrupted{where}; nothing written"
+
+
 def main(argv=None):
-    ap = build_parser()
-    args = ap.parse_args(argv)
+    """The command line; returns the exit code. Called without argv (as the program), a
+    Ctrl-C after the work is done (while Python shuts down) no longer changes the outcome."""
     try:
+        return _main(argv)
+    finally:
+        if argv is None:
+            import signal
+
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _main(argv):
+    _RUN.clear()
+    try:
+        args = build_parser().parse_args(argv)
         args.func(args)
-    except ValueError as exc:
+    except KeyboardInterrupt as exc:
+        print(("\n" if _RUN.get("progress") else "") + interrupted(exc), file=sys.stderr)
+        return 130
+    except UsageError as exc:
         print(f"contactfem: error: {exc}", file=sys.stderr)
         return 2
-    except (FloatingPointError, NewtonError) as exc:   # Newton, return map, inverted elements
-        print(f"contactfem: solver failed: {exc}", file=sys.stderr)
+    except ValueError as exc:
+        print(f"contactfem: error: {_one_line(exc)}", file=sys.stderr)
+        return 2
+    except MemoryError:
+        print("contactfem: out of memory: use a coarser mesh (see contactfem show SCENE)", file=sys.stderr)
+        return 1
+    except Exception as exc:
+        from .solver.newton import NewtonError
+
+        if isinstance(exc, (ZeroDivisionError, OverflowError)):       # Python arithmetic at the float limits
+            print(f"contactfem: solver failed: {_one_line(exc)} in {_where(exc)} (parameter values near the limits "
+                  "of floating point?)", file=sys.stderr)
+            return 1
+        if not isinstance(exc, (FloatingPointError, NewtonError)):   # Newton, return map, inverted elements
+            if os.environ.get("CONTACTFEM_DEBUG") == "1":
+                raise
+            print(f"contactfem: internal error: {type(exc).__name__}: {_one_line(exc)} "
+                  "(CONTACTFEM_DEBUG=1 shows the traceback)", file=sys.stderr)
+            return 3
+        print(f"contactfem: solver failed: {_one_line(exc)}", file=sys.stderr)
         hist = getattr(exc, "history", None)
         if hist is not None:
-            print("residual history: " + " ".join(f"{r:.3e}" for r in hist), file=sys.stderr)
+            text = " ".join(f"{r:.3e}" for r in hist) if hist else "(empty: the solve failed before its first residual)"
+            print(f"residual history: {text}", file=sys.stderr)
         return 1
     return 0
+
+
+def _where(exc):
+    """The innermost function of contactfem the exception passed through: 'name (module)'."""
+    import traceback
+
+    frames = [f for f in traceback.extract_tb(exc.__traceback__) if "contactfem" in f.filename]
+    if not frames:
+        return "a library"
+    f = frames[-1]
+    return f"{f.name} ({f.filename.split('contactfem')[-1].strip('/').replace('/', '.')[:-3]}, line {f.lineno})"
+
+
+def _one_line(exc):
+    return " ".join(str(exc).split()) or type(exc).__name__
 
 
 if __name__ == "__main__":

@@ -58,3 +58,15 @@ def test_dissipative_newmark_loses_energy():
 def test_bad_parameters_raise():
     with pytest.raises(ValueError):
         run_scene("bar_impact", "fast", {"courant": 0})
+
+
+def test_explicit_central_differences_through_the_same_scene(fast):
+    """integrator = central_difference: the same model stepped explicitly (courant 0.5 <
+    1, stable), no Newton solve. Same contact duration as the implicit run within the
+    bound of test_contact_duration (the penalty layer's h / c, about 2.5 % of 2 L / c
+    here), rebound within the 3 % of test_rebound_and_energy."""
+    r = run_scene("bar_impact", "fast", {"integrator": "central_difference", "courant": 0.5})
+    assert r["newton_iterations_total"] == 0
+    assert abs(r["error_duration"]) < 0.05, (r["duration"], r["duration_exact"])
+    assert abs(r["error_rebound"]) < 0.03, r["rebound_velocity"]
+    assert r["n_steps"] == 2 * fast["n_steps"]          # half the step of the implicit run (courant 1)

@@ -171,7 +171,8 @@ def test_very_high_impact_speed(speed, material):
 
 @pytest.mark.xfail(strict=True, reason="known limitation: implicit Newmark with an unresolved penalty "
                    "(omega_p dt >> 1) pumps energy into an impact; the trapezoidal rule carries the "
-                   "contact acceleration spike into the next step (1 dof: v -> 3 v0 after one bounce)")
+                   "contact acceleration spike into the next step (1 dof: v -> 3 v0 after one bounce); "
+                   "the energy-consistent stepper conserves it (test_conserving.py)")
 def test_unresolved_penalty_gains_energy():
     hist, _ = throw(normal=PowerLaw(1e8), delta=0.5, beta=0.25)   # omega_p dt = 141
     total = hist.kinetic + hist.strain + hist.contact

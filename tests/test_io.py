@@ -25,6 +25,8 @@ def check_same(a, b):
         elif isinstance(a[k], np.ndarray):
             assert isinstance(b[k], np.ndarray) and b[k].dtype == a[k].dtype and b[k].shape == a[k].shape, k
             assert np.array_equal(a[k], b[k]), k
+        elif isinstance(a[k], list):           # rectangular lists of numbers come back as arrays
+            assert len(a[k]) == len(b[k]) and all(np.array_equal(x, y) for x, y in zip(a[k], b[k])), k
         else:
             assert a[k] == b[k], k
 
@@ -47,7 +49,8 @@ def test_nan_needs_npz(tmp_path):
 def test_load_cli_json(tmp_path):
     """The CLI writes arrays as plain lists: they come back as arrays; ragged lists stay lists."""
     p = tmp_path / "cli.json"
-    p.write_text(json.dumps({"t_N": [[-1.0, -2.0], [0.0, -3.0]], "residuals": [[1.0, 0.1], [1.0]], "ok": True}))
+    p.write_text(json.dumps({"scene": "block", "t_N": [[-1.0, -2.0], [0.0, -3.0]], "residuals": [[1.0, 0.1], [1.0]],
+                             "ok": True}))
     r = load_run(p)
     assert isinstance(r["t_N"], np.ndarray) and r["t_N"].shape == (2, 2)
     assert isinstance(r["residuals"], list) and r["ok"] is True

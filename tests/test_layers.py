@@ -1,12 +1,13 @@
 """The layout is the architecture: every module of contactfem belongs to a layer, and no
 module imports from a layer above its own (lazy imports inside functions included).
 
-    laws < contact < bodies < solver < scenes < studies, plots, io < cli
+    laws < contact < bodies < solver < scenes < studies, plots, io < site < cli
 
 io (saving runs, ParaView export, animations, progress bars) is a utility layer beside
 plots: the solver and the scenes take callbacks (e.g. ``progress=``) instead of
 importing it. ``equations`` (the index of the paper's equations in the code) sits
-beside the studies; the package's ``__init__`` is its public face and is exempt.
+beside the studies; ``site`` (the course website, built from the lectures) uses them
+all and only the command line uses it; the package's ``__init__`` is its public face and is exempt.
 """
 import ast
 from pathlib import Path
@@ -16,7 +17,7 @@ import pytest
 PACKAGE = Path(__file__).resolve().parents[1] / "contactfem"
 
 ORDER = [("laws",), ("contact",), ("bodies",), ("solver",), ("scenes",),
-         ("studies", "plots", "io", "equations"), ("cli", "__main__")]
+         ("studies", "plots", "io", "equations"), ("site",), ("cli", "__main__")]
 LAYER = {name: level for level, names in enumerate(ORDER) for name in names}
 
 

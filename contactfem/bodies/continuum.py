@@ -35,6 +35,20 @@ class InvertedElementError(FloatingPointError):
     """Raised when det F <= 0 at a quadrature point (an element turned inside out)."""
 
 
+def degenerate_guard(make, mesh):
+    """scikit-fem raises a bare Exception for a zero Jacobian determinant: a mesh whose
+    elements have no area in floating point (lengths near 1e-300, or 1e300 squared).
+    Say so as a FloatingPointError, the error of a computation that cannot go on."""
+    try:
+        return make()
+    except Exception as err:
+        if "Jacobian" not in str(err):
+            raise
+        size = float(np.ptp(mesh.p, axis=1).max()) if mesh.p.size else 0.0
+        raise InvertedElementError(f"the mesh is degenerate in floating point (zero Jacobian determinant; "
+                                   f"mesh size {size:.3g}): lengths too small or too large") from None
+
+
 # ---------------------------------------------------------------------------
 # Materials: pure functions of F, shape (3, 3, nel, nqp)
 # ---------------------------------------------------------------------------
@@ -238,7 +252,7 @@ class Continuum:
         self.axi = kind == "axisymmetric"
         self.thickness = 1.0 if self.axi else float(thickness)
 
-        self.basis = Basis(mesh, element)
+        self.basis = degenerate_guard(lambda: Basis(mesh, element), mesh)
         self.element = element
         self.ndof = self.basis.N
         self.X = mesh.p.T.copy()

@@ -6,7 +6,7 @@ import numpy as np
 from .kinematics import outer
 
 
-def contact_element(w, t_N, dt_N, t_T, c_T_s, c_N_s, dg_N, d2g_N, ds, d2s):
+def contact_element(w, t_N, dt_N, t_T, c_T_s, c_N_s, dg_N, d2g_N, ds, d2s, ddg_T=None):
     """Nodal contact forces and their tangent for each pair.
 
     w: weight of each slave (tributary length for tractions per unit length, 1 for
@@ -20,11 +20,16 @@ def contact_element(w, t_N, dt_N, t_T, c_T_s, c_N_s, dg_N, d2g_N, ds, d2s):
                                                                     d2s = l_bar B / l^2)
     eq (49)   K_T = w [ c_T^s (ds ds^T) + t_T d2s + c_N^s C ]      (slip)
     eq (50)   C = ds dg_N^T                                         (non-symmetric)
+
+    ddg_T: the variation of the slip increment Delta g_T where it is not ds (a node that
+    closes during the step: Delta g_T = r (s - s_bar), see NodeToSegment.kinematics); the
+    c_T^s term is then c_T^s ds ddg_T^T. Default ds.
     """
+    ddg_T = ds if ddg_T is None else ddg_T
     W = w[:, None]
     R = W * (t_N[:, None] * dg_N + t_T[:, None] * ds)
     K = w[:, None, None] * (dt_N[:, None, None] * outer(dg_N, dg_N) + t_N[:, None, None] * d2g_N
-                            + c_T_s[:, None, None] * outer(ds, ds) + t_T[:, None, None] * d2s
+                            + c_T_s[:, None, None] * outer(ds, ddg_T) + t_T[:, None, None] * d2s
                             + c_N_s[:, None, None] * outer(ds, dg_N))
     return R, K
 

@@ -3,7 +3,14 @@ friction history (paper Sec. 4.3, step 4: per slave node, check the gap -> norma
 force -> trial friction -> slip check -> stick or return map -> tangents).
 
 History (s_bar, t_T_bar, q_bar and the friction law's internal variables z_bar) is
-committed only on a converged step (commit)."""
+committed only on a converged step (commit).
+
+The closing step: a node open at the start of a step (committed gap g_bar > 0) that is in
+contact at its end touched the master at the fraction theta = g_bar / (g_bar - g_N) of the
+step (the gap interpolated linearly). Its stick spring starts there: the slip increment is
+the travel after touching, Delta g_T = r (s - s_bar) with r = 1 - theta = -g_N / (g_bar - g_N),
+not the whole travel of the step (which would load the spring with the tangential motion
+made while still open)."""
 
 import numpy as np
 
@@ -48,6 +55,7 @@ class NodeToSegment:
         self.offset = float(offset)
         nc = len(self.nodes)
         self.s_bar = None                   # set at the first evaluation (or initialize)
+        self.g_bar = None                   # committed gap (the closing step, module docstring)
         self.t_T_bar = np.zeros(nc)
         self.q_bar = np.zeros(nc)
         self._law = None if friction is None else as_friction_law(friction)
@@ -72,6 +80,8 @@ class NodeToSegment:
         x_s = self.slave_positions(u)
         s0 = np.zeros(len(self.nodes))
         self.s_bar = self.master.locate(x_s, s0, u)["s"]
+        self.g_bar = None
+        self.g_bar = self.kinematics(u)["g_N"]
 
     def kinematics(self, u):
         """Gap, normal traction and variations at u (step 4a-b of Sec. 4.3), before friction."""
@@ -85,7 +95,17 @@ class NodeToSegment:
         active = k["inside"] & (g_N < 0.0)
         t_N, dt_N = self.normal.traction(np.where(active, g_N, 1.0))
         dofs = np.concatenate([self.slave_dofs(), k["master_dofs"]], axis=1)
-        return dict(k, x_s=x_s, g_N=g_N, active=active, t_N=t_N, dt_N=dt_N, dg_T=k["s"] - self.s_bar, dofs=dofs)
+        travel = k["s"] - self.s_bar
+        r, dr, ddg_T = np.ones_like(g_N), np.zeros_like(g_N), k["ds"]
+        if self.g_bar is not None:                          # the closing step (module docstring)
+            closing = active & (self.g_bar > 0.0)
+            if np.any(closing):
+                gb = np.where(closing, self.g_bar, 1.0)
+                r = np.where(closing, -g_N / (gb - g_N), 1.0)
+                dr = np.where(closing, -gb / (gb - g_N) ** 2, 0.0)
+                ddg_T = r[:, None] * k["ds"] + (travel * dr)[:, None] * k["dg_N"]
+        return dict(k, x_s=x_s, g_N=g_N, active=active, t_N=t_N, dt_N=dt_N, dg_T=r * travel, travel=travel,
+                    r=r, dr=dr, ddg_T=ddg_T, dofs=dofs)
 
     def evaluate(self, u):
         """Everything at displacement u with the committed history: kinematics,
@@ -102,7 +122,7 @@ class NodeToSegment:
     def element(self, e, t_T, c_T_s, c_N_s, **extra):
         """Add the element residuals and tangents (eqs 28, 33, 39, 49) to the kinematics e."""
         R, K = contact_element(self.weights, e["t_N"], e["dt_N"], t_T, c_T_s, c_N_s,
-                               e["dg_N"], e["d2g_N"], e["ds"], e["d2s"])
+                               e["dg_N"], e["d2g_N"], e["ds"], e["d2s"], e.get("ddg_T"))
         return dict(e, R=R, K=K, **extra)
 
     @staticmethod
@@ -137,6 +157,7 @@ class NodeToSegment:
         if hasattr(self.master, "commit"):
             self.master.commit(u)           # new converged metric l_bar of a deformable master
         self.s_bar = self.master.locate(e["x_s"], self.s_bar, u)["s"]
+        self.g_bar = self.kinematics(u)["g_N"]
 
     def energy(self, u):
         """Energy stored in the interface: the normal law's potential plus the elastic

@@ -95,6 +95,7 @@ class SplitContact:
             c_T = float(c.friction.c_T)
             t_T = self.t_T_star + c_T * (e["s"] - self.s_star)
             c_T_s, c_N_s = np.full_like(zero, c_T), zero
+            e = dict(e, ddg_T=e["ds"])     # this t_T varies with s alone (no closing-step factor)
         else:                              # eqs 40-45 at the frozen pressure p*: c_N^s = 0
             fr = return_map(c.friction, -self.p_star, zero, e["dg_T"], c.t_T_bar, c.q_bar,
                             z_bar=c.z_bar, dt=c.dt)

@@ -7,6 +7,8 @@
                  series as VTU files + a .pvd collection for ParaView (needs meshio)
     animate.py   animate_outlines(frames, "motion.gif"): body outlines over time with
                  matplotlib's PillowWriter (GIF) or FFMpegWriter (MP4)
+    outputs.py   Outputs: a run's output files checked before the run, written to temporaries
+                 and renamed into place together (none or all); check_output_path
     progress.py  ProgressBar: a progress bar on stderr for integrate(..., callback=bar);
                  chain(...) to give integrate several callbacks; progress_bar, the factory
                  for integrate(..., progress=) and run_scene(..., progress=)
@@ -14,8 +16,10 @@
 
 from .animate import animate_outlines, boundary_loop
 from .paraview import export_continuum, export_polyline, export_series
+from .outputs import Outputs, check_output_path
 from .progress import ProgressBar, chain, progress_bar
-from .runs import Recorder, load_run, save_run
+from .runs import Recorder, as_arrays, load_run, save_run
 
-__all__ = ["save_run", "load_run", "Recorder", "boundary_loop", "export_series", "export_continuum", "export_polyline",
-           "animate_outlines", "ProgressBar", "chain", "progress_bar"]
+__all__ = ["save_run", "load_run", "as_arrays", "Outputs", "check_output_path", "Recorder", "boundary_loop",
+           "export_series", "export_continuum", "export_polyline", "animate_outlines", "ProgressBar", "chain",
+           "progress_bar"]

@@ -25,11 +25,13 @@ def _polylines(frame):
 
 
 def animate_outlines(frames, path, times=None, obstacles=(), closed=False, fps=20, title="",
-                     xlim=None, ylim=None, dpi=80):
+                     xlim=None, ylim=None, dpi=80, marks=None):
     """Draw the polylines of each frame (bodies' outlines, a beam's centreline) and save
     an animation to `path` (.gif or .mp4). `obstacles` are fixed polylines (rigid masters:
     RigidLine.outline(extent), RigidPolyline.outline(), RigidArc.outline()). `closed`
-    (bool or one bool per polyline) joins the last point to the first. Returns the path."""
+    (bool or one bool per polyline) joins the last point to the first. `marks`: per frame,
+    polylines drawn in red that move with a body (a spoke of a ring shows it turning).
+    Returns the path."""
     import matplotlib.pyplot as plt
     from matplotlib import animation
 
@@ -51,6 +53,9 @@ def animate_outlines(frames, path, times=None, obstacles=(), closed=False, fps=2
     if times is not None and len(times) != len(frames):
         raise ValueError(f"parameter times has {len(times)} entries for {len(frames)} frames")
     obstacles = [np.asarray(o, dtype=float) for o in obstacles]
+    marks = None if marks is None else [_polylines(m) for m in marks]
+    if marks is not None and len(marks) != len(frames):
+        raise ValueError(f"parameter marks has {len(marks)} entries for {len(frames)} frames")
     closed = [closed] * len(frames[0]) if isinstance(closed, bool) else list(closed)
 
     allpts = np.vstack([p for f in frames for p in f] + obstacles)
@@ -63,18 +68,24 @@ def animate_outlines(frames, path, times=None, obstacles=(), closed=False, fps=2
     ax.set_ylim(ylim or (lo[1] - pad, hi[1] + pad))
     for o in obstacles:
         ax.plot(o[:, 0], o[:, 1], color="0.3", lw=2)
+        if len(o) == 2 and abs(o[0, 1] - o[1, 1]) < 1e-12 * (1 + abs(o[0, 1])):   # a floor: hatch below it
+            ax.fill_between(o[:, 0], o[:, 1], o[:, 1] - pad, color="0.85", hatch="///", edgecolor="0.6", lw=0)
     lines = [ax.plot([], [], "-", lw=1.5)[0] for _ in frames[0]]
+    spokes = [ax.plot([], [], "-o", color="tab:red", lw=1.5, ms=3)[0] for _ in (marks[0] if marks else ())]
     label = ax.set_title(title)
 
     def draw(k):
         for line, p, c in zip(lines, frames[k], closed):
             q = np.vstack([p, p[:1]]) if c else p
             line.set_data(q[:, 0], q[:, 1])
+        for line, m in zip(spokes, marks[k] if marks else ()):
+            line.set_data(m[:, 0], m[:, 1])
         if times is not None:
             label.set_text(f"{title}  t = {times[k]:.4g}".strip())
         return lines
 
     path.parent.mkdir(parents=True, exist_ok=True)
+    ax.set_ylim(ylim or (lo[1] - pad, hi[1] + pad))
     with writer.saving(fig, str(path), dpi):
         for k in range(len(frames)):
             draw(k)

@@ -5,12 +5,19 @@
     res = load_run("ring.json")         # the same dict back, arrays as numpy arrays
 
 load_run also reads the JSON written by ``contactfem run SCENE --json FILE`` (where
-arrays were written as plain lists): there every rectangular list of numbers comes back
-as a numpy array (``arrays=False`` keeps lists). Files written by save_run come back
-exactly as saved: arrays as arrays, lists as lists.
+arrays were written as plain lists). Whatever the format, every rectangular list of
+numbers comes back as a numpy array (``arrays=False`` keeps such lists as lists); ragged
+lists stay lists. A file that is not a saved run (truncated, corrupt, another program's)
+raises one ValueError saying so; load_run never unpickles anything.
+
+save_run writes to a temporary file beside the target and renames it into place, so an
+interrupted save never leaves a half-written file.
 """
 
 import json
+import os
+import secrets
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -48,18 +55,49 @@ def _as_array(lst):
     """A rectangular list of numbers as an ndarray, else None."""
     try:
         a = np.array(lst)
-    except ValueError:                             # ragged
+    except (ValueError, TypeError, OverflowError):  # ragged, or not numbers
         return None
     return a if a.dtype.kind in "biuf" and a.size > 0 else None
+
+
+def as_arrays(obj):
+    """Every rectangular list of numbers in a nested dict/list as a numpy array (what
+    ``contactfem run --save`` stores, so that .npz files hold arrays natively)."""
+    if isinstance(obj, dict):
+        return {k: as_arrays(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        a = _as_array(obj)
+        return a if a is not None else [as_arrays(v) for v in obj]
+    return obj
+
+
+class _Foreign(Exception):
+    """Raised inside load_run for a file that is not a saved run; turned into ValueError."""
+
+
+_DTYPE_KINDS = "biufcU"          # numbers, booleans and text: never Python objects
+
+
+def _tagged(obj, arrays):
+    ref = obj[_TAG]
+    if isinstance(ref, str):
+        if ref not in arrays:
+            raise _Foreign(f"array {ref!r} is missing")
+        return arrays[ref]
+    try:
+        dtype = np.dtype(obj["dtype"])
+        if dtype.kind not in _DTYPE_KINDS:
+            raise _Foreign(f"an array has dtype {obj['dtype']!r}")
+        shape = tuple(int(n) for n in obj["shape"])
+        return np.array(ref, dtype=dtype).reshape(shape)
+    except (KeyError, TypeError, ValueError, OverflowError) as err:
+        raise _Foreign(f"a malformed array ({_one_line(err)})") from None
 
 
 def _decode(obj, arrays, to_arrays):
     if isinstance(obj, dict):
         if _TAG in obj:
-            ref = obj[_TAG]
-            if isinstance(ref, str):
-                return arrays[ref]
-            return np.array(ref, dtype=np.dtype(obj["dtype"])).reshape(obj["shape"])
+            return _tagged(obj, arrays)
         return {k: _decode(v, arrays, to_arrays) for k, v in obj.items()}
     if isinstance(obj, list):
         if to_arrays:
@@ -70,6 +108,13 @@ def _decode(obj, arrays, to_arrays):
     return obj
 
 
+def _one_line(err):
+    text = " ".join(str(err).split()) or type(err).__name__
+    if "pickle" in text.lower():                   # numpy's advice to allow pickles is unsafe: never pass it on
+        text = "it holds Python objects (pickled data), which load_run does not read"
+    return text[:200]
+
+
 def save_run(results, path):
     """Write a dict of results to `path` (.json or .npz). Returns the path as a string."""
     path = Path(path)
@@ -78,32 +123,69 @@ def save_run(results, path):
     if path.suffix not in (".json", ".npz"):
         raise ValueError(f"parameter path must end in .json or .npz, got {path.name!r}")
     path.parent.mkdir(parents=True, exist_ok=True)
-    if path.suffix == ".json":
-        doc = {"format": FORMAT, "results": _encode(results, "results", None)}
-        path.write_text(json.dumps(doc, indent=1, allow_nan=False))
-    elif path.suffix == ".npz":
-        arrays = {}
-        doc = {"format": FORMAT, "results": _encode(results, "results", arrays)}
-        np.savez_compressed(path, __json__=np.array(json.dumps(doc, allow_nan=False)), **arrays)
+    tmp = path.with_name(f".{path.stem}.{secrets.token_hex(4)}.part{path.suffix}")
+    try:
+        if path.suffix == ".json":
+            doc = {"format": FORMAT, "results": _encode(results, "results", None)}
+            tmp.write_text(json.dumps(doc, indent=1, allow_nan=False))
+        else:
+            arrays = {}
+            doc = {"format": FORMAT, "results": _encode(results, "results", arrays)}
+            np.savez_compressed(tmp, __json__=np.array(json.dumps(doc, allow_nan=False)), **arrays)
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
     return str(path)
 
 
-def load_run(path, arrays=None):
-    """Read results written by save_run (or by ``contactfem run --json``). `arrays`: turn
-    rectangular lists of numbers into numpy arrays (default: only for files not written
-    by save_run)."""
+def load_run(path, arrays=True):
+    """Read results written by save_run or by ``contactfem run --json/--save``.
+
+    Rectangular lists of numbers come back as numpy arrays (``arrays=False`` keeps them as
+    lists). Raises FileNotFoundError for a missing file and ValueError, one line, for any
+    file that is not a saved run (truncated, corrupt, written by something else)."""
     path = Path(path)
+    if path.suffix not in (".json", ".npz"):
+        raise ValueError(f"parameter path must end in .json or .npz, got {path.name!r}")
+    if not path.exists():
+        raise FileNotFoundError(f"no such file: {path}")
+    try:
+        return _load(path, bool(arrays))
+    except _Foreign as err:
+        raise ValueError(f"{path} is not a saved contactfem run: {err}") from None
+    except PermissionError:
+        raise
+    except Exception as err:          # a damaged file fails anywhere inside zipfile, zlib, numpy or json
+        raise ValueError(f"{path} is not a readable contactfem run (corrupt or truncated?): "
+                         f"{_one_line(err)}") from None
+
+
+def _load(path, to_arrays):
     if path.suffix == ".npz":
+        if not zipfile.is_zipfile(path):
+            raise _Foreign("it is not a zip archive, as every .npz file is (truncated, or another kind of file)")
         with np.load(path, allow_pickle=False) as z:
+            if "__json__" not in z.files:
+                raise _Foreign("the .npz file has no __json__ entry (written by something other than save_run)")
             doc = json.loads(str(z["__json__"]))
             stored = {k: z[k] for k in z.files if k != "__json__"}
-        return _decode(doc["results"], stored, bool(arrays))
-    if path.suffix != ".json":
-        raise ValueError(f"parameter path must end in .json or .npz, got {path.name!r}")
-    doc = json.loads(path.read_text())
-    if isinstance(doc, dict) and doc.get("format") == FORMAT:
-        return _decode(doc["results"], {}, bool(arrays))
-    return _decode(doc, {}, arrays is None or arrays)
+        for k, a in stored.items():
+            if a.dtype.kind not in _DTYPE_KINDS:
+                raise _Foreign(f"array {k!r} has dtype {a.dtype}")
+    else:
+        doc = json.loads(path.read_text())
+        stored = {}
+    if not isinstance(doc, dict):
+        raise _Foreign(f"the top level is a {type(doc).__name__}, not an object")
+    if "format" in doc:
+        if doc["format"] != FORMAT:
+            raise _Foreign(f"format {doc['format']!r}, expected {FORMAT!r}")
+        if not isinstance(doc.get("results"), dict):
+            raise _Foreign("it has no results")
+        return _decode(doc["results"], stored, to_arrays)
+    if path.suffix == ".json" and "scene" in doc:            # written by `contactfem run --json`
+        return _decode(doc, stored, to_arrays)
+    raise _Foreign("it has neither a 'format' (save_run) nor a 'scene' (contactfem run --json) entry")
 
 
 class Recorder:

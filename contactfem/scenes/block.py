@@ -124,11 +124,14 @@ PARAMS = (
     Param("m", 1.0, "", 1.0, doc="exponent of the normal law (eq 4); m = 1 is the penalty method (paper)"),
     Param("c_T", 1.0e4, "F/L^2", 0.0, low_open=True,
           doc="stick stiffness (eq 5), paper: c_T = 10^4; read per unit length (per node: FITTED against it)"),
-    Param("alpha", 0.2, "", 0.0, doc="eq 10 (paper: 0.2; conical: alpha + beta = 0.5)"),
-    Param("beta", 0.3, "", 0.0, doc="eq 10 (paper: 0.3)"),
+    Param("alpha", 0.2, "", 0.0, doc="eq 10 (paper: 0.2; conical: alpha + beta = 0.5)",
+          when=(("law", ("conical", "parabolic")),)),
+    Param("beta", 0.3, "", 0.0, doc="eq 10 (paper: 0.3)", when=(("law", ("conical", "parabolic")),)),
     Param("n", 0.5, "", 0.0, 1.0, low_open=True, doc="exponent of the parabolic slip surface (paper: 0.5); "
-                                                      "the conical law has n = 1"),
-    Param("mu", 0.3, "", 0.0, doc="Coulomb coefficient for law=coulomb (ours, not the paper's: 0.3, a wide slip zone)"),
+                                                      "the conical law has n = 1",
+          when=(("law", ("parabolic",)),)),
+    Param("mu", 0.3, "", 0.0, doc="Coulomb coefficient for law=coulomb (ours, not the paper's: 0.3, a wide slip zone)",
+          when=(("law", ("coulomb",)),)),
     Param("g_N0", -1.0e-12, "L", -1e-3, 0.0, high_open=True,
           doc="initial gap of the bottom nodes. Chosen: a touch (-1e-12) so the first Newton iterate has "
               "contact stiffness (at g_N = 0 the contact is inactive and the tangent singular)"),
@@ -153,6 +156,44 @@ def block_mesh(width, height, nx, ny):
         "left": lambda x: x[0] < tx,
         "right": lambda x: x[0] > width - tx,
     })
+
+
+def contact_length(params):
+    """Sum of the slave nodes' tributary lengths: the bottom without its free ends."""
+    return (params["nx"] - 2 * params["free_end_nodes"] + 1) * params["width"] / params["nx"]
+
+
+def friction_capacity(params):
+    """An upper bound of the total friction force the foundation can carry, sum w Y(p_i),
+    given that the pressures balance the top load, sum w p_i = p_y width =: N (eqs 10-11).
+    Coulomb / conical: mu N exactly. Parabolic: alpha sum w p^n <= alpha L^(1-n) N^n
+    (Jensen: p^n is concave for n <= 1, L the contact length), plus beta N."""
+    N = params["p_y"] * params["width"]
+    if params["law"] == "coulomb":
+        return params["mu"] * N, f"mu p_y width with mu = {params['mu']:g}"
+    if params["law"] == "conical":
+        return (params["alpha"] + params["beta"]) * N, f"(alpha + beta) p_y width = {params['alpha'] + params['beta']:g} p_y width"
+    L, n = contact_length(params), params["n"]
+    return params["alpha"] * L ** (1 - n) * N ** n + params["beta"] * N, "alpha L^(1-n) (p_y width)^n + beta p_y width, at most"
+
+
+def check(params):
+    """Before any solve: the ends kept free must leave contact nodes, and the static problem
+    must have a solution (the block is held by friction alone)."""
+    k, nx = params["free_end_nodes"], params["nx"]
+    if not 2 * k < nx:
+        raise ValueError(f"parameter free_end_nodes = {k} is out of range: allowed [1, {(nx - 1) // 2}] for nx = {nx}")
+    if params["material"] == "linear":           # dead loads: the applied forces are known beforehand
+        T = abs(params["p_x"]) * params["height"]
+        cap, how = friction_capacity(params)
+        if T > cap * (1 + 1e-9):
+            raise ValueError(f"no static equilibrium: the tangential load |p_x| height = {T:.4g} exceeds the friction "
+                             f"capacity {cap:.4g} ({how}, law = {params['law']}); lower p_x or raise the friction")
+
+
+def size(params):
+    nx, ny = params["nx"], params["ny"]
+    return dict(elements=nx * ny, unknowns=2 * (nx + 1) * (ny + 1), steps=params["n_steps"])
 
 
 def per_length(params):
@@ -304,4 +345,6 @@ SCENE = Scene(
            "Fig 8's remark is reproduced by no block-shaped reading."),
     reports=("newton_residuals", "iterations", "total_normal", "total_tangential", "equilibrium_error",
              "n_stick", "n_slip", "contact"),
+    check=check,
+    size=size,
 )

@@ -513,6 +513,10 @@ SCENE = Scene(
         # above the applied 0.8 MPa and it leaves by a different, dynamic mechanism); coarser in time
         "fast": dict(n_press=8, dt_fine=2e-5, t_after=1e-4, travel_max=1.0),
     },
+    # steps: the press fit, then at most t_end / dt_fine (the adaptive step never goes below dt_fine)
+    size=lambda p: dict(elements=p["n_r"] * p["n_z"], unknowns=2 * (p["n_r"] + 1) * (p["n_z"] + 1),
+                        steps=p["n_press"] + p["t_end"] / p["dt_fine"]),
+    outlines=True,
     reports=("exit_velocity_m_s", "exit_time_ms", "breakaway_pressure_MPa", "breakaway_margin_MPa",
              "press_fit_calibrated", "press_fit_normal_force_N",
              "max_penetration_ratio", "newton_iterations_total"),

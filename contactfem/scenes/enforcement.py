@@ -15,8 +15,10 @@ ENFORCEMENT_PARAMS = (
               "(c_N, c_T become numerical parameters; a power law with m != 1 stays a constitutive law)"),
     Param("uzawa_tol", 1e-9, "", 0.0, 1e-2, low_open=True,
           doc="augmented: stop when the largest multiplier change / c (the penetration at an active node, "
-              "the stick creep at a sticking one), divided by the scene's length, is <= uzawa_tol"),
-    Param("uzawa_max_updates", 200, "", 0, 100000, doc="augmented: multiplier updates allowed per step"),
+              "the stick creep at a sticking one), divided by the scene's length, is <= uzawa_tol",
+          when=(("enforcement", ("augmented",)),)),
+    Param("uzawa_max_updates", 200, "", 0, 100000, doc="augmented: multiplier updates allowed per step",
+          when=(("enforcement", ("augmented",)),)),
 )
 
 

@@ -34,8 +34,10 @@ import numpy as np
 from ..bodies.ring import RingRecorder, make_ring
 from ..contact import NodeToSegment, RigidPolyline
 from ..laws import ParabolicSlip, PowerLaw
-from ..solver import Dirichlet, Newmark, System, integrate
+from ..solver import Dirichlet, System, integrate
+from . import time_integration
 from .base import Param, Scene
+from .rolling_ring import ring_size
 from .sloping_impact import RING_PARAMS
 
 VARIANTS = ("frictionless", "frictional")
@@ -84,8 +86,7 @@ def run(params, progress=None, normal=None, friction=None):
     contact.initialize(u0)
     rec = RingRecorder(ring, contact, every=params["outline_every"], mirror=True,
                        measures=dict(deformation=lambda u, v: radial_deviation(ring, u, ring.center_of_mass(u))))
-    stepper = Newmark(system, params["dt"], params["delta"], params["beta_newmark"],
-                      atol=1e-10, rtol=1e-10, maxit=30)
+    stepper = time_integration.make_stepper(params, system, params["dt"], atol=1e-10, rtol=1e-10, maxit=30)
     hist = integrate(stepper, 0.0, u0, v0, n_steps=params["n_steps"], recorder=rec, cutback=True, max_cuts=6,
                      progress=progress)
     rec = rec.arrays()
@@ -111,10 +112,12 @@ def run(params, progress=None, normal=None, friction=None):
         v_c_final=float(v_c[-1]), y_c_final=float(y_c[-1]),
         slipping_nodes_final=int(rec["n_slip"][-1]), contact_nodes_final=int(n_contact[-1]),
         contact_final=contact_final,
+        energy_error=time_integration.energy_error(hist)[0],
         energy_kinetic=hist.kinetic, energy_strain=hist.strain, energy_contact=hist.contact,
         energy_dissipation=hist.dissipation, energy_total=mech,
         outlines=np.array(rec["outlines"]), outline_t=np.array(rec["outline_t"]),
         wall=m["wall"].points,
+        obstacles=[m["wall"].points, m["wall"].points * [-1.0, 1.0]],     # the wall and its mirror image
         newton_iterations_total=int(np.sum(hist.iterations)),
         step_cuts_total=int(np.sum(hist.cuts)),
     )
@@ -128,26 +131,30 @@ SCENE = Scene(
               doc="frictionless (Fig 12: rebounds) or frictional eq (10) (Fig 13: sticks)"),
         *RING_PARAMS,                      # "the same ring as in Sec. 5.3" (half of it, by symmetry)
         Param("n_el", 30, "", 2, 2000, doc="elements on the half ring (paper: 30 beam elements)"),
-        Param("v0", 4.0, "", 0.0, None, low_open=True, doc="initial downward speed (paper)"),
+        Param("v0", 4.0, "L/T", 0.0, None, low_open=True, doc="initial downward speed (paper)"),
         Param("phi_deg", 20.0, "deg", 0.0, 90.0, low_open=True, high_open=True,
               doc="funnel wall angle from the vertical (chosen: scan lost it; 20 deg sticks with friction "
                   "because tan(phi) = 0.36 < mu_eff of eq (10) at the light pressures, and rebounds without)"),
-        Param("wall_length", 45.0, "", 0.0, None, low_open=True, doc="length of the funnel wall (chosen)"),
-        Param("gap0", 0.2, "", 0.0, None, doc="initial clearance of the outer surface from the wall (chosen)"),
-        Param("c_N", 10.0, "", 0.0, None, low_open=True, doc="normal penalty, nodal stiffness, eq (4) (paper)"),
+        Param("wall_length", 45.0, "L", 0.0, None, low_open=True, doc="length of the funnel wall (chosen)"),
+        Param("gap0", 0.2, "L", 0.0, None, doc="initial clearance of the outer surface from the wall (chosen)"),
+        Param("c_N", 10.0, "F/L", 0.0, None, low_open=True, doc="normal penalty, nodal stiffness, eq (4) (paper)"),
         Param("m", 1.0, "", 1.0, None, doc="exponent of the normal law eq (4) (paper)"),
-        Param("c_T", 5.0, "", 0.0, None, low_open=True, doc="tangential stick stiffness, nodal, eq (5) (paper)"),
-        Param("n", 0.75, "", 0.0, 1.0, low_open=True, doc="exponent of the slip surface eq (10) (paper)"),
-        Param("alpha", 0.3, "", 0.0, None, doc="alpha of the slip surface eq (10) (paper)"),
-        Param("beta", 0.1, "", 0.0, None, doc="beta of the slip surface eq (10) (paper)"),
-        Param("dt", 0.1, "", 0.0, None, low_open=True, doc="time step (paper)"),
+        Param("c_T", 5.0, "F/L", 0.0, None, low_open=True, doc="tangential stick stiffness, nodal, eq (5) (paper)",
+              when=(("variant", ("frictional",)),)),
+        Param("n", 0.75, "", 0.0, 1.0, low_open=True, doc="exponent of the slip surface eq (10) (paper)", when=(("variant", ("frictional",)),)),
+        Param("alpha", 0.3, "F^(1-n)", 0.0, None, doc="alpha of the slip surface eq (10) (paper)", when=(("variant", ("frictional",)),)),
+        Param("beta", 0.1, "", 0.0, None, doc="beta of the slip surface eq (10) (paper)", when=(("variant", ("frictional",)),)),
+        Param("dt", 0.1, "T", 0.0, None, low_open=True, doc="time step (paper)"),
         Param("n_steps", 150, "", 4, 100000,
               doc="number of steps (chosen: the scan gives none; 150 covers the impact and 7 s after it)"),
         Param("delta", 0.7, "", 0.5, 1.0, doc="Newmark delta (chosen as in Sec. 5.3: 0.7)"),
         Param("beta_newmark", 0.4, "", 0.0, 0.5, low_open=True, doc="Newmark beta (chosen as in Sec. 5.3: 0.4)"),
+        time_integration.CONTACT_INTEGRATION_PARAM,
         Param("outline_every", 5, "", 1, 100000, doc="store the ring outline every this many steps (paper: 5)"),
     ),
     run=run,
     presets={"fast": {}, "paper": {}},   # 30 elements, 150 steps: about a second
     reports=("stuck", "y_c_min", "v_c_final", "max_deformation", "newton_iterations_total"),
+    size=lambda p: dict(ring_size(p, half=True), steps=p["n_steps"]),
+    outlines=True,
 )

@@ -228,4 +228,5 @@ SCENE = Scene(
     run=run,
     presets={"fast": {"n_el": 32}, "paper": {"n_el": 64}},
     reports=("a", "p0", "a_exact", "p0_exact", "error_a", "error_p0"),
+    size=lambda p: dict(elements=p["n_el"] ** 2, unknowns=2 * (p["n_el"] + 1) ** 2, steps=p["n_steps"]),
 )

@@ -198,5 +198,7 @@ SCENE = Scene(
     ),
     run=run,
     presets={"fast": {}, "paper": {"nx_lower": 8, "nx_upper": 13, "ny": 4}},
+    size=lambda p: dict(elements=(p["nx_lower"] + 1 + p["nx_upper"]) * p["ny"],
+                        unknowns=2 * (p["nx_lower"] + 3 + p["nx_upper"]) * (p["ny"] + 1), steps=1),
     reports=("pressure_deviation_max", "stress_deviation_max", "load_carried", "load_applied"),
 )

@@ -53,12 +53,16 @@ import numpy as np
 from ..bodies.ring import RingRecorder, make_ring
 from ..contact import NodeToSegment, RigidLine
 from ..laws import Coulomb, PowerLaw
-from ..solver import Newmark, System, integrate
+from ..solver import System, integrate
+from . import time_integration
 from .base import Param, Scene
 
 # Paper, Fig 9 (bracketed values are the rigid thin-ring solution)
 PAPER = dict(x_roll_exact=229.0, x_roll_computed="23x (scan)", x_end_exact=376.0, x_end_computed=382.0,
              v_final=150.0)
+
+
+ANIMATION_FRAMES = 120     # frames of the run --gif animation (one every few steps)
 
 
 def rigid_ring_exact(v0, mu, g, a, k2=None, t=None):
@@ -136,13 +140,29 @@ def run(params, progress=None, normal=None, friction=None):
     contact.initialize(u0)
 
     nodes = ring.body.xdofs[ring.contact_nodes]          # (u_x, u_y) dofs of the contact nodes
+    # the animation (run --gif): about ANIMATION_FRAMES outlines at most ~60 points each, and a
+    # spoke from the centre to one point of the ring, so that rolling is told from sliding
+    n_steps = int(np.ceil(params["t_end"] / params["dt"] - 1e-9))
+    anim_every = max(1, int(np.ceil(n_steps / ANIMATION_FRAMES)))
+    n_out = len(ring.outline(u0)) - 1
+    pick = np.unique(np.r_[np.arange(0, n_out, max(1, n_out // 60)), n_out])
+    anim = dict(t=[], outlines=[], marks=[], count=0)
+
+    def record_animation(t, u, v=None, a=None):
+        if anim["count"] % anim_every == 0:
+            out = ring.outline(u)
+            anim["t"].append(t)
+            anim["outlines"].append(out[pick])
+            anim["marks"].append([np.vstack([ring.center_of_mass(u), out[0]])])
+        anim["count"] += 1
+
+    record_animation(0.0, u0)
     rec = RingRecorder(ring, interval=params["outline_interval"], tol=1e-6 * params["dt"], snapshot_measures=dict(
         node_y=lambda u, v: ring.body.X[ring.contact_nodes, 1] + u[nodes[:, 1]],   # velocity profile
         node_vx=lambda u, v: v[nodes[:, 0]]))
-    stepper = Newmark(system, params["dt"], params["delta"], params["beta_newmark"],
-                      atol=1e-6, rtol=1e-10, maxit=30)
+    stepper = time_integration.make_stepper(params, system, params["dt"], atol=1e-6, rtol=1e-10, maxit=30)
     hist = integrate(stepper, 0.0, u0, vel0, t_end=params["t_end"], recorder=rec, cutback=True, max_cuts=8,
-                     progress=progress)
+                     progress=progress, callback=record_animation)
     rec = rec.arrays()
 
     t, xc, vc, omega = rec["t"], rec["x_c"], rec["v_c"], rec["omega"]
@@ -157,6 +177,9 @@ def run(params, progress=None, normal=None, friction=None):
     else:
         v_final, omega_final = float(vc[-1, 0]), float(omega[-1])
 
+    floor = np.array([[xc[:, 0].min() - 1.2 * params["R"], 0.0], [xc[:, 0].max() + 1.2 * params["R"], 0.0]])
+    animation = dict(t=np.array(anim["t"]), outlines=np.array(anim["outlines"]), marks=np.array(anim["marks"]),
+                     obstacles=[floor])
     mu, g = params["mu"], params["g"]
     hoop = rigid_ring_exact(v0, mu, g, params["R"], t=t)   # the paper's thin hoop
     # the rigid ring of this model: lever arm a, gyration radius from the lumped masses
@@ -179,11 +202,23 @@ def run(params, progress=None, normal=None, friction=None):
         outlines=rec["outlines"], outline_t=rec["outline_t"],
         outline_vc=vc[rec["outline_k"]], outline_omega=omega[rec["outline_k"]],
         outline_node_y=rec["outline_node_y"], outline_node_vx=rec["outline_node_vx"],
+        energy_error=time_integration.energy_error(hist)[0],
         energy_kinetic=hist.kinetic, energy_strain=hist.strain, energy_dissipation=hist.dissipation,
+        animation=animation, obstacles=[floor],
         newton_iterations_total=int(np.sum(hist.iterations)),
         step_cuts_total=int(np.sum(hist.cuts)),
     )
     return out
+
+
+def ring_size(p, half=False):
+    """Elements and unknowns of the ring of make_ring (beam: 3 dofs a node; continuum: an
+    annulus of n_el x n_radial quads)."""
+    n = p["n_el"]
+    if p["kind"] == "beam":
+        return dict(elements=n, unknowns=3 * (n + (1 if half else 0)))
+    nr = p.get("n_radial", 2)
+    return dict(elements=n * nr, unknowns=2 * (n + (1 if half else 0)) * (nr + 1))
 
 
 def ring_gyration_radius2(ring):
@@ -216,7 +251,8 @@ SCENE = Scene(
         Param("rho", 7.85e-8, "kN s^2/cm^4", 0.0, None, low_open=True,
               doc="density (scan lost the exponent: steel 7850 kg/m^3 = 7.85e-8 kN s^2/cm^4)"),
         Param("n_el", 120, "", 8, 4000, doc="elements around the ring (paper: 120)"),
-        Param("n_radial", 2, "", 1, 20, doc="continuum only: elements through the wall (chosen)"),
+        Param("n_radial", 2, "", 1, 20, doc="continuum only: elements through the wall (chosen)",
+              when=(("kind", ("continuum",)),)),
         Param("v0", 300.0, "cm/s", 0.0, None, low_open=True, doc="initial velocity along the plane, no spin (paper)"),
         Param("g", 981.0, "cm/s^2", 0.0, None, low_open=True, doc="gravity (paper: 'gravity')"),
         Param("mu", 0.15, "", 0.0, None, low_open=True, doc="Coulomb friction coefficient, eq (11) (paper)"),
@@ -227,11 +263,12 @@ SCENE = Scene(
               doc="tangential stick stiffness, nodal, eq (5). Chosen: the scan's 'lo*' reads 10^2 by the rule "
                   "of lecture 04; 1 (stick slip mu W/c_T ~ 0.04 cm) gives the same motion without the hundreds "
                   "of step cutbacks of 100 (lecture 05 compares them)"),
-        Param("dt", 0.01, "s", 0.0, 0.1, low_open=True, doc="time step (paper: 0.01)"),
+        Param("dt", 0.01, "s", 0.0, None, low_open=True, doc="time step (paper: 0.01)"),
         Param("t_end", 2.0, "s", 0.0, None, low_open=True,
               doc="duration (chosen: 2 s, where the paper's exact position is 376 cm)"),
         Param("delta", 0.7, "", 0.5, 1.0, doc="Newmark delta (paper: 0.7)"),
         Param("beta_newmark", 0.4, "", 0.0, 0.5, low_open=True, doc="Newmark beta (paper: 0.4)"),
+        time_integration.CONTACT_INTEGRATION_PARAM,
         Param("outline_interval", 0.25, "s", 0.0, None, low_open=True,
               doc="store the ring outline this often (figures)"),
     ),
@@ -239,4 +276,6 @@ SCENE = Scene(
     presets={"fast": {"n_el": 40, "dt": 0.02}, "paper": {"n_el": 120, "dt": 0.01}},
     reports=("t_roll", "x_roll", "x_roll_exact", "v_final", "v_final_exact", "omega_final",
              "x_end", "x_end_exact", "newton_iterations_total"),
+    size=lambda p: dict(ring_size(p), steps=p["t_end"] / p["dt"]),
+    outlines=True,
 )

@@ -33,7 +33,9 @@ import numpy as np
 from ..bodies.ring import RingRecorder, make_ring
 from ..contact import NodeToSegment, RigidLine, tributary_lengths
 from ..laws import ParabolicSlip, PowerLaw
-from ..solver import Newmark, System, integrate
+from ..solver import System, integrate
+from . import time_integration
+from .rolling_ring import ring_size
 from .base import Param, Scene
 
 VARIANTS = ("frictionless", "frictional", "viscoplastic")
@@ -48,6 +50,11 @@ PAPER_TABLE2 = {
 def rebound_angle(vx, vy):
     """Angle of reflection from the plane's normal (Table 2): atan(|v_x| / |v_y|) in degrees."""
     return float(np.degrees(np.arctan2(abs(vx), abs(vy))))
+
+
+def check(params):
+    if params["variant"] == "viscoplastic" and params["kind"] != "beam":
+        raise ValueError("parameter variant = 'viscoplastic' needs kind = 'beam' (the continuum ring is elastic)")
 
 
 def integration_points(params):
@@ -98,8 +105,7 @@ def run(params, progress=None, normal=None, friction=None):
     contact.initialize(u0)
     rec = RingRecorder(ring, contact, every=params["outline_every"])
     system.set_dt(params["dt"])            # the viscoplastic beam needs dt before the first evaluation
-    stepper = Newmark(system, params["dt"], params["delta"], params["beta_newmark"],
-                      atol=1e-10, rtol=1e-10, maxit=30)
+    stepper = time_integration.make_stepper(params, system, params["dt"], atol=1e-10, rtol=1e-10, maxit=30)
     hist = integrate(stepper, 0.0, u0, v0, n_steps=params["n_steps"], recorder=rec, cutback=True, max_cuts=6,
                      progress=progress)
     rec = rec.arrays()
@@ -126,7 +132,10 @@ def run(params, progress=None, normal=None, friction=None):
         energy_total_max_rel_change_impact=float(np.max(np.abs(mech[window] - E0)) / E0),
         energy_total_max_rel_increase_per_step=float(np.max(np.diff(mech)) / E0),
         energy_total_final_rel=float(mech[-1] / E0),
+        energy_error=time_integration.energy_error(hist)[0], energy_error_max=time_integration.energy_error(hist)[1],
+        energy_after_rebound_rel=float(mech[-1] / E0 - 1.0) if rebounded else None,
         outlines=rec["outlines"], outline_t=rec["outline_t"], outline_spin=omega,
+        obstacles=[np.array([[x_c[:, 0].min() - 1.5 * params["R"], 0.0], [x_c[:, 0].max() + 1.5 * params["R"], 0.0]])],
         mass=ring.total_mass(),
         # committed plastic strains of the beam (eps_p, gam_p, kap_p): the permanent deformation
         plastic_strain_max=np.max(np.abs(getattr(ring.body, "ep", np.zeros((1, 3)))), axis=0),
@@ -146,12 +155,13 @@ def run(params, progress=None, normal=None, friction=None):
 RING_PARAMS = (
     Param("kind", "beam", choices=("beam", "continuum"),
           doc="beam: the paper's finite-deformation beam; continuum: annulus of quads (plane strain, SVK)"),
-    Param("R", 10.0, "", 0.0, None, low_open=True, doc="mean radius of the ring (paper, Sec. 5.3)"),
-    Param("thickness", 1.0, "", 0.0, None, low_open=True, doc="radial wall thickness h (paper: square section A = 1)"),
-    Param("width", 1.0, "", 0.0, None, low_open=True, doc="out-of-plane depth b (paper: square section A = 1)"),
-    Param("E", 100.0, "", 0.0, None, low_open=True, doc="Young's modulus (paper)"),
+    Param("R", 10.0, "L", 0.0, None, low_open=True, doc="mean radius of the ring (paper, Sec. 5.3). The paper gives no "
+          "units: any consistent set of length L, time T, force F (mass M = F T^2 / L)"),
+    Param("thickness", 1.0, "L", 0.0, None, low_open=True, doc="radial wall thickness h (paper: square section A = 1)"),
+    Param("width", 1.0, "L", 0.0, None, low_open=True, doc="out-of-plane depth b (paper: square section A = 1)"),
+    Param("E", 100.0, "F/L^2", 0.0, None, low_open=True, doc="Young's modulus (paper)"),
     Param("nu", 0.0, "", -1.0, 0.5, low_open=True, high_open=True, doc="Poisson's ratio (paper)"),
-    Param("rho", 0.01, "", 0.0, None, low_open=True, doc="density (paper)"),
+    Param("rho", 0.01, "M/L^3", 0.0, None, low_open=True, doc="density (paper)"),
 )
 
 SCENE = Scene(
@@ -162,11 +172,11 @@ SCENE = Scene(
               doc="frictionless (Fig 10), frictional eq (10) (Fig 11a), viscoplastic + frictional (Fig 11b)"),
         *RING_PARAMS,
         Param("n_el", 16, "", 3, 2000, doc="elements around the ring (paper: 16 linear beam elements)"),
-        Param("vx0", 2.0, "", doc="initial velocity along the plane (paper)"),
-        Param("vy0", -2.0, "", None, 0.0, high_open=True, doc="initial velocity normal to the plane, < 0 (paper)"),
-        Param("gap0", 0.05, "", 0.0, None,
+        Param("vx0", 2.0, "L/T", doc="initial velocity along the plane (paper)"),
+        Param("vy0", -2.0, "L/T", None, 0.0, high_open=True, doc="initial velocity normal to the plane, < 0 (paper)"),
+        Param("gap0", 0.05, "L", 0.0, None,
               doc="initial clearance of the outer surface above the plane (chosen: the paper starts 'just above')"),
-        Param("c_N", 50.0, "", 0.0, None, low_open=True, doc="normal penalty, eq (4) (paper: 50)"),
+        Param("c_N", 50.0, "F/L", 0.0, None, low_open=True, doc="normal penalty, eq (4) (paper: 50)"),
         Param("penalty", "per_node", choices=("per_node", "per_length"),
               doc="unit of c_N and c_T (the scan gives none): per_node = nodal stiffnesses (weights 1), "
                   "per_length = per unit length of the outer surface (weights = tributary lengths, 4.1)"),
@@ -182,20 +192,22 @@ SCENE = Scene(
         Param("rotary_inertia", True, "",
               doc="beam: rho I on the rotation dofs of the lumped mass (the scan does not say)"),
         Param("m", 1.0, "", 1.0, None, doc="exponent of the normal law eq (4) (paper)"),
-        Param("c_T", 30.0, "", 0.0, None, low_open=True, doc="tangential stick stiffness, nodal, eq (5) (paper)"),
-        Param("n", 0.8, "", 0.0, 1.0, low_open=True, doc="exponent of the slip surface eq (10) (paper)"),
-        Param("alpha", 0.2, "", 0.0, None, doc="alpha of the slip surface eq (10) (paper)"),
-        Param("beta", 0.3, "", 0.0, None, doc="beta of the slip surface eq (10) (paper)"),
-        Param("N0", 1.0, "", 0.0, None, low_open=True, doc="plastic axial force (paper, viscoplastic variant)"),
-        Param("Q0", 0.5, "", 0.0, None, low_open=True, doc="plastic shear force (paper, viscoplastic variant)"),
-        Param("M0", 0.25, "", 0.0, None, low_open=True, doc="plastic moment (paper, viscoplastic variant)"),
-        Param("eta", 0.1, "", 0.0, None, low_open=True,
+        Param("c_T", 30.0, "F/L", 0.0, None, low_open=True, doc="tangential stick stiffness, nodal, eq (5) (paper)",
+              when=(("variant", ("frictional", "viscoplastic")),)),
+        Param("n", 0.8, "", 0.0, 1.0, low_open=True, doc="exponent of the slip surface eq (10) (paper)", when=(("variant", ("frictional", "viscoplastic")),)),
+        Param("alpha", 0.2, "F^(1-n)", 0.0, None, doc="alpha of the slip surface eq (10) (paper)", when=(("variant", ("frictional", "viscoplastic")),)),
+        Param("beta", 0.3, "", 0.0, None, doc="beta of the slip surface eq (10) (paper)", when=(("variant", ("frictional", "viscoplastic")),)),
+        Param("N0", 1.0, "F", 0.0, None, low_open=True, doc="plastic axial force (paper, viscoplastic variant)", when=(("variant", ("viscoplastic",)),)),
+        Param("Q0", 0.5, "F", 0.0, None, low_open=True, doc="plastic shear force (paper, viscoplastic variant)", when=(("variant", ("viscoplastic",)),)),
+        Param("M0", 0.25, "F L", 0.0, None, low_open=True, doc="plastic moment (paper, viscoplastic variant)", when=(("variant", ("viscoplastic",)),)),
+        Param("eta", 0.1, "T", 0.0, None, low_open=True, when=(("variant", ("viscoplastic",)),),
               doc="Perzyna relaxation time (chosen: scan lost it; eta = dt = 0.1 makes the overstress relax "
                   "within about one step, nearly rate-independent plasticity with a regular tangent)"),
-        Param("dt", 0.1, "", 0.0, None, low_open=True, doc="time step (paper)"),
+        Param("dt", 0.1, "T", 0.0, None, low_open=True, doc="time step (paper)"),
         Param("n_steps", 200, "", 1, 100000, doc="number of steps (paper: 200)"),
         Param("delta", 0.7, "", 0.5, 1.0, doc="Newmark delta (paper: 0.7; 0.5 with beta 0.25 conserves energy)"),
         Param("beta_newmark", 0.4, "", 0.0, 0.5, low_open=True, doc="Newmark beta (paper: 0.4)"),
+        time_integration.CONTACT_INTEGRATION_PARAM,
         Param("outline_every", 20, "", 1, 100000, doc="store the ring outline every this many steps (figures)"),
     ),
     run=run,
@@ -210,4 +222,7 @@ SCENE = Scene(
            "frictional 1.02, 1.40, 36.0 deg; paper 1.7, 50 and 1.2, 1.7, 35). No reading tried reaches all "
            "six numbers: see the README."),
     reports=("rebound_vx", "rebound_vy", "rebound_angle_deg", "rebound_spin", "newton_iterations_total"),
+    check=check,
+    size=lambda p: dict(ring_size(p), steps=p["n_steps"]),
+    outlines=True,
 )

@@ -238,7 +238,9 @@ def integrate(stepper, t0, u0, v0=None, n_steps=None, t_end=None, callback=None,
     External work is summed with the trapezoidal rule, 1/2 (F_n + F_n+1) . (u_n+1 - u_n),
     over the loads P and the support reactions (the prescribed-dof part of G).
     Returns a History (``failures`` lists the first line of every failed Newton solve);
-    a NewtonError that ends the run carries the History so far as ``error.partial``.
+    a NewtonError that ends the run carries the History so far as ``error.partial``. A
+    KeyboardInterrupt (Ctrl-C) leaves with the time reached and the step in progress as its
+    attributes t, step and n_steps (None with an adaptive dt_rule).
     """
     s = stepper.system
     if (n_steps is None) == (t_end is None):
@@ -313,41 +315,48 @@ def integrate(stepper, t0, u0, v0=None, n_steps=None, t_end=None, callback=None,
         if recorder is not None:
             recorder(t, u, v, a, Step(k, h, result, cuts))
 
-    t = t0
-    if dt_rule is None:
-        for k in range(1, n_steps + 1):
-            if stop is not None and stop(t, u, v, a):
-                break
-            if before_step is not None:
-                before_step(t, u, v, a)
-            t_target = min(t0 + k * DT, t_end)
-            h, cuts = t_target - t, 0
-            while t < t_target - 1e-12 * DT:
-                h = min(h, t_target - t)
-                step = attempt(t, h, k, cuts)
-                if step is None:
-                    h, cuts = h / 2, cuts + 1
-                    continue
-                t = t_target if t_target - (t + h) < 1e-12 * DT else t + h
-                accept(t, h, k, cuts, step)
-    else:
-        k, last = 0, None
-        while t < t_end - 1e-9 * (t_end - t0):
-            if stop is not None and stop(t, u, v, a):
-                break
-            if before_step is not None:
-                before_step(t, u, v, a)
-            h = float(dt_rule(t, u, v, a))
-            _check_dt(h)
-            if growth is not None and last is not None:
-                h = min(h, growth * last)
-            h, cuts, k = min(h, t_end - t), 0, k + 1
-            while True:
-                step = attempt(t, h, k, cuts)
-                if step is not None:
+    t, k = t0, 0
+    try:
+        if dt_rule is None:
+            for k in range(1, n_steps + 1):
+                if stop is not None and stop(t, u, v, a):
                     break
-                h, cuts = h / 2, cuts + 1
-            t, last = t + h, h
-            accept(t, h, k, cuts, step)
+                if before_step is not None:
+                    before_step(t, u, v, a)
+                t_target = min(t0 + k * DT, t_end)
+                h, cuts = t_target - t, 0
+                while t < t_target - 1e-12 * DT:
+                    h = min(h, t_target - t)
+                    step = attempt(t, h, k, cuts)
+                    if step is None:
+                        h, cuts = h / 2, cuts + 1
+                        continue
+                    t = t_target if t_target - (t + h) < 1e-12 * DT else t + h
+                    accept(t, h, k, cuts, step)
+        else:
+            k, last = 0, None
+            while t < t_end - 1e-9 * (t_end - t0):
+                if stop is not None and stop(t, u, v, a):
+                    break
+                if before_step is not None:
+                    before_step(t, u, v, a)
+                h = float(dt_rule(t, u, v, a))
+                _check_dt(h)
+                if growth is not None and last is not None:
+                    h = min(h, growth * last)
+                h, cuts, k = min(h, t_end - t), 0, k + 1
+                while True:
+                    step = attempt(t, h, k, cuts)
+                    if step is not None:
+                        break
+                    h, cuts = h / 2, cuts + 1
+                t, last = t + h, h
+                accept(t, h, k, cuts, step)
+    except KeyboardInterrupt as interrupt:     # Ctrl-C: say where (the innermost loop names it)
+        if not hasattr(interrupt, "step"):
+            interrupt.t, interrupt.step = t, k
+            interrupt.n_steps = n_steps if dt_rule is None else None
+        close()
+        raise
     close()
     return hist.finish(u, v, a)

@@ -36,7 +36,8 @@ ORDERING = "MMD_AT_PLUS_A"
 
 class NewtonError(RuntimeError):
     """Newton did not converge. ``history`` holds the (finite) residual norms of
-    all iterations done, ``label`` names the step/time."""
+    all iterations done, ``label`` names the step/time (the message states the cause
+    only: print ``history`` to see the residuals)."""
 
     def __init__(self, message, history, label=""):
         super().__init__(message)
@@ -98,7 +99,7 @@ def newton(fun, u0, free, atol=1e-10, rtol=1e-10, maxit=25, label="", line_searc
         evaluated = None
         r = float(np.linalg.norm(G[free]))
         if not np.isfinite(r):
-            raise NewtonError(f"Newton: residual is NaN/inf at iteration {k}{where}", history, label)
+            raise NewtonError(f"Newton: non-finite residual at iteration {k}{where}", history, label)
         history.append(r)
         if r <= atol + rtol * history[0]:
             return NewtonResult(u=u, residuals=history, iterations=k, G=G)
@@ -127,5 +128,4 @@ def newton(fun, u0, free, atol=1e-10, rtol=1e-10, maxit=25, label="", line_searc
         else:
             u[free] += du
 
-    raise NewtonError(f"Newton: no convergence in {maxit} iterations{where}; "
-                      f"residuals {', '.join(f'{x:.3e}' for x in history)}", history, label)
+    raise NewtonError(f"Newton: no convergence in {maxit} iterations{where}", history, label)

@@ -51,12 +51,6 @@ class UzawaResult:
     gap_violations: list = field(default_factory=list)
 
 
-def _check(name, value, low, high=None):
-    if not (np.isfinite(value) and value >= low and (high is None or value <= high)):
-        hi = "inf" if high is None else f"{high:g}"
-        raise ValueError(f"parameter {name} = {value!r} is out of range: allowed [{low:g}, {hi})")
-
-
 class Uzawa:
     """Wraps a stepper (Static or Newmark) with the outer loop (module docstring).
 
@@ -67,10 +61,9 @@ class Uzawa:
     """
 
     def __init__(self, stepper, contacts, length, tol=1e-9, max_updates=50):
-        _check("uzawa_tol", tol, 0.0)
-        _check("length", length, 0.0)
-        if not length > 0:
-            raise ValueError(f"parameter length = {length!r} is out of range: allowed (0, inf)")
+        for name, value in (("uzawa_tol", tol), ("length", length)):
+            if not (np.isfinite(value) and value > 0):
+                raise ValueError(f"parameter {name} = {value!r} is out of range: allowed (0, inf)")
         if int(max_updates) != max_updates or max_updates < 0:
             raise ValueError(f"parameter uzawa_max_updates = {max_updates!r} is out of range: allowed integers >= 0")
         self.stepper, self.length, self.tol, self.max_updates = stepper, float(length), float(tol), int(max_updates)

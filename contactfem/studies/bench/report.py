@@ -6,6 +6,7 @@ from pathlib import Path
 import numpy as np
 
 from .common import TARGETS
+from .enforcement import enforcement_markdown
 
 def _f(x, fmt="{:.3g}"):
     if x is None:
@@ -148,6 +149,8 @@ def write_markdown(res):
               f"Hertz on {h['n_quads']} quads: p0 error {h['error_p0']:+.2%} (target 0.5 %: {_f(h['p0_within'])}), "
               f"solve {_f(h['solve_s'])} s, whole process {_f(h['process_s'])} s wall, "
               f"{_f(h.get('process_cpu_s'))} s CPU (best of 3; target 1.5 s wall: {_f(h['under_1p5s'])}).", ""]
+    if "enforcement" in res:
+        L += enforcement_markdown(res["enforcement"])
     return "\n".join(L) + "\n"
 
 

@@ -1,0 +1,120 @@
+"""Output files written all or nothing.
+
+    out = Outputs()
+    out.add("--json", "run.json", (".json",))     # checked now: before any run
+    ...                                            # the run
+    with out:                                      # on any exception: the temporaries are removed
+        write_json(out.temp("--json"))             # each file goes to a temporary beside its target
+        out.commit()                               # then all are renamed into place together
+
+A file is never seen half written: each is written under a temporary name in the target's
+folder (``.<name>.<random>.part<suffix>``) and renamed (``os.replace``, atomic on one file
+system) only when every output is complete. During the renames Ctrl-C is held back, so an
+interrupted run leaves either none or all of its outputs.
+"""
+
+import os
+import secrets
+import signal
+import threading
+from pathlib import Path
+
+
+def check_output_path(path, what, suffixes):
+    """ValueError (one line naming the option) unless `path` can be written: an allowed
+    suffix, not a folder, in an existing folder where a file can be created."""
+    p = Path(path)
+    if suffixes and p.suffix.lower() not in suffixes:
+        raise ValueError(f"{what} {path}: the file name must end in {' or '.join(suffixes)}")
+    if p.is_dir():
+        raise ValueError(f"{what} {path}: is a folder, give a file name")
+    folder = p.parent if str(p.parent) else Path(".")
+    if not folder.is_dir():
+        raise ValueError(f"{what} {path}: the folder {folder} does not exist")
+    probe = folder / f".{p.name}.{secrets.token_hex(4)}.probe"
+    try:
+        with open(probe, "xb"):
+            pass
+        probe.unlink()
+    except OSError as err:
+        raise ValueError(f"{what} {path}: cannot write in {folder} ({err.strerror or err})") from None
+    return p
+
+
+class Outputs:
+    """The output files of one run: validated when added, written to temporaries, renamed
+    into place together by commit(). As a context manager it removes the temporaries if
+    the block ends with an exception (Ctrl-C included)."""
+
+    def __init__(self):
+        self.paths = {}          # option -> target Path
+        self.temps = {}          # option -> temporary Path
+        self.committed = False
+
+    def add(self, what, path, suffixes=()):
+        p = check_output_path(path, what, suffixes)
+        for other, q in self.paths.items():
+            if q.resolve() == p.resolve():
+                raise ValueError(f"{what} {path}: the same file as {other}")
+        self.paths[what] = p
+        return p
+
+    def temp(self, what):
+        """The temporary file name to write the output `what` to (same folder, same suffix)."""
+        p = self.paths[what]
+        t = p.with_name(f".{p.stem}.{secrets.token_hex(4)}.part{p.suffix}")
+        self.temps[what] = t
+        return t
+
+    def commit(self):
+        """Rename every temporary onto its target, with Ctrl-C held back until all are done.
+        If a rename fails, the outputs already moved are removed again (none or all)."""
+        done = []
+        with hold_interrupts():
+            try:
+                for what, t in self.temps.items():
+                    os.replace(t, self.paths[what])
+                    done.append(self.paths[what])
+            except OSError:
+                for p in done:
+                    p.unlink(missing_ok=True)
+                raise
+            self.committed = True
+        return [str(p) for p in done]
+
+    def discard(self):
+        for t in self.temps.values():
+            try:
+                t.unlink(missing_ok=True)
+            except OSError:
+                pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, exc, tb):
+        if not self.committed:
+            self.discard()
+        return False
+
+
+class hold_interrupts:
+    """Hold SIGINT back for the duration of the block; a Ctrl-C that arrived meanwhile
+    is raised as KeyboardInterrupt at the end. (No-op outside the main thread.)"""
+
+    def __enter__(self):
+        self.pending = False
+        self.active = threading.current_thread() is threading.main_thread()
+        if self.active:
+            self.previous = signal.signal(signal.SIGINT, self._hold)
+        return self
+
+    def _hold(self, signum, frame):
+        self.pending = True
+
+    def __exit__(self, kind, exc, tb):
+        if self.active:
+            signal.signal(signal.SIGINT, self.previous)
+            if self.pending and kind is None:
+                raise KeyboardInterrupt
+        return False

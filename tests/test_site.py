@@ -1,0 +1,231 @@
+"""The course website: built from lectures/ and checked in headless Chromium as a reader
+would (equations typeset, images loaded, no broken link), and the checker itself shown
+to fail on a page with a missing image, a broken equation, a raw '$$' or a dead link.
+
+The tests marked `site` need the site extra and Debian's Chromium (/usr/bin/chromium);
+they skip where either is missing, except under CONTACTFEM_REQUIRE_BROWSER=1 (set by
+.ci/run, which installs both), where a missing piece is a failure.
+"""
+
+import os
+import re
+import shutil
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+LECTURES = sorted((REPO / "lectures").glob("*.ipynb"))
+
+pytestmark = pytest.mark.site
+
+
+def _require(ok, why):
+    if not ok:
+        if os.environ.get("CONTACTFEM_REQUIRE_BROWSER") == "1":
+            pytest.fail(why, pytrace=False)
+        pytest.skip(why)
+
+
+@pytest.fixture(scope="module")
+def chromium():
+    from contactfem.site.browser import find_chromium
+
+    path = find_chromium()
+    _require(path is not None, "Chromium not installed (apt-get install -y chromium)")
+    return path
+
+
+@pytest.fixture(scope="module")
+def mathjax_dir(tmp_path_factory):
+    from contactfem.site.pages import copy_mathjax
+
+    root = tmp_path_factory.mktemp("pages")
+    try:
+        copy_mathjax(root / "_static" / "mathjax")
+    except RuntimeError as err:
+        _require(False, str(err))
+    return root
+
+
+# -- the checker's own tests: small hand-made sites, one thing broken in each -------------
+
+def _png(path, w=12, h=8):
+    import numpy as np
+    from PIL import Image
+
+    Image.fromarray((np.arange(w * h * 3) % 255).astype("uint8").reshape(h, w, 3)).save(path)
+
+
+def _page(body):
+    return ("<!DOCTYPE html><html><head><meta charset='utf-8'>"
+            "<script>window.MathJax = {tex: {inlineMath: [['\\\\(', '\\\\)']], displayMath: [['\\\\[', '\\\\]']],"
+            "packages: {'[-]': ['noundefined']}}};</script>"
+            "<script defer src='_static/mathjax/tex-chtml.js'></script></head>"
+            f"<body>{body}</body></html>")
+
+
+GOOD = ("<h1 id='top'>A page</h1><p>Hertz: <span class='math'>\\(p_0 = \\sqrt{{P E^*/(\\pi R)}}\\)</span></p>"
+        "<div class='math'>\\[ g_N = (\\mathbf x_s - \\mathbf x_1) \\cdot \\mathbf n \\tag{{17}} \\]</div>"
+        "<img src='fig.png' alt='a figure'><p><a href='other.html#sec'>other</a> <a href='#top'>top</a></p>"
+        "<pre>price = '$$' in code is fine</pre>{extra}")
+OTHER = "<h2 id='sec'>Other</h2><p><a href='index.html'>back</a></p>"
+
+
+def _site(root, extra="", image=True):
+    site = root / f"site{len(list(root.glob('site*')))}"
+    site.mkdir()
+    shutil.copytree(root / "_static", site / "_static")
+    (site / "index.html").write_text(_page(GOOD.format(extra=extra)))
+    (site / "other.html").write_text(_page(OTHER))
+    if image:
+        _png(site / "fig.png")
+    return site
+
+
+def _check(site, chromium):
+    from contactfem.site.browser import check_site
+
+    return check_site(site, pages=["index.html"], math_pages=["index.html"], chromium=chromium)
+
+
+def test_checker_passes_a_good_page(mathjax_dir, chromium):
+    report = _check(_site(mathjax_dir), chromium)
+    assert report["problems"] == []
+    found = report["pages"]["index.html"]
+    assert found["mathjax"] == "typeset" and found["typeset"] == 2
+    assert [i["naturalWidth"] for i in found["images"]] == [12]
+    assert Path(found["screenshot"]).stat().st_size > 1000
+    assert report["crawled"] == ["index.html", "other.html"]
+
+
+def test_checker_fails_when_an_image_is_removed(mathjax_dir, chromium):
+    problems = _check(_site(mathjax_dir, image=False), chromium)["problems"]
+    assert any("image(s) did not load" in p and "fig.png" in p for p in problems), problems
+    assert any("broken link fig.png (HTTP 404)" in p for p in problems), problems
+
+
+@pytest.mark.parametrize("tex, expect", [
+    ("\\frac{a}", "1 equation(s) failed to typeset"),        # TeX error: MathJax shows an error box
+    ("\\notamacro{x}", "1 equation(s) failed to typeset"),   # undefined control sequence
+    ("\\frac{a}{", "1 untypeset \\( or \\[ left"),            # unbalanced: the delimiters stay raw
+])
+def test_checker_fails_on_a_broken_equation(mathjax_dir, chromium, tex, expect):
+    problems = _check(_site(mathjax_dir, extra=f"<div class='math'>\\[ {tex} \\]</div>"), chromium)["problems"]
+    assert any(expect in p for p in problems), problems
+
+
+def test_checker_fails_on_raw_dollars(mathjax_dir, chromium):
+    problems = _check(_site(mathjax_dir, extra="<p>$$ t_T = c_T g_T $$</p>"), chromium)["problems"]
+    assert any("raw '$$'" in p for p in problems), problems
+
+
+def test_checker_fails_without_mathjax(mathjax_dir, chromium):
+    site = _site(mathjax_dir)
+    shutil.rmtree(site / "_static" / "mathjax")
+    problems = _check(site, chromium)["problems"]
+    assert any("MathJax did not run" in p for p in problems), problems
+    assert any("tex-chtml.js (HTTP 404)" in p for p in problems), problems
+
+
+def test_checker_fails_on_dead_links_and_offsite_scripts(mathjax_dir, chromium):
+    extra = ("<a href='missing.html'>x</a><a href='other.html#nowhere'>y</a>"
+             "<script src='https://cdn.example.org/mathjax.js'></script>")
+    problems = _check(_site(mathjax_dir, extra=extra), chromium)["problems"]
+    assert any("broken link missing.html (HTTP 404)" in p for p in problems), problems
+    assert any("no #nowhere in other.html" in p for p in problems), problems
+    assert any("from another host" in p for p in problems), problems
+
+
+# -- the real site --------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def site(chromium):
+    pytest.importorskip("nbclient")
+    try:
+        import myst_nb  # noqa: F401
+        import sphinx  # noqa: F401
+    except ImportError:
+        _require(False, "the site extra is not installed: pip install -e '.[site]'")
+    from contactfem.site import build
+
+    index = build()        # REPO/build/site; executed notebooks cached in build/site-cache
+    return index.parent
+
+
+def test_site_has_a_page_per_lecture_with_outputs_and_figures(site):
+    assert (site / "index.html").exists()
+    for nb in LECTURES:
+        page = site / (nb.stem + ".html")
+        assert page.exists(), f"no page for {nb.name}"
+        text = page.read_text()
+        assert 'class="cell_output' in text, f"{page.name}: no executed output"
+    with_images = [nb.stem for nb in LECTURES if "<img" in (site / (nb.stem + ".html")).read_text()]
+    assert len(with_images) >= len(LECTURES) // 2, with_images
+    index = (site / "index.html").read_text()
+    for nb in LECTURES:
+        assert f'href="{nb.stem}.html"' in index, f"{nb.stem} not linked from the index"
+
+
+def test_equation_index_links_every_entry_to_the_api(site):
+    from contactfem.equations import INDEX
+
+    text = (site / "equations.html").read_text()
+    api = {p.name: p.read_text() for p in (site / "api").glob("*.html")}
+    for k, e in INDEX.items():
+        m = re.search(rf'href="(api/[^"#]+\.html)#((?:module-)?{re.escape(e.where)})"', text)
+        assert m, f"eq ({k}): no link to the API entry of {e.where}"
+        page = Path(m.group(1)).name
+        assert f'id="{m.group(2)}"' in api[page], f"eq ({k}): {e.where} has no entry in api/{page}"
+
+
+def test_gallery_shows_the_figures_beside_the_papers_values(site):
+    text = (site / "gallery.html").read_text()
+    assert "paper’s value" in text or "paper's value" in text
+    imgs = re.findall(r'<img[^>]+src="([^"]+)"', text)
+    assert len(imgs) >= 10, imgs
+    for src in imgs:
+        assert (site / src).exists(), src
+    assert (site / "benchmarks.html").exists()
+
+
+def test_site_in_the_browser(site, chromium):
+    """The index and two lectures opened in headless Chromium: equations typeset, every
+    image loaded, and a crawl of the whole site finds no broken internal link."""
+    from contactfem.site.browser import check_site
+
+    lectures = [LECTURES[0].stem + ".html", LECTURES[len(LECTURES) // 2].stem + ".html"]
+    report = check_site(site, pages=["index.html"] + lectures, chromium=chromium)
+    assert report["problems"] == [], "\n".join(report["problems"])
+    for name in lectures:
+        found = report["pages"][name]
+        assert found["typeset"] > 5 and found["images"], (name, found)
+    assert len(report["crawled"]) >= len(LECTURES) + 5
+    assert (site / "_check" / "index.png").exists()
+
+
+def test_browser_check_fails_on_the_real_site_broken(site, chromium, tmp_path):
+    """The same check on a copy of the built site with one figure deleted and one
+    equation of a lecture broken: both are reported."""
+    from contactfem.site.browser import check_site
+
+    broken = tmp_path / "site"
+    shutil.copytree(site, broken, ignore=shutil.ignore_patterns("_check"))
+    name = LECTURES[0].stem + ".html"
+    page = broken / name
+    text = page.read_text()
+    img = re.search(r'<img[^>]+src="(_images/[^"]+)"', text).group(1)
+    (broken / img).unlink()
+    text, n = re.subn(r'(<span class="math[^"]*">)\\\((.*?)\\\)', r"\1\\(\\frac{\2}\\)", text, count=1)  # one argument
+    assert n == 1
+    page.write_text(text)
+    problems = check_site(broken, pages=[name], chromium=chromium)["problems"]
+    assert any(f"{name}: 1 image(s) did not load" in p for p in problems), problems
+    assert any(f"{name}: 1 equation(s) failed to typeset" in p for p in problems), problems
+
+
+def test_site_command_line():
+    from contactfem.cli import build_parser
+
+    args = build_parser().parse_args(["site", "--out", "somewhere"])
+    assert args.out == "somewhere" and args.func.__name__ == "cmd_site"
