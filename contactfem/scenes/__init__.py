@@ -32,24 +32,31 @@ def get_scene(name):
     return scenes[name]
 
 
-def run_scene(name, preset="fast", overrides=None, progress=None):
+def run_scene(name, preset="fast", overrides=None, progress=None, friction=None, normal=None):
     """Run a scene and return its results with wall time, Newton iteration count, parameters and
     the linear algebra of its Systems (``linear_algebra``: dense|sparse, ``ordering``, ``unknowns``).
     ``progress(t0, t_end, label)``: a progress-callback factory handed to the scene's time
-    loops (e.g. ``contactfem.io.progress_bar``); None shows nothing."""
+    loops (e.g. ``contactfem.io.progress_bar``); None shows nothing.
+    ``friction`` / ``normal``: law objects replacing the laws the scene's parameters build
+    (recorded as ``friction_law`` / ``normal_law``: class, file, fields)."""
     import time
 
+    from ..laws.lawfile import describe
     from ..solver.system import System
 
     scene = get_scene(name)
     params = scene.resolve(preset, overrides)
+    laws = {k: v for k, v in (("friction", friction), ("normal", normal)) if v is not None}
+    kwargs = dict(laws, progress=progress) if progress is not None else laws
     outer, System.built = System.built, []          # record the Systems the scene builds
     t0 = time.perf_counter()
     try:
-        results = scene.run(params) if progress is None else scene.run(params, progress=progress)
+        results = scene.run(params, **kwargs)
     finally:
         systems, System.built = System.built, outer
     results = dict(results)
+    for kind, law in laws.items():
+        results[f"{kind}_law"] = describe(law)
     results["wall_time_s"] = time.perf_counter() - t0
     # how K was assembled and factorised: dense or sparse (by size), and the ordering
     results["linear_algebra"] = "+".join(dict.fromkeys(s.linear_algebra for s in systems)) or None

@@ -127,8 +127,9 @@ def fit_hertz(x, p):
     return float(np.sqrt(-c0 / c1)), float(np.sqrt(c0))
 
 
-def build(params):
-    """Body, contact, load and supports of the quarter cylinder; returns a dict."""
+def build(params, normal=None, friction=None):
+    """Body, contact, load and supports of the quarter cylinder; returns a dict.
+    ``normal`` / ``friction``: law objects instead of the parameters' (frictionless by default)."""
     from ..bodies.continuum import Continuum
     from ..bodies.loads import Pressure
 
@@ -148,7 +149,7 @@ def build(params):
     w = tributary_lengths(body.X[nodes])
     weights = w if params["penalty"] == "per_length" else 1.0
     contact = make_interface(params.get("enforcement", "penalty"), body, nodes, RigidLine((0.0, -R), (0.0, 1.0)),
-                             PowerLaw(params["c_N"], 1.0), weights=weights, name="plane")
+                             normal or PowerLaw(params["c_N"], 1.0), friction, weights=weights, name="plane")
     sym = np.flatnonzero(np.abs(body.X[:, 0]) < 1e-9 * R)
     fixed = [Dirichlet(body, body.xdofs[sym, 0], 0.0)]
     q = P / (2.0 * R)
@@ -158,8 +159,8 @@ def build(params):
                 grading_k=k)
 
 
-def run(params, progress=None):
-    m = build(params)
+def run(params, progress=None, normal=None, friction=None):
+    m = build(params, normal, friction)
     body, contact, system, w = m["body"], m["contact"], m["system"], m["w"]
     R, P = params["R"], params["P"]
     a_ex = m["a_exact"]
