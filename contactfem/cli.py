@@ -90,7 +90,7 @@ def cmd_run(args):
     from .scenes.base import check_resources, describe
 
     scene = scenes.get_scene(args.scene)
-    overrides = parse_sets(args.set)
+    overrides, laws = laws_from_args(args)             # law.NAME=... go to --friction / --normal
     params = scene.resolve(args.preset, overrides)
     out = Outputs()                                   # every output checked before the run
     if args.json:
@@ -115,7 +115,7 @@ def cmd_run(args):
         from .io import progress_bar as progress
         _RUN["progress"] = True
     _RUN["phase"] = "run"
-    res, notes = run_quietly(lambda: scenes.run_scene(args.scene, args.preset, overrides, progress=progress))
+    res, notes = run_quietly(lambda: scenes.run_scene(args.scene, args.preset, overrides, progress=progress, **laws))
     _RUN["phase"] = "write"
     with out:                                         # temporaries first, then all renamed at once
         if args.json:
@@ -153,6 +153,18 @@ def run_quietly(fn):
     own = [str(w.message) for w in caught
            if issubclass(w.category, UserWarning) and "contactfem" in str(w.filename)]
     return res, list(dict.fromkeys(own))
+
+
+def laws_from_args(args):
+    """Scene overrides and the --friction / --normal law objects (fields from --set law.NAME=...)."""
+    from . import scenes
+    from .laws.lawfile import laws_from_options, split_sets
+
+    overrides, law_sets = split_sets(parse_sets(args.set))
+    if not (args.friction or args.normal or any(law_sets.values())):
+        return overrides, {}
+    params = scenes.get_scene(args.scene).resolve(args.preset, overrides)
+    return overrides, laws_from_options(args.friction, args.normal, law_sets, params)
 
 
 def cmd_figures(args):
@@ -219,7 +231,7 @@ def cmd_reconstruct(args):
     reconstruct(args.scene, quick=args.quick, top=args.top, json_path=args.json, cache=not args.no_cache)
 
 
-BENCH_STUDIES = ("tangents", "work_precision", "cost", "targets", "enforcement")  # = studies.bench.STUDIES
+BENCH_STUDIES = ("tangents", "work_precision", "cost", "targets", "enforcement", "speed")  # = studies.bench.STUDIES
 
 
 def cmd_bench(args):
@@ -266,7 +278,10 @@ def build_parser():
     rp.add_argument("--preset", default="fast",
                     help="fast (default): coarse meshes and steps, seconds; paper: the paper's data; "
                          "or a named variant of the scene (listed by show)")
-    rp.add_argument("--set", action="append", metavar="NAME=VALUE", help="override a parameter (repeatable)")
+    rp.add_argument("--set", action="append", metavar="NAME=VALUE",
+                    help="override a parameter, or a field of a law file's law as law.NAME=VALUE (repeatable)")
+    rp.add_argument("--friction", metavar="FILE.py:CLASS", help="use the friction law CLASS defined in FILE.py")
+    rp.add_argument("--normal", metavar="FILE.py:CLASS", help="use the normal law CLASS defined in FILE.py")
     rp.add_argument("--json", metavar="FILE", help="write all results to FILE as JSON")
     rp.add_argument("--gif", metavar="FILE", help="animate the recorded outlines (.gif, or .mp4 with ffmpeg)")
     rp.add_argument("--progress", action="store_true", help="show a progress bar on stderr during the time loop")
@@ -302,7 +317,8 @@ def build_parser():
     rc.add_argument("--no-cache", action="store_true", help="recompute every reading (default: reuse the "
                     "results of earlier runs of the same code, in $CONTACTFEM_CACHE or ~/.cache/contactfem)")
     rc.set_defaults(func=cmd_reconstruct)
-    bp = sub.add_parser("bench", help="speed against accuracy: tangents, work-precision, cost, targets, enforcement "
+    bp = sub.add_parser("bench", help="speed against accuracy: tangents, work-precision, cost, targets, "
+                                      "enforcement, speed "
                                       "(writes bench.json and BENCHMARKS.md)")
     bp.add_argument("--quick", action="store_true", help="fast presets and fewer points (about a minute)")
     bp.add_argument("--out", default=".", help="folder for bench.json and BENCHMARKS.md (default: .)")

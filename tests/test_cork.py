@@ -12,8 +12,9 @@ argued below, and the mechanism (margin > 0) is asserted for both presets."""
 import numpy as np
 import pytest
 
+from contactfem.bodies.loads import swept_volume
 from contactfem.scenes import run_scene
-from contactfem.scenes.cork import PAPER, Neck, cork_mesh, swept_volume
+from contactfem.scenes.cork import PAPER, Neck, cork_mesh
 from contactfem.solver import NewtonError
 
 PAPER_V = PAPER["exit_velocity_m_s"]          # 28 m/s

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
+from contactfem.solver.system import as_array
 from contactfem.solver import (CentralDifference, Dirichlet, Newmark, NewtonError, Static, System,
                                initial_acceleration, integrate, newton)
 
@@ -123,20 +124,24 @@ def test_offsets_global_dofs_and_fixed():
     assert np.allclose(s.mass(), 1.0)
 
 
-def test_tangent_matches_finite_differences():
+@pytest.mark.parametrize("linear_algebra", ["dense", "sparse"])
+def test_tangent_matches_finite_differences(linear_algebra):
     a, b = SpringChain(3, k=2.0, k3=5.0, name="a"), SpringChain(2, k=1.0, k3=1.0, name="b")
     s = System([a, b], contacts=[Wall(b, 1, y_wall=0.0, c=30.0)],
-               loads=[SpringLoad(a, 4, f0=1.0, kl=3.0), DeadLoad(b, [2], 0.7)])
+               loads=[SpringLoad(a, 4, f0=1.0, kl=3.0), DeadLoad(b, [2], 0.7)], linear_algebra=linear_algebra)
     u = np.random.default_rng(0).normal(scale=0.3, size=s.ndof)
     u[s.global_dofs(b, b.xdofs[1, 1])] = -0.4            # wall contact active
     G, K = s.residual_tangent(u, 0.0)
-    assert sp.isspmatrix_csr(K)
+    assert sp.issparse(K) == (linear_algebra == "sparse")
     h, K_fd = 1e-6, np.zeros((s.ndof, s.ndof))
     for j in range(s.ndof):
         e = np.zeros(s.ndof)
         e[j] = h
         K_fd[:, j] = (s.residual_tangent(u + e, 0.0)[0] - s.residual_tangent(u - e, 0.0)[0]) / (2 * h)
-    assert np.linalg.norm(K.toarray() - K_fd) <= 1e-6 * np.linalg.norm(K_fd)
+    assert np.linalg.norm(as_array(K) - K_fd) <= 1e-6 * np.linalg.norm(K_fd)
+    # the effective tangent of a time stepper: K + c M on the diagonal
+    _, K_eff = s.residual_tangent(u, 0.0, mass_coefficient=7.0)
+    assert np.allclose(as_array(K_eff), as_array(K) + 7.0 * np.diag(s.mass()), rtol=1e-14, atol=1e-12)
 
 
 def test_initial_acceleration_solves_M_a_equals_P_minus_R():

@@ -15,8 +15,10 @@ Kinematics (exact under large rotations; textbook: Simo & Vu-Quoc 1986, Crisfiel
 
 Discretisation: straight two-node elements (a polygon in the reference state), linear
 interpolation in the reference arc length s, ONE-point (midpoint) integration against
-shear locking (``integration=2``: two-point Gauss, which locks in shear). The element kernel is vectorised numpy over all elements; K is
-assembled from COO triplets with one ``coo_matrix(...).tocsr()``.
+shear locking (``integration=2``: two-point Gauss, which locks in shear). The element
+kernel is vectorised numpy over all elements; K comes as COO triplets on the constant
+element connectivity (``internal_coo``, what the solver's System assembles) or as a CSR
+matrix (``internal``).
 
 What scikit-fem does here: the 1D mesh in the arc length s (``MeshLine``; its
 element lengths are the reference chord lengths), and the lumped mass (row sums of
@@ -36,9 +38,6 @@ Backward Euler gives the closed-form return map (see ``return_map``).
 """
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from skfem import Basis, ElementLineP1, MeshLine, asm
-from skfem.models import mass as mass_form
 
 
 def _check(name, value, low, low_open=True):
@@ -135,6 +134,8 @@ class Beam:
 
         # scikit-fem: 1D mesh in the reference arc length s (closed: node nn sits at s = L
         # and is identified with node 0 through `fold`)
+        from skfem import MeshLine
+
         s = np.concatenate([[0.0], np.cumsum(self.L0)])
         self.mesh = MeshLine(s)
         self.fold = np.arange(ne + 1) % nn
@@ -143,6 +144,11 @@ class Beam:
         self.xdofs = 3 * np.arange(nn)[:, None] + np.array([0, 1])
         self.edofs = np.column_stack([3 * self.conn[:, 0] + k for k in range(3)]
                                      + [3 * self.conn[:, 1] + k for k in range(3)])
+        self._rows = np.repeat(self.edofs, 6, axis=1).ravel()    # COO indices of the element
+        self._cols = np.tile(self.edofs, (1, 6)).ravel()         # matrices, fixed
+        self._edofs_flat = self.edofs.ravel()
+        self._dX = chord                                          # X_b - X_a per element
+        self._dkap = np.outer(1 / self.L0, [0, 0, -1, 0, 0, 1])   # dkap/dq
         self.dof_offset = 0
 
         self.S0, self.eta, self.dt = None, None, None
@@ -178,18 +184,22 @@ class Beam:
         (ne, 3), and t, n of the total angle there."""
         U = np.asarray(u, float).reshape(-1, 3)
         a, b = self.conn.T
-        xp = (self.X[b] + U[b, :2] - self.X[a] - U[a, :2]) / self.L0[:, None]   # x'
+        xp = (self._dX + U[b, :2] - U[a, :2]) / self.L0[:, None]          # x'
         phi = self.theta0 + 0.5 * (1 - xi) * U[a, 2] + 0.5 * (1 + xi) * U[b, 2]
-        t = np.column_stack([np.cos(phi), np.sin(phi)])
-        n = np.column_stack([-np.sin(phi), np.cos(phi)])
-        E = np.column_stack([np.sum(xp * t, 1) - 1, np.sum(xp * n, 1),
-                             (U[b, 2] - U[a, 2]) / self.L0])
+        cos, sin = np.cos(phi), np.sin(phi)
+        t = np.stack([cos, sin], axis=1)
+        n = np.stack([-sin, cos], axis=1)
+        E = np.empty((len(phi), 3))
+        E[:, 0] = xp[:, 0] * cos + xp[:, 1] * sin - 1.0                   # eps = x' . t - 1
+        E[:, 1] = -xp[:, 0] * sin + xp[:, 1] * cos                        # gam = x' . n
+        E[:, 2] = (U[b, 2] - U[a, 2]) / self.L0                           # kap = theta'
         return E, t, n
 
-    def resultants(self, u, xi=0.0, k=0):
+    def resultants(self, u, xi=0.0, k=0, E=None):
         """(N, Q, M) per element at xi (integration point k), (ne, 3), with the algorithmic
-        moduli dS/dE and new plastic strains."""
-        E, _, _ = self.strains(u, xi)
+        moduli dS/dE and new plastic strains (E: the strains there, if already computed)."""
+        if E is None:
+            E = self.strains(u, xi)[0]
         if self.S0 is not None and self.dt is None:
             raise RuntimeError("viscoplastic beam: call beam.set_dt(dt) before evaluating it")
         ne = len(self.L0)
@@ -197,37 +207,51 @@ class Beam:
 
     # ---- body interface ------------------------------------------------------------
     def internal(self, u):
+        """Internal force R = dW/du and consistent tangent K = dR/du (CSR); see internal_coo."""
+        from scipy.sparse import coo_matrix
+
+        R, rows, cols, vals = self.internal_coo(u)
+        return R, coo_matrix((vals, (rows, cols)), shape=(self.ndof, self.ndof)).tocsr()
+
+    def internal_coo(self, u):
         """Internal force R = dW/du and consistent tangent K = dR/du (virtual work, midpoint rule,
-        or two-point Gauss with ``integration=2``).
+        or two-point Gauss with ``integration=2``), K as COO triplets (rows, cols, vals) on the
+        fixed element connectivity.
 
         Per element and point, with q = (u_a, theta_a, u_b, theta_b) and B = dE/dq (3 x 6):
             r_e = w L0 B^T S,     K_e = w L0 (B^T C B + N d2eps/dq2 + Q d2gam/dq2)
         deps/dphi = gam, dgam/dphi = -(1 + eps), phi = theta0 + N_a theta_a + N_b theta_b.
+        With a_t = d(x'.t)/dq, a_n = d(x'.n)/dq (phi fixed) and p = dphi/dq:
+            B = [a_t + gam p,  a_n - (1 + eps) p,  dkap/dq],
+            d2eps/dq2 = a_n p^T + p a_n^T - (1 + eps) p p^T,
+            d2gam/dq2 = -(a_t p^T + p a_t^T) - gam p p^T,
+        so the geometric part is w p^T + p w^T - (N (1 + eps) + Q gam) p p^T, w = N a_n - Q a_t.
         """
+        ne = len(self.L0)
         L0 = self.L0[:, None]
-        z = np.zeros_like(self.L0)
         re, Ke = 0.0, 0.0
-        for k, (xi, w) in enumerate(self.points):
+        for k, (xi, weight) in enumerate(self.points):
             E, t, n = self.strains(u, xi)
-            S, C, _ = self.resultants(u, xi, k)
+            S, C, _ = self.resultants(u, xi, k, E)
             eps, gam = E[:, 0], E[:, 1]
+            N, Q = S[:, 0], S[:, 1]
             p = np.array([0, 0, 0.5 * (1 - xi), 0, 0, 0.5 * (1 + xi)])   # dphi/dq
-            a_t = np.column_stack([-t / L0, z, t / L0, z])              # (x' . t) derivative
-            a_n = np.column_stack([-n / L0, z, n / L0, z])              # (x' . n) derivative
-            B = np.stack([a_t + gam[:, None] * p,
-                          a_n - (1 + eps)[:, None] * p,
-                          np.outer(1 / self.L0, [0, 0, -1, 0, 0, 1])], axis=1)   # (ne, 3, 6)
-            pp = np.outer(p, p)
-            G_eps = np.einsum("ei,j->eij", a_n, p) + np.einsum("i,ej->eij", p, a_n) - (1 + eps)[:, None, None] * pp
-            G_gam = -np.einsum("ei,j->eij", a_t, p) - np.einsum("i,ej->eij", p, a_t) - gam[:, None, None] * pp
-            re = re + w * L0 * np.einsum("eki,ek->ei", B, S)
-            Ke = Ke + w * L0[:, :, None] * (np.einsum("eki,ek,ekj->eij", B, C, B)
-                                            + S[:, 0, None, None] * G_eps + S[:, 1, None, None] * G_gam)
-        R = np.bincount(self.edofs.ravel(), re.ravel(), minlength=self.ndof)
-        rows = np.repeat(self.edofs, 6, axis=1).ravel()
-        cols = np.tile(self.edofs, (1, 6)).ravel()
-        K = coo_matrix((Ke.ravel(), (rows, cols)), shape=(self.ndof, self.ndof)).tocsr()
-        return R, K
+            a_t = np.zeros((ne, 6))
+            a_t[:, 0:2], a_t[:, 3:5] = -t / L0, t / L0                  # d(x' . t)/dq
+            a_n = np.zeros((ne, 6))
+            a_n[:, 0:2], a_n[:, 3:5] = -n / L0, n / L0                  # d(x' . n)/dq
+            B = np.empty((ne, 3, 6))
+            B[:, 0] = a_t + gam[:, None] * p
+            B[:, 1] = a_n - (1 + eps)[:, None] * p
+            B[:, 2] = self._dkap
+            w = N[:, None] * a_n - Q[:, None] * a_t
+            wp = w[:, :, None] * p                                     # w p^T
+            K = np.matmul(B.transpose(0, 2, 1) * C[:, None, :], B)    # B^T C B (C diagonal)
+            K += wp + wp.transpose(0, 2, 1) - (N * (1 + eps) + Q * gam)[:, None, None] * np.outer(p, p)
+            Ke = Ke + weight * L0[:, :, None] * K
+            re = re + weight * L0 * np.matmul(S[:, None, :], B)[:, 0]   # w L0 B^T S
+        R = np.bincount(self._edofs_flat, re.ravel(), minlength=self.ndof)
+        return R, self._rows, self._cols, Ke.ravel()
 
     def strain_energy(self, u):
         """Stored (elastic) energy sum_e L0 sum_k S_k^2 / (2 D_k); elastic case: L0 D E^2 / 2."""
@@ -246,6 +270,9 @@ class Beam:
         scikit-fem: row sums of the P1 mass matrix on the arc-length mesh = L0/2 per element end.
         """
         if getattr(self, "_mass", None) is None:   # assembled once, then reused
+            from skfem import Basis, ElementLineP1, asm
+            from skfem.models import mass as mass_form
+
             lumped_mesh = np.asarray(asm(mass_form, Basis(self.mesh, ElementLineP1())).sum(axis=1)).ravel()
             length = np.bincount(self.fold, lumped_mesh, minlength=self.X.shape[0])   # fold s = L onto s = 0
             J = self.I * length if self.rotary_inertia else 0.0 * length

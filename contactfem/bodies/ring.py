@@ -37,11 +37,8 @@ velocity (0, v_y), spin 0.
 from dataclasses import dataclass
 
 import numpy as np
-from skfem import MeshQuad
 
 from .beam import Beam, BeamGravity, ring as ring_nodes
-from .continuum import Continuum
-from .loads import BodyForce
 
 KINDS = ("beam", "continuum")
 
@@ -78,6 +75,8 @@ def annulus_mesh(R_in, R_out, n_el, n_radial, center=(0.0, 0.0), half=False):
     in the plane (radial step first, then the angular step). Boundaries "outer",
     "inner" (and "symmetry" for the half annulus).
     """
+    from skfem import MeshQuad
+
     a = _angles(n_el, half)
     n_ang = len(a)
     r = np.linspace(R_in, R_out, n_radial + 1)
@@ -246,6 +245,8 @@ class RingModel:
         g = float(g)
         if self.kind == "beam":
             return BeamGravity(self.body, g)
+        from .loads import BodyForce
+
         return BodyForce(self.body, (0.0, -self.body.rho * g))
 
     def symmetry_dofs(self):
@@ -312,6 +313,8 @@ def make_ring(kind="beam", R=1.0, thickness=0.1, n_el=32, E=1.0, nu=0.0, rho=1.0
     n_radial = _count("n_radial", n_radial, 1)
     if material not in ("svk", "neohooke"):
         raise ValueError(f"parameter material = {material!r} is not allowed: one of svk|neohooke")
+    from .continuum import Continuum      # scikit-fem is loaded when a continuum ring is built
+
     mesh, n_ang = annulus_mesh(R - h / 2, R + h / 2, n_el, n_radial, center, half)
     body = Continuum(mesh, E=E, nu=nu, rho=rho, kind="plane_strain", material=material,
                      name=name, thickness=b)

@@ -19,6 +19,8 @@ from ..laws.friction import Frictionless
 from ..laws.protocol import as_friction_law
 from ..laws.return_map import STATE_NAMES, return_map
 
+FRICTIONLESS = as_friction_law(Frictionless())
+
 
 def tributary_lengths(X):
     """Half the length of the two neighbouring edges of each node of an ordered chain X (n, 2)."""
@@ -70,10 +72,17 @@ class NodeToSegment:
 
     # -- kinematics -------------------------------------------------------------
     def slave_dofs(self):
-        return self.slave.dof_offset + self.slave.xdofs[self.nodes]
+        """Global (u_x, u_y) dofs of the slave nodes, (nc, 2); kept while the slave body
+        stays at the same place in the global vector."""
+        offset = self.slave.dof_offset
+        if getattr(self, "_dofs_at", None) != offset:
+            self._dofs, self._dofs_at = offset + self.slave.xdofs[self.nodes], offset
+            self._X_s = self.slave.X[self.nodes]
+        return self._dofs
 
     def slave_positions(self, u):
-        return self.slave.X[self.nodes] + u[self.slave_dofs()]
+        dofs = self.slave_dofs()
+        return self._X_s + u[dofs]
 
     def initialize(self, u):
         """Take the projections at u as the reference for the first slip increment."""
@@ -94,7 +103,7 @@ class NodeToSegment:
             g_N = g_N + self._law.gap_offset(self.z_bar)    # worn surface: the gap opens
         active = k["inside"] & (g_N < 0.0)
         t_N, dt_N = self.normal.traction(np.where(active, g_N, 1.0))
-        dofs = np.concatenate([self.slave_dofs(), k["master_dofs"]], axis=1)
+        dofs = np.concatenate([self.slave_dofs(), k["master_dofs"]], axis=1) if k["master_dofs"].size else self._dofs
         travel = k["s"] - self.s_bar
         r, dr, ddg_T = np.ones_like(g_N), np.zeros_like(g_N), k["ds"]
         if self.g_bar is not None:                          # the closing step (module docstring)
@@ -113,25 +122,28 @@ class NodeToSegment:
         e = self.kinematics(u)
         if self.friction is None:
             z = np.zeros_like(e["t_N"])
-            fr = return_map(Frictionless(), e["t_N"], e["dt_N"], z, z, self.q_bar)
+            fr = return_map(FRICTIONLESS, e["t_N"], e["dt_N"], z, z, self.q_bar)
         else:
             fr = return_map(self._law, e["t_N"], e["dt_N"], e["dg_T"], self.t_T_bar, self.q_bar,
                             z_bar=self.z_bar, dt=self.dt)
         return self.element(e, fr.t_T, fr.c_T_s, fr.c_N_s, friction=fr)
 
     def element(self, e, t_T, c_T_s, c_N_s, **extra):
-        """Add the element residuals and tangents (eqs 28, 33, 39, 49) to the kinematics e."""
-        R, K = contact_element(self.weights, e["t_N"], e["dt_N"], t_T, c_T_s, c_N_s,
-                               e["dg_N"], e["d2g_N"], e["ds"], e["d2s"], e.get("ddg_T"))
+        """Add the element residuals and tangents (eqs 28, 33, 39, 49) of the active pairs
+        to the kinematics e (an open pair contributes nothing: R and K hold active pairs only)."""
+        on = e["active"]
+        ddg_T = e.get("ddg_T")
+        R, K = contact_element(self.weights[on], e["t_N"][on], e["dt_N"][on], t_T[on], c_T_s[on], c_N_s[on],
+                               e["dg_N"][on], e["d2g_N"][on], e["ds"][on], e["d2s"][on],
+                               None if ddg_T is None else ddg_T[on])
         return dict(e, R=R, K=K, **extra)
 
     @staticmethod
     def scatter(e, ndof):
         """Global residual and COO triplets of the active pairs of an evaluation e."""
-        on = e["active"]
-        R_c = np.zeros(ndof)
-        np.add.at(R_c, e["dofs"][on].ravel(), e["R"][on].ravel())
-        rows, cols, vals = to_coo(e["dofs"][on], e["K"][on])
+        dofs = e["dofs"][e["active"]]
+        R_c = np.bincount(dofs.ravel(), e["R"].ravel(), minlength=ndof)
+        rows, cols, vals = to_coo(dofs, e["K"])
         return R_c, rows, cols, vals
 
     # -- the contact interface used by the solver -------------------------------

@@ -72,12 +72,13 @@ def line_variations(x_s, point, normal):
     """A fixed straight line through `point` with unit `normal` (a rigid master with
     x_1, x_2 fixed): g_N = (x_s - point).n, arc coordinate s = (x_s - point).t with
     n = e3 x t. Both are linear in x_s, so their second variations vanish."""
-    n = np.broadcast_to(normal, x_s.shape)
-    t = np.stack([n[:, 1], -n[:, 0]], axis=1)                      # e3 x t = n
+    normal = np.asarray(normal, dtype=float)
+    tangent = np.array([normal[1], -normal[0]])                    # e3 x t = n
     d = x_s - point
-    z2 = np.zeros((len(x_s), 2, 2))
-    return dict(t=t, n=n, g_N=np.einsum("ij,ij->i", d, n), s=np.einsum("ij,ij->i", d, t),
-                dg_N=n.copy(), d2g_N=z2, ds=t.copy(), d2s=z2.copy())
+    nc = len(x_s)
+    n, t = np.tile(normal, (nc, 1)), np.tile(tangent, (nc, 1))
+    z2 = np.zeros((nc, 2, 2))
+    return dict(t=t, n=n, g_N=d @ normal, s=d @ tangent, dg_N=n.copy(), d2g_N=z2, ds=t.copy(), d2s=z2.copy())
 
 
 def arc_variations(x_s, center, R, inside, theta_ref):

@@ -11,7 +11,6 @@ written here.
 """
 
 from pathlib import Path
-from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
@@ -34,6 +33,8 @@ def _pad3(x):
 
 def write_pvd(path, files, times):
     """The ParaView collection: one <DataSet timestep=...> per file (paths relative to the .pvd)."""
+    from xml.sax.saxutils import quoteattr    # (pulls in urllib: ~0.1 s, only when writing)
+
     path = Path(path)
     rows = "\n".join(f'    <DataSet timestep="{float(t)!r}" part="0" file={quoteattr(Path(f).name)}/>'
                      for f, t in zip(files, times))

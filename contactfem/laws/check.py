@@ -106,7 +106,8 @@ def _check_derivatives(rep, L, p, q, v, z, lam, dt, rtol):
             good.append(name)
             worst_all = max(worst_all, float(err[i]))
     if good:
-        rep.add(True, f"{', '.join(good)} agree with finite differences (worst relative error beyond round-off {worst_all:.1e})", "")
+        verb = "agrees" if len(good) == 1 else "agree"
+        rep.add(True, f"{', '.join(good)} {verb} with finite differences (worst relative error beyond round-off {worst_all:.1e})", "")
 
 
 def check_friction_law(law, normal=None, scale=1.0, rtol=1e-5, dt=1.0):

@@ -74,13 +74,17 @@ def return_map(law, t_N, dt_N, dg_T, t_T_bar, q_bar, z_bar=None, dt=None, tol=1e
     else:
         dt = 1.0 if dt is None else dt
     z_bar = L.initial_state(n) if z_bar is None else np.broadcast_to(np.asarray(z_bar, dtype=float), (n, L.n_state))
+    in_contact = p > 0.0
+    if not in_contact.any():                  # every node open (a body in flight): nothing to integrate
+        zero = np.zeros(n)
+        return FrictionState(t_T=zero, c_T_s=zero.copy(), c_N_s=zero.copy(), state=np.full(n, OPEN), lam=zero.copy(),
+                             q=q_bar.copy(), z=np.array(z_bar, dtype=float), v=zero.copy())
     t_tr = t_T_bar + c_T * dg_T                                   # eq (42)
     zero = np.zeros(n)
     z0 = L.evolve(z_bar, p, zero, dt)[0]
     Y0 = L.slip_bound(p, q_bar, zero, z0)[0]
     f_tr = np.abs(t_tr) - Y0                                      # eq (40)
 
-    in_contact = p > 0.0
     slip = in_contact & (f_tr > 0.0) & (c_T > 0.0)
     stick = in_contact & ~slip
 

@@ -1,6 +1,10 @@
 """Scenes: each module composes bodies, obstacles, laws and loads into one of the
 paper's examples (or a verification problem with a closed form) and declares its
-parameters. A module becomes a scene by defining ``SCENE = Scene(...)``."""
+parameters. A module becomes a scene by defining ``SCENE = Scene(...)``.
+
+Listing the scenes imports every scene module, so a scene module imports scikit-fem
+(and the continuum bodies built on it) inside the functions that build the model:
+``contactfem list`` and ``show`` then load neither scikit-fem nor scipy nor matplotlib."""
 
 import importlib
 import pkgutil
@@ -28,18 +32,36 @@ def get_scene(name):
     return scenes[name]
 
 
-def run_scene(name, preset="fast", overrides=None, progress=None):
-    """Run a scene and return its results with wall time, Newton iteration count and parameters.
+def run_scene(name, preset="fast", overrides=None, progress=None, friction=None, normal=None):
+    """Run a scene and return its results with wall time, Newton iteration count, parameters and
+    the linear algebra of its Systems (``linear_algebra``: dense|sparse, ``ordering``, ``unknowns``).
     ``progress(t0, t_end, label)``: a progress-callback factory handed to the scene's time
-    loops (e.g. ``contactfem.io.progress_bar``); None shows nothing."""
+    loops (e.g. ``contactfem.io.progress_bar``); None shows nothing.
+    ``friction`` / ``normal``: law objects replacing the laws the scene's parameters build
+    (recorded as ``friction_law`` / ``normal_law``: class, file, fields)."""
     import time
+
+    from ..laws.lawfile import describe
+    from ..solver.system import System
 
     scene = get_scene(name)
     params = scene.resolve(preset, overrides)
+    laws = {k: v for k, v in (("friction", friction), ("normal", normal)) if v is not None}
+    kwargs = dict(laws, progress=progress) if progress is not None else laws
+    outer, System.built = System.built, []          # record the Systems the scene builds
     t0 = time.perf_counter()
-    results = scene.run(params) if progress is None else scene.run(params, progress=progress)
+    try:
+        results = scene.run(params, **kwargs)
+    finally:
+        systems, System.built = System.built, outer
     results = dict(results)
+    for kind, law in laws.items():
+        results[f"{kind}_law"] = describe(law)
     results["wall_time_s"] = time.perf_counter() - t0
+    # how K was assembled and factorised: dense or sparse (by size), and the ordering
+    results["linear_algebra"] = "+".join(dict.fromkeys(s.linear_algebra for s in systems)) or None
+    results["ordering"] = "+".join(dict.fromkeys(s.ordering for s in systems)) or None
+    results["unknowns"] = max((s.ndof for s in systems), default=None)
     results.setdefault("newton_iterations_total", 0)
     results["scene"] = name
     results["preset"] = preset

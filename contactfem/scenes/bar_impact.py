@@ -47,9 +47,7 @@ rebound velocity (momentum / mass at the end) and the energy error.
 """
 
 import numpy as np
-from skfem import MeshQuad
 
-from ..bodies.continuum import Continuum
 from ..contact import NodeToSegment, RigidLine, tributary_lengths
 from ..laws import PowerLaw
 from ..solver import CentralDifference, System, integrate
@@ -63,7 +61,12 @@ def bar_exact(L, E, rho, v0):
     return dict(c=c, stress=rho * c * v0, duration=2.0 * L / c, rebound_velocity=v0)
 
 
-def build(params):
+def build(params, normal=None, friction=None):
+    """``normal`` / ``friction``: law objects instead of the parameters' (frictionless by default)."""
+    from skfem import MeshQuad
+
+    from ..bodies.continuum import Continuum
+
     L, H = params["L"], params["h"]
     n = params["n_el"]
     mesh = MeshQuad.init_tensor(np.linspace(0.0, L, n + 1), np.linspace(0.0, H, 2))
@@ -73,14 +76,14 @@ def build(params):
     nodes = nodes[np.argsort(body.X[nodes, 1])]
     w = tributary_lengths(body.X[nodes])
     c_N = params["c_N_factor"] * params["E"] / (L / n)
-    contact = NodeToSegment(body, nodes, RigidLine((0.0, 0.0), (1.0, 0.0)), PowerLaw(c_N, 1.0),
+    contact = NodeToSegment(body, nodes, RigidLine((0.0, 0.0), (1.0, 0.0)), normal or PowerLaw(c_N, 1.0), friction,
                             weights=w, name="wall")
     system = System([body], [contact])
     return dict(body=body, contact=contact, system=system, nodes=nodes, w=w, c_N=c_N)
 
 
-def run(params, progress=None):
-    m = build(params)
+def run(params, progress=None, normal=None, friction=None):
+    m = build(params, normal, friction)
     body, contact, system = m["body"], m["contact"], m["system"]
     L, H, v0 = params["L"], params["h"], params["v0"]
     ex = bar_exact(L, params["E"], params["rho"], v0)

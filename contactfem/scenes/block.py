@@ -57,15 +57,14 @@ its shear-buckling load G A, and elements invert (p_y <= 50 converges).
 """
 
 import numpy as np
-from skfem import MeshQuad
 
-from ..bodies.continuum import MATERIALS, Continuum
-from ..bodies.loads import Pressure, Traction
+from ..bodies.materials import MATERIALS
 from ..contact import RigidLine, tributary_lengths
 from ..contact.augmented import make_interface
 from ..contact.tangents import TANGENTS, ContactTangent  # noqa: F401  (ContactTangent: public here too)
 from ..laws.friction import Coulomb, ParabolicSlip
 from ..laws.normal import PowerLaw
+from ..laws.protocol import FrictionLaw
 from ..solver import Static, System, integrate
 from . import enforcement
 from .base import Param, Scene
@@ -147,6 +146,8 @@ PARAMS = (
 
 def block_mesh(width, height, nx, ny):
     """MeshQuad of the block [0, width] x [0, height] with boundaries bottom/top/left/right."""
+    from skfem import MeshQuad
+
     mesh = MeshQuad.init_tensor(np.linspace(0.0, width, nx + 1), np.linspace(0.0, height, ny + 1))
     tx, ty = 1e-9 * width, 1e-9 * height
     return mesh.with_boundaries({
@@ -215,9 +216,13 @@ def friction_law(params):
     raise ValueError(f"parameter law = {law!r} is not allowed: one of {'|'.join(LAWS)}")
 
 
-def build(params, friction=None):
+def build(params, friction=None, normal=None):
     """Body, contact, loads and System of the block (no solve). Returns a dict.
-    ``friction``: a friction law object to use instead of params["law"] (a student's law)."""
+    ``friction`` / ``normal``: law objects to use instead of the ones params build
+    (params["law"] and the penalty law of c_N, m): a student's law."""
+    from ..bodies.continuum import Continuum
+    from ..bodies.loads import Pressure, Traction
+
     W, H = params["width"], params["height"]
     mesh = block_mesh(W, H, params["nx"], params["ny"])
     body = Continuum(mesh, E=params["E"], nu=params["nu"], rho=0.0, kind="plane_" + params["plane"],
@@ -230,7 +235,7 @@ def build(params, friction=None):
     weights = tributary_lengths(body.X[bottom])[k:-k]        # tractions per unit length of the bottom
     slaves = bottom[k:-k]                                   # the first and last element never touch
     contact = make_interface(params.get("enforcement", "penalty"), body, slaves, RigidLine((0.0, 0.0), (0.0, 1.0)),
-                             PowerLaw(c_N=params["c_N"] * per_length(params), m=params["m"]),
+                             normal or PowerLaw(c_N=params["c_N"] * per_length(params), m=params["m"]),
                              friction or friction_law(params), weights=weights, offset=-params["g_N0"], name="foundation")
     p_y, p_x = params["p_y"], params["p_x"]
     loads = [Pressure(body, "top", lambda t: p_y * t),                # dead loads, ramped over the
@@ -240,12 +245,12 @@ def build(params, friction=None):
     return dict(body=body, contact=contact, loads=loads, system=system, slaves=slaves)
 
 
-def solve(params, friction=None, progress=None):
+def solve(params, friction=None, progress=None, normal=None):
     """Build the block and apply the load in ``n_steps`` static steps of the pseudo-time
     (default: the whole load in ONE step, Newton from u = 0). Returns build()'s dict plus
     u, the NewtonResult of every step and the contact report and contact forces R_c at
     the converged final state (taken before the friction history is committed)."""
-    sc = build(params, friction)
+    sc = build(params, friction, normal)
     system, contact = sc["system"], sc["contact"]
     n = params["n_steps"]
     stepper = Static(system, dt=1.0 / n, atol=params["atol"], rtol=params["rtol"], maxit=params["maxit"])
@@ -259,7 +264,9 @@ def solve(params, friction=None, progress=None):
     def converged(t, u, v, a, step):                 # before the friction history is committed
         results.append(step.result)
         if step.k == n:
-            last.update(report=contact.report(u), R_c=contact.assemble(u)[0])
+            rep, fr = contact.report(u), contact.evaluate(u)["friction"]
+            Y = FrictionLaw(contact.friction).slip_bound(-rep["t_N"], fr.q, fr.v, fr.z)[0]    # after the step
+            last.update(report=rep, R_c=contact.assemble(u)[0], slip_bound=Y)
 
     hist = integrate(stepper, 0.0, u, n_steps=n, before_commit=converged, progress=progress,
                      label=lambda k, t1, dt: f"block, load step {k} of {n}")
@@ -279,15 +286,15 @@ def load_norms(body, loads):
     return [float(np.linalg.norm(ld.assemble(u, 1.0)[0])) for ld in loads]
 
 
-def run(params, progress=None):
-    s = solve(params, progress=progress)
+def run(params, progress=None, normal=None, friction=None):
+    s = solve(params, friction, progress, normal)
     body, rep, res = s["body"], s["report"], s["result"]
     dofs = body.xdofs
     total_normal = float(s["R_c"][dofs[:, 1]].sum())          # = sum w t_N (signed, < 0 compressive)
     total_tangential = float(s["R_c"][dofs[:, 0]].sum())      # = sum w t_T
     W, H = params["width"], params["height"]
     applied_normal, applied_tangential = -params["p_y"] * W, params["p_x"] * H
-    Y = slip_bound(params, rep["t_N"])
+    Y = s["slip_bound"]                                       # of the law in use, after the step
     excess = np.abs(rep["t_T"]) - Y                           # <= 0 everywhere, = 0 on slipping nodes
     slipping = rep["state"] == "slip"
     top, side = load_norms(body, s["loads"])

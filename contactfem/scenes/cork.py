@@ -81,10 +81,7 @@ and the fast one, which differ only in time stepping and press-fit increments).
 """
 
 import numpy as np
-from skfem import MeshQuad
 
-from ..bodies.continuum import Continuum, boundary_loop
-from ..bodies.loads import GasPressure, swept_volume  # noqa: F401  (swept_volume: public here too)
 from ..contact import NodeToSegment, tributary_lengths
 from ..contact.masters import RigidComposite
 from ..laws.friction import SlipHardening
@@ -169,6 +166,8 @@ def cork_radius(z, R_tip, R_cork, L_taper):
 def cork_mesh(R_tip, R_cork, L_taper, length, n_r, n_z):
     """MeshQuad of the cork's meridian (x = r, y = z): n_r x n_z elements, radius
     ``cork_radius(z)``, with boundaries axis, outer, bottom, top."""
+    from skfem import MeshQuad
+
     mesh = MeshQuad.init_tensor(np.linspace(0.0, 1.0, n_r + 1), np.linspace(0.0, length, n_z + 1))
     tr, tz = 1e-9, 1e-9 * length
     mesh = mesh.with_boundaries({
@@ -258,8 +257,12 @@ def centre_of_mass_velocity(body, v):
 # The model
 # ---------------------------------------------------------------------------
 
-def build(params):
-    """Cork, neck, contact, gas: everything both stages share."""
+def build(params, normal=None, friction=None):
+    """Cork, neck, contact, gas: everything both stages share.
+    ``normal`` / ``friction``: law objects instead of the ones the parameters build."""
+    from ..bodies.continuum import Continuum
+    from ..bodies.loads import GasPressure
+
     P = params
     if not P["R_cork"] > P["R_neck"]:
         raise ValueError(f"parameter R_cork = {P['R_cork']} must exceed R_neck = {P['R_neck']} (a press fit)")
@@ -277,8 +280,8 @@ def build(params):
         w = np.full(len(side), 2.0 * np.pi * P["R_neck"])
     else:
         w = np.ones(len(side))
-    friction = SlipHardening(c_T=P["c_T"], mu=P["mu"], h=P["h"])
-    contacts = [NodeToSegment(cork, side, neck, PowerLaw(P["c_N"], P["m"]), friction, weights=w, name="neck")]
+    friction = friction or SlipHardening(c_T=P["c_T"], mu=P["mu"], h=P["h"])
+    contacts = [NodeToSegment(cork, side, neck, normal or PowerLaw(P["c_N"], P["m"]), friction, weights=w, name="neck")]
     axis = cork.boundary_nodes("axis")
     bottom = cork.boundary_nodes("bottom")
     gas = GasPressure(cork, "bottom", bottom, np.pi * P["R_neck"]**2, P["gas_column"], P["p_step"], P["n_ramp"],
@@ -418,10 +421,10 @@ def snapshot_times(t_ramp, t_exit, t_last):
     return np.minimum(ours, t_last)
 
 
-def simulate(params, log=None, progress=None):
+def simulate(params, log=None, progress=None, normal=None, friction=None):
     """Both stages; returns the model, the press-fit state and record, and the pop
     record (for the figures and the lecture; ``run`` reduces it to JSON-able results)."""
-    model = build(params)
+    model = build(params, normal, friction)
     u_fit, fit = press_fit(model, params, log, progress)
     fit.update(contact_forces(model["contacts"], u_fit))
     fit["min_area_ratio"] = float(np.min(quad_areas(model["cork"], u_fit) / quad_areas(model["cork"], 0 * u_fit)))
@@ -447,9 +450,11 @@ def press_fit_only(params):
                 press_fit_calibrated=bool(params["R_tip"] == R_TIP_FITTED))
 
 
-def run(params, progress=None):
+def run(params, progress=None, normal=None, friction=None):
+    from ..bodies.continuum import boundary_loop
+
     P = params
-    model, u_fit, fit, out = simulate(P, progress=progress)
+    model, u_fit, fit, out = simulate(P, progress=progress, normal=normal, friction=friction)
     h = out["history"]
     t_ramp = P["n_ramp"] * P["dt"]
     p_break = breakaway(h)

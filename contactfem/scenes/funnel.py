@@ -51,8 +51,10 @@ def funnel_wall(phi_deg, length):
     return np.array([[-length * np.sin(phi), length * np.cos(phi)], [0.0, 0.0]])
 
 
-def build(params):
-    """Half ring, funnel wall, contact and symmetry conditions; returns a dict."""
+def build(params, normal=None, friction=None):
+    """Half ring, funnel wall, contact and symmetry conditions; returns a dict.
+    ``normal`` / ``friction``: law objects instead of the ones the parameters build
+    (a friction law given makes the run frictional)."""
     R, h = params["R"], params["thickness"]
     phi = np.radians(params["phi_deg"])
     yc0 = (R + h / 2) / np.sin(phi) + params["gap0"]      # wall distance of the centre = R + h/2 + gap
@@ -60,10 +62,9 @@ def build(params):
                      E=params["E"], nu=params["nu"], rho=params["rho"], center=(0.0, yc0), half=True,
                      name="half ring")
     wall = RigidPolyline(funnel_wall(params["phi_deg"], params["wall_length"]))
-    friction = None
-    if params["variant"] == "frictional":
+    if friction is None and params["variant"] == "frictional":
         friction = ParabolicSlip(params["c_T"], params["alpha"], params["beta"], params["n"])
-    contact = NodeToSegment(ring.body, ring.contact_nodes, wall, PowerLaw(params["c_N"], params["m"]),
+    contact = NodeToSegment(ring.body, ring.contact_nodes, wall, normal or PowerLaw(params["c_N"], params["m"]),
                             friction, weights=1.0, offset=ring.offset, name="funnel")
     symmetry = Dirichlet(ring.body, ring.symmetry_dofs(), 0.0)
     system = System([ring.body], [contact], fixed=[symmetry])
@@ -77,8 +78,8 @@ def radial_deviation(ring, u, center):
     return float(np.max(np.abs(r - ring.R)) / ring.R)
 
 
-def run(params, progress=None):
-    m = build(params)
+def run(params, progress=None, normal=None, friction=None):
+    m = build(params, normal, friction)
     ring, contact, system = m["ring"], m["contact"], m["system"]
     u0 = np.zeros(ring.body.ndof)
     v0 = ring.initial_velocity((0.0, -params["v0"]))

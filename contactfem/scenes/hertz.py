@@ -37,10 +37,7 @@ iteration: the initial overlap a^2 / 2R guesses the active set.
 """
 
 import numpy as np
-from skfem import MeshQuad
 
-from ..bodies.continuum import Continuum
-from ..bodies.loads import Pressure
 from ..contact import RigidLine, tributary_lengths
 from ..contact.augmented import make_interface
 from ..laws import PowerLaw
@@ -85,6 +82,8 @@ def quarter_disk(R, n_el, k):
     xi = 0 -> symmetry line x = 0, xi = 1 -> arc from -45 deg to A = (R, 0).
     Both coordinates are stretched with sinh(k s)/sinh(k), so the mesh is finest at B.
     Boundaries: 'symmetry' (x = 0), 'top' (y = 0), 'arc'."""
+    from skfem import MeshQuad
+
     xi = stretching(n_el, k)
     XI, ETA = np.meshgrid(xi, xi, indexing="ij")               # (n+1, n+1)
 
@@ -128,8 +127,12 @@ def fit_hertz(x, p):
     return float(np.sqrt(-c0 / c1)), float(np.sqrt(c0))
 
 
-def build(params):
-    """Body, contact, load and supports of the quarter cylinder; returns a dict."""
+def build(params, normal=None, friction=None):
+    """Body, contact, load and supports of the quarter cylinder; returns a dict.
+    ``normal`` / ``friction``: law objects instead of the parameters' (frictionless by default)."""
+    from ..bodies.continuum import Continuum
+    from ..bodies.loads import Pressure
+
     R, E, nu, P = params["R"], params["E"], params["nu"], params["P"]
     a_ex, p0_ex = hertz_exact(P, R, E, nu)
     n = params["n_el"]
@@ -146,7 +149,7 @@ def build(params):
     w = tributary_lengths(body.X[nodes])
     weights = w if params["penalty"] == "per_length" else 1.0
     contact = make_interface(params.get("enforcement", "penalty"), body, nodes, RigidLine((0.0, -R), (0.0, 1.0)),
-                             PowerLaw(params["c_N"], 1.0), weights=weights, name="plane")
+                             normal or PowerLaw(params["c_N"], 1.0), friction, weights=weights, name="plane")
     sym = np.flatnonzero(np.abs(body.X[:, 0]) < 1e-9 * R)
     fixed = [Dirichlet(body, body.xdofs[sym, 0], 0.0)]
     q = P / (2.0 * R)
@@ -156,8 +159,8 @@ def build(params):
                 grading_k=k)
 
 
-def run(params, progress=None):
-    m = build(params)
+def run(params, progress=None, normal=None, friction=None):
+    m = build(params, normal, friction)
     body, contact, system, w = m["body"], m["contact"], m["system"], m["w"]
     R, P = params["R"], params["P"]
     a_ex = m["a_exact"]

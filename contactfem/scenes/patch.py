@@ -46,10 +46,7 @@ p): only the sum is meaningful.
 """
 
 import numpy as np
-from skfem import MeshQuad
 
-from ..bodies.continuum import Continuum
-from ..bodies.loads import Pressure
 from ..contact import BodySurface, NodeToSegment, tributary_lengths
 from ..laws import PowerLaw
 from ..solver import Dirichlet, Static, System, integrate
@@ -58,6 +55,10 @@ from .base import Param, Scene
 
 def block(xs, y0, y1, ny, name, E, nu):
     """A block of quads on the grid xs x linspace(y0, y1, ny + 1); boundaries bottom, top."""
+    from skfem import MeshQuad
+
+    from ..bodies.continuum import Continuum
+
     mesh = MeshQuad.init_tensor(np.asarray(xs, dtype=float), np.linspace(y0, y1, ny + 1))
     tol = 1e-9 * (xs[-1] - xs[0])
     mesh = mesh.with_boundaries({"bottom": lambda x: np.abs(x[1] - y0) < tol,
@@ -93,7 +94,10 @@ class OverhangPressure:
         return P, e, e, np.zeros(0)
 
 
-def build(params):
+def build(params, normal=None, friction=None):
+    """``normal`` / ``friction``: law objects instead of the parameters' (frictionless by default)."""
+    from ..bodies.loads import Pressure
+
     W, H, E, nu = params["W"], params["H"], params["E"], params["nu"]
     e = W / params["nx_lower"]
     xs_lower = -0.5 * e + e * np.arange(params["nx_lower"] + 2)      # [-e/2, W + e/2], shifted
@@ -103,12 +107,12 @@ def build(params):
                          "(node-to-segment switching is non-smooth there): choose nx_upper odd")
     lower = block(xs_lower, 0.0, H, params["ny"], "lower", E, nu)
     upper = block(xs_upper, H, 2 * H, params["ny"], "upper", params["E_upper"], nu)
-    law = PowerLaw(params["c_N"], 1.0)
+    law = normal or PowerLaw(params["c_N"], 1.0)
     half = 0.5 if params["passes"] == 2 else 1.0
     top_lower = lower.boundary_nodes("top")           # outward normal +y (towards the upper block)
     bottom_upper = upper.boundary_nodes("bottom")     # outward normal -y (towards the lower block)
     w_upper = tributary_lengths(upper.X[bottom_upper])
-    contacts = [NodeToSegment(upper, bottom_upper, BodySurface(lower, top_lower), law,
+    contacts = [NodeToSegment(upper, bottom_upper, BodySurface(lower, top_lower), law, friction,
                               weights=half * w_upper, name="upper_on_lower")]
     if params["passes"] == 2:
         # the lower block's top nodes over [0, W]; each carries its tributary part of [0, W]
@@ -118,7 +122,7 @@ def build(params):
         w = tributary_lengths(chain)
         w[1] += w[0]
         w[-2] += w[-1]
-        contacts.append(NodeToSegment(lower, inner, BodySurface(upper, bottom_upper), law,
+        contacts.append(NodeToSegment(lower, inner, BodySurface(upper, bottom_upper), law, friction,
                                       weights=half * w[1:-1], name="lower_on_upper"))
 
     def node(body, x, y):
@@ -137,8 +141,8 @@ def build(params):
     return dict(lower=lower, upper=upper, contacts=contacts, system=system, bottom_upper=bottom_upper)
 
 
-def run(params, progress=None):
-    m = build(params)
+def run(params, progress=None, normal=None, friction=None):
+    m = build(params, normal, friction)
     lower, upper, system = m["lower"], m["upper"], m["system"]
     p = params["p"]
     # initial guess: the upper block pushed into the lower by twice the penalty

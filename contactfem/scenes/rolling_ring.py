@@ -114,8 +114,9 @@ def detect_rolling(t, slip, v0, lo=0.1, hi=0.9, roll=0.02):
     return float(-icpt / slope)
 
 
-def build(params):
-    """The ring touching the plane y = 0 (lowest outer point at y = 0), contact, gravity."""
+def build(params, normal=None, friction=None):
+    """The ring touching the plane y = 0 (lowest outer point at y = 0), contact, gravity.
+    ``normal`` / ``friction``: law objects instead of the ones the parameters build."""
     R, h = params["R"], params["thickness"]
     args = dict(kind=params["kind"], R=R, thickness=h, width=params["width"], n_el=params["n_el"],
                 E=params["E"], nu=params["nu"], rho=params["rho"], n_radial=params["n_radial"], name="ring")
@@ -123,15 +124,15 @@ def build(params):
     y0 = -probe.outline(np.zeros(probe.body.ndof))[:, 1].min()   # R + h/2 if a node sits at the bottom
     ring = make_ring(center=(0.0, y0), **args)
     plane = RigidLine((0.0, 0.0), (0.0, 1.0))
-    contact = NodeToSegment(ring.body, ring.contact_nodes, plane, PowerLaw(params["c_N"], params["m"]),
-                            Coulomb(params["c_T"], params["mu"]), weights=1.0, offset=ring.offset,
+    contact = NodeToSegment(ring.body, ring.contact_nodes, plane, normal or PowerLaw(params["c_N"], params["m"]),
+                            friction or Coulomb(params["c_T"], params["mu"]), weights=1.0, offset=ring.offset,
                             name="plane")
     system = System([ring.body], [contact], [ring.gravity(params["g"])])
     return dict(ring=ring, contact=contact, system=system, plane=plane)
 
 
-def run(params, progress=None):
-    m = build(params)
+def run(params, progress=None, normal=None, friction=None):
+    m = build(params, normal, friction)
     ring, contact, system = m["ring"], m["contact"], m["system"]
     v0 = params["v0"]
     u0 = np.zeros(ring.body.ndof)

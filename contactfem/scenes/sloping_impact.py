@@ -65,8 +65,10 @@ def integration_points(params):
     return 1 if params["variant"] == "viscoplastic" else 2
 
 
-def build(params):
-    """The ring (make_ring), the plane y = 0 and the contact; returns a dict."""
+def build(params, normal=None, friction=None):
+    """The ring (make_ring), the plane y = 0 and the contact; returns a dict.
+    ``normal`` / ``friction``: law objects instead of the ones the parameters build
+    (a friction law given makes any variant frictional)."""
     h = params["thickness"]
     plastic = None
     if params["variant"] == "viscoplastic":
@@ -80,8 +82,7 @@ def build(params):
     ring = make_ring(kind=params["kind"], R=R, thickness=h, width=params["width"], n_el=params["n_el"],
                      E=params["E"], nu=params["nu"], rho=params["rho"], center=center, plastic=plastic,
                      name="ring", **beam)
-    friction = None
-    if params["variant"] != "frictionless":
+    if friction is None and params["variant"] != "frictionless":
         friction = ParabolicSlip(params["c_T"], params["alpha"], params["beta"], params["n"])
     plane = RigidLine((0.0, 0.0), (0.0, 1.0))
     if params["penalty"] == "per_node":
@@ -90,14 +91,14 @@ def build(params):
         w = tributary_lengths(ring.outline(np.zeros(ring.body.ndof)))     # closed polyline: node 0 twice
         weights = np.concatenate([[w[0] + w[-1]], w[1:-1]])
     offset = ring.offset if params["contact_at"] == "outer" else 0.0
-    contact = NodeToSegment(ring.body, ring.contact_nodes, plane, PowerLaw(params["c_N"], params["m"]),
+    contact = NodeToSegment(ring.body, ring.contact_nodes, plane, normal or PowerLaw(params["c_N"], params["m"]),
                             friction, weights=weights, offset=offset, name="plane")
     system = System([ring.body], [contact])
     return dict(ring=ring, contact=contact, system=system, plane=plane)
 
 
-def run(params, progress=None):
-    m = build(params)
+def run(params, progress=None, normal=None, friction=None):
+    m = build(params, normal, friction)
     ring, contact, system = m["ring"], m["contact"], m["system"]
     u0 = np.zeros(ring.body.ndof)
     v0 = ring.initial_velocity((params["vx0"], params["vy0"]))

@@ -27,7 +27,6 @@ derivative of W over M / dt^2 (a few iterations more on the nonlinear beam ring;
 a linear body).
 """
 import numpy as np
-import scipy.sparse as sp
 
 from ..contact.conserving import ConservingContact
 from .newmark import _check_dt
@@ -50,6 +49,8 @@ class EnergyConsistent:
 
     def _bodies(self, u0, u1):
         """Discrete-gradient internal forces of every body, as (G, rows, cols, vals)."""
+        import scipy.sparse as sp     # (imported here: listing the scenes loads no scipy)
+
         s = self.system
         G = np.zeros(s.ndof)
         rows, cols, vals = [], [], []
@@ -79,6 +80,8 @@ class EnergyConsistent:
         c = 2.0 / dt ** 2
         for ct in s.contacts:
             ct.begin_step(u)
+
+        import scipy.sparse as sp
 
         def fun(u1):
             G, rows, cols, vals = self._bodies(u, u1)

@@ -23,7 +23,6 @@ import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
 
 from .newton import NewtonError, NewtonResult, newton
 
@@ -79,9 +78,9 @@ class Newmark:
         c = 1.0 / (beta * dt ** 2)
         u_pred = u + dt * v + dt ** 2 * (0.5 - beta) * a
 
-        def effective(u1):                    # eq 29 with a+ = c (u1 - u_pred)
-            G, K = s.residual_tangent(u1, t1)
-            return G + M * c * (u1 - u_pred), K + sp.diags(c * M)
+        def effective(u1):                    # eq 29 with a+ = c (u1 - u_pred); tangent K + c M
+            G, K = s.residual_tangent(u1, t1, mass_coefficient=c)
+            return G + M * c * (u1 - u_pred), K
 
         # initial guess: the acceleration stays a (u + dt v + dt^2 a / 2)
         guess = s.apply_dirichlet(u_pred + beta * dt ** 2 * a, t1)

@@ -1,13 +1,14 @@
 """Full Newton iteration within a step (paper Sec. 4.3).
 
 Solves G(u) = 0 on the free dofs, where ``fun(u) -> (G, K)`` returns the full
-residual vector and its tangent K = dG/du (scipy.sparse). The prescribed dofs keep
-the values they have in the initial guess.
+residual vector and its tangent K = dG/du (a dense numpy array or scipy.sparse). The
+prescribed dofs keep the values they have in the initial guess.
 
-Linear solver: ``scipy.sparse.linalg.splu`` (SuperLU, ordering ORDERING). The contact tangent with
-friction is non-symmetric (paper eq 49-50), so no symmetric solver applies; splu
-rather than spsolve because splu *raises* on an exactly singular matrix, while
-spsolve only warns and returns NaNs.
+Linear solver: dense K by LAPACK's LU with partial pivoting (``numpy.linalg.solve``),
+sparse K by ``scipy.sparse.linalg.splu`` (SuperLU, ordering ORDERING). The contact
+tangent with friction is non-symmetric (paper eq 49-50), so no symmetric solver
+applies; splu rather than spsolve because splu *raises* on an exactly singular matrix,
+while spsolve only warns and returns NaNs (numpy.linalg.solve raises as well).
 
 Convergence test (on the Euclidean norm of the free part of G):
 
@@ -24,14 +25,32 @@ the contact's ReturnMapError derive from it), so a driver can cut the step back.
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.linalg import splu
 
 # Column ordering of SuperLU. The tangents here have a symmetric sparsity pattern (the
 # contact element couples the same dofs both ways), for which the minimum degree
 # ordering of A^T + A fills in less than scipy's default COLAMD: 1.6-2x faster
 # factorisations from 1e3 to 1e5 unknowns (BENCHMARKS.md, `contactfem bench`).
 ORDERING = "MMD_AT_PLUS_A"
+DENSE_ORDERING = "natural (LAPACK LU, partial pivoting)"   # what a dense K gets
+
+
+def solve_free(K, b, free, all_free):
+    """du_f from K_ff du_f = b on the free dofs; K dense (LAPACK) or sparse (SuperLU).
+    Raises RuntimeError on an exactly singular K_ff."""
+    if isinstance(K, np.ndarray):
+        Kff = K if all_free else K[np.ix_(free, free)]
+        try:
+            return np.linalg.solve(Kff, b)
+        except np.linalg.LinAlgError as err:           # "Singular matrix"
+            raise RuntimeError(f"Factor is exactly singular ({err})") from None
+    import scipy.sparse as sp
+    from scipy.sparse.linalg import splu
+
+    if all_free:
+        Kff = K if K.format == "csc" else sp.csc_matrix(K)
+    else:
+        Kff = sp.csr_matrix(K)[free][:, free].tocsc()
+    return splu(Kff, permc_spec=ORDERING).solve(b)
 
 
 class NewtonError(RuntimeError):
@@ -58,7 +77,7 @@ def newton(fun, u0, free, atol=1e-10, rtol=1e-10, maxit=25, label="", line_searc
 
     Parameters
     ----------
-    fun   : u -> (G, K), full residual (n,) and tangent (n, n) sparse
+    fun   : u -> (G, K), full residual (n,) and tangent (n, n), dense or sparse
     u0    : (n,) initial guess, prescribed dofs already set
     free  : indices (or boolean mask) of the unknown dofs
     atol, rtol : convergence test ||G_k|| <= atol + rtol * ||G_0|| (module docstring)
@@ -105,9 +124,8 @@ def newton(fun, u0, free, atol=1e-10, rtol=1e-10, maxit=25, label="", line_searc
             return NewtonResult(u=u, residuals=history, iterations=k, G=G)
         if k == maxit:
             break
-        Kff = sp.csc_matrix(K) if all_free else sp.csr_matrix(K)[free][:, free].tocsc()
         try:
-            du = splu(Kff, permc_spec=ORDERING).solve(-G[free])
+            du = solve_free(K, -G[free], free, all_free)
         except RuntimeError as err:                   # "Factor is exactly singular"
             raise NewtonError(f"Newton: singular tangent at iteration {k}{where}: {err}",
                               history, label) from err

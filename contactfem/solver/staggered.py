@@ -36,7 +36,6 @@ consistent Newton's. A cycle limit raises NewtonError (never returns an unconver
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
 
 from ..contact.tangents import PHASES, SplitContact  # noqa: F401  (SplitContact: public here too)
 from .newton import NewtonError, newton
@@ -130,8 +129,8 @@ class Staggered:
         u_pred = u + dt * v + dt ** 2 * (0.5 - beta) * a
 
         def effective(u1):                                   # as Newmark.step
-            G, K = s.residual_tangent(u1, t1)
-            return G + M * c * (u1 - u_pred), K + sp.diags(c * M)
+            G, K = s.residual_tangent(u1, t1, mass_coefficient=c)
+            return G + M * c * (u1 - u_pred), K
 
         guess = s.apply_dirichlet(u_pred + beta * dt ** 2 * a, t1)
         res = staggered(effective, guess, s.free_dofs, self.splits, max_cycles=self.max_cycles,

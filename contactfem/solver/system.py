@@ -10,9 +10,14 @@ The inertia term M a of eq 29 is added by the time steppers (newmark.py).
 
 Bodies are placed one after another in the global vector: body b owns the global
 dofs ``b.dof_offset + local``.
+
+K is a dense numpy array for small systems and a scipy CSC matrix on a fixed sparsity
+pattern above (``System.linear_algebra``, chosen by size: assembly.py).
 """
 import numpy as np
-import scipy.sparse as sp
+
+from .assembly import TangentAssembler, choose_linear_algebra
+from .newton import DENSE_ORDERING, ORDERING
 
 
 class Dirichlet:
@@ -43,6 +48,11 @@ def _triplets(rows, cols, vals):
             np.asarray(vals, dtype=float).ravel())
 
 
+def as_array(K):
+    """A tangent as a dense numpy array, whether the System assembled it dense or sparse."""
+    return K.toarray() if hasattr(K, "toarray") else np.asarray(K)
+
+
 class System:
     """Bodies, contacts, loads and Dirichlet conditions assembled into one problem.
 
@@ -52,12 +62,17 @@ class System:
     contacts : list of contacts, ``assemble(u) -> (R_c, rows, cols, vals)``
     loads    : list of loads, ``assemble(u, t) -> (P, rows, cols, vals)``
     fixed    : list of Dirichlet conditions
+    linear_algebra : "auto" (default: dense up to assembly.DENSE_MAX unknowns, sparse
+               above), "dense" or "sparse"
 
     Attributes: ``ndof``, ``fixed_dofs`` and ``free_dofs`` (global, sorted),
-    ``dissipation`` (frictional dissipation summed over all committed steps).
+    ``dissipation`` (frictional dissipation summed over all committed steps),
+    ``linear_algebra`` ("dense" or "sparse") and ``ordering`` (of the factorisation).
     """
 
-    def __init__(self, bodies, contacts=(), loads=(), fixed=()):
+    built = None     # a list while contactfem.scenes.run_scene records the Systems a scene builds
+
+    def __init__(self, bodies, contacts=(), loads=(), fixed=(), linear_algebra="auto"):
         self.bodies = list(bodies)
         self.contacts = list(contacts)
         self.loads = list(loads)
@@ -82,6 +97,12 @@ class System:
         self.free_dofs = np.setdiff1d(np.arange(self.ndof), self.fixed_dofs)
         self.dissipation = 0.0
         self._mass = None
+        self.linear_algebra = choose_linear_algebra(self.ndof, linear_algebra)
+        self.ordering = DENSE_ORDERING if self.linear_algebra == "dense" else ORDERING
+        self._tangent = TangentAssembler(self.ndof, self.linear_algebra)
+        self._body_coo = {}          # body -> (K, rows, cols) of its last sparse tangent
+        if System.built is not None:
+            System.built.append(self)
 
     def global_dofs(self, body, local):
         """Global numbers of a body's local dofs."""
@@ -122,40 +143,56 @@ class System:
             P += load.assemble(u, t)[0]
         return P
 
-    def residual_tangent(self, u, t):
-        """G = R(u) + R_c(u) - P(u, t) (static part of eq 29) and K = dG/du (CSR).
+    def _body_triplets(self, body, u_local):
+        """R and the COO triplets of a body's tangent. Bodies with ``internal_coo`` (the
+        beam) give constant index arrays; a sparse K (the continuum) is converted, reusing
+        the index arrays while its pattern stays the same."""
+        if hasattr(body, "internal_coo"):
+            return body.internal_coo(u_local)
+        R, K = body.internal(u_local)
+        K = K.tocsr()
+        last = self._body_coo.get(body)
+        if last is not None and (last[0] is K or (np.array_equal(last[0].indptr, K.indptr)
+                                                   and np.array_equal(last[0].indices, K.indices))):
+            rows, cols = last[1], last[2]
+        else:
+            rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
+            cols = K.indices
+        self._body_coo[body] = (K, rows, cols)
+        return R, rows, cols, K.data
 
-        All contributions are collected as COO triplets and the sparse matrix is
-        built once (duplicates are summed by the COO -> CSR conversion).
+    def residual_tangent(self, u, t, mass_coefficient=0.0):
+        """G = R(u) + R_c(u) - P(u, t) (static part of eq 29) and K = dG/du.
+
+        With ``mass_coefficient`` c > 0, K + c M is returned instead (M the lumped mass):
+        the effective tangent of an implicit time stepper (Newmark: c = 1 / (beta dt^2)).
+        K is a dense array or a CSC matrix (``self.linear_algebra``); all contributions
+        arrive as COO triplets and are summed into it once (duplicates add up).
         """
         u = np.asarray(u, dtype=float)
         if u.shape != (self.ndof,):
             raise ValueError(f"u must have shape ({self.ndof},), got {u.shape}")
         G = np.zeros(self.ndof)
-        rows, cols, vals = [], [], []
+        blocks = []                                    # (rows, cols, vals, offset, key)
 
         for body in self.bodies:                       # block diagonal: internal forces
-            R, K = body.internal(self.local(body, u))
-            G[body.dof_offset:body.dof_offset + body.ndof] += R
-            K = sp.coo_matrix(K)
-            rows.append(K.row + body.dof_offset)
-            cols.append(K.col + body.dof_offset)
-            vals.append(K.data)
+            off = body.dof_offset
+            R, rows, cols, vals = self._body_triplets(body, u[off:off + body.ndof])
+            G[off:off + body.ndof] += R
+            blocks.append((rows, cols, vals, off, body))
 
         for contact in self.contacts:                  # contact residual eq 28 and its tangent
             Rc, r, c, v = contact.assemble(u)
             G += Rc
-            r, c, v = _triplets(r, c, v)
-            rows.append(r), cols.append(c), vals.append(v)
+            blocks.append((*_triplets(r, c, v), 0, None))
 
         for load in self.loads:                        # loads enter with a minus sign
             P, r, c, v = load.assemble(u, t)
             G -= P
             r, c, v = _triplets(r, c, v)
-            rows.append(r), cols.append(c), vals.append(-v)
+            blocks.append((r, c, -v, 0, None))
 
-        K = sp.coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                          shape=(self.ndof, self.ndof)).tocsr()
+        K = self._tangent.assemble(blocks, mass_coefficient * self.mass() if mass_coefficient else None)
         return G, K
 
     def set_dt(self, dt):

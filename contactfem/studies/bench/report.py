@@ -7,6 +7,7 @@ import numpy as np
 
 from .common import TARGETS
 from .enforcement import enforcement_markdown
+from .speed import PARTS, SPEED_TARGETS
 
 def _f(x, fmt="{:.3g}"):
     if x is None:
@@ -30,11 +31,87 @@ OPTIMISATIONS = [
     "indexing of K when every dof is free | solver/newton.py | rolling ring, paper preset: 7.1 s; "
     "factorisation at 1e5 unknowns: 2.4 s | 5.5 s; 1.4 s |",
     "| all of the above | | hertz 64^2, whole process: 4.0 s; svk block 4096 quads body.internal: 1.49 s "
-    "| 1.2 s; 0.45 s |", "",
+    "| 1.2 s; 0.45 s |",
+    "| lazy imports: a scene module imports scikit-fem and the continuum bodies inside the functions that "
+    "build; the solver imports scipy only for a sparse K; xml (and urllib) only when writing ParaView files "
+    "| scenes/, bodies/, solver/, io/paraview.py | `contactfem list`: 0.59 s CPU (median of 5, loaded machine) "
+    "| 0.20-0.25 s CPU |",
+    "| K dense (LAPACK) up to 100 unknowns, a fixed CSC pattern above (values scattered with one bincount); "
+    "the Newmark mass term added on the pattern's diagonal; the beam kernel without repeated strains and "
+    "einsum temporaries, as COO triplets on its fixed connectivity; contact elements of the active pairs "
+    "only, scattered with bincount; the return map skips a body in flight "
+    "| solver/assembly.py, solver/system.py, solver/newton.py, bodies/beam.py, contact/interface.py, "
+    "laws/return_map.py | one Newton iteration inside the paper runs (CPU, loaded machine; midpoint beam): "
+    "sloping impact 2.2-2.6 ms, rolling ring 3.0 ms | 0.69-0.89 ms; 2.1 ms |", "",
     "Not adopted: pypardiso (MKL PARDISO, installs from PyPI, about 0.8 s of import time and a large "
     "download): at 1e5 unknowns 1.0-1.4 s against 1.3-1.4 s for SuperLU with MMD_AT_PLUS_A, slower "
     "at the paper sizes; not a clear win. scikit-umfpack does not install from PyPI here (needs swig and "
     "SuiteSparse to build).", ""]
+
+
+def _ms(x):
+    return "-" if x is None else f"{1e3 * x:.3f}"
+
+
+def speed_section(sp):
+    """Study 5 (speed): start-up, the split of one Newton iteration, the Table 2 sweep."""
+    T = SPEED_TARGETS
+    s = sp["startup"]
+    load = sp.get("load_average")
+    L = ["## Start-up and the cost of one Newton iteration", ""]
+    if load and load[0] > 1.5:
+        L += [f"The machine was loaded when this ran (load average {load[0]:.1f} on 2 cores): wall times include "
+              "waiting for a core and CPU times are inflated by the other processes sharing the caches; the "
+              "targets are for a quiet machine.", ""]
+    L += [f"Start-up: whole processes, median of {len(s['python']['walls_s'])} runs (wall and CPU seconds).", "",
+          "| process | wall [s] | CPU [s] |", "|---|---|---|"]
+    names = {"python": "`python -c pass`", "list": "`contactfem list`",
+             "scipy_skfem": "`python -c \"import scipy.sparse.linalg, skfem\"`",
+             "run_block": "`contactfem run block --preset paper`"}
+    for key, label in names.items():
+        L.append(f"| {label} | {s[key]['wall_s']:.3f} | {s[key]['cpu_s']:.3f} |")
+    L += ["", f"`contactfem list`: {s['list']['wall_s']:.3f} s, {s['list_over_python']:.1f} x `python -c pass` "
+              f"(target {T['list_s']} s: {_f(s['list']['wall_s'] < T['list_s'])}). "
+              f"`contactfem run block --preset paper`: {s['run_block_over_scipy_skfem']:.2f} x an interpreter that "
+              f"imports scipy.sparse.linalg and scikit-fem (target {T['run_block_over_scipy_skfem']}: "
+              f"{_f(s['run_block_over_scipy_skfem'] <= T['run_block_over_scipy_skfem'])}).", "",
+          "One Newton iteration, CPU milliseconds: the run's totals divided by its linear solves "
+          "(contactfem/studies/bench/speed.py). bulk: the bodies' internal forces and tangents; contact: every "
+          "contact's residual and tangent; assembly: summing them into K, loads included; solve: factorisation "
+          "and solve; overhead: the rest of newton() and the time stepper's effective residual. K: dense "
+          "(LAPACK) up to 100 unknowns, sparse (fixed pattern, SuperLU) above.", "",
+          "| scene | unknowns | K | iteration [ms] | bulk | contact | assembly | solve | overhead | solves | run [s] |",
+          "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in sp["iterations"]:
+        label = r["scene"] + "".join(f", {v}" for v in r["overrides"].values())
+        L.append(f"| {label} | {r['ndof'] or '-'} | {r['linear_algebra'] or '-'} | {_ms(r['iteration_s'])} | "
+                 + " | ".join(_ms(r[f'{p}_s']) for p in PARTS) + f" | {r['solves']} | {r['run_wall_s']:.2f} |")
+    goals = {("sloping_impact", "frictional"): "sloping_impact_iteration_s", ("rolling_ring", None): "rolling_ring_iteration_s"}
+    for r in sp["iterations"]:
+        key = goals.get((r["scene"], r["overrides"].get("variant")))
+        if key and r["preset"] == "paper":
+            L.append(f"\n{r['scene']}: {_ms(r['iteration_s'])} ms per iteration "
+                     f"(target {1e3 * T[key]:g} ms: {_f(r['iteration_s'] <= T[key])}).")
+    t2 = sp.get("table2")
+    if t2:
+        L += ["", "### Table 2: convergence of the rebound under refinement", "",
+              "Each line is one run of the two sweeps below (paper data, Newmark 0.7/0.4; the paper prints two "
+              "digits). Wall time: " + "; ".join(f"`{sw['command']}` {sw['wall_s']:.1f} s" for sw in t2["sweeps"])
+              + f"; together {t2['total_wall_s']:.1f} s (target {T['table2_s']:g} s: "
+              f"{_f(t2['total_wall_s'] < T['table2_s'])}); CPU time of all processes "
+              f"{_f(t2.get('total_cpu_s'))} s, i.e. {_f((t2.get('total_cpu_s') or 0) / max(t2.get('jobs', 2), 1))} s "
+              "on the 2 cores if nothing else ran.", "",
+              "| variant | elements | dt | v_x | v_y | angle [deg] | spin | linear solves | paper v_x, v_y, angle |",
+              "|---|---|---|---|---|---|---|---|---|"]
+        for r in t2["rows"]:
+            p = r["paper"]
+            ref = f"{p['vx']}, {p['vy']}, {p['angle_deg']}" if p else "-"
+            if r["error"]:
+                L.append(f"| {r['variant']} | {r['n_el']} | {r['dt']:g} | failed: {r['error'][:60]} | | | | | {ref} |")
+                continue
+            L.append(f"| {r['variant']} | {r['n_el']} | {r['dt']:g} | {r['rebound_vx']:.3f} | {r['rebound_vy']:.3f} | "
+                     f"{r['rebound_angle_deg']:.1f} | {r['rebound_spin']:.4f} | {int(r['newton_iterations_total'])} | {ref} |")
+    return L + [""]
 
 
 def write_markdown(res):
@@ -151,6 +228,8 @@ def write_markdown(res):
               f"{_f(h.get('process_cpu_s'))} s CPU (best of 3; target 1.5 s wall: {_f(h['under_1p5s'])}).", ""]
     if "enforcement" in res:
         L += enforcement_markdown(res["enforcement"])
+    if "speed" in res:
+        L += speed_section(res["speed"])
     return "\n".join(L) + "\n"
 
 

@@ -1,0 +1,202 @@
+"""Study 5, speed: where the time of a run goes. Start-up of the process and the cost of one
+Newton iteration, split into its parts, for every paper scene; the Table 2 refinement
+study as `contactfem sweep` runs it (report: report.py).
+
+One Newton iteration is what ``newton()`` does between two linear solves: evaluate the
+residual and tangent (bulk: the bodies' internal forces and tangents; contact: every
+contact's residual and tangent; assembly: summing them into K, loads included), solve
+K du = -G, and the rest (Python overhead: the time stepper's effective residual, norms,
+bookkeeping). The parts are measured inside a real run of the scene by wrapping those
+functions with timers (CPU time of this process, so that a loaded machine disturbs them
+less); their sum over the run is divided by the number of linear solves. A converged
+step evaluates once more than it solves, so this per-iteration cost includes that share.
+
+Start-up: whole `python` processes (median of 5 runs, wall and CPU time): an empty
+interpreter, `contactfem list`, an interpreter that imports scipy.sparse.linalg and
+scikit-fem (what any scikit-fem program pays), and `contactfem run block --preset paper`.
+"""
+
+import os
+import resource
+import statistics
+import subprocess
+import sys
+import time
+from contextlib import contextmanager
+
+PARTS = ("bulk", "contact", "assembly", "solve", "overhead")
+# what the speed work aims at (whole-process and per-iteration times on 2 cores)
+SPEED_TARGETS = dict(list_s=0.25, sloping_impact_iteration_s=0.5e-3, rolling_ring_iteration_s=0.8e-3,
+                     table2_s=60.0, run_block_over_scipy_skfem=1.3)
+
+
+def _process(args, repeat=5):
+    """Median wall and CPU (user + sys) time of a whole process `args`, over `repeat` runs."""
+    walls, cpus = [], []
+    for _ in range(repeat):
+        r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        t0 = time.perf_counter()
+        proc = subprocess.run(args, capture_output=True, text=True)
+        walls.append(time.perf_counter() - t0)
+        r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        if proc.returncode != 0:
+            raise RuntimeError(f"bench: {' '.join(args)} failed: {proc.stderr.strip()[-500:]}")
+        cpus.append((r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime))
+    return dict(wall_s=statistics.median(walls), cpu_s=statistics.median(cpus), walls_s=walls)
+
+
+def startup_study(repeat=5):
+    """Start-up of whole processes (module docstring) and the ratios the targets refer to."""
+    py = sys.executable
+    out = {
+        "python": _process([py, "-c", "pass"], repeat),
+        "list": _process([py, "-m", "contactfem", "list"], repeat),
+        "scipy_skfem": _process([py, "-c", "import scipy.sparse.linalg, skfem"], repeat),
+        "run_block": _process([py, "-m", "contactfem", "run", "block", "--preset", "paper"], repeat),
+    }
+    out["list_over_python"] = out["list"]["wall_s"] / out["python"]["wall_s"]
+    out["run_block_over_scipy_skfem"] = out["run_block"]["wall_s"] / out["scipy_skfem"]["wall_s"]
+    return out
+
+
+@contextmanager
+def _timers():
+    """Wrap the parts of a Newton iteration with CPU timers while inside newton().
+
+    Yields a dict: seconds per part and the number of linear solves, summed over the run."""
+    from ...bodies.beam import Beam
+    from ...bodies.continuum import Continuum
+    from ...contact.interface import NodeToSegment
+    from ...solver import newmark, staggered
+    from ...solver.system import System
+
+    newton_module = sys.modules["contactfem.solver.newton"]     # (the package exports the function newton)
+    acc = dict.fromkeys(("newton", "residual_tangent", "bulk", "contact", "solve"), 0.0)
+    acc["solves"], depth = 0, [0]
+    clock = time.process_time
+
+    def timed(fn, key, only_in_newton=True):
+        def wrapper(*args, **kw):
+            if only_in_newton and not depth[0]:
+                return fn(*args, **kw)
+            t0 = clock()
+            try:
+                return fn(*args, **kw)
+            finally:
+                acc[key] += clock() - t0
+        return wrapper
+
+    def timed_newton(fn):
+        def wrapper(*args, **kw):
+            depth[0] += 1
+            t0 = clock()
+            try:
+                result = fn(*args, **kw)
+                acc["solves"] += result.iterations
+                return result
+            finally:
+                depth[0] -= 1
+                acc["newton"] += clock() - t0
+        return wrapper
+
+    patches = [(Beam, "internal_coo", timed(Beam.internal_coo, "bulk")),
+               (Continuum, "internal", timed(Continuum.internal, "bulk")),
+               (NodeToSegment, "assemble", timed(NodeToSegment.assemble, "contact")),
+               (System, "residual_tangent", timed(System.residual_tangent, "residual_tangent")),
+               (newton_module, "solve_free", timed(newton_module.solve_free, "solve"))]
+    for module in (newmark, staggered):
+        if hasattr(module, "newton"):
+            patches.append((module, "newton", timed_newton(module.newton)))
+    saved = [(owner, name, getattr(owner, name)) for owner, name, _ in patches]
+    try:
+        for owner, name, fn in patches:
+            setattr(owner, name, fn)
+        yield acc
+    finally:
+        for owner, name, fn in saved:
+            setattr(owner, name, fn)
+
+
+def iteration_split(scene, preset="paper", overrides=None):
+    """Run a scene with timers; per-iteration cost of each part (seconds, CPU) and the run's totals."""
+    from ...scenes import run_scene
+
+    t0, c0 = time.perf_counter(), time.process_time()
+    with _timers() as acc:
+        res = run_scene(scene, preset, dict(overrides or {}))
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    n = max(acc["solves"], 1)
+    parts = dict(bulk=acc["bulk"], contact=acc["contact"],
+                 assembly=acc["residual_tangent"] - acc["bulk"] - acc["contact"], solve=acc["solve"])
+    parts["overhead"] = acc["newton"] - sum(parts.values())
+    out = {f"{k}_s": v / n for k, v in parts.items()}
+    out.update(iteration_s=acc["newton"] / n, solves=acc["solves"], newton_cpu_s=acc["newton"],
+               run_wall_s=wall, run_cpu_s=cpu, linear_algebra=res.get("linear_algebra"),
+               ordering=res.get("ordering"), ndof=res.get("unknowns"))
+    return out
+
+
+# the paper's scenes at the paper preset (quick: the fast preset)
+SCENES = (("block", {}), ("rolling_ring", {}), ("sloping_impact", {"variant": "frictional"}),
+          ("sloping_impact", {"variant": "frictionless"}), ("funnel", {"variant": "frictional"}),
+          ("cork", {}), ("hertz", {}))
+
+
+def table2_study(n_els=(16, 32, 64, 128), jobs=2, refine=8):
+    """The Table 2 convergence study as a user runs it: `contactfem sweep sloping_impact` over
+    both variants and the element counts, at the paper's dt = 0.1 (200 steps) and at dt / refine
+    (200 refine steps, the same 20 s), with `--jobs`. Returns the rows and each sweep's wall time."""
+    import csv
+    import tempfile
+    from pathlib import Path
+
+    from ...scenes.sloping_impact import PAPER_TABLE2
+
+    out = dict(n_el=list(n_els), jobs=jobs, sweeps=[], rows=[])
+    with tempfile.TemporaryDirectory() as tmp:
+        for dt, n_steps in ((0.1, 200), (0.1 / refine, 200 * refine)):
+            table = Path(tmp) / f"table2_dt{n_steps}.csv"
+            args = [sys.executable, "-m", "contactfem", "sweep", "sloping_impact", "--preset", "paper",
+                    "--set", "variant=frictionless,frictional", "--set", "n_el=" + ",".join(map(str, n_els)),
+                    "--set", f"dt={dt:g}", "--set", f"n_steps={n_steps}", "--jobs", str(jobs), "--out", str(table)]
+            r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+            t0 = time.perf_counter()
+            proc = subprocess.run(args, capture_output=True, text=True)
+            wall = time.perf_counter() - t0
+            r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+            if proc.returncode != 0:
+                raise RuntimeError(f"bench: the Table 2 sweep failed: {proc.stderr.strip()[-500:]}")
+            # CPU of the sweep and of its worker processes (user + sys): on a loaded machine the
+            # wall time is mostly waiting for a core
+            cpu = (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
+            out["sweeps"].append(dict(command="contactfem " + " ".join(args[3:-2]), wall_s=wall, cpu_s=cpu))
+            with open(table, newline="") as fh:
+                for row in csv.DictReader(fh):
+                    variant = row["param.variant"]
+                    num = lambda k: float(row[k]) if row.get(k) not in (None, "") else None   # noqa: E731
+                    out["rows"].append(dict(variant=variant, n_el=int(row["param.n_el"]), dt=dt,
+                                            error=row.get("error") or None,
+                                            rebound_vx=num("rebound_vx"), rebound_vy=num("rebound_vy"),
+                                            rebound_angle_deg=num("rebound_angle_deg"),
+                                            rebound_spin=num("rebound_spin"),
+                                            newton_iterations_total=num("newton_iterations_total"),
+                                            paper=PAPER_TABLE2.get(variant)))
+    out["rows"].sort(key=lambda r: (r["variant"], r["dt"] < 0.1, r["n_el"]))
+    out["total_wall_s"] = sum(sw["wall_s"] for sw in out["sweeps"])
+    out["total_cpu_s"] = sum(sw["cpu_s"] for sw in out["sweeps"])
+    return out
+
+
+def speed_study(quick=False):
+    """Start-up times, the per-iteration cost of every paper scene and the Table 2 sweep.
+    Quick: two scenes at the fast preset, one run of each process, no sweep."""
+    preset = "fast" if quick else "paper"
+    scenes = SCENES[:1] + SCENES[2:3] if quick else SCENES
+    rows = []
+    for scene, over in scenes:
+        row = dict(scene=scene, overrides=over, preset=preset)
+        row.update(iteration_split(scene, preset, over))
+        rows.append(row)
+    load = list(os.getloadavg()) if hasattr(os, "getloadavg") else None
+    return dict(preset=preset, iterations=rows, startup=startup_study(repeat=1 if quick else 5),
+                table2=None if quick else table2_study(), load_average=load)
