@@ -236,6 +236,7 @@ BENCH_STUDIES = ("tangents", "work_precision", "cost", "targets", "enforcement",
 
 def cmd_bench(args):
     """`contactfem bench [--quick] [--out DIR] [--only NAME ...]`: bench.json and BENCHMARKS.md."""
+    import json
     from pathlib import Path
 
     from .studies.bench import run_bench, write_outputs
@@ -372,6 +373,10 @@ def _main(argv):
     except ValueError as exc:
         print(f"contactfem: error: {_one_line(exc)}", file=sys.stderr)
         return 2
+    except BrokenPipeError:                          # the reader went away (`contactfem equations | head`)
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())         # so that Python's exit flush does not fail again
+        return 0
     except MemoryError:
         print("contactfem: out of memory: use a coarser mesh (see contactfem show SCENE)", file=sys.stderr)
         return 1

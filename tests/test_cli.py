@@ -53,3 +53,25 @@ def test_run_writes_json_with_the_contract_keys(tmp_path):
     for key in ("wall_time_s", "newton_iterations_total", "parameters"):
         assert key in res
     assert res["parameters"]["c_T"] > 0
+
+
+def test_bench_only_keeps_the_other_studies_of_an_earlier_run(tmp_path, monkeypatch):
+    """`bench --only NAME` merges into DIR/bench.json: the earlier studies stay."""
+    import contactfem.studies.bench as bench
+
+    (tmp_path / "bench.json").write_text(json.dumps({"machine": {"cpu": "x"}, "tangents": {"kept": 1}}))
+    monkeypatch.setattr(bench, "run_bench", lambda quick, only, progress: {"speed": {"new": 2}})
+    written = []
+    monkeypatch.setattr(bench, "write_outputs", lambda res, out: written.append(res) or [])
+    from contactfem.cli import main
+    assert main(["bench", "--only", "speed", "--out", str(tmp_path)]) == 0
+    assert written[0]["tangents"] == {"kept": 1} and written[0]["speed"] == {"new": 2}
+
+
+def test_a_closed_pipe_is_not_an_error():
+    """`contactfem equations | head -1`: the reader leaves early; no error line, exit 0."""
+    import subprocess
+    import sys
+    p = subprocess.run(f"{sys.executable} -m contactfem equations | head -1", shell=True,
+                       capture_output=True, text=True)
+    assert p.stdout.count("\n") == 1 and p.stderr == ""
