@@ -16,3 +16,20 @@ class PointCloud:
 @pytest.fixture
 def rng():
     return np.random.default_rng(12345)
+
+
+def assert_locate_matches_fd(master, x, atol=1e-7, atol2=1e-6, same_segment=True, h=1e-6):
+    """A rigid master's projection at one point x: the first (dg_N, ds) and second
+    (d2g_N, d2s) variations of ``locate`` against central differences."""
+    x = np.array([x], dtype=float)
+    k = master.locate(x, np.zeros(1), None)
+    for i in range(2):
+        d = np.zeros((1, 2))
+        d[0, i] = h
+        kp, km = master.locate(x + d, np.zeros(1), None), master.locate(x - d, np.zeros(1), None)
+        if same_segment:
+            assert kp["seg"][0] == km["seg"][0] == k["seg"][0]
+        assert (kp["g_N"] - km["g_N"])[0] / (2 * h) == pytest.approx(k["dg_N"][0, i], abs=atol)
+        assert (kp["s"] - km["s"])[0] / (2 * h) == pytest.approx(k["ds"][0, i], abs=atol)
+        assert np.allclose((kp["dg_N"] - km["dg_N"])[0] / (2 * h), k["d2g_N"][0, i], atol=atol2)
+        assert np.allclose((kp["ds"] - km["ds"])[0] / (2 * h), k["d2s"][0, i], atol=atol2)

@@ -248,12 +248,8 @@ def reconstruct_block(quick=False, cache=True, progress=None):
                 for c_N in (1e2, 1e4, 1e6) for unit in ("per_node", "per_length")]
     if quick:
         readings.append(paper)
-    rows = []
     try:
-        for i, rd in enumerate(readings):
-            rows.append(evaluate_block(rd, cache))
-            if progress:
-                progress(i + 1, len(readings))
+        rows = evaluate_all(readings, evaluate_block, cache, progress)
         if not quick:                      # stage C around the best of stage B
             seen = {json.dumps({k: r[k] for k in BLOCK_KEYS}, sort_keys=True) for r in rows}
             extra = []
@@ -265,11 +261,20 @@ def reconstruct_block(quick=False, cache=True, progress=None):
                     if key not in seen:
                         seen.add(key)
                         extra.append(rd)
-            for rd in extra:
-                rows.append(evaluate_block(rd, cache))
+            rows += evaluate_all(extra, evaluate_block, cache)
     finally:
         cache.save()
     return rank(rows), geos
+
+
+def evaluate_all(readings, evaluate, cache, progress=None):
+    """Score every reading with ``evaluate(reading, cache)``; ``progress(done, total)``."""
+    rows = []
+    for i, rd in enumerate(readings):
+        rows.append(evaluate(rd, cache))
+        if progress:
+            progress(i + 1, len(readings))
+    return rows
 
 
 def _fmt_res(res):
@@ -382,17 +387,12 @@ def reconstruct_sloping_impact(quick=False, cache=True, progress=None):
     cache = Cache("sloping_impact", ["scenes/sloping_impact.py", "contact", "laws", "bodies/beam.py",
                                      "bodies/ring.py", "solver", "studies/reconstruct.py"], enabled=cache)
     readings = sloping_impact_readings(quick)
-    rows = []
     try:
-        for i, rd in enumerate(readings):
-            rows.append(evaluate_sloping(rd, cache))
-            if progress:
-                progress(i + 1, len(readings))
+        rows = evaluate_all(readings, evaluate_sloping, cache, progress)
         if not quick:
             extra = [dict({k: best[k] for k in SLOPING_KEYS}, c_N=c) for best in rank(rows)[:6]
                      for c in (25.0, 100.0, 500.0)]
-            for rd in extra:
-                rows.append(evaluate_sloping(rd, cache))
+            rows += evaluate_all(extra, evaluate_sloping, cache)
     finally:
         cache.save()
     return rank(rows)
