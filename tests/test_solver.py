@@ -124,7 +124,7 @@ def test_offsets_global_dofs_and_fixed():
     assert np.allclose(s.mass(), 1.0)
 
 
-@pytest.mark.parametrize("linear_algebra", ["dense", "sparse"])
+@pytest.mark.parametrize("linear_algebra", ["dense", "sparse", "banded"])
 def test_tangent_matches_finite_differences(linear_algebra):
     a, b = SpringChain(3, k=2.0, k3=5.0, name="a"), SpringChain(2, k=1.0, k3=1.0, name="b")
     s = System([a, b], contacts=[Wall(b, 1, y_wall=0.0, c=30.0)],
@@ -132,7 +132,8 @@ def test_tangent_matches_finite_differences(linear_algebra):
     u = np.random.default_rng(0).normal(scale=0.3, size=s.ndof)
     u[s.global_dofs(b, b.xdofs[1, 1])] = -0.4            # wall contact active
     G, K = s.residual_tangent(u, 0.0)
-    assert sp.issparse(K) == (linear_algebra == "sparse")
+    assert sp.issparse(K) == (linear_algebra != "dense")
+    assert hasattr(K, "band_plan") == (linear_algebra == "banded")
     h, K_fd = 1e-6, np.zeros((s.ndof, s.ndof))
     for j in range(s.ndof):
         e = np.zeros(s.ndof)

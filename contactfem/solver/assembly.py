@@ -1,4 +1,4 @@
-"""Assembly of the global tangent K from COO triplets, dense or sparse.
+"""Assembly of the global tangent K from COO triplets: dense, sparse or banded.
 
 Small systems (at most DENSE_MAX unknowns: the beam rings of the paper) get K as a
 dense numpy array: the triplets are summed with one ``bincount`` and Newton factorises
@@ -10,36 +10,67 @@ Larger systems get K as a scipy CSC matrix on a FIXED sparsity pattern: the patt
 kept; each assembly only scatters the values into it. Where a contact couples dofs the
 pattern does not hold yet (a slave reaching a new master segment), the pattern grows
 once (union) and is kept from then on. The diagonal is always in the pattern, so a time
-stepper can add its mass term M / (beta dt^2) there.
+stepper can add its mass term M / (beta dt^2) there. Every K is a shallow copy of one
+CSC matrix made with the pattern (its index arrays shared, its own values): scipy's
+constructor checks the arrays again at every call (17-40 us for 360 unknowns, the copy 3 us).
+
+Banded: when the pattern is (re)built, its free block is renumbered by reverse
+Cuthill-McKee and its band measured (banded.py). If the band LU's work n kl (kl + ku)
+is at most banded.BANDED_FLOPS, K carries that plan (``K.band_plan``) and Newton solves
+with LAPACK's banded LU instead of SuperLU: the paper's rolling ring (360 unknowns, a
+ring of beams, kl = ku = 8: 55 us against SuperLU's 320 us), the block (468, 35: 170
+against 700 us) and the cork (259 free, 28: 84 against 495 us); not Hertz (8385 free,
+kl = ku = 258: 38 against 30 ms), where the band holds far more than SuperLU's factors.
+The band is made for the free dofs (the System's Dirichlet dofs are left out), so a
+partly fixed system is solved banded too; any other free set falls back to SuperLU.
+K stays a CSC matrix for every other use (products, ``toarray``, slicing).
 
 The positions of a contribution in the pattern are cached when it arrives with the same
 index arrays as before (a body's constant connectivity, ``key`` = the body).
 """
 
+import copy
+
 import numpy as np
+
+from .banded import BANDED_FLOPS, BandPlan
+from .newton import DENSE_ORDERING, ORDERING
 
 # Up to this many unknowns K is dense. Measured on the paper's ring matrices (banded, 3
 # dofs per node): LAPACK beats SuperLU below about 100-150 unknowns (48: 16 us against
 # 43 us; 96: 55 against 62 us; 198: 284 against 145 us), and above ~100 a multi-threaded
 # BLAS on a loaded machine makes dense solves erratic (BENCHMARKS.md, `contactfem bench`).
 DENSE_MAX = 100
+KINDS = ("auto", "dense", "sparse", "banded")
 
 
-def choose_linear_algebra(n, requested="auto"):
-    """'dense' or 'sparse' for a system of n unknowns ('auto': dense up to DENSE_MAX)."""
-    if requested not in ("auto", "dense", "sparse"):
-        raise ValueError(f"parameter linear_algebra = {requested!r} is not allowed: one of auto|dense|sparse")
+def choose_linear_algebra(n, requested="auto", plan=None):
+    """'dense', 'sparse' or 'banded' for a system of n unknowns. 'auto': dense up to
+    DENSE_MAX; above, banded when the band plan of the pattern (banded.BandPlan, None
+    while the pattern is not known) needs at most BANDED_FLOPS, else sparse."""
+    if requested not in KINDS:
+        raise ValueError(f"parameter linear_algebra = {requested!r} is not allowed: one of {'|'.join(KINDS)}")
     if requested != "auto":
         return requested
-    return "dense" if n <= DENSE_MAX else "sparse"
+    if n <= DENSE_MAX:
+        return "dense"
+    return "banded" if plan is not None and plan.flops <= BANDED_FLOPS else "sparse"
 
 
 class TangentAssembler:
-    """Sums COO contributions into K (n x n), dense or on a fixed CSC pattern."""
+    """Sums COO contributions into K (n x n), dense or on a fixed CSC pattern.
 
-    def __init__(self, n, kind):
-        self.n, self.kind = int(n), kind
+    ``linear_algebra``: auto|dense|sparse|banded (choose_linear_algebra); ``free``: the
+    dofs Newton solves for (None: all), the block a band plan is made for. ``kind`` is
+    the current choice, ``used`` maps each kind used so far to its ordering."""
+
+    def __init__(self, n, linear_algebra="auto", free=None):
+        self.n, self.requested = int(n), linear_algebra
+        self.kind = choose_linear_algebra(self.n, linear_algebra)
+        self.free = None if free is None or len(free) == self.n else np.asarray(free)
         self.keys = None            # sparse: sorted pattern keys col * n + row
+        self.plan = None            # banded: the BandPlan of the pattern
+        self.used = {}              # kind -> ordering, of every assembly so far
         self._cache = {}            # key -> (rows, cols, positions) of a constant contribution
         self.pattern_builds = 0     # how often the pattern was (re)computed
 
@@ -49,9 +80,16 @@ class TangentAssembler:
         diag = np.arange(self.n) * (self.n + 1)
         old = diag if self.keys is None else self.keys
         self.keys = np.union1d(old, keys)
-        self.indices = self.keys % self.n                                    # row of each entry
-        self.indptr = np.searchsorted(self.keys, np.arange(self.n + 1) * self.n)
+        from scipy.sparse import csc_matrix
+
+        indices = self.keys % self.n                                         # row of each entry
+        indptr = np.searchsorted(self.keys, np.arange(self.n + 1) * self.n)
+        self._template = csc_matrix((np.zeros(self.keys.size), indices, indptr), shape=(self.n, self.n))
+        self.indices, self.indptr = self._template.indices, self._template.indptr   # scipy's index dtype
         self.diag_pos = np.searchsorted(self.keys, diag)
+        if self.requested in ("auto", "banded"):
+            self.plan = BandPlan(self.indptr, self.indices, self.n, self.free)
+            self.kind = choose_linear_algebra(self.n, self.requested, self.plan)
         self._cache.clear()
         self.pattern_builds += 1
 
@@ -78,10 +116,12 @@ class TangentAssembler:
 
         A block adds vals at (rows + offset, cols + offset); ``key`` (or None) names a
         contribution whose index arrays are the same objects at every call (cached).
-        Dense: an (n, n) array. Sparse: a CSC matrix on the pattern. Duplicates are summed.
+        Dense: an (n, n) array. Sparse: a CSC matrix on the pattern; banded: the same, with
+        the band plan as ``K.band_plan`` (newton.solve_free). Duplicates are summed.
         """
         n = self.n
         if self.kind == "dense":
+            self.used["dense"] = DENSE_ORDERING
             index = np.concatenate([(r + o) * n + (c + o) for r, c, _, o, _ in blocks] + [np.zeros(0, int)])
             vals = np.concatenate([v for _, _, v, _, _ in blocks] + [np.zeros(0)])
             K = np.bincount(index, vals, minlength=n * n).reshape(n, n)
@@ -100,6 +140,19 @@ class TangentAssembler:
                            minlength=self.keys.size)
         if diagonal is not None:
             data[self.diag_pos] += diagonal
-        from scipy.sparse import csc_matrix
+        K = copy.copy(self._template)             # shares the pattern's index arrays (docstring)
+        K.data = data
+        if self.kind == "banded":
+            K.band_plan = self.plan
+            self.used["banded"] = self.plan.describe()
+        else:
+            self.used["sparse"] = ORDERING
+        return K
 
-        return csc_matrix((data, self.indices, self.indptr), shape=(n, n))
+    def describe(self):
+        """(linear_algebra, ordering) of the assemblies so far ('+'-joined if the choice
+        changed as the pattern grew); the current choice before the first one."""
+        if not self.used:
+            kind = self.kind
+            return kind, {"dense": DENSE_ORDERING, "sparse": ORDERING}.get(kind, "reverse Cuthill-McKee")
+        return "+".join(self.used), "+".join(self.used.values())

@@ -5,10 +5,13 @@ residual vector and its tangent K = dG/du (a dense numpy array or scipy.sparse).
 prescribed dofs keep the values they have in the initial guess.
 
 Linear solver: dense K by LAPACK's LU with partial pivoting (``numpy.linalg.solve``),
-sparse K by ``scipy.sparse.linalg.splu`` (SuperLU, ordering ORDERING). The contact
-tangent with friction is non-symmetric (paper eq 49-50), so no symmetric solver
-applies; splu rather than spsolve because splu *raises* on an exactly singular matrix,
-while spsolve only warns and returns NaNs (numpy.linalg.solve raises as well).
+a banded K (a CSC matrix carrying ``band_plan``, assembly.py: the paper's rings and small
+meshes) by LAPACK's banded LU with partial pivoting after a reverse Cuthill-McKee
+renumbering (dgbsv, banded.py), any other sparse K by ``scipy.sparse.linalg.splu``
+(SuperLU, ordering ORDERING). The contact tangent with friction is non-symmetric (paper
+eq 49-50), so no symmetric solver applies; splu rather than spsolve because splu *raises*
+on an exactly singular matrix, while spsolve only warns and returns NaNs (numpy.linalg.solve
+and the banded solve raise as well).
 
 Convergence test (on the Euclidean norm of the free part of G):
 
@@ -35,14 +38,18 @@ DENSE_ORDERING = "natural (LAPACK LU, partial pivoting)"   # what a dense K gets
 
 
 def solve_free(K, b, free, all_free):
-    """du_f from K_ff du_f = b on the free dofs; K dense (LAPACK) or sparse (SuperLU).
-    Raises RuntimeError on an exactly singular K_ff."""
+    """du_f from K_ff du_f = b on the free dofs; K dense (LAPACK), banded (LAPACK's band
+    LU, when K's ``band_plan`` is made for K's pattern and these free dofs) or sparse
+    (SuperLU). Raises RuntimeError on an exactly singular K_ff."""
     if isinstance(K, np.ndarray):
         Kff = K if all_free else K[np.ix_(free, free)]
         try:
             return np.linalg.solve(Kff, b)
         except np.linalg.LinAlgError as err:           # "Singular matrix"
             raise RuntimeError(f"Factor is exactly singular ({err})") from None
+    plan = getattr(K, "band_plan", None)
+    if plan is not None and plan.fits(K, None if all_free else free):
+        return plan.solve(K.data, b)
     import scipy.sparse as sp
     from scipy.sparse.linalg import splu
 

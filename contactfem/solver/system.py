@@ -12,12 +12,12 @@ Bodies are placed one after another in the global vector: body b owns the global
 dofs ``b.dof_offset + local``.
 
 K is a dense numpy array for small systems and a scipy CSC matrix on a fixed sparsity
-pattern above (``System.linear_algebra``, chosen by size: assembly.py).
+pattern above, solved by LAPACK's banded LU where the pattern is a narrow band after
+renumbering, else by SuperLU (``System.linear_algebra``, chosen automatically: assembly.py).
 """
 import numpy as np
 
-from .assembly import TangentAssembler, choose_linear_algebra
-from .newton import DENSE_ORDERING, ORDERING
+from .assembly import TangentAssembler
 
 
 class Dirichlet:
@@ -62,12 +62,13 @@ class System:
     contacts : list of contacts, ``assemble(u) -> (R_c, rows, cols, vals)``
     loads    : list of loads, ``assemble(u, t) -> (P, rows, cols, vals)``
     fixed    : list of Dirichlet conditions
-    linear_algebra : "auto" (default: dense up to assembly.DENSE_MAX unknowns, sparse
-               above), "dense" or "sparse"
+    linear_algebra : "auto" (default: dense up to assembly.DENSE_MAX unknowns; above, banded
+               where the band LU is cheap, else sparse), "dense", "sparse" or "banded"
 
     Attributes: ``ndof``, ``fixed_dofs`` and ``free_dofs`` (global, sorted),
     ``dissipation`` (frictional dissipation summed over all committed steps),
-    ``linear_algebra`` ("dense" or "sparse") and ``ordering`` (of the factorisation).
+    ``linear_algebra`` ("dense", "sparse" or "banded"; "banded+sparse" if the choice changed
+    as the contact pattern grew) and ``ordering`` (of the factorisation).
     """
 
     built = None     # a list while contactfem.scenes.run_scene records the Systems a scene builds
@@ -97,12 +98,20 @@ class System:
         self.free_dofs = np.setdiff1d(np.arange(self.ndof), self.fixed_dofs)
         self.dissipation = 0.0
         self._mass = None
-        self.linear_algebra = choose_linear_algebra(self.ndof, linear_algebra)
-        self.ordering = DENSE_ORDERING if self.linear_algebra == "dense" else ORDERING
-        self._tangent = TangentAssembler(self.ndof, self.linear_algebra)
+        self._tangent = TangentAssembler(self.ndof, linear_algebra, self.free_dofs)
         self._body_coo = {}          # body -> (K, rows, cols) of its last sparse tangent
         if System.built is not None:
             System.built.append(self)
+
+    @property
+    def linear_algebra(self):
+        """How K is held and solved: dense, sparse or banded (assembly.py)."""
+        return self._tangent.describe()[0]
+
+    @property
+    def ordering(self):
+        """The ordering of the factorisation (e.g. the band's kl and ku)."""
+        return self._tangent.describe()[1]
 
     def global_dofs(self, body, local):
         """Global numbers of a body's local dofs."""
@@ -166,7 +175,8 @@ class System:
 
         With ``mass_coefficient`` c > 0, K + c M is returned instead (M the lumped mass):
         the effective tangent of an implicit time stepper (Newmark: c = 1 / (beta dt^2)).
-        K is a dense array or a CSC matrix (``self.linear_algebra``); all contributions
+        K is a dense array or a CSC matrix (``self.linear_algebra``; banded: a CSC matrix
+        that carries its band plan, ``K.band_plan``); all contributions
         arrive as COO triplets and are summed into it once (duplicates add up).
         """
         u = np.asarray(u, dtype=float)
