@@ -220,6 +220,9 @@ def test_banded_tangent_is_the_sparse_matrix():
     x = rng.normal(size=n)
     assert np.allclose(K1 @ x, ref @ x, rtol=1e-14, atol=1e-14)
     assert sp.issparse(K1) and K1.format == "csc" and not hasattr(sparse.assemble([(A.row, A.col, A.data, 0, None)]), "band_plan")
+    with pytest.raises(ValueError):                 # the shared pattern is not changed in place
+        K1.eliminate_zeros()
+    assert np.array_equal(K2.toarray(), 2 * A.toarray())
     # the plan is for all dofs: a solve on other free dofs goes to SuperLU, with the same answer
     from contactfem.solver.newton import solve_free
 

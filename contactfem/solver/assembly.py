@@ -11,8 +11,9 @@ kept; each assembly only scatters the values into it. Where a contact couples do
 pattern does not hold yet (a slave reaching a new master segment), the pattern grows
 once (union) and is kept from then on. The diagonal is always in the pattern, so a time
 stepper can add its mass term M / (beta dt^2) there. Every K is a shallow copy of one
-CSC matrix made with the pattern (its index arrays shared, its own values): scipy's
-constructor checks the arrays again at every call (17-40 us for 360 unknowns, the copy 3 us).
+CSC matrix made with the pattern (its index arrays shared and read-only, its own values):
+scipy's constructor checks the arrays again at every call (17-40 us for 360 unknowns, the
+copy 3 us). What changes K's structure in place (``eliminate_zeros``) raises; copy K first.
 
 Banded: when the pattern is (re)built, its free block is renumbered by reverse
 Cuthill-McKee and its band measured (banded.py). If the band LU's work n kl (kl + ku)
@@ -86,6 +87,7 @@ class TangentAssembler:
         indptr = np.searchsorted(self.keys, np.arange(self.n + 1) * self.n)
         self._template = csc_matrix((np.zeros(self.keys.size), indices, indptr), shape=(self.n, self.n))
         self.indices, self.indptr = self._template.indices, self._template.indptr   # scipy's index dtype
+        self.indices.flags.writeable = self.indptr.flags.writeable = False          # shared by every K
         self.diag_pos = np.searchsorted(self.keys, diag)
         if self.requested in ("auto", "banded"):
             self.plan = BandPlan(self.indptr, self.indices, self.n, self.free)

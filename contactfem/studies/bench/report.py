@@ -42,7 +42,15 @@ OPTIMISATIONS = [
     "only, scattered with bincount; the return map skips a body in flight "
     "| solver/assembly.py, solver/system.py, solver/newton.py, bodies/beam.py, contact/interface.py, "
     "laws/return_map.py | one Newton iteration inside the paper runs (CPU, loaded machine; midpoint beam): "
-    "sloping impact 2.2-2.6 ms, rolling ring 3.0 ms | 0.69-0.89 ms; 2.1 ms |", "",
+    "sloping impact 2.2-2.6 ms, rolling ring 3.0 ms | 0.69-0.89 ms; 2.1 ms |",
+    "| banded LU: the fixed pattern's free block renumbered by reverse Cuthill-McKee once per pattern, "
+    "LAPACK's dgbsv when its work n kl (kl + ku) is at most 1e7 flops (rolling ring kl = ku = 8, block 35, "
+    "cork 28; Hertz, 258, stays on SuperLU); K a shallow copy of one CSC matrix of the pattern (no scipy "
+    "format checks at every assembly) | solver/banded.py, solver/assembly.py, solver/newton.py | one Newton "
+    "iteration inside the paper runs (CPU, best of 5 (cork, Hertz: 3), loaded machine): rolling ring 1.17 ms "
+    "(solve 0.41, "
+    "assembly 0.16), block 1.64 ms (solve 0.92); cork solve 1.32 ms; Hertz assembly 1.64 ms "
+    "| 0.69 ms (0.071, 0.092), 0.74 ms (0.21); 0.17 ms; 1.24 ms |", "",
     "Not adopted: pypardiso (MKL PARDISO, installs from PyPI, about 0.8 s of import time and a large "
     "download): at 1e5 unknowns 1.0-1.4 s against 1.3-1.4 s for SuperLU with MMD_AT_PLUS_A, slower "
     "at the paper sizes; not a clear win. scikit-umfpack does not install from PyPI here (needs swig and "
@@ -79,7 +87,8 @@ def speed_section(sp):
           "(contactfem/studies/bench/speed.py). bulk: the bodies' internal forces and tangents; contact: every "
           "contact's residual and tangent; assembly: summing them into K, loads included; solve: factorisation "
           "and solve; overhead: the rest of newton() and the time stepper's effective residual. K: dense "
-          "(LAPACK) up to 100 unknowns, sparse (fixed pattern, SuperLU) above.", "",
+          "(LAPACK) up to 100 unknowns; above, a fixed pattern, solved banded (reverse Cuthill-McKee, LAPACK's "
+          "band LU) where the band is narrow, else sparse (SuperLU).", "",
           "| scene | unknowns | K | iteration [ms] | bulk | contact | assembly | solve | overhead | solves | run [s] |",
           "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in sp["iterations"]:
