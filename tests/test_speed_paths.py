@@ -35,6 +35,21 @@ def test_list_and_show_import_nothing_heavy(argv):
     assert heavy_modules_after(f"from contactfem.cli import main; main({argv!r})") == []
 
 
+def test_a_scene_is_found_without_importing_the_others():
+    code = "from contactfem.scenes import get_scene\nassert get_scene('block').name == 'block'"
+    probe = code + "\nimport sys\nprint(sorted(m for m in sys.modules if m.startswith('contactfem.scenes.')))"
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True)
+    loaded = eval(out.stdout.strip().splitlines()[-1])
+    assert "contactfem.scenes.block" in loaded
+    assert not {"contactfem.scenes.cork", "contactfem.scenes.funnel", "contactfem.scenes.hertz"} & set(loaded)
+
+
+@pytest.mark.parametrize("name", ["nonsense", "base", "_private", "block.py", "../cli", ""])
+def test_an_unknown_scene_name_lists_the_known_ones(name):
+    with pytest.raises(ValueError, match="unknown scene.*known are.*block.*sloping_impact"):
+        get_scene(name)
+
+
 def test_building_a_scene_loads_what_it_needs():
     """scikit-fem comes in when a scene builds a body, not before."""
     code = ("from contactfem.scenes import get_scene, sloping_impact\n"

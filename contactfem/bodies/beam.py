@@ -148,7 +148,6 @@ class Beam:
         self._cols = np.tile(self.edofs, (1, 6)).ravel()         # matrices, fixed
         self._edofs_flat = self.edofs.ravel()
         self._dX = chord                                          # X_b - X_a per element
-        self._dkap = np.outer(1 / self.L0, [0, 0, -1, 0, 0, 1])   # dkap/dq
         self.dof_offset = 0
 
         self.S0, self.eta, self.dt = None, None, None
@@ -226,32 +225,63 @@ class Beam:
             d2eps/dq2 = a_n p^T + p a_n^T - (1 + eps) p p^T,
             d2gam/dq2 = -(a_t p^T + p a_t^T) - gam p p^T,
         so the geometric part is w p^T + p w^T - (N (1 + eps) + Q gam) p p^T, w = N a_n - Q a_t.
+
+        All integration points of all elements are one vectorised pass: row j = k ne + e is
+        point k of element e (the rows of the plastic strains ``ep``), the points' sums are
+        taken at the end. p is zero but at the rotations (entries 2 and 5: N_a, N_b), so the
+        geometric part only touches rows and columns 2 and 5.
         """
+        g = self._gauss()
         ne = len(self.L0)
-        L0 = self.L0[:, None]
-        re, Ke = 0.0, 0.0
-        for k, (xi, weight) in enumerate(self.points):
-            E, t, n = self.strains(u, xi)
-            S, C, _ = self.resultants(u, xi, k, E)
-            eps, gam = E[:, 0], E[:, 1]
-            N, Q = S[:, 0], S[:, 1]
-            p = np.array([0, 0, 0.5 * (1 - xi), 0, 0, 0.5 * (1 + xi)])   # dphi/dq
-            a_t = np.zeros((ne, 6))
-            a_t[:, 0:2], a_t[:, 3:5] = -t / L0, t / L0                  # d(x' . t)/dq
-            a_n = np.zeros((ne, 6))
-            a_n[:, 0:2], a_n[:, 3:5] = -n / L0, n / L0                  # d(x' . n)/dq
-            B = np.empty((ne, 3, 6))
-            B[:, 0] = a_t + gam[:, None] * p
-            B[:, 1] = a_n - (1 + eps)[:, None] * p
-            B[:, 2] = self._dkap
-            w = N[:, None] * a_n - Q[:, None] * a_t
-            wp = w[:, :, None] * p                                     # w p^T
-            K = np.matmul(B.transpose(0, 2, 1) * C[:, None, :], B)    # B^T C B (C diagonal)
-            K += wp + wp.transpose(0, 2, 1) - (N * (1 + eps) + Q * gam)[:, None, None] * np.outer(p, p)
-            Ke = Ke + weight * L0[:, :, None] * K
-            re = re + weight * L0 * np.matmul(S[:, None, :], B)[:, 0]   # w L0 B^T S
+        q = np.asarray(u, float)[g["edofs"]]                           # (m, 6) element dofs per row
+        xp = (g["dX"] + q[:, 3:5] - q[:, 0:2]) * g["invL"][:, None]     # x'
+        phi = g["theta0"] + g["Na"] * q[:, 2] + g["Nb"] * q[:, 5]
+        cos, sin = np.cos(phi), np.sin(phi)
+        E = np.empty((len(phi), 3))
+        E[:, 0] = xp[:, 0] * cos + xp[:, 1] * sin - 1.0                   # eps = x' . t - 1
+        E[:, 1] = -xp[:, 0] * sin + xp[:, 1] * cos                        # gam = x' . n
+        E[:, 2] = (q[:, 5] - q[:, 2]) * g["invL"]                         # kap = theta'
+        if self.S0 is not None and self.dt is None:
+            raise RuntimeError("viscoplastic beam: call beam.set_dt(dt) before evaluating it")
+        S, C, _ = return_map(E, self.ep, self.D, self.S0, self.eta, self.dt)
+        eps, gam, N, Q = E[:, 0], E[:, 1], S[:, 0], S[:, 1]
+        tL, sL = cos * g["invL"], sin * g["invL"]                         # t / L0 (a_t), n = (-s, c)
+        B = np.zeros((len(phi), 3, 6))
+        B[:, 0, 0], B[:, 0, 1], B[:, 0, 3], B[:, 0, 4] = -tL, -sL, tL, sL                 # a_t
+        B[:, 1, 0], B[:, 1, 1], B[:, 1, 3], B[:, 1, 4] = sL, -tL, -sL, tL                 # a_n
+        B[:, 0, 2], B[:, 0, 5] = gam * g["Na"], gam * g["Nb"]                             # + gam p
+        B[:, 1, 2], B[:, 1, 5] = -(1 + eps) * g["Na"], -(1 + eps) * g["Nb"]               # - (1 + eps) p
+        B[:, 2, 2], B[:, 2, 5] = -g["invL"], g["invL"]                                    # dkap/dq
+        K = np.matmul(B.transpose(0, 2, 1) * C[:, None, :], B)                           # B^T C B
+        w = N[:, None] * B[:, 1] - Q[:, None] * B[:, 0]          # N a_n - Q a_t (+ a p term, below)
+        w[:, 2] = w[:, 5] = 0.0                                  # a_t, a_n vanish at the rotations
+        c = N * (1 + eps) + Q * gam
+        for j, Nj in ((2, g["Na"]), (5, g["Nb"])):               # w p^T + p w^T
+            K[:, :, j] += w * Nj[:, None]
+            K[:, j, :] += w * Nj[:, None]
+        K[:, 2, 2] -= c * g["Na"] * g["Na"]                      # - c p p^T
+        K[:, 2, 5] -= c * g["Na"] * g["Nb"]
+        K[:, 5, 2] -= c * g["Nb"] * g["Na"]
+        K[:, 5, 5] -= c * g["Nb"] * g["Nb"]
+        wL = g["wL0"]
+        re = wL[:, None] * np.matmul(S[:, None, :], B)[:, 0]                             # w L0 B^T S
+        Ke = wL[:, None] * K.reshape(-1, 36)
+        if len(self.points) > 1:                                 # sum the points of each element
+            re, Ke = re.reshape(-1, ne, 6).sum(axis=0), Ke.reshape(-1, ne, 36).sum(axis=0)
         R = np.bincount(self._edofs_flat, re.ravel(), minlength=self.ndof)
         return R, self._rows, self._cols, Ke.ravel()
+
+    def _gauss(self):
+        """Per-row constants of internal_coo (row k ne + e: point k of element e), made once."""
+        if getattr(self, "_g", None) is None:
+            ne, k = len(self.L0), len(self.points)
+            xi = np.repeat([x for x, _ in self.points], ne)
+            weight = np.repeat([w for _, w in self.points], ne)
+            tile = lambda a: np.concatenate([a] * k)                # noqa: E731
+            self._g = dict(edofs=np.concatenate([self.edofs] * k), dX=tile(self._dX), invL=tile(1 / self.L0),
+                           theta0=tile(self.theta0), Na=0.5 * (1 - xi), Nb=0.5 * (1 + xi),
+                           wL0=weight * tile(self.L0))
+        return self._g
 
     def strain_energy(self, u):
         """Stored (elastic) energy sum_e L0 sum_k S_k^2 / (2 D_k); elastic case: L0 D E^2 / 2."""

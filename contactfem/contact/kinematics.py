@@ -75,9 +75,9 @@ def line_variations(x_s, point, normal):
     normal = np.asarray(normal, dtype=float)
     tangent = np.array([normal[1], -normal[0]])                    # e3 x t = n
     d = x_s - point
-    nc = len(x_s)
-    n, t = np.tile(normal, (nc, 1)), np.tile(tangent, (nc, 1))
-    z2 = np.zeros((nc, 2, 2))
+    n, t = np.empty_like(d), np.empty_like(d)
+    n[:], t[:] = normal, tangent                                    # one row per slave
+    z2 = np.zeros((len(d), 2, 2))
     return dict(t=t, n=n, g_N=d @ normal, s=d @ tangent, dg_N=n.copy(), d2g_N=z2, ds=t.copy(), d2s=z2.copy())
 
 

@@ -100,6 +100,13 @@ def _as_array(value, shape, what):
         raise LawError(f"{what} has shape {a.shape}, expected {shape} (one value per contact node)") from None
 
 
+def as_shape(a, shape):
+    """a as a float array of the given shape (broadcast; no copy when it already is one)."""
+    if type(a) is np.ndarray and a.shape == shape and a.dtype == np.float64:
+        return a
+    return np.broadcast_to(np.asarray(a, dtype=float), shape)
+
+
 class FrictionLaw:
     """A friction law read through the protocol (module docstring): Y and all its
     derivatives, the state evolution and its derivatives, whatever the law supplies.
@@ -195,10 +202,10 @@ class FrictionLaw:
         p = np.asarray(p, dtype=float)
         n = p.size
         p = p.reshape(n)
-        q = np.broadcast_to(np.asarray(q, dtype=float), (n,))
-        v = np.zeros(n) if v is None else np.broadcast_to(np.asarray(v, dtype=float), (n,))
+        q = as_shape(q, (n,))
+        v = np.zeros(n) if v is None else as_shape(v, (n,))
         k = self.n_state
-        z = np.zeros((n, k)) if z is None else np.broadcast_to(np.asarray(z, dtype=float), (n, k))
+        z = np.zeros((n, k)) if z is None else as_shape(z, (n, k))
         args = [p, q, v, z]
         Y, ders = self._split(self._call(args, ""), n)
         if np.iscomplexobj(Y):

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..laws.protocol import as_friction_law
+from ..laws.protocol import as_shape, as_friction_law
 
 OPEN, STICK, SLIP = 0, 1, 2
 STATE_NAMES = np.array(["open", "stick", "slip"])
@@ -63,9 +63,8 @@ def return_map(law, t_N, dt_N, dg_T, t_T_bar, q_bar, z_bar=None, dt=None, tol=1e
     (For the paper's Y(p, q): Y_lam = dY/dq, Y_P = dY/dp, eq 48 as printed.)
     """
     L = as_friction_law(law)
-    t_N, dt_N, dg_T, t_T_bar, q_bar = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (t_N, dt_N, dg_T, t_T_bar, q_bar)))
-    p = -t_N
-    n = p.size
+    t_N, dt_N, dg_T, t_T_bar, q_bar = _node_arrays(t_N, dt_N, dg_T, t_T_bar, q_bar)
+    n = t_N.size
     c_T = L.c_T
     if L.needs_dt:
         if dt is None or not (np.isfinite(dt) and dt > 0):
@@ -73,43 +72,44 @@ def return_map(law, t_N, dt_N, dg_T, t_T_bar, q_bar, z_bar=None, dt=None, tol=1e
                              f"the return map needs the time step dt > 0, got {dt!r}")
     else:
         dt = 1.0 if dt is None else dt
-    z_bar = L.initial_state(n) if z_bar is None else np.broadcast_to(np.asarray(z_bar, dtype=float), (n, L.n_state))
-    in_contact = p > 0.0
-    if not in_contact.any():                  # every node open (a body in flight): nothing to integrate
-        zero = np.zeros(n)
-        return FrictionState(t_T=zero, c_T_s=zero.copy(), c_N_s=zero.copy(), state=np.full(n, OPEN), lam=zero.copy(),
-                             q=q_bar.copy(), z=np.array(z_bar, dtype=float), v=zero.copy())
-    t_tr = t_T_bar + c_T * dg_T                                   # eq (42)
-    zero = np.zeros(n)
-    z0 = L.evolve(z_bar, p, zero, dt)[0]
-    Y0 = L.slip_bound(p, q_bar, zero, z0)[0]
+    z_bar = L.initial_state(n) if z_bar is None else as_shape(z_bar, (n, L.n_state))
+
+    # open nodes (p = 0) carry nothing and keep their history: integrate the nodes in contact, c
+    t_T, c_T_s, c_N_s, lam = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
+    state, q, z = np.full(n, OPEN), q_bar.copy(), np.array(z_bar, dtype=float)
+    c = np.flatnonzero(t_N < 0.0)
+    if not c.size:                            # every node open (a body in flight): nothing to integrate
+        return FrictionState(t_T=t_T, c_T_s=c_T_s, c_N_s=c_N_s, state=state, lam=lam, q=q, z=z, v=lam.copy())
+    p, q_c, z_c = -t_N[c], q_bar[c], z_bar[c]
+    t_tr = t_T_bar[c] + c_T * dg_T[c]                             # eq (42)
+    zero = np.zeros(c.size)
+    z0 = L.evolve(z_c, p, zero, dt)[0] if L.n_state else z_c
+    Y0 = L.slip_bound(p, q_c, zero, z0)[0]
     f_tr = np.abs(t_tr) - Y0                                      # eq (40)
+    slips = (f_tr > 0.0) & (c_T > 0.0)
 
-    slip = in_contact & (f_tr > 0.0) & (c_T > 0.0)
-    stick = in_contact & ~slip
+    t_T[c] = np.where(slips, 0.0, t_tr)                           # stick: the trial state
+    c_T_s[c] = np.where(slips, 0.0, c_T)
+    state[c] = np.where(slips, SLIP, STICK)
+    z[c] = z0
 
-    t_T = np.where(stick, t_tr, 0.0)
-    c_T_s = np.where(stick, c_T, 0.0)
-    c_N_s = np.zeros_like(p)
-    lam = np.zeros_like(p)
-    q = q_bar.copy()
-    z = np.array(np.where(in_contact[:, None], z0, z_bar), dtype=float)
-
-    if np.any(slip):
-        i = np.flatnonzero(slip)
-        a_tr, s, pi, qi, zi = np.abs(t_tr[i]), np.sign(t_tr[i]), p[i], q_bar[i], z_bar[i]
+    if np.any(slips):
+        i, c_i = np.flatnonzero(slips), c[slips]                  # slipping: position in c, node
+        a_tr, s, pi, qi, zi = np.abs(t_tr[i]), np.sign(t_tr[i]), p[i], q_c[i], z_c[i]
         lo, hi = np.zeros(len(i)), a_tr / c_T                     # phi(lo) > 0 >= phi(hi) (Y >= 0)
         lam_i = f_tr[i] / c_T                                     # exact if Y depends on p alone
 
         def local(lam_i):
-            zz, z_p, z_lam = L.evolve(zi, pi, lam_i, dt)
-            Y, Y_p, Y_q, Y_v, Y_z = L.slip_bound(pi, qi + lam_i, lam_i / dt, zz)
-            Y_lam = Y_q + Y_v / dt + np.einsum("ij,ij->i", Y_z, z_lam)
-            Y_P = Y_p + np.einsum("ij,ij->i", Y_z, z_p)
-            return a_tr - c_T * lam_i - Y, Y_lam, Y_P, zz
+            if L.n_state:
+                zz, z_p, z_lam = L.evolve(zi, pi, lam_i, dt)
+                Y, Y_p, Y_q, Y_v, Y_z = L.slip_bound(pi, qi + lam_i, lam_i / dt, zz)
+                return a_tr - c_T * lam_i - Y, (Y_q + Y_v / dt + np.einsum("ij,ij->i", Y_z, z_lam),
+                                                Y_p + np.einsum("ij,ij->i", Y_z, z_p)), zz
+            Y, Y_p, Y_q, Y_v, _ = L.slip_bound(pi, qi + lam_i, lam_i / dt)
+            return a_tr - c_T * lam_i - Y, (Y_q + Y_v / dt, Y_p), zi
 
         for _ in range(maxit):                                     # eq (44): local Newton
-            phi, Y_lam, Y_P, zz = local(lam_i)
+            phi, (Y_lam, Y_P), zz = local(lam_i)
             if not np.all(np.isfinite(phi)):
                 raise ReturnMapError(f"return map: the slip bound of {L.name} is not finite at p = {pi[~np.isfinite(phi)][:3]}")
             if np.all(np.abs(phi) <= tol * np.maximum(1.0, a_tr)):
@@ -127,14 +127,21 @@ def return_map(law, t_N, dt_N, dg_T, t_T_bar, q_bar, z_bar=None, dt=None, tol=1e
         if np.any(D == 0.0):
             raise ReturnMapError(f"return map: the slip bound of {L.name} softens exactly as fast as the stick stiffness "
                                  "(c_T + dY/dlambda = 0): the slip is not unique")
-        t_T[i] = s * (a_tr - c_T * lam_i)                          # eq (43)
-        c_T_s[i] = c_T * Y_lam / D                                # eq (48)
-        c_N_s[i] = s * Y_P * (-dt_N[i]) * c_T / D                 # eq (48)
-        lam[i] = lam_i
-        q[i] = qi + lam_i
-        z[i] = zz
-
-    state = np.where(slip, SLIP, np.where(stick, STICK, OPEN))
-    if not (np.all(np.isfinite(t_T)) and np.all(np.isfinite(c_T_s)) and np.all(np.isfinite(c_N_s))):
+        t_T[c_i] = s * (a_tr - c_T * lam_i)                        # eq (43)
+        c_T_s[c_i] = c_T * Y_lam / D                              # eq (48)
+        c_N_s[c_i] = s * Y_P * (-dt_N[c_i]) * c_T / D             # eq (48)
+        lam[c_i] = lam_i
+        q[c_i] = qi + lam_i
+        z[c_i] = zz
+    if not np.isfinite(t_T.sum() + c_T_s.sum() + c_N_s.sum()):  # (a sum is non-finite if any term is)
         raise ReturnMapError("return map produced a non-finite traction or modulus")
     return FrictionState(t_T=t_T, c_T_s=c_T_s, c_N_s=c_N_s, state=state, lam=lam, q=q, z=z, v=lam / dt)
+
+
+def _node_arrays(*arrays):
+    """The arguments as float arrays of one shape (n,) (broadcast if need be)."""
+    if all(type(a) is np.ndarray and a.dtype == np.float64 and a.ndim == 1 for a in arrays) \
+            and len({a.shape for a in arrays}) == 1:
+        return arrays
+    arrays = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in arrays))
+    return [a.reshape(-1) for a in arrays]

@@ -1,5 +1,6 @@
 """Figures of `contactfem bench` (lecture 09): the tangent comparison, the
-work-precision diagrams and the cost of a Newton iteration.
+work-precision diagrams, the cost of a Newton iteration, and where the time of the
+paper's runs goes (start-up and one iteration of each scene).
 
 Data: the bench JSON named by $CONTACTFEM_BENCH, else the repository's bench.json (a
 committed full run), else a quick bench run here (about half a minute)."""
@@ -24,15 +25,15 @@ def bench_json_path():
 
 
 def load_bench(preset="fast"):
-    """The bench result: from the JSON if present, else a quick bench of the three studies
-    the figures need (tangents, work_precision, cost), computed once per process."""
+    """The bench result: from the JSON if present, else a quick bench of the four studies
+    the figures need (tangents, work_precision, cost, speed), computed once per process."""
     path = bench_json_path()
     if path.exists():
         return json.loads(path.read_text())
     if "quick" not in _CACHE:
         from ..studies.bench import run_bench
 
-        _CACHE["quick"] = run_bench(quick=True, only=("tangents", "work_precision", "cost"), progress=None)
+        _CACHE["quick"] = run_bench(quick=True, only=("tangents", "work_precision", "cost", "speed"), progress=None)
     return _CACHE["quick"]
 
 
@@ -166,3 +167,58 @@ def bench_cost(preset="fast", outdir=None):
     ax2.set_title("contact cost is linear in the contact nodes")
     fig.tight_layout()
     return [savefig(fig, outdir or default_outdir(), "bench_cost")]
+
+
+@figure("bench_speed", "bench")
+def bench_speed(preset="fast", outdir=None):
+    """One Newton iteration of each paper scene split into bulk, contact, assembly, solve and
+    overhead (CPU ms, with the targets), and the start-up of whole processes."""
+    from ..studies.bench.speed import PARTS, SPEED_TARGETS as T
+
+    plt = pyplot()
+    sp = load_bench(preset)["speed"]
+    rows = sp["iterations"]
+    fig, (ax, ax2) = plt.subplots(1, 2, figsize=(13, 4.6), gridspec_kw=dict(width_ratios=[3, 2]))
+    names = [r["scene"] + "".join(f", {v}" for v in r["overrides"].values()) + f"\n{r['ndof']} unknowns, "
+             f"{r['linear_algebra']}" for r in rows]
+    colors = dict(bulk="C0", contact="C3", assembly="C7", solve="C2", overhead="C8")
+    left = np.zeros(len(rows))
+    for part in PARTS:
+        ms = np.array([1e3 * r[f"{part}_s"] for r in rows])
+        ax.barh(range(len(rows)), ms, left=left, color=colors[part], label=part)
+        left += ms
+    goals = {("sloping_impact", "frictional"): T["sloping_impact_iteration_s"],
+             ("rolling_ring", None): T["rolling_ring_iteration_s"]}
+    # a linear axis for the small scenes; rows beyond it (cork, hertz) are cut and labelled
+    xmax = 1.3 * max(t for t in left if t <= 6 * left.min())
+    for i, r in enumerate(rows):
+        cut = left[i] > xmax
+        ax.text(xmax * 0.99 if cut else left[i] + 0.01 * xmax, i, f"{left[i]:.3g} ms" + (" (cut)" if cut else ""),
+                va="center", ha="right" if cut else "left", fontsize=8, color="w" if cut else "k")
+        goal = goals.get((r["scene"], r["overrides"].get("variant")))
+        if goal and r["preset"] == "paper":
+            ax.plot([1e3 * goal] * 2, [i - 0.4, i + 0.4], "k-", lw=2)
+    ax.plot([], [], "k-", lw=2, label="target")
+    ax.set_xlim(0, xmax)
+    ax.set_yticks(range(len(rows)), names, fontsize=7)
+    ax.invert_yaxis()
+    ax.set_xlabel("one Newton iteration [ms CPU]")
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=6)
+    ax.set_title(f"{sp['preset']} preset: where an iteration goes", fontsize=9)
+    st = sp["startup"]
+    procs = (("python", "python -c pass"), ("list", "contactfem list"),
+             ("scipy_skfem", "import scipy.sparse.linalg, skfem"), ("run_block", "contactfem run block\n--preset paper"))
+    walls = [st[k]["wall_s"] for k, _ in procs]
+    ax2.barh(range(len(procs)), walls, color=["C7", "C0", "C7", "C0"])
+    for i, w in enumerate(walls):
+        ax2.text(w * 1.02, i, f"{w:.3f} s", va="center", fontsize=8)
+    ax2.plot([T["list_s"]] * 2, [0.6, 1.4], "k-", lw=2)
+    ax2.plot([T["run_block_over_scipy_skfem"] * st["scipy_skfem"]["wall_s"]] * 2, [2.6, 3.4], "k-", lw=2)
+    ax2.set_yticks(range(len(procs)), [p for _, p in procs], fontsize=7)
+    ax2.invert_yaxis()
+    ax2.set_xlim(0, 1.3 * max(walls))
+    ax2.set_xlabel("whole process, wall [s] (median)")
+    ax2.set_title(f"start-up: list {st['list_over_python']:.1f} x python, run block "
+                  f"{st['run_block_over_scipy_skfem']:.2f} x scipy + skfem", fontsize=9)
+    fig.tight_layout()
+    return [savefig(fig, outdir or default_outdir(), "bench_speed")]

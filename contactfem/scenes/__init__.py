@@ -26,6 +26,18 @@ def all_scenes():
 
 
 def get_scene(name):
+    """The Scene called `name`. A scene lives in the module of its name, so only that module
+    is imported (the others only when the name is unknown, to list the known ones)."""
+    if isinstance(name, str) and name.isidentifier() and not name.startswith("_") and name != "base":
+        module = f"{__name__}.{name}"
+        try:
+            scene = getattr(importlib.import_module(module), "SCENE", None)
+        except ModuleNotFoundError as err:
+            if err.name != module:
+                raise
+            scene = None
+        if scene is not None and scene.name == name:
+            return scene
     scenes = all_scenes()
     if name not in scenes:
         raise ValueError(f"unknown scene {name!r}: known are {', '.join(scenes) or '(none)'}")
