@@ -292,7 +292,9 @@ def build_parser():
     rp.set_defaults(func=cmd_run)
     fp = sub.add_parser("figures", help="regenerate every figure and table of the paper into figures/")
     fp.add_argument("--preset", default="fast", choices=["fast", "paper"])
-    fp.add_argument("--outdir", default=None, help="default: the repo's figures/ folder")
+    fp.add_argument("--outdir", default=None,
+                    help="default: the repo's figures/ folder for --preset paper (the figures kept with the code), "
+                         "figures/fast/ for the fast preset")
     fp.add_argument("--only", default=None, help="only figures whose file name contains this text")
     fp.set_defaults(func=cmd_figures)
     ep = sub.add_parser("equations", help="the equation index: paper equation -> implementing function")

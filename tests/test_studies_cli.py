@@ -52,3 +52,21 @@ def test_run_animates_saves_and_reloads(tmp_path, capsys):
 def test_gif_of_a_scene_without_outlines_is_a_clear_error(tmp_path, capsys):
     assert main(["run", "block", "--gif", str(tmp_path / "b.gif")]) == 2
     assert "records no outlines" in capsys.readouterr().err
+
+
+def test_a_quick_figure_run_never_writes_over_the_paper_figures(monkeypatch):
+    """figures/ holds the paper preset's figures (kept with the code); other presets write
+    into figures/<preset>/ unless a folder is given."""
+    from pathlib import Path
+
+    from contactfem.plots import default_outdir
+
+    monkeypatch.delenv("CONTACTFEM_FIGURES", raising=False)
+    monkeypatch.delenv("CONTACTFEM_PRESET", raising=False)
+    paper, fast = Path(default_outdir("paper")), Path(default_outdir("fast"))
+    assert paper.name == "figures" and fast == paper / "fast"
+    assert Path(default_outdir()) == fast                      # the default preset is fast
+    monkeypatch.setenv("CONTACTFEM_PRESET", "paper")
+    assert Path(default_outdir()) == paper
+    monkeypatch.setenv("CONTACTFEM_FIGURES", "/tmp/elsewhere")
+    assert default_outdir("paper") == default_outdir("fast") == "/tmp/elsewhere"

@@ -24,13 +24,17 @@ def figure(stem, label):
     return deco
 
 
-def default_outdir():
-    """$CONTACTFEM_FIGURES if set (the tests use a temporary folder), else the repo's figures/."""
+def default_outdir(preset=None):
+    """$CONTACTFEM_FIGURES if set (the tests use a temporary folder), else the repo's figures/
+    for the paper preset (the figures kept with the code) and figures/<preset>/ for another
+    (default: $CONTACTFEM_PRESET or fast), so a quick run never writes over the paper's figures."""
     env = os.environ.get("CONTACTFEM_FIGURES")
     if env:
         return env
+    preset = preset or default_preset()
     repo = Path(__file__).resolve().parents[2]
-    return str(repo / "figures") if (repo / "pyproject.toml").exists() else "figures"
+    base = repo / "figures" if (repo / "pyproject.toml").exists() else Path("figures")
+    return str(base if preset == "paper" else base / preset)
 
 
 def default_preset():
@@ -47,7 +51,7 @@ def load_all():
 
 def make_all(preset="fast", outdir=None, only=None):
     """Draw every registered figure (or those whose stem contains `only`)."""
-    outdir = outdir or default_outdir()
+    outdir = outdir or default_outdir(preset)
     Path(outdir).mkdir(parents=True, exist_ok=True)
     written = []
     for stem, (label, fn) in sorted(load_all().items()):

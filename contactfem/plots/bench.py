@@ -64,7 +64,7 @@ def bench_tangents(preset="fast", outdir=None):
     np.atleast_1d(axes)[0].set_ylabel("linear solves to convergence")
     fig.suptitle("The consistent non-symmetric tangent (eqs 49-50) against the alternatives")
     fig.tight_layout()
-    return [savefig(fig, outdir or default_outdir(), "bench_tangents")]
+    return [savefig(fig, outdir or default_outdir(preset), "bench_tangents")]
 
 
 def _rows(block):
@@ -130,7 +130,7 @@ def bench_work_precision(preset="fast", outdir=None):
     ax.set_ylabel("|duration / (2L/c) - 1|")
     ax.legend(fontsize=8)
     fig.tight_layout()
-    return [savefig(fig, outdir or default_outdir(), "bench_work_precision")]
+    return [savefig(fig, outdir or default_outdir(preset), "bench_work_precision")]
 
 
 @figure("bench_cost", "bench")
@@ -166,7 +166,7 @@ def bench_cost(preset="fast", outdir=None):
     ax2.legend(fontsize=8)
     ax2.set_title("contact cost is linear in the contact nodes")
     fig.tight_layout()
-    return [savefig(fig, outdir or default_outdir(), "bench_cost")]
+    return [savefig(fig, outdir or default_outdir(preset), "bench_cost")]
 
 
 @figure("bench_speed", "bench")
@@ -221,4 +221,4 @@ def bench_speed(preset="fast", outdir=None):
     ax2.set_title(f"start-up: list {st['list_over_python']:.1f} x python, run block "
                   f"{st['run_block_over_scipy_skfem']:.2f} x scipy + skfem", fontsize=9)
     fig.tight_layout()
-    return [savefig(fig, outdir or default_outdir(), "bench_speed")]
+    return [savefig(fig, outdir or default_outdir(preset), "bench_speed")]

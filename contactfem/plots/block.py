@@ -81,7 +81,7 @@ def fig06(preset="fast", outdir=None, law="conical"):
         ax.set_aspect("equal")
     fig.suptitle("Fig 6: elastic block on a rigid rough foundation, whole load in one step", fontsize=10)
     fig.tight_layout()
-    return [savefig(fig, outdir or default_outdir(), "fig06_block_mesh_deformed")]
+    return [savefig(fig, outdir or default_outdir(preset), "fig06_block_mesh_deformed")]
 
 
 def draw_stresses(ax, r, label="", style="-", faint=False):
@@ -124,7 +124,7 @@ def fig07(preset="fast", outdir=None):
                      f"(n = 1, alpha + beta = {P['alpha'] + P['beta']:g})\n"
                      f"sum |t_N| w = {-r['total_normal']:.6g}, sum t_T w = {r['total_tangential']:.6g}; "
                      + slip_words(r))
-    return [savefig(fig, outdir or default_outdir(), "fig07_block_conical_stresses")]
+    return [savefig(fig, outdir or default_outdir(preset), "fig07_block_conical_stresses")]
 
 
 @figure("fig08_block_parabolic_stresses", "Fig 8")
@@ -139,7 +139,7 @@ def fig08(preset="fast", outdir=None):
     _stress_axes(ax, "Fig 8: stresses on the contact area, parabolic slip surface "
                      f"(n = {P['n']:g}, alpha = {P['alpha']:g}, beta = {P['beta']:g})\n"
                      f"{slip_words(r)}; grey: the conical case (Fig 7)")
-    return [savefig(fig, outdir or default_outdir(), "fig08_block_parabolic_stresses")]
+    return [savefig(fig, outdir or default_outdir(preset), "fig08_block_parabolic_stresses")]
 
 
 def slip_words(r):
@@ -204,7 +204,7 @@ def table1_markdown(hist):
 @figure("table1_block_newton_residuals", "Table 1")
 def table1(preset="fast", outdir=None):
     plt = pyplot()
-    outdir = outdir or default_outdir()
+    outdir = outdir or default_outdir(preset)
     hist = residual_histories(preset)
     md = Path(outdir) / "table1_block_newton_residuals.md"
     md.parent.mkdir(parents=True, exist_ok=True)

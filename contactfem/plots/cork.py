@@ -71,7 +71,7 @@ def fig14_cork_mesh(preset="fast", outdir=None):
         ax.set_xlabel("r (mm)")
     axes[0].set_ylabel("z (mm)")
     fig.suptitle(f"Fig 14: the cork (axisymmetric, the meridian mirrored; R_tip = {r['parameters']['R_tip']:g} mm)")
-    return [savefig(fig, outdir or default_outdir(), "fig14_cork_mesh")]
+    return [savefig(fig, outdir or default_outdir(preset), "fig14_cork_mesh")]
 
 
 @figure("fig15_cork_configurations", "Fig 15")
@@ -93,7 +93,7 @@ def fig15_cork_configurations(preset="fast", outdir=None):
     v = r["exit_velocity_m_s"]
     fig.suptitle("Fig 15: the cork leaving the bottle"
                  + (f"; exit velocity {v:.1f} m/s (paper ~28 m/s)" if v is not None else "; it did not leave"))
-    return [savefig(fig, outdir or default_outdir(), "fig15_cork_configurations")]
+    return [savefig(fig, outdir or default_outdir(preset), "fig15_cork_configurations")]
 
 
 @figure("fig16_cork_pressure", "Fig 16")
@@ -113,7 +113,7 @@ def fig16_cork_pressure(preset="fast", outdir=None):
     ax.set_ylabel("p (MPa)")
     ax.set_title("Fig 16: the pressure on the cork")
     ax.legend(fontsize=8)
-    return [savefig(fig, outdir or default_outdir(), "fig16_cork_pressure")]
+    return [savefig(fig, outdir or default_outdir(preset), "fig16_cork_pressure")]
 
 
 @figure("fig17_cork_displacement", "Fig 17")
@@ -129,7 +129,7 @@ def fig17_cork_displacement(preset="fast", outdir=None):
     ax.set_ylabel("axial displacement (mm)")
     ax.set_title("Fig 17: the displacement of the cork")
     ax.legend(fontsize=8)
-    return [savefig(fig, outdir or default_outdir(), "fig17_cork_displacement")]
+    return [savefig(fig, outdir or default_outdir(preset), "fig17_cork_displacement")]
 
 
 # The sensitivity study of lecture 08: one reconstructed datum changed at a time, each
@@ -184,7 +184,7 @@ def table_cork_sensitivity(preset="fast", outdir=None):
         lines.append(f"| {label} | {'-' if F is None else format(F, '.0f')} | " + " | ".join(vs) + " |")
     lines.append("")
     lines.append(f"Paper: ~2500 N, 28 m/s at p0 = 0.8 MPa. Preset: {preset}.")
-    path = Path(outdir or default_outdir()) / "table_cork_sensitivity.md"
+    path = Path(outdir or default_outdir(preset)) / "table_cork_sensitivity.md"
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text("\n".join(lines) + "\n")
     return [str(path)]
@@ -315,7 +315,7 @@ def cork_knife_edge(preset="fast", outdir=None, data=None):
     import json
     from pathlib import Path
 
-    out = Path(outdir or default_outdir())
+    out = Path(outdir or default_outdir(preset))
     out.mkdir(parents=True, exist_ok=True)
     (out / "cork_knife_edge.json").write_text(json.dumps(jsonable(d), indent=1))   # the data, to redraw
     return [savefig(fig, str(out), "cork_knife_edge"), str(out / "cork_knife_edge.json")]

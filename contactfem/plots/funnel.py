@@ -65,7 +65,7 @@ def fig12(preset="fast", outdir=None):
     r = result("frictionless", preset)
     fig = draw_funnel(r, f"Fig 12: ring falling into a funnel, frictionless (funnel wall at "
                          f"{r['parameters']['phi_deg']:g} deg from the vertical: chosen)")
-    return [savefig(fig, outdir or default_outdir(), "fig12_funnel_frictionless")]
+    return [savefig(fig, outdir or default_outdir(preset), "fig12_funnel_frictionless")]
 
 
 @figure("fig13_funnel_frictional", "Fig 13")
@@ -74,4 +74,4 @@ def fig13(preset="fast", outdir=None):
     p = r["parameters"]
     fig = draw_funnel(r, f"Fig 13: ring falling into a funnel, frictional eq (10): n = {p['n']:g}, "
                          f"alpha = {p['alpha']:g}, beta = {p['beta']:g} (wall at {p['phi_deg']:g} deg: chosen)")
-    return [savefig(fig, outdir or default_outdir(), "fig13_funnel_frictional")]
+    return [savefig(fig, outdir or default_outdir(preset), "fig13_funnel_frictional")]

@@ -101,7 +101,7 @@ def fig01_true_contact_area(preset="fast", outdir=None):
     ax.set_title(r"Fig 1: $A_r/A = (|t_N|/(AH))^n$, eq (3)")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
-    return [savefig(fig, outdir or default_outdir(), "fig01_true_contact_area")]
+    return [savefig(fig, outdir or default_outdir(preset), "fig01_true_contact_area")]
 
 
 def fig02_history(n_up=60, n_back=60):
@@ -136,7 +136,7 @@ def fig02_force_vs_microdisplacement(preset="fast", outdir=None):
     ax.set_title("Fig 2: tangential force vs micro-displacement")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="lower right")
-    return [savefig(fig, outdir or default_outdir(), "fig02_force_vs_microdisplacement")]
+    return [savefig(fig, outdir or default_outdir(preset), "fig02_force_vs_microdisplacement")]
 
 
 @figure("fig03_shear_vs_normal", "Fig 3")
@@ -169,7 +169,7 @@ def fig03_shear_vs_normal(preset="fast", outdir=None):
     a2.grid(True, alpha=0.3)
     a2.legend(fontsize=8)
     fig.suptitle("Fig 3: shear vs normal stress")
-    return [savefig(fig, outdir or default_outdir(), "fig03_shear_vs_normal")]
+    return [savefig(fig, outdir or default_outdir(preset), "fig03_shear_vs_normal")]
 
 
 def fig04_geometry(law, t_N, t_T_trial):
@@ -225,4 +225,4 @@ def fig04_parabolic_slip_surface(preset="fast", outdir=None):
     ax.set_ylabel(r"tangential traction $t_T$")
     ax.set_title(r"Fig 4: parabolic slip surface, $\alpha = 0.2$, $\beta = 0.3$")
     ax.legend(fontsize=7, loc="lower left")
-    return [savefig(fig, outdir or default_outdir(), "fig04_parabolic_slip_surface")]
+    return [savefig(fig, outdir or default_outdir(preset), "fig04_parabolic_slip_surface")]

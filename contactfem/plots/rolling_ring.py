@@ -147,7 +147,7 @@ def fig09(preset="fast", outdir=None, **overrides):
              f"mu = {p['mu']:g}); v_final = {r['v_final']:.1f} cm/s (exact {r['v_final_exact']:.0f})")
     stem = "fig09_rolling_ring" + ("" if not overrides else "_" + "_".join(f"{k}{v}" for k, v in sorted(overrides.items())))
     fig = draw_rolling(r, title)
-    return [savefig(fig, outdir or default_outdir(), stem)]
+    return [savefig(fig, outdir or default_outdir(preset), stem)]
 
 
 @figure("fig09b_rolling_ring_convergence", "Fig 9 (convergence)")
@@ -178,4 +178,4 @@ def fig09b(preset="fast", outdir=None):
     a2.legend(fontsize=8)
     fig.suptitle("Rolling ring: error of the start of rolling x_roll and of the rolling speed v_final", fontsize=10)
     fig.tight_layout()
-    return [savefig(fig, outdir or default_outdir(), "fig09b_rolling_ring_convergence")]
+    return [savefig(fig, outdir or default_outdir(preset), "fig09b_rolling_ring_convergence")]

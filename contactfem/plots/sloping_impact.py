@@ -62,7 +62,7 @@ def fig10(preset="fast", outdir=None):
     p = r["parameters"]
     fig = draw_impact(r, f"Fig 10: sloping impact, frictionless contact (Newmark {p['delta']:g}/{p['beta_newmark']:g}, "
                          f"dt = {p['dt']:g})")
-    return [savefig(fig, outdir or default_outdir(), "fig10_sloping_impact_frictionless")]
+    return [savefig(fig, outdir or default_outdir(preset), "fig10_sloping_impact_frictionless")]
 
 
 @figure("fig11a_sloping_impact_frictional", "Fig 11a")
@@ -71,7 +71,7 @@ def fig11a(preset="fast", outdir=None):
     p = r["parameters"]
     fig = draw_impact(r, f"Fig 11a: sloping impact, frictional contact (eq 10: n = {p['n']:g}, alpha = {p['alpha']:g}, "
                          f"beta = {p['beta']:g})")
-    return [savefig(fig, outdir or default_outdir(), "fig11a_sloping_impact_frictional")]
+    return [savefig(fig, outdir or default_outdir(preset), "fig11a_sloping_impact_frictional")]
 
 
 @figure("fig11b_sloping_impact_viscoplastic", "Fig 11b")
@@ -80,7 +80,7 @@ def fig11b(preset="fast", outdir=None):
     eta = r["parameters"]["eta"]
     fig = draw_impact(r, "Fig 11b: frictional contact, viscoplastic ring (N0 = 1, Q0 = 0.5, M0 = 0.25; "
                          f"eta = {eta:g} chosen)")
-    return [savefig(fig, outdir or default_outdir(), "fig11b_sloping_impact_viscoplastic")]
+    return [savefig(fig, outdir or default_outdir(preset), "fig11b_sloping_impact_viscoplastic")]
 
 
 def table2_rows(preset="fast", refined_n_el=32):
@@ -128,7 +128,7 @@ def table2(preset="fast", outdir=None, refined_n_el=32):
                 if result("frictionless", preset).get("fitted") else "") + ".", "",
              "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     lines += ["| " + " | ".join(b) + " |" for b in body]
-    out = outdir or default_outdir()
+    out = outdir or default_outdir(preset)
     from pathlib import Path
 
     Path(out).mkdir(parents=True, exist_ok=True)

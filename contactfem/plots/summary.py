@@ -174,7 +174,7 @@ def table_lines(text, prefix=""):
 
 @figure("summary", "README table")
 def summary(preset="fast", outdir=None):
-    path = Path(outdir or default_outdir()) / "summary.md"
+    path = Path(outdir or default_outdir(preset)) / "summary.md"
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(summary_markdown(preset))
     return [str(path)]

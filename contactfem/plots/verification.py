@@ -29,7 +29,7 @@ def verif_hertz_pressure(preset="fast", outdir=None):
     ax.set_title(f"Hertz line contact: $p_0$ error {100 * r['error_p0']:+.2f} %, "
                  f"$a$ (fit) error {100 * r['error_a']:+.2f} %", fontsize=10)
     ax.legend()
-    return [savefig(fig, outdir or default_outdir(), "verif_hertz_pressure")]
+    return [savefig(fig, outdir or default_outdir(preset), "verif_hertz_pressure")]
 
 
 def hertz_refinement_data(preset="fast", c_N=1e7):
@@ -73,7 +73,7 @@ def verif_hertz_refinement(preset="fast", outdir=None):
     fig.suptitle("Hertz under mesh refinement: p0 error " + "; ".join(
         f"{k.replace('_', ' ')} {e[k][0]:+.2f} % -> {e[k][-1]:+.2f} %" for k in ("per_length", "nodal")),
         fontsize=10)
-    return [savefig(fig, outdir or default_outdir(), "verif_hertz_refinement")]
+    return [savefig(fig, outdir or default_outdir(preset), "verif_hertz_refinement")]
 
 
 @figure("verif_bar_impact", "verification")
@@ -95,7 +95,7 @@ def verif_bar_impact(preset="fast", outdir=None):
     ax2.set_xlabel("$t / (2L/c)$")
     ax2.set_ylabel("$(E - E_0) / E_0$")
     ax2.set_title("total energy (kinetic + strain + penalty)", fontsize=10)
-    return [savefig(fig, outdir or default_outdir(), "verif_bar_impact")]
+    return [savefig(fig, outdir or default_outdir(preset), "verif_bar_impact")]
 
 
 @figure("verif_patch", "verification")
@@ -113,4 +113,4 @@ def verif_patch(preset="fast", outdir=None):
     ax.set_ylabel("interface pressure / $p$")
     ax.set_title("Contact patch test, non-matching meshes", fontsize=10)
     ax.legend(fontsize=8)
-    return [savefig(fig, outdir or default_outdir(), "verif_patch")]
+    return [savefig(fig, outdir or default_outdir(preset), "verif_patch")]
