@@ -140,6 +140,29 @@ def test_results_match_the_recorded_run_before_the_fast_paths():
             assert abs(got - want) <= 1e-12 * max(1.0, abs(want)), variant
 
 
+def test_paper_runs_match_the_runs_recorded_before_the_kernel_and_band_speed_ups():
+    """The paper runs as they stand (two-point beam, dense LAPACK for the 48 unknowns of the
+    impact, banded LU for the ring), against the same runs recorded before the one-pass beam
+    kernel, the return map on the contact nodes only and the banded solve (SuperLU for the
+    ring): unchanged to 1e-12 of each value's size, with the same iteration counts."""
+    from contactfem.scenes import run_scene
+
+    recorded = {   # recorded with contactfem 825230e
+        ("sloping_impact", "frictional"): dict(rebound_vx=1.0087092363598826, rebound_vy=1.3971672124219205,
+                                               rebound_spin=-0.10755302801377273, newton_iterations_total=432),
+        ("sloping_impact", "frictionless"): dict(rebound_vx=2.0000000000001115, rebound_vy=1.4623828181468355,
+                                                 newton_iterations_total=420),
+        ("rolling_ring", None): dict(t_roll=1.019631099709421, x_roll=229.41649685869655,
+                                     v_final=149.2611742098239, omega_final=-2.985684796331272,
+                                     x_end=375.80596267016216, v_end=148.68100861459516, newton_iterations_total=603),
+    }
+    for (scene, variant), values in recorded.items():
+        res = run_scene(scene, "paper", {"variant": variant} if variant else {})
+        assert res["linear_algebra"] == ("banded" if scene == "rolling_ring" else "dense")
+        for key, want in values.items():
+            assert abs(res[key] - want) <= 1e-12 * max(1.0, abs(want)), (scene, variant, key, res[key], want)
+
+
 # -- the bench's split of a Newton iteration -----------------------------------------------
 
 def test_iteration_cost_splits_the_newton_time_of_a_real_run():
