@@ -149,6 +149,9 @@ def test_quick_bench_writes_json_and_markdown(tmp_path):
     c = res["cost"]
     for name, r in c["cases"].items():
         assert r["ndof"] > 0 and r["solve_s"] > 0
+    ring = c["cases"]["rolling ring 120 beams"]      # the solve newton() uses: banded for the ring
+    assert ring["linear_algebra"] == "banded" and ring["solve_s"] == ring["solve_banded_s"]
+    assert all(r["solve_banded_s"] is None for n, r in c["cases"].items() if n.startswith("hertz"))
     wp = res["work_precision"]
     assert all(r["ok"] for r in wp["hertz_mesh"]["rows"])
     assert abs(wp["hertz_mesh"]["rows"][-1]["error_p0"]) < 0.005        # 32^2 quads: p0 within 0.5 %

@@ -142,7 +142,7 @@ def bench_cost(preset="fast", outdir=None):
     fig, (ax, ax2) = plt.subplots(1, 2, figsize=(13, 4.2), gridspec_kw=dict(width_ratios=[2, 1]))
     names = list(c["cases"])
     parts = (("bulk_s", "bulk (body.internal)", "C0"), ("contact_s", "contact", "C3"),
-             ("assembly_s", "global assembly", "C7"), ("solve_s", "linear solve (SuperLU)", "C2"))
+             ("assembly_s", "global assembly", "C7"), ("solve_s", "linear solve", "C2"))
     bottom = np.zeros(len(names))
     for key, label, color in parts:
         vals = np.array([c["cases"][n][key] for n in names])

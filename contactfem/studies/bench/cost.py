@@ -1,6 +1,7 @@
 """Study 3, cost: the time of one Newton iteration split into bulk assembly
 (body.internal), contact (contact.assemble), global assembly (COO -> CSR) and linear
-solve (SuperLU with two orderings, and pypardiso if installed), at the paper sizes and
+solve (SuperLU with two orderings, LAPACK's band LU where the System chose it, and
+pypardiso if installed), at the paper sizes and
 for the block refined to about 1e5 unknowns; contact time against the number of contact
 nodes (slope ~1: linear)."""
 
@@ -13,8 +14,9 @@ def iteration_cost(system, u, t=1.0, repeat=3, solvers=True):
     """Wall times (best of `repeat`) of the parts of one Newton iteration at u:
     bulk (every body.internal), contact (every contact.assemble), assembly (the whole
     System.residual_tangent minus those two: loads, COO -> CSR), solve (splu factor +
-    solve of the free block with the default COLAMD and with MMD_AT_PLUS_A ordering,
-    and pypardiso if installed)."""
+    solve of the free block with the default COLAMD and with MMD_AT_PLUS_A ordering, the
+    band LU if the System solves banded, and pypardiso if installed); ``solve_s`` is the
+    solver newton() uses (``linear_algebra``)."""
     import scipy.sparse as sp
     from scipy.sparse.linalg import splu
 
@@ -32,6 +34,10 @@ def iteration_cost(system, u, t=1.0, repeat=3, solvers=True):
         return out
     for spec in ("COLAMD", "MMD_AT_PLUS_A"):
         _, out[f"solve_splu_{spec}_s"] = best_of(lambda: splu(Kff, permc_spec=spec).solve(b), repeat)
+    plan = getattr(K, "band_plan", None)
+    out["linear_algebra"] = system.linear_algebra
+    out["solve_banded_s"] = (best_of(lambda: plan.solve(K.data, b), repeat)[1]
+                             if plan is not None and plan.fits(K, free) else None)
     try:
         import pypardiso
         A = Kff.tocsr()
@@ -42,7 +48,8 @@ def iteration_cost(system, u, t=1.0, repeat=3, solvers=True):
         _, out["solve_pypardiso_s"] = best_of(lambda: (ps.factorize(A), ps.solve(A, b)), repeat)
     except ImportError:
         out["solve_pypardiso_s"] = None
-    out["solve_s"] = out["solve_splu_MMD_AT_PLUS_A_s"]           # what newton() uses
+    out["solve_s"] = (out["solve_banded_s"] if out["solve_banded_s"] is not None    # what newton() uses
+                      else out["solve_splu_MMD_AT_PLUS_A_s"])
     return out
 
 

@@ -202,15 +202,19 @@ def write_markdown(res):
         c = res["cost"]
         L += ["## Cost of one Newton iteration", "",
               "Best of a few repeats. bulk: body.internal (R and K of the bodies); contact: contact.assemble; "
-              "assembly: the rest of System.residual_tangent (loads, COO -> CSR); solve: splu factor + solve "
-              "of the free block (the ordering newton() uses, MMD_AT_PLUS_A; COLAMD is scipy's default).", "",
-              "| case | unknowns | contact nodes | bulk [s] | contact [s] | assembly [s] | solve MMD [s] | "
-              "solve COLAMD [s] | pypardiso [s] | contact share |", "|---|---|---|---|---|---|---|---|---|---|"]
+              "assembly: the rest of System.residual_tangent (loads, COO -> CSR); solve: factorisation + solve "
+              "of the free block by LAPACK's band LU where the System solves banded (band), else by splu with "
+              "the ordering newton() uses (MMD_AT_PLUS_A); SuperLU with each ordering for comparison (COLAMD is "
+              "scipy's default).", "",
+              "| case | unknowns | contact nodes | bulk [s] | contact [s] | assembly [s] | solve [s] | "
+              "solve MMD [s] | solve COLAMD [s] | pypardiso [s] | contact share |",
+              "|---|---|---|---|---|---|---|---|---|---|---|"]
         for name, r in c["cases"].items():
             tot = r["bulk_s"] + r["contact_s"] + r["assembly_s"] + r["solve_s"]
+            band = " (band)" if r.get("solve_banded_s") is not None else ""
             L.append(f"| {name} | {r['ndof']} | {r['n_contact_nodes']} | {_f(r['bulk_s'])} | {_f(r['contact_s'])} | "
-                     f"{_f(r['assembly_s'])} | {_f(r['solve_s'])} | {_f(r['solve_splu_COLAMD_s'])} | "
-                     f"{_f(r['solve_pypardiso_s'])} | {r['contact_s'] / tot:.1%} |")
+                     f"{_f(r['assembly_s'])} | {_f(r['solve_s'])}{band} | {_f(r['solve_splu_MMD_AT_PLUS_A_s'])} | "
+                     f"{_f(r['solve_splu_COLAMD_s'])} | {_f(r['solve_pypardiso_s'])} | {r['contact_s'] / tot:.1%} |")
         n = np.array([r["n_contact_nodes"] for r in c["contact_scaling"]], float)
         tc = np.array([r["contact_s"] for r in c["contact_scaling"]])
         per_node, fixed = np.polyfit(n, tc, 1)
