@@ -350,3 +350,33 @@ def test_banded_and_sparse_paths_give_the_same_run(run, args, kl, monkeypatch):
     assert (banded["linear_algebra"], sparse["linear_algebra"]) == ("banded", "sparse")
     assert banded["ordering"] == f"reverse Cuthill-McKee, LAPACK banded LU (kl={kl}, ku={kl})"
     numbers_agree(banded, sparse)
+
+
+def test_a_growing_pattern_gets_a_new_band_or_goes_sparse():
+    """A contact coupling new dofs grows the pattern: the band is measured again (a chain
+    closed into a ring stays banded, its K solved right), and a coupling that makes the band
+    too wide for the band LU sends later solves to SuperLU; the System reports both."""
+    from contactfem.solver.newton import solve_free
+
+    n = 400
+    A, p = scrambled_band(n, 4, 4, seed=8)
+    A = A.tocoo()
+    body = (A.row, A.col, A.data + 10.0 * (A.row == A.col), 0, "body")
+    asm = TangentAssembler(n, "auto")
+    K0 = asm.assemble([body])
+    kl0 = K0.band_plan.kl
+    first, last = np.argsort(p)[[0, -1]]                                # the two ends of the chain
+    ring = (np.array([first, last]), np.array([last, first]), np.array([0.5, -0.25]), 0, None)
+    K1 = asm.assemble([body, ring])
+    assert asm.kind == "banded" and asm.pattern_builds == 2 and K1.band_plan is not K0.band_plan
+    b = np.random.default_rng(9).normal(size=n)
+    for K in (K0, K1):                                     # an earlier K keeps its own plan
+        x = solve_free(K, b, np.arange(n), True)
+        assert np.max(np.abs(x - np.linalg.solve(K.toarray(), b))) <= 1e-12 * np.max(np.abs(x))
+    spread = np.random.default_rng(10).choice(n, 60, replace=False)     # one contact couples them all
+    r, c = np.meshgrid(spread, spread)
+    wide = (r.ravel(), c.ravel(), np.full(r.size, 1e-3), 0, None)
+    K2 = asm.assemble([body, ring, wide])
+    assert asm.kind == "sparse" and not hasattr(K2, "band_plan") and asm.plan.flops > 1e7 >= K1.band_plan.flops
+    assert asm.describe()[0] == "banded+sparse" and asm.describe()[1].endswith("+MMD_AT_PLUS_A")
+    assert kl0 <= K1.band_plan.kl
