@@ -16,12 +16,14 @@ scipy's constructor checks the arrays again at every call (17-40 us for 360 unkn
 copy 3 us). What changes K's structure in place (``eliminate_zeros``) raises; copy K first.
 
 Banded: when the pattern is (re)built, its free block is renumbered by reverse
-Cuthill-McKee and its band measured (banded.py). If the band LU's work n kl (kl + ku)
-is at most banded.BANDED_FLOPS, K carries that plan (``K.band_plan``) and Newton solves
-with LAPACK's banded LU instead of SuperLU: the paper's rolling ring (360 unknowns, a
-ring of beams, kl = ku = 8: 55 us against SuperLU's 320 us), the block (468, 35: 170
-against 700 us) and the cork (259 free, 28: 84 against 495 us); not Hertz (8385 free,
-kl = ku = 258: 38 against 30 ms), where the band holds far more than SuperLU's factors.
+Cuthill-McKee and its band measured (banded.py). If the band LU's work per unknown,
+kl (kl + ku), is at most banded.BANDED_WORK (a band of up to ~86 on each side), K
+carries that plan (``K.band_plan``) and Newton solves with LAPACK's banded LU instead of
+SuperLU, 3-8x faster: the bar impact (kl = 7), the patch test (47), the paper's rolling
+ring (360 unknowns, a ring of beams, kl = ku = 8: 55 us against SuperLU's 320 us), the
+block (468, 35: 170 against 700 us) and the cork (259 free, 28: 84 against 495 us); not
+Hertz (8385 free, kl = ku = 258: 38 against 30 ms; 2145 at the fast preset, 130: 3.8
+against 5.8 ms, near the limit), where SuperLU's orderings fill in less than the band.
 The band is made for the free dofs (the System's Dirichlet dofs are left out), so a
 partly fixed system is solved banded too; any other free set falls back to SuperLU.
 K stays a CSC matrix for every other use (products, ``toarray``, slicing).
@@ -34,7 +36,7 @@ import copy
 
 import numpy as np
 
-from .banded import BANDED_FLOPS, BandPlan
+from .banded import BANDED_WORK, BandPlan
 from .newton import DENSE_ORDERING, ORDERING
 
 # Up to this many unknowns K is dense. Measured on the paper's ring matrices (banded, 3
@@ -48,14 +50,20 @@ KINDS = ("auto", "dense", "sparse", "banded")
 def choose_linear_algebra(n, requested="auto", plan=None):
     """'dense', 'sparse' or 'banded' for a system of n unknowns. 'auto': dense up to
     DENSE_MAX; above, banded when the band plan of the pattern (banded.BandPlan, None
-    while the pattern is not known) needs at most BANDED_FLOPS, else sparse."""
+    while the pattern is not known) needs at most BANDED_WORK per unknown, else sparse."""
     if requested not in KINDS:
         raise ValueError(f"parameter linear_algebra = {requested!r} is not allowed: one of {'|'.join(KINDS)}")
     if requested != "auto":
         return requested
     if n <= DENSE_MAX:
         return "dense"
-    return "banded" if plan is not None and plan.flops <= BANDED_FLOPS else "sparse"
+    return "banded" if plan is not None and plan.work <= BANDED_WORK else "sparse"
+
+
+def _keys(rows, cols, offset, n):
+    """Pattern keys (col + offset) n + row + offset, in 64 bits: a body's int32 index arrays
+    (scipy's) would overflow from n = 46341 unknowns on."""
+    return (np.asarray(cols, dtype=np.int64) + offset) * n + (np.asarray(rows, dtype=np.int64) + offset)
 
 
 class TangentAssembler:
@@ -101,7 +109,7 @@ class TangentAssembler:
             hit = self._cache.get(key)
             if hit is not None and hit[0] is rows and hit[1] is cols:
                 return hit[2]
-        keys = (cols + offset) * self.n + (rows + offset)
+        keys = _keys(rows, cols, offset, self.n)
         if self.keys is None:
             self._grow(keys)
         pos = np.searchsorted(self.keys, keys)
@@ -131,7 +139,7 @@ class TangentAssembler:
                 K.flat[::n + 1] += diagonal
             return K
         if self.keys is None:                     # the first assembly: the whole pattern at once
-            self._grow(np.concatenate([(c + o) * n + (r + o) for r, c, _, o, _ in blocks] + [np.zeros(0, int)]))
+            self._grow(np.concatenate([_keys(r, c, o, n) for r, c, _, o, _ in blocks] + [np.zeros(0, np.int64)]))
         for _ in range(2):                        # a grown pattern voids positions found before it
             builds = self.pattern_builds
             pos = [self._positions(r, c, o, key) for r, c, _, o, key in blocks]

@@ -6,7 +6,9 @@ tangent is a band matrix with a half-bandwidth of a few nodes' dofs (the paper's
 ring: kl = ku = 8 for 360 unknowns), and a small continuum mesh is banded too (the block
 of Sec. 5.1, 468 unknowns: 35). LAPACK's general band LU with partial pivoting (dgbsv)
 then costs about n kl (kl + ku) flops, 55-170 microseconds here, where SuperLU spends
-0.3-0.7 ms on the same matrices (its symbolic analysis is redone at every call).
+0.3-0.7 ms on the same matrices (its symbolic analysis is redone at every call). Where
+the band is wide (a fine 2-D mesh: kl grows like the square root of n) SuperLU's
+orderings fill in less and win: BANDED_WORK below.
 
 The tangent with friction is not symmetric (paper eqs 49-50): a general LU with row
 interchanges, not a Cholesky factorisation. Pivoting widens the upper band to kl + ku,
@@ -19,15 +21,20 @@ it takes in the band storage. A solve only scatters the values there and calls L
 
 import numpy as np
 
-# Above this many flops (n kl (kl + ku), the work of the band LU) SuperLU is used instead.
-# Measured, factorisation + solve (best of 7-30, 2 cores shared, so +-30 %): the paper's
-# rolling ring (n = 360, kl = ku = 8, 4.6e4 flops) 55 us against SuperLU's 320 us; cork
-# (259 free, 28, 4.1e5) 84 against 495 us; block (468, 35, 1.2e6) 170 against 700 us.
-# The block refined (studies/bench/cost.py): 992 unknowns (kl 63, 7.9e6 flops) 1.5 ms
-# against 2.6 ms; 1722 (83, 2.4e7) 2.6 against 5.3 ms; 3782 (123, 1.1e8) even; 10302
-# (203, 8.5e8) 65 against 38 ms; Hertz (8385 free, 258, 1.1e9) 38 against 30 ms. The band
-# wins clearly (at least 1.7x) up to ~2e7 flops; the limit keeps a margin below that.
-BANDED_FLOPS = 1.0e7
+# The band LU is used while its work per unknown, kl (kl + ku), is at most BANDED_WORK; above,
+# SuperLU. What decides is the width of the band, not the number of unknowns: SuperLU's fill
+# on these meshes grows like the band's. Measured, factorisation + solve (best of 5-30, 2
+# cores shared, so +-30 %), band / SuperLU (MMD_AT_PLUS_A):
+#   rolling ring, paper: n = 360, kl = ku = 8 (work 128): 55 / 320 us; 4000 elements: n = 12000,
+#     the same band: 1.5 / 9.8 ms;
+#   cork (free block): 259, 28 (1568): 84 / 495 us; block: 468, 35 (2450): 170 / 700 us;
+#   block strips (studies/bench/cost.py): 200 x 4: 2010, 19 (722): 0.41 / 1.7 ms; 400 x 10: 8822,
+#     43 (3698): 7.4 / 16.7 ms; 1000 x 10: 22022, 43: 21 / 42 ms;
+#   square blocks: 992, 63 (7938): 1.5 / 2.6 ms; 1722, 83 (13778): 2.6 / 5.3 ms; 3782, 123 (30258):
+#     10.8 / 10.6 ms; 6642, 163 (53138): 24 / 27 ms; 10302, 203 (82418): 65 / 38 ms;
+#   Hertz, paper: 8385 free, 258 (133128): 38 / 30 ms.
+# The band wins by 1.7x or more up to a work of ~1.4e4 and breaks even at ~3e4.
+BANDED_WORK = 1.5e4
 
 
 class BandPlan:
@@ -62,9 +69,9 @@ class BandPlan:
         self.slot = c * self.ldab + (self.kl + self.ku + r - c)
 
     @property
-    def flops(self):
-        """The work of the band LU, n kl (kl + ku) (the choice of assembly.py)."""
-        return self.n * self.kl * (self.kl + self.ku)
+    def work(self):
+        """The band LU's work per unknown, kl (kl + ku) flops (the choice of assembly.py)."""
+        return self.kl * (self.kl + self.ku)
 
     def describe(self):
         return f"reverse Cuthill-McKee, LAPACK banded LU (kl={self.kl}, ku={self.ku})"

@@ -44,7 +44,7 @@ OPTIMISATIONS = [
     "laws/return_map.py | one Newton iteration inside the paper runs (CPU, loaded machine; midpoint beam): "
     "sloping impact 2.2-2.6 ms, rolling ring 3.0 ms | 0.69-0.89 ms; 2.1 ms |",
     "| banded LU: the fixed pattern's free block renumbered by reverse Cuthill-McKee once per pattern, "
-    "LAPACK's dgbsv when its work n kl (kl + ku) is at most 1e7 flops (rolling ring kl = ku = 8, block 35, "
+    "LAPACK's dgbsv when its work per unknown kl (kl + ku) is at most 1.5e4 (rolling ring kl = ku = 8, block 35, "
     "cork 28; Hertz, 258, stays on SuperLU); K a shallow copy of one CSC matrix of the pattern (no scipy "
     "format checks at every assembly) | solver/banded.py, solver/assembly.py, solver/newton.py | one Newton "
     "iteration inside the paper runs (CPU, best of 5 (cork, Hertz: 3), loaded machine): rolling ring 1.17 ms "
