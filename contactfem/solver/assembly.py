@@ -22,8 +22,9 @@ carries that plan (``K.band_plan``) and Newton solves with LAPACK's banded LU in
 SuperLU, 3-8x faster: the bar impact (kl = 7), the patch test (47), the paper's rolling
 ring (360 unknowns, a ring of beams, kl = ku = 8: 55 us against SuperLU's 320 us), the
 block (468, 35: 170 against 700 us) and the cork (259 free, 28: 84 against 495 us); not
-Hertz (8385 free, kl = ku = 258: 38 against 30 ms; 2145 at the fast preset, 130: 3.8
-against 5.8 ms, near the limit), where SuperLU's orderings fill in less than the band.
+Hertz (8385 free, kl = ku = 258: 38 against 30 ms), where SuperLU's orderings fill in
+less than the band. (Hertz at the fast preset, 2145 unknowns, kl = 130, would still
+solve 1.5x faster banded, 3.8 against 5.8 ms: the limit keeps a margin.)
 The band is made for the free dofs (the System's Dirichlet dofs are left out), so a
 partly fixed system is solved banded too; any other free set falls back to SuperLU.
 K stays a CSC matrix for every other use (products, ``toarray``, slicing).
