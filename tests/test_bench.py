@@ -163,3 +163,20 @@ def test_bench_cli_names_every_study():
     from contactfem.cli import BENCH_STUDIES
     from contactfem.studies.bench import STUDIES
     assert tuple(STUDIES) == BENCH_STUDIES
+
+
+def test_readme_states_the_committed_benchmark_numbers():
+    """The README's sentence on the tangents gives the numbers of the committed bench.json
+    (the run that BENCHMARKS.md shows)."""
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    bench = json.loads((root / "bench.json").read_text())
+    readme = " ".join((root / "README.md").read_text().split())
+    blk = bench["tangents"]["block"]
+    n = {law: {v: blk[law][v]["iterations"] for v in ("consistent", "frozen", "staggered")} for law in blk}
+    assert (f"the consistent non-symmetric tangent needs {n['coulomb']['consistent']} (Coulomb) and "
+            f"{n['parabolic']['consistent']} (parabolic)") in readme
+    assert f"eq (50) needs {n['coulomb']['frozen']} and {n['parabolic']['frozen']}" in readme
+    assert f"algorithm needs {n['coulomb']['staggered']} and {n['parabolic']['staggered']}" in readme
+    assert not any(blk[law]["symmetric"]["converged"] for law in blk)      # "diverges once nodes slip"

@@ -12,7 +12,8 @@ from .common import best_of
 
 def iteration_cost(system, u, t=1.0, repeat=3, solvers=True):
     """Wall times (best of `repeat`) of the parts of one Newton iteration at u:
-    bulk (every body.internal), contact (every contact.assemble), assembly (the whole
+    bulk (every body.internal, or internal_coo where the body has it, as the System calls it),
+    contact (every contact.assemble), assembly (the whole
     System.residual_tangent minus those two: loads, COO -> CSR), solve (splu factor +
     solve of the free block with the default COLAMD and with MMD_AT_PLUS_A ordering, the
     band LU if the System solves banded, and pypardiso if installed); ``solve_s`` is the
@@ -21,7 +22,9 @@ def iteration_cost(system, u, t=1.0, repeat=3, solvers=True):
     from scipy.sparse.linalg import splu
 
     out = dict(ndof=int(system.ndof))
-    _, out["bulk_s"] = best_of(lambda: [b.internal(system.local(b, u)) for b in system.bodies], repeat)
+    # each body as the System evaluates it (a beam's COO triplets, a continuum's sparse K)
+    _, out["bulk_s"] = best_of(lambda: [getattr(b, "internal_coo", b.internal)(system.local(b, u))
+                                        for b in system.bodies], repeat)
     _, out["contact_s"] = best_of(lambda: [c.assemble(u) for c in system.contacts], repeat)
     (G, K), total = best_of(lambda: system.residual_tangent(u, t), repeat)
     out["assembly_s"] = max(total - out["bulk_s"] - out["contact_s"], 0.0)

@@ -91,7 +91,8 @@ def speed_section(sp):
               f"`contactfem run block --preset paper`: {s['run_block_over_scipy_skfem']:.2f} x an interpreter that "
               f"imports scipy.sparse.linalg and scikit-fem (target {T['run_block_over_scipy_skfem']}: "
               f"{_f(s['run_block_over_scipy_skfem'] <= T['run_block_over_scipy_skfem'])}).", "",
-          "One Newton iteration, CPU milliseconds: the run's totals divided by its linear solves "
+          "One Newton iteration, CPU milliseconds of the thread that runs it: the run's totals divided by its linear solves, each scene "
+          "run in a fresh interpreter, best of " + ("1" if sp.get("preset") == "fast" else "3") + " runs "
           "(contactfem/studies/bench/speed.py). bulk: the bodies' internal forces and tangents; contact: every "
           "contact's residual and tangent; assembly: summing them into K, loads included; solve: factorisation "
           "and solve; overhead: the rest of newton() and the time stepper's effective residual. K: dense "
@@ -201,7 +202,7 @@ def write_markdown(res):
     if "cost" in res:
         c = res["cost"]
         L += ["## Cost of one Newton iteration", "",
-              "Best of a few repeats. bulk: body.internal (R and K of the bodies); contact: contact.assemble; "
+              "Best of a few repeats. bulk: the bodies' R and K as the System evaluates them (a beam's COO triplets, a continuum's sparse K); contact: contact.assemble; "
               "assembly: the rest of System.residual_tangent (loads, COO -> CSR); solve: factorisation + solve "
               "of the free block by LAPACK's band LU where the System solves banded (band), else by splu with "
               "the ordering newton() uses (MMD_AT_PLUS_A); SuperLU with each ordering for comparison (COLAMD is "

@@ -84,6 +84,7 @@ def tangent_study(quick=False):
     (paper Table 1); the frictional sloping impact (paper data, 200 steps; 60 if quick)."""
     block = get_scene("block")
     out = {"block": {}, "sloping_impact": {}}
+    _block_variant(block.resolve("paper", {"law": "coulomb"}), "consistent")   # warm-up: first-call costs untimed
     for law in ("coulomb",) if quick else ("coulomb", "parabolic"):
         params = block.resolve("paper", {"law": law})
         rows = {v: _block_variant(params, v) for v in VARIANTS}
