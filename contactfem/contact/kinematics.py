@@ -71,14 +71,17 @@ def segment_variations(x_s, x_1, x_2):
 def line_variations(x_s, point, normal):
     """A fixed straight line through `point` with unit `normal` (a rigid master with
     x_1, x_2 fixed): g_N = (x_s - point).n, arc coordinate s = (x_s - point).t with
-    n = e3 x t. Both are linear in x_s, so their second variations vanish."""
+    n = e3 x t. Both are linear in x_s, so their second variations vanish (the slave rows
+    of eqs 31-32 and 37-38 hold N_0 or T_0, which are zero there).
+    `point` and `normal`: one line (2,) or one per slave (nc, 2) (a rigid polyline's segments)."""
     normal = np.asarray(normal, dtype=float)
-    tangent = np.array([normal[1], -normal[0]])                    # e3 x t = n
     d = x_s - point
     n, t = np.empty_like(d), np.empty_like(d)
-    n[:], t[:] = normal, tangent                                    # one row per slave
+    n[:] = normal                                                   # one row per slave
+    t[:, 0], t[:, 1] = n[:, 1], -n[:, 0]                            # e3 x t = n
     z2 = np.zeros((len(d), 2, 2))
-    return dict(t=t, n=n, g_N=d @ normal, s=d @ tangent, dg_N=n.copy(), d2g_N=z2, ds=t.copy(), d2s=z2.copy())
+    return dict(t=t, n=n, g_N=np.einsum("ij,ij->i", d, n), s=np.einsum("ij,ij->i", d, t),
+                dg_N=n.copy(), d2g_N=z2, ds=t.copy(), d2s=z2.copy())
 
 
 def arc_variations(x_s, center, R, inside, theta_ref):

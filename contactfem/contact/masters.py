@@ -21,7 +21,7 @@ neighbouring segment keeps its friction history.
 
 import numpy as np
 
-from .kinematics import arc_variations, line_variations, segment_variations
+from .kinematics import arc_variations, e3_cross, line_variations, segment_variations
 
 
 def _check_points(points, name):
@@ -88,15 +88,14 @@ class RigidPolyline:
         self.S = _arc_lengths(self.points)
 
     def locate(self, x_s, s_bar, u):
+        """Each slave against the fixed line of its closest segment j (eqs 17-19 with x_1, x_2
+        fixed: line_variations), s = S[j] + (x_s - P_j).t_j."""
         P = self.points
         j, inside = closest_segment(x_s, P)
-        k = segment_variations(x_s, P[j], P[j + 1])
-        l = k["l"]
-        sl = slice(0, 2)  # slave rows/columns only
-        return dict(g_N=k["g_N"], s=self.S[j] + k["alpha"] * l, t=k["t"], n=k["n"],
-                    dg_N=k["dg_N"][:, sl], d2g_N=k["d2g_N"][:, sl, sl],
-                    ds=l[:, None] * k["dalpha"][:, sl], d2s=l[:, None, None] * k["d2alpha"][:, sl, sl],
-                    master_dofs=np.zeros((len(x_s), 0), dtype=int), inside=inside, seg=j)
+        a = P[j + 1] - P[j]
+        t = a / np.linalg.norm(a, axis=1)[:, None]
+        k = line_variations(x_s, P[j], e3_cross(t))
+        return dict(k, s=self.S[j] + k["s"], master_dofs=np.zeros((len(x_s), 0), dtype=int), inside=inside, seg=j)
 
     def outline(self):
         return self.points
