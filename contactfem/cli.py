@@ -222,7 +222,17 @@ def plain_table(markdown):
 def cmd_site(args):
     from .site import build
 
-    print(f"site -> {build(args.out)}")
+    try:
+        index = build(args.out)
+    except RuntimeError as err:                    # Sphinx's own messages, then one line of ours
+        head, _, detail = str(err).partition("\n")
+        head = head.rstrip(":")
+        if detail.strip():
+            print(detail.rstrip(), file=sys.stderr)
+        print(f"contactfem: error: {head}" + (" (Sphinx's messages above)" if detail.strip() else ""),
+              file=sys.stderr)
+        raise SystemExit(1) from None
+    print(f"site -> {index}")
 
 
 def cmd_reconstruct(args):

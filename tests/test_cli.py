@@ -75,3 +75,19 @@ def test_a_closed_pipe_is_not_an_error():
     p = subprocess.run(f"{sys.executable} -m contactfem equations | head -1", shell=True,
                        capture_output=True, text=True)
     assert p.stdout.count("\n") == 1 and p.stderr == ""
+
+
+def test_a_failed_site_build_shows_sphinx_then_one_line(monkeypatch, capsys):
+    import contactfem.site as site
+
+    def broken(out=None):
+        raise RuntimeError("the site build failed (Sphinx exit code 1):\nlectures/03.ipynb:12: WARNING: undefined label")
+
+    monkeypatch.setattr(site, "build", broken)
+    with pytest.raises(SystemExit) as exit_:
+        main(["site", "--out", "/tmp/nowhere"])
+    assert exit_.value.code == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[0] == "lectures/03.ipynb:12: WARNING: undefined label"
+    assert err[-1] == "contactfem: error: the site build failed (Sphinx exit code 1) (Sphinx's messages above)"
+    assert not any("Traceback" in line for line in err)
