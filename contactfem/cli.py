@@ -251,12 +251,23 @@ def cmd_bench(args):
 
     from .studies.bench import run_bench, write_outputs
 
+    out = args.out or ("bench-quick" if args.quick else ".")
+    old = Path(out) / "bench.json"
+    earlier = None
+    if old.exists():
+        try:
+            earlier = json.loads(old.read_text())
+        except ValueError:
+            earlier = None
+    if earlier is not None and bool(earlier.get("quick")) != bool(args.quick):
+        kind = "a quick" if earlier.get("quick") else "a full"
+        raise ValueError(f"--out {out}: {old} holds {kind} bench run; a {'quick' if args.quick else 'full'} run "
+                         "would replace or mix with it: write it to another folder (--out DIR)")
     res = run_bench(quick=args.quick, only=args.only,
                     progress=lambda m: print(m, file=sys.stderr, flush=True))
-    old = Path(args.out) / "bench.json"
-    if args.only and old.exists():                  # keep the other studies of an earlier run
-        res = dict(json.loads(old.read_text()), **res)
-    for path in write_outputs(res, args.out):
+    if args.only and earlier is not None:           # keep the other studies of an earlier run
+        res = dict(earlier, **res)
+    for path in write_outputs(res, out):
         print(path)
 
 
@@ -333,8 +344,10 @@ def build_parser():
     bp = sub.add_parser("bench", help="speed against accuracy: tangents, work-precision, cost, targets, "
                                       "enforcement, speed "
                                       "(writes bench.json and BENCHMARKS.md)")
-    bp.add_argument("--quick", action="store_true", help="fast presets and fewer points (about a minute)")
-    bp.add_argument("--out", default=".", help="folder for bench.json and BENCHMARKS.md (default: .)")
+    bp.add_argument("--quick", action="store_true", help="fast presets and fewer points (seconds)")
+    bp.add_argument("--out", default=None,
+                    help="folder for bench.json and BENCHMARKS.md (default: . for a full run, bench-quick/ for "
+                         "--quick); a quick run never replaces or mixes with a full one")
     bp.add_argument("--only", action="append", choices=list(BENCH_STUDIES),
                     help="run only this study (repeatable); the other studies of DIR/bench.json are kept")
     bp.set_defaults(func=cmd_bench)

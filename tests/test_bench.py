@@ -165,6 +165,24 @@ def test_bench_cli_names_every_study():
     assert tuple(STUDIES) == BENCH_STUDIES
 
 
+
+def test_a_quick_bench_never_replaces_or_mixes_with_a_full_run(tmp_path, monkeypatch, capsys):
+    """--quick writes into bench-quick/ by default; a folder holding the other kind of run is
+    refused before anything runs (one line naming --out)."""
+    import contactfem.studies.bench as bench
+
+    ran = []
+    monkeypatch.setattr(bench, "run_bench", lambda quick=False, only=None, progress=None:
+                        ran.append(quick) or {"quick": quick, "machine": {}})
+    monkeypatch.chdir(tmp_path)
+    assert main(["bench", "--quick", "--only", "speed"]) == 0
+    assert (tmp_path / "bench-quick" / "bench.json").exists() and not (tmp_path / "bench.json").exists()
+    (tmp_path / "bench.json").write_text(json.dumps({"quick": False, "machine": {}, "speed": {}}))
+    assert main(["bench", "--quick", "--only", "speed", "--out", "."]) == 2
+    assert "--out .: bench.json holds a full bench run" in capsys.readouterr().err
+    assert main(["bench", "--only", "speed", "--out", "bench-quick"]) == 2
+    assert ran == [True]
+
 def test_readme_states_the_committed_benchmark_numbers():
     """The README's sentence on the tangents gives the numbers of the committed bench.json
     (the run that BENCHMARKS.md shows)."""
