@@ -115,7 +115,8 @@ def cmd_run(args):
         from .io import progress_bar as progress
         _RUN["progress"] = True
     _RUN["phase"] = "run"
-    res, notes = run_quietly(lambda: scenes.run_scene(args.scene, args.preset, overrides, progress=progress, **laws))
+    res, notes = run_quietly(lambda: scenes.run_scene(args.scene, args.preset, overrides, progress=progress,
+                                                      linear_algebra=args.linear_algebra, **laws))
     _RUN["phase"] = "write"
     with out:                                         # temporaries first, then all renamed at once
         if args.json:
@@ -307,6 +308,9 @@ def build_parser():
     rp.add_argument("--json", metavar="FILE", help="write all results to FILE as JSON")
     rp.add_argument("--gif", metavar="FILE", help="animate the recorded outlines (.gif, or .mp4 with ffmpeg)")
     rp.add_argument("--progress", action="store_true", help="show a progress bar on stderr during the time loop")
+    rp.add_argument("--linear-algebra", default=None, choices=["auto", "dense", "banded", "sparse"],
+                    help="how K is stored and factorised (default auto: dense up to 100 unknowns, banded where "
+                         "the band is narrow, else sparse); the JSON's linear_algebra says what was used")
     rp.add_argument("--save", metavar="FILE", help="save the run (.json or .npz) for contactfem.io.load_run")
     rp.add_argument("--force", action="store_true",
                     help="run even if the estimated size exceeds the limits (2 GB, 1e6 unknowns, 1e6 steps)")

@@ -118,7 +118,7 @@ def test_observed_order_of_a_power_law():
 
 
 def test_quick_bench_writes_json_and_markdown(tmp_path):
-    """The quick bench (about half a minute) through the CLI; its tangent study shows the
+    """The quick bench (seconds) through the CLI; its tangent study shows the
     paper's claim: the consistent tangent needs the fewest linear solves, the staggered
     algorithm reaches the same solution with more."""
     assert main(["bench", "--quick", "--out", str(tmp_path)]) == 0

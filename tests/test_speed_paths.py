@@ -392,3 +392,33 @@ def test_large_pattern_with_int32_indices():
     K = TangentAssembler(n, "sparse").assemble([(rows, cols, vals, 0, "body")], np.ones(n))
     ref = sp.coo_matrix((vals, (rows, cols)), shape=(n, n)) + sp.identity(n)
     assert abs(K - ref).max() == 0.0 and K.nnz == n + 2
+
+
+@pytest.mark.parametrize("kind", ["dense", "banded", "sparse"])
+def test_a_scene_runs_with_the_linear_algebra_a_user_forces(kind, tmp_path):
+    """run_scene(..., linear_algebra=) and `run --linear-algebra` reach every System the scene
+    builds; the results stay those of the automatic choice (dense here) to 1e-12."""
+    from contactfem.cli import main
+    from contactfem.scenes import run_scene
+    from contactfem.solver import System
+
+    over = {"variant": "frictional", "n_steps": 40}
+    auto = run_scene("sloping_impact", "paper", over)
+    forced = run_scene("sloping_impact", "paper", over, linear_algebra=kind)
+    assert (auto["linear_algebra"], forced["linear_algebra"]) == ("dense", kind)
+    assert System.default_linear_algebra == "auto"                 # restored after the run
+    assert forced["newton_iterations_total"] == auto["newton_iterations_total"]
+    for key in ("x_c", "y_c", "vx_c", "vy_c", "energy_total"):
+        a, b = np.asarray(auto[key]), np.asarray(forced[key])
+        assert np.max(np.abs(a - b)) <= 1e-12 * np.max(np.abs(a)), key
+    out = tmp_path / "r.json"
+    assert main(["run", "sloping_impact", "--preset", "paper", "--set", "variant=frictional", "--set", "n_steps=40",
+                 "--linear-algebra", kind, "--json", str(out)]) == 0
+    assert json.loads(out.read_text())["linear_algebra"] == kind
+
+
+def test_a_wrong_linear_algebra_names_the_allowed_ones():
+    from contactfem.scenes import run_scene
+
+    with pytest.raises(ValueError, match="linear_algebra = 'Sparse' is not allowed: one of auto|dense|sparse|banded"):
+        run_scene("block", "fast", linear_algebra="Sparse")

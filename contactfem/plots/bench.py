@@ -3,7 +3,7 @@ work-precision diagrams, the cost of a Newton iteration, and where the time of t
 paper's runs goes (start-up and one iteration of each scene).
 
 Data: the bench JSON named by $CONTACTFEM_BENCH, else the repository's bench.json (a
-committed full run), else a quick bench run here (about half a minute)."""
+committed full run), else a quick bench run here (seconds)."""
 
 import json
 import os

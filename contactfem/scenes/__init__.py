@@ -44,9 +44,13 @@ def get_scene(name):
     return scenes[name]
 
 
-def run_scene(name, preset="fast", overrides=None, progress=None, friction=None, normal=None):
+def run_scene(name, preset="fast", overrides=None, progress=None, friction=None, normal=None,
+              linear_algebra=None):
     """Run a scene and return its results with wall time, Newton iteration count, parameters and
-    the linear algebra of its Systems (``linear_algebra``: dense|sparse, ``ordering``, ``unknowns``).
+    the linear algebra of its Systems (``linear_algebra``: dense|banded|sparse, joined by + if
+    they differ; ``ordering``; ``unknowns``, the largest System's).
+    ``linear_algebra``: auto|dense|banded|sparse for every System the scene builds (None: auto,
+    chosen by size and band width), to compare the solvers on one scene.
     ``progress(t0, t_end, label)``: a progress-callback factory handed to the scene's time
     loops (e.g. ``contactfem.io.progress_bar``); None shows nothing.
     ``friction`` / ``normal``: law objects replacing the laws the scene's parameters build
@@ -58,14 +62,22 @@ def run_scene(name, preset="fast", overrides=None, progress=None, friction=None,
 
     scene = get_scene(name)
     params = scene.resolve(preset, overrides)
+    if linear_algebra is not None:
+        from ..solver.assembly import KINDS
+
+        if linear_algebra not in KINDS:
+            raise ValueError(f"parameter linear_algebra = {linear_algebra!r} is not allowed: one of {'|'.join(KINDS)}")
     laws = {k: v for k, v in (("friction", friction), ("normal", normal)) if v is not None}
     kwargs = dict(laws, progress=progress) if progress is not None else laws
     outer, System.built = System.built, []          # record the Systems the scene builds
+    outer_la = System.default_linear_algebra
+    System.default_linear_algebra = linear_algebra or outer_la
     t0 = time.perf_counter()
     try:
         results = scene.run(params, **kwargs)
     finally:
         systems, System.built = System.built, outer
+        System.default_linear_algebra = outer_la
     results = dict(results)
     for kind, law in laws.items():
         results[f"{kind}_law"] = describe(law)

@@ -2,7 +2,7 @@
 within a step, and Newmark time stepping (paper Sec. 4.1, 4.3).
 
     system = System(bodies, contacts, loads, fixed=[Dirichlet(body, dofs, value)])
-    G, K = system.residual_tangent(u, t)     # G = R + R_c - P (eq 29 without M a), K CSR
+    G, K = system.residual_tangent(u, t)     # G = R + R_c - P (eq 29 without M a); K dense or CSC
     stepper = Newmark(system, dt, delta=0.7, beta=0.4)   # or Static(system), CentralDifference
     hist = integrate(stepper, t0, u0, v0, n_steps=200, cutback=True)
     hist.t, hist.kinetic, hist.strain, hist.contact, hist.dissipation, hist.residuals

@@ -1,6 +1,6 @@
 """Assembly of the global tangent K from COO triplets: dense, sparse or banded.
 
-Small systems (at most DENSE_MAX unknowns: the beam rings of the paper) get K as a
+Small systems (at most DENSE_MAX unknowns: the rings of the sloping impact and the funnel) get K as a
 dense numpy array: the triplets are summed with one ``bincount`` and Newton factorises
 K with LAPACK (numpy.linalg.solve). For 48 unknowns that takes about 15 us, where
 building a scipy sparse matrix and its SuperLU factors costs ten times more.

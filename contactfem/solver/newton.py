@@ -1,8 +1,9 @@
 """Full Newton iteration within a step (paper Sec. 4.3).
 
 Solves G(u) = 0 on the free dofs, where ``fun(u) -> (G, K)`` returns the full
-residual vector and its tangent K = dG/du (a dense numpy array or scipy.sparse). The
-prescribed dofs keep the values they have in the initial guess.
+residual vector and its tangent K = dG/du (a dense numpy array, or a scipy CSC matrix
+that may carry a band plan for LAPACK's band LU: solve_free). The prescribed dofs keep
+the values they have in the initial guess.
 
 Linear solver: dense K by LAPACK's LU with partial pivoting (``numpy.linalg.solve``),
 a banded K (a CSC matrix carrying ``band_plan``, assembly.py: the paper's rings and small

@@ -62,8 +62,10 @@ class System:
     contacts : list of contacts, ``assemble(u) -> (R_c, rows, cols, vals)``
     loads    : list of loads, ``assemble(u, t) -> (P, rows, cols, vals)``
     fixed    : list of Dirichlet conditions
-    linear_algebra : "auto" (default: dense up to assembly.DENSE_MAX unknowns; above, banded
-               where the band LU is cheap, else sparse), "dense", "sparse" or "banded"
+    linear_algebra : "auto" (dense up to assembly.DENSE_MAX unknowns; above, banded where the
+               band LU is cheap, else sparse), "dense", "sparse" or "banded"; None (default):
+               ``System.default_linear_algebra`` ("auto"; ``run_scene(..., linear_algebra=...)``
+               and ``contactfem run --linear-algebra`` set it for the Systems a scene builds)
 
     Attributes: ``ndof``, ``fixed_dofs`` and ``free_dofs`` (global, sorted),
     ``dissipation`` (frictional dissipation summed over all committed steps),
@@ -72,8 +74,9 @@ class System:
     """
 
     built = None     # a list while contactfem.scenes.run_scene records the Systems a scene builds
+    default_linear_algebra = "auto"      # what linear_algebra=None means (run_scene may set it)
 
-    def __init__(self, bodies, contacts=(), loads=(), fixed=(), linear_algebra="auto"):
+    def __init__(self, bodies, contacts=(), loads=(), fixed=(), linear_algebra=None):
         self.bodies = list(bodies)
         self.contacts = list(contacts)
         self.loads = list(loads)
@@ -98,6 +101,8 @@ class System:
         self.free_dofs = np.setdiff1d(np.arange(self.ndof), self.fixed_dofs)
         self.dissipation = 0.0
         self._mass = None
+        if linear_algebra is None:
+            linear_algebra = System.default_linear_algebra
         self._tangent = TangentAssembler(self.ndof, linear_algebra, self.free_dofs)
         self._body_coo = {}          # body -> (K, rows, cols) of its last sparse tangent
         if System.built is not None:

@@ -18,10 +18,11 @@ tangents.py, work_precision.py, cost.py, targets.py, enforcement.py, speed.py, r
                    against continuum ring. Observed orders: slope of log(error) against
                    log(h) by least squares.
 3. cost            time of one Newton iteration split into bulk assembly (body.internal),
-                   contact (contact.assemble), global assembly (COO -> CSR) and linear
-                   solve (SuperLU with two orderings, and pypardiso if installed), at the
-                   paper sizes and for the block refined to about 1e5 unknowns; contact
-                   time against the number of contact nodes (slope ~1: linear).
+                   contact (contact.assemble), global assembly (summing into K) and linear
+                   solve (the band LU where the System solves banded, SuperLU with two
+                   orderings, pypardiso if installed), at the paper sizes and for the block
+                   refined to about 1e5 unknowns; contact time against the number of
+                   contact nodes (slope ~1: linear).
 4. targets         every paper scene at the paper preset (wall time of the solve and of
                    the whole `contactfem run` process), against the targets.
 5. enforcement     Newton solves to reach a gap violation of 1e-8, penalty against
@@ -31,7 +32,7 @@ tangents.py, work_precision.py, cost.py, targets.py, enforcement.py, speed.py, r
                    inside a real run), and the Table 2 refinement study as `contactfem sweep`
                    runs it (speed.py).
 
-``quick`` shrinks every study (fast presets, fewer points) to about a minute in all.
+``quick`` shrinks every study (fast presets, fewer points) to seconds in all.
 No timing enters a test: times depend on the machine and its load.
 """
 

@@ -1,5 +1,5 @@
 """Study 3, cost: the time of one Newton iteration split into bulk assembly
-(body.internal), contact (contact.assemble), global assembly (COO -> CSR) and linear
+(body.internal), contact (contact.assemble), global assembly (summing into K) and linear
 solve (SuperLU with two orderings, LAPACK's band LU where the System chose it, and
 pypardiso if installed), at the paper sizes and
 for the block refined to about 1e5 unknowns; contact time against the number of contact
@@ -14,7 +14,7 @@ def iteration_cost(system, u, t=1.0, repeat=3, solvers=True):
     """Wall times (best of `repeat`) of the parts of one Newton iteration at u:
     bulk (every body.internal, or internal_coo where the body has it, as the System calls it),
     contact (every contact.assemble), assembly (the whole
-    System.residual_tangent minus those two: loads, COO -> CSR), solve (splu factor +
+    System.residual_tangent minus those two: loads, summing the triplets into K), solve (splu factor +
     solve of the free block with the default COLAMD and with MMD_AT_PLUS_A ordering, the
     band LU if the System solves banded, and pypardiso if installed); ``solve_s`` is the
     solver newton() uses (``linear_algebra``)."""
