@@ -422,3 +422,13 @@ def test_a_wrong_linear_algebra_names_the_allowed_ones():
 
     with pytest.raises(ValueError, match="linear_algebra = 'Sparse' is not allowed: one of auto|dense|sparse|banded"):
         run_scene("block", "fast", linear_algebra="Sparse")
+
+
+def test_a_run_reports_the_band_it_solved():
+    from contactfem.scenes import run_scene
+
+    ring = run_scene("rolling_ring", "fast")
+    assert ring["linear_algebra"] == "banded" and (ring["band_kl"], ring["band_ku"]) == (8, 8)
+    assert f"kl={ring['band_kl']}, ku={ring['band_ku']}" in ring["ordering"]
+    impact = run_scene("sloping_impact", "fast", {"n_steps": 5})
+    assert impact["linear_algebra"] == "dense" and impact["band_kl"] is None and impact["band_ku"] is None

@@ -48,7 +48,8 @@ def run_scene(name, preset="fast", overrides=None, progress=None, friction=None,
               linear_algebra=None):
     """Run a scene and return its results with wall time, Newton iteration count, parameters and
     the linear algebra of its Systems (``linear_algebra``: dense|banded|sparse, joined by + if
-    they differ; ``ordering``; ``unknowns``, the largest System's).
+    they differ; ``ordering``; ``unknowns``, the largest System's; ``band_kl``, ``band_ku``: the
+    half-bandwidths of a banded K, else None).
     ``linear_algebra``: auto|dense|banded|sparse for every System the scene builds (None: auto,
     chosen by size and band width), to compare the solvers on one scene.
     ``progress(t0, t_end, label)``: a progress-callback factory handed to the scene's time
@@ -86,6 +87,9 @@ def run_scene(name, preset="fast", overrides=None, progress=None, friction=None,
     results["linear_algebra"] = "+".join(dict.fromkeys(s.linear_algebra for s in systems)) or None
     results["ordering"] = "+".join(dict.fromkeys(s.ordering for s in systems)) or None
     results["unknowns"] = max((s.ndof for s in systems), default=None)
+    bands = [s.band for s in systems if s.band is not None]
+    results["band_kl"] = max((kl for kl, _ in bands), default=None)     # banded: the widest band
+    results["band_ku"] = max((ku for _, ku in bands), default=None)
     results.setdefault("newton_iterations_total", 0)
     results["scene"] = name
     results["preset"] = preset

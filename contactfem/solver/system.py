@@ -118,6 +118,13 @@ class System:
         """The ordering of the factorisation (e.g. the band's kl and ku)."""
         return self._tangent.describe()[1]
 
+    @property
+    def band(self):
+        """(kl, ku), the half-bandwidths below and above the diagonal of K renumbered by reverse
+        Cuthill-McKee, when K is solved banded; else None."""
+        plan = self._tangent.plan
+        return (plan.kl, plan.ku) if plan is not None and "banded" in self.linear_algebra else None
+
     def global_dofs(self, body, local):
         """Global numbers of a body's local dofs."""
         return body.dof_offset + np.asarray(local, dtype=int)
