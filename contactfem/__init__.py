@@ -8,6 +8,10 @@ __version__ = "0.1.0"
 __all__ = ["check_law"]
 
 
+def __dir__():
+    return sorted(list(globals()) + ["check_law"])
+
+
 def __getattr__(name):
     if name == "check_law":
         from .laws import check_law

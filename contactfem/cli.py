@@ -253,6 +253,8 @@ def cmd_bench(args):
     from .studies.bench import run_bench, write_outputs
 
     out = args.out or ("bench-quick" if args.quick else ".")
+    if Path(out).exists() and not Path(out).is_dir():
+        raise ValueError(f"--out {out}: is a file; give a folder (it gets bench.json and BENCHMARKS.md)")
     old = Path(out) / "bench.json"
     earlier = None
     if old.exists():
@@ -353,7 +355,7 @@ def build_parser():
                     help="folder for bench.json and BENCHMARKS.md (default: . for a full run, bench-quick/ for "
                          "--quick); a quick run never replaces or mixes with a full one")
     bp.add_argument("--only", action="append", choices=list(BENCH_STUDIES),
-                    help="run only this study (repeatable); the other studies of DIR/bench.json are kept")
+                    help="run only this study (repeatable); the other studies of OUT/bench.json are kept")
     bp.set_defaults(func=cmd_bench)
     return ap
 
@@ -380,12 +382,19 @@ def main(argv=None):
     """The command line; returns the exit code. Called without argv (as the program), a
     Ctrl-C after the work is done (while Python shuts down) no longer changes the outcome."""
     try:
-        return _main(argv)
+        code = _main(argv)
     finally:
         if argv is None:
             import signal
 
             signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if argv is None and code == 130:
+        # an interrupt met inside a library's import leaves CPython's "unhandled KeyboardInterrupt"
+        # flag set, which would end the process by SIGINT after our line: exit with 130 ourselves
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(130)
+    return code
 
 
 def _main(argv):

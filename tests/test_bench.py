@@ -181,7 +181,10 @@ def test_a_quick_bench_never_replaces_or_mixes_with_a_full_run(tmp_path, monkeyp
     assert main(["bench", "--quick", "--only", "speed", "--out", "."]) == 2
     assert "--out .: bench.json holds a full bench run" in capsys.readouterr().err
     assert main(["bench", "--only", "speed", "--out", "bench-quick"]) == 2
-    assert ran == [True]
+    (tmp_path / "afile").write_text("")
+    assert main(["bench", "--quick", "--out", "afile"]) == 2
+    assert "--out afile: is a file" in capsys.readouterr().err
+    assert ran == [True]                                         # nothing ran for the refused ones
 
 def test_readme_states_the_committed_benchmark_numbers():
     """The README's sentence on the tangents gives the numbers of the committed bench.json
@@ -198,3 +201,8 @@ def test_readme_states_the_committed_benchmark_numbers():
     assert f"eq (50) needs {n['coulomb']['frozen']} and {n['parabolic']['frozen']}" in readme
     assert f"algorithm needs {n['coulomb']['staggered']} and {n['parabolic']['staggered']}" in readme
     assert not any(blk[law]["symmetric"]["converged"] for law in blk)      # "diverges once nodes slip"
+    # "two to four times faster than SuperLU there": every banded case of the cost study
+    speedups = [r["solve_splu_MMD_AT_PLUS_A_s"] / r["solve_banded_s"] for r in bench["cost"]["cases"].values()
+                if r.get("solve_banded_s")]
+    assert "two to four times faster than SuperLU" in readme and speedups
+    assert all(1.5 <= x <= 4.5 for x in speedups), speedups      # "two to four": the ratios rounded
