@@ -51,10 +51,11 @@ OPTIMISATIONS = [
     "(solve 0.41, "
     "assembly 0.16), block 1.64 ms (solve 0.92); cork solve 1.32 ms; Hertz assembly 1.64 ms "
     "| 0.69 ms (0.071, 0.092), 0.74 ms (0.21); 0.17 ms; 1.24 ms |", "",
-    "Not adopted: pypardiso (MKL PARDISO, installs from PyPI, about 0.8 s of import time and a large "
-    "download): at 1e5 unknowns 1.0-1.4 s against 1.3-1.4 s for SuperLU with MMD_AT_PLUS_A, slower "
-    "at the paper sizes; not a clear win. scikit-umfpack does not install from PyPI here (needs swig and "
-    "SuiteSparse to build).", ""]
+    "Not adopted (measured when the solvers were chosen, not by this run): pypardiso (MKL PARDISO, installs "
+    "from PyPI, about 0.8 s of import time and a large download): at 1e5 unknowns 1.0-1.4 s against 1.3-1.4 s "
+    "for SuperLU with MMD_AT_PLUS_A, slower at the paper sizes; not a clear win. scikit-umfpack did not install "
+    "from PyPI (it needs swig and SuiteSparse to build). The pypardiso column of the cost table is filled "
+    "where it is installed.", ""]
 
 
 def _ms(x):
@@ -66,7 +67,7 @@ def speed_section(sp):
     T = SPEED_TARGETS
     s = sp["startup"]
     load = sp.get("load_average")
-    L = ["## Start-up and the cost of one Newton iteration", ""]
+    L = ["## Start-up, and one Newton iteration inside the paper runs", ""]
     if load and load[0] > 1.5:
         L += [f"The machine was loaded when this ran (load average {load[0]:.1f} on 2 cores): wall times include "
               "waiting for a core and CPU times are inflated by the other processes sharing the caches; the "
@@ -77,7 +78,7 @@ def speed_section(sp):
                 None: "bytecode not checked"}[s.get("bytecode_compiled")]
     if s.get("dont_write_bytecode"):
         compiled += ("; this machine sets PYTHONDONTWRITEBYTECODE, under which an editable install that was never "
-                     "compiled compiles its ~50 modules at every start (about 0.08 s more)")
+                     "compiled compiles its modules at every start (0.05-0.08 s more where this was measured)")
     n_runs = len(s["python"]["walls_s"])
     L += [f"Start-up: whole processes, " + (f"median of {n_runs} runs" if n_runs > 1 else "one run")
           + " (wall and CPU seconds; "
@@ -99,7 +100,8 @@ def speed_section(sp):
           "contact's residual and tangent; assembly: summing them into K, loads included; solve: factorisation "
           "and solve; overhead: the rest of newton() and the time stepper's effective residual. K: dense "
           "(LAPACK) up to 100 unknowns; above, a fixed pattern, solved banded (reverse Cuthill-McKee, LAPACK's "
-          "band LU) where the band is narrow, else sparse (SuperLU).", "",
+          "band LU) where the band is narrow, else sparse (SuperLU). run: wall time of the whole run in that "
+          "interpreter (building the model and its lazy imports included).", "",
           "| scene | unknowns | K | iteration [ms] | bulk | contact | assembly | solve | overhead | solves | run [s] |",
           "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in sp["iterations"]:
@@ -205,7 +207,7 @@ def write_markdown(res):
         L.append("")
     if "cost" in res:
         c = res["cost"]
-        L += ["## Cost of one Newton iteration", "",
+        L += ["## Cost of one Newton iteration, part by part (isolated calls at one state)", "",
               "Best of a few repeats. bulk: the bodies' R and K as the System evaluates them (a beam's COO triplets, a continuum's sparse K); contact: contact.assemble; "
               "assembly: the rest of System.residual_tangent (loads, summing the triplets into K); solve: factorisation + solve "
               "of the free block by LAPACK's band LU where the System solves banded (band), else by splu with "
@@ -226,14 +228,16 @@ def write_markdown(res):
         L += ["", "Contact time against contact nodes: " + ", ".join(
             f"{int(a)}: {b * 1e3:.2f} ms" for a, b in zip(n, tc))
             + f"; log-log slope {c['contact_scaling_slope']:.2f}. A straight line fits it: "
-            f"{fixed * 1e3:.2f} ms fixed (Python overhead) + {per_node * 1e6:.2f} us per contact node, "
+            f"{fixed * 1e3:.2f} ms fixed (the cost of the calls, whatever the size) + {per_node * 1e6:.2f} us per "
+            "contact node, "
             "i.e. linear in the contact nodes (the slope tends to 1 as the fixed part is amortised).", ""]
         L += OPTIMISATIONS
     if "targets" in res:
         t = res["targets"]
         L += [f"## Targets ({t['preset']} preset)", "",
-              "solve: the scene's run() in this process; process: wall and CPU (user + sys) time of the whole "
-              "`python -m contactfem run` (imports included; an empty `contactfem list` takes "
+              "solve: the scene's run() in this process; process: wall and CPU (user + sys) time of one whole "
+              "`python -m contactfem run` (one run each, imports included: a single sample, see the start-up "
+              "section for medians; an empty `contactfem list` takes "
               f"{_f(t['process_overhead_s'])} s wall, {_f(t.get('process_overhead_cpu_s'))} s CPU here). "
               "The wall time exceeds the CPU time when the machine is loaded.", "",
               "| scene | variant | linear solves | solve [s] | process wall [s] | process CPU [s] | under 10 s |",
