@@ -105,6 +105,10 @@ def bench_work_precision(preset="fast", outdir=None):
                 for r in rows:
                     ax.annotate(f"dt {r['dt']}", (r["time_s"], r["error_x_roll"]), fontsize=6,
                                 textcoords="offset points", xytext=(0, 6), ha="center")
+            elif key == "ring_dt_newmark_0.5/0.25":
+                for r in rows:
+                    ax.annotate(f"dt {r['dt']}", (r["time_s"], r["error_x_roll"]), fontsize=6, color="C1",
+                                textcoords="offset points", xytext=(4, -9))
             elif key == "ring_mesh":                     # and which mesh (at dt = 0.01)
                 for r in rows:
                     ax.annotate(f"{r['n_el']} el", (r["time_s"], r["error_x_roll"]), fontsize=6,
@@ -112,6 +116,7 @@ def bench_work_precision(preset="fast", outdir=None):
     for r in _rows(wp["ring_kind"]):
         if r["error_x_roll"]:
             ax.loglog(r["time_s"], r["error_x_roll"], "*" if r["kind"] == "continuum" else "D", ms=10,
+                      mfc="none" if r["kind"] == "beam" else None, mew=1.5,
                       label=f"{r['kind']} ring ({r['n_el']} el, dt {r['dt']})")
     ax.set_title("Rolling ring: error of the rolling point x*\n(dt study on 120 elements; mesh study at dt 0.01)",
                  fontsize=10)
