@@ -159,7 +159,7 @@ def run_quietly(fn):
 def laws_from_args(args):
     """Scene overrides and the --friction / --normal law objects (fields from --set law.NAME=...)."""
     from . import scenes
-    from .laws.lawfile import laws_from_options, split_sets
+    from .lab.lawfile import laws_from_options, split_sets
 
     overrides, law_sets = split_sets(parse_sets(args.set))
     if not (args.friction or args.normal or any(law_sets.values())):
@@ -169,6 +169,7 @@ def laws_from_args(args):
 
 
 def cmd_figures(args):
+    from .lab.bench import figures as _bench  # noqa: F401  (registers the bench figures)
     from .plots import load_all, make_all
 
     if args.only and not any(args.only in stem for stem in load_all()):
@@ -179,7 +180,7 @@ def cmd_figures(args):
 
 def cmd_sweep(args):
     from .io.outputs import Outputs
-    from .studies.sweep import parse_grid, sweep, write_table
+    from .lab.sweep import parse_grid, sweep, write_table
 
     if args.jobs < 1:
         raise ValueError(f"parameter jobs = {args.jobs} is out of range: allowed [1, inf)")
@@ -221,7 +222,7 @@ def plain_table(markdown):
 
 
 def cmd_site(args):
-    from .site import build
+    from .lab.site import build
 
     try:
         index = build(args.out)
@@ -237,12 +238,12 @@ def cmd_site(args):
 
 
 def cmd_reconstruct(args):
-    from .studies.reconstruct import main as reconstruct
+    from .lab.reconstruct import main as reconstruct
 
     reconstruct(args.scene, quick=args.quick, top=args.top, json_path=args.json, cache=not args.no_cache)
 
 
-BENCH_STUDIES = ("tangents", "work_precision", "cost", "targets", "enforcement", "speed")  # = studies.bench.STUDIES
+BENCH_STUDIES = ("tangents", "work_precision", "cost", "targets", "enforcement", "speed")  # = lab.bench.STUDIES
 
 
 def cmd_bench(args):
@@ -250,7 +251,7 @@ def cmd_bench(args):
     import json
     from pathlib import Path
 
-    from .studies.bench import run_bench, write_outputs
+    from .lab.bench import run_bench, write_outputs
 
     out = args.out or ("bench-quick" if args.quick else ".")
     if Path(out).exists() and not Path(out).is_dir():

@@ -18,7 +18,7 @@ from contactfem.laws import Coulomb, ParabolicSlip, PowerLaw
 from contactfem.scenes import block, get_scene
 from contactfem.solver import NewtonError, Static, System
 from contactfem.solver.staggered import SplitContact, Staggered
-from contactfem.studies.bench import observed_order, write_markdown
+from contactfem.lab.bench import observed_order, write_markdown
 
 from conftest import PointCloud
 
@@ -161,7 +161,7 @@ def test_quick_bench_writes_json_and_markdown(tmp_path):
 def test_bench_cli_names_every_study():
     """`contactfem bench --only NAME` offers exactly the studies run_bench knows."""
     from contactfem.cli import BENCH_STUDIES
-    from contactfem.studies.bench import STUDIES
+    from contactfem.lab.bench import STUDIES
     assert tuple(STUDIES) == BENCH_STUDIES
 
 
@@ -169,7 +169,7 @@ def test_bench_cli_names_every_study():
 def test_a_quick_bench_never_replaces_or_mixes_with_a_full_run(tmp_path, monkeypatch, capsys):
     """--quick writes into bench-quick/ by default; a folder holding the other kind of run is
     refused before anything runs (one line naming --out)."""
-    import contactfem.studies.bench as bench
+    import contactfem.lab.bench as bench
 
     ran = []
     monkeypatch.setattr(bench, "run_bench", lambda quick=False, only=None, progress=None:

@@ -57,7 +57,7 @@ def test_run_writes_json_with_the_contract_keys(tmp_path):
 
 def test_bench_only_keeps_the_other_studies_of_an_earlier_run(tmp_path, monkeypatch):
     """`bench --only NAME` merges into DIR/bench.json: the earlier studies stay."""
-    import contactfem.studies.bench as bench
+    import contactfem.lab.bench as bench
 
     (tmp_path / "bench.json").write_text(json.dumps({"machine": {"cpu": "x"}, "tangents": {"kept": 1}}))
     monkeypatch.setattr(bench, "run_bench", lambda quick, only, progress: {"speed": {"new": 2}})
@@ -78,7 +78,7 @@ def test_a_closed_pipe_is_not_an_error():
 
 
 def test_a_failed_site_build_shows_sphinx_then_one_line(monkeypatch, capsys):
-    import contactfem.site as site
+    import contactfem.lab.site as site
 
     def broken(out=None):
         raise RuntimeError("the site build failed (Sphinx exit code 1):\nlectures/03.ipynb:12: WARNING: undefined label")

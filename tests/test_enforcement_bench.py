@@ -2,8 +2,8 @@
 each of three penalties; the penalty meets it at none of them (its gap falls like 1/c_N)."""
 import pytest
 
-from contactfem.studies.bench import STUDIES, write_markdown
-from contactfem.studies.bench.enforcement import TARGET, enforcement_markdown, enforcement_study
+from contactfem.lab.bench import STUDIES, write_markdown
+from contactfem.lab.bench.enforcement import TARGET, enforcement_markdown, enforcement_study
 
 
 @pytest.fixture(scope="module")

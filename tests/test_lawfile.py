@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from contactfem.laws.lawfile import describe, laws_from_options, load_class, make_law, split_sets
+from contactfem.lab.lawfile import describe, laws_from_options, load_class, make_law, split_sets
 
 DATA = Path(__file__).parent / "data"
 SAT = f"{DATA / 'saturating.py'}:Saturating"

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from contactfem import check_law
-from contactfem.contact import SLIP, STICK, return_map
+from contactfem.laws import SLIP, STICK, return_map
 from contactfem.contact.kinematics import segment_geometry
 from contactfem.laws import Coulomb, ExponentialLaw, ParabolicSlip, PowerLaw, SlipHardening
 

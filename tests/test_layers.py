@@ -1,13 +1,16 @@
 """The layout is the architecture: every module of contactfem belongs to a layer, and no
 module imports from a layer above its own (lazy imports inside functions included).
 
-    laws < contact < bodies < solver < scenes < studies, plots, io < site < cli
+    laws < contact < bodies < solver < scenes < plots, io, equations < lab < cli
 
-io (saving runs, ParaView export, animations, progress bars) is a utility layer beside
-plots: the solver and the scenes take callbacks (e.g. ``progress=``) instead of
-importing it. ``equations`` (the index of the paper's equations in the code) sits
-beside the studies; ``site`` (the course website, built from the lectures) uses them
-all and only the command line uses it; the package's ``__init__`` is its public face and is exempt.
+The physics library is everything below ``lab``: laws, contact, bodies, solver, scenes,
+and beside them plots (the paper's figures), io (saving runs, ParaView export,
+animations, progress bars) and equations (the index of the paper's equations in the
+code). ``lab`` is what is built around the library, not part of it: the course
+website, the benchmarks that write BENCHMARKS.md, the inverse study of the scan's lost
+values, parameter sweeps, and the command line's law files. Only the command line uses
+the lab; the library imports nothing of it. The package's ``__init__`` is its public face
+and is exempt.
 """
 import ast
 from pathlib import Path
@@ -17,7 +20,8 @@ import pytest
 PACKAGE = Path(__file__).resolve().parents[1] / "contactfem"
 
 ORDER = [("laws",), ("contact",), ("bodies",), ("solver",), ("scenes",),
-         ("studies", "plots", "io", "equations"), ("site",), ("cli", "__main__")]
+         ("plots", "io", "equations"), ("lab",), ("cli", "__main__")]
+LIBRARY = ("laws", "contact", "bodies", "solver", "scenes", "plots", "io", "equations")
 LAYER = {name: level for level, names in enumerate(ORDER) for name in names}
 
 
@@ -71,7 +75,7 @@ def test_no_import_from_a_higher_layer(path):
             f"(layer {LAYER[target]}) from layer {LAYER[own]} ({own})"
             for line, target in imported_units(path)
             if target in LAYER and LAYER[target] > LAYER[own]]
-    assert not back, "back edges against laws < contact < bodies < solver < scenes < studies/plots/io < cli:\n" + "\n".join(back)
+    assert not back, "back edges against laws < contact < bodies < solver < scenes < plots/io/equations < lab < cli:\n" + "\n".join(back)
 
 
 def test_the_walk_finds_a_back_edge(tmp_path):
@@ -82,3 +86,11 @@ def test_the_walk_finds_a_back_edge(tmp_path):
     src.write_text("from .newton import newton\nfrom .. import laws\n\n"
                    "def f():\n    from ..scenes import block\n    return block\n")
     assert imported_units(src, tmp_path / "contactfem") == [(1, "solver"), (2, "laws"), (5, "scenes")]
+
+
+def test_the_library_imports_nothing_of_the_lab():
+    """The physics library stands alone: no module of it imports the lab (site, bench,
+    reconstruct, sweep, law files), lazily or not."""
+    lab = [f"{p.relative_to(PACKAGE)}:{line}" for p in modules() if unit(p) in LIBRARY
+           for line, target in imported_units(p) if target == "lab"]
+    assert not lab, "the library imports the lab:\n" + "\n".join(lab)

@@ -15,7 +15,8 @@ from conftest import PointCloud
 from fd import fd_jacobian, rel_error
 
 from contactfem import check_law
-from contactfem.contact import SLIP, STICK, NodeToSegment, RigidLine, return_map
+from contactfem.contact import NodeToSegment, RigidLine
+from contactfem.laws import SLIP, STICK, return_map
 from contactfem.laws import ArchardWear, Coulomb, DieterichRuina, FrictionLaw, LawError, PowerLaw, Stribeck
 from contactfem.scenes import block
 from contactfem.solver import Static

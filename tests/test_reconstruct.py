@@ -1,4 +1,4 @@
-"""The scan's unknowns as an inverse problem (contactfem.studies.reconstruct): the block's
+"""The scan's unknowns as an inverse problem (contactfem.lab.reconstruct): the block's
 reading against Table 1 and Fig 8, the sloping impact's against Table 2.
 
 CI runs the quick profiles; CONTACTFEM_SLOW=1 runs the full searches and checks that the
@@ -13,7 +13,7 @@ import pytest
 from contactfem.cli import main
 from contactfem.scenes import get_scene, run_scene
 from contactfem.scenes.block import PAPER_TABLE1, build, load_norms
-from contactfem.studies import reconstruct as rc
+from contactfem.lab import reconstruct as rc
 
 SLOW = os.environ.get("CONTACTFEM_SLOW") == "1"
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from contactfem.laws import Coulomb, PowerLaw
-from contactfem.laws.lawfile import laws_from_options
+from contactfem.lab.lawfile import laws_from_options
 from contactfem.scenes import get_scene, run_scene
 
 REPO = Path(__file__).resolve().parents[1]

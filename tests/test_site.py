@@ -29,7 +29,7 @@ def _require(ok, why):
 
 @pytest.fixture(scope="module")
 def chromium():
-    from contactfem.site.browser import find_chromium
+    from contactfem.lab.site.browser import find_chromium
 
     path = find_chromium()
     _require(path is not None, "Chromium not installed (apt-get install -y chromium)")
@@ -38,7 +38,7 @@ def chromium():
 
 @pytest.fixture(scope="module")
 def mathjax_dir(tmp_path_factory):
-    from contactfem.site.pages import copy_mathjax
+    from contactfem.lab.site.pages import copy_mathjax
 
     root = tmp_path_factory.mktemp("pages")
     try:
@@ -84,7 +84,7 @@ def _site(root, extra="", image=True):
 
 
 def _check(site, chromium):
-    from contactfem.site.browser import check_site
+    from contactfem.lab.site.browser import check_site
 
     return check_site(site, pages=["index.html"], math_pages=["index.html"], chromium=chromium)
 
@@ -147,7 +147,7 @@ def site(chromium):
         import sphinx  # noqa: F401
     except ImportError:
         _require(False, "the site extra is not installed: pip install -e '.[site]'")
-    from contactfem.site import build
+    from contactfem.lab.site import build
 
     index = build()        # REPO/build/site; executed notebooks cached in build/site-cache
     return index.parent
@@ -192,7 +192,7 @@ def test_gallery_shows_the_figures_beside_the_papers_values(site):
 def test_site_in_the_browser(site, chromium):
     """The index and two lectures opened in headless Chromium: equations typeset, every
     image loaded, and a crawl of the whole site finds no broken internal link."""
-    from contactfem.site.browser import check_site
+    from contactfem.lab.site.browser import check_site
 
     lectures = [LECTURES[0].stem + ".html", LECTURES[len(LECTURES) // 2].stem + ".html"]
     report = check_site(site, pages=["index.html"] + lectures, chromium=chromium)
@@ -207,7 +207,7 @@ def test_site_in_the_browser(site, chromium):
 def test_browser_check_fails_on_the_real_site_broken(site, chromium, tmp_path):
     """The same check on a copy of the built site with one figure deleted and one
     equation of a lecture broken: both are reported."""
-    from contactfem.site.browser import check_site
+    from contactfem.lab.site.browser import check_site
 
     broken = tmp_path / "site"
     shutil.copytree(site, broken, ignore=shutil.ignore_patterns("_check"))

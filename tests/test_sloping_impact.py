@@ -13,7 +13,7 @@ import pytest
 from contactfem.plots import sloping_impact as plots
 from contactfem.scenes import run_scene
 from contactfem.scenes.sloping_impact import PAPER_TABLE2, SCENE, rebound_angle
-from contactfem.studies import reconstruct as rc
+from contactfem.lab import reconstruct as rc
 
 R_OUTER = 10.5
 

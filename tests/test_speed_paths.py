@@ -169,7 +169,7 @@ def test_iteration_cost_splits_the_newton_time_of_a_real_run():
     """The parts add up to the measured Newton time, each part is non-negative, and the
     solves counted are the run's linear solves (times themselves are not asserted)."""
     from contactfem.scenes import run_scene
-    from contactfem.studies.bench.speed import PARTS, iteration_split
+    from contactfem.lab.bench.speed import PARTS, iteration_split
 
     over = {"variant": "frictional", "n_steps": 30}
     cost = iteration_split("sloping_impact", "paper", over)

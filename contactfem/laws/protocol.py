@@ -279,3 +279,12 @@ class FrictionLaw:
 def as_friction_law(law):
     """A FrictionLaw view of law (law itself if it already is one)."""
     return law if isinstance(law, FrictionLaw) else FrictionLaw(law)
+
+
+def describe(law):
+    """JSON record of a law: class, file (None for a shipped law, else the law file it came from) and fields."""
+    import dataclasses
+
+    cls = type(law)
+    fields = ({f.name: getattr(law, f.name) for f in dataclasses.fields(law)} if dataclasses.is_dataclass(law) else {})
+    return {"class": cls.__name__, "file": getattr(cls, "_contactfem_file", None), "fields": fields}

@@ -58,7 +58,7 @@ def run_scene(name, preset="fast", overrides=None, progress=None, friction=None,
     (recorded as ``friction_law`` / ``normal_law``: class, file, fields)."""
     import time
 
-    from ..laws.lawfile import describe
+    from ..laws.protocol import describe
     from ..solver.system import System
 
     scene = get_scene(name)

@@ -14,7 +14,7 @@ c_N (it reads 'lo*'), the unit of c_N and c_T (per node or per length), plane st
 or stress. These are FITTED: ``contactfem reconstruct block`` runs every reading the
 scan allows and scores it against Table 1 (first residual, number and pattern of the
 residuals, slip in the conical case) and Fig 8's remark; the defaults are its best
-reading (module ``contactfem.studies.reconstruct``):
+reading (module ``contactfem.lab.reconstruct``):
 
     width 4, height 3.25, 25 x 8 elements (first residual 171.88, paper 171.37:
     +0.30 %; no uniform mesh reproduces the printed 7 digits), p_x on the LEFT side

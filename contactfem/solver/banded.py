@@ -28,7 +28,7 @@ import numpy as np
 #   rolling ring, paper: n = 360, kl = ku = 8 (work 128): 55 / 320 us; 4000 elements: n = 12000,
 #     the same band: 1.5 / 9.8 ms;
 #   cork (free block): 259, 28 (1568): 84 / 495 us; block: 468, 35 (2450): 170 / 700 us;
-#   block strips (studies/bench/cost.py): 200 x 4: 2010, 19 (722): 0.41 / 1.7 ms; 400 x 10: 8822,
+#   block strips (lab/bench/cost.py): 200 x 4: 2010, 19 (722): 0.41 / 1.7 ms; 400 x 10: 8822,
 #     43 (3698): 7.4 / 16.7 ms; 1000 x 10: 22022, 43: 21 / 42 ms;
 #   square blocks: 992, 63 (7938): 1.5 / 2.6 ms; 1722, 83 (13778): 2.6 / 5.3 ms; 3782, 123 (30258):
 #     10.8 / 10.6 ms; 6642, 163 (53138): 24 / 27 ms; 10302, 203 (82418): 65 / 38 ms;

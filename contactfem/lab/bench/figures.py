@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import default_outdir, figure, pyplot, savefig
+from ...plots import default_outdir, figure, pyplot, savefig
 
 _CACHE = {}
 
@@ -21,7 +21,7 @@ def bench_json_path():
     env = os.environ.get("CONTACTFEM_BENCH")
     if env:
         return Path(env)
-    return Path(__file__).resolve().parents[2] / "bench.json"
+    return Path(__file__).resolve().parents[3] / "bench.json"
 
 
 def load_bench(preset="fast"):
@@ -31,7 +31,7 @@ def load_bench(preset="fast"):
     if path.exists():
         return json.loads(path.read_text())
     if "quick" not in _CACHE:
-        from ..studies.bench import run_bench
+        from . import run_bench
 
         _CACHE["quick"] = run_bench(quick=True, only=("tangents", "work_precision", "cost", "speed"), progress=None)
     return _CACHE["quick"]
@@ -185,7 +185,7 @@ def bench_cost(preset="fast", outdir=None):
 def bench_speed(preset="fast", outdir=None):
     """One Newton iteration of each paper scene split into bulk, contact, assembly, solve and
     overhead (CPU ms, with the targets), and the start-up of whole processes."""
-    from ..studies.bench.speed import PARTS, SPEED_TARGETS as T
+    from .speed import PARTS, SPEED_TARGETS as T
 
     plt = pyplot()
     sp = load_bench(preset)["speed"]

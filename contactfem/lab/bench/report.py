@@ -96,7 +96,7 @@ def speed_section(sp):
               f"{_f(s['run_block_over_scipy_skfem'] <= T['run_block_over_scipy_skfem'])}).", "",
           "One Newton iteration, CPU milliseconds of the thread that runs it: the run's totals divided by its linear solves, each scene "
           "run in a fresh interpreter, " + ("one run" if sp.get("preset") == "fast" else "best of 3 runs") + " "
-          "(contactfem/studies/bench/speed.py). bulk: the bodies' internal forces and tangents; contact: every "
+          "(contactfem/lab/bench/speed.py). bulk: the bodies' internal forces and tangents; contact: every "
           "contact's residual and tangent; assembly: summing them into K, loads included; solve: factorisation "
           "and solve; overhead: the rest of newton() and the time stepper's effective residual. K: dense "
           "(LAPACK) up to 100 unknowns; above, a fixed pattern, solved banded (reverse Cuthill-McKee, LAPACK's "
@@ -140,7 +140,7 @@ def write_markdown(res):
     """The tables of BENCHMARKS.md from a bench result."""
     L = ["# Benchmarks", "",
          "Written by `contactfem bench" + (" --quick" if res.get("quick") else "") + "` "
-         "(contactfem/studies/bench/); the raw numbers are in bench.json. Times are wall times, or CPU "
+         "(contactfem/lab/bench/); the raw numbers are in bench.json. Times are wall times, or CPU "
          "times where a table says so, on the machine below; they move with its load, iteration counts "
          "do not.", "",
          "Machine: " + ", ".join(f"{k} {v}" for k, v in res.get("machine", {}).items()), ""]

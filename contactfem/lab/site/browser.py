@@ -1,7 +1,7 @@
 """Check the built site as a reader would: served on 127.0.0.1, opened in headless
 Chromium (Debian's package, /usr/bin/chromium), every internal link crawled.
 
-    from contactfem.site.browser import check_site
+    from contactfem.lab.site.browser import check_site
     report = check_site("build/site", pages=["index.html", "01_interface_laws.html"])
     assert not report["problems"], report["problems"]
 

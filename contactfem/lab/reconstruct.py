@@ -238,7 +238,7 @@ def reconstruct_block(quick=False, cache=True, progress=None):
     quick: stage B on the paper preset's geometry and the paper preset's reading itself,
     without stage C (for CI)."""
     cache = Cache("block", ["scenes/block.py", "contact", "laws", "bodies/continuum.py", "bodies/loads.py",
-                            "solver", "studies/reconstruct.py"], enabled=cache)
+                            "solver", "lab/reconstruct.py"], enabled=cache)
     geos = block_geometries()
     paper = block_paper_reading()
     if quick:
@@ -385,7 +385,7 @@ def reconstruct_sloping_impact(quick=False, cache=True, progress=None):
     """Stage 1 (``sloping_impact_readings``), then stage 2: the six best readings with
     c_N = 25, 100, 500 (the scan's 50 is legible; how much do the numbers move with it?)."""
     cache = Cache("sloping_impact", ["scenes/sloping_impact.py", "contact", "laws", "bodies/beam.py",
-                                     "bodies/ring.py", "solver", "studies/reconstruct.py"], enabled=cache)
+                                     "bodies/ring.py", "solver", "lab/reconstruct.py"], enabled=cache)
     readings = sloping_impact_readings(quick)
     try:
         rows = evaluate_all(readings, evaluate_sloping, cache, progress)

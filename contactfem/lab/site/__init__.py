@@ -3,10 +3,10 @@ paper's examples, the equation index linked into the API reference, the benchmar
 
     contactfem site [--out DIR]        # DIR/index.html; default build/site in the checkout
 
-``build`` stages a Sphinx source folder (:mod:`contactfem.site.pages`), with the
+``build`` stages a Sphinx source folder (:mod:`contactfem.lab.site.pages`), with the
 configuration in ``lectures/_site/conf.py``, and runs Sphinx with warnings as errors.
 Executed notebooks are cached in ``build/site-cache`` (emptied when the code of the
-package changes), so a rebuild takes seconds. :mod:`contactfem.site.browser` checks
+package changes), so a rebuild takes seconds. :mod:`contactfem.lab.site.browser` checks
 the built site in headless Chromium as a reader would.
 
 Needs the ``site`` extra (``pip install -e ".[site]"``) and a checkout of the repository
@@ -21,16 +21,16 @@ import subprocess
 import sys
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[3]
 
 
 def code_hash(package_dir=None):
     """A hash of the package's source files (the site builder's own excepted): executed
     notebooks are cached per hash."""
-    package_dir = Path(package_dir or Path(__file__).resolve().parents[1])
+    package_dir = Path(package_dir or Path(__file__).resolve().parents[2])
     h = hashlib.sha256()
     for path in sorted(package_dir.rglob("*.py")):
-        if path.relative_to(package_dir).parts[0] == "site":
+        if path.relative_to(package_dir).parts[:2] == ("lab", "site"):
             continue
         h.update(str(path.relative_to(package_dir)).encode())
         h.update(path.read_bytes())

@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .protocol import FrictionLaw, LawError
+from ..laws.protocol import FrictionLaw, LawError, describe  # noqa: F401 (describe: public here too)
 
 KINDS = ("friction", "normal")
 _counter = itertools.count()
@@ -188,10 +188,3 @@ def laws_from_options(friction=None, normal=None, law_sets=None, scene_params=No
             raise ValueError(f"--set law.{name}: both laws have a parameter {name}: write friction.{name} or normal.{name}")
         values[owners[0] if owners else next(iter(classes))][name] = value
     return {k: make_law(c, values[k], scene_params, f"--{k}") for k, c in classes.items()}
-
-
-def describe(law):
-    """JSON record of a law: class, file (None for a shipped law) and fields."""
-    cls = type(law)
-    fields = ({f.name: getattr(law, f.name) for f in dataclasses.fields(law)} if dataclasses.is_dataclass(law) else {})
-    return {"class": cls.__name__, "file": getattr(cls, "_contactfem_file", None), "fields": fields}

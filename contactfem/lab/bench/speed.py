@@ -218,7 +218,7 @@ def iteration_split_fresh(scene, preset="paper", overrides=None, repeat=3):
     holds results that slow Python's garbage collector down), best of `repeat` runs."""
     import json
 
-    code = ("import json, sys\nfrom contactfem.studies.bench.speed import iteration_split\n"
+    code = ("import json, sys\nfrom contactfem.lab.bench.speed import iteration_split\n"
             "print(json.dumps(iteration_split(*json.loads(sys.argv[1]))))")
     best = None
     for _ in range(repeat):

@@ -131,7 +131,7 @@ def figures_used(page_text):
 
 
 def _role(dotted):
-    from ..equations import resolve
+    from ...equations import resolve
 
     obj = resolve(dotted)
     if inspect.ismodule(obj):
@@ -146,7 +146,7 @@ def _escape_bars(text):
 def equations_page():
     """The equation index: each equation of the paper, what it is, and a link to the
     API entry of the function, class or module that implements it."""
-    from ..equations import INDEX, NOT_MAPPED
+    from ...equations import INDEX, NOT_MAPPED
 
     out = ["# Equation index", "",
            "For each numbered equation of Wriggers, Vu Van & Stein (1990), the function, class or "
@@ -188,7 +188,7 @@ def api_pages(package="contactfem"):
     order = sorted(groups, key=lambda k: (k == "core", k))
     index = ["# API reference", "",
              "Generated from the docstrings. The layers, low to high: laws, contact, bodies, "
-             "solver, scenes, studies and plots, io, the command line.", "",
+             "solver, scenes, plots and io, the lab (benchmarks, reconstruction, sweeps, this site), the command line.", "",
              "```{toctree}", ":maxdepth: 2", ""] + [f"{k}" for k in order] + ["```", ""]
     pages["index.md"] = "\n".join(index)
     for key in order:

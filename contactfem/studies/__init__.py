@@ -1,2 +1,0 @@
-"""Studies over many runs: parameter sweeps (sweep.py) and the speed/accuracy
-benchmarks (bench.py)."""
