@@ -383,6 +383,49 @@ def test_a_growing_pattern_gets_a_new_band_or_goes_sparse():
     assert kl0 <= K1.band_plan.kl
 
 
+def grid_pattern(m, dofs=2):
+    """The CSC pattern of a bilinear m x m quad mesh, `dofs` per node, numbered row by row."""
+    line = sp.csr_matrix(np.abs(np.subtract.outer(np.arange(m + 1), np.arange(m + 1))) <= 1, dtype=float)
+    node = sp.kron(line, line)
+    return sp.kron(node, np.ones((dofs, dofs))).tocsc()
+
+
+@pytest.mark.parametrize("A, free", [
+    (scrambled_band(300, 6, 6, seed=11)[0], None),
+    (scrambled_band(300, 6, 6, seed=12)[0], np.arange(0, 300, 3)),
+    (grid_pattern(12), None), (grid_pattern(12), np.arange(5, 338)), (grid_pattern(30), None),
+    (grid_pattern(30, 1), np.setdiff1d(np.arange(961), np.arange(0, 961, 31)))])
+def test_the_band_bound_never_excludes_a_band_the_plan_would_take(A, free):
+    """banded.band_too_wide (a breadth-first bound, instead of the plan) says 'too wide' only
+    where the plan's band LU work is above the limit, at every limit; it does say so for a
+    fine 2-D mesh at the limit the System uses."""
+    from contactfem.solver.banded import BANDED_WORK, BandPlan, band_too_wide
+
+    A = sp.csc_matrix((A + A.T) != 0)                     # a structurally symmetric pattern
+    A.sort_indices()
+    n = A.shape[0]
+    plan = BandPlan(A.indptr, A.indices, n, free)
+    assert plan.kl == plan.ku
+    for work in (0.0, 10.0, 100.0, 1e3, 1e4, BANDED_WORK, 1e5):
+        if band_too_wide(A.indptr, A.indices, n, free, work):
+            assert plan.work > work
+    fine = grid_pattern(120)                            # 29282 unknowns: no numbering has a band under ~120
+    assert band_too_wide(fine.indptr, fine.indices, fine.shape[0], None, BANDED_WORK)
+
+
+def test_the_band_bound_gives_no_verdict_on_an_unsymmetric_pattern():
+    """kl (kl + ku) is not bounded by the band of the symmetrised pattern (an upper triangle
+    with one subdiagonal: kl = 1 in its own numbering, whatever its upper width): no verdict,
+    where the symmetrised pattern is found too wide."""
+    from contactfem.solver.banded import band_too_wide
+
+    n = 400
+    A = sp.csc_matrix(np.triu(np.ones((n, n))) + np.eye(n, k=-1))
+    S = sp.csc_matrix((A + A.T) != 0)
+    assert band_too_wide(S.indptr, S.indices, n, None, 1.0)
+    assert not band_too_wide(A.indptr, A.indices, n, None, 1.0)
+
+
 def test_large_pattern_with_int32_indices():
     """Above 46340 unknowns the keys col * n + row pass 2**31: a body's int32 index arrays
     (scipy's) must not overflow them (the cost study's block of 1e5 unknowns)."""

@@ -10,14 +10,19 @@ Larger systems get K as a scipy CSC matrix on a FIXED sparsity pattern: the patt
 (sorted keys ``col * n + row``, the CSC order) is computed at the first assembly and
 kept; each assembly only scatters the values into it. Where a contact couples dofs the
 pattern does not hold yet (a slave reaching a new master segment), the pattern grows
-once (union) and is kept from then on. The diagonal is always in the pattern, so a time
+once (merged) and is kept from then on. The diagonal is always in the pattern, so a time
 stepper can add its mass term M / (beta dt^2) there. Every K is a shallow copy of one
 CSC matrix made with the pattern (its index arrays shared and read-only, its own values):
 scipy's constructor checks the arrays again at every call (17-40 us for 360 unknowns, the
 copy 3 us). What changes K's structure in place (``eliminate_zeros``) raises; copy K first.
 
+The pattern is built by one sort of the keys and a mask of the first of each run of equal
+keys (Hertz on 65k quads, 2.4M keys: 0.04-0.2 s, where numpy's union1d took 2.5 s).
+
 Banded: when the pattern is (re)built, its free block is renumbered by reverse
-Cuthill-McKee and its band measured (banded.py). If the band LU's work per unknown,
+Cuthill-McKee and its band measured (banded.py), unless a breadth-first search shows that
+no numbering can give a band narrow enough (banded.band_too_wide: a fine 2-D mesh, whose
+plan would cost more than the bound's few milliseconds and never be used). If the band LU's work per unknown,
 kl (kl + ku), is at most banded.BANDED_WORK (a band of up to ~86 on each side), K
 carries that plan (``K.band_plan``) and Newton solves with LAPACK's banded LU instead of
 SuperLU, 3-8x faster: the bar impact (kl = 7), the patch test (47), the paper's rolling
@@ -38,7 +43,7 @@ import copy
 
 import numpy as np
 
-from .banded import BANDED_WORK, BandPlan
+from .banded import BANDED_WORK, BandPlan, band_too_wide
 from .newton import DENSE_ORDERING, ORDERING
 
 # Up to this many unknowns K is dense. Measured on the paper's ring matrices (banded, 3
@@ -80,7 +85,8 @@ class TangentAssembler:
         self.kind = choose_linear_algebra(self.n, linear_algebra)
         self.free = None if free is None or len(free) == self.n else np.asarray(free)
         self.keys = None            # sparse: sorted pattern keys col * n + row
-        self.plan = None            # banded: the BandPlan of the pattern
+        self.plan = None            # the BandPlan of the pattern (None where the band cannot be chosen)
+        self.banded_plan = None     # the plan of the last K solved banded
         self.used = {}              # kind -> ordering, of every assembly so far
         self._cache = {}            # key -> (rows, cols, positions) of a constant contribution
         self.pattern_builds = 0     # how often the pattern was (re)computed
@@ -90,7 +96,12 @@ class TangentAssembler:
         """Make the pattern hold `keys` (and the diagonal); positions cached so far are void."""
         diag = np.arange(self.n) * (self.n + 1)
         old = diag if self.keys is None else self.keys
-        self.keys = np.union1d(old, keys)
+        merged = np.concatenate([old, np.asarray(keys, dtype=np.int64)])
+        merged.sort(kind="stable")                  # sorted runs (old keys, a body's CSR rows): near-linear
+        unique = np.empty(merged.size, dtype=bool)
+        unique[:1] = True
+        np.not_equal(merged[1:], merged[:-1], out=unique[1:])
+        self.keys = merged[unique]
         from scipy.sparse import csc_matrix
 
         indices = self.keys % self.n                                         # row of each entry
@@ -99,8 +110,12 @@ class TangentAssembler:
         self.indices, self.indptr = self._template.indices, self._template.indptr   # scipy's index dtype
         self.indices.flags.writeable = self.indptr.flags.writeable = False          # shared by every K
         self.diag_pos = np.searchsorted(self.keys, diag)
-        if self.requested in ("auto", "banded"):
+        if self.requested == "banded" or (self.requested == "auto" and not band_too_wide(
+                self.indptr, self.indices, self.n, self.free, BANDED_WORK)):
             self.plan = BandPlan(self.indptr, self.indices, self.n, self.free)
+        else:                                       # no plan where the band cannot be chosen
+            self.plan = None
+        if self.requested in ("auto", "banded"):
             self.kind = choose_linear_algebra(self.n, self.requested, self.plan)
         self._cache.clear()
         self.pattern_builds += 1
@@ -155,7 +170,7 @@ class TangentAssembler:
         K = copy.copy(self._template)             # shares the pattern's index arrays (docstring)
         K.data = data
         if self.kind == "banded":
-            K.band_plan = self.plan
+            K.band_plan = self.banded_plan = self.plan
             self.used["banded"] = self.plan.describe()
         else:
             self.used["sparse"] = ORDERING

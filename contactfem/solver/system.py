@@ -121,9 +121,9 @@ class System:
     @property
     def band(self):
         """(kl, ku), the half-bandwidths below and above the diagonal of K renumbered by reverse
-        Cuthill-McKee, when K is solved banded; else None."""
-        plan = self._tangent.plan
-        return (plan.kl, plan.ku) if plan is not None and "banded" in self.linear_algebra else None
+        Cuthill-McKee, of the last K solved banded; None when no K was."""
+        plan = self._tangent.banded_plan                # of the last K solved banded
+        return (plan.kl, plan.ku) if plan is not None else None
 
     def global_dofs(self, body, local):
         """Global numbers of a body's local dofs."""
