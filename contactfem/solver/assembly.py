@@ -93,15 +93,19 @@ class TangentAssembler:
 
     # -- the pattern (sparse) ---------------------------------------------------------
     def _grow(self, keys):
-        """Make the pattern hold `keys` (and the diagonal); positions cached so far are void."""
+        """Make the pattern hold `keys` (and the diagonal); positions cached so far are void.
+        Returns the position of each of `keys` in the new pattern."""
         diag = np.arange(self.n) * (self.n + 1)
         old = diag if self.keys is None else self.keys
         merged = np.concatenate([old, np.asarray(keys, dtype=np.int64)])
-        merged.sort(kind="stable")                  # sorted runs (old keys, a body's CSR rows): near-linear
-        unique = np.empty(merged.size, dtype=bool)
-        unique[:1] = True
-        np.not_equal(merged[1:], merged[:-1], out=unique[1:])
-        self.keys = merged[unique]
+        order = np.argsort(merged, kind="stable")   # sorted runs (old keys, a body's CSR rows): near-linear
+        merged = merged[order]
+        first = np.empty(merged.size, dtype=bool)   # the first of each run of equal keys
+        first[:1] = True
+        np.not_equal(merged[1:], merged[:-1], out=first[1:])
+        self.keys = merged[first]
+        where = np.empty(merged.size, dtype=np.int64)
+        where[order] = np.cumsum(first) - 1         # each merged key's place in the pattern
         from scipy.sparse import csc_matrix
 
         indices = self.keys % self.n                                         # row of each entry
@@ -119,6 +123,7 @@ class TangentAssembler:
             self.kind = choose_linear_algebra(self.n, self.requested, self.plan)
         self._cache.clear()
         self.pattern_builds += 1
+        return where[old.size:]
 
     def _positions(self, rows, cols, offset, key):
         """Index of each (row + offset, col + offset) in the pattern, growing it if need be."""
@@ -127,12 +132,9 @@ class TangentAssembler:
             if hit is not None and hit[0] is rows and hit[1] is cols:
                 return hit[2]
         keys = _keys(rows, cols, offset, self.n)
-        if self.keys is None:
-            self._grow(keys)
         pos = np.searchsorted(self.keys, keys)
         if keys.size and (pos.max() >= self.keys.size or np.any(self.keys[pos] != keys)):
-            self._grow(keys)
-            pos = np.searchsorted(self.keys, keys)
+            pos = self._grow(keys)
         if key is not None:
             self._cache[key] = (rows, cols, pos)
         return pos
@@ -156,12 +158,18 @@ class TangentAssembler:
                 K.flat[::n + 1] += diagonal
             return K
         if self.keys is None:                     # the first assembly: the whole pattern at once
-            self._grow(np.concatenate([_keys(r, c, o, n) for r, c, _, o, _ in blocks] + [np.zeros(0, np.int64)]))
-        for _ in range(2):                        # a grown pattern voids positions found before it
-            builds = self.pattern_builds
-            pos = [self._positions(r, c, o, key) for r, c, _, o, key in blocks]
-            if self.pattern_builds == builds:
-                break
+            keys = [_keys(r, c, o, n) for r, c, _, o, _ in blocks]
+            pos = np.split(self._grow(np.concatenate(keys + [np.zeros(0, np.int64)])),
+                           np.cumsum([k.size for k in keys])[:-1])
+            for (r, c, _, _, key), p in zip(blocks, pos):
+                if key is not None:
+                    self._cache[key] = (r, c, p)
+        else:
+            for _ in range(2):                    # a grown pattern voids positions found before it
+                builds = self.pattern_builds
+                pos = [self._positions(r, c, o, key) for r, c, _, o, key in blocks]
+                if self.pattern_builds == builds:
+                    break
         data = np.bincount(np.concatenate(pos + [np.zeros(0, int)]),
                            np.concatenate([v for _, _, v, _, _ in blocks] + [np.zeros(0)]),
                            minlength=self.keys.size)

@@ -55,12 +55,15 @@ def band_too_wide(indptr, indices, n, free=None, work=BANDED_WORK):
     seen[free] = False
     frontier = free[:1]
     seen[frontier] = True
+    last = np.zeros(n, dtype=np.int64)              # to keep one of repeated neighbours
     reached, level, b = 1, 0, 0.0
     while frontier.size:
         start, count = indptr[frontier], indptr[frontier + 1] - indptr[frontier]
         at = np.repeat(start - np.cumsum(count) + count, count) + np.arange(count.sum())
         nxt = indices[at]
-        frontier = np.unique(nxt[~seen[nxt]])
+        nxt = nxt[~seen[nxt]]
+        last[nxt] = np.arange(nxt.size)
+        frontier = nxt[last[nxt] == np.arange(nxt.size)]
         seen[frontier] = True
         level += 1
         reached += frontier.size
