@@ -55,6 +55,30 @@ def test_tangent_matches_finite_differences(kind, material, tri):
     assert fd_jacobian_error(lambda v: np.array([body.strain_energy(v)]), grad, u) < 1e-6
 
 
+@pytest.mark.parametrize("tri", [False, True])
+@pytest.mark.parametrize("kind", ["plane_strain", "plane_stress", "axisymmetric"])
+def test_linear_strain_energy_is_the_integral_of_W(kind, tri):
+    """The linear body's energy u.K u / 2 is int W dV of materials.linear_elastic at the
+    quadrature points (2 pi r for axisymmetric), to rounding: a sum of ~100 positive terms
+    rounds at ~1e-15, so 1e-12 leaves a factor 1000."""
+    from skfem import Functional, asm
+
+    from contactfem.bodies.materials import linear_elastic
+
+    body = Continuum(block(tri=tri), E, NU, 1.0, kind=kind)
+    u = 0.05 * np.random.default_rng(2).standard_normal(body.ndof)
+    uq = body.basis.interpolate(u)
+    F = np.zeros((3, 3) + uq.shape[1:])
+    F[:2, :2] = uq.grad
+    if kind == "axisymmetric":
+        F[2, 2] = uq[0] / body.basis.global_coordinates()[0]
+    F += np.eye(3)[:, :, None, None]
+    W = linear_elastic(F, body.lam, body.mu)[0]
+    weight = (lambda w: 2 * np.pi * w.x[0]) if kind == "axisymmetric" else (lambda w: body.thickness)
+    integral = asm(Functional(lambda w: w.W * weight(w)), body.basis, W=W)
+    assert body.strain_energy(u) == pytest.approx(integral, rel=1e-12, abs=0)
+
+
 # -- patch tests -------------------------------------------------------------
 
 @pytest.mark.parametrize("material", ["linear", "svk", "neohooke"])

@@ -222,18 +222,29 @@ class Continuum:
         """Internal force R(u) and consistent tangent K = dR/du (csr)."""
         u = np.asarray(u, dtype=float)
         if self.material == "linear":
-            if self._K_linear is None:
-                _, _, A = self._constitutive(np.zeros(self.ndof), self.basis)
-                self._K_linear = asm(_tangent_form, self.basis, A=A, **self._params()).tocsr()
-            return self._K_linear @ u, self._K_linear
+            K = self._linear_stiffness()
+            return K @ u, K
         _, P, A = self._constitutive(u, self.basis)
         R = asm(_internal_form, self.basis, P=P, **self._params())
         K = asm(_tangent_form, self.basis, A=A, **self._params()).tocsr()
         return R, K
 
+    def _linear_stiffness(self):
+        """The constant K of the linear material (assembled at the first call)."""
+        if self._K_linear is None:
+            _, _, A = self._constitutive(np.zeros(self.ndof), self.basis)
+            self._K_linear = asm(_tangent_form, self.basis, A=A, **self._params()).tocsr()
+        return self._K_linear
+
     def strain_energy(self, u):
-        """Stored energy int W dV (2 pi r dA for axisymmetric)."""
-        W, _, _ = self._constitutive(np.asarray(u, dtype=float), self.basis)
+        """Stored energy int W dV (2 pi r dA for axisymmetric). Linear material: u.K u / 2,
+        the same integral on the same quadrature (W = eps:C:eps / 2, K = int grad v:C:grad du),
+        without evaluating the fields at the quadrature points (Hertz on 65k quads: 0.1-0.4 s
+        a call, against a few milliseconds)."""
+        u = np.asarray(u, dtype=float)
+        if self.material == "linear":
+            return 0.5 * float(u @ (self._linear_stiffness() @ u))
+        W, _, _ = self._constitutive(u, self.basis)
         return float(asm(_energy_form, self.basis, W=W, **self._params()))
 
     def mass(self):

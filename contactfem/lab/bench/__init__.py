@@ -1,9 +1,10 @@
 """`contactfem bench`: speed against accuracy, measured.
 
-Six studies, each a module with a function returning a JSON-able dict; ``run_bench``
+Seven studies, each a module with a function returning a JSON-able dict; ``run_bench``
 runs them all and ``write_markdown`` (report.py, the one report writer) turns the result
 into the tables of BENCHMARKS.md. Files: common.py (targets, timing, observed order),
-tangents.py, work_precision.py, cost.py, targets.py, enforcement.py, speed.py, report.py.
+tangents.py, work_precision.py, cost.py, targets.py, enforcement.py, speed.py, scaling.py,
+report.py.
 
 1. tangents        the paper's central claim (Sec. 4.2): Newton with the consistent
                    non-symmetric tangent (eqs 49-50) against a symmetrised tangent, the
@@ -31,6 +32,9 @@ tangents.py, work_precision.py, cost.py, targets.py, enforcement.py, speed.py, r
                    split into bulk, contact, assembly, solve and Python overhead (measured
                    inside a real run), and the Table 2 refinement study as `contactfem sweep`
                    runs it (speed.py).
+7. scaling         Hertz on 1k, 4k, 16k and 65k quads against the same problem written as a
+                   plain scikit-fem script (skfem.asm, scipy's spsolve, Newton on the active
+                   set), in one process: the ratio contactfem / plain per size (scaling.py).
 
 ``quick`` shrinks every study (fast presets, fewer points) to seconds in all.
 No timing enters a test: times depend on the machine and its load.
@@ -46,13 +50,15 @@ from .common import PAPER_SCENES, TARGETS, observed_order, timed
 from .cost import cost_study, iteration_cost
 from .enforcement import enforcement_study
 from .report import write_markdown, write_outputs
+from .scaling import plain_hertz, scaling_study
 from .speed import speed_study
 from .tangents import VARIANTS, tangent_study
 from .targets import targets_study
 from .work_precision import work_precision
 
 STUDIES = {"tangents": tangent_study, "work_precision": work_precision, "cost": cost_study,
-           "targets": targets_study, "enforcement": enforcement_study, "speed": speed_study}
+           "targets": targets_study, "enforcement": enforcement_study, "speed": speed_study,
+           "scaling": scaling_study}
 
 
 def machine():
@@ -79,4 +85,4 @@ def run_bench(quick=False, only=None, progress=print):
 
 __all__ = ["run_bench", "STUDIES", "TARGETS", "PAPER_SCENES", "VARIANTS", "observed_order", "machine",
            "write_markdown", "write_outputs", "tangent_study", "work_precision", "cost_study",
-           "iteration_cost", "targets_study", "enforcement_study", "speed_study"]
+           "iteration_cost", "targets_study", "enforcement_study", "speed_study", "scaling_study", "plain_hertz"]
