@@ -27,7 +27,7 @@ from skfem import (Basis, BilinearForm, ElementQuad1, ElementTriP1,
                    ElementVector, Functional, LinearForm, MeshQuad, MeshTri,
                    asm)
 
-from .materials import MATERIAL_FUNCTIONS, MATERIALS, _eye
+from .materials import MATERIAL_FUNCTIONS, MATERIALS, _eye, _isotropic_tangent
 
 KINDS = ("plane_strain", "plane_stress", "axisymmetric")
 
@@ -230,9 +230,10 @@ class Continuum:
         return R, K
 
     def _linear_stiffness(self):
-        """The constant K of the linear material (assembled at the first call)."""
+        """The constant K of the linear material (assembled at the first call), with the
+        material's tangent A = C (isotropic, the same at every point: no fields evaluated)."""
         if self._K_linear is None:
-            _, _, A = self._constitutive(np.zeros(self.ndof), self.basis)
+            A = _isotropic_tangent(self.lam, self.mu, self.basis.dx.shape)
             self._K_linear = asm(_tangent_form, self.basis, A=A, **self._params()).tocsr()
         return self._K_linear
 
