@@ -189,3 +189,21 @@ def test_bad_helper_input():
         beam.set_dt(0.0)
     with pytest.raises(RuntimeError, match="set_dt"):
         beam.internal(np.zeros(beam.ndof))
+
+
+@pytest.mark.parametrize("closed", [False, True])
+@pytest.mark.parametrize("rotary_inertia", [False, True])
+def test_lumped_mass_is_the_row_sums_of_scikit_fems_p1_mass(closed, rotary_inertia):
+    """mass() (L0 / 2 to each element end, summed with numpy) is the row sums of the P1 mass
+    matrix scikit-fem assembles on the arc-length mesh (the last node folded onto the first
+    in a ring), to the rounding of a sum of two terms: 1e-14."""
+    from skfem import Basis, ElementLineP1, asm
+    from skfem.models import mass
+
+    X = ring(2.0, 9) if closed else np.column_stack([np.linspace(0, 3, 7) ** 1.3, 0.2 * np.linspace(0, 3, 7) ** 2])
+    beam = Beam(X, closed, E=100.0, A=0.5, I=0.1, rho=3.0, rotary_inertia=rotary_inertia)
+    rows = np.asarray(asm(mass, Basis(beam.mesh, ElementLineP1())).sum(axis=1)).ravel()
+    length = np.bincount(beam.fold, rows, minlength=len(X))
+    ref = 3.0 * np.column_stack([0.5 * length, 0.5 * length, 0.1 * length * rotary_inertia]).ravel()
+    assert np.allclose(beam.mass(), ref, rtol=1e-14, atol=0)
+    assert np.allclose(beam.mesh.p.ravel(), beam.s, rtol=0, atol=0)

@@ -51,10 +51,22 @@ def test_an_unknown_scene_name_lists_the_known_ones(name):
 
 
 def test_building_a_scene_loads_what_it_needs():
-    """scikit-fem comes in when a scene builds a body, not before."""
-    code = ("from contactfem.scenes import get_scene, sloping_impact\n"
-            "sloping_impact.build(get_scene('sloping_impact').resolve('fast'))")
-    assert "skfem" in heavy_modules_after(code)
+    """scikit-fem comes in when a scene builds a continuum, not before; a ring of beams
+    (its mass summed with numpy) needs none of the heavy libraries."""
+    code = ("from contactfem.scenes import get_scene, {0}\n"
+            "{0}.build(get_scene('{0}').resolve('fast'))")
+    assert "skfem" in heavy_modules_after(code.format("block"))
+    assert heavy_modules_after(code.format("sloping_impact")) == []
+
+
+def test_a_dense_run_from_the_command_line_loads_no_heavy_library(tmp_path):
+    """The sloping impact (48 unknowns: a dense K, LAPACK through numpy) from the command
+    line, its JSON written: no scipy, scikit-fem, matplotlib or joblib."""
+    out = tmp_path / "r.json"
+    code = (f"from contactfem.cli import main\nassert main(['run', 'sloping_impact', '--set', 'n_steps=5', "
+            f"'--json', {str(out)!r}]) == 0")
+    assert heavy_modules_after(code) == []
+    assert json.loads(out.read_text())["linear_algebra"] == "dense"
 
 
 # -- dense and sparse tangents -----------------------------------------------------------

@@ -20,11 +20,13 @@ kernel is vectorised numpy over all elements; K comes as COO triplets on the con
 element connectivity (``internal_coo``, what the solver's System assembles) or as a CSR
 matrix (``internal``).
 
-What scikit-fem does here: the 1D mesh in the arc length s (``MeshLine``; its
-element lengths are the reference chord lengths), and the lumped mass (row sums of
-the P1 mass matrix ``asm(mass, basis)``). A closed ring is an open 1D mesh of
-length L whose last node (s = L) is identified with the first; the identification
-is the index map ``self.fold`` (mesh node -> beam node).
+The 1D mesh in the arc length s is scikit-fem's ``MeshLine`` (``mesh``, made on first
+use; its element lengths are the reference chord lengths). A closed ring is an open 1D
+mesh of length L whose last node (s = L) is identified with the first; the
+identification is the index map ``self.fold`` (mesh node -> beam node). The lumped mass
+is the row sums of the P1 mass matrix on that mesh, L0 / 2 to each end of an element,
+summed here without scikit-fem (a run of rings then loads no scikit-fem or scipy; the
+tests check it against ``asm(mass, basis)``).
 
 Viscoplastic variant (paper Sec. 5.3 gives only the plastic resultants N0, Q0, M0):
 a Perzyna overstress model, decoupled per resultant S in (N, Q, M) with elastic
@@ -132,13 +134,11 @@ class Beam:
             raise ValueError("parameter X has coincident consecutive nodes: element lengths must be > 0")
         self.theta0 = np.arctan2(chord[:, 1], chord[:, 0])
 
-        # scikit-fem: 1D mesh in the reference arc length s (closed: node nn sits at s = L
-        # and is identified with node 0 through `fold`)
-        from skfem import MeshLine
-
-        s = np.concatenate([[0.0], np.cumsum(self.L0)])
-        self.mesh = MeshLine(s)
+        # the 1D mesh in the reference arc length s (closed: node nn sits at s = L and is
+        # identified with node 0 through `fold`); scikit-fem's MeshLine of it: ``mesh``
+        self.s = np.concatenate([[0.0], np.cumsum(self.L0)])
         self.fold = np.arange(ne + 1) % nn
+        self._mesh = None
 
         self.ndof = 3 * nn
         self.xdofs = 3 * np.arange(nn)[:, None] + np.array([0, 1])
@@ -293,18 +293,23 @@ class Beam:
         if self.S0 is not None:
             self.ep = np.concatenate([self.resultants(u, xi, k)[2] for k, (xi, _) in enumerate(self.points)])
 
+    @property
+    def mesh(self):
+        """scikit-fem's MeshLine in the reference arc length s (made on first use)."""
+        if self._mesh is None:
+            from skfem import MeshLine
+
+            self._mesh = MeshLine(self.s)
+        return self._mesh
+
     def mass(self):
         """Lumped mass: rho A per length on u_x, u_y and rho I per length on theta (half to each node;
         0 on theta without rotary inertia).
 
-        scikit-fem: row sums of the P1 mass matrix on the arc-length mesh = L0/2 per element end.
+        The row sums of the P1 mass matrix on the arc-length mesh: L0/2 per element end.
         """
-        if getattr(self, "_mass", None) is None:   # assembled once, then reused
-            from skfem import Basis, ElementLineP1, asm
-            from skfem.models import mass as mass_form
-
-            lumped_mesh = np.asarray(asm(mass_form, Basis(self.mesh, ElementLineP1())).sum(axis=1)).ravel()
-            length = np.bincount(self.fold, lumped_mesh, minlength=self.X.shape[0])   # fold s = L onto s = 0
+        if getattr(self, "_mass", None) is None:   # computed once, then reused
+            length = np.bincount(self.conn.ravel(), np.repeat(0.5 * self.L0, 2), minlength=self.X.shape[0])
             J = self.I * length if self.rotary_inertia else 0.0 * length
             self._mass = (self.rho * np.column_stack([self.A * length, self.A * length, J])).ravel()
         return self._mass.copy()

@@ -12,14 +12,32 @@
     progress.py  ProgressBar: a progress bar on stderr for integrate(..., callback=bar);
                  chain(...) to give integrate several callbacks; progress_bar, the factory
                  for integrate(..., progress=) and run_scene(..., progress=)
+
+Each name is loaded from its module on first use, so that what a run needs (outputs.py,
+progress.py) does not bring in what it may not (animate.py reaches scikit-fem through
+the continuum's boundary_loop).
 """
 
-from .animate import animate_outlines, boundary_loop
-from .paraview import export_continuum, export_polyline, export_series
-from .outputs import Outputs, check_output_path
-from .progress import ProgressBar, chain, progress_bar
-from .runs import Recorder, as_arrays, load_run, save_run
+import importlib
+
+_WHERE = {"animate_outlines": "animate", "boundary_loop": "animate", "export_continuum": "paraview",
+          "export_polyline": "paraview", "export_series": "paraview", "Outputs": "outputs",
+          "check_output_path": "outputs", "ProgressBar": "progress", "chain": "progress",
+          "progress_bar": "progress", "Recorder": "runs", "as_arrays": "runs", "load_run": "runs",
+          "save_run": "runs"}
 
 __all__ = ["save_run", "load_run", "as_arrays", "Outputs", "check_output_path", "Recorder", "boundary_loop",
            "export_series", "export_continuum", "export_polyline", "animate_outlines", "ProgressBar", "chain",
            "progress_bar"]
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))
+
+
+def __getattr__(name):
+    if name in _WHERE:
+        value = getattr(importlib.import_module(f"{__name__}.{_WHERE[name]}"), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
