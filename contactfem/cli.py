@@ -7,9 +7,17 @@ machine), one line on stderr, found before any solve; 1 a failed solve, its caus
 line and the residual history on the next; 130 interrupted (Ctrl-C): one line, and none
 of the run's output files written."""
 
-import argparse
 import os
 import sys
+import time
+
+_LOADING = time.perf_counter()
+import argparse  # noqa: E402  (timed: the command line's own import is import time too)
+
+from .clock import imports_timed  # noqa: E402
+
+_OWN_IMPORT_S = [time.perf_counter() - _LOADING]   # counted once, by the first command of the process
+_CLOCK = {}        # the import clock of the command running (contactfem.clock)
 
 
 class UsageError(Exception):
@@ -117,6 +125,8 @@ def cmd_run(args):
     _RUN["phase"] = "run"
     res, notes = run_quietly(lambda: scenes.run_scene(args.scene, args.preset, overrides, progress=progress,
                                                       linear_algebra=args.linear_algebra, **laws))
+    if "imported" in _CLOCK:                          # what this process spent loading modules, up to here
+        res["import_time_s"] = _CLOCK["imported"][0] + _CLOCK["own"]
     _RUN["phase"] = "write"
     with out:                                         # temporaries first, then all renamed at once
         if args.json:
@@ -384,8 +394,11 @@ def main(argv=None):
     """The command line; returns the exit code. Called without argv (as the program), a
     Ctrl-C after the work is done (while Python shuts down) no longer changes the outcome."""
     try:
-        code = _main(argv)
+        with imports_timed() as imported:
+            _CLOCK.update(imported=imported, own=_OWN_IMPORT_S.pop() if _OWN_IMPORT_S else 0.0)
+            code = _main(argv)
     finally:
+        _CLOCK.clear()
         if argv is None:
             import signal
 

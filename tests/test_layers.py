@@ -1,9 +1,11 @@
 """The layout is the architecture: every module of contactfem belongs to a layer, and no
 module imports from a layer above its own (lazy imports inside functions included).
 
-    laws < contact < bodies < solver < scenes < plots, io, equations < lab < cli
+    clock < laws < contact < bodies < solver < scenes < plots, io, equations < lab < cli
 
-The physics library is everything below ``lab``: laws, contact, bodies, solver, scenes,
+``clock`` (a run's wall time without the time spent importing) imports nothing of
+contactfem, so the command line can start it first. The physics library is everything
+below ``lab``: laws, contact, bodies, solver, scenes,
 and beside them plots (the paper's figures), io (saving runs, ParaView export,
 animations, progress bars) and equations (the index of the paper's equations in the
 code). ``lab`` is what is built around the library, not part of it: the course
@@ -19,9 +21,9 @@ import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / "contactfem"
 
-ORDER = [("laws",), ("contact",), ("bodies",), ("solver",), ("scenes",),
+ORDER = [("clock",), ("laws",), ("contact",), ("bodies",), ("solver",), ("scenes",),
          ("plots", "io", "equations"), ("lab",), ("cli", "__main__")]
-LIBRARY = ("laws", "contact", "bodies", "solver", "scenes", "plots", "io", "equations")
+LIBRARY = ("clock", "laws", "contact", "bodies", "solver", "scenes", "plots", "io", "equations")
 LAYER = {name: level for level, names in enumerate(ORDER) for name in names}
 
 
@@ -75,7 +77,7 @@ def test_no_import_from_a_higher_layer(path):
             f"(layer {LAYER[target]}) from layer {LAYER[own]} ({own})"
             for line, target in imported_units(path)
             if target in LAYER and LAYER[target] > LAYER[own]]
-    assert not back, "back edges against laws < contact < bodies < solver < scenes < plots/io/equations < lab < cli:\n" + "\n".join(back)
+    assert not back, "back edges against clock < laws < contact < bodies < solver < scenes < plots/io/equations < lab < cli:\n" + "\n".join(back)
 
 
 def test_the_walk_finds_a_back_edge(tmp_path):

@@ -1,0 +1,57 @@
+"""A run's clock: wall time with the time spent importing modules taken out.
+
+contactfem loads its libraries on first use (scikit-fem when a scene builds a continuum,
+scipy when a K is sparse), so the first run in a fresh interpreter pays imports that
+later runs do not. ``imports_timed()`` sums, while it is active, the wall time of every
+``import`` statement that loads a module (the outermost statement only: the imports it
+triggers are inside its time; an import that fails counts too): ``run_scene`` subtracts
+it from the run's wall time (``wall_time_s``, the run's own time, in every entry point),
+and the command line reports what its process spent importing (``import_time_s``).
+
+It wraps ``builtins.__import__`` while active (``importlib.import_module`` is not seen;
+the imports a module's body makes are). Not for threads importing at the same time.
+Imports nothing of contactfem (the command line starts it before loading anything else).
+"""
+
+import builtins
+import sys
+import time
+from contextlib import contextmanager
+
+_running = []           # the accumulators ([seconds]) of the clocks active now
+_inside = [False]       # within a timed import statement (its nested imports are its own time)
+_wrapped = [None]       # the __import__ found when the first clock started
+
+
+def _timed_import(name, globals=None, locals=None, fromlist=(), level=0):
+    if _inside[0] or not _running:
+        return _wrapped[0](name, globals, locals, fromlist, level)
+    loaded = len(sys.modules)
+    _inside[0] = True
+    t0 = time.perf_counter()
+    failed = True
+    try:
+        module = _wrapped[0](name, globals, locals, fromlist, level)
+        failed = False
+        return module
+    finally:
+        _inside[0] = False
+        if failed or len(sys.modules) != loaded:
+            dt = time.perf_counter() - t0
+            for acc in _running:
+                acc[0] += dt
+
+
+@contextmanager
+def imports_timed():
+    """Yields a one-element list: the seconds spent loading modules so far inside the block."""
+    acc = [0.0]
+    if builtins.__import__ is not _timed_import:
+        _wrapped[0], builtins.__import__ = builtins.__import__, _timed_import
+    _running.append(acc)
+    try:
+        yield acc
+    finally:
+        _running.remove(acc)
+        if not _running and builtins.__import__ is _timed_import:
+            builtins.__import__ = _wrapped[0]

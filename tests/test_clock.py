@@ -1,0 +1,84 @@
+"""A run's clock (contactfem/clock.py): the time spent loading modules is summed while a clock
+runs (an import statement once, with the imports it triggers), and left out of a run's
+wall_time_s in every entry point; the command line adds import_time_s. The clock is a fake
+one here (time.perf_counter replaced by a counter the imported modules advance): no test
+depends on the machine's speed."""
+import builtins
+import json
+import sys
+import types
+
+import pytest
+
+from contactfem import clock
+from contactfem.scenes import base
+
+STATE = types.ModuleType("clock_test_state")      # the fake time, advanced by the modules below
+STATE.t = 0.0
+
+MODULES = {
+    "slow_outer": "import clock_test_state as s\ns.t += 1.0\nimport slow_inner\n",
+    "slow_inner": "import clock_test_state as s\ns.t += 2.0\n",
+    "slow_broken": "import clock_test_state as s\ns.t += 0.5\nraise ImportError('no')\n",
+    "slow_other": "import clock_test_state as s\ns.t += 4.0\n",
+}
+
+
+@pytest.fixture
+def fake_time(tmp_path, monkeypatch):
+    for name, text in MODULES.items():
+        (tmp_path / f"{name}.py").write_text(text)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.setitem(sys.modules, "clock_test_state", STATE)
+    monkeypatch.setattr(STATE, "t", 0.0)
+    monkeypatch.setattr("time.perf_counter", lambda: STATE.t)
+    yield STATE
+    for name in MODULES:
+        sys.modules.pop(name, None)
+
+
+def test_an_import_is_timed_once_with_what_it_imports(fake_time):
+    before = builtins.__import__
+    with clock.imports_timed() as imported:
+        import slow_outer  # noqa: F401
+        assert imported[0] == 3.0                       # 1 of its own + 2 of slow_inner, once
+        import slow_outer  # noqa: F401,F811             (loaded: nothing)
+        with pytest.raises(ImportError):
+            import slow_broken  # noqa: F401            (a failed import is import time too)
+        fake_time.t += 10.0                             # time that is not an import
+    assert imported[0] == 3.5
+    assert builtins.__import__ is before                # the clock leaves nothing behind
+
+
+def test_nested_clocks_each_see_the_imports_inside_them(fake_time):
+    with clock.imports_timed() as outer:
+        import slow_inner  # noqa: F401
+        with clock.imports_timed() as inner:
+            import slow_other  # noqa: F401
+    assert (outer[0], inner[0]) == (6.0, 4.0)
+
+
+def test_wall_time_of_a_run_leaves_out_its_imports(fake_time, monkeypatch):
+    """run_scene: a run that loads a module on first use (4 s of fake time) and computes for
+    1 s reports wall_time_s = 1 s, whichever entry point calls it."""
+    from contactfem import scenes
+
+    def run(params):
+        import slow_other  # noqa: F401
+        fake_time.t += 1.0
+        return {"x": params["x"]}
+
+    scene = base.Scene(name="timed", title="t", params=(base.Param("x", 1.0),), run=run)
+    monkeypatch.setattr(scenes, "get_scene", lambda name: scene)
+    res = scenes.run_scene("timed")
+    assert res["wall_time_s"] == 1.0 and "import_time_s" not in res
+
+
+def test_the_command_line_reports_both(tmp_path):
+    """From the command line: wall_time_s, and the process's import_time_s beside it."""
+    from contactfem.cli import main
+
+    out = tmp_path / "r.json"
+    assert main(["run", "sloping_impact", "--set", "n_steps=3", "--json", str(out)]) == 0
+    res = json.loads(out.read_text())
+    assert res["wall_time_s"] > 0 and res["import_time_s"] >= 0
