@@ -129,6 +129,9 @@ def test_quick_bench_writes_json_and_markdown(tmp_path):
                     "## Targets", "## Scaling"):
         assert section in md
     assert "nan" not in md.lower()
+    loads = res["speed"]["startup"]["loads"]           # the start-up account's claims, from the run
+    assert loads["run_rings"] == [] and "skfem" in loads["run_block_canonical"]
+    assert "What the block's process loads" in md and "The run of rings loads none of" in md
 
     tg = res["tangents"]
     for law, rows in tg["block"].items():

@@ -8,7 +8,7 @@ import numpy as np
 from .common import TARGETS
 from .enforcement import enforcement_markdown
 from .scaling import scaling_markdown
-from .speed import PARTS, SPEED_TARGETS
+from .speed import PARTS, RINGS, SPEED_TARGETS, STARTUP_LAYERS
 
 def _f(x, fmt="{:.3g}"):
     if x is None:
@@ -63,6 +63,37 @@ def _ms(x):
     return "-" if x is None else f"{1e3 * x:.3f}"
 
 
+def startup_account(s):
+    """The block's start-up layer by layer (whole processes, the same medians): what it loads that
+    it cannot do without, against `import numpy` (the target) and a run of rings."""
+    if "numpy" not in s:                               # a bench.json from before this table
+        return []
+    T, base = SPEED_TARGETS, s["numpy"]["wall_s"]
+    L = ["What the block's process loads, layer by layer (each line a whole process, the same medians; "
+         "added: its wall time less the line above's):", "",
+         "| process | wall [s] | CPU [s] | added [s] | x `import numpy` |", "|---|---|---|---|---|"]
+    prev = s["python"]["wall_s"]
+    L.append(f"| `python -c pass` | {prev:.3f} | {s['python']['cpu_s']:.3f} | - | {prev / base:.2f} |")
+    for key, _, label in STARTUP_LAYERS:
+        w = s[key]["wall_s"]
+        L.append(f"| {label} | {w:.3f} | {s[key]['cpu_s']:.3f} | {w - prev:+.3f} | {w / base:.2f} |")
+        prev = w
+    key, _, label = RINGS
+    L.append(f"| {label} | {s[key]['wall_s']:.3f} | {s[key]['cpu_s']:.3f} | - | {s[key]['wall_s'] / base:.2f} |")
+    block, skfem, sparse = s["run_block_canonical"]["wall_s"], s["skfem"]["wall_s"], s["scipy_sparse"]["wall_s"]
+    loads = s["loads"]
+    rings = ", ".join(loads["run_rings"]) or "none of scipy.sparse, scipy.linalg, scikit-fem and matplotlib"
+    L += ["", f"The block (canonical preset, banded K) takes {s['run_block_canonical_over_numpy']:.2f} x `import numpy` "
+          f"(target {T['run_block_canonical_over_numpy']}: {_f(s['run_block_canonical_over_numpy'] <= T['run_block_canonical_over_numpy'])}). "
+          f"Importing scikit-fem alone takes {s['skfem_over_numpy']:.2f} x: the block's forms need its assembly "
+          "(Basis, BilinearForm, asm), and `import skfem.assembly` runs the package's `__init__`, which loads "
+          f"{', '.join(loads['skfem_assembly'])} ({skfem - sparse:+.3f} s over scipy.sparse, scikit-fem's own "
+          f"modules included; scipy.sparse itself {sparse - base:+.3f} s over numpy). The block's run loads "
+          f"{', '.join(loads['run_block_canonical'])}; contactfem's code, the model and the run add {block - skfem:+.3f} s "
+          f"to `import skfem`. The run of rings loads {rings}: {s['run_rings_over_numpy']:.2f} x `import numpy`.", ""]
+    return L
+
+
 def speed_section(sp):
     """Study 5 (speed): start-up, the split of one Newton iteration, the Table 2 sweep."""
     T = SPEED_TARGETS
@@ -94,8 +125,9 @@ def speed_section(sp):
               f"(target {T['list_s']} s: {_f(s['list']['wall_s'] < T['list_s'])}). "
               f"`contactfem run block --preset paper`: {s['run_block_over_scipy_skfem']:.2f} x an interpreter that "
               f"imports scipy.sparse.linalg and scikit-fem (target {T['run_block_over_scipy_skfem']}: "
-              f"{_f(s['run_block_over_scipy_skfem'] <= T['run_block_over_scipy_skfem'])}).", "",
-          "One Newton iteration, CPU milliseconds of the thread that runs it: the run's totals divided by its linear solves, each scene "
+              f"{_f(s['run_block_over_scipy_skfem'] <= T['run_block_over_scipy_skfem'])}).", ""]
+    L += startup_account(s)
+    L += ["One Newton iteration, CPU milliseconds of the thread that runs it: the run's totals divided by its linear solves, each scene "
           "run in a fresh interpreter, " + ("one run" if sp.get("preset") == "fast" else "best of 3 runs") + " "
           "(contactfem/lab/bench/speed.py). bulk: the bodies' internal forces and tangents; contact: every "
           "contact's residual and tangent; assembly: summing them into K, loads included; solve: factorisation "

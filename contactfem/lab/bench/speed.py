@@ -16,6 +16,10 @@ step evaluates once more than it solves, so this per-iteration cost includes tha
 Start-up: whole `python` processes (median of 5 runs, wall and CPU time): an empty
 interpreter, `contactfem list`, an interpreter that imports scipy.sparse.linalg and
 scikit-fem (what any scikit-fem program pays), and `contactfem run block --preset paper`.
+The account of the block's start-up: interpreters that import numpy, scipy.sparse and
+scikit-fem, one after the other a layer more of what the block loads, beside `contactfem run
+block --preset canonical` and a short run of rings (the sloping impact, 5 steps: dense K,
+no scipy and no scikit-fem loaded).
 Like the libraries (compiled by pip when installed), contactfem is measured with its
 bytecode compiled beforehand.
 """
@@ -31,7 +35,15 @@ from contextlib import contextmanager
 PARTS = ("bulk", "contact", "assembly", "solve", "overhead")
 # what the speed work aims at (whole-process and per-iteration times on 2 cores)
 SPEED_TARGETS = dict(list_s=0.25, sloping_impact_iteration_s=0.5e-3, rolling_ring_iteration_s=0.8e-3,
-                     table2_s=60.0, run_block_over_scipy_skfem=1.3)
+                     table2_s=60.0, run_block_over_scipy_skfem=1.3, run_block_canonical_over_numpy=1.6)
+# the block's start-up, layer by layer: (key, what the process runs, label)
+STARTUP_LAYERS = (("numpy", ["-c", "import numpy"], "`python -c \"import numpy\"`"),
+                  ("scipy_sparse", ["-c", "import scipy.sparse"], "`python -c \"import scipy.sparse\"`"),
+                  ("skfem", ["-c", "import skfem"], "`python -c \"import skfem\"`"),
+                  ("run_block_canonical", ["-m", "contactfem", "run", "block", "--preset", "canonical"],
+                   "`contactfem run block --preset canonical`"))
+RINGS = ("run_rings", ["-m", "contactfem", "run", "sloping_impact", "--set", "n_steps=5"],
+         "`contactfem run sloping_impact --set n_steps=5`")
 
 
 def _process(args, repeat=5):
@@ -75,11 +87,34 @@ def startup_study(repeat=5):
         "scipy_skfem": _process([py, "-c", "import scipy.sparse.linalg, skfem"], repeat),
         "run_block": _process([py, "-m", "contactfem", "run", "block", "--preset", "paper"], repeat),
     }
+    for key, args, _ in STARTUP_LAYERS + (RINGS,):
+        out[key] = _process([py, *args], repeat)
     out["bytecode_compiled"] = bytecode
     out["dont_write_bytecode"] = bool(os.environ.get("PYTHONDONTWRITEBYTECODE"))
     out["list_over_python"] = out["list"]["wall_s"] / out["python"]["wall_s"]
     out["run_block_over_scipy_skfem"] = out["run_block"]["wall_s"] / out["scipy_skfem"]["wall_s"]
+    for key in ("skfem", "run_block_canonical", "run_rings"):
+        out[f"{key}_over_numpy"] = out[key]["wall_s"] / out["numpy"]["wall_s"]
+    out["loads"] = {"skfem_assembly": _loads("import skfem.assembly"),
+                    "run_block_canonical": _loads(_cli_run(STARTUP_LAYERS[-1][1][3:])),
+                    "run_rings": _loads(_cli_run(RINGS[1][3:]))}
     return out
+
+
+HEAVY = ("scipy.sparse", "scipy.sparse.linalg", "scipy.sparse.csgraph", "scipy.linalg", "skfem", "matplotlib")
+
+
+def _cli_run(args):
+    return f"from contactfem.cli import main\nassert main({['run', *args]!r}) == 0"
+
+
+def _loads(code):
+    """Which of HEAVY a fresh interpreter has loaded after running `code`."""
+    probe = f"{code}\nimport sys\nprint('loaded:', *(m for m in {HEAVY!r} if m in sys.modules))"
+    proc = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True)
+    if proc.returncode != 0:
+        raise RuntimeError(f"bench: {code!r} failed: {proc.stderr.strip()[-500:]}")
+    return proc.stdout.strip().splitlines()[-1].split()[1:]
 
 
 @contextmanager
