@@ -55,7 +55,7 @@ INDEX = {e.number: e for e in [
     Equation(26, "T_s, T_0", f"{_K}.segment_vectors"),
     Equation(27, "delta g_N = N_s . dv, delta g_T = (l_bar/l)(T_s + g_N/l N_0) . dv", f"{_K}.segment_variations"),
     Equation(28, "contact residual R_c = t_N N_s + t_T (l_bar/l)(T_s + g_N/l N_0)", _E),
-    Equation(29, "G = M a + R(v) + R_c - P = 0", "contactfem.solver.system.System.residual_tangent"),
+    Equation(29, "G = M a + R(v) + R_c - P = 0", "contactfem.solver.system.System.evaluate"),
     Equation(31, "second variation of the gap (first part)", f"{_K}.segment_variations"),
     Equation(32, "second variation of the gap", f"{_K}.segment_variations"),
     Equation(33, "normal tangent K_N", _E),

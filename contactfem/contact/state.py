@@ -135,6 +135,11 @@ class ContactState:
                     state=STATE_NAMES[self.slip], seg=self.seg, weights=c.weights)
 
     @property
+    def dg_T(self):
+        """The slip increment of the step (eq 20, with the closing step's factor r)."""
+        return self.r * (self.s - self.history.s_bar)
+
+    @property
     def n_active(self):
         """Slave nodes in contact."""
         return int(np.count_nonzero(self.active))

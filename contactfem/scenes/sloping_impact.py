@@ -32,6 +32,7 @@ import numpy as np
 
 from ..bodies.ring import make_ring
 from ..contact import NodeToSegment, RigidLine, tributary_lengths
+from ..contact.tangents import TANGENTS
 from ..laws import ParabolicSlip, PowerLaw
 from ..solver import History, Steps, System
 from . import time_integration
@@ -93,7 +94,7 @@ def build(params, *, normal=None, friction=None, system_options=None):
     offset = ring.offset if params["contact_at"] == "outer" else 0.0
     contact = NodeToSegment(ring.body, ring.contact_nodes, plane, normal=normal or PowerLaw(params["c_N"], params["m"]),
                             friction=friction, weights=weights, offset=offset, name="plane",
-                            integration=time_integration.contact_integration(params))
+                            tangent=params["tangent"], integration=time_integration.contact_integration(params))
     system = System([ring.body], [contact], **(system_options or {}))
     stepper = time_integration.make_stepper(params, system, atol=1e-10, rtol=1e-10, maxit=30)
     stage = Stage(stepper, Steps(params["dt"], n_steps=params["n_steps"], max_cuts=6), np.zeros(ring.body.ndof),
@@ -186,6 +187,9 @@ SCENE = Scene(
         Param("eta", 0.1, "T", 0.0, None, low_open=True, when=(("variant", ("viscoplastic",)),),
               doc="Perzyna relaxation time (chosen: scan lost it; eta = dt = 0.1 makes the overstress relax "
                   "within about one step, nearly rate-independent plasticity with a regular tangent)"),
+        Param("tangent", "consistent", choices=TANGENTS,
+              doc="contact tangent given to Newton: consistent (eqs 39, 49-50), symmetric ((K+K^T)/2), frozen "
+                  "(without the c_N^s C coupling of eq 49); the residual is always eq 28"),
         Param("dt", 0.1, "T", 0.0, None, low_open=True, doc="time step (paper)"),
         Param("n_steps", 200, "", 1, 100000, doc="number of steps (paper: 200)"),
         Param("delta", 0.7, "", 0.5, 1.0, doc="Newmark delta (paper: 0.7; 0.5 with beta 0.25 conserves energy)"),

@@ -206,7 +206,7 @@ class System:
                 state = contact.evaluate(u, t, dt, u0, None if phases is None else phases[i])
                 Rc, r, c, v = state.scatter(self.ndof)
                 G += Rc
-                blocks.append((r, c, v, 0, None))
+                blocks.append((*_triplets(r, c, v), 0, None))
                 states.append(state)
 
         with timed(self.instrument, "assembly"):
