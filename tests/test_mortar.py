@@ -335,6 +335,8 @@ def test_bad_input():
         MortarContact(slave, [0], RigidLine(), normal=PowerLaw(1.0))
     with pytest.raises(ValueError, match="parameter search"):
         MortarContact(slave, np.arange(4), RigidLine(), normal=PowerLaw(1.0), search=0.0)
+    with pytest.raises(ValueError, match="parameter offset"):
+        MortarContact(slave, np.arange(4), RigidLine(), normal=PowerLaw(1.0), offset=[0.1, 0.2])
     contact = MortarContact(slave, np.arange(4), RigidLine((0, 0.1)), normal=PowerLaw(1.0))
     with pytest.raises(RuntimeError, match="before start"):
         contact.evaluate(np.zeros(8))
@@ -347,3 +349,33 @@ def test_bad_input():
     contact.start(np.zeros(8))
     with pytest.raises(NormalLawError, match="normal law Sticky.traction returned t_N"):
         contact.evaluate(np.zeros(8))
+
+
+def test_energy_and_dissipation_of_a_sliding_flat_slave():
+    """A flat slave at uniform penetration g0 on a rigid line slides along its tangent:
+    stored energy L (c_N g0^2 / 2 + t_T^2 / (2 c_T)); once slipping at t_T = mu p, a further
+    slide delta dissipates mu p delta L (L: the slave's length)."""
+    c_N, c_T, mu, g0 = 50.0, 30.0, 0.3, -0.02
+    xs = np.column_stack([np.linspace(1.0, 0.0, 6) ** 1.3, np.full(6, g0)])     # non-uniform, right to left
+    L = xs[0, 0] - xs[-1, 0]
+    contact = MortarContact(PointCloud(xs), np.arange(6), RigidLine(), normal=PowerLaw(c_N=c_N),
+                            friction=Coulomb(c_T=c_T, mu=mu))
+    u = np.zeros(12)
+    contact.start(u)
+    u[0::2] -= 0.1                                           # along the slave tangent (-x): positive slip
+    st = contact.evaluate(u, 0.0, DT)
+    p = -c_N * g0
+    assert np.all(st.state == SLIP) and np.allclose(st.t_T, mu * p, rtol=1e-13)
+    assert st.energy == pytest.approx(L * (0.5 * c_N * g0**2 + (mu * p) ** 2 / (2 * c_T)), rel=1e-13)
+    contact.commit(st)
+    u[0::2] -= 0.03
+    st = contact.evaluate(u, 0.0, DT)
+    assert st.dissipation == pytest.approx(mu * p * 0.03 * L, rel=1e-12)
+
+
+def test_search_distance_leaves_far_pairs_out():
+    xs, xm, _, _ = flat_chains(0.5)                          # the slave 0.5 above the master
+    assert len(candidate_pairs(xs, xm)[0]) > 0
+    assert len(candidate_pairs(xs, xm, search=0.6)[0]) > 0
+    assert len(candidate_pairs(xs, xm, search=0.4)[0]) == 0
+    assert len(candidate_pairs(xs[::-1], xm)[0]) == 0          # reversed slave: its normal faces away

@@ -37,8 +37,9 @@ Weighted gap (the form of Popp, Gee & Wall 2009, with our segment normal n_e):
 (an identity: x_m(eta) - x_s(xi) = g n_e on each pair).
 
 Weighted slip increment (frame-indifferent; Gitterle, Popp, Gee & Wall, IJNME 84, 2010):
-their t_j . [ (D_jk - D_bar_jk) x_k - (M_jl - M_bar_jl) x_l ] with D_bar, M_bar the
-integrals of the last converged configuration and x the current positions. Taken per
+theirs is, up to its sign, t_j . [ (D_jk - D_bar_jk) x_k - (M_jl - M_bar_jl) x_l ] with
+D_bar, M_bar the integrals of the last converged configuration, x the current positions
+and t_j a nodal tangent. Taken per
 converged pair p with its slave tangent t_e, the part with the current D, M vanishes
 identically (t_e . (x_s - x_m) = 0 on a pair), which leaves
 
@@ -63,9 +64,9 @@ t_N,j) on the relative virtual displacement (as Popp, Gee & Wall 2009 write it):
     f_N,j = d/dx [ n_e . (M^p_jl x_l - D^p_jk x_k) ] with D, M, n_e held:   -D_jk n_e (slave), +M_jl n_e (master)
     f_T,j = d/dx [ t_e . (D^p_jk x_k - M^p_jl x_l) ] with D, M, t_e held:   +D_jk t_e (slave), -M_jl t_e (master)
 
-summed over the current pairs of j. Under a uniform traction these are the consistent
-nodal loads on both meshes, whatever the gap: the contact patch test holds, also with the
-penalty's gap. Tangent (contact_forces): the moduli times the linearised gap and slip,
+summed over the current pairs of j. On a flat interface a uniform traction gives the
+consistent nodal loads on both meshes whatever the gap: the contact patch test holds,
+also with the penalty's gap (node-to-segment fails it). Tangent (contact_forces): the moduli times the linearised gap and slip,
 plus the tractions times Delta f (Delta D, Delta M, Delta n_e, Delta t_e, including the
 moving overlap ends), all exact through the jets of contact/variations.py.
 
@@ -75,6 +76,9 @@ segment normal (strips of width about |g| theta missed or doubled at slave kinks
 segmentation.py); the nodal average gap and the penalty; the slip measured against the
 converged integrals and divided by the converged weight (exact for a rigid relative
 slide; a node that faced no master at the end of the last step starts with zero slip).
+Everything lives in the current configuration (finite deformation): next to a
+geometrically linear bulk the contact lengths, hence the tractions, differ from the
+small-strain ones by the strain along the surface.
 """
 
 from dataclasses import dataclass

@@ -49,7 +49,13 @@ class MortarState:
     weights w (the covered length of each node, int N_j), dg_T the slip increment of
     the step; the global residual R (len(u)) and tangent triplets (rows, cols, vals)
     (repeated indices add up); the history that commit() takes; the mortar integrals
-    (pairs, D, M, ...: contact/mortar.py) for inspection."""
+    (pairs, D, M, ...: contact/mortar.py) for inspection.
+
+    energy: sum_j w_j (W_N(g_N,j) + t_T,j^2 / (2 c_T)), the normal law's potential and
+    the stick spring, as node-to-segment reports it (the mortar forces are the virtual
+    work of the tractions, not this energy's exact gradient); dissipation: the slip work
+    of the step, sum_j w_bar_j (t_T_bar,j + t_T,j)/2 lambda_j sign(t_T,j) (trapezoidal,
+    lambda the return map's slip, per unit length of the converged weight w_bar)."""
 
     t: float
     dt: float
@@ -67,6 +73,8 @@ class MortarState:
     vals: np.ndarray
     history: MortarHistory
     integrals: object
+    energy: float
+    dissipation: float
 
     @property
     def n_pairs(self):
@@ -101,7 +109,10 @@ class MortarContact:
                              f"contact, got {type(master).__name__} (approximate a curved obstacle by a RigidPolyline)")
         if not (np.isfinite(search) or search == np.inf) or not search > 0:
             raise ValueError(f"parameter search = {search!r} is out of range: allowed (0, inf]")
-        self.offset = np.broadcast_to(np.asarray(offset, dtype=float), self.nodes.shape).copy()
+        offset = np.asarray(offset, dtype=float)
+        if offset.shape not in ((), self.nodes.shape) or not np.all(np.isfinite(offset)):
+            raise ValueError(f"parameter offset must be a finite number or one per slave node, got {offset!r}")
+        self.offset = np.broadcast_to(offset, self.nodes.shape).copy()
         self.search = float(search)
         self.unbounded = isinstance(master, RigidLine)
         self._law = None if friction is None else as_friction_law(friction)
@@ -166,13 +177,23 @@ class MortarContact:
         history = MortarHistory(t_T=fr.t_T, q=fr.q, z=z, pairs=mi.pairs, D=mi.D, M=mi.M, w=mi.w)
         return MortarState(t=t, dt=dt, nodes=self.nodes, x=xs, g_N=g_N, t_N=t_N, t_T=fr.t_T, state=fr.state,
                            weights=mi.w, dg_T=dg_T, R=R, rows=rows, cols=cols, vals=vals, history=history,
-                           integrals=mi)
+                           integrals=mi, energy=self._energy(g_N, mi.w, fr.t_T),
+                           dissipation=float(np.sum(h.w * 0.5 * (h.t_T + fr.t_T) * fr.lam * np.sign(fr.t_T))))
 
     def commit(self, state):
         """Accept a converged state: its history is the next step's."""
         self.history = state.history
 
     # -- helpers -------------------------------------------------------------------
+    def _energy(self, g_N, w, t_T):
+        closed = g_N < 0.0
+        W = np.zeros_like(g_N)
+        if hasattr(self.normal, "energy"):
+            W = np.where(closed, self.normal.energy(np.where(closed, g_N, 1.0)), 0.0)
+        if self.friction is not None and self._law.c_T > 0:
+            W = W + t_T**2 / (2.0 * self._law.c_T)
+        return float(np.sum(w * W))
+
     def _integrals(self, xs, xm):
         s, m = candidate_pairs(xs, xm, self.unbounded, self.search)
         return mortar_integrals(xs, xm, Pairs.of(s, m, len(xs)), self.unbounded)

@@ -31,12 +31,12 @@ unbounded line). Its ends move with the unknowns through xi_c, xi_d: that is the
 linearisation of the segmentation, carried exactly by the jets (contact/variations.py).
 
 Why the segment normal and not the continuous averaged nodal normal of Popp, Gee & Wall
-(IJNME 79, 2009) or Yang, Laursen & Meng (IJNME 62, 2005): with the segment normal the
-maps eta(xi) and g(xi) are affine, so every mortar integrand is a polynomial of degree
-<= 2 in xi and two Gauss points integrate it exactly, and the variations are those of a
-handful of closed-form quantities (above). This is the 2D reading of the projection onto
-the slave facet's plane along its normal used for flat facets by Puso & Laursen (CMAME
-193, 2004). The price: the normal jumps at a slave node where the chain kinks by an
+(IJNME 79, 2009): with the segment normal the maps eta(xi) and g(xi) are affine, so every
+mortar integrand is a polynomial of degree <= 2 in xi and two Gauss points integrate it
+exactly, and the linearisations are those of a handful of closed-form quantities
+(above). It is the 2D form of what the mortar segment-to-segment method of Puso &
+Laursen (CMAME 193, 2004) does on flat facets: project onto the slave facet's plane along
+its normal. The price: the normal jumps at a slave node where the chain kinks by an
 angle theta, so a master strip of width about |g| theta beside that node is covered by
 both neighbouring segments (slave concave) or by neither (slave convex). The strip
 vanishes with the gap (exactly when the slave node sits on the master); on a flat slave
@@ -55,10 +55,13 @@ from .kinematics import e3_cross
 from .variations import Jet
 
 
-def segment_frames(x):
-    """Length l, unit tangent t and normal n = e3 x t of each segment of the chain x (n, 2)."""
+def segment_frames(x, name="chain"):
+    """Length l, unit tangent t and normal n = e3 x t of each segment of the chain x (n, 2).
+    Raises ValueError for a segment of zero length (two nodes coincide)."""
     a = np.diff(x, axis=0)
     l = np.linalg.norm(a, axis=1)
+    if np.any(~(l > 1e-14 * (1.0 + np.abs(x).max(initial=0.0)))):
+        raise ValueError(f"{name} segment {int(np.argmin(l))} has zero length (degenerate): its two nodes coincide")
     t = a / l[:, None]
     return l, t, e3_cross(t)
 
@@ -68,8 +71,8 @@ def candidate_pairs(xs, xm, unbounded=False, search=np.inf):
     of positive length. xs (ns, 2) slave chain, xm (nm, 2) master chain (current positions).
     ``search``: pairs whose gap exceeds it at both ends of the overlap are left out.
     Returns (slave_segment, master_segment), index arrays of equal length."""
-    l, t, n = segment_frames(xs)
-    _, _, n_m = segment_frames(xm)
+    l, t, n = segment_frames(xs, "slave")
+    _, _, n_m = segment_frames(xm, "master")
     d_c = xm[None, :-1, :] - xs[:-1, None, :]                  # (slave seg, master seg, 2)
     d_d = xm[None, 1:, :] - xs[:-1, None, :]
     xi_c = np.einsum("ekx,ex->ek", d_c, t) / l[:, None]
@@ -127,7 +130,8 @@ def overlap(xi_c, xi_d, unbounded=False):
 
 
 def gap_at(geo, xi):
-    """g(xi) = (1 - eta) g_c + eta g_d with eta = (xi - xi_c)/(xi_d - xi_c): the gap along
-    the slave normal at slave coordinate xi (a jet or a number)."""
+    """The gap along the slave normal at slave coordinate xi (a jet or a number) and the
+    master coordinate facing it: g(xi) = (1 - eta) g_c + eta g_d, eta = (xi - xi_c)/(xi_d - xi_c).
+    Returns (g, eta)."""
     eta = (xi - geo["xi_c"]) / (geo["xi_d"] - geo["xi_c"])
     return geo["g_c"] + eta * (geo["g_d"] - geo["g_c"]), eta
