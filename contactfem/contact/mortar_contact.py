@@ -21,6 +21,7 @@ from .mortar import (Pairs, contact_forces, mortar_integrals, nodal_gap, penalty
                      weighted_slip)
 from .segmentation import candidate_pairs
 from ..laws.protocol import as_friction_law
+from ..laws.return_map import SLIP, STATE_NAMES
 
 
 @dataclass(frozen=True)
@@ -44,8 +45,10 @@ class MortarHistory:
 class MortarState:
     """One evaluation at (u, t), per slave node (in the order of ``nodes``):
 
-    x (ns, 2) positions, g_N average gap (+inf where no master faces the node), t_N, t_T
-    nodal tractions (per unit length), state (OPEN 0, STICK 1, SLIP 2; laws/return_map),
+    X, x (ns, 2) reference and current positions, g_N average gap (+inf where no master faces the node), t_N, t_T
+    nodal tractions (per unit length), dt_N = dt_N/dg_N, and the return map's c_T_s, c_N_s
+    (eq 48), lam (slip of the step), q (accumulated slip), z (the law's variables),
+    state (OPEN 0, STICK 1, SLIP 2; laws/return_map),
     weights w (the covered length of each node, int N_j), dg_T the slip increment of
     the step; the global residual R (len(u)) and tangent triplets (rows, cols, vals)
     (repeated indices add up); the history that commit() takes; the mortar integrals
@@ -60,10 +63,17 @@ class MortarState:
     t: float
     dt: float
     nodes: np.ndarray
+    X: np.ndarray
     x: np.ndarray
     g_N: np.ndarray
     t_N: np.ndarray
+    dt_N: np.ndarray
     t_T: np.ndarray
+    c_T_s: np.ndarray
+    c_N_s: np.ndarray
+    lam: np.ndarray
+    q: np.ndarray
+    z: np.ndarray
     state: np.ndarray
     weights: np.ndarray
     dg_T: np.ndarray
@@ -80,6 +90,39 @@ class MortarState:
     def n_pairs(self):
         return len(self.integrals.pairs)
 
+    # -- what the solver reads (the names of contact/state.py's ContactState) -------------
+    def scatter(self, ndof):
+        """The global contact residual (ndof,) and the tangent's COO triplets."""
+        if ndof != len(self.R):
+            raise ValueError(f"scatter: the state was evaluated with {len(self.R)} dofs, asked for {ndof}")
+        return self.R, self.rows, self.cols, self.vals
+
+    @property
+    def next_history(self):
+        """The history a commit of this state keeps."""
+        return self.history
+
+    @property
+    def slip(self):
+        """OPEN/STICK/SLIP per slave node (= state; the name ContactState uses)."""
+        return self.state
+
+    @property
+    def n_active(self):
+        """Slave nodes in contact."""
+        return int(np.count_nonzero(self.t_N < 0.0))
+
+    @property
+    def n_slip(self):
+        """Slave nodes slipping in this step."""
+        return int(np.count_nonzero(self.state == SLIP))
+
+    def report(self):
+        """Per slave node: reference and current position, average gap, tractions, nodal
+        force measures f = w t (the weights are the covered lengths), state names."""
+        return dict(X=self.X, x=self.x, g_N=self.g_N, t_N=self.t_N, t_T=self.t_T, f_N=self.weights * self.t_N,
+                    f_T=self.weights * self.t_T, state=STATE_NAMES[self.state], weights=self.weights)
+
 
 class MortarContact:
     """Mortar contact (penalty) of the chain ``slave_nodes`` of ``slave_body`` on ``master``.
@@ -95,6 +138,8 @@ class MortarContact:
                  (a positive offset closes the gap; per node or one number)
     search:      pairs farther apart than this are not formed (default: all facing pairs)
     """
+
+    integration = "standard"          # (no energy-consistent variant)
 
     def __init__(self, slave_body, slave_nodes, master, *, normal, friction=None, offset=0.0, search=np.inf,
                  name="mortar"):
@@ -117,6 +162,7 @@ class MortarContact:
         self.unbounded = isinstance(master, RigidLine)
         self._law = None if friction is None else as_friction_law(friction)
         self.history = None
+        self.evaluations = 0                # a counter for the benchmarks (not part of any result)
 
     # -- where the interface's unknowns are ----------------------------------------
     def slave_dofs(self):
@@ -152,12 +198,16 @@ class MortarContact:
         self.history = MortarHistory(t_T=np.zeros(ns), q=np.zeros(ns), z=z, pairs=mi.pairs, D=mi.D, M=mi.M,
                                      w=mi.w)
 
-    def evaluate(self, u, t=0.0, dt=None, u0=None):
+    def evaluate(self, u, t=0.0, dt=None, u0=None, phase=None):
         """Everything at u with the committed history: segmentation, mortar integrals,
         tractions (penalty and return map), residual and tangent. Pure (u0 is not needed:
-        the history holds the reference of the slip)."""
+        the history holds the reference of the slip). ``phase``: the staggered algorithm's
+        phases are not offered for mortar contact (None only)."""
+        if phase is not None:
+            raise ValueError(f"{self.name}: mortar contact has no staggered phases (phase={phase!r})")
         if self.history is None:
             raise RuntimeError(f"{self.name}: MortarContact.evaluate before start(u)")
+        self.evaluations += 1
         h = self.history
         xs, xm = self.positions(u)
         mi = self._integrals(xs, xm)
@@ -175,7 +225,8 @@ class MortarContact:
         R, rows, cols, vals = self._to_global(R_i, r, c, v, len(u))
         z = fr.z if (self._law is not None and fr.z is not None) else h.z
         history = MortarHistory(t_T=fr.t_T, q=fr.q, z=z, pairs=mi.pairs, D=mi.D, M=mi.M, w=mi.w)
-        return MortarState(t=t, dt=dt, nodes=self.nodes, x=xs, g_N=g_N, t_N=t_N, t_T=fr.t_T, state=fr.state,
+        return MortarState(t=t, dt=dt, nodes=self.nodes, X=self.slave.X[self.nodes], x=xs, g_N=g_N, t_N=t_N, dt_N=dt_N,
+                           t_T=fr.t_T, c_T_s=fr.c_T_s, c_N_s=fr.c_N_s, lam=fr.lam, q=fr.q, z=z, state=fr.state,
                            weights=mi.w, dg_T=dg_T, R=R, rows=rows, cols=cols, vals=vals, history=history,
                            integrals=mi, energy=self._energy(g_N, mi.w, fr.t_T),
                            dissipation=float(np.sum(h.w * 0.5 * (h.t_T + fr.t_T) * fr.lam * np.sign(fr.t_T))))
