@@ -63,12 +63,16 @@ def test_wall_time_of_a_run_leaves_out_its_imports(fake_time, monkeypatch):
     1 s reports wall_time_s = 1 s, whichever entry point calls it."""
     from contactfem import scenes
 
-    def run(params):
+    def build(params, *, normal=None, friction=None, system_options=None):
         import slow_other  # noqa: F401
-        fake_time.t += 1.0
-        return {"x": params["x"]}
+        return {"systems": []}
 
-    scene = base.Scene(name="timed", title="t", params=(base.Param("x", 1.0),), run=run)
+    def simulate(model, params, progress):
+        fake_time.t += 1.0
+        return []
+
+    scene = base.Scene(name="timed", title="t", params=(base.Param("x", 1.0),), build=build,
+                       measure=lambda model, params, records: {"x": params["x"]}, simulate=simulate)
     monkeypatch.setattr(scenes, "get_scene", lambda name: scene)
     res = scenes.run_scene("timed")
     assert res["wall_time_s"] == 1.0 and "import_time_s" not in res

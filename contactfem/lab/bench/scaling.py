@@ -2,7 +2,7 @@
 
 The plain script (``plain_hertz``) solves the discrete problem of the hertz scene at the paper's
 data, written as a scikit-fem example would: the scene's graded quarter-disk mesh
-(scenes.hertz.quarter_disk), plane-strain linear elasticity assembled with ``skfem.asm``, the
+(bodies.meshes.quarter_disk), plane-strain linear elasticity assembled with ``skfem.asm``, the
 dead pressure on the flat cut, u_x = 0 on the symmetry line, and the contact as a per-length
 penalty on the nodal gaps of the scene's arc nodes against the rigid line y = -R (tributary
 lengths as weights). It is solved with scipy (``skfem.solve``: ``spsolve``, SuperLU with scipy's
@@ -33,7 +33,8 @@ def plain_hertz(n_el, params=None):
     from skfem import Basis, ElementQuad1, ElementVector, FacetBasis, LinearForm, asm, condense, solve
     from skfem.models.elasticity import lame_parameters, linear_elasticity
 
-    from ...scenes.hertz import grading_for, hertz_exact, quarter_disk
+    from ...bodies.meshes import grading_for, quarter_disk
+    from ...scenes.hertz import hertz_exact
 
     p = dict(get_scene("hertz").resolve("paper"), **(params or {}), n_el=n_el)
     R, E, nu, P, c_N = p["R"], p["E"], p["nu"], p["P"], p["c_N"]
