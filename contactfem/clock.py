@@ -52,6 +52,6 @@ def imports_timed():
     try:
         yield acc
     finally:
-        _running.remove(acc)
+        del _running[next(i for i, a in enumerate(_running) if a is acc)]    # this clock, not an equal one
         if not _running and builtins.__import__ is _timed_import:
             builtins.__import__ = _wrapped[0]

@@ -58,6 +58,17 @@ def test_nested_clocks_each_see_the_imports_inside_them(fake_time):
     assert (outer[0], inner[0]) == (6.0, 4.0)
 
 
+def test_clocks_that_read_the_same_stop_in_any_order(fake_time):
+    """Each clock stops its own accumulator, also when another one holds the same value."""
+    first = clock.imports_timed()
+    second = clock.imports_timed()
+    a, b = first.__enter__(), second.__enter__()
+    second.__exit__(None, None, None)               # both read 0: the second one stops
+    import slow_inner  # noqa: F401
+    first.__exit__(None, None, None)
+    assert (a[0], b[0]) == (2.0, 0.0)
+
+
 def test_wall_time_of_a_run_leaves_out_its_imports(fake_time, monkeypatch):
     """run_scene: a run that loads a module on first use (4 s of fake time) and computes for
     1 s reports wall_time_s = 1 s, whichever entry point calls it."""
