@@ -83,6 +83,7 @@ class Wall:
     """Penalty wall y >= y_wall for one node: R_c = c g on its y dof when g < 0; its history
     is the number of commits, and every step dissipates ``dissipation_per_commit``."""
     integration = "standard"
+    unknowns = 0
 
     def __init__(self, body, node, y_wall, c, dissipation_per_commit=0.0):
         self.body, self.node, self.y_wall, self.c = body, node, y_wall, c

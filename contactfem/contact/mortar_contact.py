@@ -140,6 +140,7 @@ class MortarContact:
     """
 
     integration = "standard"          # (no energy-consistent variant)
+    unknowns = 0                      # penalty: no unknowns of its own (contact/interfaces.py)
 
     def __init__(self, slave_body, slave_nodes, master, *, normal, friction=None, offset=0.0, search=np.inf,
                  name="mortar"):
