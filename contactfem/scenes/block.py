@@ -60,7 +60,6 @@ import numpy as np
 
 from ..bodies.materials import MATERIALS
 from ..contact import RigidLine, tributary_lengths
-from ..contact.augmented import make_interface
 from ..contact.tangents import TANGENTS
 from ..laws.friction import Coulomb, ParabolicSlip
 from ..laws.normal import PowerLaw
@@ -166,6 +165,7 @@ def friction_capacity(params):
 def check(params):
     """Before any solve: the ends kept free must leave contact nodes, and the static problem
     must have a solution (the block is held by friction alone)."""
+    enforcement.check(params)
     k, nx = params["free_end_nodes"], params["nx"]
     if not 2 * k < nx:
         raise ValueError(f"parameter free_end_nodes = {k} is out of range: allowed [1, {(nx - 1) // 2}] for nx = {nx}")
@@ -221,10 +221,11 @@ def build(params, *, normal=None, friction=None, system_options=None):
         raise ValueError(f"parameter free_end_nodes = {k} is out of range: allowed [1, {(len(bottom) - 2) // 2}] for nx = {params['nx']}")
     weights = tributary_lengths(body.X[bottom])[k:-k]        # tractions per unit length of the bottom
     slaves = bottom[k:-k]                                   # the first and last element never touch
-    contact = make_interface(params.get("enforcement", "penalty"), body, slaves, RigidLine((0.0, 0.0), (0.0, 1.0)),
-                             normal=normal or PowerLaw(c_N=params["c_N"] * per_length(params), m=params["m"]),
-                             friction=friction or friction_law(params), weights=weights, offset=-params["g_N0"],
-                             name="foundation", tangent=params["tangent"])
+    contact = enforcement.interface(params, body, slaves, RigidLine((0.0, 0.0), (0.0, 1.0)),
+                                    normal=normal or PowerLaw(c_N=params["c_N"] * per_length(params), m=params["m"]),
+                                    friction=friction or friction_law(params), weights=weights,
+                                    offset=-params["g_N0"], name="foundation", tangent=params["tangent"],
+                                    material=params["material"])
     p_y, p_x = params["p_y"], params["p_x"]
     loads = [Pressure(body, "top", lambda t: p_y * t),                # dead loads, ramped over the
              Traction(body, params["p_x_face"], lambda t: (p_x * t, 0.0))]   # pseudo-time t in [0, 1]
