@@ -243,7 +243,7 @@ def cmd_reconstruct(args):
     reconstruct(args.scene, quick=args.quick, top=args.top, json_path=args.json, cache=not args.no_cache)
 
 
-BENCH_STUDIES = ("tangents", "work_precision", "cost", "targets", "enforcement", "speed")  # = lab.bench.STUDIES
+BENCH_STUDIES = ("tangents", "work_precision", "cost", "targets", "enforcement", "speed", "semismooth")  # = lab.bench.STUDIES
 
 
 def cmd_bench(args):
@@ -349,7 +349,7 @@ def build_parser():
                     "results of earlier runs of the same code, in $CONTACTFEM_CACHE or ~/.cache/contactfem)")
     rc.set_defaults(func=cmd_reconstruct)
     bp = sub.add_parser("bench", help="speed against accuracy: tangents, work-precision, cost, targets, "
-                                      "enforcement, speed "
+                                      "enforcement, speed, semi-smooth Newton "
                                       "(writes bench.json and BENCHMARKS.md)")
     bp.add_argument("--quick", action="store_true", help="fast presets and fewer points (seconds)")
     bp.add_argument("--out", default=None,
