@@ -43,10 +43,10 @@ phase at which contact begins within a step (``gap`` = v0 dt times the phase).
 ``enforcement = lagrange`` (the impenetrability exact, a semi-smooth Newton method;
 ``contact_discretization = mortar`` gives the same one-segment end face) is the limit of
 an infinitely stiff penalty: under the trapezoidal rule the end node chatters and the
-energy grows many times over (+14 times at the fast preset), while the paper's Newmark
-0.7/0.4 damps the chatter: contact duration exact to the step, energy -13 %, about what
-that rule loses with the penalty (-10 %). Exact constraints in time need an energy- or
-velocity-consistent treatment of the impact that these steppers do not have.
+energy grows several times over, while the paper's Newmark 0.7/0.4 damps the chatter:
+the contact lasts 2 L / c to the step and the energy falls by about what that rule
+removes with the penalty (tests/test_beyond_nts.py). Exact constraints in time need an
+energy- or velocity-consistent treatment of the impact that these steppers do not have.
 
 Reported beside the exact values: contact duration (from the first to the last step
 with a compressive contact force), the peak contact stress and its mean over the
