@@ -67,8 +67,9 @@ def check_laws(normal, friction, where):
 
 
 def normal_complementarity(t_N, g_N, c_N, eligible=True):
-    """C_N, dC_N/dt_N, dC_N/dg_N and xi (module docstring) per node; ``eligible``: nodes
-    that can touch at all (a node no master faces is open whatever its gap)."""
+    """C_N, dC_N/dt_N, dC_N/dg_N and xi (module docstring) per node: the Signorini
+    conditions in place of the penalty law of eq 4; ``eligible``: nodes that can touch at
+    all (a node no master faces is open whatever its gap)."""
     p = -t_N
     g = np.where(eligible, g_N, 0.0)                  # (an uncovered mortar node has g_N = inf)
     xi = np.where(eligible, p - c_N * g, -np.inf)
@@ -79,7 +80,8 @@ def normal_complementarity(t_N, g_N, c_N, eligible=True):
 
 def friction_complementarity(law, t_T, dg_T, xi, c_T):
     """C_T and its derivatives dC_T/dt_T, dC_T/d(Delta g_T), dC_T/dxi, with the set of
-    each node (OPEN, STICK, SLIP), for the slip bound Y of ``law`` (module docstring)."""
+    each node (OPEN, STICK, SLIP), for the slip bound Y of ``law`` (eqs 10, 11; module
+    docstring): exact stick and slip in place of the stick law of eq 5 and the return map."""
     closed = xi >= 0.0
     p = np.where(closed, xi, 0.0)
     Y, dY = law.slip_bound(np.where(p > 0.0, p, 1.0), np.zeros_like(p))[:2]

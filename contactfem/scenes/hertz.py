@@ -200,7 +200,7 @@ def measure(m, params, records):
     p0_max = float(p.max())
     a_ex, p0_ex = m["a_exact"], m["p0_exact"]
     in_contact = p > 0
-    h_c = float(np.median(np.diff(rep["X"][:, 0])[: max(2, np.count_nonzero(in_contact))]))
+    h_c = float(np.median(np.diff(np.sort(x))[: max(2, np.count_nonzero(in_contact))]))
     c_eff = params["c_N"] if params["penalty"] == "per_length" else params["c_N"] / w[in_contact]
     profile_exact = p0_ex * np.sqrt(np.clip(1 - (x / a_ex) ** 2, 0, None))
     return dict(
