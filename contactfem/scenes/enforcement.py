@@ -9,8 +9,6 @@ import numpy as np
 
 from ..contact import NodeToSegment
 from ..contact.augmented import AugmentedNodeToSegment
-from ..contact.lagrange import LagrangeMortar, LagrangeNodeToSegment
-from ..contact.mortar_contact import MortarContact
 from ..solver.uzawa import Uzawa
 from .base import Param
 
@@ -65,9 +63,14 @@ def interface(params, slave, nodes, master, *, normal, friction=None, weights=1.
     kinematics for a linear material, finite otherwise)."""
     enforcement = params.get("enforcement", "penalty")
     if params.get("contact_discretization", "node_to_segment") == "node_to_segment":
+        from ..contact.lagrange import LagrangeNodeToSegment
+
         cls = {"penalty": NodeToSegment, "augmented": AugmentedNodeToSegment, "lagrange": LagrangeNodeToSegment}
         return cls[enforcement](slave, nodes, master, normal=normal, friction=friction, weights=weights,
                                 offset=offset, name=name, tangent=tangent, integration=integration)
+    from ..contact.lagrange import LagrangeMortar            # (scipy: loaded when a scene builds, not by show)
+    from ..contact.mortar_contact import MortarContact
+
     check(dict(params, enforcement=enforcement, contact_discretization="mortar"))
     if tangent != "consistent" or integration != "standard":
         raise ValueError(f"contact_discretization = mortar takes tangent = consistent and contact_integration = "
