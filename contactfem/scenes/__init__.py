@@ -44,8 +44,21 @@ def get_scene(name):
     return scenes[name]
 
 
+def check_laws(scene, laws, overrides=None):
+    """scene.check_laws (law objects or classes of kinds the scene has; no parameter set that
+    builds a law they replace), the message naming the scenes a law does apply to."""
+    try:
+        scene.check_laws(laws, overrides)
+    except ValueError as err:
+        kind = next((k for k in laws if k not in scene.laws), None)
+        if kind is None:
+            raise
+        others = [n for n, s in all_scenes().items() if kind in s.laws]
+        raise ValueError(f"{err}; scenes with a {kind} law: {', '.join(others)}") from None
+
+
 def run_scene(name, preset="fast", overrides=None, progress=None, friction=None, normal=None,
-              linear_algebra=None):
+              linear_algebra=None, check=True):
     """Run a scene and return its results with wall time, Newton iteration count, parameters and
     the linear algebra of its Systems (``linear_algebra``: dense|banded|sparse, joined by + if
     they differ; ``ordering``; ``unknowns``, the largest System's; ``band_kl``, ``band_ku``: the
@@ -55,21 +68,37 @@ def run_scene(name, preset="fast", overrides=None, progress=None, friction=None,
     ``progress(t0, t_end, label)``: a progress-callback factory handed to the scene's time
     loops (e.g. ``contactfem.io.progress_bar``); None shows nothing.
     ``friction`` / ``normal``: law objects replacing the laws the scene's parameters build
-    (recorded as ``friction_law`` / ``normal_law``: class, file, fields)."""
+    (recorded as ``friction_law`` / ``normal_law``: class, file, fields; the parameters that
+    build the replaced law are refused in ``overrides`` and left out of ``parameters``, and
+    ``variant`` names the law). ``check``: check the law objects first over the range of
+    pressures, slips and gaps the scene meets (Scene.preflight): a LawError (ValueError) for
+    a value no law may return, a warning for a derivative that disagrees with finite
+    differences. During the run every value a law object returns is checked too
+    (contactfem.laws.protocol): a LawValueError ends the run."""
     import time
+    import warnings
 
     from ..laws.protocol import describe
     from ..solver.system import System
 
     scene = get_scene(name)
+    laws = {k: v for k, v in (("friction", friction), ("normal", normal)) if v is not None}
+    check_laws(scene, laws, overrides)
     params = scene.resolve(preset, overrides)
     if linear_algebra is not None:
         from ..solver.assembly import KINDS
 
         if linear_algebra not in KINDS:
             raise ValueError(f"parameter linear_algebra = {linear_algebra!r} is not allowed: one of {'|'.join(KINDS)}")
-    laws = {k: v for k, v in (("friction", friction), ("normal", normal)) if v is not None}
-    kwargs = dict(laws, progress=progress) if progress is not None else laws
+    if check:
+        for note in scene.preflight(params, laws):
+            warnings.warn(note, UserWarning, stacklevel=2)
+    from ..laws.protocol import as_normal_law
+
+    given = dict(laws)
+    if normal is not None:                         # every call into it checked (contactfem.laws.protocol)
+        given["normal"] = as_normal_law(normal)
+    kwargs = dict(given, progress=progress) if progress is not None else given
     outer, System.built = System.built, []          # record the Systems the scene builds
     outer_la = System.default_linear_algebra
     System.default_linear_algebra = linear_algebra or outer_la
@@ -82,6 +111,8 @@ def run_scene(name, preset="fast", overrides=None, progress=None, friction=None,
     results = dict(results)
     for kind, law in laws.items():
         results[f"{kind}_law"] = describe(law)
+    if "friction" in laws and scene.law_choice is not None and "variant" in results:
+        results["variant"] = scene.variant_of(params, friction)
     results["wall_time_s"] = time.perf_counter() - t0
     # how K was assembled and factorised: dense or sparse (by size), and the ordering
     results["linear_algebra"] = "+".join(dict.fromkeys(s.linear_algebra for s in systems)) or None
@@ -93,8 +124,8 @@ def run_scene(name, preset="fast", overrides=None, progress=None, friction=None,
     results.setdefault("newton_iterations_total", 0)
     results["scene"] = name
     results["preset"] = preset
-    results["parameters"] = params
+    results["parameters"] = {k: v for k, v in params.items() if scene.law_param_kind(k, v) not in laws}
     return jsonable(results)
 
 
-__all__ = ["Param", "Scene", "all_scenes", "get_scene", "run_scene", "jsonable"]
+__all__ = ["Param", "Scene", "all_scenes", "get_scene", "run_scene", "check_laws", "jsonable"]

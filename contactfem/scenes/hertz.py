@@ -206,6 +206,10 @@ def run(params, progress=None, normal=None, friction=None):
     )
 
 
+def law_range(params):
+    """Normal law only: probed down to a penetration of a tenth of the radius."""
+    return dict(g=0.1 * params["R"])
+
 SCENE = Scene(
     name="hertz",
     title="Hertz: elastic cylinder on a rigid plane (verification, closed form)",
@@ -231,4 +235,7 @@ SCENE = Scene(
     presets={"fast": {"n_el": 32}, "paper": {"n_el": 64}},
     reports=("a", "p0", "a_exact", "p0_exact", "error_a", "error_p0"),
     size=lambda p: dict(elements=p["n_el"] ** 2, unknowns=2 * (p["n_el"] + 1) ** 2, steps=p["n_steps"]),
+    laws=("normal",),
+    law_params={"normal": ("c_N",)},
+    law_range=law_range,
 )

@@ -181,6 +181,10 @@ def run(params, progress=None, normal=None, friction=None):
     return result
 
 
+def law_range(params):
+    """Normal law only: probed down to a penetration of the blocks' height."""
+    return dict(g=params["H"])
+
 SCENE = Scene(
     name="patch",
     title="Contact patch test: stacked blocks, non-matching meshes, uniform pressure (exact: uniform)",
@@ -204,4 +208,7 @@ SCENE = Scene(
     size=lambda p: dict(elements=(p["nx_lower"] + 1 + p["nx_upper"]) * p["ny"],
                         unknowns=2 * (p["nx_lower"] + 3 + p["nx_upper"]) * (p["ny"] + 1), steps=1),
     reports=("pressure_deviation_max", "stress_deviation_max", "load_carried", "load_applied"),
+    laws=("normal",),
+    law_params={"normal": ("c_N",)},
+    law_range=law_range,
 )
