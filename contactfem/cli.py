@@ -7,7 +7,10 @@ scene meets, an output that cannot be written, a run too large for this machine)
 line on stderr, found before any solve; 1 a failed solve, its cause in one line and the
 residual history on the next, or a law that returned a value no law may return during
 the run (one line naming the law, the value and the point), or a sweep with failed runs;
-130 interrupted (Ctrl-C): one line, and none of the run's output files written."""
+130 interrupted (Ctrl-C): one line, and none of the run's output files written.
+
+$CONTACTFEM_READY_FILE, if set, names a file the command line creates as soon as it
+answers Ctrl-C with its one line (for a supervisor, or a test, that interrupts it)."""
 
 import argparse
 import os
@@ -462,9 +465,20 @@ def main(argv=None):
     return code
 
 
+def _report_ready():
+    path = os.environ.get("CONTACTFEM_READY_FILE")
+    if path:
+        try:
+            with open(path, "w"):
+                pass
+        except OSError:
+            pass
+
+
 def _main(argv):
     _RUN.clear()
     try:
+        _report_ready()
         args = build_parser().parse_args(argv)
         code = args.func(args)                       # None: done (0); a command may return its own code
         if code:

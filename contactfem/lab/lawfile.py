@@ -225,9 +225,11 @@ def make_law(cls, values=None, scene_params=None, option="--friction", notes=Non
 
 
 def probe(law, path=None, option="--friction"):
-    """Call the law once with a few values per node (through the guarded adapter), so that
-    a law failing on arrays, returning the wrong number of values or NaN, or breaking the
-    protocol (no c_T, c_T <= 0, ...) is reported now, naming the file and line."""
+    """Call the law once with a few values per node (p = 0.5, 1, 2; g_N = -0.005 ... -0.02)
+    through the guarded adapter, so that a law failing on arrays, returning the wrong number
+    of values or a value no law may return (NaN, Y < 0, t_N > 0), or breaking the protocol
+    (no c_T, c_T <= 0, ...) is reported now, naming the file and line. (Its values over the
+    range of the scene are checked by the pre-flight, and during the run.)"""
     p = np.array([0.5, 1.0, 2.0])
     try:
         with np.errstate(all="ignore"):

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .normal import PowerLaw
-from .protocol import FrictionLaw, LawError, NormalLaw, explain_call_error
+from .protocol import FrictionLaw, LawError, LawValueError, NormalLaw, explain_call_error
 from .return_map import SLIP, STICK, return_map
 
 
@@ -232,7 +232,8 @@ def _check_friction_law(law, normal, scale, rtol, dt, p_max, q_max, v_max):
         return return_map(L, t_N, dt_N, dg, t_bar, q_bar, z_bar=z_bar, dt=dt)
 
     try:
-        size = (Y0 + 1e-3 * Y0.max() + 1e-300) / c_T             # the slip increment that reaches Y0
+        # the slip increment that reaches Y0, at most the range's slip (a soft c_T would ask for more)
+        size = np.minimum((Y0 + 1e-3 * Y0.max() + 1e-300) / c_T, q_max / 3.0)
         for dg in np.array([1e-4, -1e-4, 0.05, -0.05, 0.5, -0.5, 3.0, -3.0])[:, None] * size:
             fr = rm(t_N, dt_N, dg)
             states |= set(np.unique(fr.state).tolist())
@@ -262,6 +263,9 @@ def _check_friction_law(law, normal, scale, rtol, dt, p_max, q_max, v_max):
             for an, fd in ((fr.c_T_s, d_T_fd), (fr.c_N_s, d_N_fd)):
                 err = np.abs(an - fd) / (np.abs(fd) + np.abs(an) + 1e-3 * c_T)
                 worst_tan = max(worst_tan, float(np.max(np.where(same, err, 0.0))))
+    except LawValueError as err:          # a value no law may return, within the range
+        rep.add(False, "", str(err), fatal=True)
+        return rep
     except (LawError, FloatingPointError, ValueError) as err:
         rep.add(False, "", f"the return mapping fails with this law: {err}")
         return rep

@@ -206,6 +206,7 @@ class FrictionLaw:
         self.rate = self.arity >= 3
         self.stateful = self.n_state > 0
         self.supplied, self.computed = set(), set()
+        self.check_values = True               # False: only the protocol (shapes, numbers), not the values
         self._has_evolve = self.n_state > 0 and hasattr(law, "evolve")
         self._has_offset = self.n_state > 0 and hasattr(law, "gap_offset")
 
@@ -233,7 +234,7 @@ class FrictionLaw:
         if hasattr(self.law, "initial_state"):
             z = self._guarded_call("initial_state", lambda: self.law.initial_state(n), f"initial_state({n})")
             z = np.array(_as_array(z, (n, self.n_state), f"{self.name}.initial_state({n})"), dtype=float)
-            if not self.trusted and not _all_finite([z]):
+            if not self.trusted and self.check_values and not _all_finite([z]):
                 i = int(np.argmin(_rows_finite(z)))
                 raise LawValueError(f"{self.name}.initial_state({n}) returned NaN or inf: z = "
                                     f"[{', '.join(_num(x) for x in z[i])}] at node {i}")
@@ -247,7 +248,7 @@ class FrictionLaw:
             return np.zeros(n)
         g = self._guarded_call("gap_offset", lambda: self.law.gap_offset(z), "gap_offset(z)")
         g = np.array(_as_array(g, (n,), f"{self.name}.gap_offset(z)"), dtype=float)
-        if not self.trusted and not _all_finite([g]):
+        if not self.trusted and self.check_values and not _all_finite([g]):
             ok = _rows_finite(np.asarray(z, dtype=float))
             bad = ~np.isfinite(g) & ok
             if np.any(bad):
@@ -357,7 +358,7 @@ class FrictionLaw:
         arguments are themselves not finite excepted: there the solver has failed, not the law)."""
         Y = out[0]
         out = out[:1 + self.arity]
-        if not Y.size or (_all_finite(out) and not np.any(Y < 0.0)):
+        if not self.check_values or not Y.size or (_all_finite(out) and not np.any(Y < 0.0)):
             return
         p, q, v, z = args
         ok = _rows_finite(p, q, v, z)
@@ -421,7 +422,7 @@ class FrictionLaw:
             res.append(np.imag(_as_array(zc, (n, k), f"{self.name}.evolve: z")) / H_CS)
             self.computed.add(name)
         out = (z, res[0], res[1])
-        if not _all_finite(out):
+        if self.check_values and not _all_finite(out):
             zb = as_shape(z_bar, (n, k))
             p_, lam_ = as_shape(p, (n,)), as_shape(lam, (n,))
             ok = _rows_finite(zb, p_, lam_) & bool(np.isfinite(dt))
@@ -464,11 +465,12 @@ class NormalLaw:
             raise LawError(f"{self.name} has no method traction(g_N): a normal law needs one, returning "
                            "(t_N, dt_N/dg_N)")
         self.has_energy = callable(getattr(law, "energy", None))
+        self.check_values = True               # False: only the protocol (shapes, numbers), not the values
         if self.has_energy:
             self.energy = self._energy
 
     def __getattr__(self, name):               # the law's own fields (c_N, m, ...) read through the view
-        if name in ("law", "name", "has_energy"):
+        if name in ("law", "name", "has_energy", "check_values", "trusted"):
             raise AttributeError(name)
         if name == "energy":
             raise AttributeError(f"{self.name} has no method energy(g_N): this use needs the law's potential W, "
@@ -492,7 +494,7 @@ class NormalLaw:
                                 "(t_N, dt_N/dg_N)")
         t, dt = (np.array(_as_array(np.real(a) if np.iscomplexobj(a) else a, g.shape, f"{self.name}.traction: {w}"),
                           dtype=float) for a, w in zip(out, ("t_N", "dt_N/dg_N")))
-        if not (_all_finite((t, dt)) and not np.any((t > 0.0) & (g < 0.0))):
+        if self.check_values and not (_all_finite((t, dt)) and not np.any((t > 0.0) & (g < 0.0))):
             ok = np.isfinite(g)
             for name, a in (("t_N", t), ("dt_N/dg_N", dt)):
                 bad = ~np.isfinite(a) & ok
@@ -519,7 +521,7 @@ class NormalLaw:
         except Exception as err:               # noqa: BLE001
             raise LawValueError(explain_call_error(f"{self.name}.energy", err)) from None
         W = np.array(_as_array(np.real(W) if np.iscomplexobj(W) else W, g.shape, f"{self.name}.energy"), dtype=float)
-        if not _all_finite((W,)):
+        if self.check_values and not _all_finite((W,)):
             bad = ~np.isfinite(W) & np.isfinite(g)
             if np.any(bad):
                 i = np.unravel_index(int(np.argmax(bad)), W.shape)
