@@ -69,8 +69,11 @@ def cmd_show(args):
         note = ""
         if p is not None:
             kind = sc.law_param_kind(p.name)
-            note = "; ".join(x for x in (p.doc, f"used only with {p.when_text()}" if p.when else "",
-                                         f"builds the {kind} law" if kind else "") if x)
+            if sc.law_choice is not None and p.name == sc.law_choice[0]:
+                law = f"{'|'.join(map(str, sc.law_choice[1]))} choose the friction law"
+            else:
+                law = f"builds the {kind} law" if kind else ""
+            note = "; ".join(x for x in (p.doc, f"used only with {p.when_text()}" if p.when else "", law) if x)
         print("  ".join(cells) + f"  -- {note}" if note else "  ".join(cells).rstrip())
     for name, values in sc.presets.items():
         if name not in ("fast", "paper"):
@@ -196,10 +199,11 @@ def laws_from_args(args, sets=None):
 
 def cmd_figures(args):
     from .io.outputs import check_output_dir
-    from .lab.bench import figures as _bench  # noqa: F401  (registers the bench figures)
-    from .plots import default_outdir, load_all, make_all
+    from .plots import default_outdir
 
-    check_output_dir(args.outdir or default_outdir(args.preset), "--outdir")
+    check_output_dir(args.outdir or default_outdir(args.preset), "--outdir")       # before anything heavy
+    from .lab.bench import figures as _bench  # noqa: F401  (registers the bench figures)
+    from .plots import load_all, make_all
 
     if args.only and not any(args.only in stem for stem in load_all()):
         raise ValueError(f"--only {args.only!r} matches no figure: the figures are {', '.join(sorted(load_all()))}")
@@ -282,10 +286,10 @@ def cmd_site(args):
 
 def cmd_reconstruct(args):
     from .io.outputs import check_output_path
-    from .lab.reconstruct import main as reconstruct
 
     if args.json:
-        check_output_path(args.json, "--json", (".json",))
+        check_output_path(args.json, "--json", (".json",))      # before anything heavy
+    from .lab.reconstruct import main as reconstruct
 
     reconstruct(args.scene, quick=args.quick, top=args.top, json_path=args.json, cache=not args.no_cache)
 

@@ -96,12 +96,14 @@ def sweep(scene, grid, preset="fast", jobs=1, scheduler=None, friction=None, nor
 
 
 def _parallel(tasks, jobs):
-    """The tasks on `jobs` fresh worker processes that ignore Ctrl-C from their first moment
+    """The tasks on `jobs` worker processes that ignore Ctrl-C from their first moment
     (SIGINT is ignored while they start, a setting a new process keeps), so that an
     interrupt reaches only this process, which stops them: one line, no worker traceback."""
     import multiprocessing
 
-    ctx = multiprocessing.get_context("spawn")
+    # fork where there is one: the workers start at once with what is loaded, and its semaphores
+    # need no resource tracker (which would warn of them after an interrupt)
+    ctx = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn")
     previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
         pool = ctx.Pool(jobs, initializer=_ignore_interrupts)

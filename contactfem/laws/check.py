@@ -252,7 +252,7 @@ def _check_friction_law(law, normal, scale, rtol, dt, p_max, q_max, v_max):
                 worst_f = max(worst_f, np.max(np.maximum(f[stick], 0.0) / scale_f[stick]))
             min_diss = min(min_diss, float(np.min(fr.dissipation)))
             # tangents by central differences in the slip increment and in the gap
-            h_g = 1e-7 * np.abs(dg)
+            h_g = 1e-7 * (np.abs(dg) + (np.abs(t_bar) + Y0) / c_T)       # round-off: relative to t_T, not dg
             d_T_fd = _fd(lambda x: rm(t_N, dt_N, x).t_T, dg, h_g)
             h_p = 1e-7 * p
             d_N_fd = _fd(lambda x: rm(-x, dt_N, dg).t_T, p, h_p) * -dt_N     # dt_T/dg_N = dt_T/dp dp/dg_N

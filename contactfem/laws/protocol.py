@@ -140,10 +140,11 @@ def _as_array(value, shape, what):
         raise LawValueError(f"{what} is not an array of numbers ({err})") from None
     if a.dtype == object or not (np.issubdtype(a.dtype, np.number) or a.dtype == bool):
         raise LawValueError(f"{what} is not an array of numbers (got {type(value).__name__})")
-    try:
+    if a.shape == shape or a.ndim == 0:               # one value per node, or one for all
         return np.broadcast_to(a, shape)
-    except ValueError:
-        raise LawValueError(f"{what} has shape {a.shape}, expected {shape} (one value per contact node)") from None
+    if len(shape) == 2 and shape[1] == 1 and a.shape == shape[:1]:     # one internal variable, as (n,)
+        return a.reshape(shape)
+    raise LawValueError(f"{what} has shape {a.shape}, expected {shape} (one value per contact node)")
 
 
 def as_shape(a, shape):
