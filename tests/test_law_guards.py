@@ -323,3 +323,39 @@ def test_check_law_reaches_the_pressures_a_scene_meets():
     assert "p in [0, 40]" in str(check_law(bad, p_max=40.0))
     range_ = get_scene("block").law_range(get_scene("block").resolve("fast"))
     assert not check_law(bad, p_max=range_["p"]).ok
+
+
+def test_check_laws_keywords_are_documented_in_its_docstring_and_the_readme():
+    """Every keyword check_law accepts (those of the friction and the normal checks) is in
+    its docstring and in the README's table of 'Writing your own friction law', and no other."""
+    import inspect
+
+    from contactfem.laws.check import check_friction_law, check_law, check_normal_law
+
+    accepted = {n for f in (check_friction_law, check_normal_law) for n in inspect.signature(f).parameters} - {"law"}
+    documented = set(re.findall(r"^    ``(\w+)``", check_law.__doc__, re.M))
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    section = readme.split("## Writing your own friction law")[1].split("\n## ")[0]
+    in_readme = set(re.findall(r"^\| `(\w+)` \|", section, re.M))
+    assert accepted == documented == in_readme, (accepted, documented, in_readme)
+
+
+def test_the_readmes_example_of_a_lying_law_is_what_the_command_line_says(capsys):
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    block = re.search(r"\n\$ contactfem run block --friction tests/data/lying_laws.py:NaNAbove\n(.*?)\n```", readme,
+                      re.S).group(1).splitlines()
+    shown = {}
+    cmd = ["run", "block", "--friction", "tests/data/lying_laws.py:NaNAbove"]
+    shown[tuple(cmd)] = block[0]
+    assert block[1] == "$ contactfem " + " ".join(cmd + ["--no-check"])
+    shown[tuple(cmd + ["--no-check"])] = block[2]
+    import os
+
+    cwd = os.getcwd()
+    os.chdir(Path(__file__).resolve().parents[1])
+    try:
+        for argv, line in shown.items():
+            main(list(argv))
+            assert capsys.readouterr().err.strip() == line
+    finally:
+        os.chdir(cwd)
