@@ -359,3 +359,12 @@ def test_the_readmes_example_of_a_lying_law_is_what_the_command_line_says(capsys
             assert capsys.readouterr().err.strip() == line
     finally:
         os.chdir(cwd)
+
+
+@pytest.mark.parametrize("field,value", [("mu", "nan"), ("mu", "inf"), ("delta", "-inf")])
+def test_a_field_that_is_not_finite_is_refused_when_the_law_is_built(field, value, capsys):
+    rc, err, _ = cli(capsys, "run", "rolling_ring", "--friction", f"{LAWS}:OwnFields", "--set", f"law.{field}={value}")
+    assert rc == 2
+    _one_line(err, rf"OwnFields\.{field} = {value}: a law's field must be a finite number")
+    with pytest.raises(LawError, match=rf"OwnFields\.{field} = {value}"):
+        run_scene("rolling_ring", "fast", friction=law("OwnFields", **{field: float(value)}), check=False)

@@ -109,6 +109,19 @@ def _num(x):
     return f"{x.real:.6g}"
 
 
+def check_fields(law):
+    """LawError unless every number among a dataclass law's fields is finite (checked when
+    an adapter is made: a NaN field would only come back as NaN values during the run)."""
+    import dataclasses
+
+    if not dataclasses.is_dataclass(law):
+        return
+    for f in dataclasses.fields(law):
+        v = getattr(law, f.name, None)
+        if isinstance(v, (int, float, np.number)) and not isinstance(v, (bool, np.bool_)) and not math.isfinite(v):
+            raise LawError(f"{_name(law)}.{f.name} = {v}: a law's field must be a finite number")
+
+
 def slip_bound_arity(law):
     """2, 3 or 4: how many of (p, q, v, z) the law's slip_bound takes."""
     fun = getattr(law, "slip_bound", None)
@@ -155,11 +168,13 @@ def as_shape(a, shape):
 
 
 def _all_finite(arrays):
-    """True if every value of every array is finite (a sum is non-finite if any term is;
-    the exact test only where the sum overflows)."""
+    """True if every value of every array is finite (a . a is non-finite if any value is:
+    one BLAS call, a third of a microsecond; the exact test only where it overflows)."""
     for a in arrays:
-        if a.size and not math.isfinite(a.sum()) and not np.all(np.isfinite(a)):
-            return False
+        if a.size:
+            f = a.ravel()
+            if not math.isfinite(f.dot(f)) and not np.all(np.isfinite(f)):
+                return False
     return True
 
 
@@ -196,6 +211,7 @@ class FrictionLaw:
         if not (math.isfinite(self.c_T) and (self.c_T > 0 or (self.trusted and self.c_T == 0))):
             raise LawError(f"{self.name}.c_T = {self.c_T:g} is out of range: the stick stiffness (eq 5) must be a "
                            "finite number > 0")
+        check_fields(law)
         k = getattr(law, "n_state", 0)
         try:
             ok = int(k) == k and k >= 0
@@ -331,7 +347,8 @@ class FrictionLaw:
         if np.iscomplexobj(Y):
             Y = np.real(Y)
         Y = np.array(_as_array(Y, (n,), f"{self.name}.slip_bound: Y"), dtype=float)
-        self._guard_slip_bound(args, (Y,))          # Y first: its derivatives are computed from it
+        if any(d is None for d in ders):        # Y first: the missing derivatives are computed from it
+            self._guard_slip_bound(args, (Y,))
         res = []
         for j in range(4):
             name = f"dY/d{ARG_NAMES[j]}"
@@ -359,8 +376,8 @@ class FrictionLaw:
         arguments are themselves not finite excepted: there the solver has failed, not the law)."""
         Y = out[0]
         out = out[:1 + self.arity]
-        if not self.check_values or not Y.size or (_all_finite(out) and not np.any(Y < 0.0)):
-            return
+        if not self.check_values or not Y.size or (Y.min() >= 0.0 and _all_finite(out)):
+            return                             # (the minimum is NaN, not >= 0, if a value is NaN)
         p, q, v, z = args
         ok = _rows_finite(p, q, v, z)
         names = ["Y"] + [f"dY/d{a}" for a in ARG_NAMES[:self.arity]]
@@ -465,6 +482,7 @@ class NormalLaw:
                                "friction law (--friction, friction=), not as the normal law")
             raise LawError(f"{self.name} has no method traction(g_N): a normal law needs one, returning "
                            "(t_N, dt_N/dg_N)")
+        check_fields(law)
         self.has_energy = callable(getattr(law, "energy", None))
         self.check_values = True               # False: only the protocol (shapes, numbers), not the values
         if self.has_energy:
@@ -495,7 +513,7 @@ class NormalLaw:
                                 "(t_N, dt_N/dg_N)")
         t, dt = (np.array(_as_array(np.real(a) if np.iscomplexobj(a) else a, g.shape, f"{self.name}.traction: {w}"),
                           dtype=float) for a, w in zip(out, ("t_N", "dt_N/dg_N")))
-        if self.check_values and not (_all_finite((t, dt)) and not np.any((t > 0.0) & (g < 0.0))):
+        if self.check_values and t.size and not (_all_finite((t, dt)) and (t.max() <= 0.0 or not np.any((t > 0.0) & (g < 0.0)))):
             ok = np.isfinite(g)
             for name, a in (("t_N", t), ("dt_N/dg_N", dt)):
                 bad = ~np.isfinite(a) & ok
