@@ -103,7 +103,7 @@ def test_a_failed_newton_prints_its_residuals_once(capsys):
 
 def test_sweep_counts_its_failures(tmp_path, capsys):
     out = tmp_path / "sw.csv"
-    assert main(["sweep", "block", "--set", "law=coulomb", "--set", "maxit=1,40", "--out", str(out)]) == 0
+    assert main(["sweep", "block", "--set", "law=coulomb", "--set", "maxit=1,40", "--out", str(out)]) == 1
     text = capsys.readouterr().out
     assert "2 runs, 1 succeeded, 1 failed" in text and "failed: law=coulomb, maxit=1: NewtonError" in text
 
@@ -121,7 +121,7 @@ def test_show_columns_are_aligned_and_units_given(capsys):
         assert main(["show", name]) == 0
         lines = capsys.readouterr().out.splitlines()
         head = lines[1]
-        cols = [head.index(c) for c in ("default", "unit", "allowed")]
+        cols = [head.index(c) for c in ("fast (run)", "unit", "allowed")]
         for line in lines[2:2 + len(sc.params)]:
             row = line.split("  -- ")[0]
             for c in cols[1:]:
