@@ -9,7 +9,7 @@ Listing the scenes imports every scene module, so a scene module imports scikit-
 import importlib
 import pkgutil
 
-from .base import Param, Scene, jsonable
+from .base import Param, Scene, Stage, jsonable, simulate
 
 
 def all_scenes():
@@ -58,15 +58,16 @@ def check_laws(scene, laws, overrides=None):
 
 
 def run_scene(name, preset="fast", overrides=None, progress=None, friction=None, normal=None,
-              linear_algebra=None, check=True):
-    """Run a scene and return its results with wall time, Newton iteration count, parameters and
-    the linear algebra of its Systems (``linear_algebra``: dense|banded|sparse, joined by + if
-    they differ; ``ordering``; ``unknowns``, the largest System's; ``band_kl``, ``band_ku``: the
-    half-bandwidths of a banded K, else None).
+              linear_algebra=None, instrument=None, check=True):
+    """Run a scene and return its JSON-able results with the parameters used, the run's own wall
+    time, Newton iteration count and the linear algebra of its Systems (``linear_algebra``:
+    dense|banded|sparse, joined by + if they differ; ``ordering``; ``unknowns``, the largest
+    System's; ``band_kl``, ``band_ku``: the half-bandwidths of a banded K, else None), and how
+    often they were evaluated (``residual_evaluations``, ``contact_evaluations``).
     ``linear_algebra``: auto|dense|banded|sparse for every System the scene builds (None: auto,
     chosen by size and band width), to compare the solvers on one scene.
-    ``progress(t0, t_end, label)``: a progress-callback factory handed to the scene's time
-    loops (e.g. ``contactfem.io.progress_bar``); None shows nothing.
+    ``progress(t0, t_end, label)``: a progress-callback factory for the scene's time loops
+    (e.g. ``contactfem.io.progress_bar``); None shows nothing.
     ``friction`` / ``normal``: law objects replacing the laws the scene's parameters build
     (recorded as ``friction_law`` / ``normal_law``: class, file, fields; the parameters that
     build the replaced law are refused in ``overrides`` and left out of ``parameters``, and
@@ -74,58 +75,34 @@ def run_scene(name, preset="fast", overrides=None, progress=None, friction=None,
     pressures, slips and gaps the scene meets (Scene.preflight): a LawError (ValueError) for
     a value no law may return, a warning for a derivative that disagrees with finite
     differences. During the run every value a law object returns is checked too
-    (contactfem.laws.protocol): a LawValueError ends the run."""
-    import time
+    (contactfem.laws.protocol): a LawValueError ends the run.
+    ``instrument``: a solver.instrument.Timings handed to every System (the bench's timings)."""
     import warnings
 
-    from ..laws.protocol import describe
-    from ..solver.system import System
+    from ..laws.protocol import as_normal_law, describe
+    from ..solver.assembly import KINDS
 
     scene = get_scene(name)
     laws = {k: v for k, v in (("friction", friction), ("normal", normal)) if v is not None}
     check_laws(scene, laws, overrides)
     params = scene.resolve(preset, overrides)
-    if linear_algebra is not None:
-        from ..solver.assembly import KINDS
-
-        if linear_algebra not in KINDS:
-            raise ValueError(f"parameter linear_algebra = {linear_algebra!r} is not allowed: one of {'|'.join(KINDS)}")
+    if linear_algebra is not None and linear_algebra not in KINDS:
+        raise ValueError(f"parameter linear_algebra = {linear_algebra!r} is not allowed: one of {'|'.join(KINDS)}")
     if check:
         for note in scene.preflight(params, laws):
             warnings.warn(note, UserWarning, stacklevel=2)
-    from ..laws.protocol import as_normal_law
-
-    given = dict(laws)
-    if normal is not None:                         # every call into it checked (contactfem.laws.protocol)
-        given["normal"] = as_normal_law(normal)
-    kwargs = dict(given, progress=progress) if progress is not None else given
-    outer, System.built = System.built, []          # record the Systems the scene builds
-    outer_la = System.default_linear_algebra
-    System.default_linear_algebra = linear_algebra or outer_la
-    t0 = time.perf_counter()
-    try:
-        results = scene.run(params, **kwargs)
-    finally:
-        systems, System.built = System.built, outer
-        System.default_linear_algebra = outer_la
-    results = dict(results)
+    if normal is not None:                          # every call into it checked (contactfem.laws.protocol)
+        normal = as_normal_law(normal)
+    results = scene.run(params, normal=normal, friction=friction, progress=progress,
+                        linear_algebra=linear_algebra or "auto", instrument=instrument)
     for kind, law in laws.items():
         results[f"{kind}_law"] = describe(law)
     if "friction" in laws and scene.law_choice is not None and "variant" in results:
         results["variant"] = scene.variant_of(params, friction)
-    results["wall_time_s"] = time.perf_counter() - t0
-    # how K was assembled and factorised: dense or sparse (by size), and the ordering
-    results["linear_algebra"] = "+".join(dict.fromkeys(s.linear_algebra for s in systems)) or None
-    results["ordering"] = "+".join(dict.fromkeys(s.ordering for s in systems)) or None
-    results["unknowns"] = max((s.ndof for s in systems), default=None)
-    bands = [s.band for s in systems if s.band is not None]
-    results["band_kl"] = max((kl for kl, _ in bands), default=None)     # banded: the widest band
-    results["band_ku"] = max((ku for _, ku in bands), default=None)
-    results.setdefault("newton_iterations_total", 0)
     results["scene"] = name
     results["preset"] = preset
     results["parameters"] = {k: v for k, v in params.items() if scene.law_param_kind(k, v) not in laws}
     return jsonable(results)
 
 
-__all__ = ["Param", "Scene", "all_scenes", "get_scene", "run_scene", "check_laws", "jsonable"]
+__all__ = ["Param", "Scene", "Stage", "all_scenes", "get_scene", "run_scene", "check_laws", "jsonable", "simulate"]
