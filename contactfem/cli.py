@@ -123,11 +123,11 @@ def cmd_run(args):
             if shutil.which("ffmpeg") is None:
                 raise ValueError(f"--gif {args.gif}: writing .mp4 needs ffmpeg on the PATH; write a .gif instead")
     est = check_resources(scene, params, args.force)
-    for note in notes:
+    warnings = scene.preflight(params, laws) if laws and not args.no_check else []   # the laws over the scene's range
+    for note in notes:                                # (after every refusal: a refusal is one line)
         print(f"contactfem: note: {note}", file=sys.stderr)
-    if laws and not args.no_check:                    # the laws over the range the scene meets
-        for warning in scene.preflight(params, laws):
-            print(f"contactfem: warning: {warning}", file=sys.stderr)
+    for warning in warnings:
+        print(f"contactfem: warning: {warning}", file=sys.stderr)
     if est is not None and est.get("elements", 0) > 1e5:
         print(f"{scene.name}: building the mesh and the system ({describe(est)}) ...", file=sys.stderr, flush=True)
     progress = None
