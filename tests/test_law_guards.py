@@ -16,7 +16,7 @@ import pytest
 from contactfem.cli import main
 from contactfem.lab.lawfile import load_class
 from contactfem.laws import Coulomb, PowerLaw, Stribeck
-from contactfem.laws.protocol import (FrictionLaw, LawError, LawValueError, NormalLaw, as_friction_law,
+from contactfem.laws.protocol import (FrictionLaw, LawError, LawValueError, NormalLawView, as_friction_law,
                                       as_normal_law)
 from contactfem.scenes import get_scene, run_scene
 
@@ -113,7 +113,7 @@ def test_the_normal_adapter_checks_sign_values_and_says_when_a_law_has_no_energy
         N.energy(np.zeros(1))
     assert as_normal_law(PowerLaw(c_N=2.0)).has_energy and as_normal_law(N) is N
     with pytest.raises(LawError, match="is a friction law .* not as the normal law"):
-        NormalLaw(Coulomb(c_T=1.0, mu=0.3))
+        NormalLawView(Coulomb(c_T=1.0, mu=0.3))
     with pytest.raises(LawError, match="is a normal law .* not as the friction law"):
         FrictionLaw(PowerLaw(c_N=1.0))
 

@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..laws.protocol import FrictionLaw, LawError, NormalLaw, describe  # noqa: F401 (describe: public here too)
+from ..laws.protocol import FrictionLaw, LawError, NormalLawView, describe  # noqa: F401 (describe: public here too)
 
 KINDS = ("friction", "normal")
 
@@ -234,7 +234,7 @@ def probe(law, path=None, option="--friction"):
     try:
         with np.errstate(all="ignore"):
             if option == "--normal":
-                NormalLaw(law).traction(-0.01 * p)
+                NormalLawView(law).traction(-0.01 * p)
             else:
                 L = FrictionLaw(law)
                 z = L.evolve(L.initial_state(3), p, 0.1 * p, 1.0)[0]

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .normal import PowerLaw
-from .protocol import FrictionLaw, LawError, LawValueError, NormalLaw, explain_call_error
+from .protocol import FrictionLaw, LawError, LawValueError, NormalLawView, explain_call_error
 from .return_map import SLIP, STICK, return_map
 
 
@@ -194,7 +194,7 @@ def _check_friction_law(law, normal, scale, rtol, dt, p_max, q_max, v_max):
     n = len(p)
     t_N = -p
     try:      # a normal stiffness dt_N/dg_N for the modulus dt_T/dg_N (any positive one serves)
-        dt_N = np.abs(NormalLaw(normal).traction(-p / (10.0 * scale))[1])
+        dt_N = np.abs(NormalLawView(normal).traction(-p / (10.0 * scale))[1])
     except LawError:
         dt_N = np.zeros(n)
     dt_N = np.where(np.isfinite(dt_N) & (dt_N > 0), dt_N, 10.0 * scale)
@@ -286,7 +286,7 @@ def check_normal_law(law, scale=1.0, rtol=1e-6, g_max=None):
     g_max = scale if g_max is None else float(g_max)
     with np.errstate(all="ignore"):
         try:
-            N = NormalLaw(law)
+            N = NormalLawView(law)
         except LawError as err:
             rep.add(False, "", str(err), fatal=True)
             return rep
@@ -412,7 +412,7 @@ def preflight(friction=None, normal=None, p=1.0, q=1.0, v=1.0, dt=1.0, g=1.0, ho
     warnings = []
     with np.errstate(all="ignore"):
         if normal is not None:
-            N = NormalLaw(normal)
+            N = NormalLawView(normal)
             if not N.trusted:
                 rep = check_normal_law(normal, g_max=g)
                 if rep.errors:

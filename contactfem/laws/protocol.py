@@ -32,8 +32,11 @@ supplied and which computed, for ``check_law`` to say.
 The contact reads every law through an adapter, ``as_friction_law(law)`` or
 ``as_normal_law(law)``, and each adapter checks what the law returns where it returns
 (guarded evaluation): non-finite values, a negative slip bound Y, a tensile normal
-traction (t_N > 0 in contact), a wrong shape. The adapter also checks the stick
-stiffness once, when it is made: c_T finite and > 0.
+traction (t_N > 0 in contact), a wrong shape. When it is made, the adapter checks the
+stick stiffness (c_T finite and > 0) and the law's fields (every number finite).
+``check_values = False`` on an adapter leaves the values unchecked (only the protocol).
+The adapters are ``FrictionLaw`` and ``NormalLawView`` (the protocols they read are
+written down in laws/interfaces.py).
 
     LawError       the law does not follow the protocol (no c_T, c_T <= 0, a slip_bound
                    with the wrong arguments, ...), found when the adapter is made: bad
@@ -462,8 +465,8 @@ def as_friction_law(law):
     return law if isinstance(law, FrictionLaw) else FrictionLaw(law)
 
 
-class NormalLaw:
-    """A normal law read through the protocol: ``traction(g_N) -> (t_N, dt_N/dg_N)`` and,
+class NormalLawView:
+    """A normal law (laws.interfaces.NormalLaw) read through the protocol: ``traction(g_N) -> (t_N, dt_N/dg_N)`` and,
     if the law has one, ``energy(g_N)``, its potential (dW/dg_N = t_N). ``has_energy``
     says whether it has one; without one the view has no attribute ``energy`` either
     (``hasattr(view, "energy")`` is False, and reading it raises an AttributeError that
@@ -549,16 +552,16 @@ class NormalLaw:
 
 
 def as_normal_law(law):
-    """A NormalLaw view of law (law itself if it already is one): the only way the contact
+    """A NormalLawView of law (law itself if it already is one): the only way the contact
     calls a normal law. LawError if law is no normal law."""
-    return law if isinstance(law, NormalLaw) else NormalLaw(law)
+    return law if isinstance(law, NormalLawView) else NormalLawView(law)
 
 
 def describe(law):
     """JSON record of a law: class, file (None for a shipped law, else the law file it came from) and fields."""
     import dataclasses
 
-    law = getattr(law, "law", law) if isinstance(law, (FrictionLaw, NormalLaw)) else law
+    law = getattr(law, "law", law) if isinstance(law, (FrictionLaw, NormalLawView)) else law
     cls = type(law)
     fields = ({f.name: getattr(law, f.name) for f in dataclasses.fields(law)} if dataclasses.is_dataclass(law) else {})
     return {"class": cls.__name__, "file": getattr(cls, "_contactfem_file", None), "fields": fields}
