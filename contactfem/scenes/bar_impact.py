@@ -161,6 +161,10 @@ def measure(m, params, records):
     )
 
 
+def law_range(params):
+    """Normal law only: probed down to a penetration of the bar's height."""
+    return dict(g=params["h"])
+
 SCENE = Scene(
     name="bar_impact",
     title="Bar impact on a rigid wall (verification, 1-D wave theory)",
@@ -194,4 +198,7 @@ SCENE = Scene(
                         * p["n_el"] / p["courant"]),
     reports=("duration", "duration_exact", "stress_mean", "stress_peak", "stress_exact",
              "rebound_velocity", "energy_error"),
+    laws=("normal",),
+    law_params={"normal": ("c_N_factor",)},
+    law_range=law_range,
 )

@@ -319,6 +319,18 @@ def measure(model, params, records):
     }
 
 
+def law_range(params):
+    """The range the foundation's laws meet (Scene.law_range): pressures (per unit length)
+    up to the whole top load on the narrowest node, p_y width / (width / nx); slips up to
+    the block's height; the pseudo-time step 1 / n_steps; and, with dead loads (the linear
+    material), the hold: the pull |p_x| height against the friction under the load p_y width."""
+    w = params["width"] / params["nx"]
+    N = params["p_y"] * params["width"]
+    dt = 1.0 / params["n_steps"]
+    hold = (dict(T=abs(params["p_x"]) * params["height"], N=N, L=contact_length(params), w_min=w)
+            if params["material"] == "linear" else None)
+    return dict(p=N / w, q=params["height"], v=params["height"] / dt, dt=dt, g=params["height"], hold=hold)
+
 SCENE = Scene(
     name="block",
     title="Elastic block pressed on a rough rigid foundation and pulled sideways (Sec. 5.1, Figs 6-8, Table 1)",
@@ -340,4 +352,8 @@ SCENE = Scene(
              "n_stick", "n_slip", "contact"),
     check=check,
     size=size,
+    laws=("normal", "friction"),
+    law_params={"friction": ("c_T", "alpha", "beta", "n", "mu"), "normal": ("c_N", "m")},
+    law_choice=("law", LAWS),
+    law_range=law_range,
 )

@@ -219,6 +219,10 @@ def measure(m, params, records):
     )
 
 
+def law_range(params):
+    """Normal law only: probed down to a penetration of a tenth of the radius."""
+    return dict(g=0.1 * params["R"])
+
 SCENE = Scene(
     name="hertz",
     title="Hertz: elastic cylinder on a rigid plane (verification, closed form)",
@@ -256,4 +260,7 @@ SCENE = Scene(
     size=lambda p: dict(elements=p["n_el"] ** 2 * (2.5 if p["foundation"] == "elastic" else 1),
                         unknowns=2 * (p["n_el"] + 1) ** 2 * (2.5 if p["foundation"] == "elastic" else 1),
                         steps=p["n_steps"]),
+    laws=("normal",),
+    law_params={"normal": ("c_N",)},
+    law_range=law_range,
 )

@@ -177,6 +177,10 @@ def measure(m, params, records):
     return result
 
 
+def law_range(params):
+    """Normal law only: probed down to a penetration of the blocks' height."""
+    return dict(g=params["H"])
+
 SCENE = Scene(
     name="patch",
     title="Contact patch test: stacked blocks, non-matching meshes, uniform pressure (exact: uniform)",
@@ -206,4 +210,7 @@ SCENE = Scene(
     size=lambda p: dict(elements=(p["nx_lower"] + 1 + p["nx_upper"]) * p["ny"],
                         unknowns=2 * (p["nx_lower"] + 3 + p["nx_upper"]) * (p["ny"] + 1), steps=1),
     reports=("pressure_deviation_max", "stress_deviation_max", "load_carried", "load_applied"),
+    laws=("normal",),
+    law_params={"normal": ("c_N",)},
+    law_range=law_range,
 )
