@@ -223,6 +223,7 @@ def law_range(params):
     """Normal law only: probed down to a penetration of a tenth of the radius."""
     return dict(g=0.1 * params["R"])
 
+
 SCENE = Scene(
     name="hertz",
     title="Hertz: elastic cylinder on a rigid plane (verification, closed form)",
