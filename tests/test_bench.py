@@ -124,7 +124,7 @@ def test_quick_bench_writes_json_and_markdown(tmp_path):
     md = (tmp_path / "BENCHMARKS.md").read_text()
     assert md == write_markdown(res)
     for section in ("## The paper's claim", "## Work against precision", "## Cost of one Newton iteration",
-                    "## Targets", "## Scaling"):
+                    "## Targets", "## Penalty, Uzawa, semi-smooth Newton", "## Scaling"):
         assert section in md
     assert "nan" not in md.lower()
     loads = res["speed"]["startup"]["loads"]           # the start-up account's claims, from the run

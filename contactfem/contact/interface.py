@@ -63,6 +63,8 @@ class NodeToSegment:
     (the wear of a step acts from the next step on).
     """
 
+    unknowns = 0                            # no unknowns of its own (contact/interfaces.py)
+
     def __init__(self, slave, nodes, master, *, normal, friction=None, weights=1.0, offset=0.0, name="contact",
                  tangent="consistent", integration="standard"):
         if tangent not in TANGENTS:

@@ -8,6 +8,7 @@ import numpy as np
 from .common import TARGETS
 from .enforcement import enforcement_markdown
 from .scaling import scaling_markdown
+from .semismooth import semismooth_markdown
 from .speed import PARTS, RINGS, SPEED_TARGETS, STARTUP_LAYERS
 
 def _f(x, fmt="{:.3g}"):
@@ -311,6 +312,8 @@ def write_markdown(res):
         L += enforcement_markdown(res["enforcement"])
     if "speed" in res:
         L += speed_section(res["speed"])
+    if "semismooth" in res:
+        L += semismooth_markdown(res["semismooth"])
     if "scaling" in res:
         L += scaling_markdown(res["scaling"])
     return "\n".join(L) + "\n"
