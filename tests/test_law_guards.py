@@ -240,6 +240,7 @@ def test_a_laws_own_fields_keep_their_defaults_and_cli_equals_python(capsys, tmp
     b = run_scene("rolling_ring", "fast", {"t_end": 0.3}, friction=law("OwnFields", delta=0.05))
     a.pop("wall_time_s")
     b.pop("wall_time_s")
+    assert a.pop("import_time_s") >= 0 and "import_time_s" not in b     # the process's: command line only
     assert a == json.loads(json.dumps(b))
 
 
