@@ -194,24 +194,36 @@ def build(out=None, instructor=False, repo=None, only=None):
     """Write the student version (or the instructor version) of every lecture into `out`;
     returns the notebooks written. Lectures without exercises are copied as they are.
     `only`: lecture names (stems) to build, default all."""
+    version = "instructor" if instructor else "student"
+    return build_versions({version: out or default_out(instructor)}, repo=repo, only=only)[version]
+
+
+def build_versions(outs, repo=None, only=None):
+    """Both versions in one pass (otter assign runs once per lecture): `outs` maps
+    "student" and/or "instructor" to a folder. Returns {version: [notebooks written]}."""
     import nbformat
 
     sources = [s for s in lecture_sources(repo) if only is None or s.stem in only]
-    out = check_out_dir(out or default_out(instructor))
-    out.mkdir(parents=True, exist_ok=True)
-    written = []
+    outs = {v: check_out_dir(o) for v, o in outs.items()}
+    written = {v: [] for v in outs}
+    for o in outs.values():
+        o.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="contactfem-course-") as tmp:
         for src in sources:
-            dst = out / src.name
-            if not questions(nbformat.read(src, as_version=4)):
-                shutil.copy2(src, dst)
-            else:
-                student, teacher, zip_path = _assign(src, Path(tmp))
-                shutil.copy2(teacher if instructor else student, dst)
-                if instructor:
+            built = None
+            if questions(nbformat.read(src, as_version=4)):
+                built = _assign(src, Path(tmp))
+            for version, out in outs.items():
+                dst = out / src.name
+                if built is None:
+                    shutil.copy2(src, dst)
+                elif version == "student":
+                    shutil.copy2(built[0], dst)
+                else:
+                    shutil.copy2(built[1], dst)
                     (out / "autograder").mkdir(exist_ok=True)
-                    shutil.copy2(zip_path, out / "autograder" / f"{src.stem}.zip")
-            written.append(dst)
+                    shutil.copy2(built[2], out / "autograder" / f"{src.stem}.zip")
+                written[version].append(dst)
     return written
 
 
@@ -256,7 +268,9 @@ def _grade_one(path, zip_path):
         scores[name], possible[name] = float(r.score), float(r.possible)
         failed = [tcr for tcr in r.test_case_results if not tcr.passed]
         if failed:      # the first failing part's hint; the others usually repeat it
-            hint = re.sub(r"^AssertionError: ", "", failed[0].message.strip().splitlines()[-1])
+            msg = failed[0].message.strip()
+            hint = msg.split("AssertionError: ", 1)[1] if "AssertionError: " in msg else msg.splitlines()[-1]
+            hint = " ".join(hint.split())
             more = f" (and {len(failed) - 1} more part{'s' if len(failed) > 2 else ''})" if len(failed) > 1 else ""
             notes.append(f"{name}: {hint}{more}")
     return scores, possible, notes

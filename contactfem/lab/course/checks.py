@@ -52,7 +52,7 @@ def _time_limit(seconds):
 def _args_text(args, kwargs):
     def show(a):
         if isinstance(a, np.ndarray):
-            return np.array2string(a, precision=4, separator=", ", threshold=8)
+            return " ".join(np.array2string(a, precision=4, separator=", ", threshold=8).split())
         return repr(a)
     return ", ".join([show(a) for a in args] + [f"{k}={show(v)}" for k, v in kwargs.items()])
 
