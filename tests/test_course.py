@@ -123,6 +123,22 @@ def test_each_exercise_is_in_its_lecture_labelled_and_last():
     assert sorted(p.stem for p in WRONG.glob("*.py")) == sorted(ex)
 
 
+def test_course_plan_lists_every_exercise_as_graded():
+    """The README's tables of exercises (plan and checks) say what checks.EXERCISES holds."""
+    text = (REPO / "lectures" / "README.md").read_text()
+    ex = _exercises()
+    rows = {m.group(1): [c.strip() for c in m.group(2).split("|")]
+            for m in re.finditer(r"^\| `(ex\w+)` \|(.*)\|$", text, re.M)}
+    assert sorted(rows) == sorted(ex)
+    for name, (difficulty, implements, points, what) in rows.items():
+        e = ex[name]
+        assert (difficulty, implements == "yes", float(points)) == (e.difficulty, e.implements, e.points), name
+        shown = [float(x) for x in re.findall(r"\((\d+)\)", what)]
+        assert sum(shown) == e.points, f"{name}: the parts' points in the README add up to {sum(shown)}"
+    plan = dict(re.findall(r"`(ex\w+)` \((\d+)\)", text))
+    assert {k: float(v) for k, v in plan.items()} == {n: e.points for n, e in ex.items()}
+
+
 # -- the checks, in this process --------------------------------------------------------------
 
 def _run(name, code):
