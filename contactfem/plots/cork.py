@@ -18,8 +18,8 @@ import os
 
 import numpy as np
 
+from ..contact.masters import bottle_neck
 from ..scenes.base import jsonable
-from ..scenes.cork import Neck, cork_mesh
 from . import cached_run, default_outdir, figure, pyplot, savefig
 
 
@@ -29,10 +29,12 @@ def result(preset="fast", **overrides):
 
 
 def _geometry(params):
+    from ..bodies.meshes import cork_mesh
+
     P = params
     mesh = cork_mesh(P["R_tip"], P["R_cork"], P["L_neck"], P["L_neck"] + P["r_mouth"] + P["L_head"],
                      P["n_r"], P["n_z"])
-    neck = Neck(P["R_neck"], P["L_neck"], P["r_mouth"], z_low=-P["gas_column"])
+    neck = bottle_neck(P["R_neck"], P["L_neck"], P["r_mouth"], z_low=-P["gas_column"])
     return mesh, neck
 
 
@@ -50,7 +52,8 @@ def draw_neck(ax, neck, gas_column=None):
     for sign in (1.0, -1.0):
         ax.plot(sign * P[:, 0], P[:, 1], color="0.25", lw=2.0)
     if gas_column is not None:
-        ax.fill_between([-neck.R_neck, neck.R_neck], -gas_column, 0.0, color="#cfe3f5", zorder=0)
+        R_neck = P[0, 0]                             # the wall's radius: the neck's first point
+        ax.fill_between([-R_neck, R_neck], -gas_column, 0.0, color="#cfe3f5", zorder=0)
 
 
 @figure("fig14_cork_mesh", "Fig 14")
