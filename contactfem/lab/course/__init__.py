@@ -89,6 +89,25 @@ def solution_cells(nb):
     return out
 
 
+def solution_lines(nb, min_length=8):
+    """The lines of the solutions (between the # BEGIN SOLUTION and # END SOLUTION comments)
+    that appear nowhere else in the lecture: what a student version must not contain."""
+    cells = solution_cells(nb)
+    lines = set()
+    for sources in cells.values():
+        for code in sources:
+            inside = False
+            for ln in code.splitlines():
+                if BEGIN_SOLUTION.match(ln) or END_SOLUTION.match(ln):
+                    inside = bool(BEGIN_SOLUTION.match(ln))
+                    continue
+                if inside and len(ln.strip()) >= min_length:
+                    lines.add(ln.strip())
+    solution_sources = {code for sources in cells.values() for code in sources}
+    rest = "\n".join(c.source for c in nb.cells if c.source not in solution_sources)
+    return sorted(ln for ln in lines if ln not in rest)
+
+
 def _test_cell(part):
     """One otter test cell (exception-based format) that runs one part of the checks."""
     import nbformat
