@@ -26,6 +26,7 @@ class SpringChain:
         self.dt = None
         self.dof_offset = 0
         self.hyperelastic = True
+        self.quadratic_energy = k3 == 0.0
 
     def mass(self):
         return np.full(self.ndof, self.m)
@@ -55,6 +56,11 @@ class SpringChain:
 
     def commit(self, u, dt=None):
         self.commits += 1
+
+    def rigid_modes(self, u):
+        Q = np.zeros((self.ndof, 2))
+        Q[0::2, 0] = Q[1::2, 1] = 1.0
+        return Q
 
 
 @dataclass(frozen=True)
