@@ -170,7 +170,7 @@ def check(params):
 
 def measure(m, params, records):
     body, w = m["body"], m["w"]
-    R, P = params["R"], params["P"]
+    P = params["P"]
     a_ex = m["a_exact"]
     hist = History.of(records)
     state = records[-1].contacts[0]
