@@ -10,7 +10,8 @@ contact at its end touched the master at the fraction theta = g_bar / (g_bar - g
 step (the gap interpolated linearly). Its stick spring starts there: the slip increment is
 the travel after touching, Delta g_T = r (s - s_bar) with r = 1 - theta = -g_N / (g_bar - g_N),
 not the whole travel of the step (which would load the spring with the tangential motion
-made while still open)."""
+made while still open). ``NodeToSegment.closing_step = False`` (per interface) drops the
+rule, to study what it changes (the cork's exit time, lecture 08)."""
 
 import numpy as np
 
@@ -47,6 +48,8 @@ class NodeToSegment:
     variables z_bar per slave node; a law with ``gap_offset(z)`` (wear) moves the
     surface by the committed z_bar (the wear of a step acts from the next step on).
     """
+
+    closing_step = True     # the closing step of the module docstring; False: the whole travel
 
     def __init__(self, slave, nodes, master, normal, friction=None, weights=1.0, offset=0.0, name="contact"):
         self.slave, self.master, self.normal, self.friction, self.name = slave, master, normal, friction, name
@@ -106,7 +109,7 @@ class NodeToSegment:
         dofs = np.concatenate([self.slave_dofs(), k["master_dofs"]], axis=1) if k["master_dofs"].size else self._dofs
         travel = k["s"] - self.s_bar
         r, dr, ddg_T = np.ones_like(g_N), np.zeros_like(g_N), k["ds"]
-        if self.g_bar is not None:                          # the closing step (module docstring)
+        if self.closing_step and self.g_bar is not None:    # the closing step (module docstring)
             closing = active & (self.g_bar > 0.0)
             if np.any(closing):
                 gb = np.where(closing, self.g_bar, 1.0)
