@@ -32,6 +32,7 @@ _K = "contactfem.contact.kinematics"
 _E = "contactfem.contact.element.contact_element"
 _R = "contactfem.laws.return_map.return_map"
 _P = "contactfem.plots.laws"
+_REF = "contactfem.contact.reference"    # one pair at a time, in the paper's symbols (not used by the solver)
 
 INDEX = {e.number: e for e in [
     Equation(3, "true contact area A_r/A = (|t_N|/(A H))^n", f"{_P}.true_contact_area_ratio"),
@@ -55,17 +56,24 @@ INDEX = {e.number: e for e in [
     Equation(26, "T_s, T_0", f"{_K}.segment_vectors"),
     Equation(27, "delta g_N = N_s . dv, delta g_T = (l_bar/l)(T_s + g_N/l N_0) . dv", f"{_K}.segment_variations"),
     Equation(28, "contact residual R_c = t_N N_s + t_T (l_bar/l)(T_s + g_N/l N_0)", _E),
-    Equation(29, "G = M a + R(v) + R_c - P = 0", "contactfem.solver.system.System.residual_tangent"),
+    Equation(29, "G = M a + R(v) + R_c - P = 0", "contactfem.solver.system.System.evaluate"),
+    Equation(30, "linearisation of t_N delta g_N (its result is eq 33)", f"{_REF}.segment_element"),
     Equation(31, "second variation of the gap (first part)", f"{_K}.segment_variations"),
     Equation(32, "second variation of the gap", f"{_K}.segment_variations"),
     Equation(33, "normal tangent K_N", _E),
+    Equation(34, "linearisation of t_T delta g_T while sticking (its result is eq 39)", f"{_REF}.segment_element"),
+    Equation(35, "Delta g_T delta g_T = dv^T (l_bar/l)^2 A Dv", f"{_REF}.pair_variations"),
+    Equation(36, "A = (T_s + g_N/l N_0)(T_s + g_N/l N_0)^T", f"{_REF}.pair_variations"),
     Equation(37, "second variation of alpha, Delta delta alpha = dv^T B/l^2 Dv", f"{_K}.segment_variations"),
     Equation(38, "matrix B", f"{_K}.segment_variations"),
     Equation(39, "stick tangent K_T = c_T (l_bar/l)^2 A + t_T l_bar/l^2 B", _E),
     Equation(40, "slip function f(t_N, t_T) of the plane case", _R),
+    Equation(41, "slip rule of the plane case, Delta g_N^s = 0, Delta g_T^s = lambda sign(t_T)", f"{_REF}.return_map"),
     Equation(42, "elastic predictor t_T^tr = t_T_bar + c_T Delta g_T", _R),
     Equation(43, "return t_T = t_T^tr - c_T lambda sign(t_T^tr)", _R),
     Equation(44, "lambda from f(t_N, t_T) = 0 (closed form or local Newton)", _R),
+    Equation(45, "inelastic slip increment Delta g_T^s = lambda sign(t_T)", f"{_REF}.return_map"),
+    Equation(46, "linearisation of t_T delta g_T while slipping (its result is eq 49)", f"{_REF}.segment_element"),
     Equation(47, "consistent modulus c_T^s = dt_T/dg_T", _R),
     Equation(48, "consistent moduli c_T^s, c_N^s = dt_T/dg_N", _R),
     Equation(49, "slip tangent K_T = c_T^s (l_bar/l)^2 A + t_T l_bar/l^2 B + c_N^s C", _E),
@@ -81,13 +89,6 @@ NOT_MAPPED = {
     21: "virtual work of the contact forces; its matrix form is eq (28)",
     22: "variation of the gap; its matrix form is eq (27)",
     23: "variation of the slip; its matrix form is eq (27)",
-    30: "linearisation of t_N delta g_N; the result is eq (33)",
-    34: "linearisation of t_T delta g_T; the result is eq (39)",
-    35: "Delta g_T delta g_T = dv^T (l_bar/l)^2 A Dv: outer(ds, ds) in contact_element",
-    36: "A = (T_s + g_N/l N_0)(T_s + g_N/l N_0)^T: outer(ds, ds) in contact_element, not cited by number",
-    41: "slip rule of the plane case, Delta g_N^s = 0, Delta g_T^s = lambda sign(t_T): inside return_map",
-    45: "inelastic slip increment lambda sign(t_T): FrictionState.lam (cited in a comment, not a docstring)",
-    46: "linearisation of t_T delta g_T when slipping; its pieces are eqs (47)-(49)",
 }
 
 # -- citations: "eq (17)", "Eq 17", "eqs (17)-(19)", "eqs 33, 39, 49", "eqs 5 and 10", "eqn (8)" --------

@@ -16,8 +16,9 @@ from contactfem.cli import main
 from contactfem.contact import NodeToSegment, RigidLine
 from contactfem.laws import Coulomb, ParabolicSlip, PowerLaw
 from contactfem.scenes import block, get_scene
-from contactfem.solver import NewtonError, Static, System
-from contactfem.solver.staggered import SplitContact, Staggered
+from contactfem.contact.tangents import freeze
+from contactfem.solver import NewtonError, Static
+from contactfem.solver.staggered import Staggered
 from contactfem.lab.bench import observed_order, write_markdown
 
 from conftest import PointCloud
@@ -25,13 +26,12 @@ from conftest import PointCloud
 
 def _block_staggered(params, max_cycles=200):
     b = block.build(params)
-    split = SplitContact(b["contact"])
-    system = System([b["body"]], [split], b["loads"])
-    stepper = Staggered(Static(system, 1.0, atol=params["atol"], rtol=params["rtol"], maxit=params["maxit"]),
-                        [split], max_cycles=max_cycles)
+    system = b["system"]
+    stepper = Staggered(Static(system, atol=params["atol"], rtol=params["rtol"], maxit=params["maxit"]),
+                        max_cycles=max_cycles)
     u = np.zeros(system.ndof)
-    b["contact"].initialize(u)
-    u1, _, _, res = stepper.step(0.0, u, u, u)
+    system.start(u)
+    u1, _, _, res = stepper.step(0.0, u, u, u, 1.0)
     return b, system, u1, res
 
 
@@ -63,15 +63,14 @@ def test_staggered_raises_after_max_cycles():
 def test_frictionless_contact_is_the_same_in_every_phase():
     X = np.stack([np.linspace(0.1, 0.9, 4), np.zeros(4)], axis=1)
     body = PointCloud(X, "slave")
-    c = NodeToSegment(body, np.arange(4), RigidLine((0.0, 0.0), (0.0, 1.0)), PowerLaw(50.0, 1.0))
+    c = NodeToSegment(body, np.arange(4), RigidLine((0.0, 0.0), (0.0, 1.0)), normal=PowerLaw(50.0, 1.0))
     u = np.zeros(body.ndof)
     u[1::2] = -0.01
-    split = SplitContact(c)
-    split.freeze(u)
-    full = c.assemble(u)
+    c.start(np.zeros(body.ndof))
+    state = c.evaluate(u)
+    full = state.scatter(len(u))
     for phase in ("normal", "friction"):
-        split.set_phase(phase)
-        for a, b in zip(split.assemble(u), full):
+        for a, b in zip(c.evaluate(u, phase=freeze(state, phase)).scatter(len(u)), full):
             np.testing.assert_array_equal(a, b)
 
 
@@ -82,33 +81,32 @@ def test_phase_tangents_match_finite_differences(phase, friction):
     rng = np.random.default_rng(3)
     X = np.stack([np.linspace(0.1, 0.9, 5), np.zeros(5)], axis=1)
     body = PointCloud(X, "slave")
-    c = NodeToSegment(body, np.arange(5), RigidLine((0.0, 0.0), (0.0, 1.0)), PowerLaw(50.0, 1.0), friction)
+    c = NodeToSegment(body, np.arange(5), RigidLine((0.0, 0.0), (0.0, 1.0)), normal=PowerLaw(50.0, 1.0),
+                      friction=friction)
     u0 = np.zeros(body.ndof)
-    c.initialize(u0)
+    c.start(u0)
     u = u0.copy()
     u[1::2] = -0.05 * (0.5 + rng.random(5))
     u[0::2] = 0.02 * rng.standard_normal(5)        # some nodes slip, some stick
-    split = SplitContact(c)
-    split.freeze(u + 0.003 * rng.standard_normal(len(u)))   # frozen data from another state
-    split.set_phase(phase)
-    _, rows, cols, vals = split.assemble(u)
+    frozen = freeze(c.evaluate(u + 0.003 * rng.standard_normal(len(u))), phase)   # frozen data from another state
+    _, rows, cols, vals = c.evaluate(u, phase=frozen).scatter(len(u))
     K = np.zeros((len(u), len(u)))
     np.add.at(K, (rows, cols), vals)
-    Kfd = fd_jacobian(lambda v: split.assemble(v)[0], u)
+    Kfd = fd_jacobian(lambda v: c.evaluate(v, phase=frozen).scatter(len(u))[0], u)
     assert rel_error(K, Kfd) < 1e-6
     if phase == "friction":        # no coupling c_N^s C: the tangent differs from the consistent one
-        split.set_phase("full")
-        _, r2, c2, v2 = split.assemble(u)
+        _, r2, c2, v2 = c.evaluate(u).scatter(len(u))
         K2 = np.zeros_like(K)
         np.add.at(K2, (r2, c2), v2)
         assert rel_error(K, K2) > 1e-3
 
 
-def test_split_contact_rejects_bad_phase():
+def test_a_bad_phase_is_refused():
     params = get_scene("block").resolve("paper")
-    split = SplitContact(block.build(params)["contact"])
+    b = block.build(params)
+    b["system"].start(np.zeros(b["system"].ndof))
     with pytest.raises(ValueError, match="phase"):
-        split.set_phase("tangential")
+        freeze(b["contact"].evaluate(np.zeros(b["system"].ndof)), "tangential")
 
 
 def test_observed_order_of_a_power_law():

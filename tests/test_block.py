@@ -130,7 +130,7 @@ def newton_states(params, n_iter):
     sc = build(params)
     system, contact = sc["system"], sc["contact"]
     u = np.zeros(system.ndof)
-    contact.initialize(u)
+    system.start(u)
     states = [u.copy()]
     for _ in range(n_iter):
         G, K = system.residual_tangent(u, 1.0)
@@ -153,7 +153,7 @@ def test_full_tangent_finite_differences(law, material, which):
     sc, states = newton_states(SCENE.resolve("canonical", over), which)
     system, contact = sc["system"], sc["contact"]
     u = states[-1]
-    state = contact.evaluate(u)["friction"].state
+    state = contact.evaluate(u, 1.0, 1.0).slip
     assert np.any(state == 1) and np.any(state == 2), "stick and slip nodes present"
     rng = np.random.default_rng(which)
     cols = np.unique(np.concatenate([contact.slave_dofs().ravel(), rng.choice(system.ndof, 12, replace=False)]))

@@ -2,8 +2,8 @@
 fillet touched from inside (floor, counter-clockwise quarter circle, wall), the mirror
 case of the cork's neck (wall, clockwise mouth, top; tests/test_cork.py). The arc
 coordinate runs on across the joints, the normal is continuous, the first and second
-variations of g_N and s match finite differences on every piece, and translate() moves
-the master without changing s."""
+variations of g_N and s match finite differences on every piece, and a prescribed motion
+moves the master without changing s."""
 import numpy as np
 import pytest
 
@@ -42,28 +42,30 @@ def test_variations_match_finite_differences(x):
     assert_locate_matches_fd(fillet(offset=(0.2, -0.1)), np.array(x) + np.array([0.2, -0.1]))
 
 
-def test_translate_keeps_s_and_moves_the_gap():
-    m = fillet()
+def test_motion_keeps_s_and_moves_the_gap():
+    m = RigidComposite([("line", (-5.0, 0.0), (0.0, 0.0)),
+                                            ("arc", (0.0, 1.0), 1.0, -np.pi / 2, 0.0),
+                                            ("line", (1.0, 1.0), (1.0, 5.0))], motion=lambda t: (0.0, 0.1 * t))
     x = np.array([[0.5, 0.3], [0.9, 2.0]])
-    k0 = m.locate(x, np.zeros(2), None)
-    m.translate((0.0, 0.1))
-    k1 = m.locate(x + [0.0, 0.1], np.zeros(2), None)
+    k0 = m.locate(x, np.zeros(2), None, t=0.0)
+    k1 = m.locate(x + [0.0, 0.1], np.zeros(2), None, t=1.0)
     assert np.allclose(k0["s"], k1["s"]) and np.allclose(k0["g_N"], k1["g_N"])
+    assert np.allclose(m.locate(x, np.zeros(2), None)["g_N"], k0["g_N"])     # no time: no motion
 
 
 def test_a_node_sliding_round_the_fillet_keeps_its_friction_history():
     """One slave pressed into the floor, moved round the corner onto the wall: the slip
     increment s - s_bar is the path length, whatever piece the node is on."""
     body = PointCloud(np.array([[-0.5, -0.01]]), "slave")
-    contact = NodeToSegment(body, [0], fillet(), PowerLaw(c_N=100.0), Coulomb(c_T=10.0, mu=0.3))
+    contact = NodeToSegment(body, [0], fillet(), normal=PowerLaw(c_N=100.0), friction=Coulomb(c_T=10.0, mu=0.3))
     u = np.zeros(2)
-    contact.initialize(u)
-    s0 = contact.s_bar.copy()
+    contact.start(u)
+    s0 = contact.history.s_bar.copy()
     th = np.linspace(-np.pi / 2, 0.0, 7)
     for a in th:                                # along the arc, just inside the glass
         x = np.array([0.0, 1.0]) + 1.01 * np.array([np.cos(a), np.sin(a)])
-        contact.commit(x - body.X[0])
-    assert contact.s_bar[0] - s0[0] == pytest.approx(0.5 + np.pi / 2, rel=1e-9)
+        contact.commit(contact.evaluate(x - body.X[0]))
+    assert contact.history.s_bar[0] - s0[0] == pytest.approx(0.5 + np.pi / 2, rel=1e-9)
 
 
 def test_bad_pieces_are_refused():

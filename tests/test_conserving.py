@@ -19,7 +19,6 @@ from test_contact_tangent import make_master
 from test_extremes import throw
 
 from contactfem.contact import BodySurface, NodeToSegment
-from contactfem.contact.conserving import conserving_force, step_dissipation
 from contactfem.laws import Coulomb, ParabolicSlip, PowerLaw
 from contactfem.scenes import run_scene
 from contactfem.scenes.bar_impact import bar_exact
@@ -45,7 +44,8 @@ def pair(master, friction, phase, rng):
     off = sum(b.ndof for b in bodies)
     sb = PointCloud([[0.3, 0.0], [0.6, 0.0]], "slave", dof_offset=off)
     n = off + sb.ndof
-    iface = NodeToSegment(sb, [0, 1], m, PowerLaw(80.0), friction, weights=np.array([0.7, 1.2]))
+    iface = NodeToSegment(sb, [0, 1], m, normal=PowerLaw(80.0), friction=friction, weights=np.array([0.7, 1.2]),
+                          integration="energy_consistent")
     u_prev = np.zeros(n)
     u_prev[off + 1::2] = y0
     u0 = u_prev.copy()
@@ -55,18 +55,17 @@ def pair(master, friction, phase, rng):
     u1[off + 1::2] = y1 + 0.003 * rng.standard_normal(2)
     if master == "body":
         u1[:off] = 0.003 * rng.standard_normal(off)
-    iface.initialize(u_prev)
-    iface.commit(u_prev)
-    iface.commit(u0)
+    iface.start(u_prev)
+    iface.commit(iface.evaluate(u_prev))
+    iface.commit(iface.evaluate(u0))
     return iface, u0, u1
 
 
 def force(iface, u0, u1):
-    R, K, dofs, _ = conserving_force(iface, u0, u1)
-    G = np.zeros(len(u1))
-    np.add.at(G, dofs.ravel(), R.ravel())
+    """The step force (residual and tangent, dense) of the step u0 -> u1."""
+    G, rows, cols, vals = iface.evaluate(u1, u0=u0).scatter(len(u1))
     Kg = np.zeros((len(u1), len(u1)))
-    np.add.at(Kg, (np.repeat(dofs, dofs.shape[1], axis=1).ravel(), np.tile(dofs, (1, dofs.shape[1])).ravel()), K.ravel())
+    np.add.at(Kg, (rows, cols), vals)
     return G, Kg
 
 
@@ -87,9 +86,9 @@ def test_step_force_tangent(rng, master, fric, phase):
 def test_step_work_is_energy_change_plus_dissipation(rng, master, fric, phase):
     iface, u0, u1 = pair(master, FRICTIONS[fric], phase, rng)
     G, _ = force(iface, u0, u1)
-    W0 = iface.energy(u0)                      # interface energy at the committed state
-    W1 = iface.energy(u1)                      # at the end (not committed: t_T from the return map)
-    D = step_dissipation(iface, u0, u1)
+    W0 = iface.evaluate(u0).energy             # interface energy at the committed state
+    W1 = iface.evaluate(u1).energy             # at the end (not committed: t_T from the return map)
+    D = iface.evaluate(u1, u0=u0).dissipation  # of the step
     assert D >= -1e-14
     assert G @ (u1 - u0) == pytest.approx(W1 - W0 + D, rel=1e-10, abs=1e-14)
 
@@ -100,13 +99,13 @@ def test_unresolved_penalty_conserves_energy():
     from contactfem.solver import integrate
     from test_extremes import quad
     body = quad()
-    contact = NodeToSegment(body, np.arange(4), make_master("line"), PowerLaw(1e8), None, weights=0.5)
+    contact = NodeToSegment(body, np.arange(4), make_master("line"), normal=PowerLaw(1e8), weights=0.5,
+                            integration="energy_consistent")
     from contactfem.solver import System
     system = System([body], [contact])
     u0, v0 = np.zeros(system.ndof), np.zeros(system.ndof)
     v0[body.xdofs[:, 0]], v0[body.xdofs[:, 1]] = 0.5, -1.0
-    contact.initialize(u0)
-    hist = integrate(EnergyConsistent(system, 0.01, atol=1e-9, rtol=1e-9, maxit=40), 0.0, u0, v0, n_steps=30)
+    hist = integrate(EnergyConsistent(system, atol=1e-9, rtol=1e-9, maxit=40), 0.0, u0, v0, n_steps=30, dt=0.01)
     E = hist.kinetic + hist.strain + hist.contact
     assert np.count_nonzero(hist.contact > 0) + np.count_nonzero(np.diff(np.sign(hist.v[body.xdofs[:, 1]]))) > 0
     assert np.max(np.abs(E - E[0])) <= 1e-6 * E[0]

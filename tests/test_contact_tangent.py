@@ -2,6 +2,8 @@
 open, stick, slip both ways; rigid line, polyline, arc and deformable master; node
 switching segments; every shipped law; m != 1, n < 1."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from conftest import PointCloud
@@ -25,12 +27,12 @@ FRICTIONS = {"none": None, "coulomb": Coulomb(c_T=30.0, mu=0.3),
 DT = 0.1
 
 
-def check_tangent(iface, u, tol=1e-6):
-    R0, rows, cols, vals = iface.assemble(u)
+def check_tangent(iface, u, tol=1e-6, dt=DT):
+    R0, rows, cols, vals = iface.assemble(u, dt=dt)
     n = len(u)
     K = np.zeros((n, n))
     np.add.at(K, (rows, cols), vals)
-    Kfd = fd_jacobian(lambda v: iface.assemble(v)[0], u)
+    Kfd = fd_jacobian(lambda v: iface.assemble(v, dt=dt)[0], u)
     assert np.linalg.norm(K) > 0, "nothing in contact: the test is vacuous"
     err = rel_error(K, Kfd)
     assert err < tol, f"tangent mismatch {err:.2e}"
@@ -46,15 +48,20 @@ def slave_cloud(rng, n=4, y=-0.05):
     return body, u
 
 
-def set_history(iface, u, t_T_bar, dg):
-    """History such that the slip increment is dg: s_bar = s(u) - dg."""
-    iface.initialize(u)
-    iface.s_bar = iface.s_bar - dg
-    iface.t_T_bar = np.full(len(iface.nodes), t_T_bar)
-    iface.set_dt(DT)
+def set_history(iface, u, t_T_bar, dg, master=None):
+    """History such that the slip increment is dg: s_bar = s(u) - dg (``master``: the
+    master's remembered reference, e.g. a deformable master's earlier positions)."""
+    iface.start(u)
+    h = iface.history
+    if master is not None:
+        h = replace(h, master=master)
+        iface.history = h
+        h = replace(h, s_bar=iface.evaluate(u, dt=DT).s)
+    n = len(iface.nodes)
+    z = h.z_bar
     if iface.friction is not None and iface._law.n_state:     # a state reached by earlier slip (wear: 0.01 deep)
-        n = len(iface.nodes)
-        iface.z_bar = iface._law.evolve(iface.z_bar, np.ones(n), np.full(n, 0.05), DT)[0]
+        z = iface._law.evolve(h.z_bar, np.ones(n), np.full(n, 0.05), DT)[0]
+    iface.history = replace(h, s_bar=h.s_bar - dg, t_T_bar=np.full(n, t_T_bar), z_bar=z)
 
 
 MASTERS = ["line", "tilted_polyline", "arc_outside", "arc_inside"]
@@ -77,17 +84,17 @@ def make_master(kind):
 @pytest.mark.parametrize("regime", ["stick", "slip+", "slip-"])
 def test_rigid_master_tangent(rng, master, nlaw, flaw, regime):
     body, u = slave_cloud(rng)
-    iface = NodeToSegment(body, np.arange(4), make_master(master), NORMALS[nlaw], FRICTIONS[flaw],
+    iface = NodeToSegment(body, np.arange(4), make_master(master), normal=NORMALS[nlaw], friction=FRICTIONS[flaw],
                           weights=rng.uniform(0.5, 1.5, 4))
     dg = {"stick": 1e-6, "slip+": 0.5, "slip-": -0.5}[regime]
     set_history(iface, u, t_T_bar=0.0, dg=dg)
-    e = iface.evaluate(u)
-    assert np.all(e["active"])
+    e = iface.evaluate(u, dt=DT)
+    assert np.all(e.active)
     if FRICTIONS[flaw] is not None:
         expected = STICK if regime == "stick" else SLIP
-        assert np.all(e["friction"].state == expected)
+        assert np.all(e.slip == expected)
         if regime != "stick":
-            assert np.all(np.sign(e["friction"].t_T) == np.sign(dg))
+            assert np.all(np.sign(e.t_T) == np.sign(dg))
     check_tangent(iface, u)
 
 
@@ -104,14 +111,13 @@ def test_deformable_master_tangent(rng, flaw, regime, nlaw):
     u[master_body.ndof + 1::2] = -0.06 - 0.02 * rng.random(3)
     # move the master a little first so that l_bar differs from l
     surface = BodySurface(master_body, np.arange(5))
-    iface = NodeToSegment(slave_body, np.arange(3), surface, NORMALS[nlaw], FRICTIONS[flaw], weights=0.7)
+    iface = NodeToSegment(slave_body, np.arange(3), surface, normal=NORMALS[nlaw], friction=FRICTIONS[flaw], weights=0.7)
     u_old = u.copy()
     u_old[: master_body.ndof] *= 0.3
-    surface.commit(u_old)
     dg = {"stick": 1e-6, "slip+": 0.5, "slip-": -0.5}[regime]
-    set_history(iface, u, t_T_bar=0.01, dg=dg)
-    e = iface.evaluate(u)
-    assert np.all(e["active"])
+    set_history(iface, u, t_T_bar=0.01, dg=dg, master=surface.reference(u_old))
+    e = iface.evaluate(u, dt=DT)
+    assert np.all(e.active)
     K = check_tangent(iface, u)
     if FRICTIONS[flaw] is not None and regime != "stick":
         assert not np.allclose(K, K.T), "the slip tangent is non-symmetric (eq 50)"
@@ -119,10 +125,11 @@ def test_deformable_master_tangent(rng, flaw, regime, nlaw):
 
 def test_open_node_has_no_force_nor_tangent(rng):
     body, u = slave_cloud(rng, y=+0.05)
-    iface = NodeToSegment(body, np.arange(4), RigidLine(), NORMALS["penalty"], FRICTIONS["coulomb"])
+    iface = NodeToSegment(body, np.arange(4), RigidLine(), normal=NORMALS["penalty"], friction=FRICTIONS["coulomb"])
+    iface.start(u)
     R, rows, cols, vals = iface.assemble(u)
     assert np.all(R == 0) and len(vals) == 0
-    assert np.all(iface.evaluate(u)["friction"].state == OPEN)
+    assert np.all(iface.evaluate(u).slip == OPEN)
 
 
 def test_node_switches_segment_and_keeps_history(rng):
@@ -131,18 +138,18 @@ def test_node_switches_segment_and_keeps_history(rng):
     P = [[0.0, 0.0], [1.0, 0.0], [2.0, 0.1]]
     master = RigidPolyline(P)
     body = PointCloud([[0.9, 0.0]], "slave")
-    iface = NodeToSegment(body, [0], master, NORMALS["penalty"], Coulomb(c_T=100.0, mu=10.0))
+    iface = NodeToSegment(body, [0], master, normal=NORMALS["penalty"], friction=Coulomb(c_T=100.0, mu=10.0))
     u = np.array([0.0, -0.01])
-    iface.initialize(u)
-    iface.commit(u)
+    iface.start(u)
+    iface.commit(iface.evaluate(u))
     e0 = iface.evaluate(u)
-    assert e0["seg"][0] == 0
+    assert e0.seg[0] == 0
     u1 = np.array([0.2, -0.01 + 0.1 * 0.1])     # now above segment 1
     e1 = iface.evaluate(u1)
-    assert e1["seg"][0] == 1
+    assert e1.seg[0] == 1
     L1 = np.hypot(1.0, 0.1)
-    alpha = ((np.array([1.1, e1["x_s"][0, 1]]) - [1.0, 0.0]) @ np.array([1.0, 0.1]) / L1) / L1
-    assert np.isclose(e1["dg_T"][0], 0.1 + alpha * L1)
+    alpha = ((np.array([1.1, e1.x_s[0, 1]]) - [1.0, 0.0]) @ np.array([1.0, 0.1]) / L1) / L1
+    assert np.isclose(e1.dg_T[0], 0.1 + alpha * L1)
     check_tangent(iface, u1)
 
 
@@ -151,21 +158,23 @@ def test_deformable_master_node_switch_tangent(rng):
     mb = PointCloud(Xm, "master")
     sb = PointCloud([[0.95, 0.0]], "slave", dof_offset=mb.ndof)
     surf = BodySurface(mb, [0, 1, 2])
-    iface = NodeToSegment(sb, [0], surf, NORMALS["penalty"], ParabolicSlip(c_T=40.0, alpha=0.2, beta=0.3, n=0.5))
+    iface = NodeToSegment(sb, [0], surf, normal=NORMALS["penalty"],
+                          friction=ParabolicSlip(c_T=40.0, alpha=0.2, beta=0.3, n=0.5))
     u = np.zeros(mb.ndof + 2)
     u[-1] = -0.03
-    iface.initialize(u)
-    iface.commit(u)
+    iface.start(u)
+    iface.commit(iface.evaluate(u))
     u2 = u.copy()
     u2[-2] = 0.12                     # slides past the middle master node
     u2[:mb.ndof] = 0.01 * rng.standard_normal(mb.ndof)
     e = iface.evaluate(u2)
-    assert e["seg"][0] == 1 and e["friction"].state[0] == SLIP
+    assert e.seg[0] == 1 and e.slip[0] == SLIP
     check_tangent(iface, u2)
 
 
 def test_offset_surface_contacts_earlier():
     body = PointCloud([[0.0, 0.4]], "beam")
-    iface = NodeToSegment(body, [0], RigidLine(), NORMALS["penalty"], offset=0.5)
+    iface = NodeToSegment(body, [0], RigidLine(), normal=NORMALS["penalty"], offset=0.5)
+    iface.start(np.zeros(2))
     e = iface.evaluate(np.zeros(2))
-    assert e["active"][0] and np.isclose(e["g_N"][0], -0.1)
+    assert e.active[0] and np.isclose(e.g_N[0], -0.1)

@@ -14,7 +14,9 @@ import pytest
 
 from contactfem.bodies.loads import swept_volume
 from contactfem.scenes import run_scene
-from contactfem.scenes.cork import PAPER, Neck, cork_mesh
+from contactfem.bodies.meshes import cork_mesh
+from contactfem.contact.masters import bottle_neck as Neck
+from contactfem.scenes.cork import PAPER
 from contactfem.solver import NewtonError
 from conftest import assert_locate_matches_fd
 

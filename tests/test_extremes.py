@@ -36,13 +36,12 @@ def throw(normal=None, friction=None, master=None, v=(0.5, -1.0), dt=0.01, n_ste
     """Throw the unit quad at `master` with velocity v; returns (history, contact)."""
     body = quad(origin, material)
     contact = NodeToSegment(body, np.arange(4), master or RigidLine((0, 0), (0, 1)),
-                            normal or PowerLaw(1e3), friction, weights=W)
+                            normal=normal or PowerLaw(1e3), friction=friction, weights=W)
     system = System([body, *extra_bodies], [contact], fixed=list(fixed))
     u0, v0 = np.zeros(system.ndof), np.zeros(system.ndof)
     v0[body.xdofs[:, 0]], v0[body.xdofs[:, 1]] = v
-    contact.initialize(u0)
-    stepper = Newmark(system, dt, delta, beta, atol=1e-9, rtol=1e-9, maxit=25)
-    return integrate(stepper, 0.0, u0, v0, n_steps=n_steps, cutback=True, max_cuts=3), contact
+    stepper = Newmark(system, delta, beta, atol=1e-9, rtol=1e-9, maxit=25)
+    return integrate(stepper, 0.0, u0, v0, n_steps=n_steps, dt=dt, cutback=True, max_cuts=3), contact
 
 
 def outcome(energy_check=True, **kw):
@@ -55,9 +54,10 @@ def outcome(energy_check=True, **kw):
     total = hist.kinetic + hist.strain + hist.contact
     for name, a in dict(u=hist.u, v=hist.v, a=hist.a, energy=total, D=hist.dissipation).items():
         assert np.all(np.isfinite(a)), f"{name} is not finite"
-    rep = contact.report(hist.u)
+    state = hist.records[-1].contacts[0]             # the converged end state
+    rep = state.report()
     if contact.friction is not None:
-        Y = contact.friction.slip_bound(-rep["t_N"], contact.q_bar)[0]
+        Y = contact.friction.slip_bound(-rep["t_N"], state.q)[0]
         assert np.all(np.abs(rep["t_T"]) <= Y * (1 + 1e-9) + 1e-12), "slip bound violated"
     if energy_check:
         E0, D = total[0], hist.dissipation[-1]

@@ -53,7 +53,7 @@ def test_per_length_penalty_is_mesh_independent_nodal_is_not():
     # a soft penalty (c_N = 1e7 MPa/mm) so that the penalty compliance shows; the nodal
     # value is the per-length one times the contact element size of the 16 x 16 mesh
     pl = [run_scene("hertz", "fast", {"n_el": n, "c_N": 1e7}) for n in (16, 32)]
-    nd = [run_scene("hertz", "fast", {"n_el": n, "c_N": 1e7 * 0.0842, "penalty": "nodal"}) for n in (16, 32)]
+    nd = [run_scene("hertz", "fast", {"n_el": n, "c_N": 1e7 * 0.0842, "penalty": "per_node"}) for n in (16, 32)]
     # per length: the same interface law on both meshes, the same penetration and p0
     assert pl[1]["penetration_max"] == pytest.approx(pl[0]["penetration_max"], rel=0.01)
     assert pl[1]["p0"] == pytest.approx(pl[0]["p0"], rel=0.005)

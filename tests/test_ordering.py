@@ -52,12 +52,11 @@ def run(rng=None, shuffle_slaves=False, deformable=False):
     if shuffle_slaves:
         k = np.random.default_rng(7).permutation(len(slaves))
         slaves, w = slaves[k], w[k]
-    contact = NodeToSegment(upper, slaves, master, PowerLaw(1e3), friction, weights=w)
+    contact = NodeToSegment(upper, slaves, master, normal=PowerLaw(1e3), friction=friction, weights=w)
     system = System(bodies, [contact], fixed=fixed)
     u0, v0 = np.zeros(system.ndof), np.zeros(system.ndof)
     v0[upper.xdofs[:, 0]], v0[upper.xdofs[:, 1]] = 1.0, -1.0
-    contact.initialize(u0)
-    hist = integrate(Newmark(system, 0.01, 0.7, 0.4, atol=1e-11, rtol=1e-12, maxit=25), 0.0, u0, v0, n_steps=25)
+    hist = integrate(Newmark(system, 0.7, 0.4, atol=1e-11, rtol=1e-12, maxit=25), 0.0, u0, v0, n_steps=25, dt=0.01)
     out = []
     for b, old in zip(bodies, (old_up, old_lo) if deformable else (old_up,)):
         U = np.empty((b.X.shape[0], 2))

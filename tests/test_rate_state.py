@@ -71,31 +71,29 @@ def test_history_is_committed_only_on_convergence():
     params = block.SCENE.resolve("fast", {"law": "coulomb", "n_steps": 2})
     s = block.solve(params, friction=RATE_LAWS["wear"])
     c = s["contact"]
-    assert np.all(c.z_bar >= 0) and c.z_bar.max() > 0                          # worn where it slipped
-    assert np.all(c.z_bar[c.q_bar == 0] == 0)                                  # no wear without slip
-    before = c.z_bar.copy()
-    c.set_dt(0.5)
-    c.assemble(s["u"] * 1.01)                                                 # evaluations leave it alone
-    assert np.array_equal(c.z_bar, before)
+    h = c.history
+    assert np.all(h.z_bar >= 0) and h.z_bar.max() > 0                          # worn where it slipped
+    assert np.all(h.z_bar[h.q_bar == 0] == 0)                                  # no wear without slip
+    c.evaluate(s["u"] * 1.01, dt=0.5)                                         # evaluations leave it alone
+    assert c.history is h
 
 
 def test_wear_moves_the_surface():
     """The worn depth opens the gap: a worn node carries less pressure at the same position."""
     law = ArchardWear(c_T=30.0, mu=0.3, k_w=0.5)
     body = PointCloud(np.array([[0.0, 0.0], [1.0, 0.0]]), "slave")
-    iface = NodeToSegment(body, [0, 1], RigidLine(), PowerLaw(c_N=100.0), law)
+    iface = NodeToSegment(body, [0, 1], RigidLine(), normal=PowerLaw(c_N=100.0), friction=law)
     u = np.array([0.0, -0.02, 0.0, -0.02])
-    iface.initialize(u)
-    iface.set_dt(1.0)
-    t0 = iface.evaluate(u)["t_N"].copy()
+    iface.start(u)
+    t0 = iface.evaluate(u, dt=1.0).t_N.copy()
     u1 = u.copy()
     u1[0] = 0.3                                                               # node 0 slides
-    iface.commit(u1)
-    w = iface.z_bar[:, 0]
+    iface.commit(iface.evaluate(u1, dt=1.0))
+    w = iface.history.z_bar[:, 0]
     assert w[0] > 0 and w[1] == 0
-    e = iface.evaluate(u1)
-    assert np.isclose(e["g_N"][0], -0.02 + w[0]) and e["t_N"][0] > t0[0]       # less compressive
-    assert e["t_N"][1] == t0[1]
+    e = iface.evaluate(u1, dt=1.0)
+    assert np.isclose(e.g_N[0], -0.02 + w[0]) and e.t_N[0] > t0[0]           # less compressive
+    assert e.t_N[1] == t0[1]
 
 
 @pytest.mark.parametrize("name", list(RATE_LAWS))
@@ -137,19 +135,19 @@ def test_block_tangent_against_finite_differences(name):
     s = block.solve(params, friction=RATE_LAWS[name])
     # the same two steps, stopped before committing the second
     sc = block.build(params, friction=RATE_LAWS[name])
-    c1 = sc["contact"]
-    st = Static(sc["system"], dt=0.5, atol=params["atol"], rtol=params["rtol"], maxit=40)
-    u = np.zeros(sc["system"].ndof)
-    c1.initialize(u)
-    u, *_ = st.step(0.0, u, u, u)
-    sc["system"].commit(u)
-    u, *_ = st.step(0.5, u, u, u)
+    c1, system = sc["contact"], sc["system"]
+    st = Static(system, atol=params["atol"], rtol=params["rtol"], maxit=40)
+    u = np.zeros(system.ndof)
+    system.start(u)
+    u, _, _, res = st.step(0.0, u, u, u, 0.5)
+    system.commit(res.evaluation, u, 0.5, 0.5)
+    u, *_ = st.step(0.5, u, u, u, 0.5)
     assert np.allclose(u, s["u"], atol=1e-9)
-    state = c1.evaluate(u)["friction"].state
+    state = c1.evaluate(u, 1.0, 0.5).slip
     assert np.any(state == STICK) and np.any(state == SLIP)
     cols = c1.slave_dofs().ravel()
-    K = sc["system"].residual_tangent(u, 1.0)[1].toarray()[:, cols]
-    K_fd = fd_jacobian(lambda w: sc["system"].residual_tangent(w, 1.0)[0], u, cols, h=1e-7)
+    K = system.residual_tangent(u, 1.0, dt=0.5)[1].toarray()[:, cols]
+    K_fd = fd_jacobian(lambda w: system.residual_tangent(w, 1.0, dt=0.5)[0], u, cols, h=1e-7)
     assert rel_error(K, K_fd) < 1e-6
 
 

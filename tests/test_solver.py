@@ -1,5 +1,9 @@
 """Tests of contactfem.solver with small fake bodies, loads and contacts defined here
-(a nonlinear spring chain, a one-node penalty wall, a dead load and a spring-like load)."""
+(a nonlinear spring chain, a one-node penalty wall, a dead load and a spring-like load):
+written only to the protocols (contactfem.bodies.interfaces, contactfem.contact.interfaces),
+which they are checked to satisfy."""
+from dataclasses import dataclass
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -20,14 +24,19 @@ class SpringChain:
         self.xdofs = np.arange(2 * n).reshape(n, 2)
         self.commits = 0
         self.dt = None
-
-    def set_dt(self, dt):                 # like a rate-dependent body
-        self.dt = dt
+        self.dof_offset = 0
+        self.hyperelastic = True
 
     def mass(self):
         return np.full(self.ndof, self.m)
 
-    def internal(self, u):
+    def internal_coo(self, u, dt=None):
+        self.dt = dt                      # like a rate-dependent body: the step's dt
+        R, K = self.internal(u)
+        K = K.tocoo()
+        return R, K.row, K.col, K.data
+
+    def internal(self, u, dt=None):
         U = u.reshape(-1, 2)
         d = U[1:] - U[:-1]
         f = self.k * d + self.k3 * d ** 3
@@ -40,39 +49,57 @@ class SpringChain:
                           shape=(self.ndof, self.ndof))
         return R.ravel(), K.tocsr()
 
-    def strain_energy(self, u):
+    def strain_energy(self, u, dt=None):
         d = np.diff(u.reshape(-1, 2), axis=0)
         return float(np.sum(self.k * d ** 2 / 2 + self.k3 * d ** 4 / 4))
 
-    def commit(self, u):
+    def commit(self, u, dt=None):
         self.commits += 1
 
 
+@dataclass(frozen=True)
+class WallState:
+    """What the wall knows at one u (the contact state protocol: scatter, energy, dissipation,
+    next_history)."""
+    dof: int
+    g: float
+    c: float
+    dissipation: float
+    next_history: int
+
+    def scatter(self, ndof):
+        R = np.zeros(ndof)
+        if self.g >= 0:
+            return R, [], [], []
+        R[self.dof] = self.c * self.g
+        return R, [self.dof], [self.dof], [self.c]
+
+    @property
+    def energy(self):
+        return 0.5 * self.c * min(self.g, 0.0) ** 2
+
+
 class Wall:
-    """Penalty wall y >= y_wall for one node: R_c = c g on its y dof when g < 0."""
+    """Penalty wall y >= y_wall for one node: R_c = c g on its y dof when g < 0; its history
+    is the number of commits, and every step dissipates ``dissipation_per_commit``."""
+    integration = "standard"
 
     def __init__(self, body, node, y_wall, c, dissipation_per_commit=0.0):
         self.body, self.node, self.y_wall, self.c = body, node, y_wall, c
         self.per_commit = dissipation_per_commit
-        self.dissipation = 0.0
+        self.name, self.history, self.evaluations = "wall", None, 0
 
-    def _dof_gap(self, u):
+    def start(self, u, t=0.0):
+        self.history = 0
+
+    def evaluate(self, u, t=0.0, dt=None, u0=None, phase=None):
+        self.evaluations += 1
         dof = self.body.dof_offset + self.body.xdofs[self.node, 1]
-        return dof, self.body.X[self.node, 1] + u[dof] - self.y_wall
+        return WallState(dof, self.body.X[self.node, 1] + u[dof] - self.y_wall, self.c,
+                         self.per_commit, (self.history or 0) + 1)
 
-    def assemble(self, u):
-        dof, g = self._dof_gap(u)
-        R = np.zeros(u.size)
-        if g >= 0:
-            return R, [], [], []
-        R[dof] = self.c * g
-        return R, [dof], [dof], [self.c]
-
-    def energy(self, u):
-        return 0.5 * self.c * min(self._dof_gap(u)[1], 0.0) ** 2
-
-    def commit(self, u):
-        self.dissipation = self.per_commit
+    def commit(self, state):
+        self.history = state.next_history
 
 
 class DeadLoad:
@@ -87,6 +114,9 @@ class DeadLoad:
         P[self.body.dof_offset + self.local_dofs] = self.value * self.f(t)
         return P, [], [], []
 
+    def commit(self, u, t):
+        pass
+
 
 class SpringLoad:
     """A displacement-dependent load P = f0 - kl u on one dof: dP/du = -kl."""
@@ -99,6 +129,19 @@ class SpringLoad:
         P = np.zeros(u.size)
         P[g] = self.f0 - self.kl * u[g]
         return P, [g], [g], [-self.kl]
+
+    def commit(self, u, t):
+        pass
+
+
+def test_the_fakes_are_what_the_solver_asks_for():
+    """The protocols of contactfem.*.interfaces are all the solver relies on."""
+    from contactfem.bodies.interfaces import Body, Load
+    from contactfem.contact.interfaces import Contact
+
+    body = SpringChain(2)
+    assert isinstance(body, Body) and isinstance(Wall(body, 0, 0.0, 1.0), Contact)
+    assert isinstance(DeadLoad(body, [0], 1.0), Load) and isinstance(SpringLoad(body, 0, 1.0, 1.0), Load)
 
 
 def oscillator(k=4.0, m=1.0):
@@ -129,6 +172,7 @@ def test_tangent_matches_finite_differences(linear_algebra):
     a, b = SpringChain(3, k=2.0, k3=5.0, name="a"), SpringChain(2, k=1.0, k3=1.0, name="b")
     s = System([a, b], contacts=[Wall(b, 1, y_wall=0.0, c=30.0)],
                loads=[SpringLoad(a, 4, f0=1.0, kl=3.0), DeadLoad(b, [2], 0.7)], linear_algebra=linear_algebra)
+    s.start(np.zeros(s.ndof))
     u = np.random.default_rng(0).normal(scale=0.3, size=s.ndof)
     u[s.global_dofs(b, b.xdofs[1, 1])] = -0.4            # wall contact active
     G, K = s.residual_tangent(u, 0.0)
@@ -221,9 +265,8 @@ def test_average_acceleration_conserves_energy_and_gives_the_period():
     body, s = oscillator(k, m)
     w = np.sqrt(k / m)
     dt = 2 * np.pi / w / 40
-    xs = []
-    hist = integrate(Newmark(s, dt, delta=0.5, beta=0.25), 0.0, np.array([0, 0, 1.0, 0]),
-                     n_steps=400, callback=lambda t, u, v, a: xs.append(u[2]))
+    hist = integrate(Newmark(s, delta=0.5, beta=0.25), 0.0, np.array([0, 0, 1.0, 0]), n_steps=400, dt=dt)
+    xs = [r.u[2] for r in hist.records[1:]]
     E = total_energy(hist)
     assert np.max(np.abs(E - E[0])) < 1e-12 * E[0]
     # trapezoidal rule: tan(theta / 2) = omega dt / 2, so the period is 2 pi dt / theta
@@ -239,8 +282,7 @@ def test_paper_parameters_dissipate_at_the_spectral_rate():
     body, s = oscillator(k, m)
     w = np.sqrt(k / m)
     dt, n = 2 * np.pi / w / 10, 60
-    hist = integrate(Newmark(s, dt, delta=delta, beta=beta), 0.0, np.array([0, 0, 1.0, 0]),
-                     n_steps=n)
+    hist = integrate(Newmark(s, delta=delta, beta=beta), 0.0, np.array([0, 0, 1.0, 0]), n_steps=n, dt=dt)
     E = total_energy(hist)
     # amplification matrix of (u, v) for u'' = -w^2 u
     W = (w * dt) ** 2
@@ -257,7 +299,7 @@ def test_energy_balance_with_loads_and_moving_support():
     body = SpringChain(3, k=3.0, m=0.5)
     s = System([body], loads=[DeadLoad(body, [4], 0.8, f=np.cos)],
                fixed=[Dirichlet(body, [0], lambda t: 0.2 * np.sin(2 * t)), Dirichlet(body, [1])])
-    hist = integrate(Newmark(s, 0.05, delta=0.5, beta=0.25), 0.0, np.zeros(s.ndof), t_end=3.0)
+    hist = integrate(Newmark(s, delta=0.5, beta=0.25), 0.0, np.zeros(s.ndof), t_end=3.0, dt=0.05)
     assert hist.t[-1] == pytest.approx(3.0) and len(hist.t) == 61
     balance = total_energy(hist) - hist.external_work
     assert np.max(np.abs(balance - balance[0])) < 1e-10
@@ -268,12 +310,10 @@ def test_dirichlet_values_are_honoured():
     body = SpringChain(3, k=2.0, k3=1.0)
     move = lambda t: [0.1 * np.sin(2 * t), -0.05 * t]
     s = System([body], fixed=[Dirichlet(body, [0, 1], move), Dirichlet(body, [5], 0.3)])
-    seen = []
-    integrate(Newmark(s, 0.1), 0.0, np.zeros(s.ndof), n_steps=20,
-              callback=lambda t, u, v, a: seen.append((t, u[[0, 1, 5]].copy())))
-    for t, got in seen:
-        assert np.allclose(got, move(t) + [0.3])
-    u = Static(s).step(0.0, np.zeros(s.ndof), None, None)[0]
+    hist = integrate(Newmark(s), 0.0, np.zeros(s.ndof), n_steps=20, dt=0.1)
+    for r in hist.records:
+        assert np.allclose(r.u[[0, 1, 5]], move(r.t) + [0.3])
+    u = Static(s).step(0.0, np.zeros(s.ndof), None, None, 1.0)[0]
     assert np.allclose(u[[0, 1, 5]], move(1.0) + [0.3])
 
 
@@ -281,7 +321,7 @@ def test_static_linear_problem_in_one_iteration():
     body = SpringChain(4, k=2.0)
     s = System([body], loads=[DeadLoad(body, [6, 7], [1.0, -0.5], f=lambda t: t)],
                fixed=[Dirichlet(body, [0, 1])])
-    hist = integrate(Static(s, dt=0.5), 0.0, np.zeros(s.ndof), n_steps=2)
+    hist = integrate(Static(s), 0.0, np.zeros(s.ndof), n_steps=2, dt=0.5)
     assert list(hist.iterations) == [0, 1, 1]
     assert all(len(r) == 2 for r in hist.residuals[1:])
     # three springs in series under the end load 1 * (1.0, -0.5) at t = 1
@@ -294,13 +334,13 @@ def test_static_penalty_wall_and_dissipation_bookkeeping():
     wall = Wall(body, 1, y_wall=-0.1, c=100.0, dissipation_per_commit=0.125)
     s = System([body], contacts=[wall], loads=[DeadLoad(body, [3], -2.0)],
                fixed=[Dirichlet(body, [0, 1])])
-    hist = integrate(Static(s), 0.0, np.zeros(s.ndof), n_steps=3)
+    hist = integrate(Static(s), 0.0, np.zeros(s.ndof), n_steps=3, dt=1.0)
     uy = hist.u[3]
     # equilibrium: spring (k uy + k3 uy^3) + wall c (uy + 0.1) = -2
     assert uy + 2 * uy ** 3 + 100 * (uy + 0.1) == pytest.approx(-2.0, abs=1e-9)
     assert hist.contact[-1] == pytest.approx(50 * (uy + 0.1) ** 2)
     assert np.allclose(hist.dissipation, [0, 0.125, 0.25, 0.375])
-    assert body.commits == 3
+    assert body.commits == 3 and wall.history == 3        # committed once per step
 
 
 def test_central_difference_oscillator():
@@ -308,9 +348,8 @@ def test_central_difference_oscillator():
     body, s = oscillator(k, m)
     w = np.sqrt(k / m)
     dt = 2 * np.pi / w / 40
-    xs = []
-    hist = integrate(CentralDifference(s, dt), 0.0, np.array([0, 0, 1.0, 0]), n_steps=400,
-                     callback=lambda t, u, v, a: xs.append(u[2]))
+    hist = integrate(CentralDifference(s), 0.0, np.array([0, 0, 1.0, 0]), n_steps=400, dt=dt)
+    xs = [r.u[2] for r in hist.records[1:]]
     # central differences: sin(theta / 2) = omega dt / 2
     T_h = 2 * np.pi * dt / (2 * np.arcsin(w * dt / 2))
     assert zero_crossing_period(hist.t[1:], np.array(xs)) == pytest.approx(T_h, rel=1e-4)
@@ -322,24 +361,24 @@ class FussyNewmark(Newmark):
     """Fails (like a diverging Newton) whenever dt exceeds max_dt."""
     max_dt = 0.03
 
-    def step(self, t, u, v, a, dt=None, label=""):
+    def step(self, t, u, v, a, dt, label=""):
         if dt > self.max_dt:
             raise NewtonError(f"too large ({label})", [1.0, 2.0], label)
-        return super().step(t, u, v, a, dt=dt, label=label)
+        return super().step(t, u, v, a, dt, label=label)
 
 
 def test_cutback_halves_the_step_and_keeps_the_time_grid():
     body, s = oscillator()
-    hist = integrate(FussyNewmark(s, 0.1), 0.0, np.array([0, 0, 1.0, 0]), n_steps=3,
+    hist = integrate(FussyNewmark(s), 0.0, np.array([0, 0, 1.0, 0]), n_steps=3, dt=0.1,
                      cutback=True, max_cuts=4)
     assert np.allclose(hist.dt[1:], 0.025) and len(hist.t) == 1 + 3 * 4
-    assert hist.t[-1] == pytest.approx(0.3) and hist.cuts[1] == 2
-    assert body.commits == 12 and body.dt == pytest.approx(0.025)       # the body was told the cut dt
+    assert hist.t[-1] == pytest.approx(0.3) and hist.cuts[1] == 2 and hist.cuts.sum() == 3 * 2
+    assert body.commits == 12 and body.dt == pytest.approx(0.025)       # the body was given the cut dt
     with pytest.raises(NewtonError, match="step 1") as info:
-        integrate(FussyNewmark(s, 0.1), 0.0, np.zeros(4), n_steps=3, cutback=True, max_cuts=1)
+        integrate(FussyNewmark(s), 0.0, np.zeros(4), n_steps=3, dt=0.1, cutback=True, max_cuts=1)
     assert info.value.history == [1.0, 2.0] and len(info.value.partial.t) == 1
     with pytest.raises(NewtonError):
-        integrate(FussyNewmark(s, 0.1), 0.0, np.zeros(4), n_steps=3)
+        integrate(FussyNewmark(s), 0.0, np.zeros(4), n_steps=3, dt=0.1)
 
 
 # -- bad input ------------------------------------------------------------------------
@@ -348,27 +387,29 @@ def test_bad_input_raises():
     body, s = oscillator()
     for dt in (0.0, -1.0, np.nan):
         with pytest.raises(ValueError, match="dt"):
-            Newmark(s, dt)
+            integrate(Newmark(s), 0.0, np.zeros(4), n_steps=2, dt=dt)
+        with pytest.raises(ValueError, match="dt"):
+            Newmark(s).step(0.0, np.zeros(4), np.zeros(4), np.zeros(4), dt)
     for beta in (0.0, -0.1, 0.6):
         with pytest.raises(ValueError, match="beta"):
-            Newmark(s, 0.1, beta=beta)
+            Newmark(s, beta=beta)
     for delta in (-0.1, 1.1):
         with pytest.raises(ValueError, match="delta"):
-            Newmark(s, 0.1, delta=delta)
+            Newmark(s, delta=delta)
     with pytest.warns(UserWarning, match="unconditionally stable"):
-        Newmark(s, 0.1, delta=0.5, beta=0.2)
+        Newmark(s, delta=0.5, beta=0.2)
     with pytest.raises(ValueError, match="local_dofs"):
         System([body], fixed=[Dirichlet(body, [4])])
     with pytest.raises(ValueError, match="Dirichlet value"):
         System([body], fixed=[Dirichlet(body, [0, 1], [1.0, 2.0, 3.0])]).prescribed(0.0)
     with pytest.raises(ValueError, match="n_steps"):
-        integrate(Static(s), 0.0, np.zeros(4))
+        integrate(Static(s), 0.0, np.zeros(4), dt=0.1)
     with pytest.raises(ValueError, match="n_steps"):
-        integrate(Static(s), 0.0, np.zeros(4), n_steps=2, t_end=1.0)
+        integrate(Static(s), 0.0, np.zeros(4), n_steps=2, t_end=1.0, dt=0.1)
     with pytest.raises(ValueError, match="n_steps"):
-        integrate(Static(s), 0.0, np.zeros(4), n_steps=0)
+        integrate(Static(s), 0.0, np.zeros(4), n_steps=0, dt=0.1)
     with pytest.raises(ValueError, match="mass"):
-        CentralDifference(System([SpringChain(2, m=0.0)]), 0.1)
+        CentralDifference(System([SpringChain(2, m=0.0)]))
 
 
 def test_line_search_rescues_newton_where_full_steps_diverge():

@@ -1,6 +1,7 @@
-"""One time loop: ``contactfem.solver.integrate`` steps every scene. Its hooks (a dt rule
-with cutback and growth, a before-step hook, prescribed motion, a stop rule, recorders, a
-progress callback) are what the scenes need, so no scene keeps a loop of its own."""
+"""One time loop: ``contactfem.solver.march`` steps every scene, a generator of records.
+Its schedules (fixed steps or an adaptive rule, with the halving of failed steps and growth)
+are what the scenes need; a scene records and stops by iterating, so no scene keeps a time
+loop of its own."""
 import ast
 import io
 from pathlib import Path
@@ -8,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from contactfem.solver import NewtonError, Static, integrate
+from contactfem.solver import Adaptive, NewtonError, Static, Steps, integrate, march
 
 SCENES = Path(__file__).resolve().parents[1] / "contactfem" / "scenes"
 
@@ -36,7 +37,7 @@ def private_loops(path):
 @pytest.mark.parametrize("path", sorted(SCENES.glob("*.py")), ids=lambda p: p.name)
 def test_no_scene_keeps_its_own_time_loop(path):
     loops = private_loops(path)
-    assert not loops, f"{path.name}: time loops outside solver.integrate: {loops}"
+    assert not loops, f"{path.name}: time loops outside solver.march: {loops}"
 
 
 def test_the_grep_finds_a_private_loop(tmp_path):
@@ -47,31 +48,30 @@ def test_the_grep_finds_a_private_loop(tmp_path):
 
 
 class Spring:
-    """A one-dof System stand-in: G = k u - f(t); Newton fails while `fail` says so."""
-    dynamic = False
+    """A one-dof System stand-in: G = k u - t; Newton fails while `fail` says so."""
 
     def __init__(self, k=2.0, fail=lambda t1, dt: False):
         self.k, self.fail = k, fail
         self.ndof, self.fixed_dofs, self.free_dofs = 1, np.zeros(0, int), np.array([0])
         self.commits = []
+        self.instrument = None
 
     def apply_dirichlet(self, u, t):
         return np.array(u, dtype=float)
 
-    def set_dt(self, dt):
-        self.dt = dt
+    def start(self, u, t=0.0):
+        pass
 
-    def residual_tangent(self, u, t):
+    def evaluate(self, u, t, dt=None, u0=None, mass_coefficient=0.0, phases=None):
         import scipy.sparse as sp
-        return self.k * u - t, sp.csr_matrix([[self.k]])
 
-    def external_force(self, u, t):
-        return np.array([t])
+        from contactfem.solver import Evaluation
+        return Evaluation(self.k * u - t, sp.csr_matrix([[self.k]]), (), np.array([t]))
 
-    def energies(self, u, v):
-        return dict(kinetic=0.0, strain=0.5 * self.k * float(u @ u), contact=0.0, dissipation=0.0)
+    def energies(self, u, v, evaluation, dt=None):
+        return dict(kinetic=0.0, strain=0.5 * self.k * float(u @ u), contact=0.0)
 
-    def commit(self, u):
+    def commit(self, evaluation, u, t, dt=None):
         self.commits.append(float(u[0]))
 
     def mass(self):
@@ -79,46 +79,62 @@ class Spring:
 
 
 class FailingStatic(Static):
-    def step(self, t, u, v, a, dt=None, label=""):
+    def step(self, t, u, v, a, dt, label=""):
         if self.system.fail(t + dt, dt):
             raise NewtonError(f"no convergence ({label})", [1.0], label)
-        return super().step(t, u, v, a, dt=dt, label=label)
+        return super().step(t, u, v, a, dt, label=label)
 
 
-def test_dt_rule_cutback_growth_and_hooks():
-    """A dt rule asks for 0.25; the step ending at 0.5 fails at full size and is halved;
+def test_adaptive_rule_cutback_growth():
+    """A rule asks for 0.25; the step ending at 0.5 fails at full size and is halved;
     with growth = 1 the halved size is kept, with growth = 2 it doubles back."""
     for growth, expected in ((1.0, [0.25, 0.125, 0.125, 0.125, 0.125, 0.125, 0.125]),
                              (2.0, [0.25, 0.125, 0.25, 0.25, 0.125])):
         sys = Spring(fail=lambda t1, dt: abs(t1 - 0.5) < 1e-12 and dt > 0.2)
-        calls, moves, recs = [], [], []
-        hist = integrate(FailingStatic(sys, dt=0.25), 0.0, np.zeros(1), t_end=1.0,
-                         dt_rule=lambda t, u, v, a: 0.25, growth=growth, cutback=True, max_cuts=3,
-                         before_step=lambda t, u, v, a: calls.append(t), motion=moves.append,
-                         recorder=lambda t, u, v, a, step: recs.append((step.k, step.dt, step.cuts)))
-        assert np.allclose(hist.dt[1:], expected[:len(hist.dt) - 1]) and hist.t[-1] == pytest.approx(1.0)
-        assert len(calls) == len(hist.t) - 1                  # once per accepted step
-        assert len(moves) == len(hist.t) - 1 + 1              # once per attempt (one failed)
-        assert recs[0] == (0, 0.0, 0) and recs[2][2] == 1     # the halved step is recorded as cut once
-        assert hist.failures and "no convergence" in hist.failures[0]
-        assert np.allclose(hist.u, 0.5)                       # k u = t at t = 1
+        schedule = Adaptive(lambda rec: 0.25, t_end=1.0, dt=0.25, growth=growth, max_cuts=3)
+        recs = list(march(FailingStatic(sys), schedule, 0.0, np.zeros(1)))
+        dts = [r.dt for r in recs[1:]]
+        assert np.allclose(dts, expected[:len(dts)]) and recs[-1].t == pytest.approx(1.0)
+        assert len(sys.commits) == len(recs) - 1                 # committed once per accepted step
+        assert (recs[0].k, recs[0].dt, recs[0].cuts) == (0, 0.0, 0) and recs[2].cuts == 1
+        assert recs[2].failures and "no convergence" in recs[2].failures[0]
+        assert np.allclose(recs[-1].u, 0.5)                      # k u = t at t = 1
 
 
-def test_stop_min_dt_and_progress():
-    sys = Spring()
-    hist = integrate(Static(sys, dt=0.1), 0.0, np.zeros(1), t_end=1.0, dt_rule=lambda t, u, v, a: 0.1,
-                     stop=lambda t, u, v, a: t >= 0.5 - 1e-12)
-    assert hist.t[-1] == pytest.approx(0.5)
+def test_the_scene_stops_by_leaving_the_loop_and_min_dt_ends_the_cuts():
+    recs = []
+    for rec in march(Static(Spring()), Adaptive(lambda rec: 0.1, t_end=1.0, dt=0.1), 0.0, np.zeros(1)):
+        recs.append(rec)
+        if rec.t >= 0.5 - 1e-12:
+            break
+    assert recs[-1].t == pytest.approx(0.5) and len(recs) == 6
     sys = Spring(fail=lambda t1, dt: True)
     with pytest.raises(NewtonError) as err:
-        integrate(FailingStatic(sys, dt=0.5), 0.0, np.zeros(1), t_end=1.0, dt_rule=lambda t, u, v, a: 0.5,
-                  cutback=True, max_cuts=10, min_dt=0.1)
-    assert len(err.value.partial.failures) == 3               # 0.5, 0.25, 0.125; 0.0625 < min_dt
+        list(march(FailingStatic(sys), Adaptive(lambda rec: 0.5, t_end=1.0, dt=0.5, max_cuts=10, min_dt=0.1),
+                   0.0, np.zeros(1)))
+    assert err.value.record.k == 0                               # the last record before the failure
+    with pytest.raises(NewtonError) as err:
+        integrate(FailingStatic(sys), 0.0, np.zeros(1), t_end=1.0, dt=0.5, cutback=True, max_cuts=10, min_dt=0.1)
+    assert len(err.value.partial.t) == 1                         # 0.5, 0.25, 0.125 failed; 0.0625 < min_dt
+
+
+def test_progress_bar_follows_the_records():
     from contactfem.io import ProgressBar
     out = io.StringIO()
-    integrate(Static(Spring(), dt=0.25), 0.0, np.zeros(1), n_steps=4,
+    integrate(Static(Spring()), 0.0, np.zeros(1), n_steps=4, dt=0.25,
               progress=lambda t0, t1, label: ProgressBar(t0=t0, t_end=t1, label=label, stream=out))
     assert "100%" in out.getvalue() and out.getvalue().endswith("\n")
+
+
+def test_fixed_steps_snap_to_the_grid_and_cover_a_halved_step():
+    """Steps(0.1, n_steps=3) with the step to 0.2 failing at full size: 0.1, then two halves
+    of 0.05, then 0.1 again; every grid time is hit exactly."""
+    sys = Spring(fail=lambda t1, dt: abs(t1 - 0.2) < 1e-12 and dt > 0.06)
+    recs = list(march(FailingStatic(sys), Steps(0.1, n_steps=3, max_cuts=2), 0.0, np.zeros(1)))
+    assert np.allclose([r.dt for r in recs[1:]], [0.1, 0.05, 0.05, 0.1])
+    assert np.allclose([r.t for r in recs], [0.0, 0.1, 0.15, 0.2, 0.3], rtol=0, atol=1e-15)
+    assert recs[3].t == 2 * 0.1 and recs[4].t == 3 * 0.1           # the grid t0 + k dt, exactly
+    assert [r.cuts for r in recs] == [0, 0, 1, 0, 0]
 
 
 def test_run_cork_progress_shows_a_bar(capsys):

@@ -96,7 +96,7 @@ class Beam:
     nu       Poisson's ratio, used only for the default G
     kappa_s  shear correction factor (default 5/6, rectangle)
     plastic  None (elastic) or dict(N0=, Q0=, M0=, eta=0.1): Perzyna viscoplasticity;
-             then set the step with ``beam.set_dt(dt)`` before calling internal().
+             then every evaluation needs the step's ``dt`` (internal_coo(u, dt), commit(u, dt)).
     integration     1 (midpoint, default) or 2 (two-point Gauss: stiffer, shear locking)
     rotary_inertia  True (default): rho I on the rotation dofs of the lumped mass; False: 0
     """
@@ -150,7 +150,7 @@ class Beam:
         self._dX = chord                                          # X_b - X_a per element
         self.dof_offset = 0
 
-        self.S0, self.eta, self.dt = None, None, None
+        self.S0, self.eta = None, None
         if plastic is not None:
             unknown = set(plastic) - {"N0", "Q0", "M0", "eta"}
             if unknown:
@@ -168,10 +168,18 @@ class Beam:
         self.ep = np.zeros((len(self.points) * ne, 3))
         self.rotary_inertia = bool(rotary_inertia)
 
-    # ---- time step for the viscoplastic update ---------------------------------
-    def set_dt(self, dt):
-        """Time step used by the backward-Euler viscoplastic update."""
-        self.dt = _check("dt", dt, 0.0)
+    @property
+    def hyperelastic(self):
+        """True for the elastic beam (a stored energy, no history); False when viscoplastic."""
+        return self.S0 is None
+
+    def _dt(self, dt):
+        """The step's dt, needed by the backward-Euler viscoplastic update only."""
+        if self.S0 is None:
+            return dt
+        if dt is None:
+            raise RuntimeError("viscoplastic beam: the step's dt is needed (internal_coo(u, dt), commit(u, dt))")
+        return _check("dt", dt, 0.0)
 
     # ---- kinematics ----------------------------------------------------------------
     def positions(self, u):
@@ -194,28 +202,28 @@ class Beam:
         E[:, 2] = (U[b, 2] - U[a, 2]) / self.L0                           # kap = theta'
         return E, t, n
 
-    def resultants(self, u, xi=0.0, k=0, E=None):
+    def resultants(self, u, xi=0.0, k=0, E=None, dt=None):
         """(N, Q, M) per element at xi (integration point k), (ne, 3), with the algorithmic
-        moduli dS/dE and new plastic strains (E: the strains there, if already computed)."""
+        moduli dS/dE and new plastic strains (E: the strains there, if already computed; dt: the
+        step, viscoplastic only)."""
         if E is None:
             E = self.strains(u, xi)[0]
-        if self.S0 is not None and self.dt is None:
-            raise RuntimeError("viscoplastic beam: call beam.set_dt(dt) before evaluating it")
         ne = len(self.L0)
-        return return_map(E, self.ep[k * ne:(k + 1) * ne], self.D, self.S0, self.eta, self.dt)
+        return return_map(E, self.ep[k * ne:(k + 1) * ne], self.D, self.S0, self.eta, self._dt(dt))
 
     # ---- body interface ------------------------------------------------------------
-    def internal(self, u):
+    def internal(self, u, dt=None):
         """Internal force R = dW/du and consistent tangent K = dR/du (CSR); see internal_coo."""
         from scipy.sparse import coo_matrix
 
-        R, rows, cols, vals = self.internal_coo(u)
+        R, rows, cols, vals = self.internal_coo(u, dt)
         return R, coo_matrix((vals, (rows, cols)), shape=(self.ndof, self.ndof)).tocsr()
 
-    def internal_coo(self, u):
+    def internal_coo(self, u, dt=None):
         """Internal force R = dW/du and consistent tangent K = dR/du (virtual work, midpoint rule,
         or two-point Gauss with ``integration=2``), K as COO triplets (rows, cols, vals) on the
-        fixed element connectivity.
+        fixed element connectivity (the same index arrays at every call). dt: the step
+        (viscoplastic only).
 
         Per element and point, with q = (u_a, theta_a, u_b, theta_b) and B = dE/dq (3 x 6):
             r_e = w L0 B^T S,     K_e = w L0 (B^T C B + N d2eps/dq2 + Q d2gam/dq2)
@@ -241,9 +249,7 @@ class Beam:
         E[:, 0] = xp[:, 0] * cos + xp[:, 1] * sin - 1.0                   # eps = x' . t - 1
         E[:, 1] = -xp[:, 0] * sin + xp[:, 1] * cos                        # gam = x' . n
         E[:, 2] = (q[:, 5] - q[:, 2]) * g["invL"]                         # kap = theta'
-        if self.S0 is not None and self.dt is None:
-            raise RuntimeError("viscoplastic beam: call beam.set_dt(dt) before evaluating it")
-        S, C, _ = return_map(E, self.ep, self.D, self.S0, self.eta, self.dt)
+        S, C, _ = return_map(E, self.ep, self.D, self.S0, self.eta, self._dt(dt))
         eps, gam, N, Q = E[:, 0], E[:, 1], S[:, 0], S[:, 1]
         tL, sL = cos * g["invL"], sin * g["invL"]                         # t / L0 (a_t), n = (-s, c)
         B = np.zeros((len(phi), 3, 6))
@@ -283,15 +289,17 @@ class Beam:
                            wL0=weight * tile(self.L0))
         return self._g
 
-    def strain_energy(self, u):
-        """Stored (elastic) energy sum_e L0 sum_k S_k^2 / (2 D_k); elastic case: L0 D E^2 / 2."""
-        return float(sum(w * np.sum(self.L0[:, None] * self.resultants(u, xi, k)[0] ** 2 / (2 * self.D))
+    def strain_energy(self, u, dt=None):
+        """Stored (elastic) energy sum_e L0 sum_k S_k^2 / (2 D_k); elastic case: L0 D E^2 / 2
+        (viscoplastic: the resultants of a step of dt from the committed plastic strains)."""
+        return float(sum(w * np.sum(self.L0[:, None] * self.resultants(u, xi, k, dt=dt)[0] ** 2 / (2 * self.D))
                          for k, (xi, w) in enumerate(self.points)))
 
-    def commit(self, u):
-        """Accept u as converged: store the plastic strains (no-op if elastic)."""
+    def commit(self, u, dt=None):
+        """Accept u as converged at the end of a step of dt: store the plastic strains
+        (no-op if elastic)."""
         if self.S0 is not None:
-            self.ep = np.concatenate([self.resultants(u, xi, k)[2] for k, (xi, _) in enumerate(self.points)])
+            self.ep = np.concatenate([self.resultants(u, xi, k, dt=dt)[2] for k, (xi, _) in enumerate(self.points)])
 
     def mass(self):
         """Lumped mass: rho A per length on u_x, u_y and rho I per length on theta (half to each node;
@@ -349,6 +357,9 @@ class BeamGravity:
         if g.shape != (2,) or not np.all(np.isfinite(g)):
             raise ValueError(f"parameter g must be a finite number or 2-vector, got {g!r}")
         self.beam, self.g = beam, g
+
+    def commit(self, u, t):
+        """A dead load keeps no history."""
 
     def assemble(self, u_global, t):
         """(P, rows, cols, vals): the dead load and an empty tangent."""

@@ -188,6 +188,7 @@ class Continuum:
         self.dof_offset = 0
         self._K_linear = None
         self._mass = None
+        self._coo = None                # (indptr, indices, rows) of the last tangent's pattern
 
     # -- kinematics and constitutive update at the quadrature points --------
 
@@ -218,7 +219,23 @@ class Continuum:
 
     # -- body interface ----------------------------------------------------
 
-    def internal(self, u):
+    @property
+    def hyperelastic(self):
+        """The materials here are elastic: a stored energy W(u), no history."""
+        return True
+
+    def internal_coo(self, u, dt=None):
+        """R(u) and K = dR/du as COO triplets (rows, cols, vals): the CSR tangent's entries, its
+        index arrays kept (the same objects) while its pattern stays the same (scikit-fem's
+        assembly gives the same pattern at every call), so that the System places them once."""
+        R, K = self.internal(u)
+        last = self._coo
+        if last is None or not (last[0] is K.indptr or (np.array_equal(last[0], K.indptr)
+                                                        and np.array_equal(last[1], K.indices))):
+            last = self._coo = (K.indptr, K.indices, np.repeat(np.arange(K.shape[0]), np.diff(K.indptr)))
+        return R, last[2], last[1], K.data
+
+    def internal(self, u, dt=None):
         """Internal force R(u) and consistent tangent K = dR/du (csr)."""
         u = np.asarray(u, dtype=float)
         if self.material == "linear":
@@ -231,7 +248,7 @@ class Continuum:
         K = asm(_tangent_form, self.basis, A=A, **self._params()).tocsr()
         return R, K
 
-    def strain_energy(self, u):
+    def strain_energy(self, u, dt=None):
         """Stored energy int W dV (2 pi r dA for axisymmetric)."""
         W, _, _ = self._constitutive(np.asarray(u, dtype=float), self.basis)
         return float(asm(_energy_form, self.basis, W=W, **self._params()))
@@ -245,7 +262,7 @@ class Continuum:
             self._mass = np.asarray(M.sum(axis=1)).ravel()
         return self._mass.copy()
 
-    def commit(self, u):
+    def commit(self, u, dt=None):
         """Elastic: no history to update."""
 
     def corner_jacobian_ratios(self, u):
@@ -272,6 +289,14 @@ class Continuum:
     def inverted_elements(self, u):
         """Indices of the elements with a non-positive det J somewhere (corner_jacobian_ratios)."""
         return np.flatnonzero(np.min(self.corner_jacobian_ratios(u), axis=1) <= 0.0)
+
+    def element_areas(self, u):
+        """Current (signed) area of every element in the plane (shoelace formula over its
+        nodes, counter-clockwise): > 0 for a valid element, <= 0 for an inverted one."""
+        x = self.X + np.asarray(u)[self.xdofs]
+        q = x[self.mesh.t.T]                            # (nel, nodes, 2)
+        xs, ys = q[..., 0], q[..., 1]
+        return 0.5 * np.sum(xs * np.roll(ys, -1, axis=1) - np.roll(xs, -1, axis=1) * ys, axis=1)
 
     def volume(self):
         """Reference volume int dV (2 pi r dA axisymmetric, thickness * area plane)."""

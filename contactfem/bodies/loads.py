@@ -42,6 +42,9 @@ class _Load:
     def _local(self, u, t):
         raise NotImplementedError
 
+    def commit(self, u_global, t):
+        """Accept the converged state u at time t (a load with no history ignores it)."""
+
     def assemble(self, u_global, t):
         off, n = self.body.dof_offset, self.body.ndof
         P_local, rows, cols, vals = self._local(np.asarray(u_global)[off:off + n], t)
@@ -212,3 +215,34 @@ class GasPressure(Pressure):
         if t <= self.n_ramp * self.dt_ramp * (1 + 1e-9):
             return self.p_step * np.ceil(t / self.dt_ramp - 1e-6)
         return self.value
+
+
+class OverhangPressure:
+    """Dead pressure p on the parts of a straight horizontal chain of surface nodes
+    (a body's top, ordered by x) that lie outside [x0, x1]: consistent nodal forces
+    int N_i p ds of the linear shape functions over the loaded part of each edge,
+    pushing in -y (the patch test's lower block, where it overhangs the upper one)."""
+
+    def __init__(self, body, nodes, p, x0, x1):
+        self.body = body
+        x = body.X[nodes, 0]
+        f = np.zeros(len(nodes))
+        for i in range(len(nodes) - 1):
+            xa, xb = x[i], x[i + 1]
+            L = xb - xa
+            for lo, hi in ((xa, min(xb, x0)), (max(xa, x1), xb)):       # loaded sub-intervals
+                if hi > lo:
+                    # int_lo^hi (xb - s)/L ds and int_lo^hi (s - xa)/L ds
+                    f[i] += ((xb - lo) ** 2 - (xb - hi) ** 2) / (2 * L)
+                    f[i + 1] += ((hi - xa) ** 2 - (lo - xa) ** 2) / (2 * L)
+        self.local = np.zeros(body.ndof)
+        self.local[body.xdofs[nodes, 1]] = -p * f * body.thickness
+
+    def commit(self, u_global, t):
+        """A dead load keeps no history."""
+
+    def assemble(self, u_global, t):
+        P = np.zeros(len(u_global))
+        P[self.body.dof_offset:self.body.dof_offset + self.body.ndof] = self.local
+        e = np.zeros(0, dtype=int)
+        return P, e, e, np.zeros(0)

@@ -37,10 +37,8 @@ outer iteration is exactly the penalty step); lam_N carries over from the last s
 
 import numpy as np
 
-from ..laws.friction import Frictionless
 from ..laws.normal import PowerLaw
 from .interface import NodeToSegment
-from ..laws.return_map import return_map
 
 ENFORCEMENTS = ("penalty", "augmented")
 
@@ -53,8 +51,9 @@ def augments_normal(law):
 
 class AugmentedNodeToSegment(NodeToSegment):
     """NodeToSegment (same arguments) with normal and tangential multipliers (module
-    docstring). ``update_multipliers(u)`` is the Uzawa update; everything else is used
-    by the solver exactly like the penalty interface."""
+    docstring), held fixed during a Newton solve: ``update_multipliers(state)`` is the Uzawa
+    update from a converged inner state; everything else is used by the solver exactly like
+    the penalty interface."""
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
@@ -67,12 +66,12 @@ class AugmentedNodeToSegment(NodeToSegment):
     def start_step(self):
         """lam_T = the converged traction t_T_bar (called at the start of every step, so a
         step retried after a cut-back starts again from the committed state)."""
-        self.lam_T = self.t_T_bar.copy()
+        self.lam_T = self.history.t_T_bar.copy()
 
-    def kinematics(self, u):
+    def kinematics(self, u, t, h):
         """As NodeToSegment.kinematics, with the penalty law evaluated at the shifted gap
         g_N + lam_N / c_N (eq 4, m = 1; module docstring)."""
-        e = super().kinematics(u)
+        e = super().kinematics(u, t, h)
         if not self.augment_normal:
             return e
         g_eff = e["g_N"] + self.lam_N / self.normal.c_N
@@ -80,61 +79,44 @@ class AugmentedNodeToSegment(NodeToSegment):
         t_N, dt_N = self.normal.traction(np.where(active, g_eff, 1.0))
         return dict(e, active=active, t_N=t_N, dt_N=dt_N, g_eff=g_eff)
 
-    def evaluate(self, u):
-        """Tractions with the return mapping (eqs 40-44) started from lam_T, element
-        residual and tangent (eqs 28, 33, 39, 49)."""
-        e = self.kinematics(u)
-        if self.friction is None:
-            z = np.zeros_like(e["t_N"])
-            fr = return_map(Frictionless(), e["t_N"], e["dt_N"], z, z, self.q_bar)
-        else:
-            fr = return_map(self._law, e["t_N"], e["dt_N"], e["dg_T"], self.lam_T, self.q_bar,
-                            z_bar=self.z_bar, dt=self.dt)
-        return self.element(e, fr.t_T, fr.c_T_s, fr.c_N_s, friction=fr)
+    def predictor(self, h):
+        """The return mapping (eqs 40-44) starts from the multiplier lam_T (module docstring)."""
+        return self.lam_T
 
-    def violation(self, u):
-        """What the next update would change, in length units: max |t - lam| / c over the
-        slave nodes, normal (= the penetration of an active node) and tangential (= the
-        stick creep |s - s_bar| of a sticking node); and the largest penetration
-        (augmented normal only; 0 otherwise)."""
-        e = self.evaluate(u)
-        on = e["active"]
-        dN = 0.0
-        pen = 0.0
+    def violation(self, state):
+        """What the next update would change at a converged inner state, in length units:
+        max |t - lam| / c over the slave nodes, normal (= the penetration of an active node)
+        and tangential (= the stick creep |s - s_bar| of a sticking node); and the largest
+        penetration (augmented normal only; 0 otherwise)."""
+        on = state.active
+        dN = pen = 0.0
         if self.augment_normal:
-            t_N = np.where(on, e["t_N"], 0.0)
+            t_N = np.where(on, state.t_N, 0.0)
             dN = float(np.max(np.abs(t_N - self.lam_N), initial=0.0)) / self.normal.c_N
-            inside = e["inside"]
-            pen = float(np.max(np.where(inside, -e["g_N"], 0.0), initial=0.0))
+            pen = float(np.max(np.where(state.inside, -state.g_N, 0.0), initial=0.0))
         dT = 0.0
         if self.friction is not None:
-            t_T = np.where(on, e["friction"].t_T, 0.0)
-            dT = float(np.max(np.abs(t_T - self.lam_T), initial=0.0)) / self.friction.c_T
-        return dict(change=max(dN, dT, 0.0), normal=dN, tangential=dT, penetration=max(pen, 0.0), e=e)
+            t_T = np.where(on, state.t_T, 0.0)
+            dT = float(np.max(np.abs(t_T - self.lam_T), initial=0.0)) / self.c_T
+        return dict(change=max(dN, dT, 0.0), normal=dN, tangential=dT, penetration=max(pen, 0.0))
 
-    def update_multipliers(self, u):
-        """The Uzawa update lam <- t at u (module docstring). Returns ``violation(u)``
-        (before the update)."""
-        v = self.violation(u)
-        e = v.pop("e")
-        on = e["active"]
+    def update_multipliers(self, state):
+        """The Uzawa update lam <- t at a converged inner state (module docstring)."""
+        on = state.active
         if self.augment_normal:
-            self.lam_N = np.where(on, e["t_N"], 0.0)
+            self.lam_N = np.where(on, state.t_N, 0.0)
         if self.friction is not None:
-            self.lam_T = np.where(on, e["friction"].t_T, 0.0)
+            self.lam_T = np.where(on, state.t_T, 0.0)
         self.updates += 1
-        return v
 
-    def commit(self, u):
-        """The penalty interface's commit (t_T_bar = t_T, accumulated slip, projection);
-        then lam_T = t_T_bar so the next step starts from the converged traction, and
-        lam_N = t_N (warm start of the next step)."""
-        e = self.evaluate(u)
-        t_N = np.where(e["active"], e["t_N"], 0.0)
-        super().commit(u)
-        self.lam_T = self.t_T_bar.copy()
+    def commit(self, state):
+        """The penalty interface's commit (t_T_bar = t_T, accumulated slip, projection); then
+        lam_T = t_T_bar so the next step starts from the converged traction, and lam_N = t_N
+        (warm start of the next step)."""
+        super().commit(state)
+        self.lam_T = self.history.t_T_bar.copy()
         if self.augment_normal:
-            self.lam_N = t_N
+            self.lam_N = np.where(state.active, state.t_N, 0.0)
 
 
 def make_interface(enforcement, *args, **kwargs):

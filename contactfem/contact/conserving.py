@@ -89,16 +89,18 @@ def secant(law, g0, g1):
     return np.where(small, tm, phi), np.where(small, 0.5 * dtm, dphi)
 
 
-def conserving_force(contact, u0, u1):
-    """Residual and tangent (COO) of the energy-consistent contact force of a NodeToSegment
-    over the step u0 -> u1 (module docstring), plus a dict of per-node step quantities."""
+def conserving_force(contact, u0, u1, t, h, e1, fr):
+    """Residual and tangent of the energy-consistent contact force of a NodeToSegment over the
+    step u0 -> u1 (module docstring), per pair: (R, K, on, work_T), with e1 and fr the
+    kinematics and the return map's result at u1 and h the committed history; ``on`` marks the
+    pairs that carry a force (in range at the end and penetrating at either end), ``work_T``
+    the friction force's work over the step (per node)."""
     um = 0.5 * (u0 + u1)
-    e0, em, e1 = contact.kinematics(u0), contact.kinematics(um), contact.evaluate(u1)
+    e0, em = contact.kinematics(u0, t, h), contact.kinematics(um, t, h)
     nc = len(contact.nodes)
     dofs = e1["dofs"]
     d = (u1 - u0)[dofs]
     w = contact.weights
-    # which pairs carry a force: in range at the end, and penetrating at either end
     on = e1["inside"] & ((e0["g_N"] < 0.0) | (e1["g_N"] < 0.0))
     g0 = np.where(on, e0["g_N"], 1.0)
     g1 = np.where(on, e1["g_N"], 1.0)
@@ -106,84 +108,24 @@ def conserving_force(contact, u0, u1):
     gN, DgN = discrete_gradient(e0["g_N"], e1["g_N"], em["dg_N"], e1["dg_N"], em["d2g_N"], d)
     R = (w * phi)[:, None] * gN
     K = w[:, None, None] * (outer(gN, dphi[:, None] * e1["dg_N"]) + phi[:, None, None] * DgN)
-    fr = e1["friction"]
-    t_bar = contact.t_T_bar
+    t_bar = h.t_T_bar
     work_T = np.zeros(nc)
     if contact.friction is not None:
-        c_T = float(contact.friction.c_T)
+        c_T = contact.c_T
         sB, DsB = discrete_gradient(e0["travel"], e1["travel"], em["ds"], e1["ds"], em["d2s"], d)
         r = e1["r"]
         act = e1["active"]
-        t1 = np.where(act, fr.t_T, 0.0)
+        t1 = np.where(act, fr["t_T"], 0.0)
         dS = r * (e1["travel"] - e0["travel"])              # slip increment after touching
         jump = t1 - t_bar
         small = np.abs(dS) <= 1e-12 * (1.0 + np.abs(e1["travel"]))
         ratio = np.where(small, 1.0, jump / (c_T * np.where(small, 1.0, dS)))   # 1 in stick
         tau = np.where(act, t1 - 0.5 * jump * ratio, 0.0)   # = t1 - (t1 - t_bar)^2 / (2 c_T dS)
-        dt1 = fr.c_T_s[:, None] * e1["ddg_T"] + fr.c_N_s[:, None] * e1["dg_N"]
+        dt1 = fr["c_T_s"][:, None] * e1["ddg_T"] + fr["c_N_s"][:, None] * e1["dg_N"]
         dtau = np.where(act[:, None], (1.0 - ratio)[:, None] * dt1 + (0.5 * c_T * ratio ** 2)[:, None] * e1["ddg_T"], 0.0)
         dr = e1["dr"][:, None] * e1["dg_N"]                  # dr/du of the closing-step factor
         R = R + (w * tau * r)[:, None] * sB
         K = K + w[:, None, None] * (r[:, None, None] * outer(sB, dtau) + tau[:, None, None] * outer(sB, dr)
                                     + (tau * r)[:, None, None] * DsB)
         work_T = w * tau * dS
-    R = np.where(on[:, None], R, 0.0)
-    K = np.where(on[:, None, None], K, 0.0)
-    return R, K, dofs, dict(on=on, work_T=np.where(on, work_T, 0.0), t_T=np.where(e1["active"], fr.t_T, 0.0))
-
-
-def assemble_conserving(contact, u0, u1):
-    """Global residual and COO triplets of conserving_force."""
-    R, K, dofs, _ = conserving_force(contact, u0, u1)
-    R_c = np.zeros(len(u1))
-    np.add.at(R_c, dofs.ravel(), R.ravel())
-    rows, cols, vals = to_coo(dofs, K)
-    return R_c, rows, cols, vals
-
-
-def step_dissipation(contact, u0, u1):
-    """Energy the friction force of the step dissipates: its work minus the change of the
-    stick springs' energy, sum w [ (t_T_bar + t_T)/2 r (s_1 - s_0) - (t_T^2 - t_T_bar^2) / (2 c_T) ].
-    Equal to sum w (t_T_bar + t_T)/2 lambda sign(t_T) for nodes in contact throughout."""
-    if contact.friction is None or not contact.friction.c_T > 0:
-        return 0.0
-    _, _, _, q = conserving_force(contact, u0, u1)
-    c_T = contact.friction.c_T
-    dW = contact.weights * (q["t_T"] ** 2 - contact.t_T_bar ** 2) / (2.0 * c_T)
-    return float(np.sum(q["work_T"]) - np.sum(dW))
-
-
-class ConservingContact:
-    """A NodeToSegment whose force over a step is the energy-consistent one (module
-    docstring). The stepper calls ``begin_step(u0)``; ``assemble(u)`` is then the force of
-    the step u0 -> u (without a step begun: the interface's own force, e.g. for the
-    initial acceleration). ``commit`` records the step's dissipation as ``step_dissipation``
-    (work of the friction force minus the change of stored energy). Everything else is the
-    wrapped interface's."""
-
-    def __init__(self, contact):
-        if not hasattr(contact.normal, "energy"):
-            raise ValueError(f"contact {contact.name!r}: energy-consistent integration needs a normal law "
-                             "with a potential (energy method)")
-        self.contact = contact
-        self.u0 = None
-
-    def __getattr__(self, name):
-        return getattr(self.contact, name)
-
-    def begin_step(self, u0):
-        self.u0 = np.array(u0, dtype=float)
-
-    def assemble(self, u):
-        if self.u0 is None:
-            return self.contact.assemble(u)
-        return assemble_conserving(self.contact, self.u0, u)
-
-    def commit(self, u):
-        c = self.contact
-        D = step_dissipation(c, self.u0, u) if self.u0 is not None else None
-        c.commit(u)
-        if D is not None:
-            c.dissipation_total += D - c.dissipation
-            c.dissipation = D
-        self.u0 = None
+    return R[on], K[on], on, np.where(on, work_T, 0.0)

@@ -34,6 +34,15 @@ def contact_element(w, t_N, dt_N, t_T, c_T_s, c_N_s, dg_N, d2g_N, ds, d2s, ddg_T
     return R, K
 
 
+def normal_element(w, t_N, dt_N, dg_N, d2g_N):
+    """The frictionless element: eq (28) with t_T = 0 and eq (33),
+
+        R_c = w t_N dg_N,    K_N = w [ dt_N/dg_N dg_N dg_N^T + t_N d2g_N ]."""
+    R = (w * t_N)[:, None] * dg_N
+    K = w[:, None, None] * (dt_N[:, None, None] * outer(dg_N, dg_N) + t_N[:, None, None] * d2g_N)
+    return R, K
+
+
 def to_coo(dofs, K):
     """COO triplets (rows, cols, vals) of the element matrices K (nc, k, k) placed at
     global dofs (nc, k)."""

@@ -1,26 +1,39 @@
-"""A contact interface: slave nodes of one body against a master, with their
-friction history (paper Sec. 4.3, step 4: per slave node, check the gap -> normal
-force -> trial friction -> slip check -> stick or return map -> tangents).
+"""A contact interface: slave nodes of one body against a master, with their friction
+history (paper Sec. 4.3, step 4: per slave node, check the gap -> normal force -> trial
+friction -> slip check -> stick or return map -> tangents).
 
-History (s_bar, t_T_bar, q_bar and the friction law's internal variables z_bar) is
-committed only on a converged step (commit).
+    contact = NodeToSegment(body, nodes, RigidLine(), normal=PowerLaw(c_N), friction=Coulomb(c_T, mu))
+    contact.start(u0)                           # the history at the initial state
+    state = contact.evaluate(u, t, dt)          # a ContactState (contact/state.py): nothing changes
+    R_c, rows, cols, vals = state.scatter(len(u))
+    contact.commit(state)                       # a converged state's history is kept
+
+``evaluate`` is a pure function of u and the committed ``history`` (a ContactHistory value);
+only ``commit`` changes the history, with the converged state's ``next_history``.
 
 The closing step: a node open at the start of a step (committed gap g_bar > 0) that is in
 contact at its end touched the master at the fraction theta = g_bar / (g_bar - g_N) of the
 step (the gap interpolated linearly). Its stick spring starts there: the slip increment is
 the travel after touching, Delta g_T = r (s - s_bar) with r = 1 - theta = -g_N / (g_bar - g_N),
 not the whole travel of the step (which would load the spring with the tangential motion
-made while still open). ``NodeToSegment.closing_step = False`` (per interface) drops the
-rule, to study what it changes (the cork's exit time, lecture 08)."""
+made while still open). ``NodeToSegment.closing_step = False`` (per contact) drops the
+rule, to study what it changes (the cork's exit time, lecture 08).
+
+Strategies the contact is built with (not wrappers): ``tangent`` (contact/tangents.py: the
+consistent tangent of eqs 33, 39, 49-50, or the symmetric and frozen variants the paper
+compares) and ``integration`` (``standard``: the forces at the end of the step;
+``energy_consistent``: the discrete-gradient force of the step, contact/conserving.py).
+"""
 
 import numpy as np
 
-from .element import contact_element, to_coo
-from ..laws.friction import Frictionless
 from ..laws.protocol import as_friction_law
-from ..laws.return_map import STATE_NAMES, return_map
+from ..laws.return_map import OPEN, STICK, return_map
+from .element import contact_element, normal_element, to_coo
+from .state import ContactHistory, ContactState
+from .tangents import TANGENTS
 
-FRICTIONLESS = as_friction_law(Frictionless())
+INTEGRATIONS = ("standard", "energy_consistent")
 
 
 def tributary_lengths(X):
@@ -42,38 +55,57 @@ class NodeToSegment:
               (the block, Sec. 5.1), 1 when c_N, c_T are nodal stiffnesses (rings, cork)
     offset:   the slave surface lies `offset` beyond the node along the master normal
               (half the thickness of a beam whose centreline nodes are the slaves)
+    tangent:  consistent | symmetric | frozen (contact/tangents.py)
+    integration: standard | energy_consistent (module docstring)
 
-    A friction law with a slip rate or internal variables (contactfem.laws.protocol)
-    gets the time step from ``set_dt`` (called by every stepper) and keeps its
-    variables z_bar per slave node; a law with ``gap_offset(z)`` (wear) moves the
-    surface by the committed z_bar (the wear of a step acts from the next step on).
+    A friction law with a slip rate or internal variables (contactfem.laws.protocol) gets
+    the step's dt from ``evaluate`` and keeps its variables z per slave node in the
+    history; a law with ``gap_offset(z)`` (wear) moves the surface by the committed z
+    (the wear of a step acts from the next step on).
     """
 
     closing_step = True     # the closing step of the module docstring; False: the whole travel
 
-    def __init__(self, slave, nodes, master, normal, friction=None, weights=1.0, offset=0.0, name="contact"):
+    def __init__(self, slave, nodes, master, *, normal, friction=None, weights=1.0, offset=0.0, name="contact",
+                 tangent="consistent", integration="standard"):
+        if tangent not in TANGENTS:
+            raise ValueError(f"parameter tangent = {tangent!r} is not allowed: one of {'|'.join(TANGENTS)}")
+        if integration not in INTEGRATIONS:
+            raise ValueError(f"parameter integration = {integration!r} is not allowed: one of {'|'.join(INTEGRATIONS)}")
+        if integration == "energy_consistent" and not hasattr(normal, "energy"):
+            raise ValueError(f"contact {name!r}: energy-consistent integration needs a normal law with a potential "
+                             "(an energy method)")
         self.slave, self.master, self.normal, self.friction, self.name = slave, master, normal, friction, name
+        self.tangent, self.integration = tangent, integration
         self.nodes = np.asarray(nodes, dtype=int)
         self.weights = np.broadcast_to(np.asarray(weights, dtype=float), self.nodes.shape).copy()
         if np.any(self.weights <= 0):
             raise ValueError("parameter weights must be positive (tributary lengths or 1)")
         self.offset = float(offset)
-        nc = len(self.nodes)
-        self.s_bar = None                   # set at the first evaluation (or initialize)
-        self.g_bar = None                   # committed gap (the closing step, module docstring)
-        self.t_T_bar = np.zeros(nc)
-        self.q_bar = np.zeros(nc)
         self._law = None if friction is None else as_friction_law(friction)
-        self.z_bar = self._law.initial_state(nc) if self._law is not None else np.zeros((nc, 0))
-        self.dt = None                      # time step, for rate- and state-dependent laws
-        self.dissipation = 0.0              # of the last committed step
-        self.dissipation_total = 0.0
+        self.c_T = 0.0 if self._law is None else self._law.c_T
+        self._has_energy = hasattr(normal, "energy")
+        self.history = None                 # ContactHistory, from start() and every commit()
+        self.evaluations = 0                # how often evaluate() ran (instrumentation)
 
-    def set_dt(self, dt):
-        """The step size of the coming step (slip rate = slip increment / dt)."""
-        self.dt = float(dt)
+    # -- the history ------------------------------------------------------------------
+    def start(self, u, t=0.0):
+        """The history at the initial state u: the projections there are the reference of the
+        first slip increment, no traction, no slip, the law's initial variables."""
+        nc = len(self.nodes)
+        ref = self.master.reference(u)
+        k = self.master.locate(self.slave_positions(u), np.zeros(nc), u, t=t, ref=ref)
+        z = self._law.initial_state(nc) if self._law is not None else np.zeros((nc, 0))
+        g = k["g_N"] - self.offset + self.gap_offset(z)
+        self.history = ContactHistory(s_bar=k["s"], g_bar=g, t_T_bar=np.zeros(nc), q_bar=np.zeros(nc), z_bar=z,
+                                      master=ref)
 
-    # -- kinematics -------------------------------------------------------------
+    def commit(self, state):
+        """Accept a converged state: its history (t_T, accumulated slip, law variables, the
+        projection and the master's metric) becomes the committed one."""
+        self.history = state.next_history
+
+    # -- kinematics -------------------------------------------------------------------
     def slave_dofs(self):
         """Global (u_x, u_y) dofs of the slave nodes, (nc, 2); kept while the slave body
         stays at the same place in the global vector."""
@@ -87,108 +119,110 @@ class NodeToSegment:
         dofs = self.slave_dofs()
         return self._X_s + u[dofs]
 
-    def initialize(self, u):
-        """Take the projections at u as the reference for the first slip increment."""
-        x_s = self.slave_positions(u)
-        s0 = np.zeros(len(self.nodes))
-        self.s_bar = self.master.locate(x_s, s0, u)["s"]
-        self.g_bar = None
-        self.g_bar = self.kinematics(u)["g_N"]
+    def gap_offset(self, z):
+        """How far a friction law with internal variables has moved the surface (wear), (nc,)."""
+        if self._law is None or not self._law.n_state:
+            return np.zeros(len(self.nodes))
+        return self._law.gap_offset(z)
 
-    def kinematics(self, u):
-        """Gap, normal traction and variations at u (step 4a-b of Sec. 4.3), before friction."""
-        if self.s_bar is None:
-            self.initialize(u)
+    def normal_energy(self, g_N):
+        """The normal law's potential at g_N (0 for a law without one)."""
+        return self.normal.energy(g_N) if self._has_energy else np.zeros_like(g_N)
+
+    def kinematics(self, u, t, h):
+        """Gap, normal traction and variations at u with the history h (step 4a-b of Sec. 4.3),
+        before friction: a dict of per-node arrays."""
         x_s = self.slave_positions(u)
-        k = self.master.locate(x_s, self.s_bar, u)
-        g_N = k["g_N"] - self.offset
-        if self._law is not None and self._law.n_state:
-            g_N = g_N + self._law.gap_offset(self.z_bar)    # worn surface: the gap opens
+        k = self.master.locate(x_s, h.s_bar, u, t=t, ref=h.master)
+        g_raw = k["g_N"] - self.offset
+        g_N = g_raw + self.gap_offset(h.z_bar) if self._law is not None and self._law.n_state else g_raw
         active = k["inside"] & (g_N < 0.0)
         t_N, dt_N = self.normal.traction(np.where(active, g_N, 1.0))
         dofs = np.concatenate([self.slave_dofs(), k["master_dofs"]], axis=1) if k["master_dofs"].size else self._dofs
-        travel = k["s"] - self.s_bar
+        travel = k["s"] - h.s_bar
         r, dr, ddg_T = np.ones_like(g_N), np.zeros_like(g_N), k["ds"]
-        if self.closing_step and self.g_bar is not None:    # the closing step (module docstring)
-            closing = active & (self.g_bar > 0.0)
-            if np.any(closing):
-                gb = np.where(closing, self.g_bar, 1.0)
-                r = np.where(closing, -g_N / (gb - g_N), 1.0)
-                dr = np.where(closing, -gb / (gb - g_N) ** 2, 0.0)
-                ddg_T = r[:, None] * k["ds"] + (travel * dr)[:, None] * k["dg_N"]
-        return dict(k, x_s=x_s, g_N=g_N, active=active, t_N=t_N, dt_N=dt_N, dg_T=r * travel, travel=travel,
-                    r=r, dr=dr, ddg_T=ddg_T, dofs=dofs)
+        closing = active & (h.g_bar > 0.0) & self.closing_step
+        if np.any(closing):                                 # the closing step (module docstring)
+            gb = np.where(closing, h.g_bar, 1.0)
+            r = np.where(closing, -g_N / (gb - g_N), 1.0)
+            dr = np.where(closing, -gb / (gb - g_N) ** 2, 0.0)
+            ddg_T = r[:, None] * k["ds"] + (travel * dr)[:, None] * k["dg_N"]
+        return dict(k, x_s=x_s, g_N=g_N, g_raw=g_raw, active=active, t_N=t_N, dt_N=dt_N, dg_T=r * travel,
+                    travel=travel, r=r, dr=dr, ddg_T=ddg_T, dofs=dofs)
 
-    def evaluate(self, u):
-        """Everything at displacement u with the committed history: kinematics,
-        tractions, return mapping, element residuals and tangents."""
-        e = self.kinematics(u)
-        if self.friction is None:
-            z = np.zeros_like(e["t_N"])
-            fr = return_map(FRICTIONLESS, e["t_N"], e["dt_N"], z, z, self.q_bar)
+    # -- friction (eqs 40-48) -----------------------------------------------------------
+    def predictor(self, h):
+        """The traction the elastic predictor starts from (eq 42): the converged t_T_bar."""
+        return h.t_T_bar
+
+    def friction_state(self, k, h, dt, phase=None):
+        """t_T, c_T^s, c_N^s and the return map's record at the kinematics k: frictionless,
+        the return map of eqs 40-48, or a phase of the staggered algorithm (tangents.Phase)."""
+        nc = len(k["g_N"])
+        zero = np.zeros(nc)
+        if self._law is None:
+            slip = np.where(k["t_N"] < 0.0, STICK, OPEN)
+            return dict(t_T=zero, c_T_s=zero, c_N_s=zero, slip=slip, lam=zero, q=h.q_bar, z=h.z_bar)
+        if phase is not None and phase.kind == "normal":   # stick about the frozen state
+            slip = np.where(k["t_N"] < 0.0, STICK, OPEN)
+            return dict(t_T=phase.t_T + self.c_T * (k["s"] - phase.s), c_T_s=np.full(nc, self.c_T), c_N_s=zero,
+                        slip=slip, lam=zero, q=h.q_bar, z=h.z_bar, ddg_T=k["ds"])
+        if phase is not None:                              # friction phase: the pressure frozen
+            fr = return_map(self._law, -phase.p, zero, k["dg_T"], self.predictor(h), h.q_bar, z_bar=h.z_bar, dt=dt)
         else:
-            fr = return_map(self._law, e["t_N"], e["dt_N"], e["dg_T"], self.t_T_bar, self.q_bar,
-                            z_bar=self.z_bar, dt=self.dt)
-        return self.element(e, fr.t_T, fr.c_T_s, fr.c_N_s, friction=fr)
+            fr = return_map(self._law, k["t_N"], k["dt_N"], k["dg_T"], self.predictor(h), h.q_bar,
+                            z_bar=h.z_bar, dt=dt)
+        return dict(t_T=fr.t_T, c_T_s=fr.c_T_s, c_N_s=fr.c_N_s, slip=fr.state, lam=fr.lam, q=fr.q, z=fr.z)
 
-    def element(self, e, t_T, c_T_s, c_N_s, **extra):
-        """Add the element residuals and tangents (eqs 28, 33, 39, 49) of the active pairs
-        to the kinematics e (an open pair contributes nothing: R and K hold active pairs only)."""
-        on = e["active"]
-        ddg_T = e.get("ddg_T")
-        R, K = contact_element(self.weights[on], e["t_N"][on], e["dt_N"][on], t_T[on], c_T_s[on], c_N_s[on],
-                               e["dg_N"][on], e["d2g_N"][on], e["ds"][on], e["d2s"][on],
-                               None if ddg_T is None else ddg_T[on])
-        return dict(e, R=R, K=K, **extra)
+    # -- one evaluation ------------------------------------------------------------------
+    def evaluate(self, u, t=0.0, dt=None, u0=None, phase=None):
+        """The ContactState at the trial displacement u of the step (t - dt, t] that starts
+        from u0 (needed by energy-consistent integration), with the committed history:
+        kinematics, tractions, return mapping, element residuals and tangents. ``phase``:
+        a phase of the staggered algorithm (contact/tangents.py), None for the contact as it is."""
+        h = self.history
+        if h is None:
+            raise ValueError(f"contact {self.name!r}: call start(u) before evaluating it (the initial history)")
+        self.evaluations += 1
+        k = self.kinematics(u, t, h)
+        fr = self.friction_state(k, h, dt, phase)
+        work_T = None
+        if self.integration == "energy_consistent" and u0 is not None:
+            from .conserving import conserving_force
 
-    @staticmethod
-    def scatter(e, ndof):
-        """Global residual and COO triplets of the active pairs of an evaluation e."""
-        dofs = e["dofs"][e["active"]]
-        R_c = np.bincount(dofs.ravel(), e["R"].ravel(), minlength=ndof)
-        rows, cols, vals = to_coo(dofs, e["K"])
-        return R_c, rows, cols, vals
+            R, K, on, work_T = conserving_force(self, u0, u, t, h, k, fr)
+            element_dofs = k["dofs"][on]
+        else:
+            on = k["active"]
+            R, K = self.element(k, fr, on)
+            element_dofs = k["dofs"][on]
+        return ContactState(contact=self, history=h, u=u, t=t, x_s=k["x_s"], g_N=k["g_N"], g_raw=k["g_raw"], s=k["s"],
+                            s_next=k.get("s_next", k["s"]), n=k["n"], tangent=k["t"], seg=k["seg"],
+                            inside=k["inside"], active=k["active"], r=k["r"], t_N=k["t_N"], dt_N=k["dt_N"],
+                            t_T=fr["t_T"], c_T_s=fr["c_T_s"], c_N_s=fr["c_N_s"], slip=fr["slip"], lam=fr["lam"],
+                            q=fr["q"], z=fr["z"], R=R, K=K, element_dofs=element_dofs, work_T=work_T)
 
-    # -- the contact interface used by the solver -------------------------------
-    def assemble(self, u):
-        """Global contact residual R_c (eq 28) and tangent triplets (eqs 33, 39, 49)."""
-        return self.scatter(self.evaluate(u), len(u))
+    def element(self, k, fr, on):
+        """The element residuals and tangents (eqs 28, 33, 39, 49-50) of the pairs `on`, with
+        the tangent strategy the contact was built with (tangents.py)."""
+        w = self.weights[on]
+        if self._law is None:
+            R, K = normal_element(w, k["t_N"][on], k["dt_N"][on], k["dg_N"][on], k["d2g_N"][on])
+        else:
+            ddg_T = fr.get("ddg_T", k["ddg_T"])
+            c_N_s = fr["c_N_s"][on] if self.tangent != "frozen" else np.zeros(np.count_nonzero(on))
+            R, K = contact_element(w, k["t_N"][on], k["dt_N"][on], fr["t_T"][on], fr["c_T_s"][on], c_N_s,
+                                   k["dg_N"][on], k["d2g_N"][on], k["ds"][on], k["d2s"][on], ddg_T[on])
+        if self.tangent == "symmetric":
+            K = 0.5 * (K + K.transpose(0, 2, 1))
+        return R, K
 
-    def commit(self, u):
-        """Accept u as converged: store t_T, accumulated slip and the projection."""
-        e = self.evaluate(u)
-        fr = e["friction"]
-        # energy dissipated in the step: the trapezoidal work of the traction on the slip,
-        # 1/2 (t_T_bar + t_T) dg_T^s with dg_T^s = lambda sign(t_T) (eq 45). It balances
-        # the trapezoidal energy bookkeeping of the time integrator; the return map's
-        # lambda |t_T| (FrictionState.dissipation, >= 0) is the algorithmic measure.
-        slip_work = 0.5 * (self.t_T_bar + fr.t_T) * fr.lam * np.sign(fr.t_T)
-        self.dissipation = float(np.sum(self.weights * slip_work))
-        self.dissipation_total += self.dissipation
-        self.t_T_bar = np.where(e["active"], fr.t_T, 0.0)
-        self.q_bar = fr.q
-        if fr.z is not None and self._law is not None:
-            self.z_bar = fr.z
-        if hasattr(self.master, "commit"):
-            self.master.commit(u)           # new converged metric l_bar of a deformable master
-        self.s_bar = self.master.locate(e["x_s"], self.s_bar, u)["s"]
-        self.g_bar = self.kinematics(u)["g_N"]
+    # -- conveniences (tests, lectures) -------------------------------------------------
+    def assemble(self, u, t=0.0, dt=None, u0=None):
+        """Global contact residual R_c (eq 28) and tangent triplets (eqs 33, 39, 49) at u."""
+        return self.evaluate(u, t, dt, u0).scatter(len(u))
 
-    def energy(self, u):
-        """Energy stored in the interface: the normal law's potential plus the elastic
-        tangential (stick) spring t_T^2 / (2 c_T)."""
-        e = self.evaluate(u)
-        g = np.where(e["active"], e["g_N"], 1.0)
-        W_N = self.normal.energy(g) if hasattr(self.normal, "energy") else np.zeros_like(g)
-        W_T = 0.0
-        if self.friction is not None and self.friction.c_T > 0:
-            W_T = e["friction"].t_T ** 2 / (2.0 * self.friction.c_T)
-        return float(np.sum(self.weights * (W_N + W_T)))
 
-    def report(self, u):
-        """Per slave node: reference and current position, gap, tractions, forces, state."""
-        e = self.evaluate(u)
-        fr = e["friction"]
-        return dict(X=self.slave.X[self.nodes], x=e["x_s"], g_N=e["g_N"], t_N=e["t_N"], t_T=fr.t_T,
-                    f_N=self.weights * e["t_N"], f_T=self.weights * fr.t_T, n=e["n"], t=e["t"],
-                    state=STATE_NAMES[fr.state], seg=e["seg"], weights=self.weights)
+def element_triplets(state):
+    """COO triplets of a state's element tangents (rows, cols, vals)."""
+    return to_coo(state.element_dofs, state.K)

@@ -2,8 +2,10 @@
 coordinate vary with the unknowns.
 
 Every master answers one question for an array of slave positions x_s (nc, 2):
-``locate(x_s, s_bar, u)`` returns the contact kinematics of each slave with its
-closest master segment (or point of a smooth obstacle):
+``locate(x_s, s_bar, u, t=None, ref=None)`` returns the contact kinematics of each slave
+with its closest master segment (or point of a smooth obstacle) at time t (a moving rigid
+obstacle), in the metric of ``ref`` (what ``reference(u)`` gave at the last converged
+state: a deformable master's node positions; None for a rigid master):
 
     g_N (nc,), s (nc,)        gap (eq 17) and arc coordinate of the projection
     dg_N, ds (nc, k)          first variations w.r.t. the pair's dofs (eq 27)
@@ -11,6 +13,11 @@ closest master segment (or point of a smooth obstacle):
     master_dofs (nc, k - 2)   global dofs of the master nodes (none for rigid masters)
     inside (nc,) bool         the projection falls on the master
     seg (nc,) int             segment index (-1 for smooth obstacles)
+    s_next (nc,)              deformable master: s in the metric of the current configuration
+                              (the next s_bar once this state is committed); rigid: s
+
+Masters hold no state: what they remember between steps is ``reference(u)``, kept in the
+contact's history (contact/state.py).
 
 The first two dofs of each pair are the slave's. The tangential slip increment of
 eq (20) is Delta g_T = s - s_bar: s is measured along the master in the metric of
@@ -66,10 +73,13 @@ class RigidLine:
         self.point = np.asarray(point, dtype=float)
         self.normal = nrm / np.linalg.norm(nrm)
 
-    def locate(self, x_s, s_bar, u):
+    def locate(self, x_s, s_bar, u, t=None, ref=None):
         k = line_variations(x_s, self.point, self.normal)
         nc = len(x_s)
         return dict(k, master_dofs=np.zeros((nc, 0), dtype=int), inside=np.ones(nc, bool), seg=np.full(nc, -1))
+
+    def reference(self, u):
+        return None
 
     def outline(self, extent=(-1.0, 1.0)):
         t = np.array([self.normal[1], -self.normal[0]])
@@ -87,7 +97,10 @@ class RigidPolyline:
         self.points = _check_points(points, "points")
         self.S = _arc_lengths(self.points)
 
-    def locate(self, x_s, s_bar, u):
+    def reference(self, u):
+        return None
+
+    def locate(self, x_s, s_bar, u, t=None, ref=None):
         """Each slave against the fixed line of its closest segment j (eqs 17-19 with x_1, x_2
         fixed: line_variations), s = S[j] + (x_s - P_j).t_j."""
         P = self.points
@@ -117,7 +130,10 @@ class RigidArc:
         self.center = np.asarray(center, dtype=float)
         self.R, self.theta0, self.theta1, self.inside = float(R), float(theta0), float(theta1), bool(inside)
 
-    def locate(self, x_s, s_bar, u):
+    def reference(self, u):
+        return None
+
+    def locate(self, x_s, s_bar, u, t=None, ref=None):
         theta_ref = np.asarray(s_bar, dtype=float) / self.R
         k = arc_variations(x_s, self.center, self.R, self.inside, theta_ref)
         th = k["theta"]
@@ -145,7 +161,6 @@ class BodySurface:
         if self.nodes.ndim != 1 or len(self.nodes) < 2:
             raise ValueError("parameter nodes of a master surface must list at least 2 nodes")
         _check_points(body.X[self.nodes], "master nodes (reference positions)")
-        self.x_bar = body.X[self.nodes].copy()   # last converged positions
 
     def dofs(self):
         return self.body.dof_offset + self.body.xdofs[self.nodes]       # (nm, 2)
@@ -153,23 +168,28 @@ class BodySurface:
     def positions(self, u):
         return self.body.X[self.nodes] + u[self.dofs()]
 
-    def locate(self, x_s, s_bar, u):
+    def reference(self, u):
+        """The converged node positions x_bar: the metric (l_bar, S_bar) of the next step's s."""
+        return self.positions(u)
+
+    def locate(self, x_s, s_bar, u, t=None, ref=None):
+        """Eqs (17)-(19), (27), (31)-(38) with the master nodes moving; s = S_bar[j] + alpha l_bar
+        in the metric of ref (the converged positions x_bar; the reference positions if None)."""
+        x_bar = self.body.X[self.nodes] if ref is None else ref
         P = self.positions(u)
         j, inside = closest_segment(x_s, P)
         k = segment_variations(x_s, P[j], P[j + 1])
-        l_bar = np.linalg.norm(self.x_bar[j + 1] - self.x_bar[j], axis=1)
-        S_bar = _arc_lengths(self.x_bar)
+        l_bar = np.linalg.norm(x_bar[j + 1] - x_bar[j], axis=1)
+        S_bar = _arc_lengths(x_bar)
         dofs = self.dofs()
         return dict(g_N=k["g_N"], s=S_bar[j] + k["alpha"] * l_bar, t=k["t"], n=k["n"],
                     dg_N=k["dg_N"], d2g_N=k["d2g_N"],
                     ds=l_bar[:, None] * k["dalpha"], d2s=l_bar[:, None, None] * k["d2alpha"],
-                    master_dofs=np.concatenate([dofs[j], dofs[j + 1]], axis=1), inside=inside, seg=j)
-
-    def commit(self, u):
-        self.x_bar = self.positions(u)
+                    master_dofs=np.concatenate([dofs[j], dofs[j + 1]], axis=1), inside=inside, seg=j,
+                    s_next=_arc_lengths(P)[j] + k["alpha"] * k["l"])
 
     def outline(self, u=None):
-        return self.x_bar if u is None else self.positions(u)
+        return self.body.X[self.nodes] if u is None else self.positions(u)
 
 
 def _expand(mask, like):
@@ -192,13 +212,14 @@ class RigidComposite:
     one piece to the next; with equal tangents at the joints the normal is continuous.
     A node belongs to the first piece whose end it has not passed (its coordinate on the
     piece is below the piece's length), the last piece otherwise; a node exactly at a
-    joint belongs to the line piece there. ``translate(offset)``
-    moves the whole master rigidly (a prescribed obstacle motion; s is unchanged).
+    joint belongs to the line piece there. ``motion(t) -> (dx, dy)`` (optional) moves the
+    whole master rigidly with time (a prescribed obstacle motion, e.g. a press fit; s is
+    unchanged); ``offset`` is a fixed translation.
     """
 
     rigid = True
 
-    def __init__(self, pieces, offset=(0.0, 0.0)):
+    def __init__(self, pieces, offset=(0.0, 0.0), motion=None):
         self.pieces = []
         for p in pieces:
             kind = p[0]
@@ -217,32 +238,39 @@ class RigidComposite:
             else:
                 raise ValueError(f"piece kind {kind!r} is not allowed: one of line|arc")
         self.S = np.concatenate([[0.0], np.cumsum([p["length"] for p in self.pieces])])
-        self.translate(offset)
-
-    def translate(self, offset):
-        """Move the master rigidly to ``offset`` (from its defining position)."""
         self.offset = np.asarray(offset, dtype=float)
+        self.motion = motion
 
-    def _piece(self, i, x_s):
+    def position(self, t=None):
+        """The translation of the master at time t: offset + motion(t)."""
+        if self.motion is None or t is None:
+            return self.offset
+        return self.offset + np.asarray(self.motion(t), dtype=float)
+
+    def reference(self, u):
+        return None
+
+    def _piece(self, i, x_s, offset):
         """Kinematics of every slave with piece i and its coordinate along it."""
         p, nc = self.pieces[i], len(x_s)
         if p["kind"] == "line":
             t = p["t"]
-            k = line_variations(x_s, p["A"] + self.offset, np.array([-t[1], t[0]]))
+            k = line_variations(x_s, p["A"] + offset, np.array([-t[1], t[0]]))
             return k, k["s"]
-        c = p["c"] + self.offset
+        c = p["c"] + offset
         k = arc_variations(x_s, c, p["R"], not p["cw"], np.full(nc, 0.5 * (p["th0"] + p["th1"])))
         if p["cw"]:                        # travelled clockwise: t = -e_theta, s = R (theta0 - theta)
             k = dict(k, t=-k["t"], ds=-k["ds"], d2s=-k["d2s"])
             return k, p["R"] * p["th0"] - k["s"]
         return k, k["s"] - p["R"] * p["th0"]
 
-    def locate(self, x_s, s_bar, u):
+    def locate(self, x_s, s_bar, u, t=None, ref=None):
         nc, m = len(x_s), len(self.pieces)
         own = np.full(nc, m - 1)
+        offset = self.position(t)
         local = []
         for i in range(m):
-            k, s_loc = self._piece(i, x_s)
+            k, s_loc = self._piece(i, x_s, offset)
             local.append((k, s_loc))
         for i in reversed(range(m - 1)):         # a joint belongs to the line beside it
             L_i = self.pieces[i]["length"]
@@ -261,16 +289,38 @@ class RigidComposite:
         inside = ~(((own == 0) & (local[0][1] < 0.0)) | ((own == m - 1) & (local[-1][1] > self.pieces[-1]["length"])))
         return dict(out, master_dofs=np.zeros((nc, 0), dtype=int), inside=inside, seg=own)
 
-    def outline(self, n=32):
-        """Points along the master (n per arc), for drawing."""
+    def outline(self, n=32, t=None):
+        """Points along the master (n per arc) at time t, for drawing."""
+        offset = self.position(t)
         pts = []
         for p in self.pieces:
             if p["kind"] == "line":
-                pts += [p["A"] + self.offset, p["A"] + p["length"] * p["t"] + self.offset]
+                pts += [p["A"] + offset, p["A"] + p["length"] * p["t"] + offset]
             else:
                 th = np.linspace(p["th0"], p["th1"], n)
-                pts += list(p["c"] + self.offset + p["R"] * np.column_stack([np.cos(th), np.sin(th)]))
+                pts += list(p["c"] + offset + p["R"] * np.column_stack([np.cos(th), np.sin(th)]))
         pts = np.array(pts)
         scale = max(float(np.max(np.abs(pts))), 1.0)
         keep = np.concatenate([[True], np.linalg.norm(np.diff(pts, axis=0), axis=1) > 1e-9 * scale])
         return pts[keep]
+
+
+def bottle_neck(R_neck, L_neck, r_mouth, z_low=-10.0, shift=0.0, motion=None):
+    """The rigid neck of a bottle (the champagne cork, Sec. 5.5) in the meridian plane
+    (x = r, y = z): one smooth RigidComposite of three pieces,
+
+        wall   the line r = R_neck for z_low <= z <= L_neck, traversed upwards, so that its
+               normal n = e3 x t (eq 18) = -e_r points into the neck, towards the cork;
+        mouth  the rounded lip: the circle of radius r_mouth about (R_neck + r_mouth, L_neck),
+               angles pi .. pi/2 (clockwise), touched from outside, n = e_r of the circle;
+        top    the flat top of the bottle z = L_neck + r_mouth, traversed outwards (n = +e_z).
+
+    The pieces meet with equal tangents (a continuous normal) and the arc coordinate runs on
+    from piece to piece, so a node keeps its friction history (eq 20) from the wall to the
+    mouth. ``shift``: a fixed radial translation; ``motion(t) -> (dr, dz)``: a prescribed one
+    (the press fit moves the neck inwards)."""
+    r_top = R_neck + r_mouth + 6.0
+    return RigidComposite([("line", (R_neck, z_low), (R_neck, L_neck)),
+                           ("arc", (R_neck + r_mouth, L_neck), r_mouth, np.pi, np.pi / 2),
+                           ("line", (R_neck + r_mouth, L_neck + r_mouth), (r_top, L_neck + r_mouth))],
+                          offset=(shift, 0.0), motion=motion)

@@ -1,12 +1,13 @@
 """A progress bar for long runs, on stderr, without dependencies.
 
     bar = ProgressBar(t0=0.0, t_end=2.0, label="ring")
-    hist = integrate(stepper, 0.0, u0, v0, t_end=2.0, callback=bar)
+    for rec in march(stepper, Steps(dt, t_end=2.0), 0.0, u0, v0):
+        bar(rec.t)
     bar.close()
 
 or, counting steps: ``bar = ProgressBar(total=200)`` and ``bar.update()`` per step.
-Several callbacks at once: ``integrate(..., callback=chain(bar, recorder))``. A scene or
-``integrate`` makes its own bars with ``progress=progress_bar`` (one per time loop).
+Several callbacks at once: ``chain(bar, recorder)``. A scene or ``integrate`` makes its own
+bars with ``progress=progress_bar`` (one per time loop; solver.march.watch).
 """
 
 import sys

@@ -189,13 +189,13 @@ def _load(path, to_arrays):
 
 
 class Recorder:
-    """An integrate callback keeping snapshots (t, u, v) every `every` accepted steps:
+    """Keeps snapshots (t, u, v) of every `every`-th call, e.g. of the records of a march:
 
         rec = Recorder(every=5)
-        integrate(stepper, 0.0, u0, v0, n_steps=200, callback=rec)
+        for r in march(stepper, Steps(dt, n_steps=200), 0.0, u0, v0):
+            rec(r.t, r.u, r.v)
         rec.t, rec.u            # arrays (n_snap,), (n_snap, ndof)
-
-    Call ``rec(t0, u0, v0)`` once before integrating to keep the initial state too."""
+    """
 
     def __init__(self, every=1):
         if int(every) != every or every < 1:

@@ -165,11 +165,11 @@ def residual_distance(ours, paper, floor=RESIDUAL_FLOOR):
 
 def _block_case(params):
     """One solve of the block, reduced to what the score and the physical screen need."""
-    from ..scenes.block import run
+    from ..scenes.block import SCENE
     from ..solver.newton import NewtonError
 
     try:
-        r = run(params)
+        r = SCENE.run(params)
     except (NewtonError, FloatingPointError, np.linalg.LinAlgError) as exc:
         return dict(converged=False, error=str(exc).splitlines()[0][:120])
     c = r["contact"]
@@ -429,11 +429,11 @@ SLOPING_STEPS = 80
 
 
 def _sloping_case(params):
-    from ..scenes.sloping_impact import run
+    from ..scenes.sloping_impact import SCENE
     from ..solver.newton import NewtonError
 
     try:
-        r = run(params)
+        r = SCENE.run(params)
     except (NewtonError, FloatingPointError, np.linalg.LinAlgError) as exc:
         return dict(converged=False, error=str(exc).splitlines()[0][:120])
     return dict(converged=True, vx=r["rebound_vx"], vy=r["rebound_vy"], angle=r["rebound_angle_deg"],

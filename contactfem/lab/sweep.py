@@ -2,7 +2,7 @@
 run in parallel on the local cores through joblib, or on a Dask cluster when a
 scheduler address is given (joblib's dask backend). Results land in one table.
 
-    contactfem sweep hertz --set n_el=8,16,32 --set penalty=per_length,nodal --jobs 2 --out hertz.csv
+    contactfem sweep hertz --set n_el=8,16,32 --set penalty=per_length,per_node --jobs 2 --out hertz.csv
 """
 
 import csv

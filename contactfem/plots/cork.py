@@ -21,8 +21,8 @@ import os
 
 import numpy as np
 
+from ..contact.masters import bottle_neck
 from ..scenes.base import jsonable
-from ..scenes.cork import Neck, cork_mesh
 from . import cached_run, default_outdir, figure, pyplot, savefig
 
 
@@ -32,10 +32,12 @@ def result(preset="fast", **overrides):
 
 
 def _geometry(params):
+    from ..bodies.meshes import cork_mesh
+
     P = params
     mesh = cork_mesh(P["R_tip"], P["R_cork"], P["L_neck"], P["L_neck"] + P["r_mouth"] + P["L_head"],
                      P["n_r"], P["n_z"])
-    neck = Neck(P["R_neck"], P["L_neck"], P["r_mouth"], z_low=-P["gas_column"])
+    neck = bottle_neck(P["R_neck"], P["L_neck"], P["r_mouth"], z_low=-P["gas_column"])
     return mesh, neck
 
 
@@ -53,7 +55,8 @@ def draw_neck(ax, neck, gas_column=None):
     for sign in (1.0, -1.0):
         ax.plot(sign * P[:, 0], P[:, 1], color="0.25", lw=2.0)
     if gas_column is not None:
-        ax.fill_between([-neck.R_neck, neck.R_neck], -gas_column, 0.0, color="#cfe3f5", zorder=0)
+        R_neck = P[0, 0]                             # the wall's radius: the neck's first point
+        ax.fill_between([-R_neck, R_neck], -gas_column, 0.0, color="#cfe3f5", zorder=0)
 
 
 @figure("fig14_cork_mesh", "Fig 14")
@@ -366,12 +369,13 @@ def exit_cases():
 
 
 def exit_case(case, preset=EXIT_PRESET):
-    """One run of the cork (scenes.cork: build, press_fit, pop, as ``simulate``) with the closing
-    step of its contact on or off in each stage and, with a ramp step, the time step refined
-    under the unchanged pressure ramp. Returns the case with the exit time and velocity, the
-    press-fit force and the slowest speed of the cork after the ramp (its stall)."""
+    """One run of the cork (the stages of scenes/cork_stages.py, as its ``simulate``) with the
+    closing step of its contact on or off in each stage and, with a ramp step, the time step
+    refined under the unchanged pressure ramp. Returns the case with the exit time and
+    velocity, the press-fit force and the slowest speed of the cork after the ramp (its stall)."""
     from ..scenes import get_scene
-    from ..scenes.cork import build, pop, press_fit
+    from ..scenes.cork import build
+    from ..scenes.cork_stages import contact_forces, history, pop, press_fit
 
     group, label, over, (fit_rule, pop_rule), ramp = case
     row = dict(group=group, label=label, overrides=dict(over), closing_step_press_fit=fit_rule,
@@ -383,24 +387,24 @@ def exit_case(case, preset=EXIT_PRESET):
             model["gas"].dt_ramp = ramp
         for c in model["contacts"]:
             c.closing_step = fit_rule
-        u_fit, fit = press_fit(model, P)
+        fit_last, _ = press_fit(model, P)
         for c in model["contacts"]:
             c.closing_step = pop_rule
-        out = pop(model, P, u_fit)
+        model["neck"].motion = None                  # the press fit is done (as simulate)
+        records, pressures, exit_time, _ = pop(model, P, fit_last.u)
     except Exception as err:                        # a failed run is a row of the study, not hidden
         return dict(row, exited=None, error=f"{type(err).__name__}: {str(err).splitlines()[0][:100]}")
-    h = out["history"]
+    exited = bool(model["gas"].released and records[-1].contacts[0].n_active == 0)
+    h = history(model, dict(records=records, pressures=pressures))
     t_ramp = P["n_ramp"] * (ramp or P["dt"])
     after = np.flatnonzero(h["t"] > t_ramp * (1 + 1e-9))
     k = after[np.argmin(h["v_cm"][after])]
-    from ..scenes.cork import contact_forces
-
-    return dict(row, exited=bool(out["exited"]), error=None,
-                exit_time_ms=out["exit_time"] * 1e3 if out["exited"] else None,
-                exit_velocity_m_s=float(h["v_cm"][-1]) if out["exited"] else None,
-                press_fit_normal_force_N=contact_forces(model["contacts"], u_fit)["normal"],
+    return dict(row, exited=exited, error=None,
+                exit_time_ms=exit_time * 1e3 if exited else None,
+                exit_velocity_m_s=float(h["v_cm"][-1]) if exited else None,
+                press_fit_normal_force_N=contact_forces(fit_last.contacts)["normal"],
                 v_min_after_ramp_m_s=float(h["v_cm"][k]), t_v_min_ms=float(h["t"][k] * 1e3),
-                steps=int(len(h["t"]) - 1), newton_failures=len(out["failures"]))
+                steps=int(len(h["t"]) - 1), newton_failures=sum(len(rec.failures) for rec in records))
 
 
 def exit_time_data(cases=None, jobs=2):

@@ -39,7 +39,7 @@ def hertz_refinement_data(preset="fast", c_N=1e7):
     sizes = (8, 16, 32) if preset == "fast" else (16, 32, 64, 128)
     pl = [run_scene("hertz", preset, {"n_el": n, "c_N": c_N}) for n in sizes]
     c_nodal = c_N * pl[0]["h_contact"]
-    nd = [run_scene("hertz", preset, {"n_el": n, "c_N": c_nodal, "penalty": "nodal"}) for n in sizes]
+    nd = [run_scene("hertz", preset, {"n_el": n, "c_N": c_nodal, "penalty": "per_node"}) for n in sizes]
     keys = ("h_contact", "error_p0", "error_a", "penetration_max", "c_N_per_length_max")
     return dict(n_el=list(sizes), c_N=c_N, c_N_nodal=c_nodal,
                 per_length={k: [r[k] for r in pl] for k in keys}, nodal={k: [r[k] for r in nd] for k in keys})

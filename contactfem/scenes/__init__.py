@@ -9,7 +9,7 @@ Listing the scenes imports every scene module, so a scene module imports scikit-
 import importlib
 import pkgutil
 
-from .base import Param, Scene, jsonable
+from .base import Param, Scene, Stage, jsonable, simulate
 
 
 def all_scenes():
@@ -45,56 +45,35 @@ def get_scene(name):
 
 
 def run_scene(name, preset="fast", overrides=None, progress=None, friction=None, normal=None,
-              linear_algebra=None):
-    """Run a scene and return its results with wall time, Newton iteration count, parameters and
-    the linear algebra of its Systems (``linear_algebra``: dense|banded|sparse, joined by + if
-    they differ; ``ordering``; ``unknowns``, the largest System's; ``band_kl``, ``band_ku``: the
-    half-bandwidths of a banded K, else None).
+              linear_algebra=None, instrument=None):
+    """Run a scene and return its JSON-able results with the parameters used, the run's own wall
+    time, Newton iteration count and the linear algebra of its Systems (``linear_algebra``:
+    dense|banded|sparse, joined by + if they differ; ``ordering``; ``unknowns``, the largest
+    System's; ``band_kl``, ``band_ku``: the half-bandwidths of a banded K, else None), and how
+    often they were evaluated (``residual_evaluations``, ``contact_evaluations``).
     ``linear_algebra``: auto|dense|banded|sparse for every System the scene builds (None: auto,
     chosen by size and band width), to compare the solvers on one scene.
-    ``progress(t0, t_end, label)``: a progress-callback factory handed to the scene's time
-    loops (e.g. ``contactfem.io.progress_bar``); None shows nothing.
+    ``progress(t0, t_end, label)``: a progress-callback factory for the scene's time loops
+    (e.g. ``contactfem.io.progress_bar``); None shows nothing.
     ``friction`` / ``normal``: law objects replacing the laws the scene's parameters build
-    (recorded as ``friction_law`` / ``normal_law``: class, file, fields)."""
-    import time
-
+    (recorded as ``friction_law`` / ``normal_law``: class, file, fields).
+    ``instrument``: a solver.instrument.Timings handed to every System (the bench's timings)."""
     from ..laws.protocol import describe
-    from ..solver.system import System
+    from ..solver.assembly import KINDS
 
     scene = get_scene(name)
     params = scene.resolve(preset, overrides)
-    if linear_algebra is not None:
-        from ..solver.assembly import KINDS
-
-        if linear_algebra not in KINDS:
-            raise ValueError(f"parameter linear_algebra = {linear_algebra!r} is not allowed: one of {'|'.join(KINDS)}")
-    laws = {k: v for k, v in (("friction", friction), ("normal", normal)) if v is not None}
-    kwargs = dict(laws, progress=progress) if progress is not None else laws
-    outer, System.built = System.built, []          # record the Systems the scene builds
-    outer_la = System.default_linear_algebra
-    System.default_linear_algebra = linear_algebra or outer_la
-    t0 = time.perf_counter()
-    try:
-        results = scene.run(params, **kwargs)
-    finally:
-        systems, System.built = System.built, outer
-        System.default_linear_algebra = outer_la
-    results = dict(results)
-    for kind, law in laws.items():
-        results[f"{kind}_law"] = describe(law)
-    results["wall_time_s"] = time.perf_counter() - t0
-    # how K was assembled and factorised: dense or sparse (by size), and the ordering
-    results["linear_algebra"] = "+".join(dict.fromkeys(s.linear_algebra for s in systems)) or None
-    results["ordering"] = "+".join(dict.fromkeys(s.ordering for s in systems)) or None
-    results["unknowns"] = max((s.ndof for s in systems), default=None)
-    bands = [s.band for s in systems if s.band is not None]
-    results["band_kl"] = max((kl for kl, _ in bands), default=None)     # banded: the widest band
-    results["band_ku"] = max((ku for _, ku in bands), default=None)
-    results.setdefault("newton_iterations_total", 0)
+    if linear_algebra is not None and linear_algebra not in KINDS:
+        raise ValueError(f"parameter linear_algebra = {linear_algebra!r} is not allowed: one of {'|'.join(KINDS)}")
+    results = scene.run(params, normal=normal, friction=friction, progress=progress,
+                        linear_algebra=linear_algebra or "auto", instrument=instrument)
+    for kind, law in (("friction", friction), ("normal", normal)):
+        if law is not None:
+            results[f"{kind}_law"] = describe(law)
     results["scene"] = name
     results["preset"] = preset
     results["parameters"] = params
     return jsonable(results)
 
 
-__all__ = ["Param", "Scene", "all_scenes", "get_scene", "run_scene", "jsonable"]
+__all__ = ["Param", "Scene", "Stage", "all_scenes", "get_scene", "run_scene", "jsonable", "simulate"]

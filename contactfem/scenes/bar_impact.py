@@ -50,9 +50,9 @@ import numpy as np
 
 from ..contact import NodeToSegment, RigidLine, tributary_lengths
 from ..laws import PowerLaw
-from ..solver import CentralDifference, System, integrate
+from ..solver import CentralDifference, History, Steps, System
 from . import time_integration
-from .base import Param, Scene
+from .base import Param, Scene, Stage
 
 
 def bar_exact(L, E, rho, v0):
@@ -61,7 +61,13 @@ def bar_exact(L, E, rho, v0):
     return dict(c=c, stress=rho * c * v0, duration=2.0 * L / c, rebound_velocity=v0)
 
 
-def build(params, normal=None, friction=None):
+def check(params):
+    if params["integrator"] == "central_difference" and params["contact_integration"] == "energy_consistent":
+        raise ValueError("parameter contact_integration = 'energy_consistent' is implicit: "
+                         "use it with integrator = newmark")
+
+
+def build(params, *, normal=None, friction=None, system_options=None):
     """``normal`` / ``friction``: law objects instead of the parameters' (frictionless by default)."""
     from skfem import MeshQuad
 
@@ -76,39 +82,34 @@ def build(params, normal=None, friction=None):
     nodes = nodes[np.argsort(body.X[nodes, 1])]
     w = tributary_lengths(body.X[nodes])
     c_N = params["c_N_factor"] * params["E"] / (L / n)
-    contact = NodeToSegment(body, nodes, RigidLine((0.0, 0.0), (1.0, 0.0)), normal or PowerLaw(c_N, 1.0), friction,
-                            weights=w, name="wall")
-    system = System([body], [contact])
-    return dict(body=body, contact=contact, system=system, nodes=nodes, w=w, c_N=c_N)
-
-
-def run(params, progress=None, normal=None, friction=None):
-    m = build(params, normal, friction)
-    body, contact, system = m["body"], m["contact"], m["system"]
-    L, H, v0 = params["L"], params["h"], params["v0"]
-    ex = bar_exact(L, params["E"], params["rho"], v0)
-    h_x = L / params["n_el"]
-    dt = params["courant"] * h_x / ex["c"]
+    contact = NodeToSegment(body, nodes, RigidLine((0.0, 0.0), (1.0, 0.0)), normal=normal or PowerLaw(c_N, 1.0),
+                            friction=friction, weights=w, name="wall",
+                            integration=time_integration.contact_integration(params))
+    system = System([body], [contact], **(system_options or {}))
+    v0, ex = params["v0"], bar_exact(L, params["E"], params["rho"], params["v0"])
+    dt = params["courant"] * (L / n) / ex["c"]
     t_end = params["t_end"] * ex["duration"] + params["gap"] / v0
-    F_scale = ex["stress"] * H
     explicit = params["integrator"] == "central_difference"
     if explicit:
-        if params["contact_integration"] == "energy_consistent":
-            raise ValueError("parameter contact_integration = 'energy_consistent' is implicit: "
-                             "use it with integrator = newmark")
-        stepper = CentralDifference(system, dt)
+        stepper = CentralDifference(system)
     else:
-        stepper = time_integration.make_stepper(params, system, dt, atol=1e-9 * F_scale, rtol=1e-12, maxit=30)
-    u0 = np.zeros(body.ndof)
+        F_scale = ex["stress"] * H
+        stepper = time_integration.make_stepper(params, system, atol=1e-9 * F_scale, rtol=1e-12, maxit=30)
     v0_vec = np.zeros(body.ndof)
     v0_vec[body.xdofs[:, 0]] = -v0
-    contact.initialize(u0)
-    force = [0.0]
+    stage = Stage(stepper, Steps(dt, t_end=t_end, max_cuts=0 if explicit else 4), np.zeros(body.ndof), v0_vec,
+                  name="bar_impact")
+    return dict(body=body, contact=contact, system=system, systems=[system], nodes=nodes, w=w, c_N=c_N,
+                stage=stage, dt=dt)
 
-    def record(t, u, v, a):
-        force.append(float(-contact.report(u)["f_N"].sum()))
 
-    hist = integrate(stepper, 0.0, u0, v0_vec, t_end=t_end, callback=record, cutback=not explicit, progress=progress)
+def measure(m, params, records):
+    body = m["body"]
+    L, H, v0 = params["L"], params["h"], params["v0"]
+    ex = bar_exact(L, params["E"], params["rho"], v0)
+    dt = m["dt"]
+    hist = History.of(records)
+    force = [0.0] + [float(-rec.contacts[0].report()["f_N"].sum()) for rec in records[1:]]
     t, F = hist.t, np.asarray(force)
     stress = F / H
     on = np.flatnonzero(F > 0.0)
@@ -164,7 +165,9 @@ SCENE = Scene(
         Param("t_end", 1.5, "2L/c", 0.0, None, low_open=True, doc="simulated time in units of 2 L / c"),
         time_integration.CONTACT_INTEGRATION_PARAM,
     ),
-    run=run,
+    build=build,
+    measure=measure,
+    check=check,
     presets={"fast": {"n_el": 40}, "paper": {"n_el": 100}},
     size=lambda p: dict(elements=p["n_el"], unknowns=4 * (p["n_el"] + 1),
                         steps=(2 * p["t_end"] + p["gap"] / p["L"] * (p["E"] / p["rho"]) ** 0.5 / p["v0"])

@@ -1,17 +1,82 @@
-"""What a scene is: named parameters with units and ranges, presets, and a run
-function returning a JSON-able dict of results.
+"""What a scene is: named parameters with units and ranges, presets, and three steps,
 
-A scene module defines ``SCENE = Scene(...)``; the registry in
-``contactfem.scenes`` finds it. Parameter names follow the paper's symbols
-(c_N, c_T, m, n, alpha, beta, mu, E, nu, dt, delta, beta_newmark, ...)."""
+    model = scene.build(params, normal=..., friction=..., system_options=...)   # bodies, contacts, System
+    records = simulate(model, params, progress)   # the time loop (solver.march) over the model's Stage
+    results = scene.measure(model, params, records)   # a JSON-able dict from the records
+
+that ``run`` puts together (one function for every scene: it also reports the size of the
+system, how it was solved and how often it was evaluated). A scene with more than one stage
+(the cork: press fit, then pop) gives its own ``simulate``.
+
+A scene module defines ``SCENE = Scene(...)``; the registry in ``contactfem.scenes`` finds
+it. Parameter names follow the paper's symbols (c_N, c_T, m, n, alpha, beta, mu, E, nu, dt,
+delta, beta_newmark, ...)."""
 
 import math
+import time
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
 import numpy as np
 
 from ..laws.validation import require
+
+PENALTIES = ("per_length", "per_node")
+PENALTY_DOC = ("unit of c_N and c_T: per_length = tractions per unit gap and per unit length of the contact "
+               "boundary (nodal weights = tributary lengths; per unit area of an axisymmetric surface), "
+               "per_node = nodal stiffnesses (weights 1)")
+
+
+@dataclass
+class Stage:
+    """One march of a scene (solver.march): the stepper, the schedule, the initial state,
+    and how the progress bar and error messages name it."""
+    stepper: object
+    schedule: object
+    u0: np.ndarray
+    v0: np.ndarray = None
+    t0: float = 0.0
+    a0: np.ndarray = None
+    name: str = ""
+    label: Callable | None = None
+
+
+def simulate(model, params=None, progress=None):
+    """The records of the model's stage (``model["stage"]``): the initial state and every step."""
+    from ..solver.march import march, watch
+
+    st = model["stage"]
+    records = march(st.stepper, st.schedule, st.t0, st.u0, st.v0, a0=st.a0, label=st.label)
+    return list(watch(records, progress, st.t0, st.schedule.t_end, st.name or model.get("name", "")))
+
+
+def run(scene, params, normal=None, friction=None, progress=None, linear_algebra="auto", instrument=None):
+    """Build, simulate and measure a scene with resolved parameters; ``linear_algebra`` and
+    ``instrument`` (solver.instrument.Timings) go to every System the scene builds (its
+    ``system_options``). The results come with the
+    run's own wall time (``wall_time_s``: building, solving and measuring, no imports before
+    it), the linear algebra of the Systems it built (``linear_algebra``, ``ordering``,
+    ``unknowns``, ``band_kl``, ``band_ku``) and how often they were evaluated
+    (``residual_evaluations``: System evaluations, one per residual Newton needs;
+    ``contact_evaluations``: contact evaluations, one per contact in each)."""
+    t0 = time.perf_counter()
+    options = dict(linear_algebra=linear_algebra, instrument=instrument)
+    model = scene.build(params, normal=normal, friction=friction, system_options=options)
+    records = (scene.simulate or simulate)(model, params, progress)
+    results = dict(scene.measure(model, params, records))
+    systems = model["systems"]
+    results["wall_time_s"] = time.perf_counter() - t0
+    results["linear_algebra"] = "+".join(dict.fromkeys(s.linear_algebra for s in systems)) or None
+    results["ordering"] = "+".join(dict.fromkeys(s.ordering for s in systems)) or None
+    results["unknowns"] = max((s.ndof for s in systems), default=None)
+    bands = [s.band for s in systems if s.band is not None]
+    results["band_kl"] = max((kl for kl, _ in bands), default=None)     # banded: the widest band
+    results["band_ku"] = max((ku for _, ku in bands), default=None)
+    results["residual_evaluations"] = int(sum(s.evaluations for s in systems))
+    contacts = {id(c): c for s in systems for c in s.contacts}
+    results["contact_evaluations"] = int(sum(c.evaluations for c in contacts.values()))
+    results.setdefault("newton_iterations_total", 0)
+    return results
 
 
 @dataclass(frozen=True)
@@ -74,13 +139,20 @@ class Scene:
     name: str
     title: str
     params: tuple
-    run: Callable[[dict], dict]
+    build: Callable                               # (params, *, normal, friction, system_options) -> model dict
+    measure: Callable                             # (model, params, records) -> results dict
+    simulate: Callable | None = None              # (model, params, progress) -> records; default: the model's stage
     presets: dict = field(default_factory=dict)   # preset name -> {param: value}
     reports: tuple = ()                           # names of the main results, for `show`
     check: Callable[[dict], None] | None = None   # cross-parameter checks (ValueError), before any run
     size: Callable[[dict], dict] | None = None    # {"elements", "unknowns", "steps"} from the parameters
     outlines: bool = False                        # records body outlines (run --gif can animate them)
     notes: str = ""                               # what `show` says after the parameters (data read/fitted)
+
+    def run(self, params, normal=None, friction=None, progress=None, linear_algebra="auto", instrument=None):
+        """Build, simulate and measure (module function ``run``)."""
+        return run(self, params, normal=normal, friction=friction, progress=progress, linear_algebra=linear_algebra,
+                   instrument=instrument)
 
     def param(self, name):
         for p in self.params:

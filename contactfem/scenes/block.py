@@ -62,13 +62,13 @@ import numpy as np
 from ..bodies.materials import MATERIALS
 from ..contact import RigidLine, tributary_lengths
 from ..contact.augmented import make_interface
-from ..contact.tangents import TANGENTS, ContactTangent  # noqa: F401  (ContactTangent: public here too)
+from ..contact.tangents import TANGENTS
 from ..laws.friction import Coulomb, ParabolicSlip
 from ..laws.normal import PowerLaw
 from ..laws.protocol import FrictionLaw
-from ..solver import Static, System, integrate
+from ..solver import Static, Steps, System
 from . import enforcement
-from .base import Param, Scene
+from .base import PENALTIES, PENALTY_DOC, Param, Scene, Stage, simulate
 
 # Table 1 of the paper: norm of the residual ||G|| per Newton iteration (the first
 # entry is the residual of the initial state). The scan garbled the exponents of
@@ -118,9 +118,9 @@ PARAMS = (
               "superscript 2); 1e5 FITTED to Table 1 (contactfem reconstruct block). It gives a largest "
               "penetration of 7.1e-3 at the corner where the pressure peaks (the run reports max_penetration), "
               "two orders below the elastic settlement"),
-    Param("penalty", "per_length", choices=("per_length", "per_node"),
-          doc="unit of c_N and c_T: per_length (tractions per unit gap) or per_node (nodal stiffnesses, "
-              "converted to per length by the bottom element length width/nx; the scan gives no unit)"),
+    Param("penalty", "per_length", choices=PENALTIES,
+          doc=PENALTY_DOC + " (here converted to per length by the bottom element length width/nx; the scan "
+              "gives no unit; per_length FITTED)"),
     Param("m", 1.0, "", 1.0, doc="exponent of the normal law (eq 4); m = 1 is the penalty method (paper)"),
     Param("c_T", 1.0e4, "F/L^2", 0.0, low_open=True,
           doc="stick stiffness (eq 5), paper: c_T = 10^4; read per unit length (per node: FITTED against it)"),
@@ -144,20 +144,6 @@ PARAMS = (
     Param("maxit", 40, "", 1, 500, doc="Newton: maximal number of linear solves"),
     *enforcement.ENFORCEMENT_PARAMS,
 )
-
-
-def block_mesh(width, height, nx, ny):
-    """MeshQuad of the block [0, width] x [0, height] with boundaries bottom/top/left/right."""
-    from skfem import MeshQuad
-
-    mesh = MeshQuad.init_tensor(np.linspace(0.0, width, nx + 1), np.linspace(0.0, height, ny + 1))
-    tx, ty = 1e-9 * width, 1e-9 * height
-    return mesh.with_boundaries({
-        "bottom": lambda x: x[1] < ty,
-        "top": lambda x: x[1] > height - ty,
-        "left": lambda x: x[0] < tx,
-        "right": lambda x: x[0] > width - tx,
-    })
 
 
 def contact_length(params):
@@ -218,12 +204,13 @@ def friction_law(params):
     raise ValueError(f"parameter law = {law!r} is not allowed: one of {'|'.join(LAWS)}")
 
 
-def build(params, friction=None, normal=None):
-    """Body, contact, loads and System of the block (no solve). Returns a dict.
-    ``friction`` / ``normal``: law objects to use instead of the ones params build
-    (params["law"] and the penalty law of c_N, m): a student's law."""
+def build(params, *, normal=None, friction=None, system_options=None):
+    """Body, contact, loads, System and the load stepping of the block (no solve): a dict.
+    ``normal`` / ``friction``: law objects to use instead of the ones params build
+    (the penalty law of c_N, m, and params["law"]): a student's law."""
     from ..bodies.continuum import Continuum
     from ..bodies.loads import Pressure, Traction
+    from ..bodies.meshes import block_mesh
 
     W, H = params["width"], params["height"]
     mesh = block_mesh(W, H, params["nx"], params["ny"])
@@ -237,42 +224,42 @@ def build(params, friction=None, normal=None):
     weights = tributary_lengths(body.X[bottom])[k:-k]        # tractions per unit length of the bottom
     slaves = bottom[k:-k]                                   # the first and last element never touch
     contact = make_interface(params.get("enforcement", "penalty"), body, slaves, RigidLine((0.0, 0.0), (0.0, 1.0)),
-                             normal or PowerLaw(c_N=params["c_N"] * per_length(params), m=params["m"]),
-                             friction or friction_law(params), weights=weights, offset=-params["g_N0"], name="foundation")
+                             normal=normal or PowerLaw(c_N=params["c_N"] * per_length(params), m=params["m"]),
+                             friction=friction or friction_law(params), weights=weights, offset=-params["g_N0"],
+                             name="foundation", tangent=params["tangent"])
     p_y, p_x = params["p_y"], params["p_x"]
     loads = [Pressure(body, "top", lambda t: p_y * t),                # dead loads, ramped over the
              Traction(body, params["p_x_face"], lambda t: (p_x * t, 0.0))]   # pseudo-time t in [0, 1]
-    system_contact = contact if params["tangent"] == "consistent" else ContactTangent(contact, params["tangent"])
-    system = System([body], [system_contact], loads)
-    return dict(body=body, contact=contact, loads=loads, system=system, slaves=slaves)
-
-
-def solve(params, friction=None, progress=None, normal=None):
-    """Build the block and apply the load in ``n_steps`` static steps of the pseudo-time
-    (default: the whole load in ONE step, Newton from u = 0). Returns build()'s dict plus
-    u, the NewtonResult of every step and the contact report and contact forces R_c at
-    the converged final state (taken before the friction history is committed)."""
-    sc = build(params, friction, normal)
-    system, contact = sc["system"], sc["contact"]
+    system = System([body], [contact], loads, **(system_options or {}))
     n = params["n_steps"]
-    stepper = Static(system, dt=1.0 / n, atol=params["atol"], rtol=params["rtol"], maxit=params["maxit"])
     h = params["width"] / params["nx"]                        # gap_violation: penetration / element size
+    stepper = Static(system, atol=params["atol"], rtol=params["rtol"], maxit=params["maxit"])
     stepper = enforcement.wrap(dict(params, enforcement=params.get("enforcement", "penalty")), stepper,
                                [contact], length=h)
-    u = np.zeros(system.ndof)
-    contact.initialize(u)
-    results, last = [], {}
+    stage = Stage(stepper, Steps(1.0 / n, n_steps=n), np.zeros(system.ndof), name="block",
+                  label=lambda k, t1, dt: f"block, load step {k} of {n}")
+    return dict(body=body, contact=contact, loads=loads, system=system, systems=[system], slaves=slaves,
+                stepper=stepper, stage=stage, element_size=h)
 
-    def converged(t, u, v, a, step):                 # before the friction history is committed
-        results.append(step.result)
-        if step.k == n:
-            rep, fr = contact.report(u), contact.evaluate(u)["friction"]
-            Y = FrictionLaw(contact.friction).slip_bound(-rep["t_N"], fr.q, fr.v, fr.z)[0]    # after the step
-            last.update(report=rep, R_c=contact.assemble(u)[0], slip_bound=Y)
 
-    hist = integrate(stepper, 0.0, u, n_steps=n, before_commit=converged, progress=progress,
-                     label=lambda k, t1, dt: f"block, load step {k} of {n}")
-    return dict(sc, u=hist.u, result=results[-1], results=results, stepper=stepper, element_size=h, **last)
+def converged(model, records):
+    """What the block reports of its converged final state, read from the last record: the
+    NewtonResult of every load step, the contact's report and forces R_c, and the slip bound
+    of the law in use after the step (before the friction history is committed)."""
+    last = records[-1]
+    state = last.contacts[0]
+    Y = FrictionLaw(model["contact"].friction).slip_bound(-state.t_N, state.q, state.lam / last.dt, state.z)[0]
+    return dict(u=last.u, result=last.result, results=[r.result for r in records[1:]], report=state.report(),
+                R_c=state.scatter(len(last.u))[0], slip_bound=Y, state=state)
+
+
+def solve(params, *, friction=None, normal=None, progress=None, system_options=None):
+    """Build the block and apply the load in ``n_steps`` static steps of the pseudo-time
+    (default: the whole load in ONE step, Newton from u = 0). Returns build()'s dict plus the
+    records and what ``converged`` reads from them."""
+    model = build(params, friction=friction, normal=normal, **(system_options or {}))
+    records = simulate(model, params, progress)
+    return dict(model, records=records, **converged(model, records))
 
 
 def slip_bound(params, t_N):
@@ -288,8 +275,8 @@ def load_norms(body, loads):
     return [float(np.linalg.norm(ld.assemble(u, 1.0)[0])) for ld in loads]
 
 
-def run(params, progress=None, normal=None, friction=None):
-    s = solve(params, friction, progress, normal)
+def measure(model, params, records):
+    s = dict(model, **converged(model, records))
     body, rep, res = s["body"], s["report"], s["result"]
     dofs = body.xdofs
     total_normal = float(s["R_c"][dofs[:, 1]].sum())          # = sum w t_N (signed, < 0 compressive)
@@ -301,11 +288,12 @@ def run(params, progress=None, normal=None, friction=None):
     slipping = rep["state"] == "slip"
     top, side = load_norms(body, s["loads"])
     u = s["u"]
+    iterations = [r.iterations for r in s["results"]]
     return {
         "newton_residuals": list(res.residuals),                     # of the (last) load step
         "newton_residuals_per_step": [list(r.residuals) for r in s["results"]],
-        "iterations": int(sum(r.iterations for r in s["results"])),  # linear solves
-        "newton_iterations_total": int(sum(r.iterations for r in s["results"])),
+        "iterations": int(sum(iterations)),                          # linear solves
+        "newton_iterations_total": int(sum(iterations)),
         "total_normal": total_normal,
         "total_tangential": total_tangential,
         "applied_normal": applied_normal,
@@ -331,8 +319,8 @@ def run(params, progress=None, normal=None, friction=None):
         "fitted": {k: params[k] for k in FITTED},
         "fitted_to": "Table 1 (first residual, number and pattern of the residuals, conical slip); "
                      "see contactfem reconstruct block",
-        **enforcement.report(params, s["stepper"], [r.iterations for r in s["results"]],
-                             enforcement.penetration(s["contact"], u), s["element_size"], "the element size width / nx"),
+        **enforcement.report(params, records, enforcement.penetration(s["state"]), s["element_size"],
+                             "the element size width / nx"),
     }
 
 
@@ -340,7 +328,8 @@ SCENE = Scene(
     name="block",
     title="Elastic block pressed on a rough rigid foundation and pulled sideways (Sec. 5.1, Figs 6-8, Table 1)",
     params=PARAMS,
-    run=run,
+    build=build,
+    measure=measure,
     # fast = paper: the paper's 200 elements are already small. canonical: the reading used before the
     # reconstruction study (no node slips with the conical law)
     presets={"fast": {}, "paper": {},

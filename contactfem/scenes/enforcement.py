@@ -29,18 +29,18 @@ def wrap(params, stepper, contacts, length):
     return Uzawa(stepper, contacts, length, tol=params["uzawa_tol"], max_updates=params["uzawa_max_updates"])
 
 
-def report(params, stepper, iterations, penetration, length, length_name):
-    """What a scene reports about its enforcement: uzawa_iterations (outer iterations summed
-    over the steps; 0 for penalty), multiplier_updates, newton_per_outer (linear solves of
-    each outer iteration, all steps in order; for penalty the solves of each step, given as
-    ``iterations``) and gap_violation = largest penetration / length, the length the scene
-    states (``length_name``), with its value after each outer iteration (gap_violation_per_outer).
+def report(params, records, penetration, length, length_name):
+    """What a scene reports about its enforcement, from its records: uzawa_iterations (outer
+    iterations summed over the steps; 0 for penalty), multiplier_updates, newton_per_outer
+    (linear solves of each outer iteration, all steps in order; for penalty the solves of each
+    step) and gap_violation = largest penetration / length, the length the scene states
+    (``length_name``), with its value after each outer iteration (gap_violation_per_outer).
     For a penalty step the traction error is about c_N times the gap; with the augmented
     method it is about c_N times the last gap violation, so tractions to a relative accuracy eps
     need uzawa_tol ~ eps p / (c_N length) (p a traction scale)."""
-    results = getattr(stepper, "results", None)
-    if results is None:
-        per_outer, outer, updates, gaps = [int(i) for i in iterations], 0, 0, []
+    results = [rec.result for rec in records[1:]]
+    if params["enforcement"] == "penalty":
+        per_outer, outer, updates, gaps = [int(r.iterations) for r in results], 0, 0, []
     else:
         gaps = [float(g) for r in results for g in r.gap_violations]
         per_outer = [int(i) for r in results for i in r.newton_per_outer]
@@ -52,7 +52,6 @@ def report(params, stepper, iterations, penetration, length, length_name):
                 gap_violation_per_outer=gaps)
 
 
-def penetration(contact, u):
-    """Largest penetration max(-g_N, 0) over the slave nodes whose projection is on the master."""
-    rep = contact.report(u)
-    return float(np.max(np.maximum(-rep["g_N"], 0.0), initial=0.0))
+def penetration(state):
+    """Largest penetration max(-g_N, 0) over the slave nodes of a contact state."""
+    return float(np.max(np.maximum(-state.g_N, 0.0), initial=0.0))

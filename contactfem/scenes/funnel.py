@@ -31,14 +31,13 @@ vibrating in place, so the mean, not the instantaneous, velocity is tested).
 
 import numpy as np
 
-from ..bodies.ring import RingRecorder, make_ring
+from ..bodies.ring import make_ring
 from ..contact import NodeToSegment, RigidPolyline
 from ..laws import ParabolicSlip, PowerLaw
-from ..solver import Dirichlet, System, integrate
+from ..solver import Dirichlet, History, Steps, System
 from . import time_integration
-from .base import Param, Scene
-from .rolling_ring import ring_size
-from .sloping_impact import RING_PARAMS
+from .base import Param, Scene, Stage
+from .rings import RING_PARAMS, ring_history, ring_size, snapshot_indices
 
 VARIANTS = ("frictionless", "frictional")
 
@@ -51,8 +50,8 @@ def funnel_wall(phi_deg, length):
     return np.array([[-length * np.sin(phi), length * np.cos(phi)], [0.0, 0.0]])
 
 
-def build(params, normal=None, friction=None):
-    """Half ring, funnel wall, contact and symmetry conditions; returns a dict.
+def build(params, *, normal=None, friction=None, system_options=None):
+    """Half ring, funnel wall, contact, symmetry conditions and the march; returns a dict.
     ``normal`` / ``friction``: law objects instead of the ones the parameters build
     (a friction law given makes the run frictional)."""
     R, h = params["R"], params["thickness"]
@@ -64,11 +63,15 @@ def build(params, normal=None, friction=None):
     wall = RigidPolyline(funnel_wall(params["phi_deg"], params["wall_length"]))
     if friction is None and params["variant"] == "frictional":
         friction = ParabolicSlip(params["c_T"], params["alpha"], params["beta"], params["n"])
-    contact = NodeToSegment(ring.body, ring.contact_nodes, wall, normal or PowerLaw(params["c_N"], params["m"]),
-                            friction, weights=1.0, offset=ring.offset, name="funnel")
+    contact = NodeToSegment(ring.body, ring.contact_nodes, wall, normal=normal or PowerLaw(params["c_N"], params["m"]),
+                            friction=friction, weights=1.0, offset=ring.offset, name="funnel",
+                            integration=time_integration.contact_integration(params))
     symmetry = Dirichlet(ring.body, ring.symmetry_dofs(), 0.0)
-    system = System([ring.body], [contact], fixed=[symmetry])
-    return dict(ring=ring, wall=wall, contact=contact, system=system)
+    system = System([ring.body], [contact], fixed=[symmetry], **(system_options or {}))
+    stepper = time_integration.make_stepper(params, system, atol=1e-10, rtol=1e-10, maxit=30)
+    stage = Stage(stepper, Steps(params["dt"], n_steps=params["n_steps"], max_cuts=6), np.zeros(ring.body.ndof),
+                  ring.initial_velocity((0.0, -params["v0"])), name="funnel")
+    return dict(ring=ring, wall=wall, contact=contact, system=system, systems=[system], stage=stage)
 
 
 def radial_deviation(ring, u, center):
@@ -78,18 +81,12 @@ def radial_deviation(ring, u, center):
     return float(np.max(np.abs(r - ring.R)) / ring.R)
 
 
-def run(params, progress=None, normal=None, friction=None):
-    m = build(params, normal, friction)
-    ring, contact, system = m["ring"], m["contact"], m["system"]
-    u0 = np.zeros(ring.body.ndof)
-    v0 = ring.initial_velocity((0.0, -params["v0"]))
-    contact.initialize(u0)
-    rec = RingRecorder(ring, contact, every=params["outline_every"], mirror=True,
-                       measures=dict(deformation=lambda u, v: radial_deviation(ring, u, ring.center_of_mass(u))))
-    stepper = time_integration.make_stepper(params, system, params["dt"], atol=1e-10, rtol=1e-10, maxit=30)
-    hist = integrate(stepper, 0.0, u0, v0, n_steps=params["n_steps"], recorder=rec, cutback=True, max_cuts=6,
-                     progress=progress)
-    rec = rec.arrays()
+def measure(m, params, records):
+    ring = m["ring"]
+    hist = History.of(records)
+    rec = ring_history(ring, records, measures=dict(
+        deformation=lambda u, v: radial_deviation(ring, u, ring.center_of_mass(u))))
+    shots = snapshot_indices(rec["t"], every=params["outline_every"])
     t, y_c, v_c = rec["t"], rec["x_c"][:, 1], rec["v_c"][:, 1]   # the mirrored ring: centre on x = 0
     n_contact = np.asarray(rec["n_contact"])
     k0 = len(t) - max(2, len(t) // 4)                           # the last quarter of the run
@@ -98,7 +95,7 @@ def run(params, progress=None, normal=None, friction=None):
     in_contact_window = bool(np.all(n_contact[k0:] > 0))
     stuck = in_contact_window and abs(mean_v_window) < 0.02 * params["v0"]
     k_low = int(np.argmin(y_c))
-    rep = contact.report(hist.u)                                # the interface at the end of the run
+    rep = records[-1].contacts[0].report()                      # the interface at the end of the run
     on = rep["state"] != "open"
     contact_final = dict(x=rep["x"][on], t_N=rep["t_N"][on], t_T=rep["t_T"][on], state=rep["state"][on].tolist())
     mech = hist.kinetic + hist.strain + hist.contact
@@ -115,7 +112,7 @@ def run(params, progress=None, normal=None, friction=None):
         energy_error=time_integration.energy_error(hist)[0],
         energy_kinetic=hist.kinetic, energy_strain=hist.strain, energy_contact=hist.contact,
         energy_dissipation=hist.dissipation, energy_total=mech,
-        outlines=np.array(rec["outlines"]), outline_t=np.array(rec["outline_t"]),
+        outlines=np.array([ring.outline(records[k].u, mirror=True) for k in shots]), outline_t=t[shots],
         wall=m["wall"].points,
         obstacles=[m["wall"].points, m["wall"].points * [-1.0, 1.0]],     # the wall and its mirror image
         newton_iterations_total=int(np.sum(hist.iterations)),
@@ -152,7 +149,8 @@ SCENE = Scene(
         time_integration.CONTACT_INTEGRATION_PARAM,
         Param("outline_every", 5, "", 1, 100000, doc="store the ring outline every this many steps (paper: 5)"),
     ),
-    run=run,
+    build=build,
+    measure=measure,
     presets={"fast": {}, "paper": {}},   # 30 elements, 150 steps: about a second
     reports=("stuck", "y_c_min", "v_c_final", "max_deformation", "newton_iterations_total"),
     size=lambda p: dict(ring_size(p, half=True), steps=p["n_steps"]),

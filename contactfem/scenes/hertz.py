@@ -12,15 +12,15 @@ with E* = E / (1 - nu^2) for one elastic body):
 Model: by symmetry the quarter disk x >= 0, y <= 0 (centre at the origin, contact point
 B = (0, -R)); u_x = 0 on x = 0; a uniform pressure q = P / (2 R) on the flat cut y = 0
 carries the half load P / 2. The mesh is a transfinite (Coons) map of a square onto the
-quarter disk, graded with a sinh stretching towards the contact point (see quarter_disk).
+quarter disk, graded with a sinh stretching towards the contact point (bodies/meshes.py, quarter_disk).
 Contact: the nodes of the arc near B against RigidLine y = -R, penalty law eq (4) with m = 1:
 
     penalty = per_length:  c_N is a traction per unit gap (stress/length); nodal forces
                            f_i = w_i c_N g_i with w_i the tributary lengths (the block's units)
-    penalty = nodal:       c_N is a nodal stiffness (force/length per unit thickness; the
-                           rings' and the cork's units): f_i = c_N g_i, whatever the mesh
+    penalty = per_node:    c_N is a nodal stiffness (force/length per unit thickness; the
+                           rings' units): f_i = c_N g_i, whatever the mesh
 
-With `nodal` the effective interface stiffness per unit length, c_N / w_i, grows as the
+With `per_node` the effective interface stiffness per unit length, c_N / w_i, grows as the
 mesh is refined and varies along a graded mesh: the answer depends on the mesh.
 
 The pressure at each contact node is p_i = -f_i / w_i (for both penalty kinds). Reported:
@@ -41,77 +41,15 @@ import numpy as np
 from ..contact import RigidLine, tributary_lengths
 from ..contact.augmented import make_interface
 from ..laws import PowerLaw
-from ..solver import Dirichlet, Static, System, integrate
+from ..solver import Dirichlet, History, Static, Steps, System
 from . import enforcement
-from .base import Param, Scene
+from .base import PENALTIES, PENALTY_DOC, Param, Scene, Stage
 
 
 def hertz_exact(P, R, E, nu):
     """Hertz line contact of an elastic cylinder on a rigid plane: (a, p0)."""
     a = np.sqrt(4.0 * P * R * (1.0 - nu**2) / (np.pi * E))
     return a, 2.0 * P / (np.pi * a)
-
-
-def stretching(n, k):
-    """n + 1 points in [0, 1], sinh(k s) / sinh(k) for uniform s: fine and almost
-    uniform near 0, growing geometrically towards 1 (k -> 0: uniform)."""
-    s = np.linspace(0.0, 1.0, n + 1)
-    return s if k < 1e-8 else np.sinh(k * s) / np.sinh(k)
-
-
-def grading_for(xi_zone, frac):
-    """The k of `stretching` that maps s = frac onto xi = xi_zone (bisection on the
-    monotone function sinh(k frac) / sinh(k))."""
-    if xi_zone >= frac:
-        return 0.0
-    lo, hi = 1e-6, 200.0
-    for _ in range(100):
-        k = 0.5 * (lo + hi)
-        if np.sinh(k * frac) / np.sinh(k) > xi_zone:
-            lo = k
-        else:
-            hi = k
-    return 0.5 * (lo + hi)
-
-
-def quarter_disk(R, n_el, k):
-    """MeshQuad of the quarter disk x >= 0, y <= 0, x^2 + y^2 <= R^2 with n_el x n_el quads.
-
-    Transfinite (Coons) interpolation of the unit square (xi, eta):
-    eta = 0 -> arc from B = (0, -R) to angle -45 deg, eta = 1 -> flat cut y = 0,
-    xi = 0 -> symmetry line x = 0, xi = 1 -> arc from -45 deg to A = (R, 0).
-    Both coordinates are stretched with sinh(k s)/sinh(k), so the mesh is finest at B.
-    Boundaries: 'symmetry' (x = 0), 'top' (y = 0), 'arc'."""
-    from skfem import MeshQuad
-
-    xi = stretching(n_el, k)
-    XI, ETA = np.meshgrid(xi, xi, indexing="ij")               # (n+1, n+1)
-
-    def arc(theta):
-        return R * np.stack([np.cos(theta), np.sin(theta)])
-
-    bottom = arc(-np.pi / 2 + XI * np.pi / 4)
-    top = np.stack([XI * R, 0.0 * XI])
-    left = np.stack([0.0 * ETA, -R + ETA * R])
-    right = arc(-np.pi / 4 + ETA * np.pi / 4)
-    P00, P10, P01, P11 = arc(-np.pi / 2), arc(-np.pi / 4), np.zeros(2), arc(0.0)
-    corners = ((1 - XI) * (1 - ETA))[None] * P00[:, None, None] + (XI * (1 - ETA))[None] * P10[:, None, None] \
-        + ((1 - XI) * ETA)[None] * P01[:, None, None] + (XI * ETA)[None] * P11[:, None, None]
-    x = (1 - ETA) * bottom + ETA * top + (1 - XI) * left + XI * right - corners
-    p = x.reshape(2, -1)
-    idx = np.arange((n_el + 1) ** 2).reshape(n_el + 1, n_el + 1)
-    t = np.stack([idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]]).reshape(4, -1)
-    # counter-clockwise: (xi, eta) -> (x, y) reverses orientation? check with the signed area
-    a, b, d = p[:, t[0]], p[:, t[1]], p[:, t[3]]
-    area = (b[0] - a[0]) * (d[1] - a[1]) - (b[1] - a[1]) * (d[0] - a[0])
-    if np.mean(area) < 0:
-        t = t[::-1]
-    tol = 1e-9 * R
-    return MeshQuad(p, t).with_boundaries({
-        "symmetry": lambda x: np.abs(x[0]) < tol,
-        "top": lambda x: np.abs(x[1]) < tol,
-        "arc": lambda x: (np.abs(x[0]) > tol) & (np.abs(x[1]) > tol),
-    })
 
 
 def fit_hertz(x, p):
@@ -127,11 +65,12 @@ def fit_hertz(x, p):
     return float(np.sqrt(-c0 / c1)), float(np.sqrt(c0))
 
 
-def build(params, normal=None, friction=None):
-    """Body, contact, load and supports of the quarter cylinder; returns a dict.
+def build(params, *, normal=None, friction=None, system_options=None):
+    """Body, contact, load, supports and load stepping of the quarter cylinder; returns a dict.
     ``normal`` / ``friction``: law objects instead of the parameters' (frictionless by default)."""
     from ..bodies.continuum import Continuum
     from ..bodies.loads import Pressure
+    from ..bodies.meshes import grading_for, quarter_disk
 
     R, E, nu, P = params["R"], params["E"], params["nu"], params["P"]
     a_ex, p0_ex = hertz_exact(P, R, E, nu)
@@ -149,37 +88,37 @@ def build(params, normal=None, friction=None):
     w = tributary_lengths(body.X[nodes])
     weights = w if params["penalty"] == "per_length" else 1.0
     contact = make_interface(params.get("enforcement", "penalty"), body, nodes, RigidLine((0.0, -R), (0.0, 1.0)),
-                             normal or PowerLaw(params["c_N"], 1.0), friction, weights=weights, name="plane")
+                             normal=normal or PowerLaw(params["c_N"], 1.0), friction=friction, weights=weights,
+                             name="plane")
     sym = np.flatnonzero(np.abs(body.X[:, 0]) < 1e-9 * R)
     fixed = [Dirichlet(body, body.xdofs[sym, 0], 0.0)]
     q = P / (2.0 * R)
     load = Pressure(body, "top", lambda t: q * min(t, 1.0))
-    system = System([body], [contact], [load], fixed)
-    return dict(body=body, contact=contact, system=system, nodes=nodes, w=w, a_exact=a_ex, p0_exact=p0_ex,
-                grading_k=k)
-
-
-def run(params, progress=None, normal=None, friction=None):
-    m = build(params, normal, friction)
-    body, contact, system, w = m["body"], m["contact"], m["system"], m["w"]
-    R, P = params["R"], params["P"]
-    a_ex = m["a_exact"]
+    system = System([body], [contact], [load], fixed, **(system_options or {}))
     # initial guess: the rigid translation that overlaps the plane over |x| < a (a^2 / 2R),
     # so that the first tangent is not singular (the plane is the only vertical support)
     u0 = np.zeros(body.ndof)
     u0[body.xdofs[:, 1]] = -a_ex**2 / (2.0 * R)
-    contact.initialize(u0)
     scale = P                                               # force scale of the residual
     # the residual cannot fall below roundoff of the stiffest contact spring (c_N w, nodal
     # force per unit gap) times the displacement scale R: a floor for very stiff penalties
     k_c = params["c_N"] * (np.max(w) if params["penalty"] == "per_length" else 1.0)
     atol = max(1e-10 * scale, 1e-15 * k_c * R)
-    stepper = Static(system, dt=1.0 / params["n_steps"], atol=atol, rtol=1e-12, maxit=40)
-    stepper = enforcement.wrap(params, stepper, [contact], length=a_ex)   # gap_violation: penetration / a
-    hist = integrate(stepper, 0.0, u0, n_steps=params["n_steps"], cutback=True, max_cuts=6, progress=progress)
-    u = hist.u
+    stepper = enforcement.wrap(params, Static(system, atol=atol, rtol=1e-12, maxit=40), [contact],
+                               length=a_ex)                  # gap_violation: penetration / a
+    n = params["n_steps"]
+    stage = Stage(stepper, Steps(1.0 / n, n_steps=n, max_cuts=6), u0, name="hertz")
+    return dict(body=body, contact=contact, system=system, systems=[system], nodes=nodes, w=w, a_exact=a_ex,
+                p0_exact=p0_ex, grading_k=k, stage=stage)
 
-    rep = contact.report(u)
+
+def measure(m, params, records):
+    body, w = m["body"], m["w"]
+    R, P = params["R"], params["P"]
+    a_ex = m["a_exact"]
+    hist = History.of(records)
+    state = records[-1].contacts[0]
+    rep = state.report()
     # Hertz's a and p(x) are small-strain quantities: positions in the reference configuration
     # (the deformed x differs by the lateral expansion u_x, about nu a / R of a)
     x = rep["X"][:, 0]
@@ -201,8 +140,7 @@ def run(params, progress=None, normal=None, friction=None):
         profile_x=x, profile_p=p, profile_p_exact=p0_ex * np.sqrt(np.clip(1 - (x / a_ex) ** 2, 0, None)),
         newton_iterations_total=int(np.sum(hist.iterations)),
         newton_residuals=[list(r) for r in hist.residuals[1:]],
-        **enforcement.report(params, stepper, hist.iterations[1:],
-                             enforcement.penetration(contact, u), a_ex, "the exact contact half-width a"),
+        **enforcement.report(params, records, enforcement.penetration(state), a_ex, "the exact contact half-width a"),
     )
 
 
@@ -220,14 +158,15 @@ SCENE = Scene(
         Param("n_el", 64, "", 2, 2000, doc="quads per side of the quarter disk (n_el^2 quads)"),
         Param("grading", 1.0, "", 0.0, 3.0,
               doc="multiplies the sinh stretching that puts a third of the elements within 1.5 a (0: uniform)"),
-        Param("penalty", "per_length", "", choices=("per_length", "nodal"),
-              doc="per_length: c_N in MPa/mm, weights = tributary lengths; nodal: c_N in N/mm per node"),
+        Param("penalty", "per_length", "", choices=PENALTIES,
+              doc=PENALTY_DOC + " (c_N in MPa/mm per length, N/mm per node)"),
         Param("c_N", 1.0e9, "MPa/mm or N/mm", 0.0, None, low_open=True,
               doc="penalty stiffness (eq 4, m = 1); chosen: stiff enough that the penalty error is < 0.1 %"),
         Param("n_steps", 1, "", 1, 1000, doc="load steps (the whole load in one step by default)"),
         *enforcement.ENFORCEMENT_PARAMS,
     ),
-    run=run,
+    build=build,
+    measure=measure,
     presets={"fast": {"n_el": 32}, "paper": {"n_el": 64}},
     reports=("a", "p0", "a_exact", "p0_exact", "error_a", "error_p0"),
     size=lambda p: dict(elements=p["n_el"] ** 2, unknowns=2 * (p["n_el"] + 1) ** 2, steps=p["n_steps"]),

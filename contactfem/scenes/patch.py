@@ -49,8 +49,8 @@ import numpy as np
 
 from ..contact import BodySurface, NodeToSegment, tributary_lengths
 from ..laws import PowerLaw
-from ..solver import Dirichlet, Static, System, integrate
-from .base import Param, Scene
+from ..solver import Dirichlet, History, Static, Steps, System
+from .base import Param, Scene, Stage
 
 
 def block(xs, y0, y1, ny, name, E, nu):
@@ -66,37 +66,10 @@ def block(xs, y0, y1, ny, name, E, nu):
     return Continuum(mesh, E, nu, 0.0, kind="plane_strain", name=name)
 
 
-class OverhangPressure:
-    """Dead pressure p on the parts of a straight horizontal chain of surface nodes
-    (a body's top, ordered by x) that lie outside [x0, x1]: consistent nodal forces
-    int N_i p ds of the linear shape functions over the loaded part of each edge,
-    pushing in -y. Implements the load interface (assemble(u, t) -> P, rows, cols, vals)."""
-
-    def __init__(self, body, nodes, p, x0, x1):
-        self.body = body
-        x = body.X[nodes, 0]
-        f = np.zeros(len(nodes))
-        for i in range(len(nodes) - 1):
-            xa, xb = x[i], x[i + 1]
-            L = xb - xa
-            for lo, hi in ((xa, min(xb, x0)), (max(xa, x1), xb)):       # loaded sub-intervals
-                if hi > lo:
-                    # int_lo^hi (xb - s)/L ds and int_lo^hi (s - xa)/L ds
-                    f[i] += ((xb - lo) ** 2 - (xb - hi) ** 2) / (2 * L)
-                    f[i + 1] += ((hi - xa) ** 2 - (lo - xa) ** 2) / (2 * L)
-        self.local = np.zeros(body.ndof)
-        self.local[body.xdofs[nodes, 1]] = -p * f * body.thickness
-
-    def assemble(self, u_global, t):
-        P = np.zeros(len(u_global))
-        P[self.body.dof_offset:self.body.dof_offset + self.body.ndof] = self.local
-        e = np.zeros(0, dtype=int)
-        return P, e, e, np.zeros(0)
-
-
-def build(params, normal=None, friction=None):
-    """``normal`` / ``friction``: law objects instead of the parameters' (frictionless by default)."""
-    from ..bodies.loads import Pressure
+def build(params, *, normal=None, friction=None, system_options=None):
+    """The two blocks, the contact passes, the loads and supports and the one load step.
+    ``normal`` / ``friction``: law objects instead of the parameters' (frictionless by default)."""
+    from ..bodies.loads import OverhangPressure, Pressure
 
     W, H, E, nu = params["W"], params["H"], params["E"], params["nu"]
     e = W / params["nx_lower"]
@@ -112,7 +85,7 @@ def build(params, normal=None, friction=None):
     top_lower = lower.boundary_nodes("top")           # outward normal +y (towards the upper block)
     bottom_upper = upper.boundary_nodes("bottom")     # outward normal -y (towards the lower block)
     w_upper = tributary_lengths(upper.X[bottom_upper])
-    contacts = [NodeToSegment(upper, bottom_upper, BodySurface(lower, top_lower), law, friction,
+    contacts = [NodeToSegment(upper, bottom_upper, BodySurface(lower, top_lower), normal=law, friction=friction,
                               weights=half * w_upper, name="upper_on_lower")]
     if params["passes"] == 2:
         # the lower block's top nodes over [0, W]; each carries its tributary part of [0, W]
@@ -122,7 +95,7 @@ def build(params, normal=None, friction=None):
         w = tributary_lengths(chain)
         w[1] += w[0]
         w[-2] += w[-1]
-        contacts.append(NodeToSegment(lower, inner, BodySurface(upper, bottom_upper), law, friction,
+        contacts.append(NodeToSegment(lower, inner, BodySurface(upper, bottom_upper), normal=law, friction=friction,
                                       weights=half * w[1:-1], name="lower_on_upper"))
 
     def node(body, x, y):
@@ -137,27 +110,26 @@ def build(params, normal=None, friction=None):
              Dirichlet(upper, upper.xdofs[node(upper, 0.0, 2 * H), 0], 0.0)]
     top_sorted = top_lower[np.argsort(lower.X[top_lower, 0])]
     loads = [Pressure(upper, "top", params["p"]), OverhangPressure(lower, top_sorted, params["p"], 0.0, W)]
-    system = System([lower, upper], contacts, loads, fixed)
-    return dict(lower=lower, upper=upper, contacts=contacts, system=system, bottom_upper=bottom_upper)
-
-
-def run(params, progress=None, normal=None, friction=None):
-    m = build(params, normal, friction)
-    lower, upper, system = m["lower"], m["upper"], m["system"]
+    system = System([lower, upper], contacts, loads, fixed, **(system_options or {}))
     p = params["p"]
     # initial guess: the upper block pushed into the lower by twice the penalty
     # penetration p / c_N, so the interface is active and the first tangent regular
     u0 = np.zeros(system.ndof)
     u0[upper.dof_offset + upper.xdofs[:, 1]] = -2.0 * p / params["c_N"]
-    for c in m["contacts"]:
-        c.initialize(u0)
-    stepper = Static(system, dt=1.0, atol=1e-10 * p * params["W"], rtol=1e-12, maxit=30)
-    hist = integrate(stepper, 0.0, u0, n_steps=1, progress=progress)
-    u = hist.u
+    stepper = Static(system, atol=1e-10 * p * params["W"], rtol=1e-12, maxit=30)
+    return dict(lower=lower, upper=upper, contacts=contacts, system=system, systems=[system], bottom_upper=bottom_upper,
+                stage=Stage(stepper, Steps(1.0, n_steps=1), u0, name="patch"))
+
+
+def measure(m, params, records):
+    lower, upper = m["lower"], m["upper"]
+    p = params["p"]
+    hist = History.of(records)
+    u, states = records[-1].u, records[-1].contacts
 
     result = dict(newton_iterations_total=int(np.sum(hist.iterations)), passes=params["passes"])
-    for c in m["contacts"]:                       # each pass's own traction law values
-        rep = c.report(u)
+    for c, st in zip(m["contacts"], states):      # each pass's own traction law values
+        rep = st.report()
         result[f"{c.name}_x"] = rep["X"][:, 0]
         result[f"{c.name}_t_N"] = -rep["t_N"]
     # what the upper block feels: the nodal contact forces on its bottom nodes from all
@@ -165,7 +137,7 @@ def run(params, progress=None, normal=None, friction=None):
     # lengths; the exact solution gives p at every node
     nodes = m["bottom_upper"]
     dofs = upper.dof_offset + upper.xdofs[nodes, 1]
-    f = -sum(c.assemble(u)[0][dofs] for c in m["contacts"])
+    f = -sum(st.scatter(len(u))[0][dofs] for st in states)
     pressure = f / tributary_lengths(upper.X[nodes])
     order = np.argsort(upper.X[nodes, 0])
     result["interface_x"] = upper.X[nodes, 0][order]
@@ -199,7 +171,8 @@ SCENE = Scene(
               doc="penalty per unit length (eq 4, m = 1); chosen: 1000 E / H"),
         Param("passes", 1, "", choices=(1, 2), doc="1: one-pass node-to-segment; 2: two-pass, halved weights"),
     ),
-    run=run,
+    build=build,
+    measure=measure,
     presets={"fast": {}, "paper": {"nx_lower": 8, "nx_upper": 13, "ny": 4}},
     size=lambda p: dict(elements=(p["nx_lower"] + 1 + p["nx_upper"]) * p["ny"],
                         unknowns=2 * (p["nx_lower"] + 3 + p["nx_upper"]) * (p["ny"] + 1), steps=1),

@@ -50,12 +50,13 @@ Measured from the simulation (all centre-of-mass quantities of RingModel):
 
 import numpy as np
 
-from ..bodies.ring import RingRecorder, make_ring
+from ..bodies.ring import make_ring
 from ..contact import NodeToSegment, RigidLine
 from ..laws import Coulomb, PowerLaw
-from ..solver import System, integrate
+from ..solver import History, Steps, System
 from . import time_integration
-from .base import Param, Scene
+from .base import Param, Scene, Stage
+from .rings import ring_history, ring_size, snapshot_indices
 
 # Paper, Fig 9 (bracketed values are the rigid thin-ring solution)
 PAPER = dict(x_roll_exact=229.0, x_roll_computed="23x (scan)", x_end_exact=376.0, x_end_computed=382.0,
@@ -114,9 +115,9 @@ def detect_rolling(t, slip, v0, lo=0.1, hi=0.9, roll=0.02):
     return float(-icpt / slope)
 
 
-def build(params, normal=None, friction=None):
-    """The ring touching the plane y = 0 (lowest outer point at y = 0), contact, gravity.
-    ``normal`` / ``friction``: law objects instead of the ones the parameters build."""
+def build(params, *, normal=None, friction=None, system_options=None):
+    """The ring touching the plane y = 0 (lowest outer point at y = 0), contact, gravity, and
+    its march. ``normal`` / ``friction``: law objects instead of the ones the parameters build."""
     R, h = params["R"], params["thickness"]
     args = dict(kind=params["kind"], R=R, thickness=h, width=params["width"], n_el=params["n_el"],
                 E=params["E"], nu=params["nu"], rho=params["rho"], n_radial=params["n_radial"], name="ring")
@@ -124,46 +125,37 @@ def build(params, normal=None, friction=None):
     y0 = -probe.outline(np.zeros(probe.body.ndof))[:, 1].min()   # R + h/2 if a node sits at the bottom
     ring = make_ring(center=(0.0, y0), **args)
     plane = RigidLine((0.0, 0.0), (0.0, 1.0))
-    contact = NodeToSegment(ring.body, ring.contact_nodes, plane, normal or PowerLaw(params["c_N"], params["m"]),
-                            friction or Coulomb(params["c_T"], params["mu"]), weights=1.0, offset=ring.offset,
-                            name="plane")
-    system = System([ring.body], [contact], [ring.gravity(params["g"])])
-    return dict(ring=ring, contact=contact, system=system, plane=plane)
+    contact = NodeToSegment(ring.body, ring.contact_nodes, plane, normal=normal or PowerLaw(params["c_N"], params["m"]),
+                            friction=friction or Coulomb(params["c_T"], params["mu"]), weights=1.0, offset=ring.offset,
+                            name="plane", integration=time_integration.contact_integration(params))
+    system = System([ring.body], [contact], [ring.gravity(params["g"])], **(system_options or {}))
+    stepper = time_integration.make_stepper(params, system, atol=1e-6, rtol=1e-10, maxit=30)
+    stage = Stage(stepper, Steps(params["dt"], t_end=params["t_end"], max_cuts=8), np.zeros(ring.body.ndof),
+                  ring.initial_velocity((params["v0"], 0.0)), name="rolling_ring")
+    return dict(ring=ring, contact=contact, system=system, systems=[system], plane=plane, stage=stage)
 
 
-def run(params, progress=None, normal=None, friction=None):
-    m = build(params, normal, friction)
-    ring, contact, system = m["ring"], m["contact"], m["system"]
-    v0 = params["v0"]
-    u0 = np.zeros(ring.body.ndof)
-    vel0 = ring.initial_velocity((v0, 0.0))
-    contact.initialize(u0)
-
-    nodes = ring.body.xdofs[ring.contact_nodes]          # (u_x, u_y) dofs of the contact nodes
-    # the animation (run --gif): about ANIMATION_FRAMES outlines at most ~60 points each, and a
-    # spoke from the centre to one point of the ring, so that rolling is told from sliding
-    n_steps = int(np.ceil(params["t_end"] / params["dt"] - 1e-9))
-    anim_every = max(1, int(np.ceil(n_steps / ANIMATION_FRAMES)))
+def animation(ring, records, floor):
+    """About ANIMATION_FRAMES outlines of at most ~60 points each, for `run --gif`, with a spoke
+    from the centre to one point of the ring, so that rolling is told from sliding."""
+    every = max(1, int(np.ceil((len(records) - 1) / ANIMATION_FRAMES)))
+    u0 = records[0].u
     n_out = len(ring.outline(u0)) - 1
     pick = np.unique(np.r_[np.arange(0, n_out, max(1, n_out // 60)), n_out])
-    anim = dict(t=[], outlines=[], marks=[], count=0)
+    frames = records[::every]
+    outlines = [ring.outline(r.u) for r in frames]
+    return dict(t=np.array([r.t for r in frames]), outlines=np.array([o[pick] for o in outlines]),
+                marks=np.array([[np.vstack([ring.center_of_mass(r.u), o[0]])] for r, o in zip(frames, outlines)]),
+                obstacles=[floor])
 
-    def record_animation(t, u, v=None, a=None):
-        if anim["count"] % anim_every == 0:
-            out = ring.outline(u)
-            anim["t"].append(t)
-            anim["outlines"].append(out[pick])
-            anim["marks"].append([np.vstack([ring.center_of_mass(u), out[0]])])
-        anim["count"] += 1
 
-    record_animation(0.0, u0)
-    rec = RingRecorder(ring, interval=params["outline_interval"], tol=1e-6 * params["dt"], snapshot_measures=dict(
-        node_y=lambda u, v: ring.body.X[ring.contact_nodes, 1] + u[nodes[:, 1]],   # velocity profile
-        node_vx=lambda u, v: v[nodes[:, 0]]))
-    stepper = time_integration.make_stepper(params, system, params["dt"], atol=1e-6, rtol=1e-10, maxit=30)
-    hist = integrate(stepper, 0.0, u0, vel0, t_end=params["t_end"], recorder=rec, cutback=True, max_cuts=8,
-                     progress=progress, callback=record_animation)
-    rec = rec.arrays()
+def measure(model, params, records):
+    ring = model["ring"]
+    v0 = params["v0"]
+    nodes = ring.body.xdofs[ring.contact_nodes]          # (u_x, u_y) dofs of the contact nodes
+    hist = History.of(records)
+    rec = ring_history(ring, records)
+    shots = snapshot_indices(rec["t"], interval=params["outline_interval"], tol=1e-6 * params["dt"])
 
     t, xc, vc, omega = rec["t"], rec["x_c"], rec["v_c"], rec["omega"]
     a = ring.rolling_radius
@@ -178,14 +170,12 @@ def run(params, progress=None, normal=None, friction=None):
         v_final, omega_final = float(vc[-1, 0]), float(omega[-1])
 
     floor = np.array([[xc[:, 0].min() - 1.2 * params["R"], 0.0], [xc[:, 0].max() + 1.2 * params["R"], 0.0]])
-    animation = dict(t=np.array(anim["t"]), outlines=np.array(anim["outlines"]), marks=np.array(anim["marks"]),
-                     obstacles=[floor])
     mu, g = params["mu"], params["g"]
     hoop = rigid_ring_exact(v0, mu, g, params["R"], t=t)   # the paper's thin hoop
     # the rigid ring of this model: lever arm a, gyration radius from the lumped masses
     k2 = ring_gyration_radius2(ring)
-    model = rigid_ring_exact(v0, mu, g, a, k2)
-    out = dict(
+    exact = rigid_ring_exact(v0, mu, g, a, k2)
+    return dict(
         kind=params["kind"], rolled=rolled,
         t_roll=t_roll, x_roll=x_roll, v_final=v_final, omega_final=omega_final,
         x_end=float(xc[-1, 0]), v_end=float(vc[-1, 0]), omega_end=float(omega[-1]),
@@ -194,31 +184,21 @@ def run(params, progress=None, normal=None, friction=None):
         x_roll_rel_err=(x_roll / hoop["x_star"] - 1.0) if rolled else None,
         v_final_rel_err=v_final / hoop["v_star"] - 1.0,
         x_end_rel_err=float(xc[-1, 0] / hoop["x"][-1] - 1.0),
-        t_star_model=model["t_star"], x_roll_model=model["x_star"], v_final_model=model["v_star"],
+        t_star_model=exact["t_star"], x_roll_model=exact["x_star"], v_final_model=exact["v_star"],
         rolling_radius=a, gyration_radius2=k2, mass=ring.total_mass(), ndof=ring.body.ndof,
         paper=PAPER,
         t=t, x_c=xc[:, 0], y_c=xc[:, 1], vx_c=vc[:, 0], vy_c=vc[:, 1], omega=omega, slip_velocity=slip,
         x_exact=hoop["x"], vx_exact=hoop["v"], omega_exact=hoop["omega"],
-        outlines=rec["outlines"], outline_t=rec["outline_t"],
-        outline_vc=vc[rec["outline_k"]], outline_omega=omega[rec["outline_k"]],
-        outline_node_y=rec["outline_node_y"], outline_node_vx=rec["outline_node_vx"],
+        outlines=[ring.outline(records[k].u) for k in shots], outline_t=t[shots],
+        outline_vc=vc[shots], outline_omega=omega[shots],
+        outline_node_y=[ring.body.X[ring.contact_nodes, 1] + records[k].u[nodes[:, 1]] for k in shots],
+        outline_node_vx=[records[k].v[nodes[:, 0]] for k in shots],
         energy_error=time_integration.energy_error(hist)[0],
         energy_kinetic=hist.kinetic, energy_strain=hist.strain, energy_dissipation=hist.dissipation,
-        animation=animation, obstacles=[floor],
+        animation=animation(ring, records, floor), obstacles=[floor],
         newton_iterations_total=int(np.sum(hist.iterations)),
         step_cuts_total=int(np.sum(hist.cuts)),
     )
-    return out
-
-
-def ring_size(p, half=False):
-    """Elements and unknowns of the ring of make_ring (beam: 3 dofs a node; continuum: an
-    annulus of n_el x n_radial quads)."""
-    n = p["n_el"]
-    if p["kind"] == "beam":
-        return dict(elements=n, unknowns=3 * (n + (1 if half else 0)))
-    nr = p.get("n_radial", 2)
-    return dict(elements=n * nr, unknowns=2 * (n + (1 if half else 0)) * (nr + 1))
 
 
 def ring_gyration_radius2(ring):
@@ -272,7 +252,8 @@ SCENE = Scene(
         Param("outline_interval", 0.25, "s", 0.0, None, low_open=True,
               doc="store the ring outline this often (figures)"),
     ),
-    run=run,
+    build=build,
+    measure=measure,
     presets={"fast": {"n_el": 40, "dt": 0.02}, "paper": {"n_el": 120, "dt": 0.01}},
     reports=("t_roll", "x_roll", "x_roll_exact", "v_final", "v_final_exact", "omega_final",
              "x_end", "x_end_exact", "newton_iterations_total"),

@@ -30,13 +30,14 @@ the spin after rebound is the angular velocity about the centre of mass
 
 import numpy as np
 
-from ..bodies.ring import RingRecorder, make_ring
+from ..bodies.ring import make_ring
 from ..contact import NodeToSegment, RigidLine, tributary_lengths
+from ..contact.tangents import TANGENTS
 from ..laws import ParabolicSlip, PowerLaw
-from ..solver import System, integrate
+from ..solver import History, Steps, System
 from . import time_integration
-from .rolling_ring import ring_size
-from .base import Param, Scene
+from .base import PENALTIES, PENALTY_DOC, Param, Scene, Stage
+from .rings import RING_PARAMS, ring_history, ring_size, snapshot_indices
 
 VARIANTS = ("frictionless", "frictional", "viscoplastic")
 
@@ -65,8 +66,8 @@ def integration_points(params):
     return 1 if params["variant"] == "viscoplastic" else 2
 
 
-def build(params, normal=None, friction=None):
-    """The ring (make_ring), the plane y = 0 and the contact; returns a dict.
+def build(params, *, normal=None, friction=None, system_options=None):
+    """The ring (make_ring), the plane y = 0, the contact and the march; returns a dict.
     ``normal`` / ``friction``: law objects instead of the ones the parameters build
     (a friction law given makes any variant frictional)."""
     h = params["thickness"]
@@ -91,25 +92,22 @@ def build(params, normal=None, friction=None):
         w = tributary_lengths(ring.outline(np.zeros(ring.body.ndof)))     # closed polyline: node 0 twice
         weights = np.concatenate([[w[0] + w[-1]], w[1:-1]])
     offset = ring.offset if params["contact_at"] == "outer" else 0.0
-    contact = NodeToSegment(ring.body, ring.contact_nodes, plane, normal or PowerLaw(params["c_N"], params["m"]),
-                            friction, weights=weights, offset=offset, name="plane")
-    system = System([ring.body], [contact])
-    return dict(ring=ring, contact=contact, system=system, plane=plane)
+    contact = NodeToSegment(ring.body, ring.contact_nodes, plane, normal=normal or PowerLaw(params["c_N"], params["m"]),
+                            friction=friction, weights=weights, offset=offset, name="plane",
+                            tangent=params["tangent"], integration=time_integration.contact_integration(params))
+    system = System([ring.body], [contact], **(system_options or {}))
+    stepper = time_integration.make_stepper(params, system, atol=1e-10, rtol=1e-10, maxit=30)
+    stage = Stage(stepper, Steps(params["dt"], n_steps=params["n_steps"], max_cuts=6), np.zeros(ring.body.ndof),
+                  ring.initial_velocity((params["vx0"], params["vy0"])), name="sloping_impact")
+    return dict(ring=ring, contact=contact, system=system, systems=[system], plane=plane, stage=stage)
 
 
-def run(params, progress=None, normal=None, friction=None):
-    m = build(params, normal, friction)
-    ring, contact, system = m["ring"], m["contact"], m["system"]
-    u0 = np.zeros(ring.body.ndof)
-    v0 = ring.initial_velocity((params["vx0"], params["vy0"]))
-    contact.initialize(u0)
-    rec = RingRecorder(ring, contact, every=params["outline_every"])
-    system.set_dt(params["dt"])            # the viscoplastic beam needs dt before the first evaluation
-    stepper = time_integration.make_stepper(params, system, params["dt"], atol=1e-10, rtol=1e-10, maxit=30)
-    hist = integrate(stepper, 0.0, u0, v0, n_steps=params["n_steps"], recorder=rec, cutback=True, max_cuts=6,
-                     progress=progress)
-    rec = rec.arrays()
-    t, x_c, v_c, omega = rec["t"], rec["x_c"], rec["v_c"], rec["omega"][rec["outline_k"]]
+def measure(model, params, records):
+    ring = model["ring"]
+    hist = History.of(records)
+    rec = ring_history(ring, records)
+    shots = snapshot_indices(rec["t"], every=params["outline_every"])
+    t, x_c, v_c, omega = rec["t"], rec["x_c"], rec["v_c"], rec["omega"][shots]
     n_contact = rec["n_contact"]
     touched = np.flatnonzero(n_contact > 0)
     rebounded = bool(touched.size and touched[-1] < len(t) - 1)
@@ -134,7 +132,7 @@ def run(params, progress=None, normal=None, friction=None):
         energy_total_final_rel=float(mech[-1] / E0),
         energy_error=time_integration.energy_error(hist)[0], energy_error_max=time_integration.energy_error(hist)[1],
         energy_after_rebound_rel=float(mech[-1] / E0 - 1.0) if rebounded else None,
-        outlines=rec["outlines"], outline_t=rec["outline_t"], outline_spin=omega,
+        outlines=[ring.outline(records[k].u) for k in shots], outline_t=t[shots], outline_spin=omega,
         obstacles=[np.array([[x_c[:, 0].min() - 1.5 * params["R"], 0.0], [x_c[:, 0].max() + 1.5 * params["R"], 0.0]])],
         mass=ring.total_mass(),
         # committed plastic strains of the beam (eps_p, gam_p, kap_p): the permanent deformation
@@ -153,19 +151,6 @@ def run(params, progress=None, normal=None, friction=None):
     return out
 
 
-# The ring of Sec. 5.3; Sec. 5.4 (the funnel) uses "the same ring" and imports these.
-RING_PARAMS = (
-    Param("kind", "beam", choices=("beam", "continuum"),
-          doc="beam: the paper's finite-deformation beam; continuum: annulus of quads (plane strain, SVK)"),
-    Param("R", 10.0, "L", 0.0, None, low_open=True, doc="mean radius of the ring (paper, Sec. 5.3). The paper gives no "
-          "units: any consistent set of length L, time T, force F (mass M = F T^2 / L)"),
-    Param("thickness", 1.0, "L", 0.0, None, low_open=True, doc="radial wall thickness h (paper: square section A = 1)"),
-    Param("width", 1.0, "L", 0.0, None, low_open=True, doc="out-of-plane depth b (paper: square section A = 1)"),
-    Param("E", 100.0, "F/L^2", 0.0, None, low_open=True, doc="Young's modulus (paper)"),
-    Param("nu", 0.0, "", -1.0, 0.5, low_open=True, high_open=True, doc="Poisson's ratio (paper)"),
-    Param("rho", 0.01, "M/L^3", 0.0, None, low_open=True, doc="density (paper)"),
-)
-
 SCENE = Scene(
     name="sloping_impact",
     title="Sloping impact of a ring on a rigid plane at 45 degrees (Sec. 5.3, Figs 10-11, Table 2)",
@@ -179,9 +164,8 @@ SCENE = Scene(
         Param("gap0", 0.05, "L", 0.0, None,
               doc="initial clearance of the outer surface above the plane (chosen: the paper starts 'just above')"),
         Param("c_N", 50.0, "F/L", 0.0, None, low_open=True, doc="normal penalty, eq (4) (paper: 50)"),
-        Param("penalty", "per_node", choices=("per_node", "per_length"),
-              doc="unit of c_N and c_T (the scan gives none): per_node = nodal stiffnesses (weights 1), "
-                  "per_length = per unit length of the outer surface (weights = tributary lengths, 4.1)"),
+        Param("penalty", "per_node", choices=PENALTIES,
+              doc=PENALTY_DOC + " (the scan gives none; per_node chosen: the ring's data are nodal)"),
         Param("contact_at", "outer", choices=("outer", "axis"),
               doc="where the contact acts (the scan does not say): outer = outer fibre (gap from the "
                   "centreline node minus h/2), axis = the beam axis (the centreline nodes themselves)"),
@@ -205,6 +189,9 @@ SCENE = Scene(
         Param("eta", 0.1, "T", 0.0, None, low_open=True, when=(("variant", ("viscoplastic",)),),
               doc="Perzyna relaxation time (chosen: scan lost it; eta = dt = 0.1 makes the overstress relax "
                   "within about one step, nearly rate-independent plasticity with a regular tangent)"),
+        Param("tangent", "consistent", choices=TANGENTS,
+              doc="contact tangent given to Newton: consistent (eqs 39, 49-50), symmetric ((K+K^T)/2), frozen "
+                  "(without the c_N^s C coupling of eq 49); the residual is always eq 28"),
         Param("dt", 0.1, "T", 0.0, None, low_open=True, doc="time step (paper)"),
         Param("n_steps", 200, "", 1, 100000, doc="number of steps (paper: 200)"),
         Param("delta", 0.7, "", 0.5, 1.0, doc="Newmark delta (paper: 0.7; 0.5 with beta 0.25 conserves energy)"),
@@ -212,7 +199,8 @@ SCENE = Scene(
         time_integration.CONTACT_INTEGRATION_PARAM,
         Param("outline_every", 20, "", 1, 100000, doc="store the ring outline every this many steps (figures)"),
     ),
-    run=run,
+    build=build,
+    measure=measure,
     # 16 elements, 200 steps: the paper's run takes ~2 s. midpoint: the one-point beam of the
     # earlier reading (every elastic ring integrated with the midpoint rule)
     presets={"fast": {}, "paper": {}, "midpoint": {"integration": "1"}},

@@ -18,11 +18,18 @@ CONTACT_INTEGRATION_PARAM = Param(
         "c_N, dt and the phase at which contact begins; friction only dissipates (delta, beta_newmark unused)")
 
 
-def make_stepper(params, system, dt, **newton_options):
-    """Newmark(delta, beta_newmark) or EnergyConsistent, as params['contact_integration'] says."""
-    if params.get("contact_integration", "standard") == "energy_consistent":
-        return EnergyConsistent(system, dt, **newton_options)
-    return Newmark(system, dt, params["delta"], params["beta_newmark"], **newton_options)
+def contact_integration(params):
+    """How the scene's contacts integrate their forces over a step (NodeToSegment's
+    ``integration``): standard, or energy_consistent with the energy-consistent stepper."""
+    return params.get("contact_integration", "standard")
+
+
+def make_stepper(params, system, **newton_options):
+    """Newmark(delta, beta_newmark) or EnergyConsistent, as params['contact_integration'] says
+    (the System's contacts built with ``integration=contact_integration(params)``)."""
+    if contact_integration(params) == "energy_consistent":
+        return EnergyConsistent(system, **newton_options)
+    return Newmark(system, params["delta"], params["beta_newmark"], **newton_options)
 
 
 def energy_error(hist):

@@ -1,27 +1,30 @@
-"""Solving: the System that composes bodies, contacts and loads, Newton's method
-within a step, and Newmark time stepping (paper Sec. 4.1, 4.3).
+"""Solving: the System that composes bodies, contacts and loads, Newton's method within a
+step, the time steppers and the time loop (paper Sec. 4.1, 4.3).
 
     system = System(bodies, contacts, loads, fixed=[Dirichlet(body, dofs, value)])
-    G, K = system.residual_tangent(u, t)     # G = R + R_c - P (eq 29 without M a); K dense or CSC
-    stepper = Newmark(system, dt, delta=0.7, beta=0.4)   # or Static(system), CentralDifference
-    hist = integrate(stepper, t0, u0, v0, n_steps=200, cutback=True)
-    hist.t, hist.kinetic, hist.strain, hist.contact, hist.dissipation, hist.residuals
+    ev = system.evaluate(u, t, dt)            # G = R + R_c - P (eq 29 without M a), K, contact states
+    stepper = Newmark(system, delta=0.7, beta=0.4)   # or Static(system), CentralDifference, EnergyConsistent
+    for rec in march(stepper, Steps(dt=0.1, n_steps=200), t0, u0, v0):
+        rec.t, rec.u, rec.v, rec.contacts, rec.energy, rec.iterations
+    hist = integrate(stepper, t0, u0, v0, n_steps=200, dt=0.1)   # the same, collected into arrays
 
-``integrate`` is the one time loop of every scene; its keyword hooks cover what they
-need: ``dt_rule`` (adaptive steps, with ``growth`` after a cutback and ``min_dt``),
-``before_step`` (explicit coupling, e.g. a gas pressure), ``motion`` (a prescribed
-obstacle motion), ``stop``, ``before_commit`` and ``recorder`` (what to keep of each
-step), ``progress`` (e.g. ``contactfem.io.progress_bar``) and ``label``.
+``march`` is the one time loop of every scene (march.py): a generator of records, each the
+converged step as a value; the schedule (schedule.py: ``Steps``, ``Adaptive``) sets the step
+sizes and the halving of failed steps; a scene stops by leaving the loop.
 
-Files: system.py (System, Dirichlet), newton.py (newton, NewtonResult, NewtonError),
-newmark.py (Newmark, Static, CentralDifference, integrate, History, Step, initial_acceleration),
-staggered.py (the two-step algorithm of Sec. 2.2 on contact.tangents.SplitContact).
-A stepper's ``step`` never commits; ``integrate`` commits only converged steps.
+Files: system.py (System, Dirichlet, Evaluation), newton.py (newton, NewtonResult, NewtonError),
+newmark.py (Newmark, Static, CentralDifference), march.py (march, Record, integrate, History),
+schedule.py (Steps, Adaptive), conserving.py (EnergyConsistent), uzawa.py (the augmented
+Lagrangian's outer loop), staggered.py (the two-step algorithm of Sec. 2.2), interfaces.py
+(what a stepper and a schedule are). A stepper's ``step`` never commits; the time loop commits
+only converged steps.
 """
-from .system import Dirichlet, System
+from .system import Dirichlet, Evaluation, System
 from .newton import NewtonError, NewtonResult, newton
-from .newmark import (CentralDifference, History, Newmark, Static, Step, initial_acceleration,
-                      integrate)
+from .newmark import CentralDifference, Newmark, Static, initial_acceleration
+from .march import History, Record, integrate, march, watch
+from .schedule import Adaptive, Steps
 
-__all__ = ["Dirichlet", "System", "NewtonError", "NewtonResult", "newton", "Newmark", "Static",
-           "CentralDifference", "History", "Step", "integrate", "initial_acceleration"]
+__all__ = ["Dirichlet", "Evaluation", "System", "NewtonError", "NewtonResult", "newton", "Newmark", "Static",
+           "CentralDifference", "History", "Record", "integrate", "march", "watch", "initial_acceleration",
+           "Adaptive", "Steps"]

@@ -2,8 +2,9 @@
 gradients (Gonzalez 1996) for the bodies and for the contact (contact/conserving.py,
 Armero & Petocz 1998).
 
-    stepper = EnergyConsistent(system, dt)          # wraps the system's contacts
-    hist = integrate(stepper, t0, u0, v0, n_steps=...)
+    contact = NodeToSegment(..., integration="energy_consistent")
+    stepper = EnergyConsistent(System(bodies, [contact], ...))
+    for rec in march(stepper, Steps(dt, n_steps=...), t0, u0, v0): ...
 
 One step from (u_0, v_0) solves for u_1, with d = u_1 - u_0 and v_1 = 2 d / dt - v_0,
 
@@ -28,22 +29,25 @@ a linear body).
 """
 import numpy as np
 
-from ..contact.conserving import ConservingContact
 from .newmark import _check_dt
 from .newton import newton
+from .system import Evaluation
 
 
 class EnergyConsistent:
-    """Energy-consistent implicit stepper (module docstring). Replaces each contact of the
-    system by a ConservingContact (in place). ``newton_options`` go to ``newton``."""
+    """Energy-consistent implicit stepper (module docstring) of a System whose contacts are
+    built with ``integration="energy_consistent"`` and whose bodies are hyperelastic.
+    ``newton_options`` go to ``newton``."""
     dynamic = True
 
-    def __init__(self, system, dt, **newton_options):
-        _check_dt(dt)
-        self.system, self.dt, self.newton_options = system, dt, newton_options
-        system.contacts = [c if isinstance(c, ConservingContact) else ConservingContact(c) for c in system.contacts]
+    def __init__(self, system, **newton_options):
+        self.system, self.newton_options = system, newton_options
+        for c in system.contacts:
+            if c.integration != "energy_consistent":
+                raise ValueError(f"contact {c.name!r}: energy-consistent time stepping needs contacts built with "
+                                 "integration='energy_consistent'")
         for b in system.bodies:
-            if getattr(b, "S0", None) is not None:
+            if not b.hyperelastic:
                 raise ValueError(f"body {b.name!r}: energy-consistent integration needs hyperelastic bodies "
                                  "(use contact_integration=standard for the viscoplastic ring)")
 
@@ -70,24 +74,24 @@ class EnergyConsistent:
             vals += [0.5 * K.data, np.full(b.ndof, c)]
         return G, rows, cols, vals
 
-    def step(self, t, u, v, a, dt=None, label=""):
-        dt = self.dt if dt is None else dt
+    def step(self, t, u, v, a, dt, label=""):
         _check_dt(dt)
         s = self.system
-        s.set_dt(dt)
         t1, tm = t + dt, t + 0.5 * dt
         M = s.mass()
         c = 2.0 / dt ** 2
-        for ct in s.contacts:
-            ct.begin_step(u)
 
         import scipy.sparse as sp
 
         def fun(u1):
+            s.evaluations += 1
             G, rows, cols, vals = self._bodies(u, u1)
             um = 0.5 * (u + u1)
+            states = []
             for ct in s.contacts:
-                Rc, r, cc, vv = ct.assemble(u1)
+                state = ct.evaluate(u1, t1, dt, u)
+                Rc, r, cc, vv = state.scatter(s.ndof)
+                states.append(state)
                 G += Rc
                 rows.append(np.asarray(r, int)), cols.append(np.asarray(cc, int)), vals.append(np.asarray(vv, float))
             for load in s.loads:
@@ -98,12 +102,13 @@ class EnergyConsistent:
             G += M * c * (u1 - u - dt * v)
             K = sp.coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                               shape=(s.ndof, s.ndof)).tocsr() + sp.diags(c * M)
-            return G, K
+            return Evaluation(G, K, tuple(states))
 
         guess = s.apply_dirichlet(u + dt * v + 0.5 * dt ** 2 * a, t1)
-        result = newton(fun, guess, s.free_dofs, label=label or f"t = {t1:.6g}, dt = {dt:.3g}",
+        result = newton(fun, guess, s.free_dofs, instrument=s.instrument, label=label or f"t = {t1:.6g}, dt = {dt:.3g}",
                         **self.newton_options)
         u1 = result.u
+        result.evaluation = result.evaluation._replace(P=s.external_force(u1, t1))   # the loads' work
         v1 = 2.0 * (u1 - u) / dt - v
         a1 = (v1 - v) / dt
         return u1, v1, a1, result

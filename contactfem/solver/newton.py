@@ -1,9 +1,11 @@
 """Full Newton iteration within a step (paper Sec. 4.3).
 
-Solves G(u) = 0 on the free dofs, where ``fun(u) -> (G, K)`` returns the full
+Solves G(u) = 0 on the free dofs, where ``fun(u) -> (G, K, ...)`` returns the full
 residual vector and its tangent K = dG/du (a dense numpy array, or a scipy CSC matrix
-that may carry a band plan for LAPACK's band LU: solve_free). The prescribed dofs keep
-the values they have in the initial guess.
+that may carry a band plan for LAPACK's band LU: solve_free), possibly followed by more
+(a System's Evaluation carries the contacts' states): what ``fun`` returned at the
+converged iterate is the result's ``evaluation``, so nothing needs to evaluate it again.
+The prescribed dofs keep the values they have in the initial guess.
 
 Linear solver: dense K by LAPACK's LU with partial pivoting (``numpy.linalg.solve``),
 a banded K (a CSC matrix carrying ``band_plan``, assembly.py: the paper's rings and small
@@ -29,6 +31,8 @@ the contact's ReturnMapError derive from it), so a driver can cut the step back.
 from dataclasses import dataclass, field
 
 import numpy as np
+
+from .instrument import timed
 
 # Column ordering of SuperLU. The tangents here have a symmetric sparsity pattern (the
 # contact element couples the same dofs both ways), for which the minimum degree
@@ -78,14 +82,16 @@ class NewtonResult:
     residuals: list = field(default_factory=list)  # ||G|| of every iterate, first = initial guess
     iterations: int = 0                           # number of linear solves
     G: np.ndarray = None                          # full residual at u (its fixed-dof part = reactions)
+    evaluation: object = None                     # what fun returned at u (G, K, contact states, ...)
+    evaluations: int = 0                          # calls of fun (residuals + line-search trials)
 
 
-def newton(fun, u0, free, atol=1e-10, rtol=1e-10, maxit=25, label="", line_search=0):
+def newton(fun, u0, free, atol=1e-10, rtol=1e-10, maxit=25, label="", line_search=0, instrument=None):
     """Full Newton method: K_ff du_f = -G_f, u_f += du_f, until converged.
 
     Parameters
     ----------
-    fun   : u -> (G, K), full residual (n,) and tangent (n, n), dense or sparse
+    fun   : u -> (G, K, ...), full residual (n,) and tangent (n, n), dense or sparse
     u0    : (n,) initial guess, prescribed dofs already set
     free  : indices (or boolean mask) of the unknown dofs
     atol, rtol : convergence test ||G_k|| <= atol + rtol * ||G_0|| (module docstring)
@@ -96,9 +102,19 @@ def newton(fun, u0, free, atol=1e-10, rtol=1e-10, maxit=25, label="", line_searc
             accept u + s du at the first s = 1, 1/2, 1/4, ... with ||G_f|| < (1 - 1e-4 s) ||G_f,k||,
             else the smallest step). It helps where stick/slip switching makes full steps cycle;
             near the solution full steps are accepted, so the quadratic rate is kept.
+    instrument : None or a solver.instrument.Timings: times the linear solves ("solve") and the
+            whole of newton ("newton"), counts the solves
 
     Returns a NewtonResult; raises NewtonError (never returns NaN).
     """
+    with timed(instrument, "newton"):
+        result = _newton(fun, u0, free, atol, rtol, maxit, label, line_search, instrument)
+    if instrument is not None:
+        instrument.solves += result.iterations
+    return result
+
+
+def _newton(fun, u0, free, atol, rtol, maxit, label, line_search, instrument):
     if maxit < 0:
         raise ValueError(f"maxit must be >= 0, got {maxit}")
     if atol < 0 or rtol < 0:
@@ -112,28 +128,33 @@ def newton(fun, u0, free, atol=1e-10, rtol=1e-10, maxit=25, label="", line_searc
     if int(line_search) != line_search or line_search < 0:
         raise ValueError(f"parameter line_search = {line_search} is out of range: allowed integers [0, inf)")
     history = []
+    calls = 0
 
     def evaluate(v, k):
+        nonlocal calls
+        calls += 1
         try:
             return fun(v)
         except FloatingPointError as err:             # inverted element, failed return map
             raise NewtonError(f"Newton: {type(err).__name__} at iteration {k}{where}: {err}",
                               history, label) from err
 
-    evaluated = None                                  # (G, K) at u from the line search
+    evaluated = None                                  # fun's value at u from the line search
     for k in range(maxit + 1):
-        G, K = evaluated if evaluated is not None else evaluate(u, k)
+        out = evaluated if evaluated is not None else evaluate(u, k)
         evaluated = None
+        G, K = out[0], out[1]
         r = float(np.linalg.norm(G[free]))
         if not np.isfinite(r):
             raise NewtonError(f"Newton: non-finite residual at iteration {k}{where}", history, label)
         history.append(r)
         if r <= atol + rtol * history[0]:
-            return NewtonResult(u=u, residuals=history, iterations=k, G=G)
+            return NewtonResult(u=u, residuals=history, iterations=k, G=G, evaluation=out, evaluations=calls)
         if k == maxit:
             break
         try:
-            du = solve_free(K, -G[free], free, all_free)
+            with timed(instrument, "solve"):
+                du = solve_free(K, -G[free], free, all_free)
         except RuntimeError as err:                   # "Factor is exactly singular"
             raise NewtonError(f"Newton: singular tangent at iteration {k}{where}: {err}",
                               history, label) from err
@@ -152,6 +173,7 @@ def newton(fun, u0, free, atol=1e-10, rtol=1e-10, maxit=25, label="", line_searc
                 step /= 2
             u = trial
         else:
+            u = u.copy()                              # a new iterate: the last evaluation keeps its own u
             u[free] += du
 
     raise NewtonError(f"Newton: no convergence in {maxit} iterations{where}", history, label)

@@ -27,17 +27,19 @@ Each phase is a full Newton solve (to the same absolute tolerance as the whole s
 ``iterations`` counts every linear solve of every phase, the figure to compare with the
 consistent Newton's. A cycle limit raises NewtonError (never returns an unconverged u).
 
-    split = SplitContact(contact)                   # wraps a NodeToSegment
-    system = System(bodies, [split], loads, fixed)  # same bodies and loads
-    stepper = Staggered(Newmark(system, dt, ...), [split])   # or Staggered(Static(system))
-    u1, v1, a1, result = stepper.step(t, u, v, a)   # result.iterations = all linear solves
-    hist = integrate(stepper, ...)                  # works like any stepper
+    system = System(bodies, [contact], loads, fixed)     # the contacts as they are
+    stepper = Staggered(Newmark(system, ...))            # or Staggered(Static(system))
+    u1, v1, a1, result = stepper.step(t, u, v, a, dt)    # result.iterations = all linear solves
+    for rec in march(stepper, ...): ...                  # works like any stepper
+
+A phase is a value frozen from the full evaluation that starts it (contact/tangents.py,
+``freeze``) and handed to every evaluation of the phase: the contacts are not wrapped.
 """
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..contact.tangents import PHASES, SplitContact  # noqa: F401  (SplitContact: public here too)
+from ..contact.tangents import freeze
 from .newton import NewtonError, newton
 
 @dataclass
@@ -49,13 +51,15 @@ class StaggeredResult:
     residuals: list = field(default_factory=list)
     iterations: int = 0
     G: np.ndarray = None
+    evaluation: object = None
+    evaluations: int = 0
     cycles: int = 0
     phase_iterations: list = field(default_factory=list)
 
 
-def staggered(fun, u0, free, splits, atol=1e-10, rtol=1e-10, maxit=25, max_cycles=60, label=""):
-    """The staggered iteration (module docstring) on fun(u) -> (G, K), the (effective)
-    residual of a System whose contacts include the SplitContacts ``splits``.
+def staggered(fun, u0, free, atol=1e-10, rtol=1e-10, maxit=25, max_cycles=60, label="", instrument=None):
+    """The staggered iteration (module docstring) on fun(u, phases) -> the (effective)
+    Evaluation of a System, ``phases`` one per contact (None: the full contacts).
 
     Converged when the full residual satisfies ||G|| <= atol + rtol ||G_0|| (the test of
     ``newton``); each phase is solved by ``newton`` to that same absolute tolerance.
@@ -63,40 +67,36 @@ def staggered(fun, u0, free, splits, atol=1e-10, rtol=1e-10, maxit=25, max_cycle
     """
     free = np.asarray(free)
     where = f" ({label})" if label else ""
-
-    def full(u):
-        for s in splits:
-            s.set_phase("full")
-        return fun(u)
-
     u = np.array(u0, dtype=float)
-    G, _ = full(u)
-    history = [float(np.linalg.norm(G[free]))]
+    ev = fun(u, None)
+    calls = 1
+    history = [float(np.linalg.norm(ev.G[free]))]
     tol = atol + rtol * history[0]
     solves, per_phase = 0, []
     for cycle in range(1, max_cycles + 1):
         if history[-1] <= tol:
-            return StaggeredResult(u=u, residuals=history, iterations=solves, G=G, cycles=cycle - 1,
-                                   phase_iterations=per_phase)
-        for phase in ("normal", "friction"):
-            for s in splits:
-                s.freeze(u)
-                s.set_phase(phase)
+            return StaggeredResult(u=u, residuals=history, iterations=solves, G=ev.G, evaluation=ev,
+                                   evaluations=calls, cycles=cycle - 1, phase_iterations=per_phase)
+        for kind in ("normal", "friction"):
+            if kind == "friction":               # freeze from the full state at the end of the normal phase
+                ev, calls = fun(u, None), calls + 1
+            phases = [freeze(state, kind) for state in ev.contacts]
             try:
-                res = newton(fun, u, free, atol=tol, rtol=0.0, maxit=maxit, label=f"{phase} phase{where}")
+                res = newton(lambda w: fun(w, phases), u, free, atol=tol, rtol=0.0, maxit=maxit,
+                             label=f"{kind} phase{where}", instrument=instrument)
             except NewtonError as err:
-                raise NewtonError(f"staggered: {phase} phase of cycle {cycle} failed{where}: {err}",
+                raise NewtonError(f"staggered: {kind} phase of cycle {cycle} failed{where}: {err}",
                                   history, label) from err
-            u, solves = res.u, solves + res.iterations
+            u, solves, calls = res.u, solves + res.iterations, calls + res.evaluations
             per_phase.append(res.iterations)
-        G, _ = full(u)
-        r = float(np.linalg.norm(G[free]))
+        ev, calls = fun(u, None), calls + 1
+        r = float(np.linalg.norm(ev.G[free]))
         if not np.isfinite(r):
             raise NewtonError(f"staggered: residual is NaN/inf after cycle {cycle}{where}", history, label)
         history.append(r)
     if history[-1] <= tol:
-        return StaggeredResult(u=u, residuals=history, iterations=solves, G=G, cycles=max_cycles,
-                               phase_iterations=per_phase)
+        return StaggeredResult(u=u, residuals=history, iterations=solves, G=ev.G, evaluation=ev, evaluations=calls,
+                               cycles=max_cycles, phase_iterations=per_phase)
     raise NewtonError(f"staggered: no convergence in {max_cycles} cycles{where}; full residuals "
                       f"{', '.join(f'{x:.3e}' for x in history[-5:])} (last 5)", history, label)
 
@@ -104,37 +104,34 @@ def staggered(fun, u0, free, splits, atol=1e-10, rtol=1e-10, maxit=25, max_cycle
 class Staggered:
     """Wraps a Newmark or Static stepper: the same step equation (Newmark: eq 29 with
     a+ = (u+ - u_pred) / (beta dt^2); Static: G = 0), solved by ``staggered`` instead of
-    ``newton``. Use with ``integrate`` like any stepper; the atol, rtol, maxit of the
+    ``newton``. Use with ``march`` like any stepper; the atol, rtol, maxit of the
     wrapped stepper apply to every phase."""
 
-    def __init__(self, stepper, splits, max_cycles=60):
-        self.stepper, self.splits, self.max_cycles = stepper, list(splits), max_cycles
-        self.system, self.dt, self.dynamic = stepper.system, stepper.dt, stepper.dynamic
+    def __init__(self, stepper, max_cycles=60):
+        self.stepper, self.max_cycles = stepper, max_cycles
+        self.system, self.dynamic = stepper.system, stepper.dynamic
         if self.dynamic and not hasattr(stepper, "beta"):
             raise ValueError("parameter stepper must be a Newmark or Static stepper (an implicit one)")
 
-    def step(self, t, u, v, a, dt=None, label=""):
+    def step(self, t, u, v, a, dt, label=""):
         st, s = self.stepper, self.system
-        dt = st.dt if dt is None else dt
-        s.set_dt(dt)
         t1 = t + dt
-        opts = dict(st.newton_options)
+        opts = dict(st.newton_options, instrument=s.instrument)
         if not self.dynamic:
-            res = staggered(lambda w: s.residual_tangent(w, t1), s.apply_dirichlet(u, t1), s.free_dofs,
-                            self.splits, max_cycles=self.max_cycles, label=label, **opts)
+            res = staggered(lambda w, ph: s.evaluate(w, t1, dt, u, phases=ph), s.apply_dirichlet(u, t1),
+                            s.free_dofs, max_cycles=self.max_cycles, label=label, **opts)
             zero = np.zeros(s.ndof)
             return res.u, zero, zero.copy(), res
         beta, delta, M = st.beta, st.delta, s.mass()
         c = 1.0 / (beta * dt ** 2)
         u_pred = u + dt * v + dt ** 2 * (0.5 - beta) * a
 
-        def effective(u1):                                   # as Newmark.step
-            G, K = s.residual_tangent(u1, t1, mass_coefficient=c)
-            return G + M * c * (u1 - u_pred), K
+        def effective(u1, phases):                           # as Newmark.step
+            ev = s.evaluate(u1, t1, dt, u, mass_coefficient=c, phases=phases)
+            return ev._replace(G=ev.G + M * c * (u1 - u_pred))
 
         guess = s.apply_dirichlet(u_pred + beta * dt ** 2 * a, t1)
-        res = staggered(effective, guess, s.free_dofs, self.splits, max_cycles=self.max_cycles,
-                        label=label, **opts)
+        res = staggered(effective, guess, s.free_dofs, max_cycles=self.max_cycles, label=label, **opts)
         a1 = c * (res.u - u_pred)
         v1 = v + dt * ((1 - delta) * a + delta * a1)
         return res.u, v1, a1, res

@@ -14,10 +14,26 @@ dofs ``b.dof_offset + local``.
 K is a dense numpy array for small systems and a scipy CSC matrix on a fixed sparsity
 pattern above, solved by LAPACK's banded LU where the pattern is a narrow band after
 renumbering, else by SuperLU (``System.linear_algebra``, chosen automatically: assembly.py).
+
+One evaluation of the System at a trial u is a value, ``Evaluation(G, K, contacts, P)``:
+the contacts' states (contact/state.py) travel with it, so the converged one is what the
+time loop commits, records and reports (solver/march.py); nothing evaluates it again.
 """
+from typing import NamedTuple
+
 import numpy as np
 
 from .assembly import TangentAssembler
+from .instrument import timed
+
+
+class Evaluation(NamedTuple):
+    """The System at one trial u: residual G, tangent K, the contacts' states and the loads P
+    (a tuple, so ``G, K = evaluation[:2]`` reads as before)."""
+    G: np.ndarray
+    K: object
+    contacts: tuple = ()
+    P: np.ndarray = None
 
 
 class Dirichlet:
@@ -59,24 +75,23 @@ class System:
     Parameters
     ----------
     bodies   : list of bodies (the interface of contactfem.bodies)
-    contacts : list of contacts, ``assemble(u) -> (R_c, rows, cols, vals)``
+    bodies   : list of bodies (contactfem.bodies.interfaces.Body)
+    contacts : list of contacts (contactfem.contact.interfaces.Contact): ``evaluate(u, t, dt, u0)``
+               gives a state, ``state.scatter(ndof) -> (R_c, rows, cols, vals)``
     loads    : list of loads, ``assemble(u, t) -> (P, rows, cols, vals)``
     fixed    : list of Dirichlet conditions
-    linear_algebra : "auto" (dense up to assembly.DENSE_MAX unknowns; above, banded where the
-               band LU is cheap, else sparse), "dense", "sparse" or "banded"; None (default):
-               ``System.default_linear_algebra`` ("auto"; ``run_scene(..., linear_algebra=...)``
-               and ``contactfem run --linear-algebra`` set it for the Systems a scene builds)
+    linear_algebra : "auto" (default: dense up to assembly.DENSE_MAX unknowns; above, banded where
+               the band LU is cheap, else sparse), "dense", "sparse" or "banded"
+    instrument : None, or a solver.instrument.Timings that times the parts of every evaluation
+               and of the Newton solves of the steppers (the bench's split of an iteration)
 
     Attributes: ``ndof``, ``fixed_dofs`` and ``free_dofs`` (global, sorted),
-    ``dissipation`` (frictional dissipation summed over all committed steps),
     ``linear_algebra`` ("dense", "sparse" or "banded"; "banded+sparse" if the choice changed
-    as the contact pattern grew) and ``ordering`` (of the factorisation).
+    as the contact pattern grew), ``ordering`` (of the factorisation) and ``evaluations``
+    (how often the System was evaluated: one per residual Newton needs).
     """
 
-    built = None     # a list while contactfem.scenes.run_scene records the Systems a scene builds
-    default_linear_algebra = "auto"      # what linear_algebra=None means (run_scene may set it)
-
-    def __init__(self, bodies, contacts=(), loads=(), fixed=(), linear_algebra=None):
+    def __init__(self, bodies, contacts=(), loads=(), fixed=(), linear_algebra="auto", instrument=None):
         self.bodies = list(bodies)
         self.contacts = list(contacts)
         self.loads = list(loads)
@@ -99,14 +114,10 @@ class System:
         self.fixed_dofs = np.unique(np.concatenate(
             [self.global_dofs(d.body, d.local_dofs) for d in self.fixed] + [np.zeros(0, int)]))
         self.free_dofs = np.setdiff1d(np.arange(self.ndof), self.fixed_dofs)
-        self.dissipation = 0.0
         self._mass = None
-        if linear_algebra is None:
-            linear_algebra = System.default_linear_algebra
         self._tangent = TangentAssembler(self.ndof, linear_algebra, self.free_dofs)
-        self._body_coo = {}          # body -> (K, rows, cols) of its last sparse tangent
-        if System.built is not None:
-            System.built.append(self)
+        self.evaluations = 0
+        self.instrument = instrument
 
     @property
     def linear_algebra(self):
@@ -164,83 +175,78 @@ class System:
             P += load.assemble(u, t)[0]
         return P
 
-    def _body_triplets(self, body, u_local):
-        """R and the COO triplets of a body's tangent. Bodies with ``internal_coo`` (the
-        beam) give constant index arrays; a sparse K (the continuum) is converted, reusing
-        the index arrays while its pattern stays the same."""
-        if hasattr(body, "internal_coo"):
-            return body.internal_coo(u_local)
-        R, K = body.internal(u_local)
-        K = K.tocsr()
-        last = self._body_coo.get(body)
-        if last is not None and (last[0] is K or (np.array_equal(last[0].indptr, K.indptr)
-                                                   and np.array_equal(last[0].indices, K.indices))):
-            rows, cols = last[1], last[2]
-        else:
-            rows = np.repeat(np.arange(K.shape[0]), np.diff(K.indptr))
-            cols = K.indices
-        self._body_coo[body] = (K, rows, cols)
-        return R, rows, cols, K.data
+    def evaluate(self, u, t, dt=None, u0=None, mass_coefficient=0.0, phases=None):
+        """The System at u, time t, at the end of a step of dt from u0: an Evaluation with
+        G = R(u) + R_c(u) - P(u, t) (static part of eq 29), K = dG/du and the contacts' states.
 
-    def residual_tangent(self, u, t, mass_coefficient=0.0):
-        """G = R(u) + R_c(u) - P(u, t) (static part of eq 29) and K = dG/du.
-
-        With ``mass_coefficient`` c > 0, K + c M is returned instead (M the lumped mass):
-        the effective tangent of an implicit time stepper (Newmark: c = 1 / (beta dt^2)).
-        K is a dense array or a CSC matrix (``self.linear_algebra``; banded: a CSC matrix
-        that carries its band plan, ``K.band_plan``); all contributions
-        arrive as COO triplets and are summed into it once (duplicates add up).
+        With ``mass_coefficient`` c > 0, K + c M is returned instead (M the lumped mass): the
+        effective tangent of an implicit time stepper (Newmark: c = 1 / (beta dt^2)). ``phases``:
+        one staggered-algorithm phase per contact (contact/tangents.py), or None. K is a dense
+        array or a CSC matrix (``self.linear_algebra``; banded: a CSC matrix that carries its band
+        plan, ``K.band_plan``); all contributions arrive as COO triplets and are summed into it
+        once (duplicates add up).
         """
         u = np.asarray(u, dtype=float)
         if u.shape != (self.ndof,):
             raise ValueError(f"u must have shape ({self.ndof},), got {u.shape}")
+        self.evaluations += 1
         G = np.zeros(self.ndof)
         blocks = []                                    # (rows, cols, vals, offset, key)
 
-        for body in self.bodies:                       # block diagonal: internal forces
-            off = body.dof_offset
-            R, rows, cols, vals = self._body_triplets(body, u[off:off + body.ndof])
-            G[off:off + body.ndof] += R
-            blocks.append((rows, cols, vals, off, body))
+        with timed(self.instrument, "bulk"):
+            for body in self.bodies:                   # block diagonal: internal forces
+                off = body.dof_offset
+                R, rows, cols, vals = body.internal_coo(u[off:off + body.ndof], dt)
+                G[off:off + body.ndof] += R
+                blocks.append((rows, cols, vals, off, body))
 
-        for contact in self.contacts:                  # contact residual eq 28 and its tangent
-            Rc, r, c, v = contact.assemble(u)
-            G += Rc
-            blocks.append((*_triplets(r, c, v), 0, None))
+        states = []
+        with timed(self.instrument, "contact"):
+            for i, contact in enumerate(self.contacts):   # contact residual eq 28 and its tangent
+                state = contact.evaluate(u, t, dt, u0, None if phases is None else phases[i])
+                Rc, r, c, v = state.scatter(self.ndof)
+                G += Rc
+                blocks.append((*_triplets(r, c, v), 0, None))
+                states.append(state)
 
-        for load in self.loads:                        # loads enter with a minus sign
-            P, r, c, v = load.assemble(u, t)
+        with timed(self.instrument, "assembly"):
+            P = np.zeros(self.ndof)
+            for load in self.loads:                    # loads enter with a minus sign
+                Pl, r, c, v = load.assemble(u, t)
+                P += Pl
+                r, c, v = _triplets(r, c, v)
+                blocks.append((r, c, -v, 0, None))
             G -= P
-            r, c, v = _triplets(r, c, v)
-            blocks.append((r, c, -v, 0, None))
+            K = self._tangent.assemble(blocks, mass_coefficient * self.mass() if mass_coefficient else None)
+        return Evaluation(G, K, tuple(states), P)
 
-        K = self._tangent.assemble(blocks, mass_coefficient * self.mass() if mass_coefficient else None)
-        return G, K
+    def residual_tangent(self, u, t, mass_coefficient=0.0, dt=None, u0=None):
+        """(G, K) of ``evaluate`` (for a quick look; the solver keeps the whole Evaluation)."""
+        return self.evaluate(u, t, dt, u0, mass_coefficient)[:2]
 
-    def set_dt(self, dt):
-        """Tell rate-dependent bodies (viscoplastic beam) and contacts (friction laws with
-        a slip rate or internal variables) the step size: their ``set_dt``."""
-        for part in self.bodies + self.contacts:
-            if hasattr(part, "set_dt"):
-                part.set_dt(dt)
-
-    # -- history and energies ---------------------------------------------------
-
-    def commit(self, u):
-        """Accept u as converged: bodies and contacts update their history, and the
-        frictional dissipation of the step is added to ``self.dissipation``."""
-        for body in self.bodies:
-            body.commit(self.local(body, u).copy())
+    # -- history ----------------------------------------------------------------------
+    def start(self, u, t=0.0):
+        """The initial history of every contact that has none yet (``contact.start``)."""
         for contact in self.contacts:
-            contact.commit(u)
-            self.dissipation += float(contact.dissipation)
+            if contact.history is None:
+                contact.start(u, t)
 
-    def energies(self, u, v):
-        """Kinetic (1/2 v.M v), strain and contact energy, and the accumulated
-        frictional dissipation, as a dict of floats."""
+    def commit(self, evaluation, u, t, dt=None):
+        """Accept a converged step ending at (u, t): the bodies and loads update their history
+        at u, the contacts keep their converged states' histories."""
+        for body in self.bodies:
+            body.commit(self.local(body, u).copy(), dt)
+        for contact, state in zip(self.contacts, evaluation.contacts):
+            contact.commit(state)
+        for load in self.loads:
+            load.commit(u, t)
+
+    # -- energies ------------------------------------------------------------------
+    def energies(self, u, v, evaluation, dt=None):
+        """Kinetic (1/2 v.M v), strain and interface energy of a converged state, as a dict
+        of floats; the interface energy is read from the evaluation's contact states."""
         return {
             "kinetic": 0.5 * float(np.dot(v, self.mass() * v)),
-            "strain": float(sum(b.strain_energy(self.local(b, u)) for b in self.bodies)),
-            "contact": float(sum(c.energy(u) for c in self.contacts)),
-            "dissipation": self.dissipation,
+            "strain": float(sum(b.strain_energy(self.local(b, u), dt) for b in self.bodies)),
+            "contact": float(sum(st.energy for st in evaluation.contacts)),
         }

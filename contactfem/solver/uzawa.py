@@ -1,7 +1,7 @@
 """The Uzawa (outer) loop of augmented-Lagrangian contact (contact/augmented.py).
 
     stepper = Uzawa(Static(system, ...), contacts, length=a, tol=1e-9)
-    u1, v1, a1, result = stepper.step(t, u, v, a)    # works with integrate like any stepper
+    u1, v1, a1, result = stepper.step(t, u, v, a, dt)    # works with march like any stepper
 
 One step: solve the step equation by the wrapped stepper's Newton method (the same
 consistent tangent as the penalty method) with the multipliers held fixed; measure what
@@ -21,9 +21,10 @@ many (with an easy Newton): the speed/accuracy trade, now between outer and inne
 iterations instead of between accuracy and conditioning.
 
 A static step restarts Newton from the last outer iterate; a dynamic step (Newmark) from
-its own predictor (its equation depends on the start of the step). The interfaces'
-histories are committed by ``integrate`` after the last outer iteration, as for any
-stepper.
+its own predictor (its equation depends on the start of the step). The violation and the
+update read the contact states of each converged inner solve (its evaluation), so nothing
+is evaluated twice; the interfaces' histories are committed by the time loop (march.py)
+after the last outer iteration, as for any stepper.
 """
 from dataclasses import dataclass, field
 
@@ -43,6 +44,8 @@ class UzawaResult:
     residuals: list = field(default_factory=list)
     iterations: int = 0
     G: np.ndarray = None
+    evaluation: object = None
+    evaluations: int = 0
     uzawa_iterations: int = 0
     updates: int = 0
     newton_per_outer: list = field(default_factory=list)
@@ -67,22 +70,24 @@ class Uzawa:
         if int(max_updates) != max_updates or max_updates < 0:
             raise ValueError(f"parameter uzawa_max_updates = {max_updates!r} is out of range: allowed integers >= 0")
         self.stepper, self.length, self.tol, self.max_updates = stepper, float(length), float(tol), int(max_updates)
-        self.contacts = [c for c in contacts if hasattr(c, "update_multipliers")]
+        from ..contact.augmented import AugmentedNodeToSegment
+
+        self.contacts = [c for c in contacts if isinstance(c, AugmentedNodeToSegment)]
         if not self.contacts:
             raise ValueError("Uzawa needs at least one augmented interface (enforcement = 'augmented')")
-        self.system, self.dt, self.dynamic = stepper.system, stepper.dt, stepper.dynamic
+        self.system, self.dynamic = stepper.system, stepper.dynamic
         self.results = []                # UzawaResult of every converged step
 
-    def step(self, t, u, v, a, dt=None, label=""):
+    def step(self, t, u, v, a, dt, label=""):
         for c in self.contacts:
             c.start_step()                # a retried (cut back) step starts from the committed state
         start = u
-        residuals, per_outer, viols, self._gaps = [], [], [], []
+        residuals, per_outer, viols, self._gaps, self._calls = [], [], [], [], 0
         opts = getattr(self.stepper, "newton_options", None)
         saved = dict(opts) if opts is not None else None
         try:
             for k in range(self.max_updates + 1):
-                u1, v1, a1, res = self.stepper.step(t, start, v, a, dt=dt,
+                u1, v1, a1, res = self.stepper.step(t, start, v, a, dt,
                                                     label=f"{label} (outer iteration {k + 1})" if label else "")
                 if k == 0 and opts is not None and res.residuals:
                     # later solves start close to the solution: keep the tolerance of the first
@@ -105,17 +110,19 @@ class Uzawa:
         """Book-keeping of outer iteration k: the step's result if converged, else update."""
         residuals += list(res.residuals)
         per_outer.append(res.iterations)
-        checks = [c.violation(u1) for c in self.contacts]
+        self._calls += res.evaluations
+        states = dict(zip(self.system.contacts, res.evaluation.contacts))
+        checks = [c.violation(states[c]) for c in self.contacts]
         viol = max(c["change"] for c in checks) / self.length
         gap = max(c["penetration"] for c in checks) / self.length
         viols.append(viol)
         self._gaps.append(gap)
         if viol <= self.tol:
             result = UzawaResult(u=u1, residuals=residuals, iterations=sum(per_outer), G=res.G,
-                                 uzawa_iterations=k + 1, updates=k, newton_per_outer=per_outer,
+                                 evaluation=res.evaluation, evaluations=self._calls, uzawa_iterations=k + 1, updates=k, newton_per_outer=per_outer,
                                  violations=viols, gap_violation=gap, gap_violations=list(self._gaps))
             self.results.append(result)
             return u1, v1, a1, result
         for c in self.contacts:
-            c.update_multipliers(u1)
+            c.update_multipliers(states[c])
         return None

@@ -10,11 +10,11 @@ import numpy as np
 from ...scenes import get_scene
 from .common import best_of
 
-def iteration_cost(system, u, t=1.0, repeat=3, solvers=True):
+def iteration_cost(system, u, t=1.0, repeat=3, solvers=True, dt=None):
     """Wall times (best of `repeat`) of the parts of one Newton iteration at u:
-    bulk (every body.internal, or internal_coo where the body has it, as the System calls it),
-    contact (every contact.assemble), assembly (the whole
-    System.residual_tangent minus those two: loads, summing the triplets into K), solve (splu factor +
+    bulk (every body.internal_coo, as the System calls it), contact (every contact's
+    evaluation and scatter), assembly (the whole System.evaluate minus those two: loads,
+    summing the triplets into K), solve (splu factor +
     solve of the free block with the default COLAMD and with MMD_AT_PLUS_A ordering, the
     band LU if the System solves banded, and pypardiso if installed); ``solve_s`` is the
     solver newton() uses (``linear_algebra``)."""
@@ -23,10 +23,9 @@ def iteration_cost(system, u, t=1.0, repeat=3, solvers=True):
 
     out = dict(ndof=int(system.ndof))
     # each body as the System evaluates it (a beam's COO triplets, a continuum's sparse K)
-    _, out["bulk_s"] = best_of(lambda: [getattr(b, "internal_coo", b.internal)(system.local(b, u))
-                                        for b in system.bodies], repeat)
-    _, out["contact_s"] = best_of(lambda: [c.assemble(u) for c in system.contacts], repeat)
-    (G, K), total = best_of(lambda: system.residual_tangent(u, t), repeat)
+    _, out["bulk_s"] = best_of(lambda: [b.internal_coo(system.local(b, u), dt) for b in system.bodies], repeat)
+    _, out["contact_s"] = best_of(lambda: [c.evaluate(u, t, dt).scatter(system.ndof) for c in system.contacts], repeat)
+    (G, K), total = best_of(lambda: system.residual_tangent(u, t, dt=dt), repeat)
     out["assembly_s"] = max(total - out["bulk_s"] - out["contact_s"], 0.0)
     out["residual_tangent_s"] = total
     free = system.free_dofs
@@ -66,7 +65,7 @@ def _block_system(nx, ny, material="linear", width=None):
         p.update(width=width, height=width * ny / nx)  # square elements
     b = block.build(p)
     u = np.zeros(b["system"].ndof)
-    b["contact"].initialize(u)
+    b["system"].start(u)
     # a state with every slave in contact: the block pushed down by 1e-3 (stick)
     u[b["body"].xdofs[:, 1]] = -1e-3
     return b["system"], u
@@ -84,11 +83,11 @@ def cost_study(quick=False):
     m = hertz.build(hz.resolve("paper", {"n_el": 32 if quick else 64}))
     u = np.zeros(m["system"].ndof)
     u[m["body"].xdofs[:, 1]] = -m["a_exact"] ** 2 / (2 * 10.0)
-    m["contact"].initialize(u)
+    m["system"].start(u)
     cases[f"hertz {m['body'].mesh.t.shape[1]} quads"] = iteration_cost(m["system"], u)
     ring = rolling_ring.build(get_scene("rolling_ring").resolve("paper"))
     u = np.zeros(ring["system"].ndof)
-    ring["contact"].initialize(u)
+    ring["system"].start(u)
     cases["rolling ring 120 beams"] = iteration_cost(ring["system"], u, t=0.0)
     n_big = 64 if quick else 223                        # 2 (n + 1)^2 = 100352 unknowns
     for material in ("linear",) if quick else ("linear", "svk"):
@@ -101,7 +100,7 @@ def cost_study(quick=False):
     for nx in ((50, 200, 800) if quick else (50, 200, 800, 1600, 3200)):
         system, u = _block_system(nx, 1, width=4.0)
         c = system.contacts[0]
-        _, t_c = best_of(lambda: c.assemble(u), 5)
+        _, t_c = best_of(lambda: c.evaluate(u, 1.0).scatter(system.ndof), 5)
         scaling.append(dict(n_contact_nodes=int(len(c.nodes)), contact_s=t_c))
     slope = float(np.polyfit(np.log([r["n_contact_nodes"] for r in scaling[1:]]),
                              np.log([r["contact_s"] for r in scaling[1:]]), 1)[0])

@@ -6,10 +6,10 @@ One Newton iteration is what ``newton()`` does between two linear solves: evalua
 residual and tangent (bulk: the bodies' internal forces and tangents; contact: every
 contact's residual and tangent; assembly: summing them into K, loads included), solve
 K du = -G, and the rest (Python overhead: the time stepper's effective residual, norms,
-bookkeeping). The parts are measured inside a real run of the scene by wrapping those
-functions with timers (CPU time of the thread that runs them, so that a loaded machine
-disturbs them less, and the idle BLAS threads spinning on another core do not count); their
-sum over the run is divided by the number of linear solves. Each scene runs in a
+bookkeeping). The parts are measured inside a real run of the scene by an instrument the
+Systems are built with (solver/instrument.py: CPU time of the thread that runs them, so that
+a loaded machine disturbs them less, and the idle BLAS threads spinning on another core do
+not count); their sum over the run is divided by the number of linear solves. Each scene runs in a
 fresh interpreter (best of 3 runs), as a user's run does. A converged
 step evaluates once more than it solves, so this per-iteration cost includes that share.
 
@@ -26,7 +26,6 @@ import statistics
 import subprocess
 import sys
 import time
-from contextlib import contextmanager
 
 PARTS = ("bulk", "contact", "assembly", "solve", "overhead")
 # what the speed work aims at (whole-process and per-iteration times on 2 cores)
@@ -82,83 +81,28 @@ def startup_study(repeat=5):
     return out
 
 
-@contextmanager
-def _timers():
-    """Wrap the parts of a Newton iteration with CPU timers while inside newton().
-
-    Yields a dict: seconds per part and the number of linear solves, summed over the run."""
-    from ...bodies.beam import Beam
-    from ...bodies.continuum import Continuum
-    from ...contact.interface import NodeToSegment
-    from ...solver import newmark, staggered
-    from ...solver.system import System
-
-    newton_module = sys.modules["contactfem.solver.newton"]     # (the package exports the function newton)
-    acc = dict.fromkeys(("newton", "residual_tangent", "bulk", "contact", "solve"), 0.0)
-    acc["solves"], depth = 0, [0]
-    # CPU time of this thread: OpenBLAS's worker threads spin for a while after a library call
-    # (~50 ms at the start of a run, on the other core); the solves of the paper's systems are
-    # below OpenBLAS's threading thresholds, so those threads do no part of an iteration
-    clock = time.thread_time
-
-    def timed(fn, key, only_in_newton=True):
-        def wrapper(*args, **kw):
-            if only_in_newton and not depth[0]:
-                return fn(*args, **kw)
-            t0 = clock()
-            try:
-                return fn(*args, **kw)
-            finally:
-                acc[key] += clock() - t0
-        return wrapper
-
-    def timed_newton(fn):
-        def wrapper(*args, **kw):
-            depth[0] += 1
-            t0 = clock()
-            try:
-                result = fn(*args, **kw)
-                acc["solves"] += result.iterations
-                return result
-            finally:
-                depth[0] -= 1
-                acc["newton"] += clock() - t0
-        return wrapper
-
-    patches = [(Beam, "internal_coo", timed(Beam.internal_coo, "bulk")),
-               (Continuum, "internal", timed(Continuum.internal, "bulk")),
-               (NodeToSegment, "assemble", timed(NodeToSegment.assemble, "contact")),
-               (System, "residual_tangent", timed(System.residual_tangent, "residual_tangent")),
-               (newton_module, "solve_free", timed(newton_module.solve_free, "solve"))]
-    for module in (newmark, staggered):
-        if hasattr(module, "newton"):
-            patches.append((module, "newton", timed_newton(module.newton)))
-    saved = [(owner, name, getattr(owner, name)) for owner, name, _ in patches]
-    try:
-        for owner, name, fn in patches:
-            setattr(owner, name, fn)
-        yield acc
-    finally:
-        for owner, name, fn in saved:
-            setattr(owner, name, fn)
-
-
 def iteration_split(scene, preset="paper", overrides=None):
-    """Run a scene with timers; per-iteration cost of each part (seconds, CPU) and the run's totals."""
+    """Run a scene with an instrument (solver/instrument.py) handed to every System it builds;
+    per-iteration cost of each part (seconds, CPU of the running thread) and the run's totals.
+    bulk, contact: the System's parts; assembly: loads and summing into K; solve: the linear
+    solves; overhead: the rest of newton() and the stepper's effective residual."""
     from ...scenes import run_scene
+    from ...solver.instrument import Timings
 
+    timings = Timings()
     t0, c0 = time.perf_counter(), time.process_time()
-    with _timers() as acc:
-        res = run_scene(scene, preset, dict(overrides or {}))
+    res = run_scene(scene, preset, dict(overrides or {}), instrument=timings)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
-    n = max(acc["solves"], 1)
-    parts = dict(bulk=acc["bulk"], contact=acc["contact"],
-                 assembly=acc["residual_tangent"] - acc["bulk"] - acc["contact"], solve=acc["solve"])
-    parts["overhead"] = acc["newton"] - sum(parts.values())
+    sec = timings.seconds
+    n = max(timings.solves, 1)
+    parts = {k: sec[k] for k in ("bulk", "contact", "assembly", "solve")}
+    parts["overhead"] = sec["newton"] - sum(parts.values())
     out = {f"{k}_s": v / n for k, v in parts.items()}
-    out.update(iteration_s=acc["newton"] / n, solves=acc["solves"], newton_cpu_s=acc["newton"],
+    out.update(iteration_s=sec["newton"] / n, solves=timings.solves, newton_cpu_s=sec["newton"],
                run_wall_s=wall, run_cpu_s=cpu, linear_algebra=res.get("linear_algebra"),
-               ordering=res.get("ordering"), ndof=res.get("unknowns"))
+               ordering=res.get("ordering"), ndof=res.get("unknowns"),
+               residual_evaluations=res.get("residual_evaluations"), wall_time_s=res.get("wall_time_s"),
+               newton_iterations_total=res.get("newton_iterations_total"))
     return out
 
 

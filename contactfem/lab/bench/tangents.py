@@ -8,9 +8,8 @@ import time
 
 import numpy as np
 
-from ...contact.tangents import ContactTangent, SplitContact
 from ...scenes import get_scene
-from ...solver import Newmark, NewtonError, Static, System, integrate
+from ...solver import Newmark, NewtonError, Static, integrate
 from ...solver.staggered import Staggered
 
 
@@ -23,13 +22,12 @@ def _block_variant(params, variant):
     try:
         if variant == "staggered":
             b = block.build(dict(params, tangent="consistent"))
-            split = SplitContact(b["contact"])
-            system = System([b["body"]], [split], b["loads"])
-            stepper = Staggered(Static(system, 1.0, atol=params["atol"], rtol=params["rtol"],
-                                       maxit=params["maxit"]), [split], max_cycles=200)
+            system = b["system"]
+            stepper = Staggered(Static(system, atol=params["atol"], rtol=params["rtol"], maxit=params["maxit"]),
+                                max_cycles=200)
             u = np.zeros(system.ndof)
-            b["contact"].initialize(u)
-            u, _, _, res = stepper.step(0.0, u, u, u, label="block, staggered")
+            system.start(u)
+            u, _, _, res = stepper.step(0.0, u, u, u, 1.0, label="block, staggered")
             extra = dict(cycles=res.cycles, phase_iterations=res.phase_iterations)
         else:
             s = block.solve(dict(params, tangent=variant))
@@ -46,25 +44,16 @@ def _impact_variant(params, variant):
     algorithm: total linear solves, step cutbacks, rebound velocity."""
     from ...scenes import sloping_impact
 
-    m = sloping_impact.build(params)
-    ring, contact = m["ring"], m["contact"]
-    if variant == "staggered":
-        wrapped = SplitContact(contact)
-    elif variant == "consistent":
-        wrapped = contact
-    else:
-        wrapped = ContactTangent(contact, variant)
-    system = System([ring.body], [wrapped])
-    newmark = Newmark(system, params["dt"], params["delta"], params["beta_newmark"], atol=1e-10, rtol=1e-10,
-                      maxit=30)
-    stepper = Staggered(newmark, [wrapped], max_cycles=100) if variant == "staggered" else newmark
+    tangent = "consistent" if variant == "staggered" else variant
+    m = sloping_impact.build(dict(params, tangent=tangent))
+    ring, system = m["ring"], m["system"]
+    newmark = Newmark(system, params["delta"], params["beta_newmark"], atol=1e-10, rtol=1e-10, maxit=30)
+    stepper = Staggered(newmark, max_cycles=100) if variant == "staggered" else newmark
     u0 = np.zeros(ring.body.ndof)
-    contact.initialize(u0)
-    system.set_dt(params["dt"])
     t0 = time.perf_counter()
     try:
         hist = integrate(stepper, 0.0, u0, ring.initial_velocity((params["vx0"], params["vy0"])),
-                         n_steps=params["n_steps"], cutback=True, max_cuts=6)
+                         n_steps=params["n_steps"], dt=params["dt"], cutback=True, max_cuts=6)
     except NewtonError as err:
         part = getattr(err, "partial", None)
         return dict(converged=False, iterations=None, time_s=time.perf_counter() - t0,

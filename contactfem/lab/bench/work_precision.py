@@ -32,7 +32,7 @@ def _bar_run(params, explicit):
     """bar_impact (the scene) with implicit Newmark or explicit central differences."""
     from ...scenes import bar_impact
 
-    r, wall = timed(bar_impact.run, dict(params, integrator="central_difference" if explicit else "newmark"))
+    r, wall = timed(bar_impact.SCENE.run, dict(params, integrator="central_difference" if explicit else "newmark"))
     return dict(time_s=wall, steps=int(r["n_steps"]), iterations=int(r["newton_iterations_total"]),
                 error_duration=float(r["error_duration"]), error_rebound=float(r["error_rebound"]),
                 energy_error=float(r["energy_error"]))

@@ -1,0 +1,50 @@
+"""What a body and a load are: the interfaces the solver relies on, written down.
+
+``typing.Protocol`` classes: any object with these members is one (the beam and the
+continuum, the loads of loads.py and a student's own); the solver never asks what a body
+or load can do (no ``hasattr``). ``u`` is always the body's own (local) displacement vector
+for a body, the global one for a load; ``dt`` is the step being taken (only a body with a
+rate-dependent law, the viscoplastic beam, needs it).
+"""
+from typing import Protocol, runtime_checkable
+
+import numpy as np
+
+
+@runtime_checkable
+class Body(Protocol):
+    """A body (see contactfem.bodies): node positions, unknowns, mass, internal forces."""
+
+    name: str
+    X: np.ndarray               # (nn, 2) reference positions of the nodes that can touch
+    ndof: int
+    xdofs: np.ndarray           # (nn, 2) local dof numbers of each node's (u_x, u_y)
+    dof_offset: int             # where the body's dofs start in the global vector (set by the System)
+    hyperelastic: bool          # a stored energy and no history (energy-consistent stepping needs it)
+
+    def mass(self) -> np.ndarray:
+        """Lumped (diagonal) mass, (ndof,)."""
+
+    def internal_coo(self, u: np.ndarray, dt=None) -> tuple:
+        """(R, rows, cols, vals): internal forces R(u) and the tangent dR/du as COO triplets;
+        rows and cols the same objects from call to call while the pattern is the same."""
+
+    def internal(self, u: np.ndarray, dt=None) -> tuple:
+        """(R, K) with K a scipy sparse matrix."""
+
+    def strain_energy(self, u: np.ndarray, dt=None) -> float:
+        """The stored energy at u."""
+
+    def commit(self, u: np.ndarray, dt=None) -> None:
+        """Accept u as converged at the end of a step of dt (history variables)."""
+
+
+@runtime_checkable
+class Load(Protocol):
+    """An external load (see bodies/loads.py)."""
+
+    def assemble(self, u: np.ndarray, t: float) -> tuple:
+        """(P, rows, cols, vals): the external forces (global) and dP/du as COO triplets."""
+
+    def commit(self, u: np.ndarray, t: float) -> None:
+        """Accept the converged state u at time t (a gas pressure updates its value)."""

@@ -1,0 +1,261 @@
+"""Mortar contact of a slave surface on a master, with its history (beyond the paper:
+segment-to-segment instead of the paper's node-to-segment; the kernel is
+contact/mortar.py, the segmentation contact/segmentation.py).
+
+The protocol (tentative, as the solver's contact protocol is being settled):
+
+    contact.start(u, t)                    the history of the initial state
+    state = contact.evaluate(u, t, dt)     pure: a frozen MortarState, nothing changes
+    contact.commit(state)                  the state's history becomes the committed one
+
+A converged step is evaluated once; what is recorded reads that state, and commit takes
+the history it carries (no re-evaluation).
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .masters import BodySurface, RigidLine, RigidPolyline
+from .mortar import (Pairs, contact_forces, mortar_integrals, nodal_gap, penalty_tractions, slip_increment,
+                     weighted_slip)
+from .segmentation import candidate_pairs
+from ..laws.protocol import as_friction_law
+from ..laws.return_map import SLIP, STATE_NAMES
+
+
+@dataclass(frozen=True)
+class MortarHistory:
+    """What a step starts from, per slave node: the tangential traction t_T, the
+    accumulated slip q and the friction law's internal variables z (n, k) at the end of
+    the last converged step; the converged pairs with their mortar integrals D, M
+    (np, 2, 2) (the reference of the slip: the master points each slave point faced) and
+    the converged nodal weights w."""
+
+    t_T: np.ndarray
+    q: np.ndarray
+    z: np.ndarray
+    pairs: Pairs
+    D: np.ndarray
+    M: np.ndarray
+    w: np.ndarray
+
+
+@dataclass(frozen=True)
+class MortarState:
+    """One evaluation at (u, t), per slave node (in the order of ``nodes``):
+
+    X, x (ns, 2) reference and current positions, g_N average gap (+inf where no master faces the node), t_N, t_T
+    nodal tractions (per unit length), dt_N = dt_N/dg_N, and the return map's c_T_s, c_N_s
+    (eq 48), lam (slip of the step), q (accumulated slip), z (the law's variables),
+    state (OPEN 0, STICK 1, SLIP 2; laws/return_map),
+    weights w (the covered length of each node, int N_j), dg_T the slip increment of
+    the step; the global residual R (len(u)) and tangent triplets (rows, cols, vals)
+    (repeated indices add up); the history that commit() takes; the mortar integrals
+    (pairs, D, M, ...: contact/mortar.py) for inspection.
+
+    energy: sum_j w_j (W_N(g_N,j) + t_T,j^2 / (2 c_T)), the normal law's potential and
+    the stick spring, as node-to-segment reports it (the mortar forces are the virtual
+    work of the tractions, not this energy's exact gradient); dissipation: the slip work
+    of the step, sum_j w_bar_j (t_T_bar,j + t_T,j)/2 lambda_j sign(t_T,j) (trapezoidal,
+    lambda the return map's slip, per unit length of the converged weight w_bar)."""
+
+    t: float
+    dt: float
+    nodes: np.ndarray
+    X: np.ndarray
+    x: np.ndarray
+    g_N: np.ndarray
+    t_N: np.ndarray
+    dt_N: np.ndarray
+    t_T: np.ndarray
+    c_T_s: np.ndarray
+    c_N_s: np.ndarray
+    lam: np.ndarray
+    q: np.ndarray
+    z: np.ndarray
+    state: np.ndarray
+    weights: np.ndarray
+    dg_T: np.ndarray
+    R: np.ndarray
+    rows: np.ndarray
+    cols: np.ndarray
+    vals: np.ndarray
+    history: MortarHistory
+    integrals: object
+    energy: float
+    dissipation: float
+
+    @property
+    def n_pairs(self):
+        return len(self.integrals.pairs)
+
+    # -- what the solver reads (the names of contact/state.py's ContactState) -------------
+    def scatter(self, ndof):
+        """The global contact residual (ndof,) and the tangent's COO triplets."""
+        if ndof != len(self.R):
+            raise ValueError(f"scatter: the state was evaluated with {len(self.R)} dofs, asked for {ndof}")
+        return self.R, self.rows, self.cols, self.vals
+
+    @property
+    def next_history(self):
+        """The history a commit of this state keeps."""
+        return self.history
+
+    @property
+    def slip(self):
+        """OPEN/STICK/SLIP per slave node (= state; the name ContactState uses)."""
+        return self.state
+
+    @property
+    def n_active(self):
+        """Slave nodes in contact."""
+        return int(np.count_nonzero(self.t_N < 0.0))
+
+    @property
+    def n_slip(self):
+        """Slave nodes slipping in this step."""
+        return int(np.count_nonzero(self.state == SLIP))
+
+    def report(self):
+        """Per slave node: reference and current position, average gap, tractions, nodal
+        force measures f = w t (the weights are the covered lengths), state names."""
+        return dict(X=self.X, x=self.x, g_N=self.g_N, t_N=self.t_N, t_T=self.t_T, f_N=self.weights * self.t_N,
+                    f_T=self.weights * self.t_T, state=STATE_NAMES[self.state], weights=self.weights)
+
+
+class MortarContact:
+    """Mortar contact (penalty) of the chain ``slave_nodes`` of ``slave_body`` on ``master``.
+
+    slave_nodes: ordered so that n = e3 x t points out of the slave body (as the masters'
+                 nodes are ordered, contact/masters.py)
+    master:      BodySurface (deformable, its nodes carry unknowns), RigidPolyline, or
+                 RigidLine (an unbounded straight line)
+    normal:      a normal law (t_N(g_N), eq 4: PowerLaw(c_N) is the penalty with c_N a
+                 traction per unit gap, per unit length)
+    friction:    a friction law (c_T and slip_bound, eqs 5, 10, 11) or None (frictionless)
+    offset:      the slave surface lies ``offset`` beyond the chain along its normal
+                 (a positive offset closes the gap; per node or one number)
+    search:      pairs farther apart than this are not formed (default: all facing pairs)
+    """
+
+    integration = "standard"          # (no energy-consistent variant)
+
+    def __init__(self, slave_body, slave_nodes, master, *, normal, friction=None, offset=0.0, search=np.inf,
+                 name="mortar"):
+        self.slave, self.master, self.normal, self.friction, self.name = slave_body, master, normal, friction, name
+        self.nodes = np.asarray(slave_nodes, dtype=int)
+        if self.nodes.ndim != 1 or len(self.nodes) < 2:
+            raise ValueError("parameter slave_nodes must list at least 2 nodes of the slave body (a chain)")
+        if np.any(np.linalg.norm(np.diff(slave_body.X[self.nodes], axis=0), axis=1) <= 0.0):
+            raise ValueError("parameter slave_nodes has a zero-length segment: two consecutive nodes coincide")
+        if not isinstance(master, (BodySurface, RigidPolyline, RigidLine)):
+            raise ValueError(f"parameter master must be a BodySurface, RigidPolyline or RigidLine for mortar "
+                             f"contact, got {type(master).__name__} (approximate a curved obstacle by a RigidPolyline)")
+        if not (np.isfinite(search) or search == np.inf) or not search > 0:
+            raise ValueError(f"parameter search = {search!r} is out of range: allowed (0, inf]")
+        offset = np.asarray(offset, dtype=float)
+        if offset.shape not in ((), self.nodes.shape) or not np.all(np.isfinite(offset)):
+            raise ValueError(f"parameter offset must be a finite number or one per slave node, got {offset!r}")
+        self.offset = np.broadcast_to(offset, self.nodes.shape).copy()
+        self.search = float(search)
+        self.unbounded = isinstance(master, RigidLine)
+        self._law = None if friction is None else as_friction_law(friction)
+        self.history = None
+        self.evaluations = 0                # a counter for the benchmarks (not part of any result)
+
+    # -- where the interface's unknowns are ----------------------------------------
+    def slave_dofs(self):
+        """Global (u_x, u_y) dofs of the slave nodes (ns, 2)."""
+        return self.slave.dof_offset + self.slave.xdofs[self.nodes]
+
+    def master_dofs(self):
+        """Global dofs of the master nodes (nm, 2); -1 for a rigid master's fixed points."""
+        if isinstance(self.master, BodySurface):
+            return self.master.dofs()
+        return np.full((len(self._master_points()), 2), -1)
+
+    def _master_points(self):
+        if isinstance(self.master, RigidLine):            # two points of the line, n = e3 x t
+            n = self.master.normal
+            return np.array([self.master.point, self.master.point + np.array([n[1], -n[0]])])
+        return self.master.points
+
+    def positions(self, u):
+        """Current slave chain xs (ns, 2) and master chain xm (nm, 2)."""
+        xs = self.slave.X[self.nodes] + u[self.slave_dofs()]
+        xm = self.master.positions(u) if isinstance(self.master, BodySurface) else self._master_points()
+        return xs, xm
+
+    # -- the protocol --------------------------------------------------------------
+    def start(self, u, t=0.0):
+        """The history of the state u: no traction, no slip, the pairs of u as the
+        reference of the first step's slip."""
+        xs, xm = self.positions(u)
+        mi = self._integrals(xs, xm)
+        ns = len(self.nodes)
+        z = self._law.initial_state(ns) if self._law is not None else np.zeros((ns, 0))
+        self.history = MortarHistory(t_T=np.zeros(ns), q=np.zeros(ns), z=z, pairs=mi.pairs, D=mi.D, M=mi.M,
+                                     w=mi.w)
+
+    def evaluate(self, u, t=0.0, dt=None, u0=None, phase=None):
+        """Everything at u with the committed history: segmentation, mortar integrals,
+        tractions (penalty and return map), residual and tangent. Pure (u0 is not needed:
+        the history holds the reference of the slip). ``phase``: the staggered algorithm's
+        phases are not offered for mortar contact (None only)."""
+        if phase is not None:
+            raise ValueError(f"{self.name}: mortar contact has no staggered phases (phase={phase!r})")
+        if self.history is None:
+            raise RuntimeError(f"{self.name}: MortarContact.evaluate before start(u)")
+        self.evaluations += 1
+        h = self.history
+        xs, xm = self.positions(u)
+        mi = self._integrals(xs, xm)
+        offset = self.offset
+        if self._law is not None and self._law.n_state:
+            offset = offset - self._law.gap_offset(h.z)           # a worn surface: the gap opens
+        g_N, _, _ = nodal_gap(mi, offset)
+        slip, dg_T = None, np.zeros(len(self.nodes))
+        if self.friction is not None:
+            slip = weighted_slip(xs, xm, h.pairs, h.D, h.M)
+            dg_T, _ = slip_increment(slip, h.w)
+        t_N, dt_N, fr = penalty_tractions(self.normal, self.friction, g_N, dg_T, h.t_T, h.q,
+                                          z_bar=h.z if self._law is not None else None, dt=dt)
+        R_i, (r, c, v) = contact_forces(mi, t_N, dt_N, offset, slip, fr if slip is not None else None, h.w)
+        R, rows, cols, vals = self._to_global(R_i, r, c, v, len(u))
+        z = fr.z if (self._law is not None and fr.z is not None) else h.z
+        history = MortarHistory(t_T=fr.t_T, q=fr.q, z=z, pairs=mi.pairs, D=mi.D, M=mi.M, w=mi.w)
+        return MortarState(t=t, dt=dt, nodes=self.nodes, X=self.slave.X[self.nodes], x=xs, g_N=g_N, t_N=t_N, dt_N=dt_N,
+                           t_T=fr.t_T, c_T_s=fr.c_T_s, c_N_s=fr.c_N_s, lam=fr.lam, q=fr.q, z=z, state=fr.state,
+                           weights=mi.w, dg_T=dg_T, R=R, rows=rows, cols=cols, vals=vals, history=history,
+                           integrals=mi, energy=self._energy(g_N, mi.w, fr.t_T),
+                           dissipation=float(np.sum(h.w * 0.5 * (h.t_T + fr.t_T) * fr.lam * np.sign(fr.t_T))))
+
+    def commit(self, state):
+        """Accept a converged state: its history is the next step's."""
+        self.history = state.history
+
+    # -- helpers -------------------------------------------------------------------
+    def _energy(self, g_N, w, t_T):
+        closed = g_N < 0.0
+        W = np.zeros_like(g_N)
+        if hasattr(self.normal, "energy"):
+            W = np.where(closed, self.normal.energy(np.where(closed, g_N, 1.0)), 0.0)
+        if self.friction is not None and self._law.c_T > 0:
+            W = W + t_T**2 / (2.0 * self._law.c_T)
+        return float(np.sum(w * W))
+
+    def _integrals(self, xs, xm):
+        s, m = candidate_pairs(xs, xm, self.unbounded, self.search)
+        return mortar_integrals(xs, xm, Pairs.of(s, m, len(xs)), self.unbounded)
+
+    def _to_global(self, R_i, r, c, v, ndof):
+        """Interface dofs (slave nodes, then master nodes) to global dofs; a rigid
+        master's rows and columns are dropped."""
+        g = np.concatenate([self.slave_dofs().ravel(), self.master_dofs().ravel()])
+        R = np.zeros(ndof)
+        on = g >= 0
+        np.add.at(R, g[on], R_i[on])
+        rows, cols = g[r], g[c]
+        keep = (rows >= 0) & (cols >= 0)
+        return R, rows[keep], cols[keep], v[keep]

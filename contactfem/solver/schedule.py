@@ -1,0 +1,101 @@
+"""Schedules: the step sizes of a march (march.py), and what happens when a step fails.
+
+    Steps(dt, n_steps=200)                   fixed steps of dt (or up to t_end)
+    Adaptive(rule, t_end, dt=...)            rule(record) -> the size of the next step
+
+Both halve a step whose Newton fails, up to ``max_cuts`` times and never below
+``min_dt`` (``cut``); the march then retries the step with the smaller size. A schedule
+answers three questions: the size of the next step after a record (None: the run is
+over), the size after a failure, and the time a step ends at.
+"""
+import math
+
+import numpy as np
+
+
+def _check_dt(dt, name="dt"):
+    if not (np.isfinite(dt) and dt > 0):
+        raise ValueError(f"parameter {name} = {dt!r} is out of range: allowed (0, inf)")
+    return float(dt)
+
+
+class _Cuts:
+    def __init__(self, max_cuts, min_dt):
+        if int(max_cuts) != max_cuts or max_cuts < 0:
+            raise ValueError(f"parameter max_cuts = {max_cuts!r} is out of range: allowed integers >= 0")
+        self.max_cuts, self.min_dt = int(max_cuts), min_dt
+
+    def cut(self, dt, cuts):
+        """The size to retry a failed step of dt with (its cuts-th halving so far), or None."""
+        if cuts >= self.max_cuts or (self.min_dt is not None and dt / 2 < self.min_dt * (1 - 1e-9)):
+            return None
+        return dt / 2
+
+
+class Steps(_Cuts):
+    """Fixed steps of dt from t0: n_steps of them, or as many as reach t_end (the last one
+    shortened). After a halved step the rest of the step is covered with the smaller size;
+    the next step starts again with dt. Step ends are snapped onto the grid t0 + k dt."""
+
+    def __init__(self, dt, n_steps=None, t_end=None, t0=0.0, max_cuts=0, min_dt=None):
+        super().__init__(max_cuts, min_dt)
+        self.dt, self.t0 = _check_dt(dt), float(t0)
+        if (n_steps is None) == (t_end is None):
+            raise ValueError("give exactly one of n_steps and t_end")
+        if t_end is not None:
+            if not t_end > t0:
+                raise ValueError(f"parameter t_end = {t_end!r} is out of range: allowed (t0, inf) = ({t0}, inf)")
+            self.n_steps = int(np.ceil((t_end - t0) / self.dt - 1e-9))
+            self.t_end = float(t_end)
+        else:
+            if int(n_steps) != n_steps or n_steps < 1:
+                raise ValueError(f"parameter n_steps = {n_steps!r} is out of range: allowed integers >= 1")
+            self.n_steps = int(n_steps)
+            self.t_end = self.t0 + self.n_steps * self.dt
+
+    def _target(self, t):
+        """The grid time the step from t heads for: the first t0 + k dt beyond t."""
+        k = min(math.floor((t - self.t0) / self.dt + 1e-12) + 1, self.n_steps)
+        return min(self.t0 + k * self.dt, self.t_end)
+
+    def next_dt(self, rec):
+        if rec.t >= self.t_end - 1e-12 * self.dt:
+            return None
+        target = self._target(rec.t)
+        on_grid = rec.k == 0 or abs(rec.t - (target - self.dt)) <= 1e-12 * self.dt or rec.t == self.t0
+        if not on_grid:                                 # within a halved step: go on with its size
+            return min(rec.dt, target - rec.t)
+        return target - rec.t
+
+    def end_time(self, t, dt):
+        target = self._target(t)
+        return target if target - (t + dt) < 1e-12 * self.dt else t + dt
+
+
+class Adaptive(_Cuts):
+    """Steps of the size ``rule(record)`` gives after each record, up to t_end (the last one
+    shortened); ``growth``: a step is at most growth times the last accepted one (growth = 1
+    keeps a halved size); ``dt``: the size the initial state is evaluated with (rate-dependent
+    bodies and laws) and ``n_steps`` None (the number of steps is not known beforehand)."""
+
+    n_steps = None
+
+    def __init__(self, rule, t_end, dt, t0=0.0, max_cuts=0, min_dt=None, growth=None):
+        super().__init__(max_cuts, min_dt)
+        self.rule, self.t0, self.t_end, self.dt = rule, float(t0), float(t_end), _check_dt(dt)
+        if not self.t_end > self.t0:
+            raise ValueError(f"parameter t_end = {t_end!r} is out of range: allowed (t0, inf) = ({t0}, inf)")
+        if growth is not None and not growth >= 1:
+            raise ValueError(f"parameter growth = {growth!r} is out of range: allowed [1, inf)")
+        self.growth = growth
+
+    def next_dt(self, rec):
+        if rec.t >= self.t_end - 1e-9 * (self.t_end - self.t0):
+            return None
+        h = _check_dt(float(self.rule(rec)), "dt (the schedule's rule)")
+        if self.growth is not None and rec.k > 0:
+            h = min(h, self.growth * rec.dt)
+        return min(h, self.t_end - rec.t)
+
+    def end_time(self, t, dt):
+        return t + dt
