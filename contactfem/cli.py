@@ -340,11 +340,13 @@ def build_parser():
     st.add_argument("--out", default=None, metavar="DIR", help="output folder, DIR/index.html (default: build/site)")
     st.set_defaults(func=cmd_site)
     rc = sub.add_parser("reconstruct", help="the scan's lost values as an inverse problem: run every reading "
-                        "the scan allows, score it against what the paper prints, print the ranked table")
+                        "the scan allows, record how it ends (converged, no equilibrium, no convergence, "
+                        "physically rejected), score the admissible ones against what the paper prints, print "
+                        "the ranked table")
     rc.add_argument("scene", help="block | sloping_impact")
     rc.add_argument("--quick", action="store_true", help="a small profile of the search (seconds)")
     rc.add_argument("--top", type=int, default=25, help="rows of the ranked table to print")
-    rc.add_argument("--json", metavar="FILE", help="write every reading and its scores to FILE")
+    rc.add_argument("--json", metavar="FILE", help="write every reading, its outcome and its scores to FILE")
     rc.add_argument("--no-cache", action="store_true", help="recompute every reading (default: reuse the "
                     "results of earlier runs of the same code, in $CONTACTFEM_CACHE or ~/.cache/contactfem)")
     rc.set_defaults(func=cmd_reconstruct)
