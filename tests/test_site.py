@@ -140,7 +140,7 @@ def test_checker_fails_on_dead_links_and_offsite_scripts(mathjax_dir, chromium):
 # -- the real site --------------------------------------------------------------------
 
 @pytest.fixture(scope="module")
-def site(chromium):
+def site(chromium, tmp_path_factory):
     pytest.importorskip("nbclient")
     try:
         import myst_nb  # noqa: F401
@@ -149,7 +149,9 @@ def site(chromium):
         _require(False, "the site extra is not installed: pip install -e '.[site]'")
     from contactfem.lab.site import build
 
-    index = build()        # REPO/build/site; executed notebooks cached in build/site-cache
+    with pytest.MonkeyPatch.context() as mp:      # lecture 04's study caches here, never in ~/.cache
+        mp.setenv("CONTACTFEM_CACHE", str(tmp_path_factory.mktemp("reconstruct-cache")))
+        index = build()    # REPO/build/site; executed notebooks cached in build/site-cache
     return index.parent
 
 
