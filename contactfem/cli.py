@@ -1,11 +1,16 @@
-"""Command line: `contactfem list | show SCENE | run SCENE [--preset fast|paper]
-[--set NAME=VALUE ...] [--json FILE] | figures | sweep | bench | equations`.
+"""Command line: `contactfem list | show | run | figures | sweep | bench | equations |
+reconstruct | site` (`contactfem COMMAND --help` for each).
 
 Exit codes: 0 done; 2 bad input (unknown scene, unknown, repeated, out-of-range or
-inapplicable parameter, an output file that cannot be written, a run too large for this
-machine), one line on stderr, found before any solve; 1 a failed solve, its cause in one
-line and the residual history on the next; 130 interrupted (Ctrl-C): one line, and none
-of the run's output files written."""
+inapplicable parameter, a law that breaks the protocol or returns NaN in the range the
+scene meets, an output that cannot be written, a run too large for this machine), one
+line on stderr, found before any solve; 1 a failed solve, its cause in one line and the
+residual history on the next, or a law that returned a value no law may return during
+the run (one line naming the law, the value and the point), or a sweep with failed runs;
+130 interrupted (Ctrl-C): one line, and none of the run's output files written.
+
+$CONTACTFEM_READY_FILE, if set, names a file the command line creates as soon as it
+answers Ctrl-C with its one line (for a supervisor, or a test, that interrupts it)."""
 
 import argparse
 import os
@@ -52,26 +57,36 @@ def cmd_show(args):
 
     sc = scenes.get_scene(args.scene)
     print(f"{sc.name}: {sc.title}")
-    rows = [("parameter", "default", "fast", "paper", "unit", "allowed")]
+    fast, paper = sc.resolve("fast"), sc.resolve("paper")
+    rows = [("parameter", "fast (run)", "paper", "unit", "allowed")]
     for p in sc.params:
-        fast = sc.presets.get("fast", {}).get(p.name, "")
-        paper = sc.presets.get("paper", {}).get(p.name, "")
-        rows.append((p.name, _show_value(p.default), _show_value(fast), _show_value(paper), p.unit or "-",
-                     p.range_text()))
+        rows.append((p.name, _show_value(fast[p.name]),
+                     "" if paper[p.name] == fast[p.name] else _show_value(paper[p.name]), p.unit or "-", p.range_text()))
     widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
-    right = (False, True, True, True, False, False)
+    right = (False, True, True, False, False)
     for r, p in zip(rows, (None,) + tuple(sc.params)):
         cells = [c.rjust(w) if rj else c.ljust(w) for c, w, rj in zip(r, widths, right)]
         note = ""
         if p is not None:
-            note = "; ".join(x for x in (p.doc, f"used only with {p.when_text()}" if p.when else "") if x)
+            kind = sc.law_param_kind(p.name)
+            if sc.law_choice is not None and p.name == sc.law_choice[0]:
+                law = f"{'|'.join(map(str, sc.law_choice[1]))} choose the friction law"
+            else:
+                law = f"builds the {kind} law" if kind else ""
+            note = "; ".join(x for x in (p.doc, f"used only with {p.when_text()}" if p.when else "", law) if x)
         print("  ".join(cells) + f"  -- {note}" if note else "  ".join(cells).rstrip())
     for name, values in sc.presets.items():
         if name not in ("fast", "paper"):
             print(f"preset {name}: " + ", ".join(f"{k}={v}" for k, v in values.items()))
     if sc.notes:
         print(sc.notes)
-    print("fast is the default preset; paper uses the paper's data and meshes. Values: --set NAME=VALUE.")
+    print("The column 'fast (run)' is the fast preset, what `contactfem run` uses unless --preset is given; 'paper' "
+          "shows where --preset paper differs. Values: --set NAME=VALUE.")
+    if sc.laws:
+        print(f"Laws: {' and '.join(sc.laws)}; replace them with --friction / --normal (a law file FILE.py:CLASS, "
+              "a module path or a shipped law), their fields with --set law.NAME=VALUE.")
+    else:
+        print("Laws: none to replace (no contact interface of its own).")
     if sc.reports:
         print("reports: " + ", ".join(sc.reports))
 
@@ -90,7 +105,7 @@ def cmd_run(args):
     from .scenes.base import check_resources, describe
 
     scene = scenes.get_scene(args.scene)
-    overrides, laws = laws_from_args(args)             # law.NAME=... go to --friction / --normal
+    overrides, laws, notes = laws_from_args(args)      # law.NAME=... go to --friction / --normal
     params = scene.resolve(args.preset, overrides)
     out = Outputs()                                   # every output checked before the run
     if args.json:
@@ -108,6 +123,11 @@ def cmd_run(args):
             if shutil.which("ffmpeg") is None:
                 raise ValueError(f"--gif {args.gif}: writing .mp4 needs ffmpeg on the PATH; write a .gif instead")
     est = check_resources(scene, params, args.force)
+    warnings = scene.preflight(params, laws) if laws and not args.no_check else []   # the laws over the scene's range
+    for note in notes:                                # (after every refusal: a refusal is one line)
+        print(f"contactfem: note: {note}", file=sys.stderr)
+    for warning in warnings:
+        print(f"contactfem: warning: {warning}", file=sys.stderr)
     if est is not None and est.get("elements", 0) > 1e5:
         print(f"{scene.name}: building the mesh and the system ({describe(est)}) ...", file=sys.stderr, flush=True)
     progress = None
@@ -116,7 +136,7 @@ def cmd_run(args):
         _RUN["progress"] = True
     _RUN["phase"] = "run"
     res, notes = run_quietly(lambda: scenes.run_scene(args.scene, args.preset, overrides, progress=progress,
-                                                      linear_algebra=args.linear_algebra, **laws))
+                                                      linear_algebra=args.linear_algebra, check=False, **laws))
     _RUN["phase"] = "write"
     with out:                                         # temporaries first, then all renamed at once
         if args.json:
@@ -156,19 +176,32 @@ def run_quietly(fn):
     return res, list(dict.fromkeys(own))
 
 
-def laws_from_args(args):
-    """Scene overrides and the --friction / --normal law objects (fields from --set law.NAME=...)."""
+def laws_from_args(args, sets=None):
+    """Scene overrides, the --friction / --normal law objects (fields from --set law.NAME=...)
+    and the notes to print (fields a law took from the scene). Checks, before anything is
+    built, that the scene has those laws and that no parameter is set that builds a law they
+    replace."""
     from . import scenes
-    from .lab.lawfile import laws_from_options, split_sets
+    from .lab.lawfile import laws_from_options, load_class, split_sets
 
-    overrides, law_sets = split_sets(parse_sets(args.set))
+    overrides, law_sets = split_sets(parse_sets(args.set) if sets is None else sets)
     if not (args.friction or args.normal or any(law_sets.values())):
-        return overrides, {}
-    params = scenes.get_scene(args.scene).resolve(args.preset, overrides)
-    return overrides, laws_from_options(args.friction, args.normal, law_sets, params)
+        return overrides, {}, []
+    scene = scenes.get_scene(args.scene)
+    classes = {k: load_class(s, f"--{k}") for k, s in (("friction", args.friction), ("normal", args.normal)) if s}
+    scenes.check_laws(scene, classes, overrides)
+    params = scene.resolve(args.preset, overrides)
+    from_scene = {k: {n: params[n] for n in scene.law_params.get(k, ()) if n in params} for k in classes}
+    notes = []
+    laws = laws_from_options(args.friction, args.normal, law_sets, from_scene, notes)
+    return overrides, laws, notes
 
 
 def cmd_figures(args):
+    from .io.outputs import check_output_dir
+    from .plots import default_outdir
+
+    check_output_dir(args.outdir or default_outdir(args.preset), "--outdir")       # before anything heavy
     from .lab.bench import figures as _bench  # noqa: F401  (registers the bench figures)
     from .plots import load_all, make_all
 
@@ -186,15 +219,27 @@ def cmd_sweep(args):
         raise ValueError(f"parameter jobs = {args.jobs} is out of range: allowed [1, inf)")
     out = Outputs()
     out.add("--out", args.out, (".csv", ".json"))
-    rows = sweep(args.scene, parse_grid(parse_sets(args.set)), args.preset, args.jobs, args.scheduler)
+    if not args.set:
+        raise ValueError("sweep needs at least one --set NAME=V1,V2,... (the values to sweep); for one run use "
+                         "contactfem run")
+    _RUN["phase"] = "sweep"
+    rows = sweep(args.scene, parse_grid(parse_sets(args.set)), args.preset, args.jobs, args.scheduler,
+                 friction=args.friction, normal=args.normal, check=not args.no_check)
+    _RUN["phase"] = "write"
     with out:
         write_table(rows, out.temp("--out"))
         out.commit()
+    _RUN["phase"] = "done"
     failed = [r for r in rows if r.get("error")]
     print(f"{len(rows)} runs, {len(rows) - len(failed)} succeeded, {len(failed)} failed -> {args.out}")
     for r in failed:
         point = ", ".join(f"{k[6:]}={v}" for k, v in r.items() if k.startswith("param."))
         print(f"  failed: {point}: {r['error']}")
+    if failed:
+        print(f"contactfem: sweep: {len(failed)} of {len(rows)} runs failed (the table's error column says why)",
+              file=sys.stderr)
+        return 1
+    return 0
 
 
 def cmd_equations(args):
@@ -222,8 +267,10 @@ def plain_table(markdown):
 
 
 def cmd_site(args):
-    from .lab.site import build
+    from .io.outputs import check_output_dir
+    from .lab.site import build, default_out
 
+    check_output_dir(args.out or default_out(), "--out")
     try:
         index = build(args.out)
     except RuntimeError as err:                    # Sphinx's own messages, then one line of ours
@@ -238,12 +285,16 @@ def cmd_site(args):
 
 
 def cmd_reconstruct(args):
+    from .io.outputs import check_output_path
+
+    if args.json:
+        check_output_path(args.json, "--json", (".json",))      # before anything heavy
     from .lab.reconstruct import main as reconstruct
 
     reconstruct(args.scene, quick=args.quick, top=args.top, json_path=args.json, cache=not args.no_cache)
 
 
-BENCH_STUDIES = ("tangents", "work_precision", "cost", "targets", "enforcement", "speed")  # = lab.bench.STUDIES
+BENCH_STUDIES = ("tangents", "work_precision", "cost", "targets", "enforcement", "speed", "semismooth")  # = lab.bench.STUDIES
 
 
 def cmd_bench(args):
@@ -253,9 +304,12 @@ def cmd_bench(args):
 
     from .lab.bench import run_bench, write_outputs
 
+    from .io.outputs import check_output_dir
+
     out = args.out or ("bench-quick" if args.quick else ".")
     if Path(out).exists() and not Path(out).is_dir():
         raise ValueError(f"--out {out}: is a file; give a folder (it gets bench.json and BENCHMARKS.md)")
+    check_output_dir(out, "--out")
     old = Path(out) / "bench.json"
     earlier = None
     if old.exists():
@@ -305,9 +359,16 @@ def build_parser():
                     help="fast (default): coarse meshes and steps, seconds; paper: the paper's data; "
                          "or a named variant of the scene (listed by show)")
     rp.add_argument("--set", action="append", metavar="NAME=VALUE",
-                    help="override a parameter, or a field of a law file's law as law.NAME=VALUE (repeatable)")
-    rp.add_argument("--friction", metavar="FILE.py:CLASS", help="use the friction law CLASS defined in FILE.py")
-    rp.add_argument("--normal", metavar="FILE.py:CLASS", help="use the normal law CLASS defined in FILE.py")
+                    help="override a parameter, or a field of the --friction / --normal law as law.NAME=VALUE "
+                         "(friction.NAME, normal.NAME where both laws have it) (repeatable)")
+    rp.add_argument("--friction", metavar="LAW", help="replace the scene's friction law: FILE.py:CLASS (a law file), "
+                    "package.module:CLASS, or a shipped law (coulomb, parabolic_slip, slip_hardening, frictionless, "
+                    "stribeck, dieterich_ruina, archard_wear)")
+    rp.add_argument("--normal", metavar="LAW", help="replace the scene's normal law: FILE.py:CLASS, "
+                    "package.module:CLASS, or a shipped law (power_law, exponential_law)")
+    rp.add_argument("--no-check", action="store_true",
+                    help="skip the check of the --friction / --normal law over the range the scene meets before "
+                         "solving (the values it returns are still checked during the run)")
     rp.add_argument("--json", metavar="FILE", help="write all results to FILE as JSON")
     rp.add_argument("--gif", metavar="FILE", help="animate the recorded outlines (.gif, or .mp4 with ffmpeg)")
     rp.add_argument("--progress", action="store_true", help="show a progress bar on stderr during the time loop")
@@ -331,13 +392,20 @@ def build_parser():
     sw = sub.add_parser("sweep", help="run a scene over a grid of parameter values, in parallel")
     sw.add_argument("scene")
     sw.add_argument("--preset", default="fast", choices=["fast", "paper"])
-    sw.add_argument("--set", action="append", metavar="NAME=V1,V2,...", help="values of a parameter (repeatable)")
+    sw.add_argument("--set", action="append", metavar="NAME=V1,V2,...",
+                    help="values of a parameter, or of a law's field as law.NAME=V1,V2,... (repeatable; at least one)")
     sw.add_argument("--jobs", type=int, default=1, help="local worker processes (joblib)")
     sw.add_argument("--scheduler", default=None, help="Dask scheduler address: run on that cluster instead")
     sw.add_argument("--out", default="sweep.csv", help="table of results (.csv or .json)")
+    sw.add_argument("--friction", metavar="LAW", help="the friction law of every run, as for run; sweep its fields "
+                    "with --set law.NAME=V1,V2,...")
+    sw.add_argument("--normal", metavar="LAW", help="the normal law of every run, as for run")
+    sw.add_argument("--no-check", action="store_true", help="skip the laws' check before the runs, as for run")
     sw.set_defaults(func=cmd_sweep)
     st = sub.add_parser("site", help="build the course website (lectures executed, gallery, equation index, API)")
-    st.add_argument("--out", default=None, metavar="DIR", help="output folder, DIR/index.html (default: build/site)")
+    st.add_argument("--out", default=None, metavar="DIR", help="output folder, DIR/index.html (default: build/site "
+                    "in the checkout); the build's own files go to $CONTACTFEM_CACHE/site (default "
+                    "~/.cache/contactfem/site)")
     st.set_defaults(func=cmd_site)
     rc = sub.add_parser("reconstruct", help="the scan's lost values as an inverse problem: run every reading "
                         "the scan allows, record how it ends (converged, no equilibrium, no convergence, "
@@ -346,12 +414,13 @@ def build_parser():
     rc.add_argument("scene", help="block | sloping_impact")
     rc.add_argument("--quick", action="store_true", help="a small profile of the search (seconds)")
     rc.add_argument("--top", type=int, default=25, help="rows of the ranked table to print")
-    rc.add_argument("--json", metavar="FILE", help="write every reading, its outcome and its scores to FILE")
+    rc.add_argument("--json", metavar="FILE.json", help="write every reading, its outcome and its scores to "
+                    "FILE.json (checked before the study)")
     rc.add_argument("--no-cache", action="store_true", help="recompute every reading (default: reuse the "
                     "results of earlier runs of the same code, in $CONTACTFEM_CACHE or ~/.cache/contactfem)")
     rc.set_defaults(func=cmd_reconstruct)
     bp = sub.add_parser("bench", help="speed against accuracy: tangents, work-precision, cost, targets, "
-                                      "enforcement, speed "
+                                      "enforcement, speed, semi-smooth Newton "
                                       "(writes bench.json and BENCHMARKS.md)")
     bp.add_argument("--quick", action="store_true", help="fast presets and fewer points (seconds)")
     bp.add_argument("--out", default=None,
@@ -376,6 +445,8 @@ def interrupted(exc):
         where = " while writing the outputs"
     elif phase == "run":
         where = " during the run"
+    elif phase == "sweep":
+        where = " during the sweep"
     else:
         where = " before the run started"
     return f"contactfem: interrupted{where}; nothing written"
@@ -400,11 +471,24 @@ def main(argv=None):
     return code
 
 
+def _report_ready():
+    path = os.environ.get("CONTACTFEM_READY_FILE")
+    if path:
+        try:
+            with open(path, "w"):
+                pass
+        except OSError:
+            pass
+
+
 def _main(argv):
     _RUN.clear()
     try:
+        _report_ready()
         args = build_parser().parse_args(argv)
-        args.func(args)
+        code = args.func(args)                       # None: done (0); a command may return its own code
+        if code:
+            return code
     except KeyboardInterrupt as exc:
         print(("\n" if _RUN.get("progress") else "") + interrupted(exc), file=sys.stderr)
         return 130
@@ -412,6 +496,12 @@ def _main(argv):
         print(f"contactfem: error: {exc}", file=sys.stderr)
         return 2
     except ValueError as exc:
+        from .laws.protocol import LawValueError
+
+        if isinstance(exc, LawValueError):           # a law returned a bad value during the run: the run failed
+            print(("\n" if _RUN.get("progress") else "") + f"contactfem: law failed: {_one_line(exc)}",
+                  file=sys.stderr)
+            return 1
         print(f"contactfem: error: {_one_line(exc)}", file=sys.stderr)
         return 2
     except BrokenPipeError:                          # the reader went away (`contactfem equations | head`)

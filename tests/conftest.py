@@ -1,5 +1,23 @@
+import os
+import shutil
+import tempfile
+
 import numpy as np
 import pytest
+
+
+def pytest_configure(config):
+    """The tests' own caches: $CONTACTFEM_CACHE (the inverse study's results, the site's
+    build) is a temporary folder for the session, so no test reads or writes the user's
+    ~/.cache/contactfem (and a later command never answers from the tests' cache)."""
+    config._contactfem_cache = tempfile.mkdtemp(prefix="contactfem-test-cache-")
+    os.environ["CONTACTFEM_CACHE"] = config._contactfem_cache
+
+
+def pytest_unconfigure(config):
+    folder = getattr(config, "_contactfem_cache", None)
+    if folder:
+        shutil.rmtree(folder, ignore_errors=True)
 
 
 class PointCloud:

@@ -1,6 +1,7 @@
 """The command line: list/show/run, and bad input as one clear line with exit code 2."""
 
 import json
+import re
 import subprocess
 import sys
 
@@ -91,3 +92,51 @@ def test_a_failed_site_build_shows_sphinx_then_one_line(monkeypatch, capsys):
     assert err[0] == "lectures/03.ipynb:12: WARNING: undefined label"
     assert err[-1] == "contactfem: error: the site build failed (Sphinx exit code 1) (Sphinx's messages above)"
     assert not any("Traceback" in line for line in err)
+
+
+# ---- every command checks its outputs before any work -----------------------------------
+
+def _no_work(*args, **kwargs):
+    raise AssertionError("the work started before the output was checked")
+
+
+@pytest.mark.parametrize("argv,target,pattern", [
+    (["site", "--out", "{file}"], ("contactfem.lab.site", "build"), r"--out .*: is a file, give a folder"),
+    (["figures", "--outdir", "{file}"], ("contactfem.plots", "make_all"), r"--outdir .*: is a file, give a folder"),
+    (["figures", "--outdir", "{file}/sub"], ("contactfem.plots", "make_all"), r"--outdir .*/sub: .* is a file"),
+    (["reconstruct", "block", "--quick", "--json", "/missing/x.json"], ("contactfem.lab.reconstruct", "main"),
+     r"--json /missing/x.json: the folder /missing does not exist"),
+    (["reconstruct", "block", "--quick", "--json", "{dir}/r.txt"], ("contactfem.lab.reconstruct", "main"),
+     r"--json .*r.txt: the file name must end in .json"),
+    (["bench", "--quick", "--out", "{file}/sub"], ("contactfem.lab.bench", "run_bench"), r"--out .*/sub: .* is a file"),
+    (["sweep", "block", "--set", "mu=0.3", "--out", "/missing/s.csv"], ("contactfem.lab.sweep", "sweep"),
+     r"--out /missing/s.csv: the folder /missing does not exist"),
+])
+def test_every_command_checks_its_outputs_before_any_work(argv, target, pattern, tmp_path, monkeypatch, capsys):
+    import importlib
+
+    f = tmp_path / "a_file"
+    f.write_text("")
+    monkeypatch.setattr(importlib.import_module(target[0]), target[1], _no_work)
+    argv = [a.format(file=f, dir=tmp_path) for a in argv]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and re.search(pattern, err[0]), err
+
+
+def test_help_names_every_command():
+    text = cli("--help").stdout
+    for name in ("list", "show", "run", "figures", "equations", "sweep", "site", "reconstruct", "bench"):
+        assert re.search(rf"^    {name} +\S", text, re.M), name
+    assert "reconstruct" in text.split("positional arguments")[0]          # the description names it too
+
+
+def test_show_says_which_preset_its_columns_are(capsys):
+    assert main(["show", "rolling_ring"]) == 0
+    text = capsys.readouterr().out
+    head = text.splitlines()[1].split()
+    assert head[:4] == ["parameter", "fast", "(run)", "paper"]
+    row = next(ln for ln in text.splitlines() if ln.startswith("n_el "))
+    assert row.split()[1:3] == ["40", "120"]                       # the fast preset's, then where paper differs
+    assert "what `contactfem run` uses unless --preset is given" in text
+    assert "c_T " in text and "builds the friction law" in text

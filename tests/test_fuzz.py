@@ -2,7 +2,10 @@
 
 Cases: random parameter sets of every scene (in range, at the ends of the range, out of
 range, of the wrong type), malformed command lines, corrupt and foreign saved runs, random
-interface laws. The property of every command-line case:
+interface laws, and random law files (friction and normal laws as a student writes them,
+valid and broken: NaN, inf, negative slip bounds, tensile tractions, c_T <= 0, wrong
+derivatives, wrong shapes and counts, math instead of numpy, exceptions) run in the scenes.
+The property of every command-line case:
 
     exit 0 with finite JSON (and every requested output written), or
     exit 2 with exactly one line on stderr (the cause), or
@@ -11,10 +14,14 @@ interface laws. The property of every command-line case:
 
 Saved runs: load_run returns the run or raises one ValueError of one line (never another
 exception, never advice to allow pickles). Laws: a constructor accepts its parameters or
-raises ValueError naming one; the return mapping of an accepted law is finite.
+raises ValueError naming one; the return mapping of an accepted law is finite. Law files:
+besides the contract above, no run exits 0 after its law returned a value no law may
+return (the law file records every value it returned: NaN or inf, Y < 0, t_N > 0 in
+contact) or with a stick stiffness c_T that is not finite and > 0.
 
-Profiles: the quick one runs in CI (about a minute); CONTACTFEM_FUZZ=long runs the long one
-(>= 500 cases, every scene). The summary line with the counts is printed either way.
+Profiles: the quick one runs in CI (about two minutes); CONTACTFEM_FUZZ=long runs the long
+one (>= 500 cases, every scene, >= 300 law files). The summary line with the counts is
+printed either way.
 """
 
 import io
@@ -40,7 +47,8 @@ from contactfem.scenes import all_scenes  # noqa: E402
 from contactfem.scenes.base import LIMITS  # noqa: E402
 
 LONG = os.environ.get("CONTACTFEM_FUZZ") == "long"
-EXAMPLES = dict(params=330, cli=120, files=120, laws=80) if LONG else dict(params=30, cli=40, files=60, laws=40)
+EXAMPLES = (dict(params=330, cli=120, files=120, laws=80, lawfiles=320) if LONG else
+            dict(params=30, cli=40, files=60, laws=40, lawfiles=40))
 BUDGET = 1500 if LONG else 300          # cost of a run: steps x (unknowns / 100); dearer cases are skipped
 TIMEOUT = 180 if LONG else 90           # seconds: a case running longer is a violation (a hang)
 SCENES = sorted(all_scenes()) if LONG else ["bar_impact", "block", "hertz", "patch", "rolling_ring",
@@ -141,16 +149,22 @@ def run_case(kind, argv, folder, outputs=()):
                 violation(kind, argv, f"NaN or inf in {o}")
             if o.endswith((".json", ".npz")) and non_finite(load_run(p)):
                 violation(kind, argv, f"NaN or inf in {o} (reloaded)")
-        if any(not ln.startswith("contactfem: warning:") for ln in lines if "\r" not in ln):
+        if any(not ln.startswith(("contactfem: warning:", "contactfem: note:")) for ln in lines if "\r" not in ln):
             violation(kind, argv, f"exit 0 with stray stderr: {lines}")
         return rc
     if rc not in (1, 2):
         violation(kind, argv, f"exit code {rc}: {lines}")
+    if rc == 1:           # a run that started may have said what it found in the laws beforehand
+        while len(lines) > 1 and lines[0].startswith(("contactfem: warning:", "contactfem: note:")):
+            lines = lines[1:]
     if present:
         violation(kind, argv, f"exit {rc} but outputs written: {present}")
     if rc == 2 and not (len(lines) == 1 and lines[0].startswith("contactfem: error: ")):
         violation(kind, argv, f"exit 2 needs one line 'contactfem: error: ...', got {lines}")
-    if rc == 1:
+    if rc == 1 and lines and lines[0].startswith(("contactfem: law failed: ", "contactfem: sweep: ")):
+        if len(lines) != 1:
+            violation(kind, argv, f"exit 1 of a law or a sweep needs one line, got {lines}")
+    elif rc == 1:
         ok = (1 <= len(lines) <= 2 and lines[0].startswith("contactfem: solver failed: ")
               and all(ln.startswith("residual history: ") for ln in lines[1:]))
         newton = "Newton" in lines[0] if lines else False
@@ -383,13 +397,178 @@ def test_fuzz_laws(kind, values):
         COUNTS["law non-finite map"] += 1
 
 
+# ---- random law files --------------------------------------------------------------------
+
+LAW_HEAD = """import math
+from dataclasses import dataclass
+
+import numpy as np
+
+SEEN = []     # (method, arguments, returned values): every value the law returned, for the test
+
+
+def _seen(method, args, out):
+    if any(np.iscomplexobj(a) for a in args):
+        return    # a complex-step call: its real part is not a value of the law (only its derivative is used)
+    try:
+        vals = [np.real(np.asarray(a, dtype=complex)).copy() for a in out]
+        SEEN.append((method, [np.real(np.asarray(a, dtype=complex)).copy() for a in args], vals))
+    except Exception:
+        SEEN.append((method, None, None))
+"""
+GOOD_Y = ["self.mu * p", "self.mu * p * (1.0 + 0.1 * q)", "self.mu * self.P * np.tanh(p / self.P)",
+          "self.mu * p + 0.0 * q", "self.mu * p ** 0.7"]
+GOOD_YV = ["self.mu * p / (1.0 + v)", "p * (self.mu + 0.1 * np.exp(-v))"]
+BAD_Y = ["np.sqrt(p - self.P)", "np.where(p > self.P, np.nan, self.mu * p)",
+         "np.where(p > self.P, -self.mu * p, self.mu * p)", "-self.mu * p", "self.mu * p / (self.P - p)",
+         "np.log(p / self.P)", "np.exp(p * self.P)", "self.mu * p * np.inf", "np.where(q > self.P, np.nan, self.mu * p)"]
+BAD_YV = ["np.where(v > self.P, np.nan, self.mu * p)", "self.mu * p * (1.0 - v / self.P)"]
+MODES = ["alone"] * 16 + ["derivs"] * 8 + ["wrong_derivs", "nan_deriv", "wrong_count", "shape", "text", "cast", "math",
+                                         "ifelse", "raise_above", "no_c_T", "syntax"]
+C_T = ["30.0", "1e4", "1.0"] * 4 + [None] * 3 + ["0.0", "-1.0", "float('nan')", "float('inf')", "1e-300"]
+LAW_SETS = [None] * 24 + ["c_T=-1", "c_T=0", "c_T=nan", "c_T=10", "mu=0.5", "mu=-1", "P=1e-3", "P=1e6", "nu=1"]
+GOOD_T = ("np.where(g < 0, self.c_N * g, 0.0)", "np.where(g < 0, self.c_N, 0.0)")
+BAD_T = [("np.where(g < 0, -self.c_N * g, 0.0)", "np.where(g < 0, -self.c_N, 0.0)"),
+         ("np.where(g < -self.D, np.nan, self.c_N * np.minimum(g, 0.0))", "np.where(g < 0, self.c_N, 0.0)"),
+         ("np.where(g < 0, -(np.exp(-1e4 * g) - 1.0), 0.0)", "np.where(g < 0, 1e4 * np.exp(-1e4 * g), 0.0)"),
+         ("np.where(g < 0, self.c_N * g, 0.0)", "np.where(g < -self.D, np.inf, self.c_N)")]
+FRICTION_SCENES = ["block", "rolling_ring"] + (["sloping_impact", "funnel", "cork"] if LONG else [])
+NORMAL_SCENES = ["patch", "block"] + (["hertz", "bar_impact", "rolling_ring"] if LONG else [])
+LAW_CHEAP = dict(CHEAP, rolling_ring={"t_end": 0.1}, cork={"t_end": 2e-4, "n_press": 2})
+
+
+def _friction_source(draw):
+    rate = draw(st.booleans()) and draw(st.booleans())
+    good = draw(st.sampled_from([True, True, True, False, False]))
+    y = draw(st.sampled_from((GOOD_YV if rate else GOOD_Y) if good else (BAD_YV + BAD_Y if rate else BAD_Y)))
+    mode = draw(st.sampled_from(MODES))
+    c_T = draw(st.sampled_from(C_T))
+    P = draw(st.sampled_from(["1e-3", "0.3", "30.0", "1e3", "1e7"]))
+    args = "p, q, v" if rate else "p, q"
+    zeros = ", 0.0 * p" * (3 if rate else 2)
+    lines = ["", "", "@dataclass(frozen=True)", "class Law:"]
+    if mode != "no_c_T":
+        lines.append(f"    c_T: float = {c_T}" if c_T is not None else "    c_T: float")
+    lines += ["    mu: float = 0.3", f"    P: float = {P}", ""]
+    lines.append(f"    def slip_bound(self, {args}){'' if mode == 'syntax' else ':'}")
+    if mode == "cast":
+        lines.append("        p = np.asarray(p, dtype=float)")
+    else:
+        lines.append("        p = np.asarray(p)")
+    if mode == "ifelse":
+        lines.append("        if p > 1.0:\n            return self.mu * p")
+    if mode == "raise_above":
+        lines.append("        if np.any(np.real(p) > self.P):\n            raise RuntimeError('above P')")
+    expr = f"self.mu * math.tanh(p)" if mode == "math" else y
+    lines.append(f"        Y = {expr}")
+    out = {"alone": "Y", "derivs": None, "wrong_derivs": f"Y, 1.0 + 0.0 * p{zeros[len(', 0.0 * p'):]}",
+           "nan_deriv": f"Y, np.nan * p{zeros[len(', 0.0 * p'):]}", "wrong_count": "Y, 0.0",
+           "shape": "Y[:1] if np.ndim(Y) else Y", "text": "'Y'"}.get(mode, "Y")
+    if out is None:         # the derivatives by complex step, returned as the law's own (right)
+        h = "1e-30"
+        parts = [f"np.imag(self._y(p + 1j * {h}, q{', v' if rate else ''})) / {h}",
+                 f"np.imag(self._y(p, q + 1j * {h}{', v' if rate else ''})) / {h}"]
+        if rate:
+            parts.append(f"np.imag(self._y(p, q, v + 1j * {h})) / {h}")
+        lines[-1:] = [f"        Y = self._y(p, q{', v' if rate else ''})"]
+        out = "Y, " + ", ".join(parts)
+        lines += [f"        _seen('slip_bound', ({args},), (Y,))", f"        return {out}", "",
+                  f"    def _y(self, {args}):", f"        return {y}"]
+    else:
+        lines += [f"        _seen('slip_bound', ({args},), (Y,))", f"        return {out}"]
+    return LAW_HEAD + "\n".join(lines) + "\n", good and mode in ("alone", "derivs") and c_T not in ("0.0", "-1.0",
+                                                                    "float('nan')", "float('inf')")
+
+
+def _normal_source(draw):
+    good = draw(st.sampled_from([True, False]))
+    t, dt = GOOD_T if good else draw(st.sampled_from(BAD_T))
+    count = draw(st.sampled_from(["two"] * 7 + ["one"]))
+    c_N = draw(st.sampled_from(["10.0", "1e5", "1e3"] * 3 + ["-1.0"]))
+    D = draw(st.sampled_from(["1e-6", "1e-3", "0.1"]))
+    ret = "t, dt" if count == "two" else "t"
+    src = LAW_HEAD + "\n".join([
+        "", "", "@dataclass(frozen=True)", "class Law:", f"    c_N: float = {c_N}", f"    D: float = {D}", "",
+        "    def traction(self, g):", "        g = np.asarray(g, dtype=float)", f"        t = {t}", f"        dt = {dt}",
+        "        _seen('traction', (g,), (t, dt))", f"        return {ret}", ""])
+    return src, good and count == "two"
+
+
+@st.composite
+def law_files(draw):
+    kind = draw(st.sampled_from(["friction", "friction", "friction", "normal"]))
+    src, good = _friction_source(draw) if kind == "friction" else _normal_source(draw)
+    option = kind if draw(st.integers(0, 19)) else ("normal" if kind == "friction" else "friction")
+    scene = draw(st.sampled_from(FRICTION_SCENES if option == "friction" else NORMAL_SCENES))
+    if not draw(st.integers(0, 24)):
+        scene = draw(st.sampled_from(["hertz", "patch"]))           # a scene without that law, now and then
+    sets = dict(LAW_CHEAP.get(scene, {}))
+    law_set = draw(st.sampled_from(LAW_SETS))
+    extra = ["--no-check"] if draw(st.integers(0, 2)) == 0 else []
+    return kind, src, good, option, scene, sets, law_set, extra
+
+
+def _bad_values(module):
+    """What the law returned that no law may: [(method, first bad value)]."""
+    bad = []
+    for method, args, out in getattr(module, "SEEN", []):
+        if args is None:
+            continue
+        try:
+            ok_in = np.all([np.isfinite(a) for a in np.broadcast_arrays(*args)], axis=0)
+            vals = np.broadcast_arrays(*out, *args)[:len(out)]
+        except ValueError:
+            continue
+        for a in vals:
+            if np.any(~np.isfinite(a) & ok_in):
+                bad.append((method, "NaN or inf"))
+        if method == "slip_bound" and np.any((vals[0] < 0) & ok_in):
+            bad.append((method, "Y < 0"))
+        if method == "traction" and np.any((vals[0] > 0) & (np.broadcast_to(args[0], vals[0].shape) < 0) & ok_in):
+            bad.append((method, "t_N > 0 in contact"))
+    return bad
+
+
+@settings(max_examples=EXAMPLES["lawfiles"], **SETTINGS)
+@given(case=law_files())
+def test_fuzz_law_files(case, tmp_path_factory):
+    import sys
+
+    kind, src, good, option, scene, sets, law_set, extra = case
+    folder = tmp_path_factory.mktemp("l")
+    law = folder / "law.py"
+    law.write_text(src)
+    argv = ["run", scene, f"--{option}", f"{law}:Law", *extra, "--json", "run.json"]
+    for k, v in sets.items():
+        argv += ["--set", f"{k}={v}"]
+    if law_set:
+        argv += ["--set", f"law.{law_set}"]
+    before = set(sys.modules)
+    rc = run_case("lawfiles", argv, folder, ["run.json"])
+    COUNTS[f"law file exit {rc}"] += 1
+    modules = [sys.modules[m] for m in set(sys.modules) - before if m.startswith("contactfem_lawfile_")]
+    if rc != 0:
+        return
+    res = json.loads((folder / "run.json").read_text())
+    rec = res.get(f"{option}_law", {})
+    c_T = rec.get("fields", {}).get("c_T")
+    if option == "friction" and not (isinstance(c_T, (int, float)) and math.isfinite(c_T) and c_T > 0):
+        violation("lawfiles", argv, f"exit 0 with c_T = {c_T}")
+    for m in modules:
+        bad = _bad_values(m)
+        if bad:
+            violation("lawfiles", argv, f"exit 0 although the law returned {bad[0][1]} ({bad[0][0]})")
+
+
 # ---- the counts ---------------------------------------------------------------------------
 
 def test_fuzz_summary(capsys):
     """Print the counts (run last in this module); the long profile must have run >= 500 cases."""
     line = (f"fuzz ({'long' if LONG else 'quick'}): {COUNTS['cases']} cases "
             f"(parameters {COUNTS['params']}, command lines {COUNTS['cli']}, saved files {COUNTS['files']}, "
-            f"laws {COUNTS['laws']}); exit 0: {COUNTS['exit 0']}, exit 1: {COUNTS['exit 1']}, "
+            f"laws {COUNTS['laws']}, law files {COUNTS['lawfiles']}: exit 0 {COUNTS['law file exit 0']}, "
+            f"1 {COUNTS['law file exit 1']}, 2 {COUNTS['law file exit 2']}); exit 0: {COUNTS['exit 0']}, "
+            f"exit 1: {COUNTS['exit 1']}, "
             f"exit 2: {COUNTS['exit 2']}; load_run refused {COUNTS['load_run ValueError']}, "
             f"read {COUNTS['load_run ok']}; laws refused {COUNTS['law refused']}, accepted {COUNTS['law accepted']}; "
             f"violations: {len(VIOLATIONS)}")
@@ -397,4 +576,4 @@ def test_fuzz_summary(capsys):
         print("\n" + line)
     assert not VIOLATIONS, VIOLATIONS[:5]
     if LONG:
-        assert COUNTS["cases"] >= 500
+        assert COUNTS["cases"] >= 500 and COUNTS["lawfiles"] >= 300

@@ -56,7 +56,6 @@ def kernel_env(tmp_path, monkeypatch):
     monkeypatch.setenv("PYTHONPATH", os.pathsep.join([str(REPO)] + [p for p in [os.environ.get("PYTHONPATH")] if p]))
     monkeypatch.setenv("CONTACTFEM_PRESET", "fast")
     monkeypatch.setenv("CONTACTFEM_FIGURES", str(tmp_path / "figures"))
-    monkeypatch.setenv("CONTACTFEM_CACHE", str(tmp_path / "cache"))   # lecture 04's study: never ~/.cache
     monkeypatch.setenv("MPLBACKEND", "module://matplotlib_inline.backend_inline")
     return tmp_path
 

@@ -40,7 +40,7 @@ X_MASTER = np.array([(-0.2, -0.02), (0.2, 0.01), (0.45, -0.01), (0.7, 0.0), (1.2
 X_MASTER_SHORT = np.array([(-0.2, -0.02), (0.2, 0.01), (0.45, -0.01), (0.75, 0.0)])
 
 
-def make_contact(master_kind, normal=PowerLaw(c_N=50.0), friction=None, short=False):
+def make_contact(master_kind, normal=PowerLaw(c_N=50.0), friction=None, short=False, kinematics="finite"):
     slave = PointCloud(X_SLAVE, "slave")
     Xm = X_MASTER_SHORT if short else X_MASTER
     if master_kind == "deformable":
@@ -50,7 +50,8 @@ def make_contact(master_kind, normal=PowerLaw(c_N=50.0), friction=None, short=Fa
         master, ndof = RigidPolyline(Xm), slave.ndof
     else:
         master, ndof = RigidLine(point=(0.3, -0.01), normal=(0.05, 1.0)), slave.ndof
-    return MortarContact(slave, np.arange(len(X_SLAVE)), master, normal=normal, friction=friction), ndof
+    return MortarContact(slave, np.arange(len(X_SLAVE)), master, normal=normal, friction=friction,
+                         kinematics=kinematics), ndof
 
 
 def pressed(ndof, rng, depth=0.05):
@@ -379,3 +380,80 @@ def test_search_distance_leaves_far_pairs_out():
     assert len(candidate_pairs(xs, xm, search=0.6)[0]) > 0
     assert len(candidate_pairs(xs, xm, search=0.4)[0]) == 0
     assert len(candidate_pairs(xs[::-1], xm)[0]) == 0          # reversed slave: its normal faces away
+
+
+# -- small kinematics (the reference configuration held) --------------------------------
+
+@pytest.mark.parametrize("master_kind, short", [("line", False), ("deformable", False), ("deformable", True)],
+                         ids=["line", "deformable", "deformable-end"])
+@pytest.mark.parametrize("regime", ["frictionless", "stick", "slip+", "slip-"])
+def test_small_kinematics_tangent(rng, master_kind, regime, short):
+    friction = None if regime == "frictionless" else Coulomb(c_T=30.0, mu=0.3)
+    contact, ndof = make_contact(master_kind, friction=friction, short=short, kinematics="small")
+    u = pressed(ndof, rng)
+    contact.start(u)
+    u[0:8:2] += 0.002
+    contact.commit(contact.evaluate(u, 0.0, DT))
+    u[0:8:2] += MOTION.get(regime, 0.02)
+    st = check_tangent(contact, u)
+    if regime != "frictionless":
+        closed = st.g_N < 0
+        assert np.all(st.state[closed] == (STICK if regime == "stick" else SLIP)), st.state
+
+
+def test_small_kinematics_is_affine_and_starts_at_the_reference(rng):
+    """Gap and slip are affine in u and equal to the finite ones at u = 0; for chains that
+    touch in the reference configuration (the geometry's own variations multiply the gap,
+    which vanishes there) they are the finite ones to first order; the weights are the
+    reference ones whatever u."""
+    g = lambda c, u: c.kinematics_at(u, c.history)["mi"].g             # noqa: E731 (weighted gaps)
+    gT = lambda c, u: c.kinematics_at(u, c.history)["slip"].g_T        # noqa: E731
+    fin, ndof = make_contact("deformable", friction=Coulomb(c_T=30.0, mu=0.3))
+    small, _ = make_contact("deformable", friction=Coulomb(c_T=30.0, mu=0.3), kinematics="small")
+    zero = np.zeros(ndof)
+    fin.start(zero)
+    small.start(zero)
+    a, b = 0.01 * rng.standard_normal(ndof), 0.01 * rng.standard_normal(ndof)
+    for f in (g, gT):
+        assert np.allclose(f(small, a + b) - f(small, b), f(small, a) - f(small, zero), atol=1e-15)
+        assert np.allclose(f(small, zero), f(fin, zero), atol=1e-15)
+    assert np.array_equal(small.evaluate(0.2 * a, 0.0, DT).weights, small.history.w)
+    xs, xm, _, _ = flat_chains(0.0)
+    slave, master = PointCloud(xs), PointCloud(xm, dof_offset=2 * len(xs))
+    pair = [MortarContact(slave, np.arange(len(xs)), BodySurface(master, np.arange(len(xm))), normal=PowerLaw(50.0),
+                          friction=Coulomb(c_T=30.0, mu=0.3), kinematics=k) for k in ("finite", "small")]
+    n = 2 * (len(xs) + len(xm))
+    for c in pair:
+        c.start(np.zeros(n))
+    d = rng.standard_normal(n)
+    for eps in (1e-4, 1e-5):                                # the difference is second order in eps
+        for f in (g, gT):
+            diff = np.abs(f(pair[0], eps * d) - f(pair[1], eps * d)).max()
+            assert diff < 10 * eps**2, (eps, diff)
+
+
+def test_small_kinematics_patch_test_at_any_deformation(rng):
+    """Flat non-matching chains: uniform tractions give the consistent nodal loads of the
+    REFERENCE meshes, whatever the displacement (the finite form gives those of the
+    current ones)."""
+    xs, xm, s_x, m_x = flat_chains(0.0, angle=0.0)
+    slave, master = PointCloud(xs), PointCloud(xm, dof_offset=2 * len(xs))
+    contact = MortarContact(slave, np.arange(len(xs)), BodySurface(master, np.arange(len(xm))),
+                            normal=PowerLaw(c_N=50.0), kinematics="small")
+    n = 2 * (len(xs) + len(xm))
+    contact.start(np.zeros(n))
+    u = np.zeros(n)
+    u[0::2] = 0.1 * np.concatenate([s_x, m_x])               # a stretch of 10 % along x of both chains
+    u[1: 2 * len(xs):2] = -0.01                              # a uniform penetration of 0.01
+    st = contact.evaluate(u, 0.0, DT)
+    p = 50.0 * 0.01
+    assert np.allclose(st.t_N, -p, rtol=1e-13)
+    R = st.R.reshape(-1, 2)
+    assert np.allclose(R[:len(xs), 1], -p * hat_integrals(s_x, s_x.min(), s_x.max()), rtol=1e-13, atol=1e-15)
+    assert np.allclose(R[len(xs):, 1], p * hat_integrals(m_x, s_x.min(), s_x.max()), rtol=1e-13, atol=1e-15)
+    assert np.allclose(R[:, 0], 0.0, atol=1e-15)
+
+
+def test_kinematics_choice_is_checked():
+    with pytest.raises(ValueError, match="parameter kinematics"):
+        MortarContact(PointCloud(X_SLAVE), np.arange(4), RigidLine(), normal=PowerLaw(1.0), kinematics="large")

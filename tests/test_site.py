@@ -149,10 +149,33 @@ def site(chromium, tmp_path_factory):
         _require(False, "the site extra is not installed: pip install -e '.[site]'")
     from contactfem.lab.site import build
 
-    with pytest.MonkeyPatch.context() as mp:      # lecture 04's study caches here, never in ~/.cache
-        mp.setenv("CONTACTFEM_CACHE", str(tmp_path_factory.mktemp("reconstruct-cache")))
-        index = build()    # REPO/build/site; executed notebooks cached in build/site-cache
+    before = _tree(REPO)
+    index = build(tmp_path_factory.mktemp("site") / "out")    # its own files: $CONTACTFEM_CACHE/site (conftest)
+    assert _tree(REPO) == before, "the site build wrote into the checkout"
     return index.parent
+
+
+def _tree(root):
+    """The files of the checkout outside .git and the virtual environment (name, size)."""
+    skip = {".git", ".venv", ".pytest_cache", "__pycache__", ".hypothesis"}
+    out = set()
+    for dirpath, dirnames, filenames in os.walk(root):
+        dirnames[:] = [d for d in dirnames if d not in skip and not d.endswith(".egg-info")]
+        out |= {os.path.join(dirpath, f) for f in filenames}
+    return out
+
+
+def test_site_pages_carry_no_absolute_path(site):
+    """No page shows a path of the machine that built it: the checkout, the cache, home, /tmp."""
+    import tempfile
+
+    from contactfem.lab.site import cache_dir
+
+    needles = {str(REPO), str(cache_dir()), str(Path.home()) + "/", tempfile.gettempdir() + "/"}
+    for page in site.rglob("*.html"):
+        text = page.read_text()
+        found = [n for n in needles if n in text]
+        assert not found, f"{page.relative_to(site)} shows {found}"
 
 
 def test_site_has_a_page_per_lecture_with_outputs_and_figures(site):
@@ -179,6 +202,40 @@ def test_equation_index_links_every_entry_to_the_api(site):
         assert m, f"eq ({k}): no link to the API entry of {e.where}"
         page = Path(m.group(1)).name
         assert f'id="{m.group(2)}"' in api[page], f"eq ({k}): {e.where} has no entry in api/{page}"
+
+
+def _tables(text):
+    """The Markdown tables of a page: lists of rows, each row a list of cells."""
+    tables, cur = [], []
+    for ln in text.splitlines() + [""]:
+        if ln.startswith("|"):
+            cur.append([c.strip() for c in ln.strip().strip("|").split("|")])
+        elif cur:
+            tables.append(cur)
+            cur = []
+    return tables
+
+
+def test_gallery_page_keeps_the_readmes_tables_intact():
+    """The gallery page (generated, no build needed): the summary table is the README's,
+    row for row; every other table keeps its own columns (Table 2's readings are not merged
+    into the summary); one section per summary row, none made of a table's separator."""
+    from contactfem.lab.site.pages import gallery_page, readme_section
+
+    page = gallery_page(REPO)
+    readme = _tables("\n".join(readme_section((REPO / "README.md").read_text())))
+    tables = _tables(page)
+    assert len(readme) >= 2
+    summary = tables[0]
+    assert [r[:4] for r in summary] == [r[:4] for r in readme[0]]
+    for t in tables:
+        assert all(len(r) == len(t[0]) for r in t), t[0]
+        assert all(set(c) <= set("-: ") for c in t[1]), t[1]        # the separator is the second row
+    readings = [t for t in tables if t[0][0] == "reading"]
+    assert len(readings) == 1 and readings[0] == readme[1]
+    heads = [ln for ln in page.splitlines() if ln.startswith("## ")]
+    assert not any(set(h[3:].replace(":", "").strip()) <= set("- ") for h in heads), heads
+    assert len([h for h in heads if h != "## Verification problems and more"]) == len(readme[0]) - 2
 
 
 def test_gallery_shows_the_figures_beside_the_papers_values(site):

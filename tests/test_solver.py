@@ -26,6 +26,7 @@ class SpringChain:
         self.dt = None
         self.dof_offset = 0
         self.hyperelastic = True
+        self.quadratic_energy = k3 == 0.0
 
     def mass(self):
         return np.full(self.ndof, self.m)
@@ -56,6 +57,11 @@ class SpringChain:
     def commit(self, u, dt=None):
         self.commits += 1
 
+    def rigid_modes(self, u):
+        Q = np.zeros((self.ndof, 2))
+        Q[0::2, 0] = Q[1::2, 1] = 1.0
+        return Q
+
 
 @dataclass(frozen=True)
 class WallState:
@@ -83,6 +89,7 @@ class Wall:
     """Penalty wall y >= y_wall for one node: R_c = c g on its y dof when g < 0; its history
     is the number of commits, and every step dissipates ``dissipation_per_commit``."""
     integration = "standard"
+    unknowns = 0
 
     def __init__(self, body, node, y_wall, c, dissipation_per_commit=0.0):
         self.body, self.node, self.y_wall, self.c = body, node, y_wall, c

@@ -2,6 +2,12 @@
 
 import csv
 import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -70,3 +76,76 @@ def test_a_quick_figure_run_never_writes_over_the_paper_figures(monkeypatch):
     assert Path(default_outdir()) == paper
     monkeypatch.setenv("CONTACTFEM_FIGURES", "/tmp/elsewhere")
     assert default_outdir("paper") == default_outdir("fast") == "/tmp/elsewhere"
+
+
+# ---- sweeps of a law's fields, failed runs, Ctrl-C --------------------------------------
+
+LAWS = Path(__file__).parent / "data" / "lying_laws.py"
+
+
+def test_sweep_of_a_law_files_fields_writes_a_row_per_value(tmp_path, capsys):
+    out = tmp_path / "s.csv"
+    assert main(["sweep", "rolling_ring", "--friction", f"{LAWS}:OwnFields", "--set", "law.mu=0.1,0.2,0.3",
+                 "--set", "t_end=0.2", "--out", str(out)]) == 0
+    rows = list(csv.DictReader(out.open()))
+    assert len(rows) == 3 and all(r["error"] == "" for r in rows)
+    assert [r["param.law.mu"] for r in rows] == ["0.1", "0.2", "0.3"]
+    assert len({r["x_end"] for r in rows}) == 3                     # three laws, three results
+    assert "t_end" not in rows[0] and rows[0]["param.t_end"] == "0.2"       # a swept parameter once, as param.
+
+
+def test_sweep_points_equal_runs_of_the_same_law(tmp_path, capsys):
+    out = tmp_path / "s.json"
+    assert main(["sweep", "block", "--friction", f"{LAWS}:OwnFields", "--set", "law.mu=0.3,0.4", "--out", str(out)]) == 0
+    rows = json.loads(out.read_text())
+    from contactfem.lab.lawfile import load_class
+    from contactfem.scenes import run_scene
+
+    own = load_class(f"{LAWS}:OwnFields")
+    for row, mu in zip(rows, (0.3, 0.4)):
+        res = run_scene("block", "fast", friction=own(mu=mu))
+        assert row["total_tangential"] == res["total_tangential"] and row["newton_iterations_total"] == res["newton_iterations_total"]
+
+
+def test_sweep_needs_values_and_fails_when_a_run_fails(tmp_path, capsys):
+    assert main(["sweep", "block", "--out", str(tmp_path / "s.csv")]) == 2
+    assert "sweep needs at least one --set" in capsys.readouterr().err
+    out = tmp_path / "f.csv"
+    assert main(["sweep", "block", "--set", "maxit=1,40", "--out", str(out)]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["contactfem: sweep: 1 of 2 runs failed (the table's error column says why)"]
+    rows = list(csv.DictReader(out.open()))                   # the table is written all the same
+    assert [r["error"] != "" for r in rows] == [True, False]
+
+
+def test_sweep_refuses_a_law_that_lies_before_any_run(tmp_path, capsys):
+    assert main(["sweep", "block", "--friction", f"{LAWS}:NaNAbove", "--set", "law.p_bad=1e6,50",
+                 "--out", str(tmp_path / "s.csv")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "NaNAbove.slip_bound returned NaN or inf: Y = nan" in err[0]
+    assert not (tmp_path / "s.csv").exists()
+
+
+@pytest.mark.parametrize("delay", [0.0, 0.3, 1.0, 2.5])
+def test_ctrl_c_during_a_parallel_sweep_is_one_line(tmp_path, delay):
+    """SIGINT to the sweep's process (and, as a terminal sends it, to its whole process
+    group) while the workers start or run: one line, exit 130, no worker traceback, no table."""
+    ready = tmp_path / "ready"
+    env = dict(os.environ, CONTACTFEM_READY_FILE=str(ready))
+    p = subprocess.Popen([sys.executable, "-m", "contactfem", "sweep", "block", "--set", "c_N=1e5,2e5,3e5,4e5,5e5,6e5",
+                          "--set", "nx=40", "--jobs", "2", "--out", "s.csv"], cwd=tmp_path, env=env, text=True,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True)
+    t0 = time.monotonic()
+    while p.poll() is None and not ready.exists() and time.monotonic() - t0 < 120:
+        time.sleep(0.002)
+    time.sleep(delay)
+    if p.poll() is None:
+        os.killpg(p.pid, signal.SIGINT)                         # as Ctrl-C in a terminal: the whole group
+    out, err = p.communicate(timeout=300)
+    assert "Traceback" not in err, err
+    if p.returncode == 0:                                       # finished before the signal
+        return
+    assert p.returncode == 130, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("contactfem: interrupted") and lines[0].endswith("nothing written"), err
+    assert not (tmp_path / "s.csv").exists()

@@ -168,6 +168,8 @@ class Beam:
         self.ep = np.zeros((len(self.points) * ne, 3))
         self.rotary_inertia = bool(rotary_inertia)
 
+    quadratic_energy = False        # the strains are nonlinear in u (finite rotations)
+
     @property
     def hyperelastic(self):
         """True for the elastic beam (a stored energy, no history); False when viscoplastic."""
@@ -180,6 +182,17 @@ class Beam:
         if dt is None:
             raise RuntimeError("viscoplastic beam: the step's dt is needed (internal_coo(u, dt), commit(u, dt))")
         return _check("dt", dt, 0.0)
+
+    def rigid_modes(self, u):
+        """The rigid-body modes energy-consistent stepping keeps its correction off, (ndof, 2): the
+        translations in x and y (its correction then has no resultant: linear momentum is kept).
+        Not the rotation: in a step that turns a stressed body by 2 delta, R(u_mid) does work
+        ~ tan(delta) R . (e3 x d_def) on the rotation's chord, of the order of the deformation
+        increment d_def itself, which a correction kept off the rotation would have to put on
+        d_def alone (c ~ delta |R| / |d_def|: singular for a stressed ring turning nearly rigidly)."""
+        Q = np.zeros((self.ndof, 2))
+        Q[0::3, 0] = Q[1::3, 1] = 1.0
+        return Q
 
     # ---- kinematics ----------------------------------------------------------------
     def positions(self, u):

@@ -224,6 +224,11 @@ class Continuum:
         """The materials here are elastic: a stored energy W(u), no history."""
         return True
 
+    @property
+    def quadratic_energy(self):
+        """W(u) is quadratic (the linear material): the midpoint rule conserves its energy exactly."""
+        return self.material == "linear"
+
     def internal_coo(self, u, dt=None):
         """R(u) and K = dR/du as COO triplets (rows, cols, vals): the CSR tangent's entries, its
         index arrays kept (the same objects) while its pattern stays the same (scikit-fem's
@@ -289,6 +294,18 @@ class Continuum:
     def inverted_elements(self, u):
         """Indices of the elements with a non-positive det J somewhere (corner_jacobian_ratios)."""
         return np.flatnonzero(np.min(self.corner_jacobian_ratios(u), axis=1) <= 0.0)
+
+    def rigid_modes(self, u):
+        """The rigid-body modes energy-consistent stepping keeps its correction off, (ndof, k):
+        the translations in x and y (plane), the translation along the axis (axisymmetric: a
+        radial shift strains the hoop). Not the rotation, for the reason Beam.rigid_modes gives."""
+        if self.axi:
+            Q = np.zeros((self.ndof, 1))
+            Q[self.xdofs[:, 1], 0] = 1.0
+            return Q
+        Q = np.zeros((self.ndof, 2))
+        Q[self.xdofs[:, 0], 0] = Q[self.xdofs[:, 1], 1] = 1.0
+        return Q
 
     def element_areas(self, u):
         """Current (signed) area of every element in the plane (shoelace formula over its

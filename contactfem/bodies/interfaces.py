@@ -21,6 +21,7 @@ class Body(Protocol):
     xdofs: np.ndarray           # (nn, 2) local dof numbers of each node's (u_x, u_y)
     dof_offset: int             # where the body's dofs start in the global vector (set by the System)
     hyperelastic: bool          # a stored energy and no history (energy-consistent stepping needs it)
+    quadratic_energy: bool      # W(u) quadratic (a linear body): the midpoint rule is energy-exact for it
 
     def mass(self) -> np.ndarray:
         """Lumped (diagonal) mass, (ndof,)."""
@@ -37,6 +38,10 @@ class Body(Protocol):
 
     def commit(self, u: np.ndarray, dt=None) -> None:
         """Accept u as converged at the end of a step of dt (history variables)."""
+
+    def rigid_modes(self, u: np.ndarray) -> np.ndarray:
+        """(ndof, k): the rigid-body motions at configuration u (energy-consistent stepping
+        keeps its correction off them, so that momentum is conserved)."""
 
 
 @runtime_checkable

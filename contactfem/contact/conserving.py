@@ -25,10 +25,13 @@ phase within the step gets the secant of the potential, not the end value t_N(g_
 work overshoots (the energy an unresolved penalty pumps into a trapezoidal step).
 grad_bar(g) is Gonzalez's discrete gradient of the gap on the pair's dofs,
 
-    grad_bar(g) = dg(u_mid) + [(g_1 - g_0 - dg(u_mid) . d) / (d . d)] d,   d = u_1 - u_0 (pair dofs),
+    grad_bar(g) = dg(u_mid) + [(g_1 - g_0 - dg(u_mid) . d) / (w . w)] w,   d = u_1 - u_0 (pair dofs),
 
 exact for the flat master (g linear in u: grad_bar = n) and conserving for curved and
-deformable ones (grad_bar . d = g_1 - g_0).
+deformable ones (grad_bar . d = g_1 - g_0). For a rigid master w = d; for a deformable one
+w = P d, d without its common translation of the pair's three nodes, so that the correction
+has no resultant and the pair's forces, like dg(u_mid), keep linear momentum (the gap does
+not change under that translation).
 
 Friction: the return mapping (eqs 40-44) at the end of the step gives t_T (from the
 converged t_T_bar and the slip after touching, Delta s = r (s_1 - s_0), r the closing-step
@@ -43,8 +46,8 @@ t_T, also when the traction reverses within the step (where (t_T_bar + t_T) / 2 
 dissipation negative). A node that opens during the step (t_T = 0 at the end) carries no
 tangential force; its stick spring's energy t_T_bar^2 / (2 c_T) is dissipated (the slip bound
 falls to zero with the pressure). So the interface stores, and friction dissipates, but
-neither creates energy. ``step_dissipation`` returns the work minus the change of stored
-energy, exactly this dissipation.
+neither creates energy. A converged state's ``dissipation`` (contact/state.py) is the work
+minus the change of stored energy, exactly this dissipation.
 
 The tangents below are the exact derivatives with respect to u_1 (checked against finite
 differences in tests/test_conserving.py).
@@ -56,22 +59,39 @@ from .element import to_coo
 from .kinematics import outer
 
 
-def discrete_gradient(f0, f1, df_m, df_1, d2f_m, d):
+def translations(k):
+    """The projection P = I - T T^T (k x k, T orthonormal) that removes the rigid translations
+    of a pair of k dofs, (s_x, s_y, 1_x, 1_y, 2_x, 2_y): a deformable master's pair, whose
+    gap and slip a common translation of its three nodes does not change."""
+    T = np.zeros((k, 2))
+    T[0::2, 0] = T[1::2, 1] = 1.0 / np.sqrt(k // 2)
+    return np.eye(k) - T @ T.T
+
+
+def discrete_gradient(f0, f1, df_m, df_1, d2f_m, d, P=None):
     """Gonzalez's discrete gradient of a scalar f over the step d = u_1 - u_0 (per pair):
-    grad_bar = df(u_mid) + c d, c = (f_1 - f_0 - df(u_mid) . d) / (d . d), and its
-    derivative with respect to u_1:
-    D grad_bar = d2f(u_mid)/2 + d (df_1 - df_m - d2f_m d / 2)^T / (d.d) + c I - 2 c d d^T / (d.d).
-    The correction is left out where d . d is at roundoff level (grad_bar = df(u_mid))."""
-    dd = np.einsum("ij,ij->i", d, d)
+    grad_bar = df(u_mid) + c w, w = P d, c = (f_1 - f_0 - df(u_mid) . d) / (w . w), so that
+    grad_bar . d = f_1 - f_0 exactly. P (k x k, symmetric, P P = P; None: I) removes the
+    directions in which f does not change (the pair's translations, ``translations``): then
+    the correction c w has no resultant either, and the pair's forces keep the momentum the
+    midpoint rule keeps (df(u_mid) has no resultant when f is translation invariant). Its
+    derivative with respect to u_1 (w . w = d . P d, d(w . w)/du_1 = 2 w):
+    D grad_bar = d2f(u_mid)/2 + w (df_1 - df_m - d2f_m d / 2)^T / (w.w) + c P - 2 c w w^T / (w.w).
+    The correction is left out where w . w is at roundoff level (grad_bar = df(u_mid))."""
+    k = d.shape[1]
+    P = np.eye(k) if P is None else P
+    w = d @ P
+    ww = np.einsum("ij,ij->i", w, w)
     G = f1 - f0 - np.einsum("ij,ij->i", df_m, d)
-    use = dd > 1e-24 * (1.0 + np.abs(f0) + np.abs(f1)) ** 2
-    safe = np.where(use, dd, 1.0)
+    # the correction only where w . w and G are above rounding (a pair moving rigidly: w ~ 0, G ~ eps)
+    noise = np.abs(f0) + np.abs(f1) + np.einsum("ij,ij->i", np.abs(df_m), np.abs(d))
+    use = (ww > 1e-24 * (1.0 + np.abs(f0) + np.abs(f1)) ** 2) & (np.abs(G) > 1e-13 * noise)
+    safe = np.where(use, ww, 1.0)
     c = np.where(use, G / safe, 0.0)
     dG = df_1 - df_m - 0.5 * np.einsum("ijk,ik->ij", d2f_m, d)
-    k = d.shape[1]
-    D = 0.5 * d2f_m + np.where(use, 1.0 / safe, 0.0)[:, None, None] * outer(d, dG) \
-        + c[:, None, None] * (np.eye(k)[None] - 2.0 * outer(d, d) / safe[:, None, None])
-    return df_m + c[:, None] * d, D
+    D = 0.5 * d2f_m + np.where(use, 1.0 / safe, 0.0)[:, None, None] * outer(w, dG) \
+        + c[:, None, None] * (P[None] - 2.0 * outer(w, w) / safe[:, None, None])
+    return df_m + c[:, None] * w, D
 
 
 def secant(law, g0, g1):
@@ -105,14 +125,15 @@ def conserving_force(contact, u0, u1, t, h, e1, fr):
     g0 = np.where(on, e0["g_N"], 1.0)
     g1 = np.where(on, e1["g_N"], 1.0)
     phi, dphi = secant(contact.normal, np.minimum(g0, 1.0), np.minimum(g1, 1.0))
-    gN, DgN = discrete_gradient(e0["g_N"], e1["g_N"], em["dg_N"], e1["dg_N"], em["d2g_N"], d)
+    P = None if contact.master.rigid else translations(d.shape[1])   # a deformable master: no resultant
+    gN, DgN = discrete_gradient(e0["g_N"], e1["g_N"], em["dg_N"], e1["dg_N"], em["d2g_N"], d, P)
     R = (w * phi)[:, None] * gN
     K = w[:, None, None] * (outer(gN, dphi[:, None] * e1["dg_N"]) + phi[:, None, None] * DgN)
     t_bar = h.t_T_bar
     work_T = np.zeros(nc)
     if contact.friction is not None:
         c_T = contact.c_T
-        sB, DsB = discrete_gradient(e0["travel"], e1["travel"], em["ds"], e1["ds"], em["d2s"], d)
+        sB, DsB = discrete_gradient(e0["travel"], e1["travel"], em["ds"], e1["ds"], em["d2s"], d, P)
         r = e1["r"]
         act = e1["active"]
         t1 = np.where(act, fr["t_T"], 0.0)

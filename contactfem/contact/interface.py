@@ -65,6 +65,7 @@ class NodeToSegment:
     """
 
     closing_step = True     # the closing step of the module docstring; False: the whole travel
+    unknowns = 0                            # no unknowns of its own (contact/interfaces.py)
 
     def __init__(self, slave, nodes, master, *, normal, friction=None, weights=1.0, offset=0.0, name="contact",
                  tangent="consistent", integration="standard"):

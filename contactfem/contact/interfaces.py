@@ -29,11 +29,17 @@ class Contact(Protocol):
     """A contact interface (contact/interface.py: NodeToSegment and its augmented form).
 
     ``evaluate`` is pure: a state (contact/state.py) from u and the committed history;
-    ``commit`` keeps a converged state's history; nothing else changes a contact."""
+    ``commit`` keeps a converged state's history; nothing else changes a contact.
+
+    ``unknowns``: how many unknowns of its own the contact carries (the Lagrange multipliers
+    of contact/lagrange.py; 0 for penalty contacts). The System places them after the
+    bodies' dofs and tells the contact where (``dof_offset``); the contact's states then
+    give their rows of the residual and the tangent like any other."""
 
     name: str
     history: object
     integration: str            # "standard" | "energy_consistent"
+    unknowns: int               # unknowns of its own (0: only the bodies' dofs)
 
     def start(self, u: np.ndarray, t: float = 0.0) -> None:
         """The history at the initial state u."""

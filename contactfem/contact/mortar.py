@@ -76,12 +76,25 @@ segment normal (strips of width about |g| theta missed or doubled at slave kinks
 segmentation.py); the nodal average gap and the penalty; the slip measured against the
 converged integrals and divided by the converged weight (exact for a rigid relative
 slide; a node that faced no master at the end of the last step starts with zero slip).
-Everything lives in the current configuration (finite deformation): next to a
+Everything above lives in the current configuration (finite deformation): next to a
 geometrically linear bulk the contact lengths, hence the tractions, differ from the
 small-strain ones by the strain along the surface.
+
+Small kinematics (``linearised``, ``linear_slip``): the geometrically linear form for a
+small-strain bulk. The segmentation, D, M, n_e and t_e are computed once, in the
+reference configuration X, and held; the weighted gap and slip are then linear in the
+positions x = X + u,
+
+    g~_j   = sum_p n_e . (M^p_jl x_l - D^p_jk x_k)  = F_N,j . x       (dg~ = F_N, dw = 0)
+    g~_T,j = sum_p t_e . (D^p_jk x_k - M^p_jl x_l)  = F_T,j . (x - x_bar)
+
+(F_T,j . X = 0: on a reference pair x_m(eta) - x_s(xi) is along n_e), and the residual
+R = sum_j t_N,j F_N,j + t_T,j F_T,j has no geometric part (Delta f = 0). This is the
+contact of the small-strain theory (Hertz's, the patch test's): tractions act on the
+reference surfaces, like the bulk's dead loads.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy import sparse
@@ -335,3 +348,23 @@ def contact_forces(mi, t_N, dt_N, offset=0.0, slip=None, friction=None, w_bar=No
     rows, cols, vals = to_coo(p.dofs, blocks) if len(p) else (np.zeros(0, int),) * 2 + (np.zeros(0),)
     return np.asarray(R).ravel(), (np.concatenate([rows, K.row]), np.concatenate([cols, K.col]),
                                    np.concatenate([vals, K.data]))
+
+
+def linearised(mi, x):
+    """The mortar quantities of small kinematics (module docstring): the integrals ``mi``
+    of the reference configuration held, the weighted gap linear in the positions x (n,)
+    of the interface dofs, g~ = F_N x with gradient F_N; the weights and the virtual-work
+    vectors constant (dw = 0, df_N = df_T = 0)."""
+    p, ns = mi.pairs, len(mi.w)
+    n = mi.dg.shape[1]
+    F_N = _pair_rows(mi.f_N, p, ns, n)
+    return replace(mi, g=F_N @ x, dg=F_N, dw=sparse.csr_matrix((ns, n)), df_N=np.zeros_like(mi.df_N),
+                   df_T=np.zeros_like(mi.df_T))
+
+
+def linear_slip(mi, x, x_bar):
+    """The weighted slip increment of small kinematics, g~_T = F_T (x - x_bar), and its
+    gradient F_T (module docstring); x_bar: the interface positions of the last converged step."""
+    p, ns = mi.pairs, len(mi.w)
+    F_T = _pair_rows(mi.f_T, p, ns, len(x))
+    return WeightedSlip(p, F_T @ (x - x_bar), F_T)

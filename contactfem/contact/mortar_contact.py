@@ -17,11 +17,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from .masters import BodySurface, RigidLine, RigidPolyline
-from .mortar import (Pairs, contact_forces, mortar_integrals, nodal_gap, penalty_tractions, slip_increment,
-                     weighted_slip)
+from .mortar import (Pairs, contact_forces, linear_slip, linearised, mortar_integrals, nodal_gap, penalty_tractions,
+                     slip_increment, weighted_slip)
 from .segmentation import candidate_pairs
 from ..laws.protocol import as_friction_law
 from ..laws.return_map import SLIP, STATE_NAMES
+
+
+KINEMATICS = ("finite", "small")
 
 
 @dataclass(frozen=True)
@@ -29,8 +32,9 @@ class MortarHistory:
     """What a step starts from, per slave node: the tangential traction t_T, the
     accumulated slip q and the friction law's internal variables z (n, k) at the end of
     the last converged step; the converged pairs with their mortar integrals D, M
-    (np, 2, 2) (the reference of the slip: the master points each slave point faced) and
-    the converged nodal weights w."""
+    (np, 2, 2) (the reference of the slip: the master points each slave point faced),
+    the converged nodal weights w and interface positions x (small kinematics: the pairs,
+    D, M and w of the reference configuration, and x the reference of the slip)."""
 
     t_T: np.ndarray
     q: np.ndarray
@@ -39,6 +43,7 @@ class MortarHistory:
     D: np.ndarray
     M: np.ndarray
     w: np.ndarray
+    x: np.ndarray = None        # the interface positions (slave, master) of the converged state
 
 
 @dataclass(frozen=True)
@@ -137,12 +142,26 @@ class MortarContact:
     offset:      the slave surface lies ``offset`` beyond the chain along its normal
                  (a positive offset closes the gap; per node or one number)
     search:      pairs farther apart than this are not formed (default: all facing pairs)
+    kinematics:  finite (default) or small (contact/mortar.py). ``finite``: segmentation,
+                 mortar integrals and normals of the current configuration, with their exact
+                 linearisation: the contact of large deformation. ``small``: all of them held
+                 at the reference configuration, gap and slip linear in u: the contact that
+                 matches a small-strain (``material = linear``) bulk, whose stresses and dead
+                 loads live on the reference configuration too. With ``finite`` next to a
+                 linear bulk the tractions act on a surface that has stretched while the bulk
+                 has not, an inconsistency of the order of the strain along the surface (the
+                 patch test with nu = 0.3 deviates by ~4e-4 of p); with ``small`` the patch
+                 test holds to round-off. Scenes choose it from their material.
     """
 
     integration = "standard"          # (no energy-consistent variant)
+    unknowns = 0                      # penalty: no unknowns of its own (contact/interfaces.py)
 
     def __init__(self, slave_body, slave_nodes, master, *, normal, friction=None, offset=0.0, search=np.inf,
-                 name="mortar"):
+                 kinematics="finite", name="mortar"):
+        if kinematics not in KINEMATICS:
+            raise ValueError(f"parameter kinematics = {kinematics!r} is not allowed: one of {'|'.join(KINEMATICS)}")
+        self.kinematics = kinematics
         self.slave, self.master, self.normal, self.friction, self.name = slave_body, master, normal, friction, name
         self.nodes = np.asarray(slave_nodes, dtype=int)
         if self.nodes.ndim != 1 or len(self.nodes) < 2:
@@ -161,6 +180,7 @@ class MortarContact:
         self.search = float(search)
         self.unbounded = isinstance(master, RigidLine)
         self._law = None if friction is None else as_friction_law(friction)
+        self._reference = None              # small kinematics: the integrals of the reference configuration
         self.history = None
         self.evaluations = 0                # a counter for the benchmarks (not part of any result)
 
@@ -190,46 +210,66 @@ class MortarContact:
     # -- the protocol --------------------------------------------------------------
     def start(self, u, t=0.0):
         """The history of the state u: no traction, no slip, the pairs of u as the
-        reference of the first step's slip."""
+        reference of the first step's slip (small kinematics: the pairs of the reference
+        configuration, computed here once)."""
         xs, xm = self.positions(u)
-        mi = self._integrals(xs, xm)
+        if self.kinematics == "small":
+            zero = np.zeros(len(u))
+            self._reference = self._integrals(*self.positions(zero))
+        mi = self._integrals(xs, xm) if self.kinematics == "finite" else self._reference
         ns = len(self.nodes)
         z = self._law.initial_state(ns) if self._law is not None else np.zeros((ns, 0))
         self.history = MortarHistory(t_T=np.zeros(ns), q=np.zeros(ns), z=z, pairs=mi.pairs, D=mi.D, M=mi.M,
-                                     w=mi.w)
+                                     w=mi.w, x=np.concatenate([xs.ravel(), xm.ravel()]))
+
+    def kinematics_at(self, u, h):
+        """Segmentation, mortar integrals, nodal gaps and slip increments at u with the
+        history h: a dict with xs, xm, x (the interface positions), mi (MortarIntegrals),
+        offset, g_N, covered, dg_N (sparse, over the interface dofs), slip (WeightedSlip, None
+        when frictionless) and dg_T (the nodal slip increments)."""
+        xs, xm = self.positions(u)
+        x = np.concatenate([xs.ravel(), xm.ravel()])
+        mi = self._integrals(xs, xm) if self.kinematics == "finite" else linearised(self._reference, x)
+        offset = self.offset
+        if self._law is not None and self._law.n_state:
+            offset = offset - self._law.gap_offset(h.z)           # a worn surface: the gap opens
+        g_N, covered, dg_N = nodal_gap(mi, offset)
+        slip, dg_T = None, np.zeros(len(self.nodes))
+        if self.friction is not None:
+            slip = (weighted_slip(xs, xm, h.pairs, h.D, h.M) if self.kinematics == "finite"
+                    else linear_slip(mi, x, h.x))
+            dg_T, _ = slip_increment(slip, h.w)
+        return dict(xs=xs, xm=xm, x=x, mi=mi, offset=offset, g_N=g_N, covered=covered, dg_N=dg_N, slip=slip,
+                    dg_T=dg_T)
 
     def evaluate(self, u, t=0.0, dt=None, u0=None, phase=None):
         """Everything at u with the committed history: segmentation, mortar integrals,
         tractions (penalty and return map), residual and tangent. Pure (u0 is not needed:
         the history holds the reference of the slip). ``phase``: the staggered algorithm's
         phases are not offered for mortar contact (None only)."""
+        h = self._check(phase)
+        k = self.kinematics_at(u, h)
+        mi, slip, g_N, dg_T = k["mi"], k["slip"], k["g_N"], k["dg_T"]
+        t_N, dt_N, fr = penalty_tractions(self.normal, self.friction, g_N, dg_T, h.t_T, h.q,
+                                          z_bar=h.z if self._law is not None else None, dt=dt)
+        R_i, (r, c, v) = contact_forces(mi, t_N, dt_N, k["offset"], slip, fr if slip is not None else None, h.w)
+        R, rows, cols, vals = self._to_global(R_i, r, c, v, len(u))
+        z = fr.z if (self._law is not None and fr.z is not None) else h.z
+        history = MortarHistory(t_T=fr.t_T, q=fr.q, z=z, pairs=mi.pairs, D=mi.D, M=mi.M, w=mi.w, x=k["x"])
+        return MortarState(t=t, dt=dt, nodes=self.nodes, X=self.slave.X[self.nodes], x=k["xs"], g_N=g_N, t_N=t_N,
+                           dt_N=dt_N, t_T=fr.t_T, c_T_s=fr.c_T_s, c_N_s=fr.c_N_s, lam=fr.lam, q=fr.q, z=z,
+                           state=fr.state, weights=mi.w, dg_T=dg_T, R=R, rows=rows, cols=cols, vals=vals,
+                           history=history, integrals=mi, energy=self._energy(g_N, mi.w, fr.t_T),
+                           dissipation=float(np.sum(h.w * 0.5 * (h.t_T + fr.t_T) * fr.lam * np.sign(fr.t_T))))
+
+    def _check(self, phase):
+        """The committed history, after the checks every evaluation makes; counts the evaluation."""
         if phase is not None:
             raise ValueError(f"{self.name}: mortar contact has no staggered phases (phase={phase!r})")
         if self.history is None:
             raise RuntimeError(f"{self.name}: MortarContact.evaluate before start(u)")
         self.evaluations += 1
-        h = self.history
-        xs, xm = self.positions(u)
-        mi = self._integrals(xs, xm)
-        offset = self.offset
-        if self._law is not None and self._law.n_state:
-            offset = offset - self._law.gap_offset(h.z)           # a worn surface: the gap opens
-        g_N, _, _ = nodal_gap(mi, offset)
-        slip, dg_T = None, np.zeros(len(self.nodes))
-        if self.friction is not None:
-            slip = weighted_slip(xs, xm, h.pairs, h.D, h.M)
-            dg_T, _ = slip_increment(slip, h.w)
-        t_N, dt_N, fr = penalty_tractions(self.normal, self.friction, g_N, dg_T, h.t_T, h.q,
-                                          z_bar=h.z if self._law is not None else None, dt=dt)
-        R_i, (r, c, v) = contact_forces(mi, t_N, dt_N, offset, slip, fr if slip is not None else None, h.w)
-        R, rows, cols, vals = self._to_global(R_i, r, c, v, len(u))
-        z = fr.z if (self._law is not None and fr.z is not None) else h.z
-        history = MortarHistory(t_T=fr.t_T, q=fr.q, z=z, pairs=mi.pairs, D=mi.D, M=mi.M, w=mi.w)
-        return MortarState(t=t, dt=dt, nodes=self.nodes, X=self.slave.X[self.nodes], x=xs, g_N=g_N, t_N=t_N, dt_N=dt_N,
-                           t_T=fr.t_T, c_T_s=fr.c_T_s, c_N_s=fr.c_N_s, lam=fr.lam, q=fr.q, z=z, state=fr.state,
-                           weights=mi.w, dg_T=dg_T, R=R, rows=rows, cols=cols, vals=vals, history=history,
-                           integrals=mi, energy=self._energy(g_N, mi.w, fr.t_T),
-                           dissipation=float(np.sum(h.w * 0.5 * (h.t_T + fr.t_T) * fr.lam * np.sign(fr.t_T))))
+        return self.history
 
     def commit(self, state):
         """Accept a converged state: its history is the next step's."""

@@ -8,18 +8,35 @@
     animate.py   animate_outlines(frames, "motion.gif"): body outlines over time with
                  matplotlib's PillowWriter (GIF) or FFMpegWriter (MP4)
     outputs.py   Outputs: a run's output files checked before the run, written to temporaries
-                 and renamed into place together (none or all); check_output_path
+                 and renamed into place together (none or all); check_output_path,
+                 check_output_dir
     progress.py  ProgressBar: a progress bar on stderr (called with each record's t);
                  chain(...) to call several at once; progress_bar, the factory for
                  integrate(..., progress=), solver.march.watch and run_scene(..., progress=)
 """
 
-from .animate import animate_outlines, boundary_loop
-from .paraview import export_continuum, export_polyline, export_series
-from .outputs import Outputs, check_output_path
-from .progress import ProgressBar, chain, progress_bar
-from .runs import Recorder, as_arrays, load_run, save_run
+import importlib
 
-__all__ = ["save_run", "load_run", "as_arrays", "Outputs", "check_output_path", "Recorder", "boundary_loop",
-           "export_series", "export_continuum", "export_polyline", "animate_outlines", "ProgressBar", "chain",
-           "progress_bar"]
+# each name from its module, loaded on first use (PEP 562): checking an output path
+# (outputs.py) loads neither scikit-fem nor matplotlib
+_WHERE = {"animate_outlines": "animate", "boundary_loop": "animate", "export_continuum": "paraview",
+          "export_polyline": "paraview", "export_series": "paraview", "Outputs": "outputs",
+          "check_output_path": "outputs", "check_output_dir": "outputs", "ProgressBar": "progress",
+          "chain": "progress", "progress_bar": "progress", "Recorder": "runs", "as_arrays": "runs",
+          "load_run": "runs", "save_run": "runs"}
+
+__all__ = ["save_run", "load_run", "as_arrays", "Outputs", "check_output_path", "check_output_dir", "Recorder",
+           "boundary_loop", "export_series", "export_continuum", "export_polyline", "animate_outlines",
+           "ProgressBar", "chain", "progress_bar"]
+
+
+def __getattr__(name):
+    if name in _WHERE:
+        value = getattr(importlib.import_module(f"{__name__}.{_WHERE[name]}"), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))

@@ -41,6 +41,25 @@ def check_output_path(path, what, suffixes):
     return p
 
 
+def check_output_dir(path, what):
+    """ValueError (one line naming the option) unless `path` is a folder that exists or can
+    be made: not a file, and its nearest existing parent a folder where files can be
+    created. Makes nothing."""
+    p = Path(path)
+    if p.exists() and not p.is_dir():
+        raise ValueError(f"{what} {path}: is a file, give a folder")
+    parent = p
+    while not parent.exists():
+        if parent.parent == parent:
+            break
+        parent = parent.parent
+    if not parent.is_dir():
+        raise ValueError(f"{what} {path}: {parent} is a file, not a folder")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise ValueError(f"{what} {path}: cannot write in {parent} (permission denied)")
+    return p
+
+
 class Outputs:
     """The output files of one run: validated when added, written to temporaries, renamed
     into place together by commit(). As a context manager it removes the temporaries if

@@ -1,17 +1,21 @@
-"""A law from a Python file, for the command line:
+"""Laws for the command line, named three ways:
 
-    contactfem run SCENE --friction my_law.py:Saturating --set law.mu0=0.6
-    contactfem run SCENE --normal my_normal.py:Hyperbolic --set law.c_N=20
+    contactfem run SCENE --friction my_law.py:Saturating --set law.mu0=0.6     # a law file
+    contactfem run SCENE --friction stribeck --set law.mu_s=0.5 ...            # a shipped law
+    contactfem run SCENE --normal mypackage.laws:Hyperbolic                    # a module path
 
-The file is a module defining the law class (a frozen dataclass, as the shipped laws).
+A law file is a module defining the law class (a frozen dataclass, as the shipped laws).
 Its fields are set like scene parameters: ``law.NAME=VALUE`` (or ``friction.NAME`` /
-``normal.NAME`` when both laws have a field of that name); a field not set takes the
-scene parameter of the same name (c_T, mu, c_N, m, ...), else the dataclass default.
-Values are converted to the field's type and validated by the law itself
-(``__post_init__``), so a bad value gives the same one-line error as a scene parameter.
+``normal.NAME`` when both laws have a field of that name). A field not set keeps the
+law's own default; a field without a default takes the scene's parameter of the same
+name where the scene declares it a parameter of that law (c_T, mu, c_N, m, ...; never an
+integrator or mesh parameter), and the command line says so in one line. Values are
+converted to the field's type and validated by the law itself (``__post_init__``) and by
+the protocol (c_T finite and > 0), so a bad value gives the same one-line error as a
+scene parameter.
 
 Any error in the file (syntax, import, a name that does not exist, a law that fails on
-arrays, returns the wrong number of values, ...) is one ValueError line naming the
+arrays, returns the wrong number of values or NaN, ...) is one ValueError line naming the
 file, the line and the cause. ``describe`` gives the JSON record of a law: class, file
 and fields.
 """
@@ -25,9 +29,48 @@ from pathlib import Path
 
 import numpy as np
 
-from ..laws.protocol import FrictionLaw, LawError, describe  # noqa: F401 (describe: public here too)
+from ..laws.protocol import FrictionLaw, LawError, NormalLawView, describe  # noqa: F401 (describe: public here too)
 
 KINDS = ("friction", "normal")
+
+
+def shipped_laws():
+    """{kind: {name: class}} of the shipped laws, by the names the command line accepts
+    (the class name in lower case, with or without underscores: stribeck, power_law)."""
+    from .. import laws
+
+    out = {"friction": {}, "normal": {}}
+    for cls in (laws.Coulomb, laws.ParabolicSlip, laws.SlipHardening, laws.Frictionless, laws.Stribeck,
+                laws.DieterichRuina, laws.ArchardWear):
+        out["friction"][_snake(cls.__name__)] = cls
+    for cls in (laws.PowerLaw, laws.ExponentialLaw):
+        out["normal"][_snake(cls.__name__)] = cls
+    return out
+
+
+def _snake(name):
+    return "".join("_" + c.lower() if c.isupper() and i else c.lower() for i, c in enumerate(name))
+
+
+def _kind_of(cls):
+    if callable(getattr(cls, "slip_bound", None)):
+        return "friction"
+    if callable(getattr(cls, "traction", None)):
+        return "normal"
+    return None
+
+
+def _check_kind(cls, option, where):
+    """ValueError unless cls is a law of the kind the option asks for (--friction / --normal)."""
+    want = option.lstrip("-")
+    have = _kind_of(cls)
+    if have == want or want not in KINDS:
+        return
+    if have is None:
+        need = "slip_bound(p, q) and a stick stiffness c_T" if want == "friction" else "traction(g_N)"
+        raise ValueError(f"{where}: {cls.__name__} is not a {want} law (a {want} law has {need})")
+    raise ValueError(f"{where}: {cls.__name__} is a {have} law (it has "
+                     f"{'slip_bound' if have == 'friction' else 'traction'}): give it with --{have}, not {option}")
 _counter = itertools.count()
 
 
@@ -49,10 +92,51 @@ def _cause(err):
 
 
 def load_class(spec, option="--friction"):
-    """The class named by 'FILE.py:CLASS' (ValueError with one line naming file, line, cause)."""
-    if not isinstance(spec, str) or ":" not in spec:
+    """The law class named by spec (ValueError with one line naming file, line, cause):
+    'FILE.py:CLASS' (a law file), 'package.module:CLASS' or 'package.module.CLASS' (an
+    importable module), or the name of a shipped law ('stribeck', 'power_law')."""
+    if not isinstance(spec, str) or not spec.strip():
+        raise ValueError(f"{option} expects FILE.py:CLASS, a module path or a shipped law, got {spec!r}")
+    file, colon, name = spec.rpartition(":")
+    if colon and (file.endswith(".py") or "/" in file or "\\" in file or Path(file).expanduser().is_file()):
+        cls = _from_file(file, name, option)
+    elif colon:
+        cls = _from_module(file, name, option, spec)
+    elif spec.endswith(".py") or "/" in spec:
         raise ValueError(f"{option} expects FILE.py:CLASS, got {spec!r}")
-    file, _, name = spec.rpartition(":")
+    elif "." in spec:
+        mod, _, name = spec.rpartition(".")
+        cls = _from_module(mod, name, option, spec)
+    else:
+        kinds = shipped_laws()
+        key = _snake(spec) if not spec.islower() else spec.lower()
+        found = {k: v[key] for k, v in kinds.items() if key in v} or \
+            {k: c for k, v in kinds.items() for n, c in v.items() if n.replace("_", "") == spec.lower().replace("_", "")}
+        if not found:
+            names = "; ".join(f"{k}: {', '.join(v)}" for k, v in kinds.items())
+            raise ValueError(f"{option} {spec}: not a shipped law ({names}), a law file FILE.py:CLASS or a module "
+                             "path package.module:CLASS")
+        cls = next(iter(found.values()))
+    _check_kind(cls, option, f"{option} {spec}")
+    return cls
+
+
+def _from_module(module, name, option, spec):
+    import importlib
+
+    if not name.isidentifier():
+        raise ValueError(f"{option} expects FILE.py:CLASS or package.module:CLASS, got class name {name!r}")
+    try:
+        mod = importlib.import_module(module)
+    except Exception as err:                          # noqa: BLE001 (anything in the user's module)
+        raise ValueError(f"{option} {spec}: cannot import {module} ({_cause(err)})") from None
+    cls = getattr(mod, name, None)
+    if cls is None or not isinstance(cls, type):
+        raise ValueError(f"{option} {spec}: module {module} has no class {name}")
+    return cls
+
+
+def _from_file(file, name, option):
     path = Path(file).expanduser().resolve()
     if not path.is_file():
         raise ValueError(f"{option}: law file {file} not found")
@@ -97,9 +181,11 @@ def _convert(value, field):
         raise ValueError(f"law parameter {field.name} must be a number, got {value!r}") from None
 
 
-def make_law(cls, values=None, scene_params=None, option="--friction"):
-    """cls(**fields): the fields from ``values`` (text or numbers), else the scene parameter
-    of the same name, else the dataclass default. Validated by the law's own checks."""
+def make_law(cls, values=None, scene_params=None, option="--friction", notes=None):
+    """cls(**fields): the fields from ``values`` (text or numbers), else the law's own default,
+    else (a field without a default) the scene parameter of the same name in
+    ``scene_params`` (the scene's parameters of this law), noted in ``notes`` (a list: one
+    line). Validated by the law's own checks and the protocol, and called once (probe)."""
     values = dict(values or {})
     path = Path(getattr(cls, "_contactfem_file", "")).resolve() if getattr(cls, "_contactfem_file", None) else None
     if not dataclasses.is_dataclass(cls):
@@ -109,41 +195,50 @@ def make_law(cls, values=None, scene_params=None, option="--friction"):
     unknown = sorted(set(values) - set(fields))
     if unknown:
         raise ValueError(f"unknown law parameter law.{unknown[0]} for {cls.__name__}: known are {', '.join(fields) or '(none)'}")
-    kwargs = {}
+    kwargs, from_scene = {}, []
     for name, f in fields.items():
         if name in values:
             kwargs[name] = _convert(values[name], f)
+        elif f.default is not dataclasses.MISSING or f.default_factory is not dataclasses.MISSING:
+            continue                                  # the law's own default
         elif scene_params and name in scene_params:
             kwargs[name] = scene_params[name]
-        elif f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
+            from_scene.append(name)
+        else:
+            known = f" (the scene's parameters of this law: {', '.join(scene_params)})" if scene_params else ""
             raise ValueError(f"law parameter {name} of {cls.__name__} has no default and the scene has no parameter "
-                             f"{name}: give --set law.{name}=VALUE")
+                             f"{name} for it{known}: give --set law.{name}=VALUE")
     try:
         law = cls(**kwargs)
     except ValueError as err:
-        raise ValueError(f"{cls.__name__}: {err}") from None
+        raise ValueError(f"{cls.__name__}: {' '.join(str(err).split())}") from None
     except Exception as err:                          # noqa: BLE001
         where = _where(path, err) if path else cls.__name__
         raise ValueError(f"{where}: {_cause(err)}") from None
     probe(law, path, option)
+    if from_scene and notes is not None:
+        shown = ", ".join(f"{k} = {kwargs[k]:g}" if isinstance(kwargs[k], float) else f"{k} = {kwargs[k]}"
+                          for k in from_scene)
+        notes.append(f"{option.lstrip('-')} law {cls.__name__}: {shown} from the scene's parameters (fields without "
+                     "a default; --set law.NAME=VALUE sets them)")
     return law
 
 
 def probe(law, path=None, option="--friction"):
-    """Call the law once with a few values per node, so that a law failing on arrays or
-    returning the wrong number of values is reported now, naming the file and line."""
+    """Call the law once with a few values per node (p = 0.5, 1, 2; g_N = -0.005 ... -0.02)
+    through the guarded adapter, so that a law failing on arrays, returning the wrong number
+    of values or a value no law may return (NaN, Y < 0, t_N > 0), or breaking the protocol
+    (no c_T, c_T <= 0, ...) is reported now, naming the file and line. (Its values over the
+    range of the scene are checked by the pre-flight, and during the run.)"""
     p = np.array([0.5, 1.0, 2.0])
     try:
-        if option == "--normal":
-            if not hasattr(law, "traction"):
-                raise LawError(f"{type(law).__name__} has no method traction(g_N): a normal law needs one")
-            out = law.traction(-0.01 * p)
-            if not (isinstance(out, (tuple, list)) and len(out) == 2):
-                raise LawError(f"{type(law).__name__}.traction(g_N) must return the two values (t_N, dt_N/dg_N)")
-        else:
-            L = FrictionLaw(law)
-            z = L.evolve(L.initial_state(3), p, 0.1 * p, 1.0)[0]
-            L.slip_bound(p, 0.1 * p, 0.1 * p, z)
+        with np.errstate(all="ignore"):
+            if option == "--normal":
+                NormalLawView(law).traction(-0.01 * p)
+            else:
+                L = FrictionLaw(law)
+                z = L.evolve(L.initial_state(3), p, 0.1 * p, 1.0)[0]
+                L.slip_bound(p, 0.1 * p, 0.1 * p, z)
     except Exception as err:                          # noqa: BLE001
         where = _where(path, err) if path else type(law).__name__
         cause = str(err) if isinstance(err, LawError) else _cause(err)
@@ -152,7 +247,7 @@ def probe(law, path=None, option="--friction"):
             ctx = err.__context__
             if ctx is not None:
                 where = _where(path, ctx)
-        raise ValueError(f"{where}: {cause}") from None
+        raise ValueError(f"{where}: {' '.join(cause.split())}") from None
 
 
 def split_sets(sets):
@@ -167,10 +262,12 @@ def split_sets(sets):
     return scene, laws
 
 
-def laws_from_options(friction=None, normal=None, law_sets=None, scene_params=None):
-    """The friction and normal law objects named by --friction / --normal FILE:CLASS, with
-    their fields from law_sets (split_sets' second value). Returns {kind: law} for the
-    laws given."""
+def laws_from_options(friction=None, normal=None, law_sets=None, scene_params=None, notes=None):
+    """The friction and normal law objects named by --friction / --normal (load_class), with
+    their fields from law_sets (split_sets' second value). ``scene_params``: the scene's
+    parameters a field without a default may take, {kind: {name: value}} (or one dict for
+    both kinds); ``notes``: a list that gets one line per law that took any. Returns
+    {kind: law} for the laws given."""
     law_sets = law_sets or {"law": {}, "friction": {}, "normal": {}}
     specs = {"friction": friction, "normal": normal}
     classes = {k: load_class(s, f"--{k}") for k, s in specs.items() if s}
@@ -179,12 +276,17 @@ def laws_from_options(friction=None, normal=None, law_sets=None, scene_params=No
     values = {k: dict(law_sets.get(k, {})) for k in KINDS}
     for k in KINDS:
         if values[k] and k not in classes:
-            raise ValueError(f"--set {k}.{next(iter(values[k]))} needs --{k} FILE:CLASS")
+            raise ValueError(f"--set {k}.{next(iter(values[k]))} needs --{k} (a law file FILE.py:CLASS, a module "
+                             "path or a shipped law)")
     for name, value in law_sets.get("law", {}).items():
         owners = [k for k in classes if name in fields[k]]
         if not classes:
-            raise ValueError(f"--set law.{name} needs --friction FILE:CLASS or --normal FILE:CLASS")
+            raise ValueError(f"--set law.{name} needs --friction or --normal (a law file FILE.py:CLASS, a module "
+                             "path or a shipped law)")
         if len(owners) > 1:
             raise ValueError(f"--set law.{name}: both laws have a parameter {name}: write friction.{name} or normal.{name}")
         values[owners[0] if owners else next(iter(classes))][name] = value
-    return {k: make_law(c, values[k], scene_params, f"--{k}") for k, c in classes.items()}
+    scene_params = scene_params or {}
+    per_kind = set(scene_params) <= set(KINDS) and all(isinstance(v, dict) for v in scene_params.values())
+    return {k: make_law(c, values[k], scene_params.get(k, {}) if per_kind else scene_params, f"--{k}", notes)
+            for k, c in classes.items()}

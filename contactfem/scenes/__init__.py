@@ -44,8 +44,21 @@ def get_scene(name):
     return scenes[name]
 
 
+def check_laws(scene, laws, overrides=None):
+    """scene.check_laws (law objects or classes of kinds the scene has; no parameter set that
+    builds a law they replace), the message naming the scenes a law does apply to."""
+    try:
+        scene.check_laws(laws, overrides)
+    except ValueError as err:
+        kind = next((k for k in laws if k not in scene.laws), None)
+        if kind is None:
+            raise
+        others = [n for n, s in all_scenes().items() if kind in s.laws]
+        raise ValueError(f"{err}; scenes with a {kind} law: {', '.join(others)}") from None
+
+
 def run_scene(name, preset="fast", overrides=None, progress=None, friction=None, normal=None,
-              linear_algebra=None, instrument=None):
+              linear_algebra=None, instrument=None, check=True):
     """Run a scene and return its JSON-able results with the parameters used, the run's own wall
     time, Newton iteration count and the linear algebra of its Systems (``linear_algebra``:
     dense|banded|sparse, joined by + if they differ; ``ordering``; ``unknowns``, the largest
@@ -56,24 +69,40 @@ def run_scene(name, preset="fast", overrides=None, progress=None, friction=None,
     ``progress(t0, t_end, label)``: a progress-callback factory for the scene's time loops
     (e.g. ``contactfem.io.progress_bar``); None shows nothing.
     ``friction`` / ``normal``: law objects replacing the laws the scene's parameters build
-    (recorded as ``friction_law`` / ``normal_law``: class, file, fields).
+    (recorded as ``friction_law`` / ``normal_law``: class, file, fields; the parameters that
+    build the replaced law are refused in ``overrides`` and left out of ``parameters``, and
+    ``variant`` names the law). ``check``: check the law objects first over the range of
+    pressures, slips and gaps the scene meets (Scene.preflight): a LawError (ValueError) for
+    a value no law may return, a warning for a derivative that disagrees with finite
+    differences. During the run every value a law object returns is checked too
+    (contactfem.laws.protocol): a LawValueError ends the run.
     ``instrument``: a solver.instrument.Timings handed to every System (the bench's timings)."""
-    from ..laws.protocol import describe
+    import warnings
+
+    from ..laws.protocol import as_normal_law, describe
     from ..solver.assembly import KINDS
 
     scene = get_scene(name)
+    laws = {k: v for k, v in (("friction", friction), ("normal", normal)) if v is not None}
+    check_laws(scene, laws, overrides)
     params = scene.resolve(preset, overrides)
     if linear_algebra is not None and linear_algebra not in KINDS:
         raise ValueError(f"parameter linear_algebra = {linear_algebra!r} is not allowed: one of {'|'.join(KINDS)}")
+    if check:
+        for note in scene.preflight(params, laws):
+            warnings.warn(note, UserWarning, stacklevel=2)
+    if normal is not None:                          # every call into it checked (contactfem.laws.protocol)
+        normal = as_normal_law(normal)
     results = scene.run(params, normal=normal, friction=friction, progress=progress,
                         linear_algebra=linear_algebra or "auto", instrument=instrument)
-    for kind, law in (("friction", friction), ("normal", normal)):
-        if law is not None:
-            results[f"{kind}_law"] = describe(law)
+    for kind, law in laws.items():
+        results[f"{kind}_law"] = describe(law)
+    if "friction" in laws and scene.law_choice is not None and "variant" in results:
+        results["variant"] = scene.variant_of(params, friction)
     results["scene"] = name
     results["preset"] = preset
-    results["parameters"] = params
+    results["parameters"] = {k: v for k, v in params.items() if scene.law_param_kind(k, v) not in laws}
     return jsonable(results)
 
 
-__all__ = ["Param", "Scene", "Stage", "all_scenes", "get_scene", "run_scene", "jsonable", "simulate"]
+__all__ = ["Param", "Scene", "Stage", "all_scenes", "get_scene", "run_scene", "check_laws", "jsonable", "simulate"]

@@ -148,6 +148,11 @@ class Scene:
     size: Callable[[dict], dict] | None = None    # {"elements", "unknowns", "steps"} from the parameters
     outlines: bool = False                        # records body outlines (run --gif can animate them)
     notes: str = ""                               # what `show` says after the parameters (data read/fitted)
+    # The interface laws (a law object given to run_scene, or --friction / --normal, replaces the scene's own):
+    laws: tuple = ()                              # the kinds of law the scene's contact has: "normal", "friction"
+    law_params: dict = field(default_factory=dict)   # kind -> the parameters that build the scene's law of that kind
+    law_choice: tuple | None = None               # (parameter, values): those values of it choose the friction law
+    law_range: Callable[[dict], dict] | None = None  # the range a law meets (LAW_RANGE_KEYS), for the pre-flight
 
     def run(self, params, normal=None, friction=None, progress=None, linear_algebra="auto", instrument=None):
         """Build, simulate and measure (module function ``run``)."""
@@ -183,6 +188,66 @@ class Scene:
             self.check(values)
         return values
 
+    def law_param_kind(self, name, value=None):
+        """The kind of law ("friction", "normal") the parameter `name` (= value) builds, or None."""
+        for kind, names in self.law_params.items():
+            if name in names:
+                return kind
+        if self.law_choice is not None and name == self.law_choice[0] and \
+                (value is None or str(value) in map(str, self.law_choice[1])):
+            return "friction"
+        return None
+
+    def check_laws(self, laws, overrides=None):
+        """Before anything runs: ValueError (one line) if a law object (or class) is given for a
+        kind the scene's contact does not have, or a parameter is set that builds a law it
+        replaces (the hint names the law's own field)."""
+        import dataclasses
+
+        for kind, law in laws.items():
+            if kind not in self.laws:
+                what = "is frictionless" if kind == "friction" else "has no normal law"
+                raise ValueError(f"scene {self.name} has no {kind} law (its contact {what}): a {kind} law does "
+                                 "not apply to it")
+        for k, v in (overrides or {}).items():
+            kind = self.law_param_kind(k, v)
+            if kind is None or kind not in laws:
+                continue
+            law = laws[kind]
+            cls = law if isinstance(law, type) else type(law)
+            name = cls.__name__
+            if self.law_choice is not None and k == self.law_choice[0]:
+                raise ValueError(f"parameter {k} = {v} chooses the scene's {kind} law, which the {kind} law {name} "
+                                 f"replaces: leave {k} out")
+            fields = [f.name for f in dataclasses.fields(cls)] if dataclasses.is_dataclass(cls) else []
+            fix = (f"set {name}'s own field instead: --set law.{k}={v} (or {name}({k}={v}))" if k in fields else
+                   f"{name} has no field {k} (its fields: {', '.join(fields) or 'none'})")
+            raise ValueError(f"parameter {k} builds the scene's {kind} law, which the {kind} law {name} replaces: "
+                             + fix)
+
+    def variant_of(self, params, friction=None):
+        """The variant a run reports: the law_choice parameter's value; with a friction law
+        object, that law's class name (after the parameter's value where that value also
+        changes something else, such as the ring's material)."""
+        if self.law_choice is None:
+            return None
+        value = params[self.law_choice[0]]
+        if friction is None:
+            return value
+        name = type(friction).__name__
+        return name if str(value) in map(str, self.law_choice[1]) else f"{value} with {name}"
+
+    def preflight(self, params, laws):
+        """Check law objects over the range the scene meets (``law_range``) before solving:
+        returns warning sentences (a derivative that disagrees with finite differences);
+        raises LawError (one line) for a value no law may return (NaN, Y < 0, t_N > 0), a
+        law that breaks the protocol, or a block its friction cannot hold."""
+        from ..laws.check import preflight
+
+        if not laws or self.law_range is None:
+            return []
+        return preflight(laws.get("friction"), laws.get("normal"), **self.law_range(params))
+
     def estimate(self, params):
         """Size of the run from the resolved parameters: elements, unknowns, time (or load)
         steps, and the memory it needs in bytes (a model calibrated on the continuum scenes:
@@ -194,6 +259,23 @@ class Scene:
         est["memory_bytes"] = int(MEMORY_BASE + MEMORY_PER_UNKNOWN * n * math.log2(max(n, 2))
                                   + MEMORY_PER_STEP * est.get("steps", 0))
         return est
+
+
+# What a scene's law_range(params) returns, all maxima of the run (generous bounds from the
+# loads and penalties, not the values of one run): p the pressure |t_N| (in the law's unit:
+# per length, per area or per node, as the scene's weights), q the accumulated slip, v the slip
+# rate, dt the smallest planned time step, g the deepest penetration worth probing a normal
+# law at; and, for a static body held by friction alone, hold = dict(T=tangential load,
+# N=normal load, L=contact length (sum of the weights), w_min=smallest weight).
+LAW_RANGE_KEYS = ("p", "q", "v", "dt", "g", "hold")
+
+
+def penalty_pressure(energy, c_N, m=1.0, weight=1.0):
+    """The pressure c_N a^m of the penalty law (eq 4) at the penetration a where one node of
+    weight `weight` stores all of `energy`: w c_N a^(m+1) / (m+1) = energy. A bound of the
+    pressures of a run whose energy is `energy` (a scene's law_range)."""
+    a = ((m + 1.0) * energy / (weight * c_N)) ** (1.0 / (m + 1.0))
+    return c_N * a ** m
 
 
 def _count(x):

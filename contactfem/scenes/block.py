@@ -61,7 +61,6 @@ import numpy as np
 
 from ..bodies.materials import MATERIALS
 from ..contact import RigidLine, tributary_lengths
-from ..contact.augmented import make_interface
 from ..contact.tangents import TANGENTS
 from ..laws.friction import Coulomb, ParabolicSlip
 from ..laws.normal import PowerLaw
@@ -168,6 +167,7 @@ def friction_capacity(params):
 def check(params):
     """Before any solve: the ends kept free must leave contact nodes, and the static problem
     must have a solution (the block is held by friction alone)."""
+    enforcement.check(params)
     k, nx = params["free_end_nodes"], params["nx"]
     if not 2 * k < nx:
         raise ValueError(f"parameter free_end_nodes = {k} is out of range: allowed [1, {(nx - 1) // 2}] for nx = {nx}")
@@ -223,10 +223,11 @@ def build(params, *, normal=None, friction=None, system_options=None):
         raise ValueError(f"parameter free_end_nodes = {k} is out of range: allowed [1, {(len(bottom) - 2) // 2}] for nx = {params['nx']}")
     weights = tributary_lengths(body.X[bottom])[k:-k]        # tractions per unit length of the bottom
     slaves = bottom[k:-k]                                   # the first and last element never touch
-    contact = make_interface(params.get("enforcement", "penalty"), body, slaves, RigidLine((0.0, 0.0), (0.0, 1.0)),
-                             normal=normal or PowerLaw(c_N=params["c_N"] * per_length(params), m=params["m"]),
-                             friction=friction or friction_law(params), weights=weights, offset=-params["g_N0"],
-                             name="foundation", tangent=params["tangent"])
+    contact = enforcement.interface(params, body, slaves, RigidLine((0.0, 0.0), (0.0, 1.0)),
+                                    normal=normal or PowerLaw(c_N=params["c_N"] * per_length(params), m=params["m"]),
+                                    friction=friction or friction_law(params), weights=weights,
+                                    offset=-params["g_N0"], name="foundation", tangent=params["tangent"],
+                                    material=params["material"])
     p_y, p_x = params["p_y"], params["p_x"]
     loads = [Pressure(body, "top", lambda t: p_y * t),                # dead loads, ramped over the
              Traction(body, params["p_x_face"], lambda t: (p_x * t, 0.0))]   # pseudo-time t in [0, 1]
@@ -324,6 +325,18 @@ def measure(model, params, records):
     }
 
 
+def law_range(params):
+    """The range the foundation's laws meet (Scene.law_range): pressures (per unit length)
+    up to the whole top load on the narrowest node, p_y width / (width / nx); slips up to
+    the block's height; the pseudo-time step 1 / n_steps; and, with dead loads (the linear
+    material), the hold: the pull |p_x| height against the friction under the load p_y width."""
+    w = params["width"] / params["nx"]
+    N = params["p_y"] * params["width"]
+    dt = 1.0 / params["n_steps"]
+    hold = (dict(T=abs(params["p_x"]) * params["height"], N=N, L=contact_length(params), w_min=w)
+            if params["material"] == "linear" else None)
+    return dict(p=N / w, q=params["height"], v=params["height"] / dt, dt=dt, g=params["height"], hold=hold)
+
 SCENE = Scene(
     name="block",
     title="Elastic block pressed on a rough rigid foundation and pulled sideways (Sec. 5.1, Figs 6-8, Table 1)",
@@ -347,4 +360,8 @@ SCENE = Scene(
              "n_stick", "n_slip", "contact"),
     check=check,
     size=size,
+    laws=("normal", "friction"),
+    law_params={"friction": ("c_T", "alpha", "beta", "n", "mu"), "normal": ("c_N", "m")},
+    law_choice=("law", LAWS),
+    law_range=law_range,
 )

@@ -145,6 +145,19 @@ def build(params, *, normal=None, friction=None, system_options=None):
                 length=length, systems=[], system_options=system_options or {})   # cork_stages.py adds the Systems
 
 
+def law_range(P):
+    """The range the cork's laws meet (Scene.law_range): pressures up to twice the penalty's
+    at the full interference R_cork - R_neck; slips up to twice the cork's length; slip
+    rates up to twice the speed the gas's largest pressure could give the cork over the
+    neck (all its work W = p_0 pi R_neck^2 (L_neck + r_mouth) as kinetic energy); the
+    fine time step."""
+    a = P["R_cork"] - P["R_neck"]
+    length = P["L_neck"] + P["r_mouth"] + P["L_head"]
+    W = P["p_step"] * P["n_ramp"] * np.pi * P["R_neck"] ** 2 * (P["L_neck"] + P["r_mouth"])
+    M = P["rho"] * np.pi * P["R_cork"] ** 2 * length
+    return dict(p=2.0 * P["c_N"] * a ** P["m"], q=2.0 * length, v=2.0 * float(np.sqrt(2.0 * W / M)),
+                dt=min(P["dt"], P["dt_fine"]), g=2.0 * a)
+
 SCENE = Scene(
     name="cork",
     title="Champagne cork: press fit, then gas-driven exit (Sec. 5.5, Figs 14-17)",
@@ -165,4 +178,7 @@ SCENE = Scene(
     reports=("exit_velocity_m_s", "exit_time_ms", "breakaway_pressure_MPa", "breakaway_margin_MPa",
              "press_fit_calibrated", "press_fit_normal_force_N",
              "max_penetration_ratio", "newton_iterations_total"),
+    laws=("normal", "friction"),
+    law_params={"friction": ("c_T", "mu", "h"), "normal": ("c_N", "m")},
+    law_range=law_range,
 )

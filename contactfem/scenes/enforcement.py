@@ -1,18 +1,34 @@
-"""The enforcement parameters a scene shares: penalty (the paper) or augmented Lagrangian
-(contact/augmented.py, solver/uzawa.py), the Uzawa tolerance, and the results every scene
-reports about it (uzawa_iterations, newton_per_outer, gap_violation)."""
+"""The contact parameters a scene shares: how the contact is discretised (node-to-segment,
+the paper's, or mortar: contact/mortar_contact.py) and how its conditions are enforced
+(penalty, the paper's; augmented Lagrangian: contact/augmented.py, solver/uzawa.py; Lagrange
+multipliers solved by a semi-smooth Newton method: contact/lagrange.py), the Uzawa
+tolerance, the contact they build (``interface``) and the results every scene reports about
+them (uzawa_iterations, newton_per_outer, gap_violation)."""
 
 import numpy as np
 
-from ..contact.augmented import ENFORCEMENTS
+from ..contact import NodeToSegment
+from ..contact.augmented import AugmentedNodeToSegment
 from ..solver.uzawa import Uzawa
 from .base import Param
 
+ENFORCEMENTS = ("penalty", "augmented", "lagrange")
+DISCRETIZATIONS = ("node_to_segment", "mortar")
+
 ENFORCEMENT_PARAMS = (
+    Param("contact_discretization", "node_to_segment", choices=DISCRETIZATIONS,
+          doc="node_to_segment: the paper's (each slave node against a master segment, eqs 17-50); mortar: "
+              "segment-to-segment mortar contact (the tractions a field on the slave surface, integrated "
+              "against both meshes: passes the contact patch test), in the reference configuration for "
+              "material = linear, in the current one otherwise"),
     Param("enforcement", "penalty", choices=ENFORCEMENTS,
           doc="penalty: the paper's penalty method (the result depends on c_N); augmented: Lagrange "
               "multipliers updated in an outer Uzawa loop until the contact conditions hold to uzawa_tol "
-              "(c_N, c_T become numerical parameters; a power law with m != 1 stays a constitutive law)"),
+              "(c_N, c_T become numerical parameters; a power law with m != 1 stays a constitutive law; "
+              "node_to_segment only); lagrange: the tractions are unknowns beside the displacements and the "
+              "contact conditions equations, solved together by a semi-smooth Newton method (no penalty, no "
+              "outer loop; c_N, c_T only steer the iterates; the penalty law m = 1 with Coulomb or the eq 10 "
+              "laws)"),
     Param("uzawa_tol", 1e-9, "", 0.0, 1e-2, low_open=True,
           doc="augmented: stop when the largest multiplier change / c (the penetration at an active node, "
               "the stick creep at a sticking one), divided by the scene's length, is <= uzawa_tol",
@@ -22,9 +38,51 @@ ENFORCEMENT_PARAMS = (
 )
 
 
+def check(params):
+    """Combinations that do not exist, before any run: one ValueError naming the parameters."""
+    if params.get("contact_discretization") == "mortar" and params.get("enforcement") == "augmented":
+        raise ValueError("parameter enforcement = augmented is offered with contact_discretization = node_to_segment "
+                         "only: use penalty or lagrange with mortar")
+
+
+def outward(body, nodes):
+    """The chain of nodes ordered so that n = e3 x t points out of the body (what mortar
+    contact needs): reversed if its normals point, on the whole, towards the body's centroid."""
+    X = body.X[nodes]
+    t = np.diff(X, axis=0)
+    n = np.stack([-t[:, 1], t[:, 0]], axis=1)
+    out = np.einsum("ij,ij->", n, 0.5 * (X[1:] + X[:-1]) - body.X.mean(axis=0))
+    return np.asarray(nodes) if out > 0 else np.asarray(nodes)[::-1]
+
+
+def interface(params, slave, nodes, master, *, normal, friction=None, weights=1.0, offset=0.0, name="contact",
+              material="linear", tangent="consistent", integration="standard"):
+    """The contact the parameters ask for (contact_discretization x enforcement): NodeToSegment,
+    AugmentedNodeToSegment or LagrangeNodeToSegment with these weights, or MortarContact or
+    LagrangeMortar on the chain ``nodes`` (put in its outward order; its own weights; small
+    kinematics for a linear material, finite otherwise)."""
+    enforcement = params.get("enforcement", "penalty")
+    if params.get("contact_discretization", "node_to_segment") == "node_to_segment":
+        from ..contact.lagrange import LagrangeNodeToSegment
+
+        cls = {"penalty": NodeToSegment, "augmented": AugmentedNodeToSegment, "lagrange": LagrangeNodeToSegment}
+        return cls[enforcement](slave, nodes, master, normal=normal, friction=friction, weights=weights,
+                                offset=offset, name=name, tangent=tangent, integration=integration)
+    from ..contact.lagrange import LagrangeMortar            # (scipy: loaded when a scene builds, not by show)
+    from ..contact.mortar_contact import MortarContact
+
+    check(dict(params, enforcement=enforcement, contact_discretization="mortar"))
+    if tangent != "consistent" or integration != "standard":
+        raise ValueError(f"contact_discretization = mortar takes tangent = consistent and contact_integration = "
+                         f"standard (got {tangent}, {integration})")
+    cls = LagrangeMortar if enforcement == "lagrange" else MortarContact
+    return cls(slave, outward(slave, nodes), master, normal=normal, friction=friction, offset=offset, name=name,
+               kinematics="small" if material == "linear" else "finite")
+
+
 def wrap(params, stepper, contacts, length):
-    """The stepper itself (penalty) or wrapped in the Uzawa loop (augmented)."""
-    if params["enforcement"] == "penalty":
+    """The stepper itself (penalty, lagrange) or wrapped in the Uzawa loop (augmented)."""
+    if params["enforcement"] != "augmented":
         return stepper
     return Uzawa(stepper, contacts, length, tol=params["uzawa_tol"], max_updates=params["uzawa_max_updates"])
 
@@ -32,14 +90,14 @@ def wrap(params, stepper, contacts, length):
 def report(params, records, penetration, length, length_name):
     """What a scene reports about its enforcement, from its records: uzawa_iterations (outer
     iterations summed over the steps; 0 for penalty), multiplier_updates, newton_per_outer
-    (linear solves of each outer iteration, all steps in order; for penalty the solves of each
-    step) and gap_violation = largest penetration / length, the length the scene states
+    (linear solves of each outer iteration, all steps in order; for penalty and lagrange the
+    solves of each step) and gap_violation = largest penetration / length, the length the scene states
     (``length_name``), with its value after each outer iteration (gap_violation_per_outer).
     For a penalty step the traction error is about c_N times the gap; with the augmented
     method it is about c_N times the last gap violation, so tractions to a relative accuracy eps
     need uzawa_tol ~ eps p / (c_N length) (p a traction scale)."""
     results = [rec.result for rec in records[1:]]
-    if params["enforcement"] == "penalty":
+    if params["enforcement"] != "augmented":
         per_outer, outer, updates, gaps = [int(r.iterations) for r in results], 0, 0, []
     else:
         gaps = [float(g) for r in results for g in r.gap_violations]

@@ -36,7 +36,7 @@ from ..contact import NodeToSegment, RigidPolyline
 from ..laws import ParabolicSlip, PowerLaw
 from ..solver import Dirichlet, History, Steps, System
 from . import time_integration
-from .base import Param, Scene, Stage
+from .base import Param, Scene, Stage, penalty_pressure
 from .rings import RING_PARAMS, ring_history, ring_size, snapshot_indices
 
 VARIANTS = ("frictionless", "frictional")
@@ -120,6 +120,15 @@ def measure(m, params, records):
     )
 
 
+def law_range(params):
+    """The range the half ring's laws meet (Scene.law_range): pressures up to the one at which
+    a single node's penalty spring would hold all the kinetic energy; slips up to the
+    distance the ring can travel, slip rates up to twice its initial speed."""
+    M = params["rho"] * np.pi * params["R"] * params["thickness"] * params["width"]
+    E = 0.5 * M * params["v0"] ** 2
+    return dict(p=penalty_pressure(E, params["c_N"], params["m"]), q=params["v0"] * params["n_steps"] * params["dt"],
+                v=2.0 * params["v0"], dt=params["dt"], g=params["thickness"])
+
 SCENE = Scene(
     name="funnel",
     title="Fall of an elastic ring into a rigid funnel, half ring by symmetry (Sec. 5.4, Figs 12-13)",
@@ -155,4 +164,8 @@ SCENE = Scene(
     reports=("stuck", "y_c_min", "v_c_final", "max_deformation", "newton_iterations_total"),
     size=lambda p: dict(ring_size(p, half=True), steps=p["n_steps"]),
     outlines=True,
+    laws=("normal", "friction"),
+    law_params={"friction": ("c_T", "n", "alpha", "beta"), "normal": ("c_N", "m")},
+    law_choice=("variant", VARIANTS),
+    law_range=law_range,
 )

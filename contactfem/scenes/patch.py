@@ -43,13 +43,28 @@ two-pass error falls roughly like 1 / c_N (0.3 % at c_N = 1e7) while one pass st
 (its error comes from the load transfer, not from the penalty). Within the two-pass
 method the load splits unevenly between the passes (each pass's own t_N is far from
 p): only the sum is meaningful.
+
+Mortar contact (``contact_discretization = mortar``): the tractions are a field on the
+upper block's bottom, integrated against both meshes, so a uniform pressure gives the
+consistent nodal loads on both sides (contact/mortar.py); with the blocks' small-strain
+bulk it works in the reference configuration (small kinematics), where the overhang's
+dead load (on the reference intervals beyond [0, W]) and the mortar's load on [0, W]
+add up to the consistent load of a uniform p over the whole top of the lower block. The
+patch test then holds to round-off, with the penalty (whose own error is the uniform
+penetration p / c_N, not a traction error) and with ``enforcement = lagrange`` (no
+penetration either).
+
+``mu`` > 0: Coulomb friction (eq 11) with c_T = c_N; the upper block is then held
+sideways by the friction alone (its pin goes): the homogeneous solution slides nothing,
+carries no shear and is again the exact one.
 """
 
 import numpy as np
 
-from ..contact import BodySurface, NodeToSegment, tributary_lengths
-from ..laws import PowerLaw
+from ..contact import BodySurface, tributary_lengths
+from ..laws import Coulomb, PowerLaw
 from ..solver import Dirichlet, History, Static, Steps, System
+from . import enforcement
 from .base import Param, Scene, Stage
 
 
@@ -75,19 +90,24 @@ def build(params, *, normal=None, friction=None, system_options=None):
     e = W / params["nx_lower"]
     xs_lower = -0.5 * e + e * np.arange(params["nx_lower"] + 2)      # [-e/2, W + e/2], shifted
     xs_upper = np.linspace(0.0, W, params["nx_upper"] + 1)
-    if np.min(np.abs(xs_upper[:, None] - xs_lower[None, :])) < 1e-6 * W:
+    if params["contact_discretization"] == "node_to_segment" and \
+            np.min(np.abs(xs_upper[:, None] - xs_lower[None, :])) < 1e-6 * W:
         raise ValueError("parameters nx_lower, nx_upper put a slave node exactly above a master node "
                          "(node-to-segment switching is non-smooth there): choose nx_upper odd")
     lower = block(xs_lower, 0.0, H, params["ny"], "lower", E, nu)
     upper = block(xs_upper, H, 2 * H, params["ny"], "upper", params["E_upper"], nu)
     law = normal or PowerLaw(params["c_N"], 1.0)
-    half = 0.5 if params["passes"] == 2 else 1.0
+    if friction is None and params["mu"] > 0:
+        friction = Coulomb(c_T=params["c_N"], mu=params["mu"])
+    passes = params["passes"] if params["contact_discretization"] == "node_to_segment" else 1
+    half = 0.5 if passes == 2 else 1.0
     top_lower = lower.boundary_nodes("top")           # outward normal +y (towards the upper block)
+    top_lower = top_lower[np.argsort(lower.X[top_lower, 0])]        # left to right: n = e3 x t = +y
     bottom_upper = upper.boundary_nodes("bottom")     # outward normal -y (towards the lower block)
     w_upper = tributary_lengths(upper.X[bottom_upper])
-    contacts = [NodeToSegment(upper, bottom_upper, BodySurface(lower, top_lower), normal=law, friction=friction,
-                              weights=half * w_upper, name="upper_on_lower")]
-    if params["passes"] == 2:
+    contacts = [enforcement.interface(params, upper, bottom_upper, BodySurface(lower, top_lower), normal=law,
+                                      friction=friction, weights=half * w_upper, name="upper_on_lower")]
+    if passes == 2:
         # the lower block's top nodes over [0, W]; each carries its tributary part of [0, W]
         inner = top_lower[(lower.X[top_lower, 0] > 0.0) & (lower.X[top_lower, 0] < W)]
         xi = lower.X[inner]
@@ -95,8 +115,8 @@ def build(params, *, normal=None, friction=None, system_options=None):
         w = tributary_lengths(chain)
         w[1] += w[0]
         w[-2] += w[-1]
-        contacts.append(NodeToSegment(lower, inner, BodySurface(upper, bottom_upper), normal=law, friction=friction,
-                                      weights=half * w[1:-1], name="lower_on_upper"))
+        contacts.append(enforcement.interface(params, lower, inner, BodySurface(upper, bottom_upper), normal=law,
+                                              friction=friction, weights=half * w[1:-1], name="lower_on_upper"))
 
     def node(body, x, y):
         return int(np.argmin(np.hypot(body.X[:, 0] - x, body.X[:, 1] - y)))
@@ -106,8 +126,9 @@ def build(params, *, normal=None, friction=None, system_options=None):
     # the homogeneous solution slides the blocks against each other by eps_xx e / 2, which a
     # frictionless interface allows without any reaction
     fixed = [Dirichlet(lower, lower.xdofs[bottom, 1], 0.0),
-             Dirichlet(lower, lower.xdofs[node(lower, -0.5 * e, 0.0), 0], 0.0),
-             Dirichlet(upper, upper.xdofs[node(upper, 0.0, 2 * H), 0], 0.0)]
+             Dirichlet(lower, lower.xdofs[node(lower, -0.5 * e, 0.0), 0], 0.0)]
+    if friction is None:                              # with friction the interface holds the upper block
+        fixed.append(Dirichlet(upper, upper.xdofs[node(upper, 0.0, 2 * H), 0], 0.0))
     top_sorted = top_lower[np.argsort(lower.X[top_lower, 0])]
     loads = [Pressure(upper, "top", params["p"]), OverhangPressure(lower, top_sorted, params["p"], 0.0, W)]
     system = System([lower, upper], contacts, loads, fixed, **(system_options or {}))
@@ -117,6 +138,7 @@ def build(params, *, normal=None, friction=None, system_options=None):
     u0 = np.zeros(system.ndof)
     u0[upper.dof_offset + upper.xdofs[:, 1]] = -2.0 * p / params["c_N"]
     stepper = Static(system, atol=1e-10 * p * params["W"], rtol=1e-12, maxit=30)
+    stepper = enforcement.wrap(params, stepper, contacts, length=H)     # gap_violation: penetration / H
     return dict(lower=lower, upper=upper, contacts=contacts, system=system, systems=[system], bottom_upper=bottom_upper,
                 stage=Stage(stepper, Steps(1.0, n_steps=1), u0, name="patch"))
 
@@ -128,6 +150,8 @@ def measure(m, params, records):
     u, states = records[-1].u, records[-1].contacts
 
     result = dict(newton_iterations_total=int(np.sum(hist.iterations)), passes=params["passes"])
+    result.update(enforcement.report(params, records, max(enforcement.penetration(st) for st in states), params["H"],
+                                     "the block height H"))
     for c, st in zip(m["contacts"], states):      # each pass's own traction law values
         rep = st.report()
         result[f"{c.name}_x"] = rep["X"][:, 0]
@@ -153,6 +177,10 @@ def measure(m, params, records):
     return result
 
 
+def law_range(params):
+    """Normal law only: probed down to a penetration of the blocks' height."""
+    return dict(g=params["H"])
+
 SCENE = Scene(
     name="patch",
     title="Contact patch test: stacked blocks, non-matching meshes, uniform pressure (exact: uniform)",
@@ -169,12 +197,20 @@ SCENE = Scene(
         Param("ny", 2, "", 1, 1000, doc="elements through each block"),
         Param("c_N", 1.0e6, "MPa/mm", 0.0, None, low_open=True,
               doc="penalty per unit length (eq 4, m = 1); chosen: 1000 E / H"),
-        Param("passes", 1, "", choices=(1, 2), doc="1: one-pass node-to-segment; 2: two-pass, halved weights"),
+        Param("passes", 1, "", choices=(1, 2), doc="1: one-pass node-to-segment; 2: two-pass, halved weights",
+              when=(("contact_discretization", ("node_to_segment",)),)),
+        Param("mu", 0.0, "", 0.0, None,
+              doc="Coulomb friction coefficient of the interface (eq 11, c_T = c_N); 0: frictionless"),
+        *enforcement.ENFORCEMENT_PARAMS,
     ),
+    check=enforcement.check,
     build=build,
     measure=measure,
     presets={"fast": {}, "paper": {"nx_lower": 8, "nx_upper": 13, "ny": 4}},
     size=lambda p: dict(elements=(p["nx_lower"] + 1 + p["nx_upper"]) * p["ny"],
                         unknowns=2 * (p["nx_lower"] + 3 + p["nx_upper"]) * (p["ny"] + 1), steps=1),
     reports=("pressure_deviation_max", "stress_deviation_max", "load_carried", "load_applied"),
+    laws=("normal",),
+    law_params={"normal": ("c_N",)},
+    law_range=law_range,
 )

@@ -55,7 +55,7 @@ from ..contact import NodeToSegment, RigidLine
 from ..laws import Coulomb, PowerLaw
 from ..solver import History, Steps, System
 from . import time_integration
-from .base import Param, Scene, Stage
+from .base import Param, Scene, Stage, penalty_pressure
 from .rings import ring_history, ring_size, snapshot_indices
 
 # Paper, Fig 9 (bracketed values are the rigid thin-ring solution)
@@ -212,6 +212,16 @@ def ring_gyration_radius2(ring):
     return float((mx @ r2 + J) / mx.sum())
 
 
+def law_range(params):
+    """The range the ring's laws meet (Scene.law_range): pressures up to the one at which a
+    single node's penalty spring would hold all the energy (kinetic, and gravity's over a
+    radius), at least ten times the weight; slips up to the distance the ring can travel,
+    slip rates up to twice its initial speed."""
+    M = params["rho"] * 2.0 * np.pi * params["R"] * params["thickness"] * params["width"]
+    E = 0.5 * M * params["v0"] ** 2 + M * params["g"] * params["R"]
+    return dict(p=max(penalty_pressure(E, params["c_N"], params["m"]), 10.0 * M * params["g"]),
+                q=params["v0"] * params["t_end"], v=2.0 * params["v0"], dt=params["dt"], g=params["thickness"])
+
 SCENE = Scene(
     name="rolling_ring",
     title="Steel ring sliding, then rolling, on a rigid plane (Sec. 5.2, Fig 9)",
@@ -259,4 +269,7 @@ SCENE = Scene(
              "x_end", "x_end_exact", "newton_iterations_total"),
     size=lambda p: dict(ring_size(p), steps=p["t_end"] / p["dt"]),
     outlines=True,
+    laws=("normal", "friction"),
+    law_params={"friction": ("c_T", "mu"), "normal": ("c_N", "m")},
+    law_range=law_range,
 )

@@ -36,7 +36,7 @@ from ..contact.tangents import TANGENTS
 from ..laws import ParabolicSlip, PowerLaw
 from ..solver import History, Steps, System
 from . import time_integration
-from .base import PENALTIES, PENALTY_DOC, Param, Scene, Stage
+from .base import PENALTIES, PENALTY_DOC, Param, Scene, Stage, penalty_pressure
 from .rings import RING_PARAMS, ring_history, ring_size, snapshot_indices
 
 VARIANTS = ("frictionless", "frictional", "viscoplastic")
@@ -151,6 +151,18 @@ def measure(model, params, records):
     return out
 
 
+def law_range(params):
+    """The range the ring's laws meet (Scene.law_range): pressures up to the one at which a
+    single node's penalty spring would hold all the kinetic energy (per node, or per the
+    node's length of the outer surface for penalty = per_length); slips up to the distance
+    the ring can travel, slip rates up to three times its speed (sliding plus spin)."""
+    R, h = params["R"], params["thickness"]
+    M = params["rho"] * 2.0 * np.pi * R * h * params["width"]
+    speed = float(np.hypot(params["vx0"], params["vy0"]))
+    w = 1.0 if params["penalty"] == "per_node" else 2.0 * np.pi * (R + h / 2) / params["n_el"]
+    return dict(p=penalty_pressure(0.5 * M * speed ** 2, params["c_N"], params["m"], w),
+                q=speed * params["n_steps"] * params["dt"], v=3.0 * speed, dt=params["dt"], g=h)
+
 SCENE = Scene(
     name="sloping_impact",
     title="Sloping impact of a ring on a rigid plane at 45 degrees (Sec. 5.3, Figs 10-11, Table 2)",
@@ -217,4 +229,8 @@ SCENE = Scene(
     check=check,
     size=lambda p: dict(ring_size(p), steps=p["n_steps"]),
     outlines=True,
+    laws=("normal", "friction"),
+    law_params={"friction": ("c_T", "n", "alpha", "beta"), "normal": ("c_N", "m")},
+    law_choice=("variant", ("frictionless", "frictional")),
+    law_range=law_range,
 )

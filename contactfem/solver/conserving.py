@@ -10,22 +10,31 @@ One step from (u_0, v_0) solves for u_1, with d = u_1 - u_0 and v_1 = 2 d / dt -
 
     M (v_1 - v_0) / dt + F_int + F_c - P(u_mid, t_mid) = 0,
 
-    F_int = R(u_mid) + [(W(u_1) - W(u_0) - R(u_mid) . d) / (d . d)] d     per body,
+    F_int = R(u_mid) + [(W(u_1) - W(u_0) - R(u_mid) . d) / (w . w)] w,   w = P d   per body,
     F_c   = the discrete gradient of the interface potential (contact/conserving.py),
 
 so that d . F_int = W(u_1) - W(u_0) and d . F_c = the change of the interface energy plus
-the frictional dissipation. With d = dt (v_0 + v_1) / 2 the kinetic energy changes by
+the frictional dissipation. P removes from the body's increment d its rigid translations
+(``body.rigid_modes``), P = I - A (A^T A)^-1 A^T: W does not change under a translation, so
+R(u_mid) has no resultant, and neither has the correction c w. Since the midpoint rule
+changes the momentum by dt times the resultant force, a body in free flight keeps its
+momentum exactly, and on a frictionless rigid plane its momentum along the plane. (The
+correction along the whole increment d, as Gonzalez's discrete gradient is usually written,
+has a resultant as soon as the body translates while it deforms: the centre of mass drifts.)
+Angular momentum: R(u_mid) has no moment at the mid configuration (W does not change under
+a rotation), the correction c w does, of the order of the energy mismatch the correction
+removes; the midpoint rule alone (c = 0, a linear body) keeps it exactly. Keeping c w off
+the rotation too would need the discrete gradient in the strain invariants (Simo & Tarnow
+1992), see Beam.rigid_modes. With d = dt (v_0 + v_1) / 2 the kinetic energy changes by
 -d . (F_int + F_c - P): the total energy kinetic + strain + interface changes by the work
 of the loads minus the dissipation, exactly (to the Newton tolerance) -- whatever the
 penalty c_N, the time step, and the phase within a step at which a node touches. For a
 linear body the correction term vanishes (R is linear: the midpoint rule is the
 trapezoidal rule of Newmark 1/2, 1/4) and only the contact force differs from it.
 
-Newton's tangent: 2 M / dt^2 + K(u_mid) / 2 + c I per body (c the bracket above) plus the
-exact contact tangent; the rank-one part d (dc/du_1)^T of the bodies' correction (dense)
-is left out, so Newton converges linearly at a rate of order |d| times the third
-derivative of W over M / dt^2 (a few iterations more on the nonlinear beam ring; none on
-a linear body).
+Newton's tangent is exact: 2 M / dt^2 + K(u_mid) / 2 plus the derivative of the correction
+c w per body (dense over the body's dofs, only where c != 0: a linear body has c = 0, W is
+quadratic), with the change of the rigid modes with u_mid, plus the exact contact tangent.
 """
 import numpy as np
 
@@ -42,6 +51,7 @@ class EnergyConsistent:
 
     def __init__(self, system, **newton_options):
         self.system, self.newton_options = system, newton_options
+        self._dA = {}                   # per body: the derivative of its rigid modes (constant)
         for c in system.contacts:
             if c.integration != "energy_consistent":
                 raise ValueError(f"contact {c.name!r}: energy-consistent time stepping needs contacts built with "
@@ -51,8 +61,28 @@ class EnergyConsistent:
                 raise ValueError(f"body {b.name!r}: energy-consistent integration needs hyperelastic bodies "
                                  "(use contact_integration=standard for the viscoplastic ring)")
 
+    def _modes(self, b, um):
+        """The body's rigid modes A at u_mid (n, k) and their derivative with respect to u_mid:
+        A is affine in u (a rotation mode e3 x x), so dA/du is one constant (k, n, n) array,
+        computed once per body from the modes at the unit vectors."""
+        A = b.rigid_modes(um)
+        key = id(b)
+        if key not in self._dA:
+            base = b.rigid_modes(np.zeros(b.ndof))
+            self._dA[key] = np.stack([b.rigid_modes(e) - base for e in np.eye(b.ndof)], axis=2)   # (n, k, n)
+        return A, self._dA[key]
+
     def _bodies(self, u0, u1):
-        """Discrete-gradient internal forces of every body, as (G, rows, cols, vals)."""
+        """Discrete-gradient internal forces of every body, as (G, rows, cols, vals), with their
+        exact tangent (dense over the body's dofs where the correction acts):
+
+            F = R(u_mid) + c w,  w = (I - Pi) d,  c = gap / (w . w),
+            dF/du_1 = K(u_mid) / 2 + w (dc/du_1)^T + c dw/du_1,
+            dw/du_1 = (I - Pi) - [(I - Pi) dA y + A (A^T A)^-1 dA^T w] / 2,
+
+        Pi = A (A^T A)^-1 A^T the projector on the rigid modes A(u_mid), y = (A^T A)^-1 A^T d
+        (the derivative of a projector), dc/du_1 = (dgap/du_1 - 2 c w^T dw/du_1) / (w . w),
+        dgap/du_1 = R(u_1) - R(u_mid) - K(u_mid) d / 2."""
         import scipy.sparse as sp     # (imported here: listing the scenes loads no scipy)
 
         s = self.system
@@ -61,17 +91,38 @@ class EnergyConsistent:
         um = 0.5 * (u0 + u1)
         for b in s.bodies:
             sl = slice(b.dof_offset, b.dof_offset + b.ndof)
+            dofs = np.arange(b.ndof) + b.dof_offset
             R, K = b.internal(um[sl])
             d = (u1 - u0)[sl]
             W0, W1 = b.strain_energy(u0[sl]), b.strain_energy(u1[sl])
+            A, dA = self._modes(b, um[sl])
+            AtA_inv = np.linalg.inv(A.T @ A)
+            y = AtA_inv @ (A.T @ d)
+            w = d - A @ y                                        # d without its rigid motion
             gap = W1 - W0 - R @ d
-            dd = d @ d
-            c = gap / dd if (dd > 0 and abs(gap) > 1e-13 * (abs(W0) + abs(W1))) else 0.0
-            G[sl] += R + c * d
+            ww = w @ w
+            # no correction for a quadratic energy (the midpoint rule is exact: gap = 0 up to the
+            # rounding of R = K u, a sum of large cancelling terms when the body moves rigidly), nor
+            # where the gap is at the rounding of W
+            use = not b.quadratic_energy and ww > 0 and abs(gap) > 1e-13 * (abs(W0) + abs(W1))
+            c = gap / ww if use else 0.0
+            G[sl] += R + c * w
             K = sp.coo_matrix(K)
-            rows += [K.row + b.dof_offset, np.arange(b.ndof) + b.dof_offset]
-            cols += [K.col + b.dof_offset, np.arange(b.ndof) + b.dof_offset]
-            vals += [0.5 * K.data, np.full(b.ndof, c)]
+            rows.append(K.row + b.dof_offset)
+            cols.append(K.col + b.dof_offset)
+            vals.append(0.5 * K.data)
+            if c != 0.0:
+                n = b.ndof
+                Pi = A @ AtA_inv @ A.T
+                dAy = np.einsum("ikn,k->in", dA, y)               # (dA y) per direction du_mid
+                dAtw = np.einsum("ikn,i->kn", dA, w)              # (dA^T w)
+                dw = (np.eye(n) - Pi) - 0.5 * ((np.eye(n) - Pi) @ dAy + A @ AtA_inv @ dAtw)
+                R1 = b.internal(u1[sl])[0]
+                dc = (R1 - R - 0.5 * (K @ d) - 2.0 * c * (w @ dw)) / ww
+                Z = np.outer(w, dc) + c * dw
+                rows.append(np.repeat(dofs, n))
+                cols.append(np.tile(dofs, n))
+                vals.append(Z.ravel())
         return G, rows, cols, vals
 
     def step(self, t, u, v, a, dt, label=""):

@@ -19,6 +19,10 @@ by Newton with the effective tangent M / (beta dt^2) + K + K_c (M lumped, diagon
 Unconditionally stable (linear analysis) for delta >= 1/2 and
 beta >= (delta + 1/2)^2 / 4; delta = 1/2, beta = 1/4 (average acceleration)
 conserves energy; the paper's delta = 0.7, beta = 0.4 damps high frequencies.
+
+The unknowns a contact owns (Lagrange multipliers, system.py) are not motions: Newton
+starts them from their last converged values and they get no velocity or acceleration
+(``system.contact_dofs``; none in a penalty model, where nothing of this changes).
 """
 import warnings
 
@@ -74,13 +78,16 @@ class Newmark:
             ev = s.evaluate(u1, t1, dt, u, mass_coefficient=c)
             return ev._replace(G=ev.G + M * c * (u1 - u_pred))
 
-        # initial guess: the acceleration stays a (u + dt v + dt^2 a / 2)
+        # initial guess: the acceleration stays a (u + dt v + dt^2 a / 2); multipliers as they were
         guess = s.apply_dirichlet(u_pred + beta * dt ** 2 * a, t1)
+        own = s.contact_dofs
+        guess[own] = u[own]
         result = newton(effective, guess, s.free_dofs, instrument=s.instrument,
                         label=label or f"t = {t1:.6g}, dt = {dt:.3g}", **self.newton_options)
         u1 = result.u
         a1 = c * (u1 - u_pred)
         v1 = v + dt * ((1 - delta) * a + delta * a1)
+        a1[own], v1[own] = 0.0, 0.0
         return u1, v1, a1, result
 
 

@@ -9,7 +9,13 @@ the external loads, together with its tangent K = dG/du = K_int + K_c - dP/du.
 The inertia term M a of eq 29 is added by the time steppers (newmark.py).
 
 Bodies are placed one after another in the global vector: body b owns the global
-dofs ``b.dof_offset + local``.
+dofs ``b.dof_offset + local``. A contact may own unknowns too (``contact.unknowns`` of
+them: the Lagrange multipliers of contact/lagrange.py; 0 for a penalty contact): they
+follow the bodies' dofs, contact c owning ``c.dof_offset + range(c.unknowns)``. They have
+no mass (no velocity, no acceleration: the steppers carry them over as values, newmark.py),
+no Dirichlet condition, and the contact that owns them writes their rows of G and K; so
+the System, Newton and the time loop treat them like any other unknown, and one
+evaluation per Newton iteration still gives everything.
 
 K is a dense numpy array for small systems and a scipy CSC matrix on a fixed sparsity
 pattern above, solved by LAPACK's banded LU where the pattern is a narrow band after
@@ -77,7 +83,8 @@ class System:
     bodies   : list of bodies (the interface of contactfem.bodies)
     bodies   : list of bodies (contactfem.bodies.interfaces.Body)
     contacts : list of contacts (contactfem.contact.interfaces.Contact): ``evaluate(u, t, dt, u0)``
-               gives a state, ``state.scatter(ndof) -> (R_c, rows, cols, vals)``
+               gives a state, ``state.scatter(ndof) -> (R_c, rows, cols, vals)``; each contact
+               gets ``dof_offset``, where its own ``unknowns`` (if any) start
     loads    : list of loads, ``assemble(u, t) -> (P, rows, cols, vals)``
     fixed    : list of Dirichlet conditions
     linear_algebra : "auto" (default: dense up to assembly.DENSE_MAX unknowns; above, banded where
@@ -85,7 +92,8 @@ class System:
     instrument : None, or a solver.instrument.Timings that times the parts of every evaluation
                and of the Newton solves of the steppers (the bench's split of an iteration)
 
-    Attributes: ``ndof``, ``fixed_dofs`` and ``free_dofs`` (global, sorted),
+    Attributes: ``ndof``, ``fixed_dofs`` and ``free_dofs`` (global, sorted), ``contact_dofs``
+    (the unknowns the contacts own, after the bodies' ``body_ndof`` dofs; module docstring),
     ``linear_algebra`` ("dense", "sparse" or "banded"; "banded+sparse" if the choice changed
     as the contact pattern grew), ``ordering`` (of the factorisation) and ``evaluations``
     (how often the System was evaluated: one per residual Newton needs).
@@ -103,7 +111,12 @@ class System:
         for body in self.bodies:
             body.dof_offset = offset
             offset += body.ndof
+        self.body_ndof = offset
+        for contact in self.contacts:              # a contact's own unknowns follow the bodies'
+            contact.dof_offset = offset
+            offset += int(contact.unknowns)
         self.ndof = offset
+        self.contact_dofs = np.arange(self.body_ndof, self.ndof)   # massless, never prescribed
 
         for d in self.fixed:
             if d.body not in self.bodies:
@@ -163,9 +176,10 @@ class System:
     # -- assembly ---------------------------------------------------------------
 
     def mass(self):
-        """Global lumped (diagonal) mass, (ndof,)."""
+        """Global lumped (diagonal) mass, (ndof,); 0 at the contacts' own unknowns."""
         if self._mass is None:
-            self._mass = np.concatenate([np.asarray(b.mass(), dtype=float) for b in self.bodies])
+            self._mass = np.concatenate([np.asarray(b.mass(), dtype=float) for b in self.bodies]
+                                        + [np.zeros(self.ndof - self.body_ndof)])
         return self._mass
 
     def external_force(self, u, t):

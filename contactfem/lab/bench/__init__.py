@@ -1,9 +1,10 @@
 """`contactfem bench`: speed against accuracy, measured.
 
-Six studies, each a module with a function returning a JSON-able dict; ``run_bench``
+Seven studies, each a module with a function returning a JSON-able dict; ``run_bench``
 runs them all and ``write_markdown`` (report.py, the one report writer) turns the result
 into the tables of BENCHMARKS.md. Files: common.py (targets, timing, observed order),
-tangents.py, work_precision.py, cost.py, targets.py, enforcement.py, speed.py, report.py.
+tangents.py, work_precision.py, cost.py, targets.py, enforcement.py, speed.py, semismooth.py,
+report.py.
 
 1. tangents        the paper's central claim (Sec. 4.2): Newton with the consistent
                    non-symmetric tangent (eqs 49-50) against a symmetrised tangent, the
@@ -31,6 +32,11 @@ tangents.py, work_precision.py, cost.py, targets.py, enforcement.py, speed.py, r
                    split into bulk, contact, assembly, solve and Python overhead (measured
                    inside a real run), and the Table 2 refinement study as `contactfem sweep`
                    runs it (speed.py).
+7. semismooth      linear solves and time to a gap violation of 1e-10: penalty (at the c_N
+                   the target needs), augmented Lagrangian (Uzawa) and the semi-smooth
+                   Newton method with Lagrange multipliers (node-to-segment and mortar), on
+                   Hertz and the block with Coulomb friction; and how far each one's
+                   tractions are from the semi-smooth Newton method's.
 
 ``quick`` shrinks every study (fast presets, fewer points) to seconds in all.
 No timing enters a test: times depend on the machine and its load.
@@ -46,13 +52,15 @@ from .common import PAPER_SCENES, TARGETS, observed_order, timed
 from .cost import cost_study, iteration_cost
 from .enforcement import enforcement_study
 from .report import write_markdown, write_outputs
+from .semismooth import semismooth_study
 from .speed import speed_study
 from .tangents import VARIANTS, tangent_study
 from .targets import targets_study
 from .work_precision import work_precision
 
 STUDIES = {"tangents": tangent_study, "work_precision": work_precision, "cost": cost_study,
-           "targets": targets_study, "enforcement": enforcement_study, "speed": speed_study}
+           "targets": targets_study, "enforcement": enforcement_study, "speed": speed_study,
+           "semismooth": semismooth_study}
 
 
 def machine():
@@ -79,4 +87,4 @@ def run_bench(quick=False, only=None, progress=print):
 
 __all__ = ["run_bench", "STUDIES", "TARGETS", "PAPER_SCENES", "VARIANTS", "observed_order", "machine",
            "write_markdown", "write_outputs", "tangent_study", "work_precision", "cost_study",
-           "iteration_cost", "targets_study", "enforcement_study", "speed_study"]
+           "iteration_cost", "targets_study", "enforcement_study", "speed_study", "semismooth_study"]

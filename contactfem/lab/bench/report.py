@@ -7,6 +7,7 @@ import numpy as np
 
 from .common import TARGETS
 from .enforcement import enforcement_markdown
+from .semismooth import semismooth_markdown
 from .speed import PARTS, SPEED_TARGETS
 
 def _f(x, fmt="{:.3g}"):
@@ -266,6 +267,8 @@ def write_markdown(res):
         L += enforcement_markdown(res["enforcement"])
     if "speed" in res:
         L += speed_section(res["speed"])
+    if "semismooth" in res:
+        L += semismooth_markdown(res["semismooth"])
     return "\n".join(L) + "\n"
 
 

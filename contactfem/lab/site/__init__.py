@@ -5,9 +5,12 @@ paper's examples, the equation index linked into the API reference, the benchmar
 
 ``build`` stages a Sphinx source folder (:mod:`contactfem.lab.site.pages`), with the
 configuration in ``lectures/_site/conf.py``, and runs Sphinx with warnings as errors.
-Executed notebooks are cached in ``build/site-cache`` (emptied when the code of the
-package changes), so a rebuild takes seconds. :mod:`contactfem.lab.site.browser` checks
-the built site in headless Chromium as a reader would.
+It writes only into DIR and into its cache folder, ``$CONTACTFEM_CACHE/site`` (default
+``~/.cache/contactfem/site``): the staged sources, the figures the lectures draw, and the
+executed notebooks (emptied when the code of the package changes, so a rebuild takes
+seconds). The published pages carry no absolute path of the machine that built them
+(``scrub``). :mod:`contactfem.lab.site.browser` checks the built site in headless
+Chromium as a reader would.
 
 Needs the ``site`` extra (``pip install -e ".[site]"``) and a checkout of the repository
 (the lectures are not part of the installed package).
@@ -22,6 +25,32 @@ import sys
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[3]
+
+
+def default_out():
+    """build/site in the checkout."""
+    return REPO / "build" / "site"
+
+
+def cache_dir():
+    """The site's work and cache folder: $CONTACTFEM_CACHE/site, default ~/.cache/contactfem/site."""
+    return Path(os.environ.get("CONTACTFEM_CACHE") or Path.home() / ".cache" / "contactfem") / "site"
+
+
+def scrub(out, replacements):
+    """Replace the builder's absolute paths in the built pages (printed by a lecture, e.g.
+    where its figures went) by the names a reader understands: {path: name}."""
+    pairs = sorted(((str(k), v) for k, v in replacements.items() if str(k) not in ("", "/")),
+                   key=lambda kv: -len(kv[0]))
+    for page in Path(out).rglob("*"):
+        if page.suffix not in (".html", ".js", ".txt") or not page.is_file():
+            continue
+        text = page.read_text(errors="surrogateescape")
+        new = text
+        for old, name in pairs:
+            new = new.replace(old, name)
+        if new != text:
+            page.write_text(new, errors="surrogateescape")
 
 
 def code_hash(package_dir=None):
@@ -62,21 +91,21 @@ def _kernel_env(work, env):
 
 def build(out=None, repo=None, quiet=True):
     """Build the site into `out` (default: build/site of the checkout); returns the path
-    of its index.html. Raises RuntimeError with Sphinx's output if the build fails
-    (a warning, a failing notebook cell, a missing reference)."""
+    of its index.html. Its own files go to cache_dir(). Raises RuntimeError with Sphinx's
+    output if the build fails (a warning, a failing notebook cell, a missing reference)."""
     repo = Path(repo or REPO)
     if not (repo / "lectures" / "_site" / "conf.py").exists():
         raise RuntimeError(f"contactfem site needs a checkout of the repository: no lectures/_site in {repo}")
-    work = repo / "build"
-    out = Path(out) if out else work / "site"
-    src, cache = work / "site-src", work / "site-cache"
+    work = cache_dir()
+    out = Path(out) if out else default_out()
+    src, cache = work / "src", work / "cache"
     from .pages import stage
 
     stage(repo, src)
     _prepare_cache(cache)
     env = dict(os.environ)
-    _kernel_env(work / "site-kernel", env)
-    env.update(CONTACTFEM_PRESET="fast", CONTACTFEM_FIGURES=str(work / "site-figures"),
+    _kernel_env(work / "kernel", env)
+    env.update(CONTACTFEM_PRESET="fast", CONTACTFEM_FIGURES=str(work / "figures"),
                CONTACTFEM_SITE_CACHE=str(cache / "notebooks"), MPLBACKEND="module://matplotlib_inline.backend_inline")
     cmd = [sys.executable, "-m", "sphinx", "-b", "html", "-W", "--keep-going", "-q",
            "-d", str(cache / "doctrees"), str(src), str(out)]   # read pages live with the cache
@@ -84,4 +113,6 @@ def build(out=None, repo=None, quiet=True):
     if proc.returncode != 0:
         msg = (proc.stdout or "")[-6000:] + (proc.stderr or "")[-6000:] if quiet else ""
         raise RuntimeError(f"the site build failed (Sphinx exit code {proc.returncode}):\n{msg}")
+    scrub(out, {work.resolve(): "$CONTACTFEM_CACHE/site", work: "$CONTACTFEM_CACHE/site",
+                repo.resolve(): ".", Path.home(): "~"})
     return out / "index.html"

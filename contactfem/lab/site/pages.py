@@ -84,16 +84,14 @@ def gallery_page(repo):
     repo = Path(repo)
     section = readme_section((repo / "README.md").read_text())
     out = ["# Gallery: the paper's examples, ours beside the paper's", ""]
-    table, rows, rest = [], [], []
+    rows, rest = [], []                 # the summary table (the section's first), and what follows it
     for ln in section:
-        if ln.startswith("|"):
-            table.append(ln)
-        elif table and not rows:
-            rows, rest = table, [ln]
+        if rest or (rows and not ln.startswith("|")):
+            rest.append(ln)             # later tables (Table 2's readings) stay tables, in the text below
+        elif ln.startswith("|"):
+            rows.append(ln)
         else:
-            (rest if rows else out).append(ln)
-    if not rows:
-        rows = table
+            out.append(ln)
     for i, row in enumerate(rows):      # tables (.md) are shown inline in the row's section below
         out.append(re.sub(r"\[([^\]]+)\]\(figures/[^)\s]+\.md\)",
                           lambda m, i=i: f"{{ref}}`{m.group(1)} <gallery-row-{i}>`", row))
