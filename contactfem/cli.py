@@ -1,5 +1,5 @@
 """Command line: `contactfem list | show | run | figures | sweep | bench | equations |
-reconstruct | site` (`contactfem COMMAND --help` for each).
+reconstruct | site | course` (`contactfem COMMAND --help` for each).
 
 Exit codes: 0 done; 2 bad input (unknown scene, unknown, repeated, out-of-range or
 inapplicable parameter, a law that breaks the protocol or returns NaN in the range the
@@ -266,13 +266,41 @@ def plain_table(markdown):
     return "\n".join("  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows)
 
 
+def _course_layer():
+    try:
+        import otter  # noqa: F401  (the grading tool of the course extra)
+    except ImportError:
+        raise ValueError("contactfem course needs the course extra: pip install -e '.[course]'") from None
+    from .lab import course
+
+    return course
+
+
+def cmd_course_build(args):
+    course = _course_layer()
+    out = course.check_out_dir(args.out or course.default_out(args.instructor))
+    written = course.build(out, instructor=args.instructor)
+    version = "instructor (solutions, check cells, autograder/)" if args.instructor else "student (no solutions)"
+    print(f"{len(written)} lectures, {version} -> {out}")
+
+
+def cmd_course_grade(args):
+    import time
+
+    course = _course_layer()
+    t0 = time.perf_counter()
+    rows = course.grade(args.folder, args.out, autograders=args.autograders, jobs=args.jobs)
+    graded = sum(1 for r in rows if not r["notes"].startswith("not graded"))
+    print(f"{len(rows)} submissions ({graded} graded) in {time.perf_counter() - t0:.0f} s -> {args.out}")
+
+
 def cmd_site(args):
     from .io.outputs import check_output_dir
     from .lab.site import build, default_out
 
-    check_output_dir(args.out or default_out(), "--out")
+    check_output_dir(args.out or default_out(args.instructor), "--out")
     try:
-        index = build(args.out)
+        index = build(args.out, instructor=args.instructor)
     except RuntimeError as err:                    # Sphinx's own messages, then one line of ours
         head, _, detail = str(err).partition("\n")
         head = head.rstrip(":")
@@ -404,9 +432,27 @@ def build_parser():
     sw.set_defaults(func=cmd_sweep)
     st = sub.add_parser("site", help="build the course website (lectures executed, gallery, equation index, API)")
     st.add_argument("--out", default=None, metavar="DIR", help="output folder, DIR/index.html (default: build/site "
-                    "in the checkout); the build's own files go to $CONTACTFEM_CACHE/site (default "
-                    "~/.cache/contactfem/site)")
+                    "in the checkout, build/site-instructor with --instructor); the build's own files go to "
+                    "$CONTACTFEM_CACHE/site (default ~/.cache/contactfem/site)")
+    st.add_argument("--instructor", action="store_true",
+                    help="the instructor version of the lectures (with the solutions) instead of the student version")
     st.set_defaults(func=cmd_site)
+    cp = sub.add_parser("course", help="the course: student and instructor versions of the lectures, grading")
+    csub = cp.add_subparsers(dest="course_command", required=True)
+    cb = csub.add_parser("build", help="build the student version (no solutions) or, with --instructor, the "
+                         "instructor version (solutions, checks and the grading configurations)")
+    cb.add_argument("--instructor", action="store_true", help="the instructor version")
+    cb.add_argument("--out", default=None, metavar="DIR",
+                    help="output folder (default: build/course/student or build/course/instructor)")
+    cb.set_defaults(func=cmd_course_build)
+    cg = csub.add_parser("grade", help="grade a folder of submitted notebooks into a CSV: one row per submission, "
+                         "one column per exercise, the total and the hints of what failed")
+    cg.add_argument("folder", help="a folder of submitted notebooks (*.ipynb, subfolders included)")
+    cg.add_argument("--out", required=True, metavar="FILE.csv", help="the table of scores")
+    cg.add_argument("--autograders", default=None, metavar="DIR",
+                    help="the autograder/ folder of an instructor build (default: built from lectures/)")
+    cg.add_argument("--jobs", type=int, default=1, help="submissions graded in parallel (default 1)")
+    cg.set_defaults(func=cmd_course_grade)
     rc = sub.add_parser("reconstruct", help="the scan's lost values as an inverse problem: run every reading "
                         "the scan allows, record how it ends (converged, no equilibrium, no convergence, "
                         "physically rejected), score the admissible ones against what the paper prints, print "

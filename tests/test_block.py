@@ -128,7 +128,7 @@ def test_parabolic_lowers_friction_where_pressure_is_high(results):
 def newton_states(params, n_iter):
     """Newton iterates of the block (no commit): u_0 = 0, u_1, ... u_{n_iter}."""
     sc = build(params)
-    system, contact = sc["system"], sc["contact"]
+    system = sc["system"]
     u = np.zeros(system.ndof)
     system.start(u)
     states = [u.copy()]

@@ -1,5 +1,10 @@
-"""Every notebook in lectures/ runs top to bottom (a failing notebook is a failed test)
-and is stored without outputs.
+"""Every notebook in lectures/ runs top to bottom (a failing notebook is a failed test),
+is stored without outputs, and agrees with its text twin.
+
+Each lecture is kept twice: the notebook (NN_topic.ipynb, what Jupyter opens) and the
+same cells as MyST markdown (NN_topic.md, what a diff and a review read), paired by
+jupytext (lectures/jupytext.toml). Edit either; `jupytext --sync lectures/NN_topic.ipynb`
+(or Jupyter with jupytext installed, which saves both) brings the other in line.
 
 Each notebook is executed with nbclient in a temporary copy of lectures/ (so nothing
 is written next to the originals), with CONTACTFEM_PRESET=fast and CONTACTFEM_FIGURES
@@ -25,6 +30,7 @@ ON_CI = os.environ.get("CI", "").lower() in ("true", "1", "yes")
 
 REPO = Path(__file__).resolve().parents[1]
 LECTURES = sorted((REPO / "lectures").glob("*.ipynb"))
+TEXTS = sorted(p for p in (REPO / "lectures").glob("*.md") if p.name != "README.md")
 CELL_TIMEOUT = 300        # seconds per cell
 MAX_STORED_OUTPUT = 2000  # characters of stored output allowed per notebook ("small ones")
 
@@ -71,6 +77,37 @@ def test_stored_without_outputs(path):
     nbformat.validate(nb)
     size = _stored_output_size(nb)
     assert size <= MAX_STORED_OUTPUT, f"{path.name} is stored with {size} characters of outputs: clear them"
+
+
+def _cells(nb):
+    return [(c.cell_type, c.source, dict(c.metadata)) for c in nb.cells]
+
+
+@pytest.mark.parametrize("path", LECTURES, ids=[p.name for p in LECTURES])
+def test_notebook_and_text_agree(path):
+    """The notebook and its MyST twin hold the same cells: same kind, same source, same
+    cell metadata (outputs and execution counts are the notebook's alone)."""
+    nbformat = require("nbformat")
+    jupytext = require("jupytext")
+    text = path.with_suffix(".md")
+    sync = f"jupytext --sync lectures/{path.name}"
+    assert text.exists(), f"{path.name} has no text twin {text.name}: run `{sync}`"
+    nb, md = _cells(nbformat.read(path, as_version=4)), _cells(jupytext.read(text))
+    for i, (a, b) in enumerate(zip(nb, md)):
+        if a != b:
+            what = "kind" if a[0] != b[0] else "source" if a[1] != b[1] else "metadata"
+            first = next((f"line {k + 1}: {x!r} in the notebook, {y!r} in the text"
+                          for k, (x, y) in enumerate(zip(a[1].splitlines() + [""], b[1].splitlines() + [""]))
+                          if x != y), "")
+            pytest.fail(f"{path.name} and {text.name} differ in cell {i + 1} ({what}) {first}: "
+                        f"edit one, then `{sync}`", pytrace=False)
+    assert len(nb) == len(md), (f"{path.name} has {len(nb)} cells, {text.name} {len(md)}: "
+                                f"edit one, then `{sync}`")
+
+
+def test_every_text_has_its_notebook():
+    orphans = [p.name for p in TEXTS if not p.with_suffix(".ipynb").exists()]
+    assert not orphans, f"text lectures without a notebook: {orphans} (`jupytext --sync` on each makes it)"
 
 
 @pytest.mark.parametrize("path", LECTURES, ids=[p.name for p in LECTURES])

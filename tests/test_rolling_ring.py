@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from contactfem.scenes import get_scene, run_scene
-from contactfem.scenes.rolling_ring import detect_rolling, rigid_ring_exact
+from contactfem.scenes.rings import detect_rolling, rigid_ring_exact
 
 V0, MU, G, R = 300.0, 0.15, 981.0, 50.0
 

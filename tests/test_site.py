@@ -192,6 +192,24 @@ def test_site_has_a_page_per_lecture_with_outputs_and_figures(site):
         assert f'href="{nb.stem}.html"' in index, f"{nb.stem} not linked from the index"
 
 
+def test_site_publishes_the_student_version(site):
+    """No line of any solution is on the site; every exercise has its check cell there."""
+    import html
+
+    import nbformat
+
+    from contactfem.lab.course import questions, solution_lines
+
+    for nb_path in LECTURES:
+        nb = nbformat.read(nb_path, as_version=4)
+        page = (site / (nb_path.stem + ".html")).read_text()
+        text = html.unescape(re.sub(r"<[^>]+>", "", page))
+        for line in solution_lines(nb):
+            assert line not in text, f"{nb_path.stem}.html shows the solution line {line!r}"
+        for name, _ in questions(nb):
+            assert f'grader.check("{name}")' in text, f"{nb_path.stem}.html: no check cell for {name}"
+
+
 def test_equation_index_links_every_entry_to_the_api(site):
     from contactfem.equations import INDEX
 
@@ -287,4 +305,5 @@ def test_site_command_line():
     from contactfem.cli import build_parser
 
     args = build_parser().parse_args(["site", "--out", "somewhere"])
-    assert args.out == "somewhere" and args.func.__name__ == "cmd_site"
+    assert args.out == "somewhere" and args.func.__name__ == "cmd_site" and not args.instructor
+    assert build_parser().parse_args(["site", "--instructor"]).instructor

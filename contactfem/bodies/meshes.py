@@ -1,6 +1,7 @@
 """Meshes of the scenes' bodies, made with scikit-fem (imported when a mesh is made): a
-rectangular block, a quarter disk graded towards its contact point (Hertz), the meridian of
-a cork with a conical shaft. (The rings' annulus is in ring.py.)"""
+rectangular block, a quarter disk graded towards its contact point (Hertz) and a graded
+foundation block under it, the meridian of a cork with a conical shaft. (The rings'
+annulus is in ring.py.)"""
 
 import numpy as np
 
@@ -103,3 +104,22 @@ def cork_mesh(R_tip, R_cork, L_taper, length, n_r, n_z):
     p = mesh.p.copy()
     p[0] = p[0] * cork_radius(p[1], R_tip, R_cork, L_taper)
     return MeshQuad(p, mesh.t, _boundaries=mesh.boundaries)
+
+
+def graded(h, zone, L, growth=1.25):
+    """Coordinates 0, h, 2h, ... over [0, zone], then steps growing by `growth` up to L."""
+    x = list(np.arange(0.0, zone + 0.5 * h, h))
+    d = h
+    while x[-1] < L * (1 - 1e-12):
+        d *= growth
+        x.append(min(x[-1] + d, L))
+    return np.array(x)
+
+
+def graded_block_mesh(R, h, zone_x, zone_y):
+    """MeshQuad of the square [0, R] x [-2R, -R] (an elastic foundation under a cylinder of
+    radius R touching it at (0, -R)): elements h wide over [0, zone_x] and h high over the
+    top zone_y, growing geometrically beyond (``graded``)."""
+    from skfem import MeshQuad
+
+    return MeshQuad.init_tensor(graded(h, zone_x, R), -R - graded(h, zone_y, R)[::-1])

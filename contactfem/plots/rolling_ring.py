@@ -7,14 +7,14 @@
                                      (a) refining mesh and step together (dt = 0.8 / n_el),
                                      (b) refining the step alone on the 120-element ring
 
-Exact: the rigid thin hoop (scenes.rolling_ring.rigid_ring_exact): x* = 229.4 cm,
+Exact: the rigid thin hoop (scenes.rings.rigid_ring_exact): x* = 229.4 cm,
 v* = 150 cm/s, and x(2 s) = 376.5 cm.
 """
 
 
 import numpy as np
 
-from ..scenes.rolling_ring import rigid_ring_exact
+from ..scenes.rings import rigid_ring_exact
 from . import cached_run, default_outdir, figure, pyplot, savefig
 
 

@@ -12,14 +12,14 @@ A scene module defines ``SCENE = Scene(...)``; the registry in ``contactfem.scen
 it. Parameter names follow the paper's symbols (c_N, c_T, m, n, alpha, beta, mu, E, nu, dt,
 delta, beta_newmark, ...)."""
 
-import math
 import time
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Callable
 
 import numpy as np
 
-from ..laws.validation import require
+from .params import Param  # noqa: F401  (scene modules take it from here)
+from .resources import check_resources, describe  # noqa: F401  (the command line takes them from here)
 
 PENALTIES = ("per_length", "per_node")
 PENALTY_DOC = ("unit of c_N and c_T: per_length = tractions per unit gap and per unit length of the contact "
@@ -77,61 +77,6 @@ def run(scene, params, normal=None, friction=None, progress=None, linear_algebra
     results["contact_evaluations"] = int(sum(c.evaluations for c in contacts.values()))
     results.setdefault("newton_iterations_total", 0)
     return results
-
-
-@dataclass(frozen=True)
-class Param:
-    name: str
-    default: Any
-    unit: str = ""
-    low: float | None = None
-    high: float | None = None
-    low_open: bool = False
-    high_open: bool = False
-    choices: tuple | None = None
-    doc: str = ""
-    when: tuple = ()      # ((other_param, (values...)), ...): the parameter is used only then
-
-    def applies(self, values):
-        """Whether the resolved `values` use this parameter (see `when`)."""
-        return all(values.get(k) in vals for k, vals in self.when)
-
-    def when_text(self):
-        return " and ".join(f"{k}={'|'.join(map(str, vals))}" for k, vals in self.when)
-
-    def range_text(self):
-        if self.choices is not None:
-            return "one of " + "|".join(map(str, self.choices))
-        if isinstance(self.default, bool):
-            return "true|false"
-        lo = "-inf" if self.low is None else f"{self.low:g}"
-        hi = "inf" if self.high is None else f"{self.high:g}"
-        return ("(" if self.low_open or self.low is None else "[") + f"{lo}, {hi}" + (")" if self.high_open or self.high is None else "]")
-
-    def parse(self, value):
-        """Convert (from text if need be) and validate; ValueError names the parameter and range."""
-        if self.choices is not None:
-            v = str(value)
-            if v not in map(str, self.choices):
-                raise ValueError(f"parameter {self.name} = {value!r} is not allowed: {self.range_text()}")
-            return type(self.choices[0])(v) if not isinstance(self.choices[0], str) else v
-        if isinstance(self.default, bool):
-            if isinstance(value, bool):
-                return value
-            s = str(value).lower()
-            if s in ("true", "1", "yes"):
-                return True
-            if s in ("false", "0", "no"):
-                return False
-            raise ValueError(f"parameter {self.name} = {value!r} is not allowed: true|false")
-        if isinstance(self.default, int):
-            try:
-                iv = int(str(value))
-            except ValueError:
-                raise ValueError(f"parameter {self.name} must be an integer in {self.range_text()}, got {value!r}") from None
-            require(self.name, iv, self.low, self.high, self.low_open, self.high_open)
-            return iv
-        return require(self.name, value, self.low, self.high, self.low_open, self.high_open)
 
 
 @dataclass(frozen=True)
@@ -249,16 +194,10 @@ class Scene:
         return preflight(laws.get("friction"), laws.get("normal"), **self.law_range(params))
 
     def estimate(self, params):
-        """Size of the run from the resolved parameters: elements, unknowns, time (or load)
-        steps, and the memory it needs in bytes (a model calibrated on the continuum scenes:
-        the sparse LU factors and the assembled tangents dominate)."""
-        if self.size is None:
-            return None
-        est = {k: _count(v) for k, v in self.size(params).items()}
-        n = max(est.get("unknowns", 0), 1)
-        est["memory_bytes"] = int(MEMORY_BASE + MEMORY_PER_UNKNOWN * n * math.log2(max(n, 2))
-                                  + MEMORY_PER_STEP * est.get("steps", 0))
-        return est
+        """Size of the run from the resolved parameters (resources.estimate), or None."""
+        from .resources import estimate
+
+        return None if self.size is None else estimate(self.size(params))
 
 
 # What a scene's law_range(params) returns, all maxima of the run (generous bounds from the
@@ -276,46 +215,6 @@ def penalty_pressure(energy, c_N, m=1.0, weight=1.0):
     pressures of a run whose energy is `energy` (a scene's law_range)."""
     a = ((m + 1.0) * energy / (weight * c_N)) ** (1.0 / (m + 1.0))
     return c_N * a ** m
-
-
-def _count(x):
-    """A count from a float estimate: rounded up, overflow (inf, nan) as 1e18."""
-    x = float(x)
-    return int(math.ceil(x - 1e-9)) if math.isfinite(x) and x < 1e18 else 10 ** 18
-
-
-# Resource model (Scene.estimate) and the limits that `contactfem run` enforces unless --force.
-# Calibrated on hertz (peak resident memory): 45,602 unknowns 312 MB, 181,202 unknowns 1.08 GB,
-# i.e. about 310 bytes per unknown and per log2(unknowns) (the LU fill grows like n log n).
-MEMORY_BASE = 100e6            # the interpreter with numpy, scipy and scikit-fem loaded
-MEMORY_PER_UNKNOWN = 310.0     # bytes per unknown and per log2(unknowns)
-MEMORY_PER_STEP = 2.0e3        # bytes per time step (recorded histories)
-LIMITS = {"memory_bytes": 2e9, "unknowns": 1e6, "steps": 1e6}
-
-
-def check_resources(scene, params, force=False):
-    """ValueError naming the estimate when a run would exceed LIMITS (unless force);
-    returns the estimate (or None for a scene without a size model)."""
-    est = scene.estimate(params)
-    if est is None or force:
-        return est
-    over = [k for k, lim in LIMITS.items() if est.get(k, 0) > lim]
-    if over:
-        raise ValueError(f"{scene.name} would need {describe(est)}: above the limit of "
-                         + ", ".join(_fmt(k, LIMITS[k]) for k in over) + " (add --force to run it anyway)")
-    return est
-
-
-def _fmt(key, value):
-    if key == "memory_bytes":
-        return f"{value / 1e9:.2g} GB" if value >= 1e8 else f"{value / 1e6:.0f} MB"
-    return f"{value:,.0f} {key}"
-
-
-def describe(est):
-    """'4,000,000 elements, 8,004,002 unknowns, 1 steps, about 21 GB'"""
-    parts = [_fmt(k, est[k]) for k in ("elements", "unknowns", "steps") if k in est]
-    return ", ".join(parts) + f", about {_fmt('memory_bytes', est['memory_bytes'])}"
 
 
 def jsonable(obj, where="result"):

@@ -28,24 +28,19 @@ p0 (largest nodal pressure, at x = 0) and a, p0 from a least-squares fit of
 p^2 = p0^2 (1 - x^2/a^2) (linear in x^2) over the nodes in contact, at their positions
 in the REFERENCE configuration: Hertz's theory is a small-strain theory, its a and p(x)
 live on the undeformed surface (the deformed positions are shifted outwards by the
-lateral expansion, about nu a / R of a: -0.8 % on a if they were used).
-
-Our numbers (defaults, a / R = 0.034, c_N = 1e9 MPa/mm per length): p0 error +0.10 %,
--0.03 %, -0.05 % on 16^2, 32^2 (fast), 64^2 = 4096 quads (paper); a from the fit +0.34 %,
-+0.04 %, -0.015 % (tests/test_hertz.py keeps this refinement study). One Newton
+lateral expansion, about nu a / R of a: -0.8 % on a if they were used). The errors
+against the closed form fall under mesh refinement (tests/test_hertz.py). One Newton
 iteration: the initial overlap a^2 / 2R guesses the active set.
+
 An elastic foundation (``foundation = elastic``) instead of the rigid plane: the quarter
-block [0, R] x [-2R, -R] (u_x = 0 on x = 0, u_y = 0 on its bottom) of modulus E_foundation,
-meshed with elements ``foundation_ratio`` times the cylinder's contact elements over
-[0, 2.5 a] (non-matching meshes) and growing geometrically beyond. Hertz's a and p0 take
-1/E* = (1 - nu^2)/E + (1 - nu^2)/E_foundation (Johnson eq 4.43), which holds for two
-half-planes; the foundation of size R = 30 a changes it by far less than the mesh does.
-The cylinder's contact nodes are the slaves, the foundation's top the master
-(BodySurface): node-to-segment's slave on the symmetry line would sit exactly at the
-master's end (in and out of contact from one iterate to the next), so it is left out and
-its tributary length given to its neighbour; mortar integrates the segments and needs
-no such care. On these non-matching meshes node-to-segment's pressures oscillate about
-Hertz's profile from node to node; mortar's do not (``oscillation``, ``max_jump``).
+block [0, R] x [-2R, -R] (u_x = 0 on x = 0, u_y = 0 below) of modulus E_foundation, its
+elements ``foundation_ratio`` times the cylinder's contact elements (non-matching meshes),
+1/E* = (1 - nu^2)/E + (1 - nu^2)/E_foundation (Johnson eq 4.43, two half-planes; R = 30 a
+changes it far less than the mesh does). The foundation's top is the master (BodySurface);
+node-to-segment's slave on the symmetry line, exactly at the master's end, is left out (its
+tributary length goes to its neighbour). On these meshes node-to-segment's pressures
+oscillate about Hertz's profile from node to node, mortar's do not (``oscillation``,
+``max_jump``).
 """
 
 import numpy as np
@@ -65,26 +60,15 @@ def hertz_exact(P, R, E, nu, E2=np.inf, nu2=0.0):
     return a, 2.0 * P / (np.pi * a)
 
 
-def graded(h, zone, L, growth=1.25):
-    """Coordinates 0, h, 2h, ... over [0, zone], then steps growing by `growth` up to L."""
-    x = list(np.arange(0.0, zone + 0.5 * h, h))
-    d = h
-    while x[-1] < L * (1 - 1e-12):
-        d *= growth
-        x.append(min(x[-1] + d, L))
-    return np.array(x)
-
-
 def foundation(params, h, a):
     """The elastic foundation (module docstring): its body, the master surface on its top
     and its supports."""
-    from skfem import MeshQuad
-
     from ..bodies.continuum import Continuum
+    from ..bodies.meshes import graded_block_mesh
     from ..contact import BodySurface
 
-    R, hf = params["R"], params["foundation_ratio"] * h
-    mesh = MeshQuad.init_tensor(graded(hf, 2.5 * a, R), -R - graded(hf, a, R)[::-1])
+    R = params["R"]
+    mesh = graded_block_mesh(R, params["foundation_ratio"] * h, 2.5 * a, a)
     body = Continuum(mesh, params["E_foundation"], params["nu"], 0.0, kind="plane_strain", material=params["material"],
                      name="foundation")
     top = np.flatnonzero(np.abs(body.X[:, 1] + R) < 1e-9 * R)
@@ -186,7 +170,7 @@ def check(params):
 
 def measure(m, params, records):
     body, w = m["body"], m["w"]
-    R, P = params["R"], params["P"]
+    P = params["P"]
     a_ex = m["a_exact"]
     hist = History.of(records)
     state = records[-1].contacts[0]
@@ -217,11 +201,6 @@ def measure(m, params, records):
         newton_residuals=[list(r) for r in hist.residuals[1:]],
         **enforcement.report(params, records, enforcement.penetration(state), a_ex, "the exact contact half-width a"),
     )
-
-
-def law_range(params):
-    """Normal law only: probed down to a penetration of a tenth of the radius."""
-    return dict(g=0.1 * params["R"])
 
 
 SCENE = Scene(
@@ -263,5 +242,5 @@ SCENE = Scene(
                         steps=p["n_steps"]),
     laws=("normal",),
     law_params={"normal": ("c_N",)},
-    law_range=law_range,
+    law_range=lambda params: dict(g=0.1 * params["R"]),    # the normal law probed to a tenth of R deep
 )

@@ -1,5 +1,6 @@
 """What the ring scenes share (Secs 5.2-5.4; not a scene itself): the ring of Secs 5.3-5.4,
-the size of a ring model, and the measures a ring scene reads from its records.
+the size of a ring model, the measures a ring scene reads from its records, and the
+rigid ring's closed form that the rolling ring is compared with.
 
     history = ring_history(ring, records)     # t, x_c, v_c, omega, n_contact, n_slip per record
     shots = snapshot_indices(history["t"], every=20)   # which records the figures draw
@@ -68,3 +69,63 @@ def snapshot_indices(t, every=None, interval=None, tol=0.0):
             picked.append(k)
             due += interval
     return picked
+
+
+def rigid_ring_exact(v0, mu, g, a, k2=None, t=None):
+    """Closed form of the sliding-then-rolling rigid ring (module docstring).
+
+    a: lever arm of the friction force (contact radius), k2: squared radius of gyration
+    about the centre (default a^2, the thin hoop). Returns dict t_star, x_star, v_star,
+    omega_star, and, if t is given, x(t), v(t), omega(t) as arrays.
+    """
+    for name, val in (("v0", v0), ("mu", mu), ("g", g), ("a", a)):
+        if not (np.isfinite(val) and val > 0):
+            raise ValueError(f"parameter {name} = {val!r} is out of range: allowed (0, inf)")
+    k2 = a * a if k2 is None else k2
+    if not (np.isfinite(k2) and k2 > 0):
+        raise ValueError(f"parameter k2 = {k2!r} is out of range: allowed (0, inf)")
+    r = a * a / k2
+    t_star = v0 / (mu * g * (1 + r))
+    x_star = v0 * t_star - 0.5 * mu * g * t_star ** 2
+    v_star = v0 - mu * g * t_star
+    out = dict(t_star=t_star, x_star=x_star, v_star=v_star, omega_star=-v_star / a)
+    if t is not None:
+        t = np.asarray(t, float)
+        ts = np.minimum(t, t_star)
+        out["x"] = v0 * ts - 0.5 * mu * g * ts ** 2 + v_star * np.maximum(t - t_star, 0.0)
+        out["v"] = v0 - mu * g * ts
+        out["omega"] = -mu * g * a * ts / k2
+    return out
+
+
+def detect_rolling(t, slip, v0, lo=0.1, hi=0.9, roll=0.02):
+    """t_roll from the slip-velocity history (module docstring): the least-squares line
+    through the sliding samples lo v0 < s < hi v0 (before s first drops below roll v0),
+    extended to s = 0. Returns None if s never drops below roll v0."""
+    t, slip = np.asarray(t, float), np.asarray(slip, float)
+    below = np.flatnonzero(slip < roll * v0)
+    if below.size == 0:
+        return None
+    k = below[0]
+    sel = np.flatnonzero((slip[:k] > lo * v0) & (slip[:k] < hi * v0))
+    if sel.size < 2:                         # too few sliding samples: interpolate the crossing
+        if k == 0:
+            return float(t[0])
+        s0, s1 = slip[k - 1], slip[k]
+        return float(t[k - 1] + (t[k] - t[k - 1]) * s0 / (s0 - s1)) if s0 > s1 else float(t[k])
+    A = np.column_stack([t[sel], np.ones(sel.size)])
+    slope, icpt = np.linalg.lstsq(A, slip[sel], rcond=None)[0]
+    if not slope < 0:
+        return float(t[k])
+    return float(-icpt / slope)
+
+
+def ring_gyration_radius2(ring):
+    """k^2 = I_c / m of the undeformed model ring from its lumped masses (and the beam's
+    rotary inertia): R^2 + h^2/12 (beam), about R^2 + h^2/4 (continuum annulus)."""
+    M = ring.body.mass()
+    b = ring.body
+    mx = M[b.xdofs[:, 0]]
+    r2 = np.sum((b.X - ring.center) ** 2, axis=1)
+    J = M[2::3].sum() if ring.kind == "beam" else 0.0
+    return float((mx @ r2 + J) / mx.sum())

@@ -1,7 +1,9 @@
-"""The course as a website: the lectures executed (fast preset), the gallery of the
+"""The course as a website: the lectures executed (fast preset; the student version,
+without solutions, or with --instructor the instructor version), the gallery of the
 paper's examples, the equation index linked into the API reference, the benchmarks.
 
     contactfem site [--out DIR]        # DIR/index.html; default build/site in the checkout
+    contactfem site --instructor       # the lectures with their solutions: build/site-instructor
 
 ``build`` stages a Sphinx source folder (:mod:`contactfem.lab.site.pages`), with the
 configuration in ``lectures/_site/conf.py``, and runs Sphinx with warnings as errors.
@@ -27,9 +29,9 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[3]
 
 
-def default_out():
-    """build/site in the checkout."""
-    return REPO / "build" / "site"
+def default_out(instructor=False):
+    """build/site in the checkout (build/site-instructor for the instructor version)."""
+    return REPO / "build" / ("site-instructor" if instructor else "site")
 
 
 def cache_dir():
@@ -89,19 +91,22 @@ def _kernel_env(work, env):
     env["PYTHONPATH"] = os.pathsep.join([str(REPO)] + [p for p in [env.get("PYTHONPATH")] if p])
 
 
-def build(out=None, repo=None, quiet=True):
-    """Build the site into `out` (default: build/site of the checkout); returns the path
-    of its index.html. Its own files go to cache_dir(). Raises RuntimeError with Sphinx's
-    output if the build fails (a warning, a failing notebook cell, a missing reference)."""
+def build(out=None, repo=None, quiet=True, instructor=False):
+    """Build the site into `out` (default: build/site of the checkout, build/site-instructor
+    for the instructor version); returns the path of its index.html. The lectures are the
+    course's student version (no solutions) unless `instructor`. Its own files go to
+    cache_dir(). Raises RuntimeError with Sphinx's output if the build fails (a warning, a
+    failing notebook cell, a missing reference)."""
     repo = Path(repo or REPO)
     if not (repo / "lectures" / "_site" / "conf.py").exists():
         raise RuntimeError(f"contactfem site needs a checkout of the repository: no lectures/_site in {repo}")
     work = cache_dir()
-    out = Path(out) if out else default_out()
-    src, cache = work / "src", work / "cache"
+    out = Path(out) if out else default_out(instructor)
+    version = "site-instructor" if instructor else "site"
+    src, cache = work / f"{version}-src", work / "cache"
     from .pages import stage
 
-    stage(repo, src)
+    stage(repo, src, instructor=instructor)
     _prepare_cache(cache)
     env = dict(os.environ)
     _kernel_env(work / "kernel", env)

@@ -1,7 +1,8 @@
 """The pages of the course website that are written from the repository, not by hand.
 
 ``stage(repo, dst)`` lays out a Sphinx source folder in `dst`: every notebook of
-``lectures/`` (glob, so a new lecture appears by itself), the hand-written pages and
+``lectures/`` (glob, so a new lecture appears by itself) in its student version (the
+course's build: no solutions, a check cell after each exercise), the hand-written pages and
 the configuration of ``lectures/_site/``, and four generated pages:
 
 * ``gallery.md``   -- the README's table of the paper's examples, each row with the
@@ -227,9 +228,11 @@ def copy_mathjax(dst):
     return "tex-chtml.js"
 
 
-def stage(repo, dst):
+def stage(repo, dst, instructor=False):
     """Lay out the Sphinx source folder `dst` from the repository `repo` (see the module
-    docstring). Returns the list of lecture notebooks staged."""
+    docstring): the lectures in their student version (no solutions; with `instructor`,
+    the instructor version), built by :func:`contactfem.lab.course.build`. Returns the
+    list of lecture notebooks staged."""
     repo, dst = Path(repo), Path(dst)
     lectures = repo / "lectures"
     if dst.exists():
@@ -239,8 +242,10 @@ def stage(repo, dst):
     nbs = notebooks(lectures)
     if not nbs:
         raise RuntimeError(f"no notebooks in {lectures}")
-    for nb in nbs:
-        shutil.copy2(nb, dst / nb.name)
+    from ..course import build as course_build
+
+    course_build(dst, instructor=instructor, repo=repo)     # the student (or instructor) version
+    shutil.rmtree(dst / "autograder", ignore_errors=True)   # grading configurations: not pages
     shutil.copy2(lectures / "README.md", dst / "course.md")
     gallery = gallery_page(repo)
     (dst / "gallery.md").write_text(gallery)

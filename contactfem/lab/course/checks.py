@@ -1,0 +1,771 @@
+"""The automatic checks of the course's exercises: one entry of EXERCISES per exercise,
+each a few parts with points; a part passes or raises AssertionError with a hint a
+student can act on ("your dt_N/dg_N is off by a factor 2.5 at g_N = -0.1").
+
+A part is a function of the student's names (the answer the exercise asks for, looked up
+in the notebook by name). It calls the student's code through `call` (an exception, a
+missing answer, `...` or an endless loop becomes one sentence), then compares with the
+library's own implementation or a closed form through `compare`, which names the point
+and the kind of error: a wrong sign, a constant factor, a constant offset.
+
+`contactfem course build` writes every part into the notebook as a test of the grading
+tool (otter-grader), with its points; `grader.check("NAME")` in the student's notebook
+runs them, and `contactfem course grade` runs them on the submissions.
+"""
+
+import math
+import signal
+import threading
+from contextlib import contextmanager
+from dataclasses import dataclass
+
+import numpy as np
+
+# -- the helpers every check uses ---------------------------------------------------------
+
+STILL_DOTS = "its body is still `...`: write it in the answer cell of the exercise"
+
+
+class Timeout(Exception):
+    pass
+
+
+@contextmanager
+def _time_limit(seconds):
+    """Stop the student's code after `seconds` (an endless loop must not stop the grading)."""
+    if seconds is None or threading.current_thread() is not threading.main_thread() or not hasattr(signal, "SIGALRM"):
+        yield
+        return
+
+    def stop(signum, frame):
+        raise Timeout()
+
+    old = signal.signal(signal.SIGALRM, stop)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+
+
+def _args_text(args, kwargs):
+    def show(a):
+        if isinstance(a, np.ndarray):
+            return " ".join(np.array2string(a, precision=4, separator=", ", threshold=8).split())
+        return repr(a)
+    return ", ".join([show(a) for a in args] + [f"{k}={show(v)}" for k, v in kwargs.items()])
+
+
+def defined(obj, name, what="function"):
+    """The student's answer `name` exists (the answer cell was run)."""
+    if obj is None:
+        raise AssertionError(f"`{name}` is not defined: write the {what} `{name}` in the answer cell and run it")
+    if obj is Ellipsis:
+        raise AssertionError(f"`{name}` is still `...`: write it in the answer cell and run it")
+    return obj
+
+
+def call(fun, name, *args, timeout=20.0, **kwargs):
+    """fun(*args, **kwargs), the student's function `name`: its value, or AssertionError
+    with one sentence saying what went wrong."""
+    defined(fun, name)
+    if not callable(fun):
+        raise AssertionError(f"`{name}` should be a function, but it is {type(fun).__name__}: {fun!r:.60}")
+    where = f"{name}({_args_text(args, kwargs)})"
+    try:
+        with np.errstate(all="ignore"), _time_limit(timeout):
+            out = fun(*args, **kwargs)
+    except Timeout:
+        raise AssertionError(f"{where} did not return within {timeout:g} s: an endless loop? "
+                             "(bound every loop, e.g. by max_updates)") from None
+    except Exception as err:
+        raise AssertionError(f"{where} raised {type(err).__name__}: {err}") from None
+    if out is None:
+        raise AssertionError(f"{where} returned None: {STILL_DOTS} (and end it with `return`)")
+    if out is Ellipsis or (isinstance(out, tuple) and any(o is Ellipsis for o in out)):
+        raise AssertionError(f"{where} returned `...`: {STILL_DOTS}")
+    return out
+
+
+def parts(out, n, name, what):
+    """out unpacked into n values (a tuple such as (t_N, dt_N))."""
+    if not isinstance(out, (tuple, list)) or len(out) != n:
+        got = f"{len(out)} values" if isinstance(out, (tuple, list)) else f"one {type(out).__name__}"
+        raise AssertionError(f"{name} should return {n} values ({what}), it returned {got}")
+    return out
+
+
+def _fmt(x):
+    return f"{x:.6g}" if isinstance(x, (float, int, np.floating, np.integer)) else str(x)
+
+
+def compare(what, got, want, at, rtol=1e-6, atol=1e-12, rule=None):
+    """AssertionError naming the worst point unless got == want to rtol. `at` is a dict
+    {name: array} of the points (one per entry of want), used to say where.
+    The hint says whether the error is a sign, a constant factor or a constant offset,
+    and ends with `rule`, the formula to compare with, if given."""
+    want = np.asarray(want, dtype=float)
+    try:
+        got = np.broadcast_to(np.asarray(got, dtype=float), want.shape)
+    except (ValueError, TypeError):
+        shape = np.shape(got) if not isinstance(got, (type(None), type(Ellipsis))) else got
+        raise AssertionError(f"{what} should be an array of shape {want.shape} (one value per point), "
+                             f"got {shape!r:.80}") from None
+    flat_g, flat_w = got.reshape(-1), want.reshape(-1)
+    pts = {k: np.broadcast_to(np.asarray(v), want.shape).reshape(-1) for k, v in at.items()}
+
+    def where(i):
+        return ", ".join(f"{k} = {_fmt(v[i])}" for k, v in pts.items())
+
+    bad = ~np.isfinite(flat_g)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise AssertionError(f"your {what} is {flat_g[i]} at {where(i)}: not a finite number")
+    err = np.abs(flat_g - flat_w)
+    tol = atol + rtol * np.abs(flat_w)
+    if np.all(err <= tol):
+        return
+    i = int(np.argmax(err - tol))
+    g, w = flat_g[i], flat_w[i]
+    nz = np.abs(flat_w) > atol
+    ratio = flat_g[nz] / flat_w[nz] if nz.any() else np.array([])
+    diff = flat_g - flat_w
+    msg = f"your {what} is {_fmt(g)} at {where(i)}, expected {_fmt(w)}"
+    if ratio.size and np.allclose(ratio, -1.0, rtol=1e-6):
+        msg += ": the sign is wrong"
+    elif ratio.size and np.allclose(ratio, ratio[0], rtol=1e-6) and abs(ratio[0]) > 0:
+        msg += f": off by a factor {ratio[0]:.4g} everywhere"
+    elif np.allclose(diff, diff[0], rtol=1e-6, atol=atol) and diff.size > 1:
+        msg += f": off by {diff[0]:+.4g} everywhere"
+    elif abs(w) > atol and g != 0:
+        msg += f" (off by a factor {g / w:.4g} there)"
+    raise AssertionError(msg + (f"; {rule}" if rule else ""))
+
+
+def _fd(fun, x, h):
+    return (fun(x + h) - fun(x - h)) / (2 * h)
+
+
+@dataclass(frozen=True)
+class Part:
+    """One graded part of an exercise: `check(**answers)` raises AssertionError with a hint."""
+    name: str
+    points: float
+    check: object
+    answers: tuple      # the names of the student's answers it reads
+
+
+@dataclass(frozen=True)
+class Exercise:
+    name: str
+    lecture: str
+    difficulty: str      # easy, medium, hard
+    implements: bool     # asks the student to implement part of the method
+    parts: tuple
+    what: str            # one line for the course plan
+
+    @property
+    def points(self):
+        return sum(p.points for p in self.parts)
+
+
+def run(name, env):
+    """Run the parts of exercise `name` on the names in `env` (a notebook's globals):
+    [(part, points scored, message)]. For the instructor and the tests; the grading goes
+    through otter."""
+    out = []
+    for part in EXERCISES[name].parts:
+        try:
+            part.check(**{a: env.get(a) for a in part.answers})
+            out.append((part.name, part.points, "passed"))
+        except AssertionError as err:
+            out.append((part.name, 0.0, str(err)))
+    return out
+
+
+# -- lecture 01: the interface laws ---------------------------------------------------------
+
+def _power_law_call(power_law, g_N, c_N, m):
+    out = call(power_law, "power_law", g_N, c_N, m)
+    return parts(out, 2, "power_law", "t_N and dt_N/dg_N")
+
+
+def power_law_open(power_law):
+    g = np.array([0.01, 0.2, 0.0])
+    t_N, dt_N = _power_law_call(power_law, g, 100.0, 2.5)
+    compare("t_N for an open gap", t_N, np.zeros(3), {"g_N": g},
+            rule="no contact, no traction: t_N = 0 where g_N >= 0")
+    compare("dt_N/dg_N for an open gap", dt_N, np.zeros(3), {"g_N": g})
+
+
+def power_law_traction(power_law):
+    g = np.array([-0.01, -0.1, -0.5, -0.01, -0.1, -0.5])
+    m = np.array([1.0, 1.0, 1.0, 2.5, 2.5, 2.5])
+    for mm in (1.0, 2.5):
+        sel = m == mm
+        t_N, _ = _power_law_call(power_law, g[sel], 100.0, mm)
+        compare(f"t_N (c_N = 100, m = {mm:g})", t_N, -100.0 * (-g[sel]) ** mm, {"g_N": g[sel]})
+
+
+def power_law_derivative(power_law):
+    g = np.array([-0.01, -0.1, -0.5])
+    for mm in (1.0, 2.5):
+        _, dt_N = _power_law_call(power_law, g, 100.0, mm)
+        compare(f"dt_N/dg_N (c_N = 100, m = {mm:g})", dt_N, 100.0 * mm * (-g) ** (mm - 1.0), {"g_N": g})
+
+
+def _tresca(Tresca, **kw):
+    defined(Tresca, "Tresca", "class")
+    try:
+        return Tresca(**kw)
+    except Exception as err:
+        raise AssertionError(f"Tresca({_args_text((), kw)}) raised {type(err).__name__}: {err}") from None
+
+
+def tresca_fields(Tresca):
+    law = _tresca(Tresca, c_T=30.0, tau_y=0.2)
+    if getattr(law, "c_T", None) != 30.0 or getattr(law, "tau_y", None) != 0.2:
+        raise AssertionError("Tresca(c_T=30.0, tau_y=0.2) should keep its fields c_T and tau_y "
+                             "(a dataclass with the fields c_T: float and tau_y: float)")
+    if not callable(getattr(law, "slip_bound", None)):
+        raise AssertionError("a Tresca law needs a method slip_bound(self, p, q)")
+    out = call(law.slip_bound, "Tresca(c_T=30.0, tau_y=0.2).slip_bound", np.array([1.0]), np.array([0.0]))
+    parts(out, 3, "slip_bound", "Y, dY/dp, dY/dq")
+
+
+def _tresca_bound(Tresca):
+    law = _tresca(Tresca, c_T=30.0, tau_y=0.2)
+    p = np.array([0.5, 1.0, 4.0, 0.5, 1.0, 4.0])
+    q = np.array([0.0, 0.0, 0.0, 0.3, 0.3, 0.3])
+    out = call(law.slip_bound, "Tresca(c_T=30.0, tau_y=0.2).slip_bound", p, q)
+    return p, q, parts(out, 3, "slip_bound", "Y, dY/dp, dY/dq")
+
+
+def tresca_bound(Tresca):
+    p, q, (Y, _, _) = _tresca_bound(Tresca)
+    Yb = np.broadcast_to(np.asarray(Y, dtype=float), p.shape) if np.ndim(Y) <= 1 else np.asarray(Y)
+    if np.all(np.isfinite(Yb)) and np.allclose(Yb / p, Yb[0] / p[0]) and not np.allclose(Yb, Yb[0]):
+        raise AssertionError(f"your Y grows with the pressure (Y/p = {Yb[0] / p[0]:.4g} at every p): that is "
+                             "Coulomb's law; Tresca's bound is the constant shear strength tau_y, whatever p")
+    compare("slip bound Y (tau_y = 0.2)", Y, np.full(p.shape, 0.2), {"p": p, "q": q})
+
+
+def tresca_derivatives(Tresca):
+    p, q, (_, Y_p, Y_q) = _tresca_bound(Tresca)
+    compare("dY/dp", Y_p, np.zeros(p.shape), {"p": p, "q": q},
+            rule="Y does not depend on p")
+    compare("dY/dq", Y_q, np.zeros(p.shape), {"p": p, "q": q},
+            rule="Y does not depend on q")
+
+
+def tresca_check_law(Tresca):
+    from ...laws.check import check_law
+
+    law = _tresca(Tresca, c_T=30.0, tau_y=0.2)
+    report = check_law(law)
+    if not report.ok:
+        failed = [s for ok, s in report.checks if not ok]
+        raise AssertionError("check_law(Tresca(c_T=30.0, tau_y=0.2)) fails: " + failed[0])
+
+
+# -- lecture 02: kinematics and the tangent --------------------------------------------------
+
+def _circle(circle_gap):
+    x_s = np.array([[2.0, 0.5], [1.0, 3.0], [1.4, 1.0], [-0.5, 0.2]])
+    c, R = np.array([1.0, 1.0]), 1.5
+    out = call(circle_gap, "circle_gap", x_s, c, R)
+    g_N, n = parts(out, 2, "circle_gap", "g_N and n")
+    d = x_s - c
+    r = np.linalg.norm(d, axis=1)
+    return x_s, c, R, np.asarray(g_N, dtype=float), np.asarray(n, dtype=float), r - R, d / r[:, None]
+
+
+def circle_gap_value(circle_gap):
+    x_s, c, R, g_N, n, g_ref, n_ref = _circle(circle_gap)
+    at = {"x_s": [f"({x:g}, {y:g})" for x, y in x_s]}
+    if g_N.shape == g_ref.shape and np.allclose(g_N, -g_ref):
+        raise AssertionError("your g_N has the wrong sign: a slave outside the disc has an open gap g_N > 0, "
+                             "one inside has penetrated, g_N < 0")
+    compare("g_N (centre (1, 1), R = 1.5)", g_N, g_ref, at, rule="g_N = |x_s - centre| - R")
+
+
+def circle_gap_normal(circle_gap):
+    x_s, c, R, g_N, n, g_ref, n_ref = _circle(circle_gap)
+    if n.shape != n_ref.shape:
+        raise AssertionError(f"n should have shape {n_ref.shape} (one unit vector per slave node), got {n.shape}")
+    norm = np.linalg.norm(n, axis=1)
+    if not np.allclose(norm, 1.0, rtol=1e-8):
+        i = int(np.argmax(np.abs(norm - 1.0)))
+        raise AssertionError(f"your n at x_s = ({x_s[i, 0]:g}, {x_s[i, 1]:g}) has length {norm[i]:.4g}: "
+                             "divide by |x_s - centre| to make it a unit vector")
+    dots = np.einsum("ij,ij->i", n, n_ref)
+    if np.all(dots < -0.999999):
+        raise AssertionError("your n points into the disc: the outward normal n = (x_s - centre)/|x_s - centre| "
+                             "points from the centre to the slave")
+    i = int(np.argmin(dots))
+    if dots[i] < 1 - 1e-8:
+        raise AssertionError(f"your n at x_s = ({x_s[i, 0]:g}, {x_s[i, 1]:g}) is ({n[i, 0]:.4g}, {n[i, 1]:.4g}), "
+                             f"expected ({n_ref[i, 0]:.4g}, {n_ref[i, 1]:.4g}), the direction from the centre to the slave")
+
+
+def circle_gap_variation(circle_gap):
+    """The gap's derivative with respect to the slave's position is the normal (delta g_N = n . delta x_s)."""
+    x_s, c, R, g_N, n, g_ref, n_ref = _circle(circle_gap)
+    h = 1e-6
+    for k, name in ((0, "x"), (1, "y")):
+        e = np.zeros(2)
+        e[k] = h
+        gp = np.asarray(parts(call(circle_gap, "circle_gap", x_s + e, c, R), 2, "circle_gap", "g_N and n")[0], float)
+        gm = np.asarray(parts(call(circle_gap, "circle_gap", x_s - e, c, R), 2, "circle_gap", "g_N and n")[0], float)
+        fd = (gp - gm) / (2 * h)
+        if not np.allclose(fd, n[:, k], atol=1e-6):
+            i = int(np.argmax(np.abs(fd - n[:, k])))
+            raise AssertionError(f"d g_N / d x_s,{name} by finite differences is {fd[i]:.6g} at x_s = "
+                                 f"({x_s[i, 0]:g}, {x_s[i, 1]:g}) but your n_{name} is {n[i, k]:.6g}: the "
+                                 "variation of the gap is n . delta x_s, so g_N and n must belong together")
+
+
+def _segment_case():
+    x_s, x_1, x_2 = np.array([0.35, 0.02]), np.array([0.0, 0.0]), np.array([1.0, 0.2])
+    return x_s, x_1, x_2, 50.0
+
+
+def _K_parts(x_s, x_1, x_2, c_N):
+    from ...contact.kinematics import outer, segment_geometry, segment_vectors
+
+    l, t, n, g_N, alpha = segment_geometry(x_s[None], x_1[None], x_2[None])
+    N_s, N_0, T_s, T_0 = segment_vectors(t, n, alpha)
+    t_N = c_N * min(g_N[0], 0.0)
+    mat = c_N * outer(N_s, N_s)[0]
+    geo = -t_N * ((outer(N_0, T_s) + outer(T_s, N_0))[0] / l[0] + g_N[0] / l[0] ** 2 * outer(N_0, N_0)[0])
+    return mat, geo
+
+
+def _residual_fd(x_s, x_1, x_2, c_N):
+    from ...contact.kinematics import segment_geometry, segment_vectors
+
+    def R(X):
+        l, t, n, g_N, alpha = segment_geometry(X[None, 0:2], X[None, 2:4], X[None, 4:6])
+        N_s = segment_vectors(t, n, alpha)[0]
+        return c_N * np.minimum(g_N, 0.0)[0] * N_s[0]
+
+    X0 = np.concatenate([x_s, x_1, x_2])
+    h = 1e-7
+    return np.stack([(R(X0 + h * e) - R(X0 - h * e)) / (2 * h) for e in np.eye(6)], axis=1)
+
+
+def _K_student(normal_tangent):
+    x_s, x_1, x_2, c_N = _segment_case()
+    K = np.asarray(call(normal_tangent, "normal_tangent", x_s, x_1, x_2, c_N), dtype=float)
+    if K.shape != (6, 6):
+        raise AssertionError(f"normal_tangent should return the 6x6 matrix K_N (rows and columns s_x, s_y, 1_x, "
+                             f"1_y, 2_x, 2_y), it returned shape {K.shape}")
+    if not np.all(np.isfinite(K)):
+        raise AssertionError("your K_N has entries that are not finite numbers")
+    return K, (x_s, x_1, x_2, c_N)
+
+
+LABELS6 = ["s_x", "s_y", "1_x", "1_y", "2_x", "2_y"]
+
+
+def normal_tangent_fd(normal_tangent):
+    K, case = _K_student(normal_tangent)
+    fd = _residual_fd(*case)
+    scale = np.abs(fd).max()
+    if np.abs(K - fd).max() <= 1e-6 * scale:
+        return
+    mat, geo = _K_parts(*case)
+    if np.abs(K - mat).max() <= 1e-6 * scale:
+        raise AssertionError("your K_N is c_N N_s N_s^T alone: the geometric part "
+                             "-t_N [(N_0 T_s^T + T_s N_0^T)/l + (g_N/l^2) N_0 N_0^T] of eq (33) is missing "
+                             "(it comes from the variation of N_s)")
+    if np.abs(K - (mat - geo)).max() <= 1e-6 * scale:
+        raise AssertionError("the geometric part of your K_N has the wrong sign: eq (33) has "
+                             "-t_N [...] with t_N < 0 in contact")
+    if np.abs(K - geo).max() <= 1e-6 * scale:
+        raise AssertionError("your K_N is the geometric part alone: the material part dt_N/dg_N N_s N_s^T "
+                             "(= c_N N_s N_s^T for the penalty law) is missing")
+    i, j = np.unravel_index(np.argmax(np.abs(K - fd)), K.shape)
+    raise AssertionError(f"your K_N differs from the finite-difference Jacobian of R = t_N N_s: entry "
+                         f"({LABELS6[i]}, {LABELS6[j]}) is {K[i, j]:.6g}, finite differences give {fd[i, j]:.6g}")
+
+
+def normal_tangent_material(normal_tangent):
+    K, case = _K_student(normal_tangent)
+    mat, geo = _K_parts(*case)
+    x_s, x_1, x_2, c_N = case
+    from ...contact.kinematics import segment_geometry, segment_vectors
+
+    l, t, n, g_N, alpha = segment_geometry(x_s[None], x_1[None], x_2[None])
+    N_s = segment_vectors(t, n, alpha)[0][0]
+    got, want = N_s @ K @ N_s, N_s @ (mat + geo) @ N_s
+    if not math.isclose(got, want, rel_tol=1e-6):
+        raise AssertionError(f"N_s^T K_N N_s is {got:.6g}, expected {want:.6g} (off by a factor {got / want:.4g}): "
+                             "check the term dt_N/dg_N N_s N_s^T (dt_N/dg_N = c_N for the penalty law in contact)")
+
+
+def normal_tangent_symmetric(normal_tangent):
+    K, _ = _K_student(normal_tangent)
+    asym = np.abs(K - K.T).max()
+    if asym > 1e-10 * max(np.abs(K).max(), 1e-300):
+        i, j = np.unravel_index(np.argmax(np.abs(K - K.T)), K.shape)
+        raise AssertionError(f"your K_N is not symmetric: entry ({LABELS6[i]}, {LABELS6[j]}) is {K[i, j]:.6g}, "
+                             f"({LABELS6[j]}, {LABELS6[i]}) is {K[j, i]:.6g}; eq (33) is symmetric "
+                             "(N_0 T_s^T + T_s N_0^T, not N_0 T_s^T alone)")
+
+
+# -- lecture 03: the return mapping -----------------------------------------------------------
+
+def _coulomb_ref(t_bar, dg, p, c_T, mu):
+    from ...laws import Coulomb
+    from ...laws.return_map import return_map
+
+    fr = return_map(Coulomb(c_T=c_T, mu=mu), np.array([-p]), np.array([0.0]), np.array([dg]),
+                    np.array([t_bar]), np.array([0.0]))
+    return float(fr.t_T[0]), float(fr.lam[0])
+
+
+def _coulomb_student(coulomb_return, t_bar, dg, p, c_T=30.0, mu=0.3):
+    out = call(coulomb_return, "coulomb_return", t_bar, dg, p, c_T, mu)
+    t_T, lam = parts(out, 2, "coulomb_return", "t_T and lambda")
+    try:
+        return float(t_T), float(lam)
+    except (TypeError, ValueError):
+        raise AssertionError(f"coulomb_return should return two numbers (t_T, lambda), got {out!r:.80}") from None
+
+
+def coulomb_stick(coulomb_return):
+    for t_bar, dg, p in ((0.1, 0.002, 1.0), (-0.2, -0.001, 2.0)):
+        t_T, lam = _coulomb_student(coulomb_return, t_bar, dg, p)
+        want, _ = _coulomb_ref(t_bar, dg, p, 30.0, 0.3)
+        at = {"t_bar": t_bar, "dg_T": dg, "p": p}
+        compare("t_T in stick (c_T = 30, mu = 0.3)", t_T, want, at,
+                rule="in stick t_T is the trial traction t_bar + c_T dg_T, eq (42)")
+        compare("lambda in stick", lam, 0.0, at)
+
+
+def coulomb_slip(coulomb_return):
+    for t_bar, dg, p in ((0.2, 0.05, 1.0), (0.29, 0.1, 2.0)):
+        t_T, lam = _coulomb_student(coulomb_return, t_bar, dg, p)
+        want, _ = _coulomb_ref(t_bar, dg, p, 30.0, 0.3)
+        compare("t_T in slip (c_T = 30, mu = 0.3)", t_T, want, {"t_bar": t_bar, "dg_T": dg, "p": p})
+
+
+def coulomb_slip_backwards(coulomb_return):
+    for t_bar, dg, p in ((0.2, -0.05, 1.0), (-0.1, -0.1, 2.0)):
+        t_T, lam = _coulomb_student(coulomb_return, t_bar, dg, p)
+        want, _ = _coulomb_ref(t_bar, dg, p, 30.0, 0.3)
+        at = {"t_bar": t_bar, "dg_T": dg, "p": p}
+        if math.isclose(t_T, -want, rel_tol=1e-8):
+            raise AssertionError(f"your t_T is {t_T:.6g} at t_bar = {t_bar:g}, dg_T = {dg:g}, p = {p:g}, expected "
+                                 f"{want:.6g}: the return goes along sign(t_tr), eq (43), here negative")
+        compare("t_T when sliding backwards", t_T, want, at)
+
+
+def coulomb_lambda(coulomb_return):
+    for t_bar, dg, p in ((0.2, 0.05, 1.0), (0.2, -0.05, 1.0), (0.29, 0.1, 2.0)):
+        _, lam = _coulomb_student(coulomb_return, t_bar, dg, p)
+        _, want = _coulomb_ref(t_bar, dg, p, 30.0, 0.3)
+        compare("lambda in slip (c_T = 30)", lam, want, {"t_bar": t_bar, "dg_T": dg, "p": p},
+                rule="lambda = (|t_tr| - Y) / c_T >= 0, eq (44)")
+
+
+def _moduli_cases():
+    from ...laws import ParabolicSlip, PowerLaw, SlipHardening
+
+    normal = PowerLaw(c_N=50.0, m=1.5)
+    cases = []
+    for law, t_bar, dg, g_N in ((ParabolicSlip(c_T=30.0, alpha=0.2, beta=0.3, n=0.5), 0.3, 0.05, -0.05),
+                                (SlipHardening(c_T=30.0, mu=0.3, h=2.0), 0.1, 0.08, -0.1),
+                                (SlipHardening(c_T=30.0, mu=0.3, h=2.0), -0.1, -0.08, -0.1),
+                                (SlipHardening(c_T=30.0, mu=0.4, h=-3.0), 0.0, 0.1, -0.08)):
+        cases.append((law, normal, t_bar, dg, g_N))
+    return cases
+
+
+def _moduli(slip_moduli, case):
+    from ...laws.return_map import return_map
+
+    law, normal, t_bar, dg, g_N = case
+    t_N, dt_N = normal.traction(np.array([g_N]))
+    fr = return_map(law, t_N, dt_N, np.array([dg]), np.array([t_bar]), np.array([0.0]))
+    p = -t_N[0]
+    t_tr = t_bar + law.c_T * dg
+    _, Y_p, Y_q = law.slip_bound(np.array([p]), fr.q)
+    args = (t_tr, law.c_T, float(Y_p[0]), float(Y_q[0]), float(dt_N[0]))
+    out = call(slip_moduli, "slip_moduli", *args)
+    c_T_s, c_N_s = parts(out, 2, "slip_moduli", "c_T^s and c_N^s")
+    at = {"t_tr": args[0], "c_T": args[1], "Y_p": args[2], "Y_q": args[3], "dt_N/dg_N": args[4]}
+    return float(np.asarray(c_T_s)), float(np.asarray(c_N_s)), float(fr.c_T_s[0]), float(fr.c_N_s[0]), at
+
+
+def moduli_c_T(slip_moduli):
+    for case in _moduli_cases():
+        got, _, want, _, at = _moduli(slip_moduli, case)
+        compare("c_T^s = dt_T/dg_T", got, want, at)
+
+
+def moduli_c_N(slip_moduli):
+    for case in _moduli_cases():
+        _, got, _, want, at = _moduli(slip_moduli, case)
+        compare("c_N^s = dt_T/dg_N", got, want, at, rule="dp/dg_N = -dt_N/dg_N")
+
+
+# -- lecture 09: speed against accuracy -----------------------------------------------------------
+
+def observed_order_exact(observed_order):
+    h = np.array([0.1, 0.05, 0.025, 0.0125])
+    for p, C in ((2.0, 3.0), (1.0, 0.5)):
+        got = call(observed_order, "observed_order", h, C * h ** p)
+        compare(f"observed order of e = {C:g} h^{p:g}", got, p, {"h": "0.1 ... 0.0125"}, rtol=1e-8)
+
+
+def observed_order_least_squares(observed_order):
+    h = np.array([0.1, 0.05, 0.025, 0.0125, 0.00625])
+    e = 2.0 * h ** 1.5 * np.array([1.0, 1.3, 0.8, 1.1, 0.95])
+    want = np.polyfit(np.log(h), np.log(e), 1)[0]
+    got = call(observed_order, "observed_order", h, e)
+    two = [np.log(e[-1] / e[0]) / np.log(h[-1] / h[0]), np.log(e[1] / e[0]) / np.log(h[1] / h[0]),
+           np.log(e[-1] / e[-2]) / np.log(h[-1] / h[-2])]
+    if any(math.isclose(float(got), t, rel_tol=1e-8) for t in two):
+        raise AssertionError(f"your order {float(got):.4g} comes from two points only; fit a line through all "
+                             f"points of (log h, log e) by least squares (np.polyfit): {want:.4g}")
+    compare("observed order of noisy errors", got, want, {"h": "0.1 ... 0.00625"}, rtol=1e-8)
+
+
+def observed_order_signed(observed_order):
+    h = np.array([0.1, 0.05, 0.025, 0.0125])
+    e = -4.0 * h ** 2
+    got = call(observed_order, "observed_order", h, e)
+    if not np.isfinite(float(got)):
+        raise AssertionError("your order is not finite for negative errors e = -4 h^2: an error can be negative "
+                             "(too low); its size is |e|")
+    compare("observed order of e = -4 h^2", got, 2.0, {"h": "0.1 ... 0.0125"}, rtol=1e-8)
+
+
+def convergence_order_linear(convergence_order):
+    r = 0.5 ** np.arange(1, 8) * 3.0
+    compare("convergence order of r_k = 3 (1/2)^k", call(convergence_order, "convergence_order", r), 1.0,
+            {"r": "3/2, 3/4, ..."}, rtol=1e-8)
+
+
+def convergence_order_quadratic(convergence_order):
+    r = [0.5]
+    for _ in range(4):
+        r.append(r[-1] ** 2)
+    got = call(convergence_order, "convergence_order", np.array(r))
+    if math.isclose(float(got), 0.5, rel_tol=1e-8):
+        raise AssertionError("your order for r_(k+1) = r_k^2 is 0.5, the inverse of 2: the order is "
+                             "log(r_k+1 / r_k) / log(r_k / r_k-1) with the newest ratio on top")
+    compare("convergence order of r_(k+1) = r_k^2", got, 2.0, {"r": "0.5, 0.25, 0.0625, ..."}, rtol=1e-8)
+
+
+def convergence_order_last(convergence_order):
+    r = np.array([1.0, 0.5, 0.25, 0.125, 0.125 ** 2, 0.125 ** 4])
+    got = call(convergence_order, "convergence_order", r)
+    compare("convergence order from the last three residuals of 1, 0.5, 0.25, 0.125, 0.125^2, 0.125^4", got,
+            2.0, {"r": "..."}, rtol=1e-8)
+
+
+# -- lecture 10: your own law ------------------------------------------------------------------
+
+def _hardening(LinearHardening):
+    defined(LinearHardening, "LinearHardening", "class")
+    try:
+        law = LinearHardening(c_T=30.0, mu_0=0.3, h=0.5)
+    except Exception as err:
+        raise AssertionError(f"LinearHardening(c_T=30.0, mu_0=0.3, h=0.5) raised {type(err).__name__}: {err}") from None
+    p = np.array([0.5, 1.0, 2.0, 0.5, 1.0, 2.0])
+    q = np.array([0.0, 0.0, 0.0, 0.2, 0.4, 0.8])
+    out = call(law.slip_bound, "LinearHardening(c_T=30.0, mu_0=0.3, h=0.5).slip_bound", p, q)
+    Y, Y_p, Y_q = parts(out, 3, "slip_bound", "Y, dY/dp, dY/dq")
+    return law, p, q, Y, Y_p, Y_q
+
+
+def hardening_bound(LinearHardening):
+    law, p, q, Y, Y_p, Y_q = _hardening(LinearHardening)
+    compare("Y (mu_0 = 0.3, h = 0.5)", Y, (0.3 + 0.5 * q) * p, {"p": p, "q": q})
+
+
+def hardening_derivatives(LinearHardening):
+    law, p, q, Y, Y_p, Y_q = _hardening(LinearHardening)
+    compare("dY/dp", Y_p, 0.3 + 0.5 * q + 0 * p, {"p": p, "q": q})
+    compare("dY/dq", Y_q, 0.5 * p, {"p": p, "q": q})
+
+
+def hardening_check_law(LinearHardening):
+    from ...laws.check import check_law
+
+    law = _hardening(LinearHardening)[0]
+    report = check_law(law)
+    if not report.ok:
+        raise AssertionError("check_law(LinearHardening(c_T=30.0, mu_0=0.3, h=0.5)) fails: "
+                             + [s for ok, s in report.checks if not ok][0])
+
+
+def _cubic(QuadraticNormal):
+    defined(QuadraticNormal, "QuadraticNormal", "class")
+    try:
+        law = QuadraticNormal(c_N=200.0)
+    except Exception as err:
+        raise AssertionError(f"QuadraticNormal(c_N=200.0) raised {type(err).__name__}: {err}") from None
+    return law
+
+
+def quadratic_traction(QuadraticNormal):
+    law = _cubic(QuadraticNormal)
+    g = np.array([0.05, 0.0, -0.01, -0.1, -0.3])
+    out = call(law.traction, "QuadraticNormal(c_N=200.0).traction", g)
+    t_N, dt_N = parts(out, 2, "traction", "t_N and dt_N/dg_N")
+    compare("t_N (c_N = 200)", t_N, np.where(g < 0, -200.0 * g ** 2, 0.0), {"g_N": g})
+    compare("dt_N/dg_N (c_N = 200)", dt_N, np.where(g < 0, -400.0 * g, 0.0), {"g_N": g})
+
+
+def quadratic_energy(QuadraticNormal):
+    law = _cubic(QuadraticNormal)
+    if not callable(getattr(law, "energy", None)):
+        raise AssertionError("QuadraticNormal needs a method energy(self, g_N): the stored energy of the interface")
+    g = np.array([0.05, 0.0, -0.01, -0.1, -0.3])
+    E = np.asarray(call(law.energy, "QuadraticNormal(c_N=200.0).energy", g), dtype=float)
+    compare("energy for an open gap", E[:2], np.zeros(2), {"g_N": g[:2]})
+    if np.any(E[2:] < 0):
+        raise AssertionError("your energy is negative in contact: the interface stores energy, >= 0")
+
+
+def quadratic_energy_gradient(QuadraticNormal):
+    law = _cubic(QuadraticNormal)
+    g = np.array([-0.01, -0.1, -0.3])
+    h = 1e-6
+    E = lambda x: np.asarray(call(law.energy, "QuadraticNormal(c_N=200.0).energy", x), dtype=float)
+    fd = (E(g + h) - E(g - h)) / (2 * h)
+    t_N = -200.0 * g ** 2
+    compare("d energy / d g_N (finite differences of your energy)", fd, t_N, {"g_N": g}, rtol=1e-5,
+            rule="the energy's derivative is the traction t_N")
+
+
+# -- lecture 11: where the 1990 method stops -------------------------------------------------------
+
+def _uzawa_ref(k, P, g0, c_N, tol, max_updates=200):
+    lam, n = 0.0, 0
+    while True:
+        u = (P + c_N * g0 + lam) / (k + c_N)
+        if lam + c_N * (g0 - u) >= 0:          # open
+            u = P / k
+        g = g0 - u
+        t = min(0.0, lam + c_N * g)
+        if abs(g) <= tol or n >= max_updates:
+            return u, t, n
+        lam, n = t, n + 1
+
+
+def _uzawa(uzawa_1dof, k, P, g0, c_N, tol):
+    out = call(uzawa_1dof, "uzawa_1dof", k, P, g0, c_N, tol)
+    u, lam, n = parts(out, 3, "uzawa_1dof", "u, lambda and the number of updates")
+    try:
+        return float(u), float(lam), int(n)
+    except (TypeError, ValueError):
+        raise AssertionError(f"uzawa_1dof should return (u, lambda, updates): numbers, got {out!r:.80}") from None
+
+
+UZAWA_CASES = ((100.0, 10.0, 0.05, 1000.0, 1e-10), (100.0, 10.0, 0.05, 100.0, 1e-10), (10.0, 5.0, 0.1, 1e4, 1e-12))
+
+
+def uzawa_gap(uzawa_1dof):
+    for k, P, g0, c_N, tol in UZAWA_CASES:
+        u, lam, n = _uzawa(uzawa_1dof, k, P, g0, c_N, tol)
+        g = g0 - u
+        if abs(g) > 10 * tol:
+            pen = _uzawa_ref(k, P, g0, c_N, tol, max_updates=0)[0]
+            extra = " (that is the penalty solution: the multiplier never entered)" if math.isclose(u, pen) else ""
+            raise AssertionError(f"at k = {k:g}, P = {P:g}, g0 = {g0:g}, c_N = {c_N:g}, tol = {tol:g} your final gap "
+                                 f"is {g:.3g}{extra}: update lambda <- min(0, lambda + c_N g) and solve again "
+                                 "until |g| <= tol")
+
+
+def uzawa_multiplier(uzawa_1dof):
+    for k, P, g0, c_N, tol in UZAWA_CASES:
+        u, lam, n = _uzawa(uzawa_1dof, k, P, g0, c_N, tol)
+        compare("lambda, the contact traction", lam, k * g0 - P, {"k": k, "P": P, "g0": g0, "c_N": c_N},
+                rtol=1e-6, atol=1e-8)
+
+
+def uzawa_updates(uzawa_1dof):
+    for k, P, g0, c_N, tol in UZAWA_CASES:
+        _, _, n = _uzawa(uzawa_1dof, k, P, g0, c_N, tol)
+        want = _uzawa_ref(k, P, g0, c_N, tol)[2]
+        if abs(n - want) > 1:
+            raise AssertionError(f"your loop made {n} multiplier updates at k = {k:g}, c_N = {c_N:g}, tol = {tol:g}; "
+                                 f"{want} suffice (each shrinks the gap by k/(k + c_N) = {k / (k + c_N):.3g})")
+
+
+def _secant(secant_traction, law, g0, g1):
+    return float(np.asarray(call(secant_traction, "secant_traction", law, g0, g1), dtype=float))
+
+
+def secant_energy(secant_traction):
+    from ...laws import PowerLaw
+
+    for law in (PowerLaw(c_N=100.0, m=1.0), PowerLaw(c_N=100.0, m=2.5)):
+        for g0, g1 in ((0.02, -0.03), (-0.01, -0.05), (-0.04, 0.01), (-0.02, -0.01)):
+            F = _secant(secant_traction, law, g0, g1)
+            want = float((law.energy(np.array([g1])) - law.energy(np.array([g0])))[0] / (g1 - g0))
+            compare(f"secant traction of {law!r}", F, want, {"g0": g0, "g1": g1},
+                    rule="F (g1 - g0) must equal energy(g1) - energy(g0)")
+
+
+def secant_limit(secant_traction):
+    from ...laws import PowerLaw
+
+    law = PowerLaw(c_N=100.0, m=2.5)
+    for g in (-0.03, 0.01):
+        F = _secant(secant_traction, law, g, g)
+        want = float(law.traction(np.array([g]))[0][0])
+        if not np.isfinite(F):
+            raise AssertionError(f"your secant traction is {F} for g0 = g1 = {g:g}: when the gap does not change, "
+                                 "use the limit, the traction t_N(g) itself")
+        compare("secant traction for g0 = g1", F, want, {"g": g})
+
+
+# -- the exercises ------------------------------------------------------------------------------
+
+def _ex(name, lecture, difficulty, implements, what, *items):
+    ps = tuple(Part(f.__name__, pts, f, tuple(f.__code__.co_varnames[:f.__code__.co_argcount])) for f, pts in items)
+    return Exercise(name, lecture, difficulty, implements, ps, what)
+
+
+EXERCISES = {e.name: e for e in [
+    _ex("ex01_power_law", "01_interface_laws", "easy", True, "the normal law of eq (4) and its derivative",
+        (power_law_open, 1), (power_law_traction, 2), (power_law_derivative, 2)),
+    _ex("ex01_tresca", "01_interface_laws", "medium", True, "a Tresca friction law, passing check_law",
+        (tresca_fields, 1), (tresca_bound, 2), (tresca_derivatives, 1), (tresca_check_law, 1)),
+    _ex("ex02_circle_gap", "02_kinematics_linearisation", "easy", True,
+        "the gap and normal of a circular rigid master",
+        (circle_gap_value, 2), (circle_gap_normal, 2), (circle_gap_variation, 1)),
+    _ex("ex02_normal_tangent", "02_kinematics_linearisation", "hard", True,
+        "the normal block K_N of the tangent (eq 33), checked against finite differences",
+        (normal_tangent_fd, 3), (normal_tangent_material, 1), (normal_tangent_symmetric, 1)),
+    _ex("ex03_coulomb_return", "03_return_mapping", "medium", True,
+        "trial state, check and return for one node with Coulomb friction (eqs 40-45)",
+        (coulomb_stick, 1), (coulomb_slip, 2), (coulomb_slip_backwards, 1), (coulomb_lambda, 1)),
+    _ex("ex03_slip_moduli", "03_return_mapping", "hard", True, "the consistent moduli c_T^s, c_N^s (eqs 47-48)",
+        (moduli_c_T, 2), (moduli_c_N, 3)),
+    _ex("ex09_observed_order", "09_speed_accuracy", "easy", False,
+        "the observed order of convergence by least squares, applied to the bench",
+        (observed_order_exact, 2), (observed_order_least_squares, 2), (observed_order_signed, 1)),
+    _ex("ex09_convergence_order", "09_speed_accuracy", "medium", False,
+        "Newton's order from a residual history: consistent tangent against staggered",
+        (convergence_order_linear, 1), (convergence_order_quadratic, 2), (convergence_order_last, 1)),
+    _ex("ex10_linear_hardening", "10_write_your_own_law", "easy", True,
+        "a slip-hardening friction law with its derivatives, passing check_law",
+        (hardening_bound, 2), (hardening_derivatives, 2), (hardening_check_law, 1)),
+    _ex("ex10_quadratic_normal", "10_write_your_own_law", "medium", True,
+        "a normal law with its stored energy, the energy checked against the traction",
+        (quadratic_traction, 2), (quadratic_energy, 1), (quadratic_energy_gradient, 2)),
+    _ex("ex11_uzawa", "11_where_1990_stops", "medium", True,
+        "Uzawa's multiplier update on a one-degree-of-freedom contact",
+        (uzawa_gap, 2), (uzawa_multiplier, 2), (uzawa_updates, 1)),
+    _ex("ex11_secant_traction", "11_where_1990_stops", "medium", True,
+        "the discrete gradient of the penalty energy (an energy check of one step)",
+        (secant_energy, 3), (secant_limit, 1)),
+]}

@@ -1,0 +1,63 @@
+"""A scene's parameter: its name, default, unit, allowed range or choices, what it means, and
+when it applies; ``parse`` converts text and checks the range (one clear line naming the
+parameter and its range)."""
+
+from dataclasses import dataclass
+from typing import Any
+
+from ..laws.validation import require
+
+
+@dataclass(frozen=True)
+class Param:
+    name: str
+    default: Any
+    unit: str = ""
+    low: float | None = None
+    high: float | None = None
+    low_open: bool = False
+    high_open: bool = False
+    choices: tuple | None = None
+    doc: str = ""
+    when: tuple = ()      # ((other_param, (values...)), ...): the parameter is used only then
+
+    def applies(self, values):
+        """Whether the resolved `values` use this parameter (see `when`)."""
+        return all(values.get(k) in vals for k, vals in self.when)
+
+    def when_text(self):
+        return " and ".join(f"{k}={'|'.join(map(str, vals))}" for k, vals in self.when)
+
+    def range_text(self):
+        if self.choices is not None:
+            return "one of " + "|".join(map(str, self.choices))
+        if isinstance(self.default, bool):
+            return "true|false"
+        lo = "-inf" if self.low is None else f"{self.low:g}"
+        hi = "inf" if self.high is None else f"{self.high:g}"
+        return ("(" if self.low_open or self.low is None else "[") + f"{lo}, {hi}" + (")" if self.high_open or self.high is None else "]")
+
+    def parse(self, value):
+        """Convert (from text if need be) and validate; ValueError names the parameter and range."""
+        if self.choices is not None:
+            v = str(value)
+            if v not in map(str, self.choices):
+                raise ValueError(f"parameter {self.name} = {value!r} is not allowed: {self.range_text()}")
+            return type(self.choices[0])(v) if not isinstance(self.choices[0], str) else v
+        if isinstance(self.default, bool):
+            if isinstance(value, bool):
+                return value
+            s = str(value).lower()
+            if s in ("true", "1", "yes"):
+                return True
+            if s in ("false", "0", "no"):
+                return False
+            raise ValueError(f"parameter {self.name} = {value!r} is not allowed: true|false")
+        if isinstance(self.default, int):
+            try:
+                iv = int(str(value))
+            except ValueError:
+                raise ValueError(f"parameter {self.name} must be an integer in {self.range_text()}, got {value!r}") from None
+            require(self.name, iv, self.low, self.high, self.low_open, self.high_open)
+            return iv
+        return require(self.name, value, self.low, self.high, self.low_open, self.high_open)
