@@ -465,12 +465,14 @@ def build_parser():
     cg.add_argument("--jobs", type=int, default=1, help="submissions graded in parallel (default 1)")
     cg.set_defaults(func=cmd_course_grade)
     rc = sub.add_parser("reconstruct", help="the scan's lost values as an inverse problem: run every reading "
-                        "the scan allows, score it against what the paper prints, print the ranked table")
+                        "the scan allows, record how it ends (converged, no equilibrium, no convergence, "
+                        "physically rejected), score the admissible ones against what the paper prints, print "
+                        "the ranked table")
     rc.add_argument("scene", help="block | sloping_impact")
     rc.add_argument("--quick", action="store_true", help="a small profile of the search (seconds)")
     rc.add_argument("--top", type=int, default=25, help="rows of the ranked table to print")
-    rc.add_argument("--json", metavar="FILE.json", help="write every reading and its scores to FILE.json "
-                    "(checked before the study)")
+    rc.add_argument("--json", metavar="FILE.json", help="write every reading, its outcome and its scores to "
+                    "FILE.json (checked before the study)")
     rc.add_argument("--no-cache", action="store_true", help="recompute every reading (default: reuse the "
                     "results of earlier runs of the same code, in $CONTACTFEM_CACHE or ~/.cache/contactfem)")
     rc.set_defaults(func=cmd_reconstruct)

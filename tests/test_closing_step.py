@@ -28,6 +28,16 @@ def test_stick_spring_starts_where_the_node_touched():
     assert e.t_T[0] == pytest.approx(50.0 * 0.01, rel=1e-12)
 
 
+def test_without_the_closing_step_the_whole_travel_loads_the_spring():
+    """The switch the cork's exit-time study uses: the rule before the closing step."""
+    iface, u1 = closing_node()
+    iface.closing_step = False
+    e = iface.evaluate(u1)
+    assert e.slip[0] == STICK
+    assert e.t_T[0] == pytest.approx(50.0 * 0.02, rel=1e-12)
+    assert NodeToSegment.closing_step is True                 # the class default is untouched
+
+
 def test_node_in_contact_at_both_ends_keeps_the_whole_travel():
     iface, u1 = closing_node(g0=-0.005)
     assert iface.evaluate(u1).t_T[0] == pytest.approx(50.0 * 0.02, rel=1e-12)

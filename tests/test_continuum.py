@@ -211,3 +211,26 @@ def test_inverted_element_raises(material):
     u = dof_field(body, lambda X, Y: -2.0 * X, lambda X, Y: 0 * Y)    # x = -X: mirrored
     with pytest.raises(InvertedElementError, match="element volume non-positive"):
         body.internal(u)
+
+
+@pytest.mark.parametrize("tri", [False, True])
+def test_corner_jacobian_ratios(tri):
+    """det J of the deformed over the reference element at its corners: det F for a homogeneous
+    deformation (any element shape), 1 for a rigid rotation; <= 0 where an element is folded,
+    which a small-strain (linear) body reports instead of raising."""
+    body = Continuum(block(tri=tri), E, NU, 1.0)                        # linear: no error raised
+    F = np.array([[1.3, 0.2], [-0.1, 0.7]])
+    u = dof_field(body, lambda X, Y: (F[0, 0] - 1) * X + F[0, 1] * Y, lambda X, Y: F[1, 0] * X + (F[1, 1] - 1) * Y)
+    assert np.allclose(body.corner_jacobian_ratios(u), np.linalg.det(F), rtol=1e-12)
+    c, s = np.cos(1.1), np.sin(1.1)
+    u = dof_field(body, lambda X, Y: c * X - s * Y - X, lambda X, Y: s * X + c * Y - Y)
+    assert np.allclose(body.corner_jacobian_ratios(u), 1.0, rtol=1e-12)
+    assert body.inverted_elements(u).size == 0
+    u = dof_field(body, lambda X, Y: -2.0 * X, lambda X, Y: 0 * Y)      # x = -X: every element mirrored
+    assert np.array_equal(body.inverted_elements(u), np.arange(body.mesh.t.shape[1]))
+    # one node pushed through its element's opposite side folds the elements around it
+    u = np.zeros(body.ndof)
+    k = int(np.argmin(np.linalg.norm(body.X - [1.5, 2.0 / 3.0], axis=1)))     # an interior node
+    u[body.xdofs[k, 1]] = -0.9
+    bad = body.inverted_elements(u)
+    assert 0 < bad.size and all(k in body.mesh.t[:, e] for e in bad)

@@ -44,8 +44,9 @@ def test_penetration_stays_below_two_percent_of_the_radius(fast):
 def test_fast_preset_exit_velocity_is_near_the_paper(fast):
     # paper "about 28 m/s" (two digits: +-2 %). The fast preset differs from the paper preset
     # only by its coarser steps around the exit (dt_fine 2e-5 instead of 5e-6 s, 1 mm of travel
-    # per step instead of 0.5): measured 30.7 against 28.6 m/s, a time discretisation error of
-    # +7 %. Tolerance 15 %: that error twice, plus the paper's rounding
+    # per step instead of 0.5, fewer press-fit increments): about 7 % faster than the paper
+    # preset when this was written, a time discretisation error. Tolerance 15 %: that error
+    # twice, plus the paper's rounding
     v = fast["exit_velocity_m_s"]
     assert abs(v - PAPER_V) / PAPER_V < 0.15, f"paper {PAPER_V} m/s, ours {v:.2f} m/s, tolerance 15 %"
 
@@ -152,14 +153,22 @@ def test_bad_input_names_the_parameter():
         run_scene("cork", "fast", {"dt": -1.0})
 
 
-def test_paper_preset_leaves_by_static_breakaway_near_28_m_s():
-    # the paper preset runs in CI (about 10 s of CPU, half a minute on a busy machine)
-    r = run_scene("cork", "paper")
+@pytest.fixture(scope="module")
+def paper():
+    # the paper preset runs in CI (about 10 s of CPU, half a minute on a busy machine); shared
+    # with the figure code's cache (the summary row and the exit-time study read the same run)
+    from contactfem.plots import cached_run
+
+    return cached_run("cork", "paper")
+
+
+def test_paper_preset_leaves_by_static_breakaway_near_28_m_s(paper):
+    r = paper
     assert r["press_fit_calibrated"] is True
     assert r["breakaway_margin_MPa"] > 0, r["breakaway_margin_MPa"]        # the mechanism
     assert r["exited"]
     v = r["exit_velocity_m_s"]
-    # paper "about 28 m/s" (two digits, +-2 %); ours 28.6. Tolerance 10 %: on the knife's edge
+    # paper "about 28 m/s" (two digits, +-2 %). Tolerance 10 %: on the knife's edge
     # (margin +0.014 MPa) the exit velocity moves by ~1 m/s over the neighbouring exiting
     # points of the knife-edge study (mu 0.095: 30.4, p0 0.84: 30.9, fast preset), i.e. 3-4 %;
     # that twice, plus the rounding
@@ -187,3 +196,82 @@ def test_knife_edge_figure_draws_from_its_data(tmp_path, monkeypatch):
     assert F.knife_grid() is F.KNIFE_GRID
     monkeypatch.setenv("CONTACTFEM_SLOW", "1")
     assert F.knife_grid() is F.KNIFE_GRID_SLOW
+
+
+# ---------------------------------------------------------------------------------------
+# The exit time. The paper: "between 2.6 and 2.7 ms". The paper preset's exit lies outside that
+# window; the study plots.cork.cork_exit_time (figures/cork_exit_time.md, lecture 08 Sec. 5)
+# says why, and these tests check that it still does, on its quick profile (seven runs of the
+# paper preset, about a minute and a half).
+PAPER_WINDOW_MS = (2.6, 2.7)
+# The exit time is recorded at the end of a step; near the exit the step is dt_fine = 5e-6 s of
+# the paper preset, so two runs whose exits differ by less than 0.005 ms leave in the same step.
+ONE_STEP_MS = 5e-3
+
+
+@pytest.fixture(scope="module")
+def exit_study():
+    from contactfem.plots import cork as F
+
+    d = F.exit_time_data(F.EXIT_CASES_QUICK)
+    return d, F.exit_time_summary(d)
+
+
+def test_exit_study_reads_the_scene(exit_study, paper):
+    """The study's paper-preset case (the stages with the closing step on) is the scene's own
+    run: the same exit time and velocity."""
+    d, s = exit_study
+    assert paper["exited"] and all(r["error"] is None and r["exited"] for r in d["cases"])
+    assert s["exit_ms"] == pytest.approx(paper["exit_time_ms"], abs=1e-9)
+    assert s["exit_velocity_m_s"] == pytest.approx(paper["exit_velocity_m_s"], rel=1e-9)
+    assert (s["dt_paper_s"], s["n_press"]) == (paper["parameters"]["dt"], paper["parameters"]["n_press"])
+
+
+def test_the_closing_step_is_the_converged_rule(exit_study):
+    """Why the closing step is kept: it acts through the press fit only (switched off in the pop,
+    the exit stays in its step), and with the preset's press-fit increments it already gives the
+    exit that both rules reach with eight times as many; the rule without it is off by many
+    steps (the travel before touching loads its stick springs)."""
+    d, s = exit_study
+    assert abs(s["pop_rule_shift_ms"]) < ONE_STEP_MS
+    fit = s["press_fit_refined_ms"]
+    assert abs(fit["with"] - fit["without"]) < 2 * ONE_STEP_MS
+    assert abs(s["exit_ms"] - fit["with"]) < 2 * ONE_STEP_MS
+    assert abs(s["exit_without_ms"] - fit["without"]) > 10 * ONE_STEP_MS
+
+
+def test_exit_time_against_the_paper_or_the_study(exit_study, paper):
+    """Inside the paper's window, or outside it for the reason the study documents: the paper's
+    time step in the neck leaves a discretisation error in the stall after the ramp; refined
+    (the ramp kept), both rules give the same exit, and the paper's window lies within that
+    error of it."""
+    d, s = exit_study
+    t = paper["exit_time_ms"]
+    if PAPER_WINDOW_MS[0] <= t <= PAPER_WINDOW_MS[1]:
+        return
+    on, off = s["refined_ms"]["with"], s["refined_ms"]["without"]
+    assert abs(on - off) < 2 * ONE_STEP_MS
+    error = abs(t - on)                              # the paper step's discretisation error
+    assert error > 10 * ONE_STEP_MS
+    gap = max(PAPER_WINDOW_MS[0] - on, on - PAPER_WINDOW_MS[1], 0.0)
+    assert gap <= error, (gap, error)
+
+
+def test_published_exit_numbers_are_the_run(exit_study, paper):
+    """summary.md (and the README), figures/cork_exit_time.md and its full study print what the
+    runs give: the paper preset's exit time and velocity, the refined exit of either rule."""
+    from pathlib import Path
+
+    d, s = exit_study
+    repo = Path(__file__).resolve().parents[1]
+    summary = (repo / "figures" / "summary.md").read_text()
+    assert f"exit {paper['exit_time_ms']:.2f} ms at {paper['exit_velocity_m_s']:.1f} m/s" in summary
+    fine = [r for r in d["cases"] if r["ramp_step_s"] is not None]
+    assert f"({fine[0]['exit_time_ms']:.2f} ms with the step in the neck refined" in summary
+    study = (repo / "figures" / "cork_exit_time.md").read_text()
+    assert "every case (CONTACTFEM_SLOW=1)" in study                  # the committed table is the full one
+    onoff = {True: "on", False: "off"}
+    for r in d["cases"]:
+        row = (f"| {r['group']} | {r['label']} | {onoff[r['closing_step_press_fit']]}, {onoff[r['closing_step_pop']]} "
+               f"| {r['exit_time_ms']:.3f} | {r['exit_velocity_m_s']:.2f} |")
+        assert row in study, f"figures/cork_exit_time.md lacks the row {row!r}: regenerate it"

@@ -282,6 +282,31 @@ class Continuum:
     def commit(self, u, dt=None):
         """Elastic: no history to update."""
 
+    def corner_jacobian_ratios(self, u):
+        """det J of the element map in the deformed configuration X + u at every corner of
+        every element, over its value in the reference configuration, shape (nel, corners).
+        A corner's det J is the cross product of its two edges (up to a constant factor that
+        the ratio cancels). For the bilinear quadrilateral det J is linear in the reference
+        coordinates, so it is positive in the whole element exactly when it is positive at
+        the four corners; the linear triangle has one value. An element is inverted (turned
+        inside out, or folded) where a ratio is <= 0; a small-strain (linear) run that
+        inverts elements is outside the range of its own model."""
+        u = np.asarray(u, dtype=float)
+        t = self.mesh.t.T                                       # (nel, corners), one orientation
+
+        def corners(x):
+            q = x[t]
+            e_next = np.roll(q, -1, axis=1) - q
+            e_prev = np.roll(q, 1, axis=1) - q
+            return e_next[..., 0] * e_prev[..., 1] - e_next[..., 1] * e_prev[..., 0]
+
+        x = self.X + u[self.dof_offset + self.xdofs]           # u: the System's vector (or the body's)
+        return corners(x) / corners(self.X)
+
+    def inverted_elements(self, u):
+        """Indices of the elements with a non-positive det J somewhere (corner_jacobian_ratios)."""
+        return np.flatnonzero(np.min(self.corner_jacobian_ratios(u), axis=1) <= 0.0)
+
     def rigid_modes(self, u):
         """The rigid-body modes energy-consistent stepping keeps its correction off, (ndof, k):
         the translations in x and y (plane), the translation along the axis (axisymmetric: a

@@ -16,7 +16,8 @@ contact at its end touched the master at the fraction theta = g_bar / (g_bar - g
 step (the gap interpolated linearly). Its stick spring starts there: the slip increment is
 the travel after touching, Delta g_T = r (s - s_bar) with r = 1 - theta = -g_N / (g_bar - g_N),
 not the whole travel of the step (which would load the spring with the tangential motion
-made while still open).
+made while still open). ``NodeToSegment.closing_step = False`` (per contact) drops the
+rule, to study what it changes (the cork's exit time, lecture 08).
 
 Strategies the contact is built with (not wrappers): ``tangent`` (contact/tangents.py: the
 consistent tangent of eqs 33, 39, 49-50, or the symmetric and frozen variants the paper
@@ -63,6 +64,7 @@ class NodeToSegment:
     (the wear of a step acts from the next step on).
     """
 
+    closing_step = True     # the closing step of the module docstring; False: the whole travel
     unknowns = 0                            # no unknowns of its own (contact/interfaces.py)
 
     def __init__(self, slave, nodes, master, *, normal, friction=None, weights=1.0, offset=0.0, name="contact",
@@ -140,7 +142,7 @@ class NodeToSegment:
         dofs = np.concatenate([self.slave_dofs(), k["master_dofs"]], axis=1) if k["master_dofs"].size else self._dofs
         travel = k["s"] - h.s_bar
         r, dr, ddg_T = np.ones_like(g_N), np.zeros_like(g_N), k["ds"]
-        closing = active & (h.g_bar > 0.0)
+        closing = active & (h.g_bar > 0.0) & self.closing_step
         if np.any(closing):                                 # the closing step (module docstring)
             gb = np.where(closing, h.g_bar, 1.0)
             r = np.where(closing, -g_N / (gb - g_N), 1.0)

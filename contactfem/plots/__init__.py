@@ -96,6 +96,20 @@ def savefig(fig, outdir, stem):
     return str(path)
 
 
+def fitted_words(r, to, width=95):
+    """"FITTED to <to>: name = value, ..." from a run's JSON ``fitted`` (the values the scan lost
+    that a study chose so the result lands near the paper's), wrapped to ``width``; "" for a run
+    without fitted values. Figures that show a fitted reading put it in their title."""
+    import textwrap
+
+    fitted = r.get("fitted") or {}
+    if not fitted:
+        return ""
+    fmt = lambda v: f"{v:g}" if isinstance(v, float) else str(v)          # noqa: E731
+    text = f"FITTED to {to}: " + ", ".join(f"{k} = {fmt(v)}" for k, v in fitted.items())
+    return "\n".join(textwrap.wrap(text, width))
+
+
 def describe_newton(history, converged):
     """What a Newton residual history shows, in words computed from the numbers (for
     figure titles and table notes): "converges in k linear solves", "diverges (||G||

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..scenes.block import PAPER_TABLE1, PAPER_TABLE1_UNCERTAIN, SCENE, solve
 from ..solver.newton import NewtonError
-from . import cached_run, default_outdir, describe_newton, figure, pyplot, savefig
+from . import cached_run, default_outdir, describe_newton, figure, fitted_words, pyplot, savefig
 
 STATE_COLORS = {"stick": "tab:blue", "slip": "tab:red", "open": "0.6"}
 
@@ -123,7 +123,7 @@ def fig07(preset="fast", outdir=None):
     _stress_axes(ax, "Fig 7: stresses on the contact area, conical slip surface "
                      f"(n = 1, alpha + beta = {P['alpha'] + P['beta']:g})\n"
                      f"sum |t_N| w = {-r['total_normal']:.6g}, sum t_T w = {r['total_tangential']:.6g}; "
-                     + slip_words(r))
+                     + slip_words(r) + _fitted_line(r))
     return [savefig(fig, outdir or default_outdir(preset), "fig07_block_conical_stresses")]
 
 
@@ -138,8 +138,14 @@ def fig08(preset="fast", outdir=None):
     P = r["parameters"]
     _stress_axes(ax, "Fig 8: stresses on the contact area, parabolic slip surface "
                      f"(n = {P['n']:g}, alpha = {P['alpha']:g}, beta = {P['beta']:g})\n"
-                     f"{slip_words(r)}; grey: the conical case (Fig 7)")
+                     f"{slip_words(r)}; grey: the conical case (Fig 7)" + _fitted_line(r))
     return [savefig(fig, outdir or default_outdir(preset), "fig08_block_parabolic_stresses")]
+
+
+def _fitted_line(r):
+    """The title's line naming the block's fitted reading (from the run's JSON), or ""."""
+    words = fitted_words(r, "Table 1")
+    return "\n" + words if words else ""
 
 
 def slip_words(r):
@@ -162,6 +168,7 @@ def residual_histories(preset="fast"):
         out["coulomb, symmetric tangent"] = err.history
         out["verdict"]["coulomb, symmetric tangent"] = describe_newton(err.history, False)
     out["parameters"] = result(preset, law="conical")["parameters"]
+    out["fitted"] = result(preset, law="conical").get("fitted") or {}
     return out
 
 
@@ -221,7 +228,8 @@ def table1(preset="fast", outdir=None):
             ax.semilogy(k[~ok], paper[~ok], "s", mfc="none", color=color, alpha=0.4,
                         label=f"paper, {law}: exponent uncertain (scan?)")
         ours = hist[law]
-        ax.semilogy(np.arange(1, len(ours) + 1), ours, "-o", color=color, label=f"ours, {law}")
+        ax.semilogy(np.arange(1, len(ours) + 1), ours, "-o", color=color,
+                    label=f"ours{' (FITTED reading)' if hist['fitted'] else ''}, {law}")
     for key, style in (("coulomb", "-^"), ("coulomb, frozen tangent", "--v")):
         ours = hist[key]
         ax.semilogy(np.arange(1, len(ours) + 1), ours, style, color="tab:green" if key == "coulomb" else "0.5",
@@ -230,5 +238,6 @@ def table1(preset="fast", outdir=None):
     ax.set_ylabel("||G||")
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=7)
-    ax.set_title("Table 1: residual norm per Newton iteration, whole load in one step", fontsize=9)
+    ax.set_title("Table 1: residual norm per Newton iteration, whole load in one step"
+                 + _fitted_line(dict(fitted=hist["fitted"])), fontsize=9)
     return [str(md), savefig(fig, outdir, "table1_block_newton_residuals")]

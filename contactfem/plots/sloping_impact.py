@@ -14,7 +14,7 @@ energy histories (kinetic, strain, contact, their sum, and the frictional dissip
 import numpy as np
 
 from ..scenes.sloping_impact import PAPER_TABLE2
-from . import cached_run, default_outdir, figure, pyplot, savefig
+from . import cached_run, default_outdir, figure, fitted_words, pyplot, savefig
 
 
 def result(variant, preset="fast", **overrides):
@@ -39,9 +39,10 @@ def draw_impact(r, title):
     ax.set_aspect("equal")
     ax.set_xlabel("x")
     ax.set_ylabel("y")
+    fitted = fitted_words(r, "Table 2")
     ax.set_title(f"{title}\nrebound v = ({r['rebound_vx']:.2f}, {r['rebound_vy']:.2f}), "
                  f"angle {r['rebound_angle_deg']:.1f} deg from the normal, spin {r['rebound_spin']:.3f}; "
-                 "labels: time", fontsize=9)
+                 "labels: time" + (f"\n{fitted} (points per beam element)" if fitted else ""), fontsize=9)
     ax.legend(loc="upper left", fontsize=8)
     t = np.asarray(r["t"])
     for key, label in (("energy_kinetic", "kinetic"), ("energy_strain", "strain"),
@@ -142,6 +143,8 @@ def table2(preset="fast", outdir=None, refined_n_el=32):
     tab.auto_set_font_size(False)
     tab.set_fontsize(8)
     tab.scale(1.0, 1.5)
-    ax.set_title(f"Table 2: rebound after the sloping impact, ours ({n_el} and {refined_n_el} elements) vs paper",
+    fitted = fitted_words(result("frictionless", preset), "this table")
+    ax.set_title(f"Table 2: rebound after the sloping impact, ours ({n_el} and {refined_n_el} elements) vs paper"
+                 + (f"\nours, frictionless and frictional rows: {fitted} (points per beam element)" if fitted else ""),
                  fontsize=9)
     return [str(md), savefig(fig, out, "table2_sloping_impact")]

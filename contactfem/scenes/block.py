@@ -13,13 +13,14 @@ side carries p_x, which nodes "the first and the last element" keep out of conta
 c_N (it reads 'lo*'), the unit of c_N and c_T (per node or per length), plane strain
 or stress. These are FITTED: ``contactfem reconstruct block`` runs every reading the
 scan allows and scores it against Table 1 (first residual, number and pattern of the
-residuals, slip in the conical case) and Fig 8's remark; the defaults are its best
-reading (module ``contactfem.lab.reconstruct``):
+residuals, slip in the conical case) and Fig 8's remark; the defaults are one of its
+best readings (module ``contactfem.lab.reconstruct``):
 
     width 4, height 3.25, 25 x 8 elements (first residual 171.88, paper 171.37:
     +0.30 %; no uniform mesh reproduces the printed 7 digits), p_x on the LEFT side
-    (pushing, +x), free_end_nodes = 2, c_N = 1e5 and c_T = 1e4 per unit length,
-    plane stress.
+    (pushing, +x: this contradicts the paper's text, whose block is pulled; the readings
+    that pull meet fewer of Table 1's facts), free_end_nodes = 2, c_N = 1e5 and c_T = 1e4
+    per unit length, plane stress.
 
 With it the conical law needs 4 residuals (paper: 4) and 2 nodes slip; the parabolic
 law 7 (paper: 7). Fig 8's remark (lower friction where the pressure is highest) is
@@ -109,7 +110,8 @@ PARAMS = (
     Param("p_x", 60.0, "F/L", doc="tangential traction along +x on the side p_x_face (paper: p_x = 60 per unit length)"),
     Param("p_x_face", "left", choices=("right", "left"),
           doc="lateral side carrying p_x (the scan: 'one of its lateral sides'; left FITTED to Table 1); with "
-              "p_x > 0 the right side is pulled, the left side pushed"),
+              "p_x > 0 the right side is pulled, the left side pushed (the fitted left side contradicts the "
+              "paper's 'pulled')"),
     Param("c_N", 1.0e5, "F/L^2", 0.0, low_open=True,
           doc="normal penalty per unit length (eq 4). The scan lost it (it reads 'lo*', 10^2 if '*' is a garbled "
               "superscript 2); 1e5 FITTED to Table 1 (contactfem reconstruct block). It gives a largest "
@@ -306,6 +308,10 @@ def measure(model, params, records):
         "n_open": int(np.sum(rep["state"] == "open")),
         "max_displacement": float(np.max(np.linalg.norm(u[dofs], axis=1))),
         "max_penetration": float(max(-np.min(rep["g_N"]), 0.0)),
+        # det J of the deformed mesh (corners, over the reference): <= 0 means inverted elements,
+        # a displacement far outside the small-strain model
+        "min_jacobian_ratio": float(np.min(body.corner_jacobian_ratios(u))),
+        "inverted_elements": int(body.inverted_elements(u).size),
         "contact": {"x": rep["X"][:, 0], "x_current": rep["x"][:, 0], "t_N": rep["t_N"], "t_T": rep["t_T"],
                     "state": [str(v) for v in rep["state"]], "g_N": rep["g_N"], "slip_bound": Y,
                     "weights": rep["weights"]},
@@ -344,7 +350,9 @@ SCENE = Scene(
                            "plane": "strain"}},
     notes=("Read from the scan: E, nu, p_y = 200, p_x = 60, 200 elements, c_T = 1e4, m, the laws, one load step.\n"
            "FITTED to Table 1 (the scan lost them; contactfem reconstruct block ranks every reading): width 4, "
-           "height 3.25, 25 x 8 elements, p_x on the left side, free_end_nodes 2, c_N 1e5 per length, "
+           "height 3.25, 25 x 8 elements, p_x on the left side (it pushes the block: this CONTRADICTS the "
+           "paper's text, whose block is pulled; the readings that pull meet fewer of Table 1's facts), "
+           "free_end_nodes 2, c_N 1e5 per length, "
            "penalty per_length, plane stress. First residual 171.88 (paper 171.37, +0.30 %: no uniform mesh "
            "reaches the printed digits); conical 4 residuals with slip, parabolic 7 (paper 4 and 7). "
            "Fig 8's remark is reproduced by no block-shaped reading."),
