@@ -44,7 +44,7 @@ from hypothesis import strategies as st  # noqa: E402
 from contactfem.cli import main  # noqa: E402
 from contactfem.io import load_run, save_run  # noqa: E402
 from contactfem.scenes import all_scenes  # noqa: E402
-from contactfem.scenes.base import LIMITS  # noqa: E402
+from contactfem.scenes.resources import LIMITS  # noqa: E402
 
 LONG = os.environ.get("CONTACTFEM_FUZZ") == "long"
 EXAMPLES = (dict(params=330, cli=120, files=120, laws=80, lawfiles=320) if LONG else
