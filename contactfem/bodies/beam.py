@@ -251,9 +251,40 @@ class Beam:
         point k of element e (the rows of the plastic strains ``ep``), the points' sums are
         taken at the end. p is zero but at the rotations (entries 2 and 5: N_a, N_b), so the
         geometric part only touches rows and columns 2 and 5.
+
+        One matrix product gives both, per row: with the rows of B, w and p stacked into
+        Bx = [B; w; p] (5 x 6) and Y = [C B, S; p, 0; w - c p, 0] (5 x 7),
+            Bx^T Y = [B^T C B + w p^T + p w^T - c p p^T,  B^T S],
+        the tangent and the residual before the weight w L0 (c = N (1 + eps) + Q gam).
         """
         g = self._gauss()
         ne = len(self.L0)
+        E, cos, sin = self._row_strains(u, g)
+        S, C, _ = return_map(E, self.ep, self.D, self.S0, self.eta, self._dt(dt))
+        eps, gam, N, Q = E[:, 0], E[:, 1], S[:, 0], S[:, 1]
+        P = g["p"]                                                   # p = dphi/dq per row, (m, 6)
+        Bx = g["Bx"].copy()                                          # rows: a_t, a_n, dkap/dq, w, p
+        Bx[:, 0:2] = (cos * g["invL"])[:, None, None] * g["Tc"] + (sin * g["invL"])[:, None, None] * g["Ts"]
+        Bx[:, 3] = N[:, None] * Bx[:, 1] - Q[:, None] * Bx[:, 0]     # w = N a_n - Q a_t (zero at the rotations)
+        Bx[:, 0] += gam[:, None] * P                                 # B: a_t + gam p
+        Bx[:, 1] -= (1 + eps)[:, None] * P                           #    a_n - (1 + eps) p
+        c = N * (1 + eps) + Q * gam
+        Y = g["Y"].copy()                                            # row 3 = [p, 0], (m, 5, 7)
+        Y[:, 0:3, 0:6] = Bx[:, 0:3] * C[:, :, None]                  # C B
+        Y[:, 0:3, 6] = S
+        Y[:, 4, 0:6] = Bx[:, 3] - c[:, None] * P                     # w - c p
+        KR = Bx.transpose(0, 2, 1) @ Y                               # (m, 6, 7): K | B^T S
+        wL = g["wL0"]
+        Ke = (wL[:, None, None] * KR[:, :, 0:6]).reshape(-1, 36)     # w L0 (B^T C B + geometric part)
+        re = wL[:, None] * KR[:, :, 6]                               # w L0 B^T S
+        if len(self.points) > 1:                                 # sum the points of each element
+            re, Ke = re.reshape(-1, ne, 6).sum(axis=0), Ke.reshape(-1, ne, 36).sum(axis=0)
+        R = np.bincount(self._edofs_flat, re.ravel(), minlength=self.ndof)
+        return R, self._rows, self._cols, Ke.ravel()
+
+    def _row_strains(self, u, g):
+        """The strains E = (eps, gam, kap) (m, 3) and cos, sin of the angle phi at every row of
+        ``_gauss`` (all integration points of all elements)."""
         q = np.asarray(u, float)[g["edofs"]]                           # (m, 6) element dofs per row
         xp = (g["dX"] + q[:, 3:5] - q[:, 0:2]) * g["invL"][:, None]     # x'
         phi = g["theta0"] + g["Na"] * q[:, 2] + g["Nb"] * q[:, 5]
@@ -262,51 +293,41 @@ class Beam:
         E[:, 0] = xp[:, 0] * cos + xp[:, 1] * sin - 1.0                   # eps = x' . t - 1
         E[:, 1] = -xp[:, 0] * sin + xp[:, 1] * cos                        # gam = x' . n
         E[:, 2] = (q[:, 5] - q[:, 2]) * g["invL"]                         # kap = theta'
-        S, C, _ = return_map(E, self.ep, self.D, self.S0, self.eta, self._dt(dt))
-        eps, gam, N, Q = E[:, 0], E[:, 1], S[:, 0], S[:, 1]
-        tL, sL = cos * g["invL"], sin * g["invL"]                         # t / L0 (a_t), n = (-s, c)
-        B = np.zeros((len(phi), 3, 6))
-        B[:, 0, 0], B[:, 0, 1], B[:, 0, 3], B[:, 0, 4] = -tL, -sL, tL, sL                 # a_t
-        B[:, 1, 0], B[:, 1, 1], B[:, 1, 3], B[:, 1, 4] = sL, -tL, -sL, tL                 # a_n
-        B[:, 0, 2], B[:, 0, 5] = gam * g["Na"], gam * g["Nb"]                             # + gam p
-        B[:, 1, 2], B[:, 1, 5] = -(1 + eps) * g["Na"], -(1 + eps) * g["Nb"]               # - (1 + eps) p
-        B[:, 2, 2], B[:, 2, 5] = -g["invL"], g["invL"]                                    # dkap/dq
-        K = np.matmul(B.transpose(0, 2, 1) * C[:, None, :], B)                           # B^T C B
-        w = N[:, None] * B[:, 1] - Q[:, None] * B[:, 0]          # N a_n - Q a_t (+ a p term, below)
-        w[:, 2] = w[:, 5] = 0.0                                  # a_t, a_n vanish at the rotations
-        c = N * (1 + eps) + Q * gam
-        for j, Nj in ((2, g["Na"]), (5, g["Nb"])):               # w p^T + p w^T
-            K[:, :, j] += w * Nj[:, None]
-            K[:, j, :] += w * Nj[:, None]
-        K[:, 2, 2] -= c * g["Na"] * g["Na"]                      # - c p p^T
-        K[:, 2, 5] -= c * g["Na"] * g["Nb"]
-        K[:, 5, 2] -= c * g["Nb"] * g["Na"]
-        K[:, 5, 5] -= c * g["Nb"] * g["Nb"]
-        wL = g["wL0"]
-        re = wL[:, None] * np.matmul(S[:, None, :], B)[:, 0]                             # w L0 B^T S
-        Ke = wL[:, None] * K.reshape(-1, 36)
-        if len(self.points) > 1:                                 # sum the points of each element
-            re, Ke = re.reshape(-1, ne, 6).sum(axis=0), Ke.reshape(-1, ne, 36).sum(axis=0)
-        R = np.bincount(self._edofs_flat, re.ravel(), minlength=self.ndof)
-        return R, self._rows, self._cols, Ke.ravel()
+        return E, cos, sin
 
     def _gauss(self):
-        """Per-row constants of internal_coo (row k ne + e: point k of element e), made once."""
+        """Per-row constants of internal_coo (row k ne + e: point k of element e), made once:
+        the element dofs, chords, lengths and angles, the shape functions N_a, N_b at the
+        point, p = dphi/dq, and the constant parts of Bx and Y (internal_coo)."""
         if getattr(self, "_g", None) is None:
             ne, k = len(self.L0), len(self.points)
             xi = np.repeat([x for x, _ in self.points], ne)
             weight = np.repeat([w for _, w in self.points], ne)
             tile = lambda a: np.concatenate([a] * k)                # noqa: E731
-            self._g = dict(edofs=np.concatenate([self.edofs] * k), dX=tile(self._dX), invL=tile(1 / self.L0),
-                           theta0=tile(self.theta0), Na=0.5 * (1 - xi), Nb=0.5 * (1 + xi),
-                           wL0=weight * tile(self.L0))
+            Na, Nb, invL = 0.5 * (1 - xi), 0.5 * (1 + xi), tile(1 / self.L0)
+            m = len(xi)
+            p = np.zeros((m, 6))
+            p[:, 2], p[:, 5] = Na, Nb
+            Bx = np.zeros((m, 5, 6))
+            Bx[:, 2, 2], Bx[:, 2, 5] = -invL, invL                   # dkap/dq
+            Bx[:, 4] = p
+            Y = np.zeros((m, 5, 7))
+            Y[:, 3, 0:6] = p
+            # a_t = d(x'.t)/dq and a_n = d(x'.n)/dq at fixed phi: cos/L0 Tc + sin/L0 Ts
+            Tc = np.array([[-1.0, 0, 0, 1, 0, 0], [0, -1, 0, 0, 1, 0]])
+            Ts = np.array([[0.0, -1, 0, 0, 1, 0], [1, 0, 0, -1, 0, 0]])
+            self._g = dict(edofs=np.concatenate([self.edofs] * k), dX=tile(self._dX), invL=invL,
+                           theta0=tile(self.theta0), Na=Na, Nb=Nb, wL0=weight * tile(self.L0), p=p, Bx=Bx, Y=Y,
+                           Tc=Tc, Ts=Ts)
         return self._g
 
     def strain_energy(self, u, dt=None):
         """Stored (elastic) energy sum_e L0 sum_k S_k^2 / (2 D_k); elastic case: L0 D E^2 / 2
-        (viscoplastic: the resultants of a step of dt from the committed plastic strains)."""
-        return float(sum(w * np.sum(self.L0[:, None] * self.resultants(u, xi, k, dt=dt)[0] ** 2 / (2 * self.D))
-                         for k, (xi, w) in enumerate(self.points)))
+        (viscoplastic: the resultants of a step of dt from the committed plastic strains).
+        All integration points in one pass, the rows of internal_coo."""
+        g = self._gauss()
+        S = return_map(self._row_strains(u, g)[0], self.ep, self.D, self.S0, self.eta, self._dt(dt))[0]
+        return float(np.sum(g["wL0"][:, None] * (S ** 2 / (2 * self.D))))
 
     def commit(self, u, dt=None):
         """Accept u as converged at the end of a step of dt: store the plastic strains
@@ -380,10 +401,15 @@ class BeamGravity:
         """A dead load keeps no history."""
 
     def assemble(self, u_global, t):
-        """(P, rows, cols, vals): the dead load and an empty tangent."""
+        """(P, rows, cols, vals): the dead load and an empty tangent. P is made once for the
+        beam's place in the global vector (read-only: a dead load does not change)."""
         b = self.beam
-        P = np.zeros(np.size(u_global))
-        m = b.mass()
-        P[b.dof_offset + b.xdofs] = m[b.xdofs] * self.g
-        empty_i, empty_v = np.zeros(0, dtype=int), np.zeros(0)
-        return P, empty_i, empty_i, empty_v
+        where = (b.dof_offset, np.size(u_global))
+        if getattr(self, "_P", (None,))[0] != where:
+            P = np.zeros(where[1])
+            P[b.dof_offset + b.xdofs] = b.mass()[b.xdofs] * self.g
+            empty_i, empty_v = np.zeros(0, dtype=int), np.zeros(0)
+            for a in (P, empty_i, empty_v):
+                a.flags.writeable = False
+            self._P = (where, (P, empty_i, empty_i, empty_v))
+        return self._P[1]

@@ -130,15 +130,17 @@ class RingModel:
         return self.R if self.kind == "beam" else self.R_outer
 
     def _u(self, u):
-        """The body's local part of u (a global vector is accepted too)."""
+        """The body's local part of u (a global vector is accepted too; or a stack of them,
+        one a row)."""
         u = np.asarray(u, float)
         b = self.body
-        return u[b.dof_offset:b.dof_offset + b.ndof] if u.size != b.ndof else u
+        return u[..., b.dof_offset:b.dof_offset + b.ndof] if u.shape[-1] != b.ndof else u
 
     def positions(self, u):
-        """Current positions of all nodes (beam: centreline nodes), (nn, 2)."""
+        """Current positions of all nodes (beam: centreline nodes), (nn, 2) (a stack of u:
+        (k, nn, 2))."""
         u = self._u(u)
-        return self.body.X + u[self.body.xdofs]
+        return self.body.X + u[..., self.body.xdofs]
 
     def outline(self, u, mirror=False):
         """Outer surface as a polyline (nc + 1, 2), closed for a full ring.
@@ -184,39 +186,43 @@ class RingModel:
 
     def center_of_mass(self, u):
         """Mass-weighted mean of the node positions, sum m_i x_i / sum m_i.
-        Half ring: of the full mirrored ring, (x_c, mean y)."""
+        Half ring: of the full mirrored ring, (x_c, mean y). A stack of u (k, ndof): one
+        centre a row, (k, 2)."""
         m, _ = self._mass_split()
         c = m @ self.positions(u) / m.sum()
         if self.half:
-            c[0] = self.center[0]
+            c[..., 0] = self.center[0]
         return c
 
     def velocity_of_mass(self, v):
-        """Centre-of-mass velocity sum m_i v_i / sum m_i (half ring: (0, v_y))."""
+        """Centre-of-mass velocity sum m_i v_i / sum m_i (half ring: (0, v_y)); of each row of
+        a stack of v."""
         v = self._u(v)
         m, _ = self._mass_split()
-        w = m @ v[self.body.xdofs] / m.sum()
+        w = m @ v[..., self.body.xdofs] / m.sum()
         if self.half:
-            w[0] = 0.0
+            w[..., 0] = 0.0
         return w
 
     def angular_velocity(self, u, v):
         """Spin about the centre of mass, omega = L / I_c (CCW positive), with
         L = sum m_i (r_i x v_i) + sum J_i theta_dot_i and I_c = sum m_i |r_i|^2 + sum J_i
         (r_i, v_i relative to the centre of mass; J_i: the beam's rotary inertia).
-        Exact for a rigid motion. Half ring: 0 by symmetry."""
+        Exact for a rigid motion. Half ring: 0 by symmetry. Stacks of u and v (k, ndof): an
+        array of k spins."""
+        stack = np.ndim(u) == 2
         if self.half:
-            return 0.0
+            return np.zeros(len(u)) if stack else 0.0
         v = self._u(v)
         m, J = self._mass_split()
-        r = self.positions(u) - self.center_of_mass(u)
-        w = v[self.body.xdofs] - self.velocity_of_mass(v)
-        L = np.sum(m * (r[:, 0] * w[:, 1] - r[:, 1] * w[:, 0]))
-        Ic = np.sum(m * np.sum(r * r, axis=1))
+        r = self.positions(u) - self.center_of_mass(u)[..., None, :]
+        w = v[..., self.body.xdofs] - self.velocity_of_mass(v)[..., None, :]
+        L = np.sum(m * (r[..., 0] * w[..., 1] - r[..., 1] * w[..., 0]), axis=-1)
+        Ic = np.sum(m * np.sum(r * r, axis=-1), axis=-1)
         if self.kind == "beam":
-            L += np.sum(J * v[2::3])
+            L += np.sum(J * v[..., 2::3], axis=-1)
             Ic += J.sum()
-        return float(L / Ic)
+        return L / Ic if stack else float(L / Ic)
 
     def initial_velocity(self, v0_vec, omega=0.0):
         """Local velocity vector (ndof,) of the rigid motion v = v0 + omega e3 x (X - c)

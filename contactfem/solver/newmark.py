@@ -24,6 +24,7 @@ The unknowns a contact owns (Lagrange multipliers, system.py) are not motions: N
 starts them from their last converged values and they get no velocity or acceleration
 (``system.contact_dofs``; none in a penalty model, where nothing of this changes).
 """
+import math
 import warnings
 
 import numpy as np
@@ -33,7 +34,7 @@ from .newton import NewtonError, NewtonResult, newton
 
 
 def _check_dt(dt):
-    if not (np.isfinite(dt) and dt > 0):
+    if not (math.isfinite(dt) and dt > 0):
         raise ValueError(f"dt must be a finite number > 0, got {dt}")
 
 
@@ -70,13 +71,13 @@ class Newmark:
         _check_dt(dt)
         s, beta, delta = self.system, self.beta, self.delta
         t1 = t + dt
-        M = s.mass()
         c = 1.0 / (beta * dt ** 2)
+        Mc = s.mass() * c                     # the step's constants: c M and the predictor
         u_pred = u + dt * v + dt ** 2 * (0.5 - beta) * a
 
         def effective(u1):                    # eq 29 with a+ = c (u1 - u_pred); tangent K + c M
             ev = s.evaluate(u1, t1, dt, u, mass_coefficient=c)
-            return ev._replace(G=ev.G + M * c * (u1 - u_pred))
+            return ev._replace(G=ev.G + Mc * (u1 - u_pred))
 
         # initial guess: the acceleration stays a (u + dt v + dt^2 a / 2); multipliers as they were
         guess = s.apply_dirichlet(u_pred + beta * dt ** 2 * a, t1)
