@@ -199,8 +199,12 @@ class NodeToSegment:
             element_dofs = k["dofs"][on]
         else:
             on = k["active"].nonzero()[0]                  # the pairs in contact, by index
-            R, K = self.element(k, fr, on)
             element_dofs = k["dofs"][on]
+            if on.size:
+                R, K = self.element(k, fr, on)
+            else:                                          # none in contact (a body in flight): no element
+                m = element_dofs.shape[1]
+                R, K = np.zeros((0, m)), np.zeros((0, m, m))
         return ContactState(contact=self, history=h, u=u, t=t, x_s=k["x_s"], g_N=k["g_N"], g_raw=k["g_raw"], s=k["s"],
                             s_next=k.get("s_next", k["s"]), n=k["n"], tangent=k["t"], seg=k["seg"],
                             inside=k["inside"], active=k["active"], r=k["r"], t_N=k["t_N"], dt_N=k["dt_N"],

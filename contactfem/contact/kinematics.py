@@ -79,13 +79,15 @@ def line_variations(x_s, point, normal):
     d2g_N, d2s one array of zeros: read, never written."""
     normal = np.asarray(normal, dtype=float)
     d = x_s - point
-    n, t = np.empty_like(d), np.empty_like(d)
-    n[:] = normal                                                   # one row per slave
-    t[:, 0], t[:, 1] = n[:, 1], -n[:, 0]                            # e3 x t = n
-    if normal.ndim == 1:                                            # one line: g_N, s in one product
-        g_s = d @ np.array([[normal[0], normal[1]], [normal[1], -normal[0]]])
-        g_N, s = g_s[:, 0], g_s[:, 1]
+    if normal.ndim == 1:                                            # one line: the same n and t for all
+        nt = np.array([[normal[0], normal[1]], [normal[1], -normal[0]]])   # columns n and t (e3 x t = n)
+        g_N, s = (d @ nt).T                                         # (x_s - point).n, (x_s - point).t
+        n, t = np.empty((2,) + d.shape)
+        n[:], t[:] = nt[:, 0], nt[:, 1]                             # one row per slave
     else:
+        n, t = np.empty_like(d), np.empty_like(d)
+        n[:] = normal
+        t[:, 0], t[:, 1] = n[:, 1], -n[:, 0]                        # e3 x t = n
         g_N, s = np.einsum("ij,ij->i", d, n), np.einsum("ij,ij->i", d, t)
     z2 = np.zeros((len(d), 2, 2))
     return dict(t=t, n=n, g_N=g_N, s=s, dg_N=n, d2g_N=z2, ds=t, d2s=z2)

@@ -84,6 +84,9 @@ class ContactState:
     def scatter(self, ndof):
         """The global contact residual R_c (ndof,) and the tangent's COO triplets."""
         dofs = self.element_dofs
+        if not dofs.size:                       # no pair carries a force
+            empty = np.zeros(0, dtype=int)
+            return np.zeros(ndof), empty, empty, np.zeros(0)
         R_c = np.bincount(dofs.ravel(), self.R.ravel(), minlength=ndof)
         rows, cols, vals = to_coo(dofs, self.K)
         return R_c, rows, cols, vals

@@ -79,7 +79,7 @@ def return_map(law, t_N, dt_N, dg_T, t_T_bar, q_bar, z_bar=None, dt=None, tol=1e
 
     # open nodes (p = 0) carry nothing and keep their history: integrate the nodes in contact, c
     t_T, c_T_s, c_N_s, lam = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
-    state, q, z = np.full(n, OPEN), q_bar.copy(), np.array(z_bar, dtype=float)
+    state, q, z = np.zeros(n, dtype=int), q_bar.copy(), np.array(z_bar, dtype=float)   # state: OPEN (= 0)
     c = (t_N < 0.0).nonzero()[0]
     if not c.size:                            # every node open (a body in flight): nothing to integrate
         return FrictionState(t_T=t_T, c_T_s=c_T_s, c_N_s=c_N_s, state=state, lam=lam, q=q, z=z, v=lam.copy())
@@ -156,8 +156,11 @@ def return_map(law, t_N, dt_N, dg_T, t_T_bar, q_bar, z_bar=None, dt=None, tol=1e
 
 def _node_arrays(*arrays):
     """The arguments as float arrays of one shape (n,) (broadcast if need be)."""
-    if all(type(a) is np.ndarray and a.dtype == np.float64 and a.ndim == 1 for a in arrays) \
-            and len({a.shape for a in arrays}) == 1:
+    shape = getattr(arrays[0], "shape", None)
+    for a in arrays:
+        if type(a) is not np.ndarray or a.dtype != np.float64 or a.shape != shape or a.ndim != 1:
+            break
+    else:
         return arrays
     arrays = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in arrays))
     return [a.reshape(-1) for a in arrays]
