@@ -145,13 +145,14 @@ class NodeToSegment:
         travel = k["s"] - h.s_bar
         nc = len(g_N)
         r, dr, dg_T, ddg_T = np.ones(nc), np.zeros(nc), travel, k["ds"]    # r = 1: Delta g_T = travel
-        closing = active & (h.g_bar > 0.0) if self.closing_step else None
-        if closing is not None and closing.any():           # the closing step (module docstring)
-            gb = np.where(closing, h.g_bar, 1.0)
-            r = np.where(closing, -g_N / (gb - g_N), 1.0)
-            dr = np.where(closing, -gb / (gb - g_N) ** 2, 0.0)
+        closing = (active & (h.g_bar > 0.0)).nonzero()[0] if self.closing_step else ()
+        if len(closing):                                    # the closing step (module docstring), at those nodes
+            c, gb, g = closing, h.g_bar[closing], g_N[closing]
+            r[c] = -g / (gb - g)
+            dr[c] = -gb / (gb - g) ** 2
             dg_T = r * travel
-            ddg_T = r[:, None] * k["ds"] + (travel * dr)[:, None] * k["dg_N"]
+            ddg_T = k["ds"].copy()
+            ddg_T[c] = r[c, None] * k["ds"][c] + (travel[c] * dr[c])[:, None] * k["dg_N"][c]
         return dict(k, x_s=x_s, g_N=g_N, g_raw=g_raw, active=active, t_N=t_N, dt_N=dt_N, dg_T=dg_T,
                     travel=travel, r=r, dr=dr, ddg_T=ddg_T, dofs=dofs)
 
@@ -222,9 +223,10 @@ class NodeToSegment:
             R, K = normal_element(w, k["t_N"][on], k["dt_N"][on], k["dg_N"][on], d2g_N)
         else:
             ddg_T = fr.get("ddg_T", k["ddg_T"])
+            ddg_T = None if ddg_T is k["ds"] else ddg_T[on]          # None: d(Delta g_T) = ds
             c_N_s = fr["c_N_s"][on] if self.tangent != "frozen" else np.zeros(len(w))
             R, K = contact_element(w, k["t_N"][on], k["dt_N"][on], fr["t_T"][on], fr["c_T_s"][on], c_N_s,
-                                   k["dg_N"][on], d2g_N, k["ds"][on], d2s, ddg_T[on])
+                                   k["dg_N"][on], d2g_N, k["ds"][on], d2s, ddg_T)
         if self.tangent == "symmetric":
             K = 0.5 * (K + K.transpose(0, 2, 1))
         return R, K

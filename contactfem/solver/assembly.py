@@ -76,7 +76,8 @@ def shallow_copy(matrix):
 def _keys(rows, cols, offset, n):
     """Pattern keys (col + offset) n + row + offset, in 64 bits: a body's int32 index arrays
     (scipy's) would overflow from n = 46341 unknowns on."""
-    return (np.asarray(cols, dtype=np.int64) + offset) * n + (np.asarray(rows, dtype=np.int64) + offset)
+    cols, rows = np.asarray(cols, dtype=np.int64), np.asarray(rows, dtype=np.int64)
+    return (cols + offset) * n + (rows + offset) if offset else cols * n + rows
 
 
 class TangentAssembler:
@@ -110,6 +111,7 @@ class TangentAssembler:
         first[:1] = True
         np.not_equal(merged[1:], merged[:-1], out=first[1:])
         self.keys = merged[first]
+        self._ends = np.append(self.keys, -1)        # a position beyond the last key finds no key there
         where = np.empty(merged.size, dtype=np.int64)
         where[order] = np.cumsum(first) - 1         # each merged key's place in the pattern
         from scipy.sparse import csc_matrix
@@ -139,7 +141,7 @@ class TangentAssembler:
                 return hit[2]
         keys = _keys(rows, cols, offset, self.n)
         pos = np.searchsorted(self.keys, keys)
-        if keys.size and (pos.max() >= self.keys.size or np.any(self.keys[pos] != keys)):
+        if keys.size and (self._ends[pos] != keys).any():       # (_ends: keys and one beyond the last)
             pos = self._grow(keys)
         if key is not None:
             self._cache[key] = (rows, cols, pos)
