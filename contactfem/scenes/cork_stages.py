@@ -136,18 +136,27 @@ def pop(model, P, u0, progress=None):
     stepper = Newmark(system, delta=P["delta"], beta=P["beta_newmark"], **_newton_options(P))
     schedule = Adaptive(dt_rule, t_end=P["t_end"], dt=P["dt"], max_cuts=P["max_cuts"])
     records, pressures, exit_time, touching = [], [], None, None
-    for rec in watch(march(stepper, schedule, 0.0, u0.copy(), zero, a0=zero,
-                           label=lambda k, t1, h: f"cork t = {t1 * 1e3:.5f} ms, dt = {h:.2e}"),
-                     progress, 0.0, P["t_end"], "cork: pop"):
-        records.append(rec)
-        pressures.append(gas.pressure(rec.t) if rec.k else 0.0)
-        n_contact = sum(st.n_active for st in rec.contacts)
-        if rec.k and gas.released and n_contact == 0 and (exit_time is None or touching):
-            exit_time = rec.t                            # the last time the contact opened
-        touching = n_contact > 0
-        if exit_time is not None and rec.t >= exit_time + P["t_flight"] * (1 - 1e-9):
-            break                                        # t_flight after the exit: stop
-        gas.update(rec.u, rec.t)                         # explicit coupling: the next step's pressure
+    bar = progress(0.0, P["t_end"], "cork: pop") if progress is not None else None
+    try:
+        for rec in march(stepper, schedule, 0.0, u0.copy(), zero, a0=zero,
+                         label=lambda k, t1, h: f"cork t = {t1 * 1e3:.5f} ms, dt = {h:.2e}"):
+            if bar is not None:
+                bar(rec.t, rec.u, rec.v, rec.a)
+            records.append(rec)
+            pressures.append(gas.pressure(rec.t) if rec.k else 0.0)
+            n_contact = sum(st.n_active for st in rec.contacts)
+            if rec.k and gas.released and n_contact == 0 and (exit_time is None or touching):
+                exit_time = rec.t                            # the last time the contact opened
+            touching = n_contact > 0
+            if exit_time is not None and rec.t >= exit_time + P["t_flight"] * (1 - 1e-9):
+                if hasattr(bar, "finish"):                   # done before t_end: the bar says why
+                    bar.finish(f"the cork left at {exit_time * 1e3:.3f} ms; the run stops t_flight = "
+                               f"{P['t_flight'] * 1e3:g} ms later")
+                break                                        # t_flight after the exit: stop
+            gas.update(rec.u, rec.t)                         # explicit coupling: the next step's pressure
+    finally:
+        if hasattr(bar, "close"):
+            bar.close()
     return records, np.array(pressures), exit_time, gas.released_at
 
 
