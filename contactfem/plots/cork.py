@@ -178,21 +178,25 @@ def sensitivity_rows(preset="fast", cases=SENSITIVITY, jobs=2):
     return rows
 
 
-@figure("table_cork_sensitivity", "Sec 5.5")
-def table_cork_sensitivity(preset="fast", outdir=None):
-    """Markdown table of the exit velocity against the reconstructed data."""
-    from pathlib import Path
-
-    rows = sensitivity_rows(preset)
+def sensitivity_markdown(rows, preset):
+    """The table's lines: a header and one line per row of ``sensitivity_rows``, then the note."""
     heads = " | ".join(f"v at p0 = {0.1 * n:.1f} MPa (m/s)" for n in P0_STEPS)
     lines = [f"| case | press-fit force (N) | {heads} |", "|---|---|" + "---|" * len(P0_STEPS)]
     for label, F, vs in rows:
         lines.append(f"| {label} | {'-' if F is None else format(F, '.0f')} | " + " | ".join(vs) + " |")
     lines.append("")
     lines.append(f"Paper: ~2500 N, 28 m/s at p0 = 0.8 MPa. Preset: {preset}.")
+    return "\n".join(lines) + "\n"
+
+
+@figure("table_cork_sensitivity", "Sec 5.5")
+def table_cork_sensitivity(preset="fast", outdir=None):
+    """Markdown table of the exit velocity against the reconstructed data."""
+    from pathlib import Path
+
     path = Path(outdir or default_outdir(preset)) / "table_cork_sensitivity.md"
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text("\n".join(lines) + "\n")
+    path.write_text(sensitivity_markdown(sensitivity_rows(preset), preset))
     return [str(path)]
 
 
@@ -409,16 +413,38 @@ def exit_case(case, preset=EXIT_PRESET):
                 steps=int(len(h["t"]) - 1), newton_failures=sum(len(rec.failures) for rec in records))
 
 
+# The cases run in this process, by (preset, case): the summary's cork row and the study share
+# them (as the figures share scene runs through plots.cached_run).
+_EXIT_RUNS = {}
+
+
+def _exit_key(case, preset):
+    import json
+
+    return json.dumps([preset, case], sort_keys=True)
+
+
+def cached_exit_case(case, preset=EXIT_PRESET):
+    """``exit_case``, run once per process for each case and preset (a copy of the row)."""
+    key = _exit_key(case, preset)
+    if key not in _EXIT_RUNS:
+        _EXIT_RUNS[key] = exit_case(case, preset)
+    return dict(_EXIT_RUNS[key])
+
+
 def exit_time_data(cases=None, jobs=2):
-    """Every case of ``exit_cases()`` (in parallel on ``jobs`` cores with joblib, if installed)."""
+    """Every case of ``exit_cases()`` (those not run yet in this process in parallel on ``jobs``
+    cores with joblib, if installed)."""
     cases = cases or exit_cases()
+    todo = list({_exit_key(c, EXIT_PRESET): c for c in cases if _exit_key(c, EXIT_PRESET) not in _EXIT_RUNS}.values())
     try:
         from joblib import Parallel, delayed
     except ImportError:
-        rows = [exit_case(c) for c in cases]
+        rows = [exit_case(c) for c in todo]
     else:
-        rows = Parallel(n_jobs=jobs)(delayed(exit_case)(c) for c in cases)
-    return dict(preset=EXIT_PRESET, slow=cases is EXIT_CASES_SLOW, cases=rows)
+        rows = Parallel(n_jobs=jobs)(delayed(exit_case)(c) for c in todo)
+    _EXIT_RUNS.update({_exit_key(c, EXIT_PRESET): r for c, r in zip(todo, rows)})
+    return dict(preset=EXIT_PRESET, slow=cases is EXIT_CASES_SLOW, cases=[cached_exit_case(c) for c in cases])
 
 
 def exit_time_summary(d):

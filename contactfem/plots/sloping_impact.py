@@ -95,7 +95,7 @@ def table2_rows(preset="fast", refined_n_el=32):
         rows.append(dict(variant=variant, vx=r["rebound_vx"], vy=r["rebound_vy"], angle=r["rebound_angle_deg"],
                          spin=r["rebound_spin"], n_el=r["parameters"]["n_el"],
                          vx_ref=f["rebound_vx"], vy_ref=f["rebound_vy"], angle_ref=f["rebound_angle_deg"],
-                         paper_vx=p["vx"] if p else None, paper_vy=p["vy"] if p else None,
+                         n_el_ref=refined_n_el, paper_vx=p["vx"] if p else None, paper_vy=p["vy"] if p else None,
                          paper_angle=p["angle_deg"] if p else None))
     return rows
 
@@ -104,22 +104,29 @@ def _fmt(x, f="{:.2f}"):
     return "-" if x is None else f.format(x)
 
 
-@figure("table2_sloping_impact", "Table 2")
-def table2(preset="fast", outdir=None, refined_n_el=32):
-    rows = table2_rows(preset, refined_n_el)
-    n_el = rows[0]["n_el"]
+def table2_cells(rows):
+    """Table 2's header and rows of cells, formatted as the markdown and the image print them."""
+    n_ref = rows[0]["n_el_ref"]
     head = ["contact", "ours v_x", "ours v_y", "ours angle", "ours spin",
-            f"{refined_n_el} el. v_x", f"{refined_n_el} el. v_y", f"{refined_n_el} el. angle",
+            f"{n_ref} el. v_x", f"{n_ref} el. v_y", f"{n_ref} el. angle",
             "paper v_x", "paper v_y", "paper angle"]
-    body = []
-    for r in rows:
-        body.append([r["variant"], _fmt(r["vx"]), _fmt(r["vy"]), _fmt(r["angle"], "{:.1f}"), _fmt(r["spin"], "{:.3f}"),
-                     _fmt(r["vx_ref"]), _fmt(r["vy_ref"]), _fmt(r["angle_ref"], "{:.1f}"),
-                     _fmt(r["paper_vx"]), _fmt(r["paper_vy"]), _fmt(r["paper_angle"], "{:.0f}")])
+    body = [[r["variant"], _fmt(r["vx"]), _fmt(r["vy"]), _fmt(r["angle"], "{:.1f}"), _fmt(r["spin"], "{:.3f}"),
+             _fmt(r["vx_ref"]), _fmt(r["vy_ref"]), _fmt(r["angle_ref"], "{:.1f}"),
+             _fmt(r["paper_vx"]), _fmt(r["paper_vy"]), _fmt(r["paper_angle"], "{:.0f}")] for r in rows]
+    return head, body
+
+
+def table2_markdown(preset="fast", refined_n_el=32):
+    """figures/table2_sloping_impact.md: Table 2 from the runs (``table2_rows``)."""
+    rows = table2_rows(preset, refined_n_el)
+    head, body = table2_cells(rows)
+    n_el = rows[0]["n_el"]
+    P = result("frictionless", preset)["parameters"]
     lines = ["# Table 2: rebound of the ring after the sloping impact (Sec. 5.3)", "",
              f"Centre-of-mass velocity after rebound and angle of reflection from the normal, "
              f"atan(|v_x|/|v_y|) in degrees. 'ours': the paper's mesh ({n_el} beam elements), "
-             f"Newmark 0.7/0.4, dt = 0.1, 200 steps; '{refined_n_el} el.': the same on a refined ring. "
+             f"Newmark {P['delta']:g}/{P['beta_newmark']:g}, dt = {P['dt']:g}, {P['n_steps']} steps; "
+             f"'{refined_n_el} el.': the same on a refined ring. "
              "The paper gives no viscoplastic row (it reports a lower bounce). Spin: angular velocity "
              "about the centre of mass after rebound (counter-clockwise positive). Beam integration: "
              + "; ".join(f"{v} {result(v, preset).get('integration_points', 1)} point(s)"
@@ -129,12 +136,20 @@ def table2(preset="fast", outdir=None, refined_n_el=32):
                 if result("frictionless", preset).get("fitted") else "") + ".", "",
              "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     lines += ["| " + " | ".join(b) + " |" for b in body]
+    return "\n".join(lines) + "\n"
+
+
+@figure("table2_sloping_impact", "Table 2")
+def table2(preset="fast", outdir=None, refined_n_el=32):
+    rows = table2_rows(preset, refined_n_el)
+    n_el = rows[0]["n_el"]
+    head, body = table2_cells(rows)
     out = outdir or default_outdir(preset)
     from pathlib import Path
 
     Path(out).mkdir(parents=True, exist_ok=True)
     md = Path(out) / "table2_sloping_impact.md"
-    md.write_text("\n".join(lines) + "\n")
+    md.write_text(table2_markdown(preset, refined_n_el))
 
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(12, 1.9))
