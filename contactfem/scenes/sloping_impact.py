@@ -37,7 +37,7 @@ from ..laws import ParabolicSlip, PowerLaw
 from ..solver import History, Steps, System
 from . import time_integration
 from .base import PENALTIES, PENALTY_DOC, Param, Scene, Stage, penalty_pressure
-from .rings import RING_PARAMS, ring_history, ring_size, snapshot_indices
+from .rings import MASS_MATRIX_PARAM, RING_PARAMS, ring_history, ring_size, snapshot_indices
 
 VARIANTS = ("frictionless", "frictional", "viscoplastic")
 
@@ -82,7 +82,7 @@ def build(params, *, normal=None, friction=None, system_options=None):
         if params["kind"] == "beam" else {}
     ring = make_ring(kind=params["kind"], R=R, thickness=h, width=params["width"], n_el=params["n_el"],
                      E=params["E"], nu=params["nu"], rho=params["rho"], center=center, plastic=plastic,
-                     name="ring", **beam)
+                     name="ring", mass_matrix=params["mass_matrix"], **beam)
     if friction is None and params["variant"] != "frictionless":
         friction = ParabolicSlip(params["c_T"], params["alpha"], params["beta"], params["n"])
     plane = RigidLine((0.0, 0.0), (0.0, 1.0))
@@ -209,6 +209,7 @@ SCENE = Scene(
         Param("delta", 0.7, "", 0.5, 1.0, doc="Newmark delta (paper: 0.7; 0.5 with beta 0.25 conserves energy)"),
         Param("beta_newmark", 0.4, "", 0.0, 0.5, low_open=True, doc="Newmark beta (paper: 0.4)"),
         time_integration.CONTACT_INTEGRATION_PARAM,
+        MASS_MATRIX_PARAM,
         Param("outline_every", 20, "", 1, 100000, doc="store the ring outline every this many steps (figures)"),
     ),
     build=build,
