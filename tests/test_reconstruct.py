@@ -66,32 +66,27 @@ def block_paper():
     return {law: run_scene("block", "paper", {"law": law}) for law in ("conical", "parabolic")}
 
 
-def test_block_paper_first_residual(block_paper):
-    """Table 1: 171.3709. No uniform mesh reaches the printed digits (test above), so the
-    comparison is to 1 %: the study keeps only readings within 1 %; the preset's is +0.30 %."""
+def test_block_paper_first_residual_is_the_closed_form(block_paper):
+    """Table 1's first residual is the norm of the nodal load vector at u = 0, a closed form of
+    the reading (block_first_residual): the run gives it, up to the contact forces at the
+    initial gap g_N0 = -1e-12 (about 1e-8 against 171). (How close it comes to the printed
+    171.3709 is part of the fit: the study kept only readings within 1 % of it.)"""
+    p = block_paper["conical"]["parameters"]
+    closed = rc.block_first_residual(p["width"], p["height"], p["nx"], p["ny"], p["p_y"], p["p_x"])
     for r in block_paper.values():
-        assert abs(r["newton_residuals"][0] / 171.3709 - 1) <= 0.01, r["newton_residuals"][0]
+        assert r["newton_residuals"][0] == pytest.approx(closed, rel=1e-9)
 
 
-def test_block_paper_conical_slips_with_few_residuals(block_paper):
-    """Table 1, conical: 4 residuals, the last drop (3.2 -> 4e-11) once the stick/slip set is
-    settled. Ours: nodes slip; at most 5 residuals; the last reduction quadratic or to round-off
-    (e_{k+1} <= 10 e_k^2 or <= 1e-13, e = r / r_0)."""
-    r = block_paper["conical"]
-    assert r["n_slip"] > 0
-    res = np.array(r["newton_residuals"])
-    assert len(res) <= 5, res
-    e = res / res[0]
-    assert e[-1] <= max(10 * e[-2] ** 2, 1e-13), e
-
-
-def test_block_paper_parabolic_residuals(block_paper):
-    """Table 1, parabolic: 7 residuals. Ours: at most 8, the last two reductions quadratic."""
-    res = np.array(block_paper["parabolic"]["newton_residuals"])
-    assert len(res) <= 8, res
-    e = res / res[0]
-    for k in (-3, -2):
-        assert e[k + 1] <= max(10 * e[k] ** 2, 1e-13), e
+def test_block_paper_newton_ends_quadratically(block_paper):
+    """Table 1: the last drop (conical 3.2 -> 4e-11) is what Newton with the consistent tangent
+    does once the stick/slip set has settled. Ours: the last reduction (conical) and the last two
+    (parabolic) quadratic or to round-off, e_{k+1} <= 10 e_k^2 or <= 1e-13 (e = r / r_0). (The
+    counts of residuals were what the reading was fitted to: they are not tested here; the
+    published Table 1 is regenerated from the run in test_published_tables.py.)"""
+    for law, n_last in (("conical", 1), ("parabolic", 2)):
+        e = np.array(block_paper[law]["newton_residuals"]) / block_paper[law]["newton_residuals"][0]
+        for k in range(len(e) - 1 - n_last, len(e) - 1):
+            assert e[k + 1] <= max(10 * e[k] ** 2, 1e-13), (law, e)
 
 
 def test_run_block_json_reports_slip_and_fitted_values(tmp_path):
@@ -103,9 +98,12 @@ def test_run_block_json_reports_slip_and_fitted_values(tmp_path):
 
 
 def test_canonical_preset_is_the_earlier_reading():
+    """The README: the earlier reading (preset canonical) 'has no slip and 2 residuals': the run's."""
     p = get_scene("block").resolve("canonical")
     assert (p["width"], p["height"], p["nx"], p["ny"], p["p_x_face"]) == (4.0, 3.5, 20, 10, "right")
-    assert run_scene("block", "canonical")["n_slip"] == 0     # why it was replaced: no slip
+    r = run_scene("block", "canonical")
+    assert r["n_slip"] == 0                                   # why it was replaced: no slip
+    assert f"has no slip and {len(r['newton_residuals'])} residuals" in " ".join(README.split())
 
 
 # ---------------------------------------------------------------------------------------
