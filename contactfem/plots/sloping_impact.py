@@ -8,6 +8,8 @@
 Each figure draws the outer surface of the ring every `outline_every` steps (default 20,
 i.e. every 2 time units) over the plane, the path of the centre, and below it the
 energy histories (kinetic, strain, contact, their sum, and the frictional dissipation).
+Each draws a result it is given (``r=``, ``results=``: a lecture's own time loop) or runs
+the scene.
 """
 
 
@@ -58,8 +60,8 @@ def draw_impact(r, title):
 
 
 @figure("fig10_sloping_impact_frictionless", "Fig 10")
-def fig10(preset="fast", outdir=None):
-    r = result("frictionless", preset)
+def fig10(preset="fast", outdir=None, r=None):
+    r = r or result("frictionless", preset)
     p = r["parameters"]
     fig = draw_impact(r, f"Fig 10: sloping impact, frictionless contact (Newmark {p['delta']:g}/{p['beta_newmark']:g}, "
                          f"dt = {p['dt']:g})")
@@ -67,8 +69,8 @@ def fig10(preset="fast", outdir=None):
 
 
 @figure("fig11a_sloping_impact_frictional", "Fig 11a")
-def fig11a(preset="fast", outdir=None):
-    r = result("frictional", preset)
+def fig11a(preset="fast", outdir=None, r=None):
+    r = r or result("frictional", preset)
     p = r["parameters"]
     fig = draw_impact(r, f"Fig 11a: sloping impact, frictional contact (eq 10: n = {p['n']:g}, alpha = {p['alpha']:g}, "
                          f"beta = {p['beta']:g})")
@@ -76,20 +78,21 @@ def fig11a(preset="fast", outdir=None):
 
 
 @figure("fig11b_sloping_impact_viscoplastic", "Fig 11b")
-def fig11b(preset="fast", outdir=None):
-    r = result("viscoplastic", preset)
+def fig11b(preset="fast", outdir=None, r=None):
+    r = r or result("viscoplastic", preset)
     eta = r["parameters"]["eta"]
     fig = draw_impact(r, "Fig 11b: frictional contact, viscoplastic ring (N0 = 1, Q0 = 0.5, M0 = 0.25; "
                          f"eta = {eta:g} chosen)")
     return [savefig(fig, outdir or default_outdir(preset), "fig11b_sloping_impact_viscoplastic")]
 
 
-def table2_rows(preset="fast", refined_n_el=32):
-    """Rows of Table 2: per variant, ours (the paper's 16 elements), ours on a refined
-    ring (refined_n_el elements) and the paper's values."""
+def table2_rows(preset="fast", refined_n_el=32, results=None):
+    """Rows of Table 2: per variant, ours (the paper's 16 elements; ``results``: variant ->
+    a result to take instead of the scene's run), ours on a refined ring (refined_n_el
+    elements) and the paper's values."""
     rows = []
     for variant in ("frictionless", "frictional", "viscoplastic"):
-        r = result(variant, preset)
+        r = (results or {}).get(variant) or result(variant, preset)
         f = result(variant, preset, n_el=refined_n_el)
         p = PAPER_TABLE2.get(variant)
         rows.append(dict(variant=variant, vx=r["rebound_vx"], vy=r["rebound_vy"], angle=r["rebound_angle_deg"],
@@ -105,8 +108,11 @@ def _fmt(x, f="{:.2f}"):
 
 
 @figure("table2_sloping_impact", "Table 2")
-def table2(preset="fast", outdir=None, refined_n_el=32):
-    rows = table2_rows(preset, refined_n_el)
+def table2(preset="fast", outdir=None, refined_n_el=32, results=None):
+    """Table 2 (.md and .png); ``results``: variant -> result for the columns "ours"."""
+    rows = table2_rows(preset, refined_n_el, results)
+    given = results or {}
+    ours = lambda v: given.get(v) or result(v, preset)      # noqa: E731
     n_el = rows[0]["n_el"]
     head = ["contact", "ours v_x", "ours v_y", "ours angle", "ours spin",
             f"{refined_n_el} el. v_x", f"{refined_n_el} el. v_y", f"{refined_n_el} el. angle",
@@ -122,11 +128,11 @@ def table2(preset="fast", outdir=None, refined_n_el=32):
              f"Newmark 0.7/0.4, dt = 0.1, 200 steps; '{refined_n_el} el.': the same on a refined ring. "
              "The paper gives no viscoplastic row (it reports a lower bounce). Spin: angular velocity "
              "about the centre of mass after rebound (counter-clockwise positive). Beam integration: "
-             + "; ".join(f"{v} {result(v, preset).get('integration_points', 1)} point(s)"
+             + "; ".join(f"{v} {ours(v).get('integration_points', 1)} point(s)"
                          for v in ("frictionless", "frictional", "viscoplastic"))
              + (" (2 points FITTED to this table: `contactfem reconstruct sloping_impact`; the scan does not "
                 "say; the viscoplastic ring keeps the midpoint rule)"
-                if result("frictionless", preset).get("fitted") else "") + ".", "",
+                if ours("frictionless").get("fitted") else "") + ".", "",
              "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     lines += ["| " + " | ".join(b) + " |" for b in body]
     out = outdir or default_outdir(preset)
@@ -143,7 +149,7 @@ def table2(preset="fast", outdir=None, refined_n_el=32):
     tab.auto_set_font_size(False)
     tab.set_fontsize(8)
     tab.scale(1.0, 1.5)
-    fitted = fitted_words(result("frictionless", preset), "this table")
+    fitted = fitted_words(ours("frictionless"), "this table")
     ax.set_title(f"Table 2: rebound after the sloping impact, ours ({n_el} and {refined_n_el} elements) vs paper"
                  + (f"\nours, frictionless and frictional rows: {fitted} (points per beam element)" if fitted else ""),
                  fontsize=9)
