@@ -274,10 +274,10 @@ def compare_runs(mine, ref, skip=RUN_KEYS):
             A, B = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
         except (TypeError, ValueError):
             return None
+        if A.size == 0 and B.size == 0:                 # nothing in either ([] and an empty (0, 2) array)
+            return None
         if A.shape != B.shape:
             return note(np.inf, key)
-        if B.size == 0:
-            return None
         count += B.size
         scale = float(np.max(np.abs(B)))
         diff = float(np.max(np.abs(A - B)))

@@ -154,3 +154,79 @@ def table2(preset="fast", outdir=None, refined_n_el=32, results=None):
                  + (f"\nours, frictionless and frictional rows: {fitted} (points per beam element)" if fitted else ""),
                  fontsize=9)
     return [str(md), savefig(fig, out, "table2_sloping_impact")]
+
+
+# The discretisation study of lecture 06: the one-point ring (integration = 1) of the paper's run,
+# refined in the mesh, the step and the integrator, up to t = 20 (the paper's 200 steps of 0.1).
+# About a minute; the table is kept in figures/ (`contactfem figures --only discretisation`) and
+# tests/test_sloping_impact.py recomputes its 16-element rows (CONTACTFEM_SLOW=1: every row).
+AVERAGE = dict(delta=0.5, beta_newmark=0.25)
+DISCRETISATION = (
+    ("16, 0.1, 0.7/0.4 (the paper's run)", dict(n_el=16, dt=0.1, n_steps=200), ("frictionless", "frictional")),
+    ("16, 0.0125, 1/2 / 1/4", dict(n_el=16, dt=0.0125, n_steps=1600, **AVERAGE), ("frictionless", "frictional")),
+    ("32, 0.025, 1/2 / 1/4", dict(n_el=32, dt=0.025, n_steps=800, **AVERAGE), ("frictionless", "frictional")),
+    ("128, 0.0125, 0.7/0.4", dict(n_el=128, dt=0.0125, n_steps=1600), ("frictionless", "frictional")),
+    ("128, 0.0125, 1/2 / 1/4", dict(n_el=128, dt=0.0125, n_steps=1600, **AVERAGE), ("frictionless", "frictional")),
+    ("continuum ring 64 x 2, 0.025, 1/2 / 1/4", dict(kind="continuum", n_el=64, dt=0.025, n_steps=800, **AVERAGE),
+     ("frictionless",)),
+)
+
+
+def discretisation_rows(preset="fast", quick=False):
+    """The rebound (v_x, v_y, angle, and the energy left, E_end / E_0) of each row of
+    DISCRETISATION and variant; ``quick``: the 16-element rows only."""
+    rows = []
+    for label, over, variants in DISCRETISATION:
+        if quick and over["n_el"] != 16:
+            continue
+        row = dict(label=label, overrides=over)
+        for v in variants:
+            kw = dict(over) if over.get("kind") == "continuum" else dict(over, integration="1")
+            r = result(v, preset, **kw)
+            E = np.asarray(r["energy_total"])
+            row[v] = dict(vx=r["rebound_vx"], vy=r["rebound_vy"], angle=r["rebound_angle_deg"],
+                          energy_left=float(E[-1] / E[0]))
+        rows.append(row)
+    return rows
+
+
+def discretisation_markdown(rows):
+    """The study as a markdown table (what figures/table_sloping_impact_discretisation.md holds)."""
+    def frictionless(row):
+        r = row.get("frictionless")
+        return ("", "") if r is None else (f"{r['vy']:.2f}, {r['angle']:.1f} deg", f"{r['energy_left']:.3f}")
+
+    def frictional(row):
+        r = row.get("frictional")
+        return ("", "") if r is None else (f"{r['vx']:.2f}, {r['vy']:.2f}, {r['angle']:.1f} deg",
+                                           f"{r['energy_left']:.3f}")
+    lines = ["# The sloping impact against its discretisation (lecture 06)", "",
+             "The one-point beam ring of the paper's run (integration = 1), frictionless and frictional, refined in "
+             "the mesh (elements), the step (dt) and the integrator (Newmark delta / beta) up to t = 20. Rebound "
+             "velocity of the centre of mass and the angle of reflection from the normal; E_end / E_0: the "
+             "mechanical energy left at the end. Paper, Table 2: frictionless (2, 1.7), 50 deg; frictional "
+             "(1.2, 1.7), 35 deg.", "",
+             "| elements, dt, Newmark | frictionless v_y, angle | frictionless E_end / E_0 | frictional v_x, v_y, "
+             "angle | frictional E_end / E_0 |", "|---|---|---|---|---|"]
+    for row in rows:
+        lines.append("| " + " | ".join([row["label"], *frictionless(row), *frictional(row)]) + " |")
+    return "\n".join(lines) + "\n"
+
+
+@figure("table_sloping_impact_discretisation", "Table 2 (discretisation)")
+def table_sloping_impact_discretisation(preset="fast", outdir=None, rows=None):
+    """The discretisation study (.md, and .json with its numbers); ``rows``: discretisation_rows
+    computed before (default: computed here, about a minute)."""
+    import json
+    from pathlib import Path
+
+    from ..scenes.base import jsonable
+
+    rows = rows if rows is not None else discretisation_rows(preset)
+    out = Path(outdir or default_outdir(preset))
+    out.mkdir(parents=True, exist_ok=True)
+    md = out / "table_sloping_impact_discretisation.md"
+    md.write_text(discretisation_markdown(rows))
+    data = out / "table_sloping_impact_discretisation.json"
+    data.write_text(json.dumps(jsonable(dict(preset=preset, rows=rows)), indent=1) + "\n")
+    return [str(md), str(data)]
