@@ -281,13 +281,13 @@ def numbers_agree(a, b, rel=1e-12, skip=("wall_time_s", "linear_algebra", "order
 
 
 def cork_press_fit(preset):
-    from contactfem.scenes import cork, cork_stages
+    from contactfem.scenes import cork, cork_measure, cork_stages
 
     params = get_scene("cork").resolve(preset)
     model = cork.build(params)
     last, fit = cork_stages.press_fit(model, params)
     (system,) = model["systems"]
-    return dict(fit, **cork_stages.contact_forces(last.contacts), u=last.u, linear_algebra=system.linear_algebra,
+    return dict(fit, **cork_measure.contact_forces(last.contacts), u=last.u, linear_algebra=system.linear_algebra,
                 ordering=system.ordering)
 
 

@@ -18,7 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..scenes.block import PAPER_TABLE1, PAPER_TABLE1_UNCERTAIN, SCENE, solve
+from ..scenes.block import SCENE, solve
+from ..scenes.block_params import PAPER_TABLE1, PAPER_TABLE1_UNCERTAIN
 from ..solver.newton import NewtonError
 from . import cached_run, default_outdir, describe_newton, figure, fitted_words, pyplot, savefig
 
