@@ -133,3 +133,31 @@ def test_figures_and_table(tmp_path):
     assert all((tmp_path / f).exists() for f in files)
     md = (tmp_path / "table2_sloping_impact.md").read_text()
     assert "| frictionless |" in md and "50" in md and "35" in md
+
+
+def test_discretisation_study_kept_with_the_figures_is_the_run():
+    """figures/table_sloping_impact_discretisation.{md,json} (lecture 06 reads its conclusions from
+    it) are the study's run: the markdown is its JSON's, and its 16-element rows are recomputed
+    here to round-off (a few seconds; CONTACTFEM_SLOW=1: every row, about a minute)."""
+    import json
+    import os
+    from pathlib import Path
+
+    from contactfem.plots import sloping_impact as F
+
+    base = Path(__file__).resolve().parents[1] / "figures" / "table_sloping_impact_discretisation"
+    kept = json.loads(base.with_suffix(".json").read_text())
+    assert base.with_suffix(".md").read_text() == F.discretisation_markdown(kept["rows"])
+    assert [r["label"] for r in kept["rows"]] == [label for label, _, _ in F.DISCRETISATION]
+    by_label = {r["label"]: r for r in kept["rows"]}
+    readme = " ".join((base.parents[1] / "README.md").read_text().split())
+    converged = by_label["128, 0.0125, 1/2 / 1/4"]["frictionless"]["angle"]
+    assert f"brings the frictionless angle to {converged:.1f} deg" in readme      # the README's Table 2 section
+    rows = F.discretisation_rows(kept["preset"], quick=not os.environ.get("CONTACTFEM_SLOW"))
+    assert rows
+    for row in rows:
+        for variant in ("frictionless", "frictional"):
+            assert (variant in row) == (variant in by_label[row["label"]]), (row["label"], variant)
+            for k, v in row.get(variant, {}).items():
+                assert v == pytest.approx(by_label[row["label"]][variant][k], rel=1e-9, abs=1e-12), \
+                    (row["label"], variant, k)

@@ -12,7 +12,8 @@
                                 discretisation (.png, .md, .json): why the paper preset's exit
                                 lies outside the paper's 2.6-2.7 ms
 
-The problem is axisymmetric (x = r, y = z); the drawings mirror the meridian in the
+Figs 14-17 draw a result they are given (``r=``: a lecture's own time loops) or run the
+scene. The problem is axisymmetric (x = r, y = z); the drawings mirror the meridian in the
 axis to show the whole cork and both sides of the neck.
 """
 
@@ -60,9 +61,9 @@ def draw_neck(ax, neck, gas_column=None):
 
 
 @figure("fig14_cork_mesh", "Fig 14")
-def fig14_cork_mesh(preset="fast", outdir=None):
+def fig14_cork_mesh(preset="fast", outdir=None, r=None):
     plt = pyplot()
-    r = result(preset)
+    r = r or result(preset)
     mesh, neck = _geometry(r["parameters"])
     fig, axes = plt.subplots(1, 2, figsize=(9, 6.5), sharey=True)
     draw_mesh(axes[0], mesh, mesh.p.T)
@@ -81,9 +82,9 @@ def fig14_cork_mesh(preset="fast", outdir=None):
 
 
 @figure("fig15_cork_configurations", "Fig 15")
-def fig15_cork_configurations(preset="fast", outdir=None):
+def fig15_cork_configurations(preset="fast", outdir=None, r=None):
     plt = pyplot()
-    r = result(preset)
+    r = r or result(preset)
     mesh, neck = _geometry(r["parameters"])
     xs, ts, tp = r["snapshots_x"], r["snapshot_times_ms"], r["snapshot_paper_times_ms"]
     fig, axes = plt.subplots(1, len(xs), figsize=(1.9 * len(xs), 5.5), sharey=True)
@@ -103,9 +104,9 @@ def fig15_cork_configurations(preset="fast", outdir=None):
 
 
 @figure("fig16_cork_pressure", "Fig 16")
-def fig16_cork_pressure(preset="fast", outdir=None):
+def fig16_cork_pressure(preset="fast", outdir=None, r=None):
     plt = pyplot()
-    r = result(preset)
+    r = r or result(preset)
     fig, ax = plt.subplots(figsize=(6.5, 4))
     ax.step(r["time_ms"], r["pressure_MPa"], where="pre", color="C0", label="gas pressure (used in the step)")
     if r["gas_release_time_ms"] is not None:
@@ -123,9 +124,9 @@ def fig16_cork_pressure(preset="fast", outdir=None):
 
 
 @figure("fig17_cork_displacement", "Fig 17")
-def fig17_cork_displacement(preset="fast", outdir=None):
+def fig17_cork_displacement(preset="fast", outdir=None, r=None):
     plt = pyplot()
-    r = result(preset)
+    r = r or result(preset)
     fig, ax = plt.subplots(figsize=(6.5, 4))
     ax.plot(r["time_ms"], r["displacement_bottom_mm"], label="bottom centre")
     ax.plot(r["time_ms"], r["displacement_cm_mm"], label="centre of mass")
