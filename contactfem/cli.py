@@ -512,6 +512,8 @@ def interrupted(exc):
 def main(argv=None):
     """The command line; returns the exit code. Called without argv (as the program), a
     Ctrl-C after the work is done (while Python shuts down) no longer changes the outcome."""
+    if argv is None:
+        _catch_interrupts()
     try:
         with imports_timed() as imported:
             _CLOCK.update(imported=imported, own=_OWN_IMPORT_S.pop() if _OWN_IMPORT_S else 0.0)
@@ -529,6 +531,24 @@ def main(argv=None):
         sys.stderr.flush()
         os._exit(130)
     return code
+
+
+_INTERRUPTED = []
+
+
+def _on_sigint(signum, frame):
+    _INTERRUPTED.append(True)
+    raise KeyboardInterrupt
+
+
+def _catch_interrupts():
+    """Record every Ctrl-C before raising it: a library interrupted inside its import may
+    turn the KeyboardInterrupt into an error of its own (numpy: "ImportError: numpy._core
+    .multiarray failed to import"); what follows a recorded interrupt is that interrupt."""
+    import signal
+
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        signal.signal(signal.SIGINT, _on_sigint)
 
 
 def _report_ready():
@@ -556,6 +576,9 @@ def _main(argv):
         print(f"contactfem: error: {exc}", file=sys.stderr)
         return 2
     except ValueError as exc:
+        if _INTERRUPTED:                              # the interrupt, turned into another error by a library
+            print(("\n" if _RUN.get("progress") else "") + interrupted(exc), file=sys.stderr)
+            return 130
         from .laws.protocol import LawValueError
 
         if isinstance(exc, LawValueError):           # a law returned a bad value during the run: the run failed
@@ -572,6 +595,9 @@ def _main(argv):
         print("contactfem: out of memory: use a coarser mesh (see contactfem show SCENE)", file=sys.stderr)
         return 1
     except Exception as exc:
+        if _INTERRUPTED:                              # the interrupt, turned into another error by a library
+            print(("\n" if _RUN.get("progress") else "") + interrupted(exc), file=sys.stderr)
+            return 130
         from .solver.newton import NewtonError
 
         if isinstance(exc, (ZeroDivisionError, OverflowError)):       # Python arithmetic at the float limits

@@ -228,6 +228,36 @@ def _interrupt(folder, delay=None, when_part=False, timeout=300):
     return p.returncode, err, sorted(f.name for f in folder.iterdir())
 
 
+LIBRARY_TURNS_CTRL_C_INTO_IMPORT_ERROR = """
+import os, signal, sys, time
+import contactfem.cli as cli
+
+class Parser:
+    def parse_args(self, argv):
+        return self
+    def func(self, args):
+        try:                                    # numpy, interrupted inside its import, re-raises as its own error
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(5)
+        except KeyboardInterrupt:
+            raise ImportError("numpy._core.multiarray failed to import")
+
+cli.build_parser = Parser
+sys.argv = ["contactfem", "run", "x"]
+sys.exit(cli.main())
+"""
+
+
+def test_ctrl_c_turned_into_another_error_by_a_library_is_still_the_interrupt():
+    """A Ctrl-C landing in numpy's import surfaces as an ImportError; the command line
+    recorded the interrupt, so the user sees the interrupt's one line and exit code 130,
+    not an internal error."""
+    p = subprocess.run([sys.executable, "-c", LIBRARY_TURNS_CTRL_C_INTO_IMPORT_ERROR],
+                       capture_output=True, text=True, timeout=120)
+    assert p.returncode == 130, p.stderr
+    assert p.stderr.strip() == "contactfem: interrupted before the run started; nothing written", p.stderr
+
+
 @pytest.fixture(scope="module")
 def ring_run(tmp_path_factory):
     """The whole run, uninterrupted: its duration sets the moments to interrupt at."""

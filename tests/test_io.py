@@ -129,3 +129,22 @@ def test_progress_bar():
     assert "step 4/4" in steps.getvalue()
     with pytest.raises(ValueError, match="exactly one of total"):
         ProgressBar()
+
+
+def test_compare_runs_walks_every_number():
+    """compare_runs: the largest relative difference over the numbers both results hold (an
+    array scaled by its largest value), text compared for equality, what describes the run
+    (wall time, parameters) left out, entries the first lacks listed."""
+    from contactfem.io import compare_runs
+
+    ref = {"a": [1.0, 2.0, 4.0], "b": {"c": 3.0, "s": ["stick", "slip"]}, "wall_time_s": 1.0,
+           "parameters": {"x": 1}, "empty": [], "none": None}
+    same = {"a": np.array([1.0, 2.0, 4.0]), "b": {"c": 3.0, "s": ["stick", "slip"]}, "wall_time_s": 9.0,
+            "empty": np.zeros((0, 2)), "none": None}
+    d = compare_runs(same, ref)
+    assert d["worst"] == 0.0 and d["compared"] == 4 and d["missing"] == []
+    d = compare_runs(dict(same, a=np.array([1.0, 2.0, 4.0 + 4e-6])), ref)
+    assert d["worst"] == pytest.approx(1e-6) and d["key"] == "a"
+    assert compare_runs(dict(same, a=[1.0, 2.0]), ref)["worst"] == np.inf
+    assert compare_runs(dict(same, b={"c": 3.0, "s": ["stick", "open"]}), ref)["key"] == "b.s[1]"
+    assert compare_runs({"a": ref["a"]}, ref)["missing"] == ["b", "empty", "none"]

@@ -1,7 +1,7 @@
 """The scan's unknowns as an inverse problem (contactfem.lab.reconstruct): the block's
 reading against Table 1 and Fig 8, the sloping impact's against Table 2.
 
-CI runs the full studies through the command line (about a minute for the block, half a
+CI runs the full studies through the command line (about a minute for the block, under a
 minute for the sloping impact), each with a private cache."""
 
 import json
@@ -66,32 +66,27 @@ def block_paper():
     return {law: run_scene("block", "paper", {"law": law}) for law in ("conical", "parabolic")}
 
 
-def test_block_paper_first_residual(block_paper):
-    """Table 1: 171.3709. No uniform mesh reaches the printed digits (test above), so the
-    comparison is to 1 %: the study keeps only readings within 1 %; the preset's is +0.30 %."""
+def test_block_paper_first_residual_is_the_closed_form(block_paper):
+    """Table 1's first residual is the norm of the nodal load vector at u = 0, a closed form of
+    the reading (block_first_residual): the run gives it, up to the contact forces at the
+    initial gap g_N0 = -1e-12 (about 1e-8 against 171). (How close it comes to the printed
+    171.3709 is part of the fit: the study kept only readings within 1 % of it.)"""
+    p = block_paper["conical"]["parameters"]
+    closed = rc.block_first_residual(p["width"], p["height"], p["nx"], p["ny"], p["p_y"], p["p_x"])
     for r in block_paper.values():
-        assert abs(r["newton_residuals"][0] / 171.3709 - 1) <= 0.01, r["newton_residuals"][0]
+        assert r["newton_residuals"][0] == pytest.approx(closed, rel=1e-9)
 
 
-def test_block_paper_conical_slips_with_few_residuals(block_paper):
-    """Table 1, conical: 4 residuals, the last drop (3.2 -> 4e-11) once the stick/slip set is
-    settled. Ours: nodes slip; at most 5 residuals; the last reduction quadratic or to round-off
-    (e_{k+1} <= 10 e_k^2 or <= 1e-13, e = r / r_0)."""
-    r = block_paper["conical"]
-    assert r["n_slip"] > 0
-    res = np.array(r["newton_residuals"])
-    assert len(res) <= 5, res
-    e = res / res[0]
-    assert e[-1] <= max(10 * e[-2] ** 2, 1e-13), e
-
-
-def test_block_paper_parabolic_residuals(block_paper):
-    """Table 1, parabolic: 7 residuals. Ours: at most 8, the last two reductions quadratic."""
-    res = np.array(block_paper["parabolic"]["newton_residuals"])
-    assert len(res) <= 8, res
-    e = res / res[0]
-    for k in (-3, -2):
-        assert e[k + 1] <= max(10 * e[k] ** 2, 1e-13), e
+def test_block_paper_newton_ends_quadratically(block_paper):
+    """Table 1: the last drop (conical 3.2 -> 4e-11) is what Newton with the consistent tangent
+    does once the stick/slip set has settled. Ours: the last reduction (conical) and the last two
+    (parabolic) quadratic or to round-off, e_{k+1} <= 10 e_k^2 or <= 1e-13 (e = r / r_0). (The
+    counts of residuals were what the reading was fitted to: they are not tested here; the
+    published Table 1 is regenerated from the run in test_published_tables.py.)"""
+    for law, n_last in (("conical", 1), ("parabolic", 2)):
+        e = np.array(block_paper[law]["newton_residuals"]) / block_paper[law]["newton_residuals"][0]
+        for k in range(len(e) - 1 - n_last, len(e) - 1):
+            assert e[k + 1] <= max(10 * e[k] ** 2, 1e-13), (law, e)
 
 
 def test_run_block_json_reports_slip_and_fitted_values(tmp_path):
@@ -103,9 +98,12 @@ def test_run_block_json_reports_slip_and_fitted_values(tmp_path):
 
 
 def test_canonical_preset_is_the_earlier_reading():
+    """The README: the earlier reading (preset canonical) 'has no slip and 2 residuals': the run's."""
     p = get_scene("block").resolve("canonical")
     assert (p["width"], p["height"], p["nx"], p["ny"], p["p_x_face"]) == (4.0, 3.5, 20, 10, "right")
-    assert run_scene("block", "canonical")["n_slip"] == 0     # why it was replaced: no slip
+    r = run_scene("block", "canonical")
+    assert r["n_slip"] == 0                                   # why it was replaced: no slip
+    assert f"has no slip and {len(r['newton_residuals'])} residuals" in " ".join(README.split())
 
 
 # ---------------------------------------------------------------------------------------
@@ -133,15 +131,15 @@ def _key(row, keys):
     return {k: row[k] for k in keys}
 
 
-def _check_outcomes(out, kinds):
+def _check_outcomes(out, kinds, eligible=lambda r: True):
     rows = out["readings"]
     assert [r["outcome"] for r in rows if r["outcome"] not in kinds] == []
     assert out["outcomes"] == {o: sum(r["outcome"] == o for r in rows) for o in kinds}
     assert sum(out["outcomes"].values()) == len(rows)
     ranked = [r for r in rows if r["rank"] is not None]
-    assert all(r["outcome"] == "converged" for r in ranked)
+    assert all(r["outcome"] == "converged" and eligible(r) for r in ranked)
     assert [r["rank"] for r in ranked] == list(range(1, len(ranked) + 1))
-    assert len(ranked) == out["outcomes"]["converged"] > 0
+    assert len(ranked) == sum(r["outcome"] == "converged" and eligible(r) for r in rows) > 0
     key = [(-r["n_facts"], r["distance"]) for r in ranked]
     assert key == sorted(key)                                   # most facts, then nearest, first
 
@@ -232,7 +230,7 @@ def test_readme_block_residuals_are_the_run(block_paper):
 
 def test_sloping_study_records_every_outcome(study):
     out = study("sloping_impact")
-    _check_outcomes(out, rc.SLOPING_OUTCOMES)
+    _check_outcomes(out, rc.SLOPING_OUTCOMES, rc.follows_text)
     rows = out["readings"]
     for r in rows:
         gains = [r["frictionless_energy_gain"], r["frictional_energy_gain"]]
@@ -246,8 +244,9 @@ def test_sloping_study_records_every_outcome(study):
 
 
 def test_sloping_study_no_reading_meets_table2(study):
-    """No admissible reading brings any of Table 2's three informative numbers within 10 %;
-    every two-point reading ranks above every one-point one (why the preset uses two points);
+    """No ranked reading (admissible, with the paper's mass and integrator) brings any of Table 2's
+    three informative numbers within 10 %; every two-point reading ranks above every one-point
+    one (why the preset uses two points);
     the README's Table 2 section prints the study's rows (preset, midpoint, closest)."""
     rows = [r for r in study("sloping_impact")["readings"] if r["rank"]]
     assert len(rows) >= 40
@@ -281,6 +280,53 @@ def test_sloping_study_no_reading_meets_table2(study):
     text = " ".join(section.split())
     for t in (f"by at most {minor:.2f};", f"moves the frictionless v_y by {rule[0]:.2f}",
               f"frictional v_x, v_y by {rule[1]:.2f} and {rule[2]:.2f}", f"moves them by at most {c_N:.2f}."):
+        assert t in text, f"README's Table 2 section lacks {t!r}"
+
+
+def test_sloping_study_mass_and_integration_against_the_text(study):
+    """The paper states a lumped mass and Newmark 0.7/0.4; the study runs the preset, the
+    midpoint reading and the best ranked one also with the consistent mass and the
+    energy-consistent stepper (each of the three other combinations), shown and not ranked.
+    The energy-consistent stepper keeps the energy (frictionless: E(end) = E0 to the Newton
+    tolerance, the damped Newmark less). The README states how the preset's numbers move:
+    checked here against the study's rows."""
+    out = study("sloping_impact")
+    rows = out["readings"]
+    assert out["text"] == rc.SLOPING_TEXT
+    against = [r for r in rows if not r["follows_text"]]
+    assert all(r["rank"] is None and r["against_text"] for r in against)
+    best = next(r for r in rows if r["rank"] == 1)
+    bases = [rc.SLOPING_PAPER_READING, dict(rc.SLOPING_PAPER_READING, integration="1"), _key(best, rc.SLOPING_KEYS)]
+    for b in bases:
+        for mass, integ in (("consistent", "standard"), ("lumped", "energy_consistent"),
+                            ("consistent", "energy_consistent")):
+            key = dict(b, mass_matrix=mass, contact_integration=integ)
+            assert sum(_key(r, rc.SLOPING_KEYS) == key for r in against) == 1, key
+    for r in against:
+        if r["contact_integration"] == "energy_consistent" and r["outcome"] == "converged":
+            assert r["frictionless_energy_final"] == pytest.approx(1.0, abs=1e-6)     # no damping, no friction
+            assert r["frictional_energy_final"] < 1.0                                  # friction dissipates
+    preset = next(r for r in rows if _key(r, rc.SLOPING_KEYS) == rc.SLOPING_PAPER_READING)
+    assert preset["frictionless_energy_final"] < 1.0                                   # Newmark 0.7/0.4 damps
+
+    def row(**kw):
+        return next(r for r in rows if _key(r, rc.SLOPING_KEYS) == dict(rc.SLOPING_PAPER_READING, **kw))
+    cm, ec, both = row(mass_matrix="consistent"), row(contact_integration="energy_consistent"), \
+        row(mass_matrix="consistent", contact_integration="energy_consistent")
+
+    def d(r, k):
+        return abs(r[k]) - abs(preset[k])
+    n = len(rc.TABLE2_SCORED)
+    text = " ".join(README[README.index("**Mass and time integration"):README.index("### The cork")].split())
+    for t in (f"the frictionless v_y by {d(cm, 'frictionless_vy'):+.2f}, the frictional v_x, v_y by "
+              f"{d(cm, 'frictional_vx'):+.2f} and {d(cm, 'frictional_vy'):+.2f}",
+              f"ends with {ec['frictionless_energy_final']:.2f} E0 against {preset['frictionless_energy_final']:.2f} E0",
+              f"v_y by {d(ec, 'frictionless_vy'):+.2f} to {ec['frictionless_vy']:.2f} ({ec['frictionless_angle']:.1f} deg)",
+              f"the frictional v_x by {d(ec, 'frictional_vx'):+.2f} to {ec['frictional_vx']:.2f} and its v_y by "
+              f"{d(ec, 'frictional_vy'):+.2f} to {ec['frictional_vy']:.2f} ({ec['frictional_angle']:.1f} deg)",
+              f"{ec['n_facts']} of {n} scored numbers within 10 %",
+              f"Both together: {both['frictionless_vy']:.2f}; {both['frictional_vx']:.2f} and "
+              f"{both['frictional_vy']:.2f} ({both['n_facts']} of {n})"):
         assert t in text, f"README's Table 2 section lacks {t!r}"
 
 

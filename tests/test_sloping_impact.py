@@ -40,29 +40,31 @@ def test_rebound_angle_definition():
     assert rebound_angle(1.2, -1.7) == pytest.approx(35.22, abs=0.01)   # Table 2: 35 deg
 
 
-# Table 2 prints the velocities to two digits (1.7, 1.2: +-0.05, 3-4 %) and the angles as
-# multiples of 5 deg (+-2.5 deg). A number is reproduced when ours is within 10 % (velocities)
-# or 5 deg (angles): twice the printing uncertainty, the rest for the paper's own
+# Table 2 prints the velocities to two digits (1.7, 1.2: +-0.05, 3-4 %). A number is reproduced
+# when ours is within 10 %: twice the printing uncertainty, the rest for the paper's own
 # time-discretisation error at dt = 0.1, which for ours is of that size (lecture 06: v_y moves
 # by 0.1-0.3 from dt = 0.1 to 0.0125). Same criterion as `contactfem reconstruct sloping_impact`.
-VELOCITY_TOL, ANGLE_TOL = rc.TABLE2_VELOCITY_TOL, rc.TABLE2_ANGLE_TOL_DEG
+# The angles are not compared with the paper's here: each is atan(|v_x| / |v_y|) of its row, and
+# the beam integration was fitted so that they land near the printed ones.
+VELOCITY_TOL = rc.TABLE2_VELOCITY_TOL
 
 
-def test_table2_numbers_reproduced(res):
-    """Table 2 at the paper's 16 elements, dt = 0.1, Newmark 0.7/0.4: the frictionless v_x
-    (exact: a frictionless plane exerts no tangential force) and both angles."""
-    fl, fr = res["frictionless"], res["frictional"]
-    assert fl["rebound_vx"] == pytest.approx(2.0, abs=1e-8), "frictionless: v_x is kept (paper: 2)"
-    for r, v in ((fl, "frictionless"), (fr, "frictional")):
-        p = PAPER_TABLE2[v]["angle_deg"]
-        assert abs(r["rebound_angle_deg"] - p) <= ANGLE_TOL, \
-            f"{v} rebound angle: ours {r['rebound_angle_deg']:.1f}, paper {p}, tol {ANGLE_TOL} deg"
+@pytest.mark.parametrize("over", [{}, {"integration": "1"}, {"mass_matrix": "consistent"},
+                                  {"contact_integration": "energy_consistent"}, {"kind": "continuum", "n_el": 24}])
+def test_a_frictionless_plane_keeps_v_x(over):
+    """Table 2's frictionless v_x = 2 is no test of a reading: a frictionless plane exerts no
+    tangential force, so the momentum along it is kept, whatever the ring, its mass and the
+    stepper (both keep linear momentum exactly when the resultant is zero): v_x = 2 to 1e-8."""
+    r = run_scene("sloping_impact", "paper", dict(over, variant="frictionless", n_steps=60))
+    assert r["rebounded"] and r["rebound_vx"] == pytest.approx(2.0, rel=1e-8)
+    assert np.allclose(r["vx_c"], 2.0, rtol=1e-8, atol=0)               # at every step, through the impact
 
 
 def test_table2_velocities_out_of_reach_are_documented(res):
     """The frictionless v_y and the frictional v_x, v_y are 14-18 % below the paper's 1.7,
     1.2, 1.7 (outside the 10 % above) with every reading `contactfem reconstruct
-    sloping_impact` tries; the README states this with the study's numbers. Checked: each
+    sloping_impact` ranks (those with the paper's mass and integrator); the README states this
+    with the study's numbers. Checked: each
     velocity against the paper with the 10 % criterion, and the README's numbers against
     this run (to the two printed decimals), so that neither can drift silently."""
     readme = (Path(__file__).parents[1] / "README.md").read_text()
@@ -131,3 +133,31 @@ def test_figures_and_table(tmp_path):
     assert all((tmp_path / f).exists() for f in files)
     md = (tmp_path / "table2_sloping_impact.md").read_text()
     assert "| frictionless |" in md and "50" in md and "35" in md
+
+
+def test_discretisation_study_kept_with_the_figures_is_the_run():
+    """figures/table_sloping_impact_discretisation.{md,json} (lecture 06 reads its conclusions from
+    it) are the study's run: the markdown is its JSON's, and its 16-element rows are recomputed
+    here to round-off (a few seconds; CONTACTFEM_SLOW=1: every row, about a minute)."""
+    import json
+    import os
+    from pathlib import Path
+
+    from contactfem.plots import sloping_impact as F
+
+    base = Path(__file__).resolve().parents[1] / "figures" / "table_sloping_impact_discretisation"
+    kept = json.loads(base.with_suffix(".json").read_text())
+    assert base.with_suffix(".md").read_text() == F.discretisation_markdown(kept["rows"])
+    assert [r["label"] for r in kept["rows"]] == [label for label, _, _ in F.DISCRETISATION]
+    by_label = {r["label"]: r for r in kept["rows"]}
+    readme = " ".join((base.parents[1] / "README.md").read_text().split())
+    converged = by_label["128, 0.0125, 1/2 / 1/4"]["frictionless"]["angle"]
+    assert f"brings the frictionless angle to {converged:.1f} deg" in readme      # the README's Table 2 section
+    rows = F.discretisation_rows(kept["preset"], quick=not os.environ.get("CONTACTFEM_SLOW"))
+    assert rows
+    for row in rows:
+        for variant in ("frictionless", "frictional"):
+            assert (variant in row) == (variant in by_label[row["label"]]), (row["label"], variant)
+            for k, v in row.get(variant, {}).items():
+                assert v == pytest.approx(by_label[row["label"]][variant][k], rel=1e-9, abs=1e-12), \
+                    (row["label"], variant, k)

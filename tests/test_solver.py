@@ -27,9 +27,10 @@ class SpringChain:
         self.dof_offset = 0
         self.hyperelastic = True
         self.quadratic_energy = k3 == 0.0
+        self.mass_matrix = "lumped"
 
-    def mass(self):
-        return np.full(self.ndof, self.m)
+    def mass(self, consistent=False):
+        return sp.diags(np.full(self.ndof, self.m)).tocsr() if consistent else np.full(self.ndof, self.m)
 
     def internal_coo(self, u, dt=None):
         self.dt = dt                      # like a rate-dependent body: the step's dt

@@ -135,8 +135,9 @@ def test_effective_tangent_is_the_same_matrix_dense_and_sparse():
 # -- the bench's split of a Newton iteration -----------------------------------------------
 
 def test_iteration_cost_splits_the_newton_time_of_a_real_run():
-    """The parts add up to the measured Newton time, each part is non-negative, and the
-    solves counted are the run's linear solves (times themselves are not asserted)."""
+    """Each part is non-negative (the overhead, what the Newton time leaves after the timed
+    parts, too: the parts are timed inside it), and the solves counted are the run's linear
+    solves (times themselves are not asserted)."""
     from contactfem.scenes import run_scene
     from contactfem.lab.bench.speed import PARTS, iteration_split
 
@@ -146,7 +147,6 @@ def test_iteration_cost_splits_the_newton_time_of_a_real_run():
     assert (cost["linear_algebra"], cost["ndof"]) == ("dense", 48)
     parts = [cost[f"{p}_s"] for p in PARTS]
     assert min(parts) >= 0.0
-    assert sum(parts) == pytest.approx(cost["iteration_s"], rel=1e-9)
 
 
 def test_run_json_reports_the_linear_algebra():
@@ -281,13 +281,13 @@ def numbers_agree(a, b, rel=1e-12, skip=("wall_time_s", "linear_algebra", "order
 
 
 def cork_press_fit(preset):
-    from contactfem.scenes import cork, cork_stages
+    from contactfem.scenes import cork, cork_measure, cork_stages
 
     params = get_scene("cork").resolve(preset)
     model = cork.build(params)
     last, fit = cork_stages.press_fit(model, params)
     (system,) = model["systems"]
-    return dict(fit, **cork_stages.contact_forces(last.contacts), u=last.u, linear_algebra=system.linear_algebra,
+    return dict(fit, **cork_measure.contact_forces(last.contacts), u=last.u, linear_algebra=system.linear_algebra,
                 ordering=system.ordering)
 
 

@@ -142,3 +142,27 @@ def test_run_cork_progress_shows_a_bar(capsys):
     assert main(["run", "cork", "--progress", "--set", "t_end=0.0004", "--set", "n_press=2"]) == 0
     err = capsys.readouterr().err
     assert "cork: press fit [" in err and "cork: pop [" in err and "100%" in err
+
+
+def test_a_run_that_ends_before_t_end_finishes_its_bar_and_says_why(capsys, tmp_path):
+    """The cork stops t_flight after it has left the bottle, before t_end: its bar ends at 100 %
+    with that reason, which names the run's exit time."""
+    import json
+
+    from contactfem.cli import main
+    assert main(["run", "cork", "--progress", "--json", str(tmp_path / "cork.json")]) == 0
+    err = capsys.readouterr().err
+    last = [ln for ln in err.replace("\r", "\n").splitlines() if ln.startswith("cork: pop [")][-1]
+    exit_ms = json.loads((tmp_path / "cork.json").read_text())["exit_time_ms"]
+    assert "100%" in last and f"the cork left at {exit_ms:.3f} ms; the run stops t_flight" in last, last
+
+
+def test_progress_bar_finish_draws_the_whole_bar_with_the_reason():
+    from contactfem.io import ProgressBar
+    out = io.StringIO()
+    bar = ProgressBar(t0=0.0, t_end=1.0, label="x", stream=out)
+    bar(0.25)
+    bar.finish("stopped early")
+    bar.close()
+    assert out.getvalue().rstrip("\n").split("\r")[-1].startswith("x [" + "#" * 30 + "] 100%")
+    assert "(stopped early)" in out.getvalue() and out.getvalue().endswith("\n")

@@ -8,7 +8,9 @@ for a continuum ring and the solver never knows the difference:
                        (continuum: mesh nodes; beam: centreline nodes)
     body.ndof          int, number of unknowns of this body
     body.xdofs         (nn, 2) int, local dof numbers of each node's (u_x, u_y)
-    body.mass()        (ndof,) lumped (diagonal) mass
+    body.mass()        (ndof,) lumped (diagonal) mass; body.mass(consistent=True): the
+                       consistent mass, a scipy sparse matrix; body.mass_matrix says which
+                       the solver uses ("lumped" or "consistent")
     body.internal(u)   -> (R, K): internal force vector R(u) (ndof,) and its
                        consistent tangent K = dR/du (scipy.sparse, ndof x ndof)
     body.strain_energy(u) -> float

@@ -41,6 +41,7 @@ Backward Euler gives the closed-form return map (see ``return_map``).
 
 import numpy as np
 
+from .interfaces import MASS_MATRICES
 
 def _check(name, value, low, low_open=True):
     """Raise ValueError unless value is a finite number > low (>= low if not low_open)."""
@@ -100,11 +101,12 @@ class Beam:
     plastic  None (elastic) or dict(N0=, Q0=, M0=, eta=0.1): Perzyna viscoplasticity;
              then every evaluation needs the step's ``dt`` (internal_coo(u, dt), commit(u, dt)).
     integration     1 (midpoint, default) or 2 (two-point Gauss: stiffer, shear locking)
-    rotary_inertia  True (default): rho I on the rotation dofs of the lumped mass; False: 0
+    rotary_inertia  True (default): rho I on the rotation dofs of the mass; False: 0
+    mass_matrix     the mass the System uses: "lumped" (default) or "consistent" (``mass``)
     """
 
     def __init__(self, X, closed, E, A, I, rho, G=None, nu=0.0, kappa_s=5 / 6,
-                 name="beam", plastic=None, integration=1, rotary_inertia=True):
+                 name="beam", plastic=None, integration=1, rotary_inertia=True, mass_matrix="lumped"):
         X = np.asarray(X, dtype=float)
         if X.ndim != 2 or X.shape[1] != 2 or not np.all(np.isfinite(X)):
             raise ValueError(f"parameter X must be a finite (nn, 2) array, got shape {X.shape}")
@@ -169,6 +171,9 @@ class Beam:
         # belong to point k
         self.ep = np.zeros((len(self.points) * ne, 3))
         self.rotary_inertia = bool(rotary_inertia)
+        if mass_matrix not in MASS_MATRICES:
+            raise ValueError(f"parameter mass_matrix = {mass_matrix!r} is not allowed: one of {'|'.join(MASS_MATRICES)}")
+        self.mass_matrix = mass_matrix
 
     quadratic_energy = False        # the strains are nonlinear in u (finite rotations)
 
@@ -371,12 +376,32 @@ class Beam:
             self._mesh = MeshLine(self.s)
         return self._mesh
 
-    def mass(self):
-        """Lumped mass: rho A per length on u_x, u_y and rho I per length on theta (half to each node;
-        0 on theta without rotary inertia).
+    def _inertias(self):
+        """Mass per unit length of each dof kind: rho A on u_x and u_y, rho I on theta (0 without
+        rotary inertia)."""
+        return self.rho * np.array([self.A, self.A, self.I if self.rotary_inertia else 0.0])
 
-        The row sums of the P1 mass matrix on the arc-length mesh: L0/2 per element end.
+    def mass(self, consistent=False):
+        """The lumped mass, (ndof,): rho A per length on u_x, u_y and rho I per length on theta (half
+        to each node; 0 on theta without rotary inertia), the row sums of the P1 mass matrix on the
+        arc-length mesh (L0/2 per element end).
+
+        ``consistent=True``: that P1 mass matrix itself, a CSR matrix (ndof, ndof): per element and
+        dof kind (u_x, u_y, theta; the interpolation is linear in s for all three)
+        rho (A or I) L0 / 6 [[2, 1], [1, 2]]; the rotations are not coupled to the translations.
         """
+        if consistent:
+            from scipy.sparse import coo_matrix
+
+            a, b = self.conn.T
+            rows, cols, vals = [], [], []
+            for k, m in enumerate(self._inertias()):
+                i, j, e = 3 * a + k, 3 * b + k, m * self.L0 / 6.0
+                rows += [i, i, j, j]
+                cols += [i, j, i, j]
+                vals += [2 * e, e, e, 2 * e]
+            return coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                              shape=(self.ndof, self.ndof)).tocsr()
         if getattr(self, "_mass", None) is None:   # computed once, then reused
             length = np.bincount(self.conn.ravel(), np.repeat(0.5 * self.L0, 2), minlength=self.X.shape[0])
             J = self.I * length if self.rotary_inertia else 0.0 * length

@@ -27,6 +27,7 @@ from skfem import (Basis, BilinearForm, ElementQuad1, ElementTriP1,
                    ElementVector, Functional, LinearForm, MeshQuad, MeshTri,
                    asm)
 
+from .interfaces import MASS_MATRICES
 from .materials import MATERIAL_FUNCTIONS, MATERIALS, _eye, _isotropic_tangent
 
 KINDS = ("plane_strain", "plane_stress", "axisymmetric")
@@ -88,7 +89,7 @@ def _tangent_form(u, v, w):
 
 @BilinearForm
 def _mass_form(u, v, w):
-    """Consistent mass int rho u . v dV (lumped by row sums in Continuum.mass)."""
+    """Consistent mass int rho u . v dV (Continuum.mass; the lumped mass is its row sums)."""
     return w.rho * np.einsum("i...,i...->...", u, v) * _weight(w)
 
 
@@ -143,11 +144,12 @@ class Continuum:
 
     Parameters: mesh (MeshQuad or MeshTri, optionally with named boundaries),
     E > 0, -1 < nu < 0.5, rho >= 0, kind in KINDS, material in MATERIALS,
-    thickness > 0 (plane problems only).
+    thickness > 0 (plane problems only), mass_matrix: the mass the System uses,
+    "lumped" (row sums, diagonal) or "consistent" (``mass(consistent=True)``).
     """
 
     def __init__(self, mesh, E, nu, rho, kind="plane_strain", material="linear",
-                 name="body", thickness=1.0):
+                 name="body", thickness=1.0, mass_matrix="lumped"):
         if not E > 0:
             raise ValueError(f"E must be > 0, got {E}")
         if not -1.0 < nu < 0.5:
@@ -160,6 +162,8 @@ class Continuum:
             raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
         if material not in MATERIALS:
             raise ValueError(f"material must be one of {MATERIALS}, got {material!r}")
+        if mass_matrix not in MASS_MATRICES:
+            raise ValueError(f"parameter mass_matrix = {mass_matrix!r} is not allowed: one of {'|'.join(MASS_MATRICES)}")
         if kind == "plane_stress" and material != "linear":
             raise ValueError(f"material must be 'linear' for kind='plane_stress', got {material!r}")
         if isinstance(mesh, MeshQuad):
@@ -187,7 +191,9 @@ class Continuum:
         self.xdofs = self.basis.nodal_dofs.T.copy()
         self.dof_offset = 0
         self._K_linear = None
+        self.mass_matrix = mass_matrix  # the mass the System uses: lumped (diagonal) or consistent
         self._mass = None
+        self._M = None                  # the consistent mass matrix (made on first use)
         self._coo = None                # (indptr, indices, rows) of the last tangent's pattern
 
     # -- kinematics and constitutive update at the quadrature points --------
@@ -270,13 +276,17 @@ class Continuum:
         W, _, _ = self._constitutive(u, self.basis)
         return float(asm(_energy_form, self.basis, W=W, **self._params()))
 
-    def mass(self):
-        """Lumped mass: row sums of the consistent mass int rho N_i N_j dV, shape (ndof,)."""
+    def mass(self, consistent=False):
+        """The consistent mass int rho N_i N_j dV (scikit-fem's mass form) as a CSR matrix
+        (ndof, ndof) with ``consistent=True``; else the lumped mass, its row sums, (ndof,)."""
+        if consistent:
+            if self._M is None:
+                self._M = asm(_mass_form, self.basis, rho=self.rho, **self._params()).tocsr()
+            return self._M.copy()
         if self._mass is None and self.rho == 0.0:       # quasi-static body: nothing to integrate
             self._mass = np.zeros(self.ndof)
         if self._mass is None:
-            M = asm(_mass_form, self.basis, rho=self.rho, **self._params())
-            self._mass = np.asarray(M.sum(axis=1)).ravel()
+            self._mass = np.asarray(self.mass(consistent=True).sum(axis=1)).ravel()
         return self._mass.copy()
 
     def commit(self, u, dt=None):

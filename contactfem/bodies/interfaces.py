@@ -11,6 +11,9 @@ from typing import Protocol, runtime_checkable
 import numpy as np
 
 
+MASS_MATRICES = ("lumped", "consistent")
+
+
 @runtime_checkable
 class Body(Protocol):
     """A body (see contactfem.bodies): node positions, unknowns, mass, internal forces."""
@@ -22,9 +25,12 @@ class Body(Protocol):
     dof_offset: int             # where the body's dofs start in the global vector (set by the System)
     hyperelastic: bool          # a stored energy and no history (energy-consistent stepping needs it)
     quadratic_energy: bool      # W(u) quadratic (a linear body): the midpoint rule is energy-exact for it
+    mass_matrix: str            # the mass the System uses: "lumped" or "consistent" (MASS_MATRICES)
 
-    def mass(self) -> np.ndarray:
-        """Lumped (diagonal) mass, (ndof,)."""
+    def mass(self, consistent: bool = False):
+        """The lumped (diagonal) mass, (ndof,); with ``consistent=True`` the consistent mass as a
+        scipy sparse matrix (ndof, ndof), whose row sums are the lumped mass (asked for only of a
+        body whose ``mass_matrix`` is "consistent")."""
 
     def internal_coo(self, u: np.ndarray, dt=None) -> tuple:
         """(R, rows, cols, vals): internal forces R(u) and the tangent dR/du as COO triplets;

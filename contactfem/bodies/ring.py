@@ -171,14 +171,45 @@ class RingModel:
 
     # -- masses and rigid-body measures -----------------------------------------------
     def _mass_split(self):
-        """Translational mass per node (nn,) and rotary inertia per node (beam theta dofs);
-        computed once (the lumped mass is constant)."""
+        """Translational mass per node (nn,) and rotary inertia per node (beam theta dofs) of the
+        lumped mass, the consistent mass's row sums; computed once (the mass is constant). The
+        centre of mass and its velocity are the same sums for either mass (M is symmetric: the
+        momentum 1^T M v is the row sums times v)."""
         if getattr(self, "_masses", None) is None:
             M = self.body.mass()
             m = M[self.body.xdofs[:, 0]]
             J = M[2::3] if self.kind == "beam" else np.zeros_like(m)
             self._masses = (m, J)
         return self._masses
+
+    def _second_moments(self, r, w, theta_dot=None):
+        """sum_ij M_ij (r_i x w_j) and sum_ij M_ij (r_i . r_j) over the nodes, plus the rotary
+        terms sum_ij J_ij theta_dot_j and sum_ij J_ij: the angular momentum and the moment of
+        inertia with the body's own mass, lumped (diagonal: M_ii = m_i) or consistent.
+        r, w (..., nn, 2), theta_dot (..., nn): a stack of k states gives k values of each."""
+        b = self.body
+        if b.mass_matrix != "consistent":
+            m, J = self._mass_split()
+            L = np.sum(m * (r[..., 0] * w[..., 1] - r[..., 1] * w[..., 0]), axis=-1)
+            Ic = np.sum(m * np.sum(r * r, axis=-1), axis=-1)
+            if self.kind == "beam":
+                L = L + (np.sum(J * theta_dot, axis=-1) if theta_dot is not None else 0.0)
+                Ic = Ic + J.sum()
+            return L, Ic
+        M = b.mass(consistent=True).tocsr()
+        x = b.xdofs[:, 0]
+        Mt = M[x][:, x]                                # the same block for u_x and u_y
+
+        def Mx(a):                                     # M_t a over the node axis, a (..., nn)
+            return (Mt @ a.T).T
+
+        L = np.sum(r[..., 0] * Mx(w[..., 1]) - r[..., 1] * Mx(w[..., 0]), axis=-1)
+        Ic = np.sum(r[..., 0] * Mx(r[..., 0]) + r[..., 1] * Mx(r[..., 1]), axis=-1)
+        if self.kind == "beam":
+            Mr = M[2::3][:, 2::3]
+            L = L + (np.sum((Mr @ theta_dot.T).T, axis=-1) if theta_dot is not None else 0.0)
+            Ic = Ic + Mr.sum()
+        return L, Ic
 
     def total_mass(self):
         """Sum of the lumped translational masses (the half ring's is half the ring's)."""
@@ -207,22 +238,24 @@ class RingModel:
     def angular_velocity(self, u, v):
         """Spin about the centre of mass, omega = L / I_c (CCW positive), with
         L = sum m_i (r_i x v_i) + sum J_i theta_dot_i and I_c = sum m_i |r_i|^2 + sum J_i
-        (r_i, v_i relative to the centre of mass; J_i: the beam's rotary inertia).
-        Exact for a rigid motion. Half ring: 0 by symmetry. Stacks of u and v (k, ndof): an
-        array of k spins."""
+        (r_i, v_i relative to the centre of mass; J_i: the beam's rotary inertia); with a
+        consistent mass the double sums over M_ij. Exact for a rigid motion. Half ring: 0 by
+        symmetry. Stacks of u and v (k, ndof): an array of k spins."""
         stack = np.ndim(u) == 2
         if self.half:
             return np.zeros(len(u)) if stack else 0.0
         v = self._u(v)
-        m, J = self._mass_split()
         r = self.positions(u) - self.center_of_mass(u)[..., None, :]
         w = v[..., self.body.xdofs] - self.velocity_of_mass(v)[..., None, :]
-        L = np.sum(m * (r[..., 0] * w[..., 1] - r[..., 1] * w[..., 0]), axis=-1)
-        Ic = np.sum(m * np.sum(r * r, axis=-1), axis=-1)
-        if self.kind == "beam":
-            L += np.sum(J * v[..., 2::3], axis=-1)
-            Ic += J.sum()
+        L, Ic = self._second_moments(r, w, v[..., 2::3] if self.kind == "beam" else None)
         return L / Ic if stack else float(L / Ic)
+
+    def moment_of_inertia(self, u=None):
+        """I_c about the centre of mass in configuration u (default: the reference one), with
+        the body's mass (lumped or consistent) and the beam's rotary inertia."""
+        u = np.zeros(self.body.ndof) if u is None else self._u(u)
+        r = self.positions(u) - self.center_of_mass(u)
+        return float(self._second_moments(r, np.zeros_like(r))[1])
 
     def initial_velocity(self, v0_vec, omega=0.0):
         """Local velocity vector (ndof,) of the rigid motion v = v0 + omega e3 x (X - c)
@@ -275,7 +308,7 @@ class RingModel:
 
 def make_ring(kind="beam", R=1.0, thickness=0.1, n_el=32, E=1.0, nu=0.0, rho=1.0,
               center=(0.0, 0.0), n_radial=2, plastic=None, width=1.0, half=False,
-              name="ring", material="svk", integration=1, rotary_inertia=True):
+              name="ring", material="svk", integration=1, rotary_inertia=True, mass_matrix="lumped"):
     """Build a beam or continuum ring (see the module docstring); returns a RingModel.
 
     R          mean radius > 0;  thickness h in (0, 2R): radial wall thickness
@@ -287,6 +320,7 @@ def make_ring(kind="beam", R=1.0, thickness=0.1, n_el=32, E=1.0, nu=0.0, rho=1.0
     half       the half ring x <= center_x (symmetry plane x = center_x)
     material   continuum only: "svk" (default) or "neohooke" (plane strain)
     integration, rotary_inertia   beam only: see Beam (1 or 2 points; rho I on the rotations or not)
+    mass_matrix "lumped" (default) or "consistent": the mass the solver uses (Beam, Continuum)
     """
     if kind not in KINDS:
         raise ValueError(f"parameter kind = {kind!r} is not allowed: one of {'|'.join(KINDS)}")
@@ -311,7 +345,8 @@ def make_ring(kind="beam", R=1.0, thickness=0.1, n_el=32, E=1.0, nu=0.0, rho=1.0
         else:
             X = ring_nodes(R, n_el, center)
         body = Beam(X, closed=not half, E=E, A=h * b, I=b * h**3 / 12, rho=rho, nu=nu,
-                    name=name, plastic=plastic, integration=integration, rotary_inertia=rotary_inertia)
+                    name=name, plastic=plastic, integration=integration, rotary_inertia=rotary_inertia,
+                    mass_matrix=mass_matrix)
         return RingModel(body, kind, R, h, b, center, bool(half), np.arange(X.shape[0]), 0.5 * h)
 
     if plastic is not None:
@@ -323,6 +358,6 @@ def make_ring(kind="beam", R=1.0, thickness=0.1, n_el=32, E=1.0, nu=0.0, rho=1.0
 
     mesh, n_ang = annulus_mesh(R - h / 2, R + h / 2, n_el, n_radial, center, half)
     body = Continuum(mesh, E=E, nu=nu, rho=rho, kind="plane_strain", material=material,
-                     name=name, thickness=b)
+                     name=name, thickness=b, mass_matrix=mass_matrix)
     outer = n_radial * n_ang + np.arange(n_ang)
     return RingModel(body, kind, R, h, b, center, bool(half), outer, 0.0)

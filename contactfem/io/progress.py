@@ -5,7 +5,9 @@
         bar(rec.t)
     bar.close()
 
-or, counting steps: ``bar = ProgressBar(total=200)`` and ``bar.update()`` per step.
+or, counting steps: ``bar = ProgressBar(total=200)`` and ``bar.update()`` per step. A run that
+ends before t_end by its own rule (the cork stops some time after it has left the bottle) says
+so: ``bar.finish("why")`` draws 100 % with that reason.
 Several callbacks at once: ``chain(bar, recorder)``. A scene or ``integrate`` makes its own
 bars with ``progress=progress_bar`` (one per time loop; solver.march.watch).
 """
@@ -34,13 +36,16 @@ class ProgressBar:
         self._last = -1e300
         self._drawn_at = None
         self.closed = False
+        self.note = ""
 
     def text(self):
         f = min(max(self.fraction, 0.0), 1.0)
         k = int(round(f * self.width))
         where = f"step {self.n}/{self.total}" if self.total is not None else f"t = {self.t:.4g}"
         head = f"{self.label} " if self.label else ""
-        return f"{head}[{'#' * k}{'.' * (self.width - k)}] {100 * f:3.0f}%  {where}  {time.perf_counter() - self.start:.1f} s"
+        note = f"  ({self.note})" if self.note else ""
+        return (f"{head}[{'#' * k}{'.' * (self.width - k)}] {100 * f:3.0f}%  {where}  "
+                f"{time.perf_counter() - self.start:.1f} s{note}")
 
     def _draw(self, force=False):
         now = time.perf_counter()
@@ -65,6 +70,11 @@ class ProgressBar:
         elif self.total is not None:
             self.fraction = self.n / self.total
         self._draw(force=self.fraction >= 1.0)
+
+    def finish(self, note=""):
+        """The run is done before t_end by its own rule: draw 100 % with ``note`` saying why."""
+        self.fraction, self.note = 1.0, str(note)
+        self._draw(force=True)
 
     def close(self):
         """Draw the final state and end the line."""

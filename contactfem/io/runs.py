@@ -12,6 +12,10 @@ raises one ValueError saying so; load_run never unpickles anything.
 
 save_run writes to a temporary file beside the target and renames it into place, so an
 interrupted save never leaves a half-written file.
+
+``compare_runs(mine, ref)`` says how far two results of one scene are apart: the largest
+relative difference over every number both hold (a lecture's own time loop against the
+scene's run, a reloaded run against the one saved).
 """
 
 import json
@@ -225,3 +229,73 @@ class Recorder:
     def as_dict(self):
         """{'t': ..., 'u': ..., 'v': ...}, ready for save_run."""
         return {"t": self.t, "u": self.u, "v": self.v}
+
+
+# what describes how a run went rather than what it computed: not compared
+RUN_KEYS = ("wall_time_s", "import_time_s", "linear_algebra", "ordering", "unknowns", "band_kl", "band_ku",
+            "residual_evaluations", "contact_evaluations", "scene", "preset", "parameters")
+
+
+def compare_runs(mine, ref, skip=RUN_KEYS):
+    """How far two results of a scene are apart: walks every entry of ``ref`` that ``mine``
+    also holds (nested dicts and lists included; None and the entries ``skip`` names are
+    left out, text must be equal) and returns dict(worst=the largest relative difference, key=where it is,
+    compared=how many numbers were compared, missing=entries of ref that mine lacks). An
+    entry's difference is max |a - b| / max |b| over the entry (an array is scaled by its
+    largest value, a zero reference needs an exact zero); entries of different shape count
+    as an infinite difference."""
+    worst, where, count, missing = 0.0, None, 0, []
+
+    def walk(a, b, key):
+        nonlocal worst, where, count
+        if isinstance(b, dict):
+            if not isinstance(a, dict):
+                return note(np.inf, key)
+            for k, v in b.items():
+                if k in skip and not key:
+                    continue
+                if k not in a:
+                    missing.append(f"{key}{k}")
+                    continue
+                walk(a[k], v, f"{key}{k}.")
+            return None
+        if b is None:
+            return None
+        if isinstance(b, str):                          # text (a node's state): equal or not
+            return note(0.0 if a == b else np.inf, key)
+        if isinstance(b, (list, tuple)) and b and any(isinstance(x, (dict, list, tuple, str)) or x is None for x in b) \
+                and not _rectangular(b):
+            if not isinstance(a, (list, tuple)) or len(a) != len(b):
+                return note(np.inf, key)
+            for i, (x, y) in enumerate(zip(a, b)):
+                walk(x, y, f"{key.rstrip('.')}[{i}].")
+            return None
+        try:
+            A, B = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+        except (TypeError, ValueError):
+            return None
+        if A.size == 0 and B.size == 0:                 # nothing in either ([] and an empty (0, 2) array)
+            return None
+        if A.shape != B.shape:
+            return note(np.inf, key)
+        count += B.size
+        scale = float(np.max(np.abs(B)))
+        diff = float(np.max(np.abs(A - B)))
+        return note(diff / scale if scale > 0 else (0.0 if diff == 0 else np.inf), key)
+
+    def note(d, key):
+        nonlocal worst, where
+        if d > worst or where is None and d == worst:
+            worst, where = d, key.rstrip(".")
+        return None
+
+    walk(mine, ref, "")
+    return dict(worst=float(worst), key=where, compared=count, missing=missing)
+
+
+def _rectangular(lst):
+    try:
+        a = np.asarray(lst, dtype=float)
+    except (TypeError, ValueError):
+        return False
+    return a.dtype.kind == "f"

@@ -6,8 +6,10 @@ foundation (Sec. 5.1), whole load in one step.
     fig08_block_parabolic_stresses    Fig 8: the same for the parabolic slip surface
     table1_block_newton_residuals     Table 1: ||G|| per Newton iteration, ours beside the paper's (.md and .png)
 
-The paper's figures also show Oden & Pires' results; their numbers are not
-available here, so only ours are drawn. The stresses are tractions (force per
+Each function draws from results it is given (a lecture passes the result of its own
+time loop: ``fig07(preset, outdir, r=...)``, ``fig06(..., body=..., records=...)``) or, given
+none, runs the scene (``contactfem figures``). The paper's figures also show Oden & Pires'
+results; their numbers are not available here, so only ours are drawn. The stresses are tractions (force per
 unit length of the contact side); the normal stress is drawn as the pressure
 |t_N|, the friction stress as t_T (> 0: the foundation holds the block back).
 """
@@ -16,7 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..scenes.block import PAPER_TABLE1, PAPER_TABLE1_UNCERTAIN, SCENE, solve
+from ..scenes.block import SCENE, solve
+from ..scenes.block_params import PAPER_TABLE1, PAPER_TABLE1_UNCERTAIN
 from ..solver.newton import NewtonError
 from . import cached_run, default_outdir, describe_newton, figure, fitted_words, pyplot, savefig
 
@@ -36,11 +39,17 @@ def draw_mesh(ax, X, t, **kw):
 
 
 @figure("fig06_block_mesh_deformed", "Fig 6")
-def fig06(preset="fast", outdir=None, law="conical"):
+def fig06(preset="fast", outdir=None, law="conical", params=None, body=None, records=None):
+    """Fig 6 from the records of a block run (``body`` and ``records`` of a march, ``params``
+    its parameters), or from a run of the scene (``law``) if none are given."""
     plt = pyplot()
-    P = SCENE.resolve(preset, {"law": law})
-    s = solve(P)
-    body, u, rep = s["body"], s["u"], s["report"]
+    P = params if params is not None else SCENE.resolve(preset, {"law": law})
+    law = P["law"]
+    if records is None:
+        s = solve(P)
+        body, u, rep = s["body"], s["u"], s["report"]
+    else:
+        u, rep = records[-1].u, records[-1].contacts[0].report()
     X, t = body.X, body.mesh.t
     x = X + u[body.xdofs]
     W, H = X[:, 0].max(), X[:, 1].max()
@@ -114,9 +123,10 @@ def _stress_axes(ax, title):
 
 
 @figure("fig07_block_conical_stresses", "Fig 7")
-def fig07(preset="fast", outdir=None):
+def fig07(preset="fast", outdir=None, r=None):
+    """Fig 7 from a block result ``r`` with the conical law (default: the scene's run)."""
     plt = pyplot()
-    r = result(preset, law="conical")
+    r = r or result(preset, law="conical")
     P = r["parameters"]
     fig, ax = plt.subplots(figsize=(7.5, 5))
     draw_stresses(ax, r, "(conical)")
@@ -128,10 +138,12 @@ def fig07(preset="fast", outdir=None):
 
 
 @figure("fig08_block_parabolic_stresses", "Fig 8")
-def fig08(preset="fast", outdir=None):
+def fig08(preset="fast", outdir=None, r=None, conical=None):
+    """Fig 8 from block results with the parabolic law ``r`` and the conical one ``conical``
+    (default: the scene's runs)."""
     plt = pyplot()
-    r = result(preset, law="parabolic")
-    rc = result(preset, law="conical")
+    r = r or result(preset, law="parabolic")
+    rc = conical or result(preset, law="conical")
     fig, ax = plt.subplots(figsize=(7.5, 5))
     draw_stresses(ax, rc, "conical", style=":", faint=True)
     draw_stresses(ax, r, "(parabolic)")
@@ -155,10 +167,13 @@ def slip_words(r):
     return text + f" ({r['n_stick']} stick, {r['n_open']} open)"
 
 
-def residual_histories(preset="fast"):
+def residual_histories(preset="fast", results=None):
     """Our ||G|| per iteration for the paper's two laws, Coulomb mu = 0.3 and the
-    Coulomb case with the tangent without the c_N^s coupling ('frozen')."""
-    out = {law: result(preset, law=law)["newton_residuals"] for law in ("conical", "parabolic", "coulomb")}
+    Coulomb case with the tangent without the c_N^s coupling ('frozen'). ``results``:
+    block results by law ("conical", ...) to take instead of the scene's runs."""
+    given = results or {}
+    pick = lambda law: given.get(law) or result(preset, law=law)     # noqa: E731
+    out = {law: pick(law)["newton_residuals"] for law in ("conical", "parabolic", "coulomb")}
     out["coulomb, frozen tangent"] = result(preset, law="coulomb", tangent="frozen")["newton_residuals"]
     out["verdict"] = {key: describe_newton(hist, True) for key, hist in out.items()}
     try:
@@ -167,8 +182,8 @@ def residual_histories(preset="fast"):
     except NewtonError as err:
         out["coulomb, symmetric tangent"] = err.history
         out["verdict"]["coulomb, symmetric tangent"] = describe_newton(err.history, False)
-    out["parameters"] = result(preset, law="conical")["parameters"]
-    out["fitted"] = result(preset, law="conical").get("fitted") or {}
+    out["parameters"] = pick("conical")["parameters"]
+    out["fitted"] = pick("conical").get("fitted") or {}
     return out
 
 
@@ -209,10 +224,12 @@ def table1_markdown(hist):
 
 
 @figure("table1_block_newton_residuals", "Table 1")
-def table1(preset="fast", outdir=None):
+def table1(preset="fast", outdir=None, results=None):
+    """Table 1 (.md and .png); ``results``: block results by law to use instead of the scene's
+    runs (residual_histories)."""
     plt = pyplot()
     outdir = outdir or default_outdir(preset)
-    hist = residual_histories(preset)
+    hist = residual_histories(preset, results)
     md = Path(outdir) / "table1_block_newton_residuals.md"
     md.parent.mkdir(parents=True, exist_ok=True)
     md.write_text(table1_markdown(hist))

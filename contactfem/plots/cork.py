@@ -12,7 +12,8 @@
                                 discretisation (.png, .md, .json): why the paper preset's exit
                                 lies outside the paper's 2.6-2.7 ms
 
-The problem is axisymmetric (x = r, y = z); the drawings mirror the meridian in the
+Figs 14-17 draw a result they are given (``r=``: a lecture's own time loops) or run the
+scene. The problem is axisymmetric (x = r, y = z); the drawings mirror the meridian in the
 axis to show the whole cork and both sides of the neck.
 """
 
@@ -60,9 +61,9 @@ def draw_neck(ax, neck, gas_column=None):
 
 
 @figure("fig14_cork_mesh", "Fig 14")
-def fig14_cork_mesh(preset="fast", outdir=None):
+def fig14_cork_mesh(preset="fast", outdir=None, r=None):
     plt = pyplot()
-    r = result(preset)
+    r = r or result(preset)
     mesh, neck = _geometry(r["parameters"])
     fig, axes = plt.subplots(1, 2, figsize=(9, 6.5), sharey=True)
     draw_mesh(axes[0], mesh, mesh.p.T)
@@ -81,9 +82,9 @@ def fig14_cork_mesh(preset="fast", outdir=None):
 
 
 @figure("fig15_cork_configurations", "Fig 15")
-def fig15_cork_configurations(preset="fast", outdir=None):
+def fig15_cork_configurations(preset="fast", outdir=None, r=None):
     plt = pyplot()
-    r = result(preset)
+    r = r or result(preset)
     mesh, neck = _geometry(r["parameters"])
     xs, ts, tp = r["snapshots_x"], r["snapshot_times_ms"], r["snapshot_paper_times_ms"]
     fig, axes = plt.subplots(1, len(xs), figsize=(1.9 * len(xs), 5.5), sharey=True)
@@ -103,9 +104,9 @@ def fig15_cork_configurations(preset="fast", outdir=None):
 
 
 @figure("fig16_cork_pressure", "Fig 16")
-def fig16_cork_pressure(preset="fast", outdir=None):
+def fig16_cork_pressure(preset="fast", outdir=None, r=None):
     plt = pyplot()
-    r = result(preset)
+    r = r or result(preset)
     fig, ax = plt.subplots(figsize=(6.5, 4))
     ax.step(r["time_ms"], r["pressure_MPa"], where="pre", color="C0", label="gas pressure (used in the step)")
     if r["gas_release_time_ms"] is not None:
@@ -123,9 +124,9 @@ def fig16_cork_pressure(preset="fast", outdir=None):
 
 
 @figure("fig17_cork_displacement", "Fig 17")
-def fig17_cork_displacement(preset="fast", outdir=None):
+def fig17_cork_displacement(preset="fast", outdir=None, r=None):
     plt = pyplot()
-    r = result(preset)
+    r = r or result(preset)
     fig, ax = plt.subplots(figsize=(6.5, 4))
     ax.plot(r["time_ms"], r["displacement_bottom_mm"], label="bottom centre")
     ax.plot(r["time_ms"], r["displacement_cm_mm"], label="centre of mass")
@@ -178,21 +179,25 @@ def sensitivity_rows(preset="fast", cases=SENSITIVITY, jobs=2):
     return rows
 
 
-@figure("table_cork_sensitivity", "Sec 5.5")
-def table_cork_sensitivity(preset="fast", outdir=None):
-    """Markdown table of the exit velocity against the reconstructed data."""
-    from pathlib import Path
-
-    rows = sensitivity_rows(preset)
+def sensitivity_markdown(rows, preset):
+    """The table's lines: a header and one line per row of ``sensitivity_rows``, then the note."""
     heads = " | ".join(f"v at p0 = {0.1 * n:.1f} MPa (m/s)" for n in P0_STEPS)
     lines = [f"| case | press-fit force (N) | {heads} |", "|---|---|" + "---|" * len(P0_STEPS)]
     for label, F, vs in rows:
         lines.append(f"| {label} | {'-' if F is None else format(F, '.0f')} | " + " | ".join(vs) + " |")
     lines.append("")
     lines.append(f"Paper: ~2500 N, 28 m/s at p0 = 0.8 MPa. Preset: {preset}.")
+    return "\n".join(lines) + "\n"
+
+
+@figure("table_cork_sensitivity", "Sec 5.5")
+def table_cork_sensitivity(preset="fast", outdir=None):
+    """Markdown table of the exit velocity against the reconstructed data."""
+    from pathlib import Path
+
     path = Path(outdir or default_outdir(preset)) / "table_cork_sensitivity.md"
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text("\n".join(lines) + "\n")
+    path.write_text(sensitivity_markdown(sensitivity_rows(preset), preset))
     return [str(path)]
 
 
@@ -371,13 +376,14 @@ def exit_cases():
 
 
 def exit_case(case, preset=EXIT_PRESET):
-    """One run of the cork (the stages of scenes/cork_stages.py, as its ``simulate``) with the
+    """One run of the cork (the stages of scenes/cork_stages.py, as the scene simulates them) with the
     closing step of its contact on or off in each stage and, with a ramp step, the time step
     refined under the unchanged pressure ramp. Returns the case with the exit time and
     velocity, the press-fit force and the slowest speed of the cork after the ramp (its stall)."""
     from ..scenes import get_scene
     from ..scenes.cork import build
-    from ..scenes.cork_stages import contact_forces, history, pop, press_fit
+    from ..scenes.cork_measure import contact_forces, history
+    from ..scenes.cork_stages import pop, press_fit
 
     group, label, over, (fit_rule, pop_rule), ramp = case
     row = dict(group=group, label=label, overrides=dict(over), closing_step_press_fit=fit_rule,
@@ -409,16 +415,38 @@ def exit_case(case, preset=EXIT_PRESET):
                 steps=int(len(h["t"]) - 1), newton_failures=sum(len(rec.failures) for rec in records))
 
 
+# The cases run in this process, by (preset, case): the summary's cork row and the study share
+# them (as the figures share scene runs through plots.cached_run).
+_EXIT_RUNS = {}
+
+
+def _exit_key(case, preset):
+    import json
+
+    return json.dumps([preset, case], sort_keys=True)
+
+
+def cached_exit_case(case, preset=EXIT_PRESET):
+    """``exit_case``, run once per process for each case and preset (a copy of the row)."""
+    key = _exit_key(case, preset)
+    if key not in _EXIT_RUNS:
+        _EXIT_RUNS[key] = exit_case(case, preset)
+    return dict(_EXIT_RUNS[key])
+
+
 def exit_time_data(cases=None, jobs=2):
-    """Every case of ``exit_cases()`` (in parallel on ``jobs`` cores with joblib, if installed)."""
+    """Every case of ``exit_cases()`` (those not run yet in this process in parallel on ``jobs``
+    cores with joblib, if installed)."""
     cases = cases or exit_cases()
+    todo = list({_exit_key(c, EXIT_PRESET): c for c in cases if _exit_key(c, EXIT_PRESET) not in _EXIT_RUNS}.values())
     try:
         from joblib import Parallel, delayed
     except ImportError:
-        rows = [exit_case(c) for c in cases]
+        rows = [exit_case(c) for c in todo]
     else:
-        rows = Parallel(n_jobs=jobs)(delayed(exit_case)(c) for c in cases)
-    return dict(preset=EXIT_PRESET, slow=cases is EXIT_CASES_SLOW, cases=rows)
+        rows = Parallel(n_jobs=jobs)(delayed(exit_case)(c) for c in todo)
+    _EXIT_RUNS.update({_exit_key(c, EXIT_PRESET): r for c, r in zip(todo, rows)})
+    return dict(preset=EXIT_PRESET, slow=cases is EXIT_CASES_SLOW, cases=[cached_exit_case(c) for c in cases])
 
 
 def exit_time_summary(d):

@@ -7,6 +7,7 @@ The half ring of the computation is mirrored in the symmetry plane x = 0 to draw
 whole ring, and both walls of the funnel are drawn. Panel (a) holds the outlines up to
 the deepest position of the centre, panel (b) those after it; panel (c) the height of
 the centre against time. Panel (b) stops when the centre is back at its starting height.
+Each draws a result it is given (``r=``: a lecture's own time loop) or runs the scene.
 """
 
 
@@ -61,16 +62,16 @@ def draw_funnel(r, title):
 
 
 @figure("fig12_funnel_frictionless", "Fig 12")
-def fig12(preset="fast", outdir=None):
-    r = result("frictionless", preset)
+def fig12(preset="fast", outdir=None, r=None):
+    r = r or result("frictionless", preset)
     fig = draw_funnel(r, f"Fig 12: ring falling into a funnel, frictionless (funnel wall at "
                          f"{r['parameters']['phi_deg']:g} deg from the vertical: chosen)")
     return [savefig(fig, outdir or default_outdir(preset), "fig12_funnel_frictionless")]
 
 
 @figure("fig13_funnel_frictional", "Fig 13")
-def fig13(preset="fast", outdir=None):
-    r = result("frictional", preset)
+def fig13(preset="fast", outdir=None, r=None):
+    r = r or result("frictional", preset)
     p = r["parameters"]
     fig = draw_funnel(r, f"Fig 13: ring falling into a funnel, frictional eq (10): n = {p['n']:g}, "
                          f"alpha = {p['alpha']:g}, beta = {p['beta']:g} (wall at {p['phi_deg']:g} deg: chosen)")

@@ -7,6 +7,7 @@
                                      (a) refining mesh and step together (dt = 0.8 / n_el),
                                      (b) refining the step alone on the 120-element ring
 
+fig09 draws a result it is given (``r=``: a lecture's own time loop) or runs the scene.
 Exact: the rigid thin hoop (scenes.rings.rigid_ring_exact): x* = 229.4 cm,
 v* = 150 cm/s, and x(2 s) = 376.5 cm.
 """
@@ -140,8 +141,10 @@ def draw_rolling(r, title):
 
 
 @figure("fig09_rolling_ring", "Fig 9")
-def fig09(preset="fast", outdir=None, **overrides):
-    r = result(preset, **overrides)
+def fig09(preset="fast", outdir=None, r=None, **overrides):
+    """Fig 9 from a rolling-ring result ``r`` (a lecture's own run), else from the scene's run
+    with ``overrides``."""
+    r = r or result(preset, **overrides)
     p = r["parameters"]
     title = (f"Fig 9: ring sliding then rolling ({r['kind']}, {p['n_el']} elements, dt = {p['dt']:g} s, "
              f"mu = {p['mu']:g}); v_final = {r['v_final']:.1f} cm/s (exact {r['v_final_exact']:.0f})")

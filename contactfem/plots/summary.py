@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..scenes.block import PAPER_TABLE1
+from ..scenes.block_params import PAPER_TABLE1
 from . import cached_run, default_outdir, figure
 
 START, END = "<!-- summary:start -->", "<!-- summary:end -->"
@@ -121,10 +121,10 @@ def row_funnel(preset):
 def cork_refined_exit(preset):
     """The cork's exit time with the time step in the neck refined (the pressure ramp kept), with
     and without the closing step: the refined cases of the exit-time study (plots.cork)."""
-    from .cork import EXIT_CASES_QUICK, exit_case
+    from .cork import EXIT_CASES_QUICK, cached_exit_case
 
     cases = [c for c in EXIT_CASES_QUICK if c[4] is not None]
-    return [exit_case(c, preset) for c in cases], cases[0][2]["dt"]
+    return [cached_exit_case(c, preset) for c in cases], cases[0][2]["dt"]
 
 
 def row_cork(preset):

@@ -46,7 +46,7 @@ Reconstructed (the scan lost them; each is a Param with "chosen: ..." in its doc
   (``per_node``, w = 1), c_N = 100 N/mm would need ~2 mm of penetration per node to carry
   2500 N: the whole interference.
 
-The two stages, the adaptive step and what is measured are in ``cork_stages.py``.
+The two stages and the adaptive step are in ``cork_stages.py``, what is measured in ``cork_measure.py``.
 """
 
 import numpy as np
@@ -56,7 +56,8 @@ from ..contact.masters import bottle_neck
 from ..laws.friction import SlipHardening
 from ..laws.normal import PowerLaw
 from .base import PENALTIES, PENALTY_DOC, Param, Scene
-from .cork_stages import PAPER, R_TIP_FITTED, measure, press_fit_only, simulate  # noqa: F401 (public here)
+from .cork_measure import PAPER, R_TIP_FITTED, measure  # noqa: F401 (public here)
+from .cork_stages import press_fit_only, simulate  # noqa: F401 (public here)
 
 PARAMS = (
     Param("E", 10.0, "MPa", 0.0, low_open=True, doc="Young's modulus (paper)"),

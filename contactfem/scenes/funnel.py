@@ -37,7 +37,7 @@ from ..laws import ParabolicSlip, PowerLaw
 from ..solver import Dirichlet, History, Steps, System
 from . import time_integration
 from .base import Param, Scene, Stage, penalty_pressure
-from .rings import RING_PARAMS, ring_history, ring_size, snapshot_indices
+from .rings import MASS_MATRIX_PARAM, RING_PARAMS, ring_history, ring_size, snapshot_indices
 
 VARIANTS = ("frictionless", "frictional")
 
@@ -59,7 +59,7 @@ def build(params, *, normal=None, friction=None, system_options=None):
     yc0 = (R + h / 2) / np.sin(phi) + params["gap0"]      # wall distance of the centre = R + h/2 + gap
     ring = make_ring(kind=params["kind"], R=R, thickness=h, width=params["width"], n_el=params["n_el"],
                      E=params["E"], nu=params["nu"], rho=params["rho"], center=(0.0, yc0), half=True,
-                     name="half ring")
+                     name="half ring", mass_matrix=params["mass_matrix"])
     wall = RigidPolyline(funnel_wall(params["phi_deg"], params["wall_length"]))
     if friction is None and params["variant"] == "frictional":
         friction = ParabolicSlip(params["c_T"], params["alpha"], params["beta"], params["n"])
@@ -156,6 +156,7 @@ SCENE = Scene(
         Param("delta", 0.7, "", 0.5, 1.0, doc="Newmark delta (chosen as in Sec. 5.3: 0.7)"),
         Param("beta_newmark", 0.4, "", 0.0, 0.5, low_open=True, doc="Newmark beta (chosen as in Sec. 5.3: 0.4)"),
         time_integration.CONTACT_INTEGRATION_PARAM,
+        MASS_MATRIX_PARAM,
         Param("outline_every", 5, "", 1, 100000, doc="store the ring outline every this many steps (paper: 5)"),
     ),
     build=build,

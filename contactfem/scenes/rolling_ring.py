@@ -56,7 +56,7 @@ from ..laws import Coulomb, PowerLaw
 from ..solver import History, Steps, System
 from . import time_integration
 from .base import Param, Scene, Stage, penalty_pressure
-from .rings import detect_rolling, rigid_ring_exact, ring_gyration_radius2, ring_history, ring_size, snapshot_indices  # noqa: F401
+from .rings import MASS_MATRIX_PARAM, detect_rolling, rigid_ring_exact, ring_gyration_radius2, ring_history, ring_size, snapshot_indices  # noqa: F401
 
 # Paper, Fig 9 (bracketed values are the rigid thin-ring solution)
 PAPER = dict(x_roll_exact=229.0, x_roll_computed="23x (scan)", x_end_exact=376.0, x_end_computed=382.0,
@@ -71,7 +71,8 @@ def build(params, *, normal=None, friction=None, system_options=None):
     its march. ``normal`` / ``friction``: law objects instead of the ones the parameters build."""
     R, h = params["R"], params["thickness"]
     args = dict(kind=params["kind"], R=R, thickness=h, width=params["width"], n_el=params["n_el"],
-                E=params["E"], nu=params["nu"], rho=params["rho"], n_radial=params["n_radial"], name="ring")
+                E=params["E"], nu=params["nu"], rho=params["rho"], n_radial=params["n_radial"], name="ring",
+                mass_matrix=params["mass_matrix"])
     probe = make_ring(**args)
     y0 = -probe.outline(np.zeros(probe.body.ndof))[:, 1].min()   # R + h/2 if a node sits at the bottom
     ring = make_ring(center=(0.0, y0), **args)
@@ -199,6 +200,7 @@ SCENE = Scene(
         Param("delta", 0.7, "", 0.5, 1.0, doc="Newmark delta (paper: 0.7)"),
         Param("beta_newmark", 0.4, "", 0.0, 0.5, low_open=True, doc="Newmark beta (paper: 0.4)"),
         time_integration.CONTACT_INTEGRATION_PARAM,
+        MASS_MATRIX_PARAM,
         Param("outline_interval", 0.25, "s", 0.0, None, low_open=True,
               doc="store the ring outline this often (figures)"),
     ),

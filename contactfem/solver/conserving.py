@@ -126,13 +126,14 @@ class EnergyConsistent:
         return G, rows, cols, vals
 
     def step(self, t, u, v, a, dt, label=""):
+        import scipy.sparse as sp
+
         _check_dt(dt)
         s = self.system
         t1, tm = t + dt, t + 0.5 * dt
-        M = s.mass()
+        M = s.mass()                        # lumped (a vector) or consistent (a sparse matrix)
+        Msp = sp.diags(M) if isinstance(M, np.ndarray) else M
         c = 2.0 / dt ** 2
-
-        import scipy.sparse as sp
 
         def fun(u1):
             s.evaluations += 1
@@ -150,9 +151,9 @@ class EnergyConsistent:
                 G -= P
                 rows.append(np.asarray(r, int)), cols.append(np.asarray(cc, int))
                 vals.append(-0.5 * np.asarray(vv, float))
-            G += M * c * (u1 - u - dt * v)
+            G += s.mass_times(c * (u1 - u - dt * v))
             K = sp.coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                              shape=(s.ndof, s.ndof)).tocsr() + sp.diags(c * M)
+                              shape=(s.ndof, s.ndof)).tocsr() + c * Msp
             return Evaluation(G, K, tuple(states))
 
         guess = s.apply_dirichlet(u + dt * v + 0.5 * dt ** 2 * a, t1)

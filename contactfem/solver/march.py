@@ -127,12 +127,18 @@ def accept(system, rec, t1, dt, trial, cuts=0, failures=()):
 
 
 def acceleration(system, G):
-    """a = -G / M on the free dofs with mass (M a = P - R, a diagonal solve);
-    0 on prescribed and massless dofs."""
+    """a from M a = -G (= P - R) on the free dofs with mass (a diagonal solve for a lumped M, a
+    sparse one for a consistent M); 0 on prescribed and massless dofs."""
     M = system.mass()
     a = np.zeros(system.ndof)
-    free = system.free_dofs[M[system.free_dofs] > 0]
-    a[free] = -G[free] / M[free]
+    if isinstance(M, np.ndarray):
+        free = system.free_dofs[M[system.free_dofs] > 0]
+        a[free] = -G[free] / M[free]
+        return a
+    from scipy.sparse.linalg import spsolve
+
+    free = system.free_dofs[M.diagonal()[system.free_dofs] > 0]
+    a[free] = spsolve(M[free][:, free].tocsc(), -G[free])
     return a
 
 

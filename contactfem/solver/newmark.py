@@ -15,7 +15,8 @@ the update of the step is
     a+ = (u+ - u_pred) / (beta dt^2),    v+ = v + dt ((1 - delta) a + delta a+),
 and u+ solves eq 29 at t+ = t + dt,
     G(u+) = M a+ + R(u+) + R_c(u+) - P(u+, t+) = 0,
-by Newton with the effective tangent M / (beta dt^2) + K + K_c (M lumped, diagonal).
+by Newton with the effective tangent M / (beta dt^2) + K + K_c (M the lumped, diagonal mass,
+or the consistent one where a body asks for it: System.mass).
 Unconditionally stable (linear analysis) for delta >= 1/2 and
 beta >= (delta + 1/2)^2 / 4; delta = 1/2, beta = 1/4 (average acceleration)
 conserves energy; the paper's delta = 0.7, beta = 0.4 damps high frequencies.
@@ -39,7 +40,7 @@ def _check_dt(dt):
 
 
 def initial_acceleration(system, t, u, dt=None):
-    """a0 from M a0 = P(u0, t0) - R(u0) - R_c(u0) (eq 29 at t0, lumped M).
+    """a0 from M a0 = P(u0, t0) - R(u0) - R_c(u0) (eq 29 at t0).
     Prescribed dofs get 0 (their acceleration is not known from the data)."""
     return acceleration(system, system.evaluate(u, t, dt).G)
 
@@ -72,12 +73,14 @@ class Newmark:
         s, beta, delta = self.system, self.beta, self.delta
         t1 = t + dt
         c = 1.0 / (beta * dt ** 2)
-        Mc = s.mass() * c                     # the step's constants: c M and the predictor
+        cM = c * s.mass()                     # the step's constants: c M and the predictor
+        lumped = isinstance(cM, np.ndarray)   # a diagonal (ndof,), else a sparse consistent M
         u_pred = u + dt * v + dt ** 2 * (0.5 - beta) * a
 
         def effective(u1):                    # eq 29 with a+ = c (u1 - u_pred); tangent K + c M
             ev = s.evaluate(u1, t1, dt, u, mass_coefficient=c)
-            return ev._replace(G=ev.G + Mc * (u1 - u_pred))
+            du = u1 - u_pred
+            return ev._replace(G=ev.G + (cM * du if lumped else cM @ du))
 
         # initial guess: the acceleration stays a (u + dt v + dt^2 a / 2); multipliers as they were
         guess = s.apply_dirichlet(u_pred + beta * dt ** 2 * a, t1)
@@ -112,9 +115,11 @@ class Static:
 
 
 class CentralDifference:
-    """Explicit central differences (Newmark beta = 0, delta = 1/2), lumped mass:
+    """Explicit central differences (Newmark beta = 0, delta = 1/2):
 
-        u+ = u + dt v + dt^2 a / 2,   M a+ = P - R(u+) - R_c(u+),   v+ = v + dt (a + a+) / 2.
+        u+ = u + dt v + dt^2 a / 2,   M a+ = P - R(u+) - R_c(u+),   v+ = v + dt (a + a+) / 2
+
+    (a diagonal solve for a lumped M, a sparse one for a consistent M).
 
     Conditionally stable: dt < 2 / omega_max. Prescribed dofs: v+ = (u+ - u) / dt, a+ = 0.
     (The tangent is assembled but unused; fine for the small problems here.)
@@ -122,7 +127,7 @@ class CentralDifference:
     dynamic = True
 
     def __init__(self, system):
-        if np.any(system.mass()[system.free_dofs] <= 0):
+        if np.any(system.lumped_mass()[system.free_dofs] <= 0):
             raise ValueError("CentralDifference needs mass > 0 on every free dof")
         self.system = system
 
@@ -136,6 +141,6 @@ class CentralDifference:
         v1[s.fixed_dofs] = (u1 - u)[s.fixed_dofs] / dt
         if not (np.all(np.isfinite(u1)) and np.all(np.isfinite(a1))):
             raise NewtonError(f"explicit step gave NaN/inf ({label or f't = {t1:.6g}'})", [], label)
-        G = ev.G + s.mass() * a1
+        G = ev.G + s.mass_times(a1)
         return u1, v1, a1, NewtonResult(u=u1, residuals=[], iterations=0, G=G, evaluation=ev._replace(G=G),
                                         evaluations=1)

@@ -122,13 +122,13 @@ class Staggered:
                             s.free_dofs, max_cycles=self.max_cycles, label=label, **opts)
             zero = np.zeros(s.ndof)
             return res.u, zero, zero.copy(), res
-        beta, delta, M = st.beta, st.delta, s.mass()
+        beta, delta = st.beta, st.delta
         c = 1.0 / (beta * dt ** 2)
         u_pred = u + dt * v + dt ** 2 * (0.5 - beta) * a
 
         def effective(u1, phases):                           # as Newmark.step
             ev = s.evaluate(u1, t1, dt, u, mass_coefficient=c, phases=phases)
-            return ev._replace(G=ev.G + M * c * (u1 - u_pred))
+            return ev._replace(G=ev.G + s.mass_times(c * (u1 - u_pred)))
 
         guess = s.apply_dirichlet(u_pred + beta * dt ** 2 * a, t1)
         res = staggered(effective, guess, s.free_dofs, max_cycles=self.max_cycles, label=label, **opts)

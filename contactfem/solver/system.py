@@ -6,7 +6,10 @@ The System implements the static part of the paper's equation of motion (eq 29),
 
 with R the internal forces of the bodies, R_c the contact residual (eq 28) and P
 the external loads, together with its tangent K = dG/du = K_int + K_c - dP/du.
-The inertia term M a of eq 29 is added by the time steppers (newmark.py).
+The inertia term M a of eq 29 is added by the time steppers (newmark.py). M is the
+bodies' lumped (diagonal) mass, a vector, unless a body asks for its consistent mass
+(``body.mass_matrix == "consistent"``): then M is one sparse matrix, the consistent
+blocks of those bodies and the diagonal of the others (``mass``, ``mass_times``).
 
 Bodies are placed one after another in the global vector: body b owns the global
 dofs ``b.dof_offset + local``. A contact may own unknowns too (``contact.unknowns`` of
@@ -175,12 +178,41 @@ class System:
 
     # -- assembly ---------------------------------------------------------------
 
+    @property
+    def mass_matrix(self):
+        """"consistent" if a body's mass is (``body.mass_matrix``), else "lumped"."""
+        return "consistent" if any(b.mass_matrix == "consistent" for b in self.bodies) else "lumped"
+
     def mass(self):
-        """Global lumped (diagonal) mass, (ndof,); 0 at the contacts' own unknowns."""
+        """The global mass M, 0 at the contacts' own unknowns: its diagonal (ndof,) when every
+        body's mass is lumped, else a CSR matrix (ndof, ndof) (``mass_matrix``). Use
+        ``mass_times`` for M x, whichever it is."""
         if self._mass is None:
-            self._mass = np.concatenate([np.asarray(b.mass(), dtype=float) for b in self.bodies]
-                                        + [np.zeros(self.ndof - self.body_ndof)])
+            if self.mass_matrix == "lumped":
+                self._mass = np.concatenate([np.asarray(b.mass(), dtype=float) for b in self.bodies]
+                                            + [np.zeros(self.ndof - self.body_ndof)])
+            else:
+                import scipy.sparse as sp
+
+                blocks = [b.mass(consistent=True) if b.mass_matrix == "consistent" else sp.diags(b.mass())
+                          for b in self.bodies]
+                if self.ndof > self.body_ndof:
+                    blocks.append(sp.csr_matrix((self.ndof - self.body_ndof,) * 2))
+                self._mass = sp.block_diag(blocks, format="csr")
+                coo = self._mass.tocoo()
+                self._mass_coo = (coo.row, coo.col, coo.data)    # the same arrays at every assembly
         return self._mass
+
+    def mass_times(self, x):
+        """M x (M lumped or consistent)."""
+        M = self.mass()
+        return M * x if isinstance(M, np.ndarray) else M @ x
+
+    def lumped_mass(self):
+        """The lumped mass (ndof,): M's row sums (M itself when lumped), the mass of each dof
+        that the centre of mass and the momentum sum over."""
+        M = self.mass()
+        return M if isinstance(M, np.ndarray) else np.asarray(M.sum(axis=1)).ravel()
 
     def external_force(self, u, t):
         """P(u, t), the sum of all loads (ndof,)."""
@@ -193,8 +225,8 @@ class System:
         """The System at u, time t, at the end of a step of dt from u0: an Evaluation with
         G = R(u) + R_c(u) - P(u, t) (static part of eq 29), K = dG/du and the contacts' states.
 
-        With ``mass_coefficient`` c > 0, K + c M is returned instead (M the lumped mass): the
-        effective tangent of an implicit time stepper (Newmark: c = 1 / (beta dt^2)). ``phases``:
+        With ``mass_coefficient`` c > 0, K + c M is returned instead (M lumped or consistent:
+        ``mass``): the effective tangent of an implicit time stepper (Newmark: c = 1 / (beta dt^2)). ``phases``:
         one staggered-algorithm phase per contact (contact/tangents.py), or None. K is a dense
         array or a CSC matrix (``self.linear_algebra``; banded: a CSC matrix that carries its band
         plan, ``K.band_plan``); all contributions arrive as COO triplets and are summed into it
@@ -231,7 +263,15 @@ class System:
                 r, c, v = _triplets(r, c, v)
                 blocks.append((r, c, -v, 0, None))
             G -= P
-            K = self._tangent.assemble(blocks, mass_coefficient * self.mass() if mass_coefficient else None)
+            diagonal = None
+            if mass_coefficient:
+                M = self.mass()
+                if isinstance(M, np.ndarray):
+                    diagonal = mass_coefficient * M
+                else:                                  # consistent: one more constant block, c M
+                    r, c, v = self._mass_coo
+                    blocks.append((r, c, mass_coefficient * v, 0, "mass"))
+            K = self._tangent.assemble(blocks, diagonal)
         return Evaluation(G, K, tuple(states), P)
 
     def residual_tangent(self, u, t, mass_coefficient=0.0, dt=None, u0=None):
@@ -260,7 +300,7 @@ class System:
         """Kinetic (1/2 v.M v), strain and interface energy of a converged state, as a dict
         of floats; the interface energy is read from the evaluation's contact states."""
         return {
-            "kinetic": 0.5 * float(np.dot(v, self.mass() * v)),
+            "kinetic": 0.5 * float(np.dot(v, self.mass_times(v))),
             "strain": float(sum(b.strain_energy(self.local(b, u), dt) for b in self.bodies)),
             "contact": float(sum(st.energy for st in evaluation.contacts)),
         }

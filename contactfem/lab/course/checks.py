@@ -727,6 +727,705 @@ def secant_limit(secant_traction):
         compare("secant traction for g0 = g1", F, want, {"g": g})
 
 
+# -- the answers that run a scene: computed once per answer ----------------------------------------
+
+_MEMO = {}
+
+
+def memo(key, thunk):
+    """thunk() once per key (the student's function and its arguments): the parts of an
+    exercise that run a time loop share one run; a failure is remembered as well."""
+    if key not in _MEMO:
+        try:
+            _MEMO[key] = (True, thunk())
+        except AssertionError as err:
+            _MEMO[key] = (False, err)
+    ok, value = _MEMO[key]
+    if not ok:
+        raise AssertionError(str(value))
+    return value
+
+
+def _scene_model(name, overrides):
+    """A fresh model of a scene (its build, fast preset): stepper, schedule, u0, v0 of its stage."""
+    from ...scenes import get_scene
+
+    scene = get_scene(name)
+    params = scene.resolve("fast", overrides)
+    return scene.build(params), params
+
+
+def _counts(rec):
+    """(nodes in contact, nodes slipping) of a record's first converged contact state."""
+    from ...laws.return_map import OPEN, SLIP
+
+    st = rec.contacts[0]
+    return int(np.count_nonzero(st.slip != OPEN)), int(np.count_nonzero(st.slip == SLIP))
+
+
+def _as_list(out, n, name, what):
+    values = [np.asarray(v, dtype=float).ravel() for v in parts(out, n, name, what)]
+    sizes = {v.size for v in values}
+    if len(sizes) != 1:
+        raise AssertionError(f"{name} should return {n} arrays of one length (one entry per step), "
+                             f"got lengths {[v.size for v in values]}")
+    return values
+
+
+# -- lecture 04: the block ------------------------------------------------------------------------
+
+def _margin_cases():
+    from ...laws import Coulomb, ParabolicSlip
+
+    t_N = -np.array([10.0, 40.0, 90.0, 160.0, 250.0, 2.0])
+    t_T = np.array([5.0, -14.0, 20.0, -30.0, 80.0, 1.0])
+    return t_N, t_T, (ParabolicSlip(c_T=1e4, alpha=0.2, beta=0.3, n=0.5), Coulomb(c_T=1e4, mu=0.3))
+
+
+def _margin(slip_margin, t_N, t_T, law):
+    return np.asarray(call(slip_margin, "slip_margin", t_N, t_T, law), dtype=float)
+
+
+def margin_parabolic(slip_margin):
+    t_N, t_T, (law, _) = _margin_cases()
+    want = np.abs(t_T) - law.slip_bound(-t_N, 0 * t_N)[0]
+    got = _margin(slip_margin, t_N, t_T, law)
+    at = {"t_N": t_N, "t_T": t_T}
+    if got.shape == want.shape and np.allclose(got, t_T - law.slip_bound(-t_N, 0 * t_N)[0]):
+        raise AssertionError("your f is wrong where t_T < 0: the slip condition bounds the size of the "
+                             "friction traction, f = |t_T| - Y(|t_N|)")
+    compare("f = |t_T| - Y(|t_N|) (parabolic law, n = 0.5)", got, want, at,
+            rule="Y(p) = law.slip_bound(p, q)[0] with the pressure p = |t_N| = -t_N and q = 0")
+
+
+def margin_coulomb(slip_margin):
+    t_N, t_T, (_, law) = _margin_cases()
+    got = _margin(slip_margin, t_N, t_T, law)
+    compare("f = |t_T| - mu |t_N| (Coulomb, mu = 0.3)", got, np.abs(t_T) + 0.3 * t_N, {"t_N": t_N, "t_T": t_T},
+            rule="the pressure is |t_N| = -t_N > 0 in contact")
+
+
+def margin_block(slip_margin):
+    """On the block's converged state: f <= 0 everywhere and f = 0 at the slipping nodes."""
+    from ...laws.return_map import SLIP
+
+    def run():
+        from ...solver.march import march
+        from ...scenes.block_params import friction_law
+
+        model, P = _scene_model("block", {"law": "conical"})
+        st = model["stage"]
+        last = list(march(st.stepper, st.schedule, st.t0, st.u0))[-1].contacts[0]
+        return last, friction_law(P)
+
+    state, law = memo(("block", "conical"), run)
+    f = _margin(slip_margin, state.t_N, state.t_T, law)
+    scale = float(np.max(np.abs(state.t_N)))
+    slip = state.slip == SLIP
+    if f.shape != slip.shape:
+        raise AssertionError(f"slip_margin should return one value per node, {slip.size} here, got shape {f.shape}")
+    if np.max(f) > 1e-9 * scale:
+        i = int(np.argmax(f))
+        raise AssertionError(f"on the converged block your f is {f[i]:.4g} > 0 at x = {state.x_s[i, 0]:.3g}: "
+                             "a converged state never violates its slip condition; check |t_N| and the law")
+    if np.any(np.abs(f[slip]) > 1e-9 * scale):
+        raise AssertionError("on the converged block your f is not 0 at the slipping nodes: a slipping node "
+                             "sits on its slip surface, |t_T| = Y(|t_N|)")
+
+
+def _load_steps(load_steps, n):
+    def run():
+        model, _ = _scene_model("block", {"law": "conical"})
+        return call(load_steps, "load_steps", model["stepper"], n, timeout=60.0)
+    out = memo(("load_steps", load_steps, n), run)
+    return _as_list(out, 3, "load_steps", "the pseudo-times, the linear solves and the slipping nodes of each step")
+
+
+def _load_steps_ref(n):
+    def run():
+        from ...solver import Steps
+        from ...solver.march import march
+
+        model, _ = _scene_model("block", {"law": "conical"})
+        recs = list(march(model["stepper"], Steps(1.0 / n, n_steps=n), 0.0, np.zeros(model["system"].ndof)))[1:]
+        return (np.array([r.t for r in recs]), np.array([r.iterations for r in recs], float),
+                np.array([_counts(r)[1] for r in recs], float), np.array([_counts(r)[0] for r in recs], float))
+    return memo(("load_steps_ref", n), run)
+
+
+def load_steps_times(load_steps):
+    t, _, _ = _load_steps(load_steps, 4)
+    want = _load_steps_ref(4)[0]
+    if t.size == want.size + 1 and t[0] == 0.0:
+        raise AssertionError("your lists have 5 entries for 4 load steps: the first record of march is the "
+                             "initial state (k = 0, t = 0); keep the records with k >= 1")
+    if t.size != want.size:
+        raise AssertionError(f"load_steps(stepper, 4) should give one entry per load step, 4, got {t.size}")
+    compare("pseudo-time of each load step", t, want, {"step": np.arange(1, 5)}, rule="Steps(1 / n, n_steps=n)")
+
+
+def load_steps_solves(load_steps):
+    _, its, _ = _load_steps(load_steps, 4)
+    want = _load_steps_ref(4)[1]
+    if its.size != want.size:
+        raise AssertionError(f"load_steps(stepper, 4) should give one entry per load step, 4, got {its.size}")
+    compare("linear solves of each load step", its, want, {"step": np.arange(1, 5)},
+            rule="rec.iterations of each record")
+
+
+def load_steps_slipping(load_steps):
+    _, _, slip = _load_steps(load_steps, 4)
+    _, _, want, contact = _load_steps_ref(4)
+    if slip.size != want.size:
+        raise AssertionError(f"load_steps(stepper, 4) should give one entry per load step, 4, got {slip.size}")
+    if np.allclose(slip, contact) and not np.allclose(slip, want):
+        raise AssertionError("your counts are the nodes in contact, not the slipping ones: count the nodes "
+                             "whose state is SLIP (rec.contacts[0].slip == SLIP, or rec.contacts[0].n_slip)")
+    if np.allclose(slip, contact - want) and not np.allclose(slip, want):
+        raise AssertionError("your counts are the sticking nodes: count the nodes whose state is SLIP")
+    compare("slipping nodes after each load step", slip, want, {"step": np.arange(1, 5)},
+            rule="read them from the record's converged state, rec.contacts[0].slip == SLIP")
+
+
+def load_steps_one(load_steps):
+    t, its, slip = _load_steps(load_steps, 1)
+    want = _load_steps_ref(1)
+    compare("the whole load in one step: (t, solves, slipping nodes)", np.r_[t, its, slip],
+            np.r_[want[0], want[1], want[2]], {"entry": ["t", "solves", "slipping"]},
+            rule="n = 1 is the paper's single step")
+
+
+# -- lecture 05: the rolling ring -------------------------------------------------------------------
+
+ROLLING_CASES = ((300.0, 0.15, 981.0, 50.0, 2500.0), (300.0, 0.15, 981.0, 50.0, 1250.0),
+                 (200.0, 0.3, 981.0, 55.0, 2700.0))
+
+
+def _rolling(rolling_point):
+    out = []
+    for v0, mu, g, a, k2 in ROLLING_CASES:
+        got = parts(call(rolling_point, "rolling_point", v0, mu, g, a, k2), 3, "rolling_point", "t*, x*, v*")
+        try:
+            got = [float(np.asarray(x)) for x in got]
+        except (TypeError, ValueError):
+            raise AssertionError(f"rolling_point should return three numbers (t*, x*, v*), got {got!r:.80}") from None
+        out.append(got)
+    from ...scenes.rings import rigid_ring_exact
+
+    ref = [rigid_ring_exact(v0, mu, g, a, k2) for v0, mu, g, a, k2 in ROLLING_CASES]
+    at = {"v0": [c[0] for c in ROLLING_CASES], "mu": [c[1] for c in ROLLING_CASES], "a": [c[3] for c in ROLLING_CASES],
+          "k^2": [c[4] for c in ROLLING_CASES]}
+    return np.array(out), ref, at
+
+
+def rolling_time(rolling_point):
+    got, ref, at = _rolling(rolling_point)
+    want = np.array([r["t_star"] for r in ref])
+    no_spin = np.array([c[0] / (c[1] * c[2]) for c in ROLLING_CASES])
+    if np.allclose(got[:, 0], no_spin):
+        raise AssertionError("your t* = v0 / (mu g) is when the centre would stop; rolling starts earlier, when "
+                             "the contact point stops: v(t) + omega(t) a = 0 with omega spun up by the friction "
+                             "torque, t* = v0 / (mu g (1 + a^2/k^2))")
+    compare("t* (the start of rolling)", got[:, 0], want, at, rule="t* = v0 / (mu g (1 + a^2/k^2))")
+
+
+def rolling_position(rolling_point):
+    got, ref, at = _rolling(rolling_point)
+    compare("x* (the centre when rolling starts)", got[:, 1], np.array([r["x_star"] for r in ref]), at,
+            rule="x* = v0 t* - mu g t*^2 / 2 (uniform deceleration mu g while sliding)")
+
+
+def rolling_speed(rolling_point):
+    got, ref, at = _rolling(rolling_point)
+    compare("v* (the rolling speed)", got[:, 2], np.array([r["v_star"] for r in ref]), at,
+            rule="v* = v0 - mu g t*; for the thin hoop (k = a) v* = v0 / 2")
+
+
+def _incline(ring_on_incline, theta, mu):
+    def run():
+        out = call(ring_on_incline, "ring_on_incline", theta, mu, timeout=120.0)
+        t, s = _as_list(out, 2, "ring_on_incline", "the times and the centre's travel down the slope")
+        return t, s
+    return memo(("incline", ring_on_incline, theta, mu), run)
+
+
+def _acceleration(t, s):
+    """The centre's acceleration along the slope: s = s0 + v0 t + a t^2 / 2 by least squares."""
+    return 2.0 * np.polyfit(t, s, 2)[0]
+
+
+def incline_start(ring_on_incline):
+    t, s = _incline(ring_on_incline, 20.0, 0.5)
+    if t.size < 10:
+        raise AssertionError(f"ring_on_incline should return one time and one travel per record, got {t.size}")
+    if abs(t[0]) > 1e-12 or abs(s[0]) > 1e-9:
+        raise AssertionError(f"the first record is the initial state: t = 0 and no travel yet; yours has t = {t[0]:.3g}, "
+                             f"s = {s[0]:.3g} (measure s from the centre's initial position)")
+    if s[-1] <= 0:
+        raise AssertionError(f"your travel at the end is {s[-1]:.3g} <= 0: s is the distance the centre has moved "
+                             "DOWN the slope, (x_c(t) - x_c(0)) . d with d = (-cos theta, -sin theta) for a plane "
+                             "rising to the right")
+
+
+def _incline_verdict(what, a, want, theta, mu, rtol):
+    g = 981.0
+    th = np.radians(theta)
+    others = {"a ring sliding without friction, g sin(theta)": g * np.sin(th),
+              "a ring sliding with friction, g (sin(theta) - mu cos(theta))": g * (np.sin(th) - mu * np.cos(th)),
+              "a hoop rolling without slip, g sin(theta) / 2": g * np.sin(th) / 2,
+              "a free fall, g": g}
+    if abs(a / want - 1) <= rtol:
+        return
+    close = [k for k, v in others.items() if v > 0 and abs(a / v - 1) <= rtol]
+    hint = f" (that is {close[0]})" if close else ""
+    raise AssertionError(f"at theta = {theta:g} deg, mu = {mu:g} your ring's acceleration along the slope is "
+                         f"{a:.4g} cm/s^2{hint}; {what} gives {want:.4g} (within {100 * rtol:g} %): check the "
+                         "plane's normal (towards the ring), gravity (down, -y), the friction law and its mu")
+
+
+def incline_rolling(ring_on_incline):
+    """tan(20 deg) = 0.36 <= 2 mu = 1: the hoop rolls, a = g sin(theta) / 2. The scene's ring on
+    its fast mesh (40 beam elements, dt = 0.02) gives +0.8 % (its polygon rocks over its corners,
+    its stick springs settle at the start): 5 % leaves room for another ring of this lecture
+    and is far from every other motion (sliding: twice that)."""
+    t, s = _incline(ring_on_incline, 20.0, 0.5)
+    _incline_verdict("rolling without slip", _acceleration(t, s), 981.0 * np.sin(np.radians(20.0)) / 2, 20.0, 0.5, 0.05)
+
+
+def incline_sliding(ring_on_incline):
+    """tan(30 deg) = 0.58 > 2 mu = 0.3: the ring slides all the way, a = g (sin - mu cos), a
+    constant friction force: the fast ring gives +0.5 %, checked to 3 %."""
+    th = np.radians(30.0)
+    t, s = _incline(ring_on_incline, 30.0, 0.15)
+    _incline_verdict("sliding with Coulomb friction", _acceleration(t, s), 981.0 * (np.sin(th) - 0.15 * np.cos(th)),
+                     30.0, 0.15, 0.03)
+
+
+# -- lecture 06: the sloping impact -----------------------------------------------------------------
+
+def _rebound_case(k_last=6, n=12):
+    """A centre-of-mass history: flying in at (2, -2), in contact for records 3..k_last, then
+    leaving at (1.2, 1.7) and slowly drifting (a vibrating ring's centre is not exactly constant)."""
+    v = np.zeros((n, 2))
+    v[:3] = (2.0, -2.0)
+    v[3:k_last + 1] = np.linspace([1.8, -1.0], [1.3, 1.5], k_last - 2)
+    v[k_last + 1:] = (1.2, 1.7) + 0.01 * np.arange(n - k_last - 1)[:, None]
+    contact = np.zeros(n, bool)
+    contact[3:k_last + 1] = True
+    return v, contact
+
+
+def _rebound_call(rebound, v, contact):
+    return call(rebound, "rebound", v, contact)
+
+
+def rebound_velocity(rebound):
+    v, contact = _rebound_case()
+    out = parts(_rebound_call(rebound, v, contact), 3, "rebound", "v_x, v_y and the angle")
+    got = np.array([float(np.asarray(x)) for x in out[:2]])
+    if np.allclose(got, v[-1]):
+        raise AssertionError("your rebound velocity is the last record's: take the first record after the last "
+                             "one in contact (the ring has just left the plane)")
+    compare("rebound velocity (v_x, v_y)", got, v[7], {"component": ["v_x", "v_y"]},
+            rule="the centre's velocity at the first record after the last record in contact")
+
+
+def rebound_angle(rebound):
+    v, contact = _rebound_case()
+    out = parts(_rebound_call(rebound, v, contact), 3, "rebound", "v_x, v_y and the angle")
+    angle = float(np.asarray(out[2]))
+    vx, vy = v[7]
+    want = float(np.degrees(np.arctan2(abs(vx), abs(vy))))
+    if math.isclose(angle, 90.0 - want, rel_tol=1e-6):
+        raise AssertionError(f"your angle {angle:.4g} deg is measured from the plane; Table 2's angle of reflection "
+                             f"is measured from the normal: atan(|v_x| / |v_y|) = {want:.4g} deg")
+    if math.isclose(angle, np.radians(want), rel_tol=1e-6):
+        raise AssertionError(f"your angle {angle:.4g} is in radians: give degrees (np.degrees)")
+    compare("angle of reflection (deg)", angle, want, {"v": f"({vx:g}, {vy:g})"},
+            rule="atan(|v_x| / |v_y|), from the normal, in degrees")
+
+
+def rebound_none(rebound):
+    v, contact = _rebound_case()
+    contact[-1] = True
+    out = call(rebound, "rebound", v, contact)
+    if not (isinstance(out, tuple) and len(out) == 3 and all(x is None for x in out)):
+        raise AssertionError("when the ring is still in contact at the last record it has not rebounded: "
+                             f"return (None, None, None); yours returned {out!r:.80}")
+
+
+def _energy_cases():
+    g = np.array([-0.02, -0.1, 0.05, -0.3, 0.0, -0.05])
+    t_T = np.array([0.3, -1.2, 0.0, 2.0, 0.0, -0.4])
+    w = np.array([1.0, 0.5, 1.0, 2.0, 1.0, 1.5])
+    return g, t_T, w
+
+
+def _interface(interface_energy, g, t_T, w, c_N, m, c_T):
+    out = call(interface_energy, "interface_energy", g, t_T, w, c_N, m, c_T)
+    try:
+        return float(np.asarray(out, dtype=float))
+    except (TypeError, ValueError):
+        raise AssertionError(f"interface_energy should return one number (the sum over the nodes), got {out!r:.80}") from None
+
+
+def _energy_ref(g, t_T, w, c_N, m, c_T):
+    from ...laws import PowerLaw
+
+    W = PowerLaw(c_N=c_N, m=m).energy(g)
+    return float(np.sum(w * (W + (t_T ** 2 / (2 * c_T) if c_T else 0.0))))
+
+
+def energy_normal(interface_energy):
+    g, t_T, w = _energy_cases()
+    for m in (1.0, 1.5):
+        got = _interface(interface_energy, g, 0 * t_T, w, 50.0, m, 30.0)
+        want = _energy_ref(g, 0 * t_T, w, 50.0, m, 30.0)
+        if math.isclose(got, (m + 1) * want, rel_tol=1e-8):
+            raise AssertionError(f"your normal energy is (m + 1) times too large (m = {m:g}): the potential of "
+                                 "t_N = -c_N (-g_N)^m is c_N (-g_N)^(m+1) / (m + 1)")
+        if math.isclose(got, float(np.sum(_power_energy(g, 50.0, m))), rel_tol=1e-8) and not np.allclose(w, 1):
+            raise AssertionError("your energy leaves out the weights: each node's energy counts with its weight w")
+        compare(f"interface energy without friction (c_N = 50, m = {m:g})", got, want, {"g_N": "-0.02 ... -0.3"},
+                rule="sum_i w_i c_N (-g_N,i)^(m+1) / (m + 1) over the nodes in contact (g_N < 0)")
+
+
+def _power_energy(g, c_N, m):
+    """The potential of eq (4) per node, without weights."""
+    return np.where(g < 0, c_N * np.abs(np.minimum(g, 0)) ** (m + 1) / (m + 1), 0.0)
+
+
+def energy_open(interface_energy):
+    g = np.array([0.05, 0.2, 0.0])
+    got = _interface(interface_energy, g, np.zeros(3), np.ones(3), 50.0, 1.0, 30.0)
+    compare("interface energy of open nodes", got, 0.0, {"g_N": "0.05, 0.2, 0"},
+            rule="an open node (g_N >= 0) stores no energy: use np.where(g_N < 0, ..., 0)")
+
+
+def energy_friction(interface_energy):
+    g, t_T, w = _energy_cases()
+    got = _interface(interface_energy, g, t_T, w, 50.0, 1.0, 30.0)
+    want = _energy_ref(g, t_T, w, 50.0, 1.0, 30.0)
+    normal = _energy_ref(g, 0 * t_T, w, 50.0, 1.0, 30.0)
+    if math.isclose(got, normal, rel_tol=1e-8):
+        raise AssertionError("your energy leaves out the stick springs: a node in stick stores t_T^2 / (2 c_T) "
+                             "(eq 5: t_T = c_T g_T^e)")
+    compare("interface energy with friction (c_T = 30)", got, want, {"t_T": "0.3 ... -0.4"},
+            rule="add sum_i w_i t_T,i^2 / (2 c_T), the energy of the stick springs")
+
+
+# -- lecture 07: the funnel ----------------------------------------------------------------------
+
+def _escape(escape_angle, p, alpha=0.3, beta=0.1, n=0.75):
+    return np.asarray(call(escape_angle, "escape_angle", p, alpha, beta, n), dtype=float)
+
+
+def escape_values(escape_angle):
+    p = np.array([0.05, 0.1, 0.3, 1.0, 3.0])
+    want = np.degrees(np.arctan(0.3 * p ** -0.25 + 0.1))
+    got = _escape(escape_angle, p)
+    if got.shape == want.shape and np.allclose(got, np.radians(want)):
+        raise AssertionError("your angles are in radians: give degrees (np.degrees)")
+    if got.shape == want.shape and np.allclose(got, np.full(p.shape, np.degrees(np.arctan(0.4)))):
+        raise AssertionError("your angle does not depend on the pressure: with eq 10 the coefficient is "
+                             "mu_eff = Y / p = alpha p^(n-1) + beta, not alpha + beta")
+    compare("escape angle (deg; alpha = 0.3, beta = 0.1, n = 0.75)", got, want, {"p": p},
+            rule="tan(phi) = mu_eff(p) = alpha p^(n-1) + beta")
+
+
+def escape_coulomb(escape_angle):
+    p = np.array([0.1, 1.0, 10.0])
+    got = _escape(escape_angle, p, alpha=0.0, beta=0.3, n=1.0)
+    compare("escape angle for Coulomb mu = 0.3 (alpha = 0, n = 1)", got, np.full(3, np.degrees(np.arctan(0.3))),
+            {"p": p}, rule="tan(phi) = mu whatever the pressure")
+
+
+def escape_steeper(escape_angle):
+    lo, hi = _escape(escape_angle, np.array([0.05])), _escape(escape_angle, np.array([1.0]))
+    if not float(np.ravel(lo)[0]) > float(np.ravel(hi)[0]):
+        raise AssertionError("with n = 0.75 < 1 the effective coefficient falls as the pressure rises, so a lightly "
+                             "pressed ring holds at a steeper wall: your angle at p = 0.05 should exceed that at p = 1")
+
+
+def _census(census):
+    def run():
+        model, _ = _scene_model("funnel", {"variant": "frictional"})
+        st = model["stage"]
+        return call(census, "census", st.stepper, st.schedule, st.u0, st.v0, timeout=120.0)
+    out = memo(("census", census), run)
+    return _as_list(out, 3, "census", "the times, the nodes in contact and the slipping nodes of each record")
+
+
+def _census_ref():
+    def run():
+        from ...solver.march import march
+
+        model, _ = _scene_model("funnel", {"variant": "frictional"})
+        st = model["stage"]
+        recs = list(march(st.stepper, st.schedule, st.t0, st.u0, st.v0))
+        c = np.array([_counts(r) for r in recs], float)
+        return np.array([r.t for r in recs]), c[:, 0], c[:, 1]
+    return memo(("census_ref",), run)
+
+
+def census_times(census):
+    t, _, _ = _census(census)
+    want = _census_ref()[0]
+    if t.size == want.size - 1:
+        raise AssertionError(f"your census has {t.size} entries, the run {want.size} records: keep the initial "
+                             "state (record 0) too")
+    if t.size != want.size:
+        raise AssertionError(f"census should give one entry per record of the march, {want.size}, got {t.size}")
+    compare("time of each record", t, want, {"record": np.arange(t.size)})
+
+
+def census_contact(census):
+    _, n_c, _ = _census(census)
+    _, want, slip = _census_ref()
+    if n_c.size != want.size:
+        raise AssertionError(f"census should give one entry per record of the march, {want.size}, got {n_c.size}")
+    if np.allclose(n_c, slip) and not np.allclose(n_c, want):
+        raise AssertionError("your contact counts are the slipping nodes: a node is in contact when its state "
+                             "is not OPEN (stick or slip)")
+    compare("nodes in contact", n_c, want, {"record": np.arange(n_c.size)},
+            rule="rec.contacts[0].slip != OPEN, from the record's converged state")
+
+
+def census_slip(census):
+    _, n_c, n_s = _census(census)
+    _, contact, want = _census_ref()
+    if n_s.size != want.size:
+        raise AssertionError(f"census should give one entry per record of the march, {want.size}, got {n_s.size}")
+    if np.allclose(n_s, contact - want) and not np.allclose(n_s, want):
+        raise AssertionError("your slip counts are the sticking nodes: count the state SLIP")
+    compare("slipping nodes", n_s, want, {"record": np.arange(n_s.size)},
+            rule="rec.contacts[0].slip == SLIP, from the record's converged state")
+
+
+# -- lecture 08: the cork -------------------------------------------------------------------------
+
+def _gas(gas_pressure, du, p0=0.8, V0=9424.778, area=314.159, travel=24.0):
+    return np.asarray(call(gas_pressure, "gas_pressure", p0, V0, area, du, travel), dtype=float)
+
+
+def gas_at_rest(gas_pressure):
+    got = _gas(gas_pressure, np.array([0.0]))
+    compare("pressure before the cork moves", got, np.array([0.8]), {"du": 0.0}, rule="p = p0 at du = 0")
+
+
+def gas_boyle(gas_pressure):
+    du = np.array([1.0, 5.0, 12.0, 23.9])
+    got = _gas(gas_pressure, du)
+    want = 0.8 * 9424.778 / (9424.778 + 314.159 * du)
+    if got.shape == want.shape and np.allclose(got, 0.8 * (9424.778 + 314.159 * du) / 9424.778):
+        raise AssertionError("your pressure rises as the cork moves out: the gas expands, V grows and p falls, "
+                             "p = p0 V0 / V (Boyle)")
+    compare("gas pressure (Boyle, p0 = 0.8 MPa)", got, want, {"du": du},
+            rule="p = p0 V0 / (V0 + area du): the volume grows by the swept area times the travel")
+
+
+def gas_release(gas_pressure):
+    du = np.array([23.0, 24.0, 30.0])
+    got = _gas(gas_pressure, du)
+    want = np.array([0.8 * 9424.778 / (9424.778 + 314.159 * 23.0), 0.0, 0.0])
+    compare("gas pressure at and past the mouth", got, want, {"du": du},
+            rule="once the bottom has travelled `travel` (the length in the neck) the gas escapes: p = 0")
+
+
+def _hardening_return(hardening_return, t_bar, dg, p, q_bar, c_T=10.0, mu0=0.1, h=0.01):
+    out = call(hardening_return, "hardening_return", t_bar, dg, p, q_bar, c_T, mu0, h)
+    t_T, lam, q = parts(out, 3, "hardening_return", "t_T, lambda and q")
+    try:
+        return float(t_T), float(lam), float(q)
+    except (TypeError, ValueError):
+        raise AssertionError(f"hardening_return should return three numbers (t_T, lambda, q), got {out!r:.80}") from None
+
+
+def _hardening_ref(t_bar, dg, p, q_bar, c_T=10.0, mu0=0.1, h=0.01):
+    from ...laws import SlipHardening
+    from ...laws.return_map import return_map
+
+    fr = return_map(SlipHardening(c_T=c_T, mu=mu0, h=h), np.array([-p]), np.array([0.0]), np.array([dg]),
+                    np.array([t_bar]), np.array([q_bar]))
+    return float(fr.t_T[0]), float(fr.lam[0]), float(fr.q[0])
+
+
+HARDENING_SLIP = ((0.1, 0.05, 2.0, 0.3), (-0.2, -0.08, 3.0, 1.0), (0.15, -0.1, 1.0, 0.0), (0.0, 0.2, 4.0, 5.0))
+
+
+def hardening_stick(hardening_return):
+    for case in ((0.1, 0.005, 2.0, 0.3), (-0.05, 0.002, 3.0, 0.0)):
+        t_T, lam, q = _hardening_return(hardening_return, *case)
+        want = _hardening_ref(*case)
+        at = dict(zip(("t_bar", "dg_T", "p", "q_bar"), case))
+        compare("t_T in stick", t_T, want[0], at, rule="in stick t_T = t_bar + c_T dg_T (eq 42)")
+        compare("lambda in stick", lam, 0.0, at)
+        compare("q in stick", q, case[3], at, rule="no slip, no change of the accumulated slip")
+
+
+def hardening_slip(hardening_return):
+    for case in HARDENING_SLIP:
+        t_T, lam, q = _hardening_return(hardening_return, *case)
+        want = _hardening_ref(*case)
+        at = dict(zip(("t_bar", "dg_T", "p", "q_bar"), case))
+        t_tr = case[0] + 10.0 * case[1]
+        soft = (abs(t_tr) - (0.1 + 0.01 * case[3]) * case[2]) / 10.0
+        if math.isclose(lam, soft, rel_tol=1e-8) and not math.isclose(lam, want[1], rel_tol=1e-8):
+            raise AssertionError(f"your lambda {lam:.6g} at {', '.join(f'{k} = {v:g}' for k, v in at.items())} is "
+                                 f"the one without hardening in the consistency condition; the bound grows with the "
+                                 f"slip of the step itself: |t_tr| - c_T lambda - (mu0 + h (q_bar + lambda)) p = 0, "
+                                 f"lambda = {want[1]:.6g}")
+        compare("t_T in slip", t_T, want[0], at, rule="t_T = sign(t_tr) (mu0 + h q) p on the slip surface")
+
+
+def hardening_lambda_q(hardening_return):
+    for case in HARDENING_SLIP:
+        t_T, lam, q = _hardening_return(hardening_return, *case)
+        want = _hardening_ref(*case)
+        at = dict(zip(("t_bar", "dg_T", "p", "q_bar"), case))
+        compare("lambda in slip", lam, want[1], at,
+                rule="lambda = (|t_tr| - (mu0 + h q_bar) p) / (c_T + h p)")
+        compare("q after the step", q, want[2], at, rule="q = q_bar + lambda")
+
+
+# -- lecture 12: beyond node-to-segment -----------------------------------------------------------
+
+def _cn_cases():
+    t_N = np.array([-2.0, -0.5, 0.0, 0.0, -1.0, -3.0])
+    g_N = np.array([-0.01, 0.3, 0.2, -0.02, 0.02, 0.0])
+    return t_N, g_N, 10.0
+
+
+def _cn(C_N, t_N, g_N, c_N):
+    out = call(C_N, "C_N", t_N, g_N, c_N)
+    return [np.asarray(x, dtype=float) for x in parts(out, 3, "C_N", "C_N, dC_N/dt_N and dC_N/dg_N")]
+
+
+def cn_values(C_N):
+    from ...contact.complementarity import normal_complementarity
+
+    t_N, g_N, c_N = _cn_cases()
+    C, _, _ = _cn(C_N, t_N, g_N, c_N)
+    want = normal_complementarity(t_N, g_N, c_N)[0]
+    at = {"t_N": t_N, "g_N": g_N}
+    if C.shape == want.shape and np.allclose(C, -want):
+        raise AssertionError("your C_N has the wrong sign: with p = -t_N, xi = p - c_N g_N and C_N = p - max(0, xi)")
+    compare("C_N (c_N = 10)", C, want, at, rule="C_N = p - max(0, p - c_N g_N) with p = -t_N")
+
+
+def cn_derivatives(C_N):
+    from ...contact.complementarity import normal_complementarity
+
+    t_N, g_N, c_N = _cn_cases()
+    _, dt, dg = _cn(C_N, t_N, g_N, c_N)
+    _, w_dt, w_dg, _ = normal_complementarity(t_N, g_N, c_N)
+    at = {"t_N": t_N, "g_N": g_N}
+    compare("dC_N/dt_N", dt, w_dt, at, rule="closed (xi >= 0): C_N = c_N g_N, so 0; open: C_N = p = -t_N, so -1")
+    compare("dC_N/dg_N", dg, w_dg, at, rule="closed: c_N; open: 0")
+
+
+def cn_tie(C_N):
+    t_N, g_N, c_N = np.array([0.0]), np.array([0.0]), 10.0
+    C, dt, dg = _cn(C_N, t_N, g_N, c_N)
+    if not (np.allclose(dt, 0.0) and np.allclose(dg, c_N)):
+        raise AssertionError("at xi = 0 (touching, no pressure) your node is open; the tie goes to contact "
+                             "(xi >= 0 is closed), so that a body resting on its support is held in the first "
+                             "iteration: dC_N/dt_N = 0, dC_N/dg_N = c_N there")
+
+
+def _ct_cases():
+    t_T = np.array([0.1, 0.5, -0.4, 0.2, 0.0, 0.3])
+    dg = np.array([0.0, 0.02, -0.05, 0.01, 0.0, 0.1])
+    xi = np.array([-1.0, 2.0, 2.0, 1.0, 0.5, 3.0])
+    return t_T, dg, xi, 10.0, 0.3
+
+
+def _ct(C_T, t_T, dg, xi, c_T, mu):
+    out = call(C_T, "C_T", t_T, dg, xi, c_T, mu)
+    return [np.asarray(x, dtype=float) for x in parts(out, 4, "C_T", "C_T, dC_T/dt_T, dC_T/d(dg_T), dC_T/dxi")]
+
+
+def _ct_ref(t_T, dg, xi, c_T, mu):
+    from ...contact.complementarity import friction_complementarity
+    from ...laws import Coulomb
+
+    return friction_complementarity(Coulomb(c_T=c_T, mu=mu), t_T, dg, xi, c_T)
+
+
+def ct_open(C_T):
+    t_T, dg, xi, c_T, mu = _ct_cases()
+    got = _ct(C_T, t_T, dg, xi, c_T, mu)
+    want = _ct_ref(t_T, dg, xi, c_T, mu)
+    sel = xi < 0
+    at = {"t_T": t_T[sel], "xi": xi[sel]}
+    compare("C_T of an open node", got[0][sel], want[0][sel], at, rule="open (xi < 0): C_T = t_T, no traction")
+    compare("dC_T/dt_T of an open node", got[1][sel], want[1][sel], at)
+
+
+def ct_stick_slip(C_T):
+    t_T, dg, xi, c_T, mu = _ct_cases()
+    got = _ct(C_T, t_T, dg, xi, c_T, mu)
+    want = _ct_ref(t_T, dg, xi, c_T, mu)
+    sel = xi >= 0
+    at = {"t_T": t_T[sel], "dg_T": dg[sel], "xi": xi[sel]}
+    compare("C_T (Coulomb mu = 0.3, c_T = 10)", got[0][sel], want[0][sel], at,
+            rule="tau = t_T + c_T dg_T; stick (|tau| <= mu xi): -c_T dg_T; slip: t_T - sign(tau) mu xi")
+
+
+def ct_derivatives(C_T):
+    t_T, dg, xi, c_T, mu = _ct_cases()
+    got = _ct(C_T, t_T, dg, xi, c_T, mu)
+    want = _ct_ref(t_T, dg, xi, c_T, mu)
+    at = {"t_T": t_T, "dg_T": dg, "xi": xi}
+    for k, name, rule in ((1, "dC_T/dt_T", "stick 0; slip and open 1"), (2, "dC_T/d(dg_T)", "stick -c_T; else 0"),
+                          (3, "dC_T/dxi", "slip -sign(tau) mu (Y = mu xi); else 0")):
+        compare(name, got[k], want[k], at, rule=rule)
+
+
+SSN_CASES = ((100.0, 10.0, 0.05, 1000.0), (100.0, 10.0, 0.05, 1.0), (10.0, 5.0, 0.1, 1e4))
+
+
+def _ssn(semismooth_1dof, k, P, g0, c_N):
+    out = call(semismooth_1dof, "semismooth_1dof", k, P, g0, c_N, 1e-10)
+    u, p, n = parts(out, 3, "semismooth_1dof", "u, p and the number of iterations")
+    try:
+        return float(u), float(p), int(n)
+    except (TypeError, ValueError):
+        raise AssertionError(f"semismooth_1dof should return (u, p, iterations): numbers, got {out!r:.80}") from None
+
+
+def ssn_contact(semismooth_1dof):
+    for k, P, g0, c_N in SSN_CASES:
+        u, p, n = _ssn(semismooth_1dof, k, P, g0, c_N)
+        at = {"k": k, "P": P, "g0": g0, "c_N": c_N}
+        pen = (P + c_N * g0) / (k + c_N)
+        if math.isclose(u, pen, rel_tol=1e-9) and not math.isclose(pen, g0, rel_tol=1e-9):
+            raise AssertionError(f"at k = {k:g}, P = {P:g}, g0 = {g0:g}, c_N = {c_N:g} your u = {u:.6g} is the penalty "
+                                 "answer: here c_N only steers the iterates; the solution has g = g0 - u = 0 exactly")
+        compare("u (the node at the wall)", u, g0, at, rule="in contact the gap closes exactly: u = g0")
+        compare("p (the contact pressure)", p, P - k * g0, at, rule="equilibrium k u = P - p with u = g0")
+
+
+def ssn_open(semismooth_1dof):
+    k, P, g0, c_N = 100.0, 2.0, 0.05, 1000.0              # P / k = 0.02 < g0: never touches
+    u, p, n = _ssn(semismooth_1dof, k, P, g0, c_N)
+    at = {"k": k, "P": P, "g0": g0}
+    compare("u when the wall is not reached", u, P / k, at, rule="open: p = 0 and k u = P")
+    compare("p when the wall is not reached", p, 0.0, at)
+
+
+def ssn_iterations(semismooth_1dof):
+    for k, P, g0, c_N in SSN_CASES:
+        _, _, n = _ssn(semismooth_1dof, k, P, g0, c_N)
+        if n > 3:
+            raise AssertionError(f"at k = {k:g}, c_N = {c_N:g} your method took {n} iterations; from u = p = 0 the "
+                                 "semi-smooth Newton method finds the set (contact) in one step and is then exact "
+                                 "(the equations are linear once the set is right): 2 iterations, at most 3. Do you "
+                                 "update the set from the new iterate and solve the full Newton system?")
+        if n < 1:
+            raise AssertionError("your method reports 0 iterations: count the Newton updates you made")
+
+
 # -- the exercises ------------------------------------------------------------------------------
 
 def _ex(name, lecture, difficulty, implements, what, *items):
@@ -768,4 +1467,43 @@ EXERCISES = {e.name: e for e in [
     _ex("ex11_secant_traction", "11_where_1990_stops", "medium", True,
         "the discrete gradient of the penalty energy (an energy check of one step)",
         (secant_energy, 3), (secant_limit, 1)),
+    _ex("ex04_slip_margin", "04_block", "easy", True,
+        "the slip condition of eq 10 at every contact node, on the converged block",
+        (margin_parabolic, 2), (margin_coulomb, 1), (margin_block, 2)),
+    _ex("ex04_load_steps", "04_block", "medium", True,
+        "the block's time loop in n load steps, recording the slip from the converged contact states",
+        (load_steps_times, 1), (load_steps_solves, 1), (load_steps_slipping, 2), (load_steps_one, 1)),
+    _ex("ex05_rolling_point", "05_rolling_ring", "easy", False,
+        "the start of rolling of a rigid ring of any radius of gyration (closed form)",
+        (rolling_time, 2), (rolling_position, 2), (rolling_speed, 1)),
+    _ex("ex05_incline", "05_rolling_ring", "hard", True,
+        "a new scene from parts: the ring on an inclined plane, rolling or sliding",
+        (incline_start, 1), (incline_rolling, 2), (incline_sliding, 2)),
+    _ex("ex06_rebound", "06_sloping_impact", "easy", False,
+        "the rebound velocity and the angle of reflection of Table 2 from a centre-of-mass history",
+        (rebound_velocity, 2), (rebound_angle, 2), (rebound_none, 1)),
+    _ex("ex06_interface_energy", "06_sloping_impact", "medium", True,
+        "the energy stored in the interface (penalty potential and stick springs), the energy check's term",
+        (energy_normal, 2), (energy_open, 1), (energy_friction, 2)),
+    _ex("ex07_escape_angle", "07_funnel", "easy", False,
+        "the steepest funnel wall that holds a wedged ring, from the slip surface of eq 10",
+        (escape_values, 2), (escape_coulomb, 1), (escape_steeper, 1)),
+    _ex("ex07_census", "07_funnel", "medium", True,
+        "the funnel's time loop, counting the nodes in contact and slipping from the converged states",
+        (census_times, 1), (census_contact, 2), (census_slip, 2)),
+    _ex("ex08_gas_pressure", "08_cork", "easy", True,
+        "the explicit gas coupling: Boyle's law from the converged travel, and the release at the mouth",
+        (gas_at_rest, 1), (gas_boyle, 2), (gas_release, 1)),
+    _ex("ex08_hardening_return", "08_cork", "medium", True,
+        "the return map of the slip-hardening Coulomb law (closed form of the local Newton)",
+        (hardening_stick, 1), (hardening_slip, 2), (hardening_lambda_q, 2)),
+    _ex("ex12_normal_complementarity", "12_beyond_node_to_segment", "easy", True,
+        "the complementarity function of the normal contact condition and its Newton derivative",
+        (cn_values, 2), (cn_derivatives, 2), (cn_tie, 1)),
+    _ex("ex12_friction_complementarity", "12_beyond_node_to_segment", "hard", True,
+        "the Coulomb complementarity function: open, stick and slip sets and their derivatives",
+        (ct_open, 1), (ct_stick_slip, 2), (ct_derivatives, 2)),
+    _ex("ex12_semismooth_1dof", "12_beyond_node_to_segment", "medium", True,
+        "a semi-smooth Newton method on a one-degree-of-freedom contact",
+        (ssn_contact, 2), (ssn_open, 1), (ssn_iterations, 2)),
 ]}
