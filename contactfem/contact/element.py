@@ -27,32 +27,18 @@ def contact_element(w, t_N, dt_N, t_T, c_T_s, c_N_s, dg_N, d2g_N, ds, d2s, ddg_T
 
     d2g_N, d2s: None where they vanish (a straight rigid master, kinematics.line_variations):
     their terms t_N d2g_N and t_T d2s are left out, which adds nothing but zeros.
-
-    The first-order terms are those of the tractions' variations, dt_N = dt_N/dg_N dg_N and
-    dt_T = c_T^s d(Delta g_T) + c_N^s dg_N (eq 48): with V = [dg_N; ds] (2 x k per pair),
-        R_c = w V^T (t_N, t_T),    K = w V^T D [dg_N; ddg_T] + w (t_N d2g_N + t_T d2s),
-        D = [[dt_N/dg_N, 0], [c_N^s, c_T^s]],
-    one batched product per pair (rather than one array operation a term).
     """
-    m, k = dg_N.shape
-    V = np.empty((m, 2, k))                     # the variations of g_N and s
-    V[:, 0], V[:, 1] = dg_N, ds
-    if ddg_T is None or ddg_T is ds:
-        dV = V
-    else:                                       # [dg_N; d(Delta g_T)]
-        dV = np.empty((m, 2, k))
-        dV[:, 0], dV[:, 1] = dg_N, ddg_T
-    D = np.zeros((m, 2, 2))                     # w dt/dg: rows t_N, t_T; columns g_N, Delta g_T
-    D[:, 0, 0], D[:, 1, 0], D[:, 1, 1] = w * dt_N, w * c_N_s, w * c_T_s
-    Vt = V.transpose(0, 2, 1)
-    K = Vt @ (D @ dV)
+    ddg_T = ds if ddg_T is None else ddg_T
+    W = w[:, None]
+    R = W * (t_N[:, None] * dg_N + t_T[:, None] * ds)
+    K = dt_N[:, None, None] * outer(dg_N, dg_N)
     if d2g_N is not None:
-        K += (w * t_N)[:, None, None] * d2g_N
+        K += t_N[:, None, None] * d2g_N
+    K += c_T_s[:, None, None] * outer(ds, ddg_T)
     if d2s is not None:
-        K += (w * t_T)[:, None, None] * d2s
-    t = np.empty((m, 2, 1))                     # w (t_N, t_T)
-    t[:, 0, 0], t[:, 1, 0] = w * t_N, w * t_T
-    R = (Vt @ t)[:, :, 0]
+        K += t_T[:, None, None] * d2s
+    K += c_N_s[:, None, None] * outer(ds, dg_N)
+    K *= w[:, None, None]
     return R, K
 
 
