@@ -146,9 +146,11 @@ class Beam:
         self.xdofs = 3 * np.arange(nn)[:, None] + np.array([0, 1])
         self.edofs = np.column_stack([3 * self.conn[:, 0] + k for k in range(3)]
                                      + [3 * self.conn[:, 1] + k for k in range(3)])
-        self._rows = np.repeat(self.edofs, 6, axis=1).ravel()    # COO indices of the element
-        self._cols = np.tile(self.edofs, (1, 6)).ravel()         # matrices, fixed
-        self._edofs_flat = self.edofs.ravel()
+        # COO indices of the element matrices, fixed: entry 6 i + j of every element, entry by entry
+        self._rows = np.repeat(self.edofs.T, 6, axis=0).ravel()
+        self._cols = np.concatenate([self.edofs.T] * 6).ravel()
+        self._edofs_T = self.edofs.T.ravel()                      # the element dofs, dof by dof
+        self.ne = ne
         self._dX = chord                                          # X_b - X_a per element
         self.dof_offset = 0
 
@@ -252,66 +254,112 @@ class Beam:
             d2gam/dq2 = -(a_t p^T + p a_t^T) - gam p p^T,
         so the geometric part is w p^T + p w^T - (N (1 + eps) + Q gam) p p^T, w = N a_n - Q a_t.
 
-        All integration points of all elements are one vectorised pass: row j = k ne + e is
-        point k of element e (the rows of the plastic strains ``ep``), the points' sums are
-        taken at the end. p is zero but at the rotations (entries 2 and 5: N_a, N_b), so the
-        geometric part only touches rows and columns 2 and 5.
+        Evaluated through the variables the strains depend on, r = (x', theta_a, theta_b)
+        (x' = (X_b - X_a + u_b - u_a) / L0: the displacements enter only through it):
+            eps = x'.t - 1,  gam = x'.n,  kap = (theta_b - theta_a) / L0,   t = (c, s), n = (-s, c),
+        with c, s = cos phi, sin phi. In r (C = diag(C_N, C_Q, C_M), p = (N_a, N_b)):
+            B^T S:   x': N t + Q n,     theta: (N gam - Q (1 + eps)) p + M dkap/dtheta
+            K_r:     x'x':     C_N t t^T + C_Q n n^T
+                     x'theta:  v p^T,  v = (C_N gam - Q) t + (N - C_Q (1 + eps)) n
+                     theta theta:  alpha p p^T + C_M / L0^2 [[1, -1], [-1, 1]],
+                               alpha = C_N gam^2 + C_Q (1 + eps)^2 - N (1 + eps) - Q gam
+        (the geometric terms: d2eps/dx'dphi = n, d2gam/dx'dphi = -t, d2eps/dphi2 = -(1 + eps),
+        d2gam/dphi2 = -gam), and K_e = T^T K_r T with dx'/du_a = -1/L0, dx'/du_b = 1/L0: each
+        entry of K_e is one entry of K_r times 1, -1/L0 or 1/L0 per side (``_gauss``'s map).
+
+        Every quantity is an array over the rows (row j = k ne + e is point k of element e, the
+        rows of the plastic strains ``ep``): the element's 36 entries are made from ten arrays,
+        and the points' sums are taken at the end.
         """
         g = self._gauss()
-        ne = len(self.L0)
-        q = np.asarray(u, float)[g["edofs"]]                           # (m, 6) element dofs per row
-        xp = (g["dX"] + q[:, 3:5] - q[:, 0:2]) * g["invL"][:, None]     # x'
-        phi = g["theta0"] + g["Na"] * q[:, 2] + g["Nb"] * q[:, 5]
-        cos, sin = np.cos(phi), np.sin(phi)
-        E = np.empty((len(phi), 3))
-        E[:, 0] = xp[:, 0] * cos + xp[:, 1] * sin - 1.0                   # eps = x' . t - 1
-        E[:, 1] = -xp[:, 0] * sin + xp[:, 1] * cos                        # gam = x' . n
-        E[:, 2] = (q[:, 5] - q[:, 2]) * g["invL"]                         # kap = theta'
-        S, C, _ = return_map(E, self.ep, self.D, self.S0, self.eta, self._dt(dt))
-        eps, gam, N, Q = E[:, 0], E[:, 1], S[:, 0], S[:, 1]
-        tL, sL = cos * g["invL"], sin * g["invL"]                         # t / L0 (a_t), n = (-s, c)
-        B = np.zeros((len(phi), 3, 6))
-        B[:, 0, 0], B[:, 0, 1], B[:, 0, 3], B[:, 0, 4] = -tL, -sL, tL, sL                 # a_t
-        B[:, 1, 0], B[:, 1, 1], B[:, 1, 3], B[:, 1, 4] = sL, -tL, -sL, tL                 # a_n
-        B[:, 0, 2], B[:, 0, 5] = gam * g["Na"], gam * g["Nb"]                             # + gam p
-        B[:, 1, 2], B[:, 1, 5] = -(1 + eps) * g["Na"], -(1 + eps) * g["Nb"]               # - (1 + eps) p
-        B[:, 2, 2], B[:, 2, 5] = -g["invL"], g["invL"]                                    # dkap/dq
-        K = np.matmul(B.transpose(0, 2, 1) * C[:, None, :], B)                           # B^T C B
-        w = N[:, None] * B[:, 1] - Q[:, None] * B[:, 0]          # N a_n - Q a_t (+ a p term, below)
-        w[:, 2] = w[:, 5] = 0.0                                  # a_t, a_n vanish at the rotations
-        c = N * (1 + eps) + Q * gam
-        for j, Nj in ((2, g["Na"]), (5, g["Nb"])):               # w p^T + p w^T
-            K[:, :, j] += w * Nj[:, None]
-            K[:, j, :] += w * Nj[:, None]
-        K[:, 2, 2] -= c * g["Na"] * g["Na"]                      # - c p p^T
-        K[:, 2, 5] -= c * g["Na"] * g["Nb"]
-        K[:, 5, 2] -= c * g["Nb"] * g["Na"]
-        K[:, 5, 5] -= c * g["Nb"] * g["Nb"]
-        wL = g["wL0"]
-        re = wL[:, None] * np.matmul(S[:, None, :], B)[:, 0]                             # w L0 B^T S
-        Ke = wL[:, None] * K.reshape(-1, 36)
+        E, c, s = self._row_strains(u, g)
+        S, C, _ = return_map(E, self.ep.T, g["D"], g["S0"], self.eta, self._dt(dt))
+        eps, gam = E[0], E[1]
+        N, Q, M = S
+        C_N, C_Q, C_M = C
+        e1 = 1 + eps                                             # x'.t
+        # residual w L0 B^T S, one row of re per element dof (u_a, theta_a, u_b, theta_b)
+        f0, f1 = N * c - Q * s, N * s + Q * c                    # N t + Q n
+        h = N * gam - Q * e1                                     # theta: (N gam - Q (1 + eps)) p
+        wM = g["wiL"] * M
+        re = np.empty((6, len(c)))
+        re[3], re[4] = g["wiL"] * f0, g["wiL"] * f1
+        re[0], re[1] = -re[3], -re[4]
+        re[2], re[5] = g["wNa"] * h - wM, g["wNb"] * h + wM
+        # tangent: the ten distinct entries of w L0 K_e (docstring)
+        cc, ss, cs = c * c, s * s, c * s
+        a1, a2 = C_N * gam - Q, N - C_Q * e1
+        alpha = C_N * (gam * gam) + C_Q * (e1 * e1) - N * e1 - Q * gam
+        kk = g["wiL2"] * C_M
+        U = np.empty((10, len(c)))
+        U[0] = g["wiL2"] * (C_N * cc + C_Q * ss)                 # x'x' (times 1/L0^2)
+        U[1] = g["wiL2"] * ((C_N - C_Q) * cs)
+        U[2] = g["wiL2"] * (C_N * ss + C_Q * cc)
+        v0, v1 = a1 * c - a2 * s, a1 * s + a2 * c                # v = (C_N gam - Q) t + (N - C_Q (1 + eps)) n
+        U[3], U[4] = g["wiLNa"] * v0, g["wiLNa"] * v1            # x' theta_a (times 1/L0)
+        U[5], U[6] = g["wiLNb"] * v0, g["wiLNb"] * v1            # x' theta_b
+        U[7] = g["wNaNa"] * alpha + kk                           # theta theta
+        U[8] = g["wNaNb"] * alpha - kk
+        U[9] = g["wNbNb"] * alpha + kk
+        Ke = U[g["entry"]] * g["sign"]                           # (36, m): entry 6 i + j of each row
         if len(self.points) > 1:                                 # sum the points of each element
-            re, Ke = re.reshape(-1, ne, 6).sum(axis=0), Ke.reshape(-1, ne, 36).sum(axis=0)
-        R = np.bincount(self._edofs_flat, re.ravel(), minlength=self.ndof)
+            re, Ke = re.reshape(6, -1, self.ne).sum(axis=1), Ke.reshape(36, -1, self.ne).sum(axis=1)
+        R = np.bincount(self._edofs_T, re.ravel(), minlength=self.ndof)
         return R, self._rows, self._cols, Ke.ravel()
 
+    def _row_strains(self, u, g):
+        """The strains E = (eps, gam, kap) (3, m) and cos, sin of the angle phi at every row of
+        ``_gauss`` (all integration points of all elements)."""
+        q = np.asarray(u, float)[g["edofs"]]                     # (6, m): u_a, theta_a, u_b, theta_b per row
+        x0 = (g["dX0"] + q[3] - q[0]) * g["invL"]                # x'
+        x1 = (g["dX1"] + q[4] - q[1]) * g["invL"]
+        phi = g["theta0"] + g["Na"] * q[2] + g["Nb"] * q[5]
+        c, s = np.cos(phi), np.sin(phi)
+        E = np.empty((3, len(phi)))
+        E[0] = x0 * c + x1 * s - 1.0                             # eps = x' . t - 1
+        E[1] = x1 * c - x0 * s                                   # gam = x' . n
+        E[2] = (q[5] - q[2]) * g["invL"]                         # kap = theta'
+        return E, c, s
+
     def _gauss(self):
-        """Per-row constants of internal_coo (row k ne + e: point k of element e), made once."""
+        """Per-row constants of internal_coo (row k ne + e: point k of element e), made once:
+        the element dofs (6, m), chords, lengths and angles, the shape functions N_a, N_b at
+        the point and their products with the weight w L0 and 1/L0, and the map from the ten
+        distinct entries of K_e to its 36 (``entry``, ``sign``)."""
         if getattr(self, "_g", None) is None:
             ne, k = len(self.L0), len(self.points)
             xi = np.repeat([x for x, _ in self.points], ne)
             weight = np.repeat([w for _, w in self.points], ne)
             tile = lambda a: np.concatenate([a] * k)                # noqa: E731
-            self._g = dict(edofs=np.concatenate([self.edofs] * k), dX=tile(self._dX), invL=tile(1 / self.L0),
-                           theta0=tile(self.theta0), Na=0.5 * (1 - xi), Nb=0.5 * (1 + xi),
-                           wL0=weight * tile(self.L0))
+            Na, Nb, invL, wL0 = 0.5 * (1 - xi), 0.5 * (1 + xi), tile(1 / self.L0), weight * tile(self.L0)
+            # w L0 K_e[i, j] = sign * U[entry] (internal_coo): dofs 0, 1 (u_a), 2 (theta_a), 3, 4 (u_b), 5 (theta_b)
+            side = {0: -1.0, 1: -1.0, 3: 1.0, 4: 1.0}               # dx'/du = -1/L0 at a, 1/L0 at b
+            xx = {(0, 0): 0, (0, 1): 1, (1, 0): 1, (1, 1): 2}
+            entry, sign = np.zeros(36, dtype=int), np.ones(36)
+            for i in range(6):
+                for j in range(6):
+                    if i in side and j in side:
+                        entry[6 * i + j], sign[6 * i + j] = xx[(i % 3, j % 3)], side[i] * side[j]
+                    elif i in side or j in side:
+                        d, th = (i, j) if i in side else (j, i)
+                        entry[6 * i + j], sign[6 * i + j] = 3 + d % 3 + (2 if th == 5 else 0), side[d]
+                    else:
+                        entry[6 * i + j] = {(2, 2): 7, (2, 5): 8, (5, 2): 8, (5, 5): 9}[(i, j)]
+            self._g = dict(edofs=np.concatenate([self.edofs.T] * k, axis=1), dX0=tile(self._dX[:, 0]),
+                           dX1=tile(self._dX[:, 1]), invL=invL, theta0=tile(self.theta0), Na=Na, Nb=Nb, wL0=wL0,
+                           wiL=wL0 * invL, wiL2=wL0 * invL * invL, wNa=wL0 * Na, wNb=wL0 * Nb,
+                           wiLNa=wL0 * invL * Na, wiLNb=wL0 * invL * Nb, wNaNa=wL0 * Na * Na,
+                           wNaNb=wL0 * Na * Nb, wNbNb=wL0 * Nb * Nb, entry=entry, sign=sign[:, None],
+                           D=self.D[:, None], S0=None if self.S0 is None else self.S0[:, None])
         return self._g
 
     def strain_energy(self, u, dt=None):
         """Stored (elastic) energy sum_e L0 sum_k S_k^2 / (2 D_k); elastic case: L0 D E^2 / 2
-        (viscoplastic: the resultants of a step of dt from the committed plastic strains)."""
-        return float(sum(w * np.sum(self.L0[:, None] * self.resultants(u, xi, k, dt=dt)[0] ** 2 / (2 * self.D))
-                         for k, (xi, w) in enumerate(self.points)))
+        (viscoplastic: the resultants of a step of dt from the committed plastic strains).
+        All integration points in one pass, the rows of internal_coo."""
+        g = self._gauss()
+        S = return_map(self._row_strains(u, g)[0], self.ep.T, g["D"], g["S0"], self.eta, self._dt(dt))[0]
+        return float(np.sum(g["wL0"] * (S ** 2 / (2 * g["D"]))))
 
     def commit(self, u, dt=None):
         """Accept u as converged at the end of a step of dt: store the plastic strains
@@ -405,10 +453,15 @@ class BeamGravity:
         """A dead load keeps no history."""
 
     def assemble(self, u_global, t):
-        """(P, rows, cols, vals): the dead load and an empty tangent."""
+        """(P, rows, cols, vals): the dead load and an empty tangent. P is made once for the
+        beam's place in the global vector (read-only: a dead load does not change)."""
         b = self.beam
-        P = np.zeros(np.size(u_global))
-        m = b.mass()
-        P[b.dof_offset + b.xdofs] = m[b.xdofs] * self.g
-        empty_i, empty_v = np.zeros(0, dtype=int), np.zeros(0)
-        return P, empty_i, empty_i, empty_v
+        where = (b.dof_offset, np.size(u_global))
+        if getattr(self, "_P", (None,))[0] != where:
+            P = np.zeros(where[1])
+            P[b.dof_offset + b.xdofs] = b.mass()[b.xdofs] * self.g
+            empty_i, empty_v = np.zeros(0, dtype=int), np.zeros(0)
+            for a in (P, empty_i, empty_v):
+                a.flags.writeable = False
+            self._P = (where, (P, empty_i, empty_i, empty_v))
+        return self._P[1]

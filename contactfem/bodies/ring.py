@@ -130,15 +130,17 @@ class RingModel:
         return self.R if self.kind == "beam" else self.R_outer
 
     def _u(self, u):
-        """The body's local part of u (a global vector is accepted too)."""
+        """The body's local part of u (a global vector is accepted too; or a stack of them,
+        one a row)."""
         u = np.asarray(u, float)
         b = self.body
-        return u[b.dof_offset:b.dof_offset + b.ndof] if u.size != b.ndof else u
+        return u[..., b.dof_offset:b.dof_offset + b.ndof] if u.shape[-1] != b.ndof else u
 
     def positions(self, u):
-        """Current positions of all nodes (beam: centreline nodes), (nn, 2)."""
+        """Current positions of all nodes (beam: centreline nodes), (nn, 2) (a stack of u:
+        (k, nn, 2))."""
         u = self._u(u)
-        return self.body.X + u[self.body.xdofs]
+        return self.body.X + u[..., self.body.xdofs]
 
     def outline(self, u, mirror=False):
         """Outer surface as a polyline (nc + 1, 2), closed for a full ring.
@@ -183,26 +185,31 @@ class RingModel:
     def _second_moments(self, r, w, theta_dot=None):
         """sum_ij M_ij (r_i x w_j) and sum_ij M_ij (r_i . r_j) over the nodes, plus the rotary
         terms sum_ij J_ij theta_dot_j and sum_ij J_ij: the angular momentum and the moment of
-        inertia with the body's own mass, lumped (diagonal: M_ii = m_i) or consistent."""
+        inertia with the body's own mass, lumped (diagonal: M_ii = m_i) or consistent.
+        r, w (..., nn, 2), theta_dot (..., nn): a stack of k states gives k values of each."""
         b = self.body
         if b.mass_matrix != "consistent":
             m, J = self._mass_split()
-            L = np.sum(m * (r[:, 0] * w[:, 1] - r[:, 1] * w[:, 0]))
-            Ic = np.sum(m * np.sum(r * r, axis=1))
+            L = np.sum(m * (r[..., 0] * w[..., 1] - r[..., 1] * w[..., 0]), axis=-1)
+            Ic = np.sum(m * np.sum(r * r, axis=-1), axis=-1)
             if self.kind == "beam":
-                L += np.sum(J * theta_dot) if theta_dot is not None else 0.0
-                Ic += J.sum()
-            return float(L), float(Ic)
+                L = L + (np.sum(J * theta_dot, axis=-1) if theta_dot is not None else 0.0)
+                Ic = Ic + J.sum()
+            return L, Ic
         M = b.mass(consistent=True).tocsr()
         x = b.xdofs[:, 0]
         Mt = M[x][:, x]                                # the same block for u_x and u_y
-        L = r[:, 0] @ (Mt @ w[:, 1]) - r[:, 1] @ (Mt @ w[:, 0])
-        Ic = r[:, 0] @ (Mt @ r[:, 0]) + r[:, 1] @ (Mt @ r[:, 1])
+
+        def Mx(a):                                     # M_t a over the node axis, a (..., nn)
+            return (Mt @ a.T).T
+
+        L = np.sum(r[..., 0] * Mx(w[..., 1]) - r[..., 1] * Mx(w[..., 0]), axis=-1)
+        Ic = np.sum(r[..., 0] * Mx(r[..., 0]) + r[..., 1] * Mx(r[..., 1]), axis=-1)
         if self.kind == "beam":
             Mr = M[2::3][:, 2::3]
-            L += np.sum(Mr @ theta_dot) if theta_dot is not None else 0.0
-            Ic += Mr.sum()
-        return float(L), float(Ic)
+            L = L + (np.sum((Mr @ theta_dot.T).T, axis=-1) if theta_dot is not None else 0.0)
+            Ic = Ic + Mr.sum()
+        return L, Ic
 
     def total_mass(self):
         """Sum of the lumped translational masses (the half ring's is half the ring's)."""
@@ -210,20 +217,22 @@ class RingModel:
 
     def center_of_mass(self, u):
         """Mass-weighted mean of the node positions, sum m_i x_i / sum m_i.
-        Half ring: of the full mirrored ring, (x_c, mean y)."""
+        Half ring: of the full mirrored ring, (x_c, mean y). A stack of u (k, ndof): one
+        centre a row, (k, 2)."""
         m, _ = self._mass_split()
         c = m @ self.positions(u) / m.sum()
         if self.half:
-            c[0] = self.center[0]
+            c[..., 0] = self.center[0]
         return c
 
     def velocity_of_mass(self, v):
-        """Centre-of-mass velocity sum m_i v_i / sum m_i (half ring: (0, v_y))."""
+        """Centre-of-mass velocity sum m_i v_i / sum m_i (half ring: (0, v_y)); of each row of
+        a stack of v."""
         v = self._u(v)
         m, _ = self._mass_split()
-        w = m @ v[self.body.xdofs] / m.sum()
+        w = m @ v[..., self.body.xdofs] / m.sum()
         if self.half:
-            w[0] = 0.0
+            w[..., 0] = 0.0
         return w
 
     def angular_velocity(self, u, v):
@@ -231,21 +240,22 @@ class RingModel:
         L = sum m_i (r_i x v_i) + sum J_i theta_dot_i and I_c = sum m_i |r_i|^2 + sum J_i
         (r_i, v_i relative to the centre of mass; J_i: the beam's rotary inertia); with a
         consistent mass the double sums over M_ij. Exact for a rigid motion. Half ring: 0 by
-        symmetry."""
+        symmetry. Stacks of u and v (k, ndof): an array of k spins."""
+        stack = np.ndim(u) == 2
         if self.half:
-            return 0.0
+            return np.zeros(len(u)) if stack else 0.0
         v = self._u(v)
-        r = self.positions(u) - self.center_of_mass(u)
-        w = v[self.body.xdofs] - self.velocity_of_mass(v)
-        L, Ic = self._second_moments(r, w, v[2::3] if self.kind == "beam" else None)
-        return L / Ic
+        r = self.positions(u) - self.center_of_mass(u)[..., None, :]
+        w = v[..., self.body.xdofs] - self.velocity_of_mass(v)[..., None, :]
+        L, Ic = self._second_moments(r, w, v[..., 2::3] if self.kind == "beam" else None)
+        return L / Ic if stack else float(L / Ic)
 
     def moment_of_inertia(self, u=None):
         """I_c about the centre of mass in configuration u (default: the reference one), with
         the body's mass (lumped or consistent) and the beam's rotary inertia."""
         u = np.zeros(self.body.ndof) if u is None else self._u(u)
         r = self.positions(u) - self.center_of_mass(u)
-        return self._second_moments(r, np.zeros_like(r))[1]
+        return float(self._second_moments(r, np.zeros_like(r))[1])
 
     def initial_velocity(self, v0_vec, omega=0.0):
         """Local velocity vector (ndof,) of the rigid motion v = v0 + omega e3 x (X - c)

@@ -24,22 +24,35 @@ def contact_element(w, t_N, dt_N, t_T, c_T_s, c_N_s, dg_N, d2g_N, ds, d2s, ddg_T
     ddg_T: the variation of the slip increment Delta g_T where it is not ds (a node that
     closes during the step: Delta g_T = r (s - s_bar), see NodeToSegment.kinematics); the
     c_T^s term is then c_T^s ds ddg_T^T. Default ds.
+
+    d2g_N, d2s: None where they vanish (a straight rigid master, kinematics.line_variations):
+    their terms t_N d2g_N and t_T d2s are left out, which adds nothing but zeros.
     """
     ddg_T = ds if ddg_T is None else ddg_T
     W = w[:, None]
     R = W * (t_N[:, None] * dg_N + t_T[:, None] * ds)
-    K = w[:, None, None] * (dt_N[:, None, None] * outer(dg_N, dg_N) + t_N[:, None, None] * d2g_N
-                            + c_T_s[:, None, None] * outer(ds, ddg_T) + t_T[:, None, None] * d2s
-                            + c_N_s[:, None, None] * outer(ds, dg_N))
+    K = dt_N[:, None, None] * outer(dg_N, dg_N)
+    if d2g_N is not None:
+        K += t_N[:, None, None] * d2g_N
+    K += c_T_s[:, None, None] * outer(ds, ddg_T)
+    if d2s is not None:
+        K += t_T[:, None, None] * d2s
+    K += c_N_s[:, None, None] * outer(ds, dg_N)
+    K *= w[:, None, None]
     return R, K
 
 
 def normal_element(w, t_N, dt_N, dg_N, d2g_N):
     """The frictionless element: eq (28) with t_T = 0 and eq (33),
 
-        R_c = w t_N dg_N,    K_N = w [ dt_N/dg_N dg_N dg_N^T + t_N d2g_N ]."""
+        R_c = w t_N dg_N,    K_N = w [ dt_N/dg_N dg_N dg_N^T + t_N d2g_N ]
+
+    (d2g_N None where it vanishes, as in contact_element)."""
     R = (w * t_N)[:, None] * dg_N
-    K = w[:, None, None] * (dt_N[:, None, None] * outer(dg_N, dg_N) + t_N[:, None, None] * d2g_N)
+    K = dt_N[:, None, None] * outer(dg_N, dg_N)
+    if d2g_N is not None:
+        K += t_N[:, None, None] * d2g_N
+    K *= w[:, None, None]
     return R, K
 
 
@@ -48,5 +61,5 @@ def to_coo(dofs, K):
     global dofs (nc, k)."""
     k = dofs.shape[1]
     rows = np.repeat(dofs, k, axis=1).ravel()
-    cols = np.tile(dofs, (1, k)).ravel()
+    cols = np.concatenate([dofs] * k, axis=1).ravel()          # np.tile(dofs, (1, k)), without its overhead
     return rows, cols, K.ravel()

@@ -85,6 +85,8 @@ class NodeToSegment:
         self.offset = float(offset)
         self._law = None if friction is None else as_friction_law(friction)
         self.c_T = 0.0 if self._law is None else self._law.c_T
+        self._wear = self._law is not None and self._law.n_state > 0   # gap_offset(z) may move the surface
+        self._straight = bool(getattr(master, "straight", False))      # zero second variations (masters.py)
         self._has_energy = hasattr(normal, "energy")
         self.history = None                 # ContactHistory, from start() and every commit()
         self.evaluations = 0                # how often evaluate() ran (instrumentation)
@@ -122,7 +124,7 @@ class NodeToSegment:
 
     def gap_offset(self, z):
         """How far a friction law with internal variables has moved the surface (wear), (nc,)."""
-        if self._law is None or not self._law.n_state:
+        if not self._wear:
             return np.zeros(len(self.nodes))
         return self._law.gap_offset(z)
 
@@ -136,19 +138,22 @@ class NodeToSegment:
         x_s = self.slave_positions(u)
         k = self.master.locate(x_s, h.s_bar, u, t=t, ref=h.master)
         g_raw = k["g_N"] - self.offset
-        g_N = g_raw + self.gap_offset(h.z_bar) if self._law is not None and self._law.n_state else g_raw
+        g_N = g_raw + self.gap_offset(h.z_bar) if self._wear else g_raw
         active = k["inside"] & (g_N < 0.0)
         t_N, dt_N = self.normal.traction(np.where(active, g_N, 1.0))
         dofs = np.concatenate([self.slave_dofs(), k["master_dofs"]], axis=1) if k["master_dofs"].size else self._dofs
         travel = k["s"] - h.s_bar
-        r, dr, ddg_T = np.ones_like(g_N), np.zeros_like(g_N), k["ds"]
-        closing = active & (h.g_bar > 0.0) & self.closing_step
-        if np.any(closing):                                 # the closing step (module docstring)
-            gb = np.where(closing, h.g_bar, 1.0)
-            r = np.where(closing, -g_N / (gb - g_N), 1.0)
-            dr = np.where(closing, -gb / (gb - g_N) ** 2, 0.0)
-            ddg_T = r[:, None] * k["ds"] + (travel * dr)[:, None] * k["dg_N"]
-        return dict(k, x_s=x_s, g_N=g_N, g_raw=g_raw, active=active, t_N=t_N, dt_N=dt_N, dg_T=r * travel,
+        nc = len(g_N)
+        r, dr, dg_T, ddg_T = np.ones(nc), np.zeros(nc), travel, k["ds"]    # r = 1: Delta g_T = travel
+        closing = (active & (h.g_bar > 0.0)).nonzero()[0] if self.closing_step else ()
+        if len(closing):                                    # the closing step (module docstring), at those nodes
+            c, gb, g = closing, h.g_bar[closing], g_N[closing]
+            r[c] = -g / (gb - g)
+            dr[c] = -gb / (gb - g) ** 2
+            dg_T = r * travel
+            ddg_T = k["ds"].copy()
+            ddg_T[c] = r[c, None] * k["ds"][c] + (travel[c] * dr[c])[:, None] * k["dg_N"][c]
+        return dict(k, x_s=x_s, g_N=g_N, g_raw=g_raw, active=active, t_N=t_N, dt_N=dt_N, dg_T=dg_T,
                     travel=travel, r=r, dr=dr, ddg_T=ddg_T, dofs=dofs)
 
     # -- friction (eqs 40-48) -----------------------------------------------------------
@@ -194,9 +199,13 @@ class NodeToSegment:
             R, K, on, work_T = conserving_force(self, u0, u, t, h, k, fr)
             element_dofs = k["dofs"][on]
         else:
-            on = k["active"]
-            R, K = self.element(k, fr, on)
+            on = k["active"].nonzero()[0]                  # the pairs in contact, by index
             element_dofs = k["dofs"][on]
+            if on.size:
+                R, K = self.element(k, fr, on)
+            else:                                          # none in contact (a body in flight): no element
+                m = element_dofs.shape[1]
+                R, K = np.zeros((0, m)), np.zeros((0, m, m))
         return ContactState(contact=self, history=h, u=u, t=t, x_s=k["x_s"], g_N=k["g_N"], g_raw=k["g_raw"], s=k["s"],
                             s_next=k.get("s_next", k["s"]), n=k["n"], tangent=k["t"], seg=k["seg"],
                             inside=k["inside"], active=k["active"], r=k["r"], t_N=k["t_N"], dt_N=k["dt_N"],
@@ -204,16 +213,20 @@ class NodeToSegment:
                             q=fr["q"], z=fr["z"], R=R, K=K, element_dofs=element_dofs, work_T=work_T)
 
     def element(self, k, fr, on):
-        """The element residuals and tangents (eqs 28, 33, 39, 49-50) of the pairs `on`, with
-        the tangent strategy the contact was built with (tangents.py)."""
+        """The element residuals and tangents (eqs 28, 33, 39, 49-50) of the pairs `on` (a mask
+        or their indices), with the tangent strategy the contact was built with (tangents.py).
+        A straight rigid master has no second variations (line_variations): they are left out
+        (None), the same element without adding zeros."""
         w = self.weights[on]
+        d2g_N, d2s = (None, None) if self._straight else (k["d2g_N"][on], k["d2s"][on])
         if self._law is None:
-            R, K = normal_element(w, k["t_N"][on], k["dt_N"][on], k["dg_N"][on], k["d2g_N"][on])
+            R, K = normal_element(w, k["t_N"][on], k["dt_N"][on], k["dg_N"][on], d2g_N)
         else:
             ddg_T = fr.get("ddg_T", k["ddg_T"])
-            c_N_s = fr["c_N_s"][on] if self.tangent != "frozen" else np.zeros(np.count_nonzero(on))
+            ddg_T = None if ddg_T is k["ds"] else ddg_T[on]          # None: d(Delta g_T) = ds
+            c_N_s = fr["c_N_s"][on] if self.tangent != "frozen" else np.zeros(len(w))
             R, K = contact_element(w, k["t_N"][on], k["dt_N"][on], fr["t_T"][on], fr["c_T_s"][on], c_N_s,
-                                   k["dg_N"][on], k["d2g_N"][on], k["ds"][on], k["d2s"][on], ddg_T[on])
+                                   k["dg_N"][on], d2g_N, k["ds"][on], d2s, ddg_T)
         if self.tangent == "symmetric":
             K = 0.5 * (K + K.transpose(0, 2, 1))
         return R, K

@@ -15,6 +15,7 @@ class Master(Protocol):
     deformable body's boundary (BodySurface)."""
 
     rigid: bool
+    straight: bool          # second variations of g_N and s zero everywhere (a rigid line or polyline)
 
     def locate(self, x_s: np.ndarray, s_bar: np.ndarray, u: np.ndarray, t=None, ref=None) -> dict:
         """The kinematics of each slave with its closest master segment (masters.py): g_N, s,

@@ -73,15 +73,24 @@ def line_variations(x_s, point, normal):
     x_1, x_2 fixed): g_N = (x_s - point).n, arc coordinate s = (x_s - point).t with
     n = e3 x t. Both are linear in x_s, so their second variations vanish (the slave rows
     of eqs 31-32 and 37-38 hold N_0 or T_0, which are zero there).
-    `point` and `normal`: one line (2,) or one per slave (nc, 2) (a rigid polyline's segments)."""
+    `point` and `normal`: one line (2,) or one per slave (nc, 2) (a rigid polyline's segments).
+
+    The first variations are n and t themselves (dg_N is the array n, ds the array t), and
+    d2g_N, d2s one array of zeros: read, never written."""
     normal = np.asarray(normal, dtype=float)
     d = x_s - point
-    n, t = np.empty_like(d), np.empty_like(d)
-    n[:] = normal                                                   # one row per slave
-    t[:, 0], t[:, 1] = n[:, 1], -n[:, 0]                            # e3 x t = n
+    if normal.ndim == 1:                                            # one line: the same n and t for all
+        nt = np.array([[normal[0], normal[1]], [normal[1], -normal[0]]])   # columns n and t (e3 x t = n)
+        g_N, s = (d @ nt).T                                         # (x_s - point).n, (x_s - point).t
+        n, t = np.empty((2,) + d.shape)
+        n[:], t[:] = nt[:, 0], nt[:, 1]                             # one row per slave
+    else:
+        n, t = np.empty_like(d), np.empty_like(d)
+        n[:] = normal
+        t[:, 0], t[:, 1] = n[:, 1], -n[:, 0]                        # e3 x t = n
+        g_N, s = np.einsum("ij,ij->i", d, n), np.einsum("ij,ij->i", d, t)
     z2 = np.zeros((len(d), 2, 2))
-    return dict(t=t, n=n, g_N=np.einsum("ij,ij->i", d, n), s=np.einsum("ij,ij->i", d, t),
-                dg_N=n.copy(), d2g_N=z2, ds=t.copy(), d2s=z2.copy())
+    return dict(t=t, n=n, g_N=g_N, s=s, dg_N=n, d2g_N=z2, ds=t, d2s=z2)
 
 
 def arc_variations(x_s, center, R, inside, theta_ref):

@@ -26,9 +26,22 @@ the last converged configuration, s = S_bar[j] + alpha l_bar[j] on segment j
 neighbouring segment keeps its friction history.
 """
 
+from functools import lru_cache
+
 import numpy as np
 
 from .kinematics import arc_variations, e3_cross, line_variations, segment_variations
+
+
+@lru_cache(maxsize=16)
+def rigid_fields(nc):
+    """What every rigid master without segments answers for nc slaves: no master dofs
+    (nc, 0), every projection inside, segment -1. Made once per nc and read-only (a
+    state holds them as values; nothing writes them)."""
+    fields = dict(master_dofs=np.zeros((nc, 0), dtype=int), inside=np.ones(nc, bool), seg=np.full(nc, -1))
+    for a in fields.values():
+        a.flags.writeable = False
+    return fields
 
 
 def _check_points(points, name):
@@ -65,6 +78,7 @@ class RigidLine:
     towards the slave body (the rigid foundation of Secs 5.1-5.3)."""
 
     rigid = True
+    straight = True         # the second variations of g_N and s vanish (line_variations)
 
     def __init__(self, point=(0.0, 0.0), normal=(0.0, 1.0)):
         nrm = np.asarray(normal, dtype=float)
@@ -74,9 +88,7 @@ class RigidLine:
         self.normal = nrm / np.linalg.norm(nrm)
 
     def locate(self, x_s, s_bar, u, t=None, ref=None):
-        k = line_variations(x_s, self.point, self.normal)
-        nc = len(x_s)
-        return dict(k, master_dofs=np.zeros((nc, 0), dtype=int), inside=np.ones(nc, bool), seg=np.full(nc, -1))
+        return dict(line_variations(x_s, self.point, self.normal), **rigid_fields(len(x_s)))
 
     def reference(self, u):
         return None
@@ -92,6 +104,7 @@ class RigidPolyline:
     with x_1, x_2 fixed: only the slave rows of eqs (25)-(38) remain."""
 
     rigid = True
+    straight = True         # the second variations of g_N and s vanish (line_variations)
 
     def __init__(self, points):
         self.points = _check_points(points, "points")
@@ -121,6 +134,7 @@ class RigidArc:
     within. Exact curvature terms (no polyline facets)."""
 
     rigid = True
+    straight = False
 
     def __init__(self, center, R, theta0=-np.pi, theta1=np.pi, inside=False):
         if not float(R) > 0:
@@ -154,6 +168,7 @@ class BodySurface:
     All three nodes of each pair carry unknowns: the full 6x6 element of eqs (25)-(50)."""
 
     rigid = False
+    straight = False
 
     def __init__(self, body, nodes):
         self.body = body
@@ -218,6 +233,7 @@ class RigidComposite:
     """
 
     rigid = True
+    straight = False
 
     def __init__(self, pieces, offset=(0.0, 0.0), motion=None):
         self.pieces = []

@@ -84,6 +84,9 @@ class ContactState:
     def scatter(self, ndof):
         """The global contact residual R_c (ndof,) and the tangent's COO triplets."""
         dofs = self.element_dofs
+        if not dofs.size:                       # no pair carries a force
+            empty = np.zeros(0, dtype=int)
+            return np.zeros(ndof), empty, empty, np.zeros(0)
         R_c = np.bincount(dofs.ravel(), self.R.ravel(), minlength=ndof)
         rows, cols, vals = to_coo(dofs, self.K)
         return R_c, rows, cols, vals
@@ -107,7 +110,7 @@ class ContactState:
         W = c.normal_energy(np.where(self.active, self.g_N, 1.0))
         if c.c_T > 0.0:
             W = W + self.t_T ** 2 / (2.0 * c.c_T)
-        return float(np.sum(c.weights * W))
+        return float((c.weights * W).sum())
 
     @cached_property
     def dissipation(self):
@@ -124,8 +127,8 @@ class ContactState:
         t_bar = self.history.t_T_bar
         if self.work_T is not None:
             dW = c.weights * (np.where(self.active, self.t_T, 0.0) ** 2 - t_bar ** 2) / (2.0 * c.c_T)
-            return float(np.sum(self.work_T) - np.sum(dW))
-        return float(np.sum(c.weights * 0.5 * (t_bar + self.t_T) * self.lam * np.sign(self.t_T)))
+            return float(self.work_T.sum() - dW.sum())
+        return float((c.weights * 0.5 * (t_bar + self.t_T) * self.lam * np.sign(self.t_T)).sum())
 
     def report(self):
         """Per slave node: reference and current position, gap, tractions, nodal forces, state."""

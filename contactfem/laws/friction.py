@@ -42,10 +42,14 @@ class ParabolicSlip:
 
     def slip_bound(self, p, q):
         p = np.asarray(p, dtype=float)
-        pp = np.where(p > 0.0, p, 1.0)  # avoid 0**(n-1); masked below
-        Y = np.where(p > 0.0, self.alpha * pp**self.n + self.beta * p, 0.0)
-        dY_dp = np.where(p > 0.0, self.alpha * self.n * pp ** (self.n - 1.0) + self.beta, 0.0)
-        return Y, dY_dp, np.zeros_like(p)
+        on = p > 0.0
+        if on.all():               # every node pressed (the return map's call): no masking needed
+            return (self.alpha * p**self.n + self.beta * p, self.alpha * self.n * p ** (self.n - 1.0) + self.beta,
+                    np.zeros(p.shape))
+        pp = np.where(on, p, 1.0)  # avoid 0**(n-1); masked below
+        Y = np.where(on, self.alpha * pp**self.n + self.beta * p, 0.0)
+        dY_dp = np.where(on, self.alpha * self.n * pp ** (self.n - 1.0) + self.beta, 0.0)
+        return Y, dY_dp, np.zeros(p.shape)
 
 
 @dataclass(frozen=True)
@@ -61,7 +65,7 @@ class Coulomb:
 
     def slip_bound(self, p, q):
         p = np.asarray(p, dtype=float)
-        return self.mu * p, np.full_like(p, self.mu), np.zeros_like(p)
+        return self.mu * p, np.full(p.shape, float(self.mu)), np.zeros(p.shape)
 
 
 @dataclass(frozen=True)

@@ -32,9 +32,12 @@ class PowerLaw:
     def traction(self, g_N):
         """Return (t_N, dt_N/dg_N); t_N = -c_N (-g_N)^m in contact, 0 when open."""
         g_N = np.asarray(g_N, dtype=float)
-        a = np.where(g_N < 0.0, -g_N, 0.0)  # approach, >= 0
+        closed = g_N < 0.0
+        a = np.where(closed, -g_N, 0.0)  # approach, >= 0
+        if self.m == 1.0:                # the penalty: a**1 = a and a**0 = 1, the same numbers without powers
+            return -self.c_N * a, np.where(closed, self.c_N * 1.0, 0.0)
         t_N = -self.c_N * a**self.m
-        dt_N = np.where(g_N < 0.0, self.c_N * self.m * a ** (self.m - 1.0), 0.0)
+        dt_N = np.where(closed, self.c_N * self.m * a ** (self.m - 1.0), 0.0)
         return t_N, dt_N
 
     def energy(self, g_N):

@@ -330,6 +330,15 @@ class FrictionLaw:
         Y = _as_array(Y, (n,), f"{self.name}.slip_bound: Y")
         return np.imag(Y) / H_CS
 
+    def slip_bound_pq(self, p, q):
+        """(Y, dY/dp, dY/dq) of a law of the paper's form Y(p, q) (slip_bound(p, q), no internal
+        variables) at float arrays p, q (n,): what the return map calls at every iteration. A
+        shipped law is called as it is (exact by construction, module docstring); any other
+        law through ``slip_bound`` (its values checked)."""
+        if self.trusted:
+            return self.law.slip_bound(p, q)
+        return self.slip_bound(p, q)[:3]
+
     def slip_bound(self, p, q, v=None, z=None):
         """Y, dY/dp, dY/dq, dY/dv (n,) and dY/dz (n, k) at the given arguments."""
         p = np.asarray(p, dtype=float)

@@ -229,6 +229,8 @@ def jsonable(obj, where="result"):
     if isinstance(obj, (list, tuple)):
         return [jsonable(v, where) for v in obj]
     if isinstance(obj, np.ndarray):
+        if obj.dtype.kind in "biu" or (obj.dtype.kind == "f" and np.isfinite(obj).all()):
+            return obj.tolist()                   # numbers, every one finite: Python's ints and floats
         return jsonable(obj.tolist(), where)
     if isinstance(obj, (np.bool_,)):
         return bool(obj)

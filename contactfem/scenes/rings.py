@@ -50,10 +50,9 @@ def ring_history(ring, records, measures=None):
     whole mirrored ring for a half ring), the spin omega, and from the record's first contact
     state the nodes in contact (n_contact) and slipping in the step (n_slip); ``measures``,
     name -> f(u, v), more numbers per record."""
-    out = dict(t=np.array([r.t for r in records]),
-               x_c=np.array([ring.center_of_mass(r.u) for r in records]),
-               v_c=np.array([ring.velocity_of_mass(r.v) for r in records]),
-               omega=np.array([ring.angular_velocity(r.u, r.v) for r in records]))
+    U, V = np.array([r.u for r in records]), np.array([r.v for r in records])     # one record a row
+    out = dict(t=np.array([r.t for r in records]), x_c=ring.center_of_mass(U), v_c=ring.velocity_of_mass(V),
+               omega=ring.angular_velocity(U, V))
     if records and records[0].contacts:
         out["n_contact"] = np.array([int(np.count_nonzero(r.contacts[0].slip != OPEN)) for r in records])
         out["n_slip"] = np.array([int(np.count_nonzero(r.contacts[0].slip == SLIP)) for r in records])

@@ -39,8 +39,6 @@ The positions of a contribution in the pattern are cached when it arrives with t
 index arrays as before (a body's constant connectivity, ``key`` = the body).
 """
 
-import copy
-
 import numpy as np
 
 from .banded import BANDED_WORK, BandPlan, band_too_wide
@@ -67,10 +65,19 @@ def choose_linear_algebra(n, requested="auto", plan=None):
     return "banded" if plan is not None and plan.work <= BANDED_WORK else "sparse"
 
 
+def shallow_copy(matrix):
+    """A new matrix object sharing every attribute of `matrix` (its index and value arrays):
+    what copy.copy makes of a scipy matrix, without the pickling protocol it goes through."""
+    K = object.__new__(type(matrix))
+    K.__dict__.update(matrix.__dict__)
+    return K
+
+
 def _keys(rows, cols, offset, n):
     """Pattern keys (col + offset) n + row + offset, in 64 bits: a body's int32 index arrays
     (scipy's) would overflow from n = 46341 unknowns on."""
-    return (np.asarray(cols, dtype=np.int64) + offset) * n + (np.asarray(rows, dtype=np.int64) + offset)
+    cols, rows = np.asarray(cols, dtype=np.int64), np.asarray(rows, dtype=np.int64)
+    return (cols + offset) * n + (rows + offset) if offset else cols * n + rows
 
 
 class TangentAssembler:
@@ -104,6 +111,7 @@ class TangentAssembler:
         first[:1] = True
         np.not_equal(merged[1:], merged[:-1], out=first[1:])
         self.keys = merged[first]
+        self._ends = np.append(self.keys, -1)        # a position beyond the last key finds no key there
         where = np.empty(merged.size, dtype=np.int64)
         where[order] = np.cumsum(first) - 1         # each merged key's place in the pattern
         from scipy.sparse import csc_matrix
@@ -133,11 +141,24 @@ class TangentAssembler:
                 return hit[2]
         keys = _keys(rows, cols, offset, self.n)
         pos = np.searchsorted(self.keys, keys)
-        if keys.size and (pos.max() >= self.keys.size or np.any(self.keys[pos] != keys)):
+        if keys.size and (self._ends[pos] != keys).any():       # (_ends: keys and one beyond the last)
             pos = self._grow(keys)
         if key is not None:
             self._cache[key] = (rows, cols, pos)
         return pos
+
+    def _flat(self, rows, cols, offset, key):
+        """Dense: the flat index (row + offset) n + col + offset of each entry; cached for a
+        contribution whose index arrays come back the same (``key``), and for the diagonal
+        (rows None)."""
+        hit = self._cache.get(key) if key is not None else None
+        if hit is not None and hit[0] is rows and hit[1] is cols:
+            return hit[2]
+        n = self.n
+        flat = np.arange(n) * (n + 1) if rows is None else (rows + offset) * n + (cols + offset)
+        if key is not None:
+            self._cache[key] = (rows, cols, flat)
+        return flat
 
     # -- assembly ---------------------------------------------------------------------------
     def assemble(self, blocks, diagonal=None):
@@ -151,11 +172,13 @@ class TangentAssembler:
         n = self.n
         if self.kind == "dense":
             self.used["dense"] = DENSE_ORDERING
-            index = np.concatenate([(r + o) * n + (c + o) for r, c, _, o, _ in blocks] + [np.zeros(0, int)])
-            vals = np.concatenate([v for _, _, v, _, _ in blocks] + [np.zeros(0)])
-            K = np.bincount(index, vals, minlength=n * n).reshape(n, n)
-            if diagonal is not None:
-                K.flat[::n + 1] += diagonal
+            index = [self._flat(r, c, o, key) for r, c, _, o, key in blocks]
+            vals = [v for _, _, v, _, _ in blocks]
+            if diagonal is not None:              # the diagonal last: summed after the blocks, as K + diag
+                index.append(self._flat(None, None, 0, "diagonal"))
+                vals.append(diagonal)
+            K = np.bincount(np.concatenate(index + [np.zeros(0, int)]), np.concatenate(vals + [np.zeros(0)]),
+                            minlength=n * n).reshape(n, n)
             return K
         if self.keys is None:                     # the first assembly: the whole pattern at once
             keys = [_keys(r, c, o, n) for r, c, _, o, _ in blocks]
@@ -170,16 +193,17 @@ class TangentAssembler:
                 pos = [self._positions(r, c, o, key) for r, c, _, o, key in blocks]
                 if self.pattern_builds == builds:
                     break
-        data = np.bincount(np.concatenate(pos + [np.zeros(0, int)]),
-                           np.concatenate([v for _, _, v, _, _ in blocks] + [np.zeros(0)]),
+        vals = [v for _, _, v, _, _ in blocks]
+        if diagonal is not None:                  # the diagonal last: summed after the blocks, as K + diag
+            pos.append(self.diag_pos)
+            vals.append(diagonal)
+        data = np.bincount(np.concatenate(pos + [np.zeros(0, int)]), np.concatenate(vals + [np.zeros(0)]),
                            minlength=self.keys.size)
-        if diagonal is not None:
-            data[self.diag_pos] += diagonal
-        K = copy.copy(self._template)             # shares the pattern's index arrays (docstring)
+        K = shallow_copy(self._template)          # shares the pattern's index arrays (docstring)
         K.data = data
         if self.kind == "banded":
             K.band_plan = self.banded_plan = self.plan
-            self.used["banded"] = self.plan.describe()
+            self.used["banded"] = self.plan.description
         else:
             self.used["sparse"] = ORDERING
         return K

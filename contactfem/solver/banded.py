@@ -19,6 +19,8 @@ to the free dofs): the permutation, kl and ku, and for every stored entry of K t
 it takes in the band storage. A solve only scatters the values there and calls LAPACK.
 """
 
+from functools import lru_cache
+
 import numpy as np
 
 # The band LU is used while its work per unknown, kl (kl + ku), is at most BANDED_WORK; above,
@@ -35,6 +37,14 @@ import numpy as np
 #   Hertz, paper: 8385 free, 258 (133128): 38 / 30 ms.
 # The band wins by 1.7x or more up to a work of ~1.4e4 and breaks even at ~3e4.
 BANDED_WORK = 1.5e4
+
+
+@lru_cache(maxsize=1)
+def lapack_dgbsv():
+    """LAPACK's general band solver (scipy), imported on first use (not at every solve)."""
+    from scipy.linalg.lapack import dgbsv
+
+    return dgbsv
 
 
 def band_too_wide(indptr, indices, n, free=None, work=BANDED_WORK):
@@ -104,6 +114,7 @@ class BandPlan:
         self.kl = int(max(np.max(r - c, initial=0), 0))
         self.ku = int(max(np.max(c - r, initial=0), 0))
         self.ldab = 2 * self.kl + self.ku + 1
+        self.description = f"reverse Cuthill-McKee, LAPACK banded LU (kl={self.kl}, ku={self.ku})"
         # LAPACK: A(i, j) at ab(kl + ku + i - j, j); ab is held as its transpose (m, ldab), C order
         self.slot = c * self.ldab + (self.kl + self.ku + r - c)
 
@@ -113,7 +124,7 @@ class BandPlan:
         return self.kl * (self.kl + self.ku)
 
     def describe(self):
-        return f"reverse Cuthill-McKee, LAPACK banded LU (kl={self.kl}, ku={self.ku})"
+        return self.description
 
     def fits(self, K, free):
         """Whether K has this plan's pattern (the same index arrays) and free its free dofs."""
@@ -126,12 +137,10 @@ class BandPlan:
     def solve(self, data, b):
         """x from A x = b, A the matrix with values ``data`` (of the CSC pattern), on the block.
         Raises RuntimeError on an exactly singular matrix (a zero pivot), like SuperLU."""
-        from scipy.linalg.lapack import dgbsv
-
         band = np.zeros((self.n, self.ldab))
         band.ravel()[self.slot] = data if self.take is None else data[self.take]
-        _, _, x, info = dgbsv(self.kl, self.ku, band.T, np.asarray(b, dtype=float)[self.perm],
-                              overwrite_ab=True, overwrite_b=True)
+        _, _, x, info = lapack_dgbsv()(self.kl, self.ku, band.T, np.asarray(b, dtype=float)[self.perm],
+                                       overwrite_ab=True, overwrite_b=True)
         if info > 0:
             raise RuntimeError(f"Factor is exactly singular (banded LU: zero pivot U({info}, {info}))")
         if info < 0:

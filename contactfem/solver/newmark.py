@@ -25,6 +25,7 @@ The unknowns a contact owns (Lagrange multipliers, system.py) are not motions: N
 starts them from their last converged values and they get no velocity or acceleration
 (``system.contact_dofs``; none in a penalty model, where nothing of this changes).
 """
+import math
 import warnings
 
 import numpy as np
@@ -34,7 +35,7 @@ from .newton import NewtonError, NewtonResult, newton
 
 
 def _check_dt(dt):
-    if not (np.isfinite(dt) and dt > 0):
+    if not (math.isfinite(dt) and dt > 0):
         raise ValueError(f"dt must be a finite number > 0, got {dt}")
 
 
@@ -72,11 +73,14 @@ class Newmark:
         s, beta, delta = self.system, self.beta, self.delta
         t1 = t + dt
         c = 1.0 / (beta * dt ** 2)
+        cM = c * s.mass()                     # the step's constants: c M and the predictor
+        lumped = isinstance(cM, np.ndarray)   # a diagonal (ndof,), else a sparse consistent M
         u_pred = u + dt * v + dt ** 2 * (0.5 - beta) * a
 
         def effective(u1):                    # eq 29 with a+ = c (u1 - u_pred); tangent K + c M
             ev = s.evaluate(u1, t1, dt, u, mass_coefficient=c)
-            return ev._replace(G=ev.G + s.mass_times(c * (u1 - u_pred)))
+            du = u1 - u_pred
+            return ev._replace(G=ev.G + (cM * du if lumped else cM @ du))
 
         # initial guess: the acceleration stays a (u + dt v + dt^2 a / 2); multipliers as they were
         guess = s.apply_dirichlet(u_pred + beta * dt ** 2 * a, t1)

@@ -28,6 +28,7 @@ Failures raise NewtonError: maxit reached, NaN/inf residual or correction, singu
 tangent, or a FloatingPointError raised by fun (the bodies' InvertedElementError and
 the contact's ReturnMapError derive from it), so a driver can cut the step back.
 """
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -124,7 +125,7 @@ def _newton(fun, u0, free, atol, rtol, maxit, label, line_search, instrument):
     if free.dtype == bool:
         free = np.flatnonzero(free)
     where = f" ({label})" if label else ""
-    all_free = len(free) == len(u) and np.array_equal(free, np.arange(len(u)))
+    all_free = len(free) == len(u) and bool((free == np.arange(len(u))).all())
     if int(line_search) != line_search or line_search < 0:
         raise ValueError(f"parameter line_search = {line_search} is out of range: allowed integers [0, inf)")
     history = []
@@ -143,9 +144,10 @@ def _newton(fun, u0, free, atol, rtol, maxit, label, line_search, instrument):
     for k in range(maxit + 1):
         out = evaluated if evaluated is not None else evaluate(u, k)
         evaluated = None
-        G, K = out[0], out[1]
-        r = float(np.linalg.norm(G[free]))
-        if not np.isfinite(r):
+        G = out[0]
+        G_f = G if all_free else G[free]
+        r = math.sqrt(G_f.dot(G_f))                   # ||G_f|| (as np.linalg.norm computes it)
+        if not math.isfinite(r):
             raise NewtonError(f"Newton: non-finite residual at iteration {k}{where}", history, label)
         history.append(r)
         if r <= atol + rtol * history[0]:
@@ -154,11 +156,12 @@ def _newton(fun, u0, free, atol, rtol, maxit, label, line_search, instrument):
             break
         try:
             with timed(instrument, "solve"):
-                du = solve_free(K, -G[free], free, all_free)
+                du = solve_free(out[1], -G_f, free, all_free)
         except RuntimeError as err:                   # "Factor is exactly singular"
             raise NewtonError(f"Newton: singular tangent at iteration {k}{where}: {err}",
                               history, label) from err
-        if not np.all(np.isfinite(du)):
+        # every value finite: du.du is, unless a value is not (or the sum overflows: then each is checked)
+        if not (math.isfinite(du.dot(du)) or np.isfinite(du).all()):
             raise NewtonError(f"Newton: non-finite correction at iteration {k}{where}",
                               history, label)
         if line_search:
@@ -172,8 +175,10 @@ def _newton(fun, u0, free, atol, rtol, maxit, label, line_search, instrument):
                     break
                 step /= 2
             u = trial
+        elif all_free:
+            u = u + du                                # a new iterate: the last evaluation keeps its own u
         else:
-            u = u.copy()                              # a new iterate: the last evaluation keeps its own u
+            u = u.copy()
             u[free] += du
 
     raise NewtonError(f"Newton: no convergence in {maxit} iterations{where}", history, label)
