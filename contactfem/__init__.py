@@ -2,19 +2,23 @@
 Wriggers, Vu Van & Stein (1990), on scikit-fem. A teaching and reference toolkit.
 
 Importing the package loads nothing else (not even numpy): the command line starts at once
-and answers Ctrl-C from its first moment; ``contactfem.check_law`` is loaded on first use."""
+and answers Ctrl-C from its first moment; what it offers at the top, loaded on first use:
+
+    from contactfem import run_scene, check_law, LawError, LawValueError
+"""
 
 __version__ = "0.1.0"
-__all__ = ["check_law"]
+__all__ = ["run_scene", "check_law", "LawError", "LawValueError"]
+_HOMES = {"run_scene": "scenes", "check_law": "laws", "LawError": "laws", "LawValueError": "laws"}
 
 
 def __dir__():
-    return sorted(list(globals()) + ["check_law"])
+    return sorted(list(globals()) + __all__)
 
 
 def __getattr__(name):
-    if name == "check_law":
-        from .laws import check_law
+    if name in _HOMES:
+        import importlib
 
-        return check_law
+        return getattr(importlib.import_module(f".{_HOMES[name]}", __name__), name)
     raise AttributeError(f"module 'contactfem' has no attribute {name!r}")

@@ -320,7 +320,8 @@ def test_sloping_study_mass_and_integration_against_the_text(study):
     text = " ".join(README[README.index("**Mass and time integration"):README.index("### The cork")].split())
     for t in (f"the frictionless v_y by {d(cm, 'frictionless_vy'):+.2f}, the frictional v_x, v_y by "
               f"{d(cm, 'frictional_vx'):+.2f} and {d(cm, 'frictional_vy'):+.2f}",
-              f"ends with {ec['frictionless_energy_final']:.2f} E0 against {preset['frictionless_energy_final']:.2f} E0",
+              f"ends with {ec['frictionless_energy_final']:.2f} E0 against {preset['frictionless_energy_final']:.2f} E0 "
+              f"at t = {rc.SLOPING_STEPS * 0.1:g}, where the study stops",
               f"v_y by {d(ec, 'frictionless_vy'):+.2f} to {ec['frictionless_vy']:.2f} ({ec['frictionless_angle']:.1f} deg)",
               f"the frictional v_x by {d(ec, 'frictional_vx'):+.2f} to {ec['frictional_vx']:.2f} and its v_y by "
               f"{d(ec, 'frictional_vy'):+.2f} to {ec['frictional_vy']:.2f} ({ec['frictional_angle']:.1f} deg)",
