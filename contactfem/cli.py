@@ -163,9 +163,11 @@ def cmd_run(args):
     _RUN["phase"] = "done"
     for note in notes:
         print(f"contactfem: warning: {note}", file=sys.stderr)
-    summary = {k: v for k, v in res.items() if not isinstance(v, (list, dict))}
-    for k, v in summary.items():
-        print(f"{k}: {v}")
+    for k, v in res.items():                      # scalars, and short lists of numbers (the block's residuals)
+        if not isinstance(v, (list, dict)):
+            print(f"{k}: {v}")
+        elif isinstance(v, list) and 0 < len(v) <= 8 and all(isinstance(x, (int, float)) for x in v):
+            print(f"{k}: [{', '.join(f'{x:.6g}' for x in v)}]")
     for what, path in out.paths.items():
         print(f"{what} -> {path}")
 

@@ -82,6 +82,13 @@ def test_a_coulomb_law_file_equals_the_built_in_law(scene):
     mine = run_scene(scene, "fast", {k: v for k, v in over.items() if sc.law_param_kind(k, v) != "friction"},
                      friction=law)
     assert mine["friction_law"]["fields"] == {"c_T": params["c_T"], "mu": mu}
+    if scene == "rolling_ring":
+        # the rigid ring's closed forms are reference values for the Coulomb class the toolkit
+        # knows, not results of the run: a law class of one's own has none (None)
+        from contactfem.scenes.rolling_ring import CLOSED_FORM_KEYS
+        assert all(mine[k] is None for k in CLOSED_FORM_KEYS) and built_in["exact_mu"] == mu
+        mine = {k: v for k, v in mine.items() if k not in CLOSED_FORM_KEYS}
+        built_in = {k: v for k, v in built_in.items() if k not in CLOSED_FORM_KEYS}
     a, b = dict(_leaves(mine)), dict(_leaves(built_in))
     assert a.keys() == b.keys() and len(a) > 3
     for key in b:

@@ -121,8 +121,11 @@ def _check_derivatives(rep, L, p, q, v, z, lam, dt, rtol):
         i = int(np.argmax(err))
         if err[i] >= rtol:
             how = "computed by complex step" if name in L.computed else "returned by the law"
+            hint = (" -- the complex step needs slip_bound to be complex-analytic: np.abs, np.sign, np.maximum,"
+                    " comparisons and np.where on the argument break it (use np.sqrt(x * x) for |x|, or return"
+                    " the derivative yourself)") if name in L.computed else ""
             rep.add(False, "", f"{name} does not match finite differences: worst relative error {err[i]:.2e} at "
-                               f"{_where(where, i)} ({how}: {an[i]:.6g}, finite differences: {fd[i]:.6g})")
+                               f"{_where(where, i)} ({how}: {an[i]:.6g}, finite differences: {fd[i]:.6g}){hint}")
         else:
             good.append(name)
             worst_all = max(worst_all, float(err[i]))

@@ -84,7 +84,10 @@ def build(params, *, normal=None, friction=None, system_options=None):
     stepper = time_integration.make_stepper(params, system, atol=1e-6, rtol=1e-10, maxit=30)
     stage = Stage(stepper, Steps(params["dt"], t_end=params["t_end"], max_cuts=8), np.zeros(ring.body.ndof),
                   ring.initial_velocity((params["v0"], 0.0)), name="rolling_ring")
-    return dict(ring=ring, contact=contact, system=system, systems=[system], plane=plane, stage=stage)
+    # the closed forms hold for Coulomb friction: the scene's, or a Coulomb law given with its own mu
+    exact_mu = params["mu"] if friction is None else (friction.mu if isinstance(friction, Coulomb) else None)
+    return dict(ring=ring, contact=contact, system=system, systems=[system], plane=plane, stage=stage,
+                exact_mu=exact_mu)
 
 
 def animation(ring, records, floor):
@@ -99,6 +102,12 @@ def animation(ring, records, floor):
     return dict(t=np.array([r.t for r in frames]), outlines=np.array([o[pick] for o in outlines]),
                 marks=np.array([[np.vstack([ring.center_of_mass(r.u), o[0]])] for r, o in zip(frames, outlines)]),
                 obstacles=[floor])
+
+
+# the rigid ring's closed forms and the errors against them: for Coulomb friction only (else None)
+CLOSED_FORM_KEYS = ("exact_mu", "t_star_exact", "x_roll_exact", "v_final_exact", "omega_final_exact", "x_end_exact",
+                    "x_roll_rel_err", "v_final_rel_err", "x_end_rel_err", "t_star_model", "x_roll_model",
+                    "v_final_model", "x_exact", "vx_exact", "omega_exact")
 
 
 def measure(model, params, records):
@@ -122,25 +131,30 @@ def measure(model, params, records):
         v_final, omega_final = float(vc[-1, 0]), float(omega[-1])
 
     floor = np.array([[xc[:, 0].min() - 1.2 * params["R"], 0.0], [xc[:, 0].max() + 1.2 * params["R"], 0.0]])
-    mu, g = params["mu"], params["g"]
-    hoop = rigid_ring_exact(v0, mu, g, params["R"], t=t)   # the paper's thin hoop
-    # the rigid ring of this model: lever arm a, gyration radius from the lumped masses
+    mu, g = model["exact_mu"], params["g"]
     k2 = ring_gyration_radius2(ring)
-    exact = rigid_ring_exact(v0, mu, g, a, k2)
+    if mu is not None:
+        hoop = rigid_ring_exact(v0, mu, g, params["R"], t=t)   # the paper's thin hoop
+        # the rigid ring of this model: lever arm a, gyration radius from the lumped masses
+        exact = rigid_ring_exact(v0, mu, g, a, k2)
+        closed = dict(
+            exact_mu=mu, t_star_exact=hoop["t_star"], x_roll_exact=hoop["x_star"], v_final_exact=hoop["v_star"],
+            omega_final_exact=hoop["omega_star"], x_end_exact=float(hoop["x"][-1]),
+            x_roll_rel_err=(x_roll / hoop["x_star"] - 1.0) if rolled else None,
+            v_final_rel_err=v_final / hoop["v_star"] - 1.0,
+            x_end_rel_err=float(xc[-1, 0] / hoop["x"][-1] - 1.0),
+            t_star_model=exact["t_star"], x_roll_model=exact["x_star"], v_final_model=exact["v_star"],
+            x_exact=hoop["x"], vx_exact=hoop["v"], omega_exact=hoop["omega"])
+    else:                                   # a friction law other than Coulomb: no closed form
+        closed = dict.fromkeys(CLOSED_FORM_KEYS)
     return dict(
         kind=params["kind"], rolled=rolled,
         t_roll=t_roll, x_roll=x_roll, v_final=v_final, omega_final=omega_final,
         x_end=float(xc[-1, 0]), v_end=float(vc[-1, 0]), omega_end=float(omega[-1]),
-        t_star_exact=hoop["t_star"], x_roll_exact=hoop["x_star"], v_final_exact=hoop["v_star"],
-        omega_final_exact=hoop["omega_star"], x_end_exact=float(hoop["x"][-1]),
-        x_roll_rel_err=(x_roll / hoop["x_star"] - 1.0) if rolled else None,
-        v_final_rel_err=v_final / hoop["v_star"] - 1.0,
-        x_end_rel_err=float(xc[-1, 0] / hoop["x"][-1] - 1.0),
-        t_star_model=exact["t_star"], x_roll_model=exact["x_star"], v_final_model=exact["v_star"],
+        **closed,
         rolling_radius=a, gyration_radius2=k2, mass=ring.total_mass(), ndof=ring.body.ndof,
         paper=PAPER,
         t=t, x_c=xc[:, 0], y_c=xc[:, 1], vx_c=vc[:, 0], vy_c=vc[:, 1], omega=omega, slip_velocity=slip,
-        x_exact=hoop["x"], vx_exact=hoop["v"], omega_exact=hoop["omega"],
         outlines=[ring.outline(records[k].u) for k in shots], outline_t=t[shots],
         outline_vc=vc[shots], outline_omega=omega[shots],
         outline_node_y=[ring.body.X[ring.contact_nodes, 1] + records[k].u[nodes[:, 1]] for k in shots],
