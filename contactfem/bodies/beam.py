@@ -273,10 +273,10 @@ class Beam:
         """
         g = self._gauss()
         E, c, s = self._row_strains(u, g)
-        S, C, _ = return_map(E, self.ep.T, g["D"], g["S0"], self.eta, self._dt(dt))
+        S, C = self._resultants(E, g, dt)
         eps, gam = E[0], E[1]
-        N, Q, M = S
-        C_N, C_Q, C_M = C
+        N, Q, M = S[0], S[1], S[2]
+        C_N, C_Q, C_M = C[0], C[1], C[2]
         e1 = 1 + eps                                             # x'.t
         # residual w L0 B^T S, one row of re per element dof (u_a, theta_a, u_b, theta_b)
         f0, f1 = N * c - Q * s, N * s + Q * c                    # N t + Q n
@@ -301,9 +301,10 @@ class Beam:
         U[7] = g["wNaNa"] * alpha + kk                           # theta theta
         U[8] = g["wNaNb"] * alpha - kk
         U[9] = g["wNbNb"] * alpha + kk
-        Ke = U[g["entry"]] * g["sign"]                           # (36, m): entry 6 i + j of each row
-        if len(self.points) > 1:                                 # sum the points of each element
-            re, Ke = re.reshape(6, -1, self.ne).sum(axis=1), Ke.reshape(36, -1, self.ne).sum(axis=1)
+        if len(self.points) > 1:                                 # two points: sum them per element (rows
+            ne = self.ne                                         # e and ne + e), before K_e is spread out
+            re, U = re[:, :ne] + re[:, ne:], U[:, :ne] + U[:, ne:]
+        Ke = U[g["entry"]] * g["sign"]                           # (36, ne): entry 6 i + j of each element
         R = np.bincount(self._edofs_T, re.ravel(), minlength=self.ndof)
         return R, self._rows, self._cols, Ke.ravel()
 
@@ -311,15 +312,23 @@ class Beam:
         """The strains E = (eps, gam, kap) (3, m) and cos, sin of the angle phi at every row of
         ``_gauss`` (all integration points of all elements)."""
         q = np.asarray(u, float)[g["edofs"]]                     # (6, m): u_a, theta_a, u_b, theta_b per row
-        x0 = (g["dX0"] + q[3] - q[0]) * g["invL"]                # x'
-        x1 = (g["dX1"] + q[4] - q[1]) * g["invL"]
+        xp = (g["dX"] + q[3:5] - q[0:2]) * g["invL"]             # x' = (x'_x, x'_y), (2, m)
         phi = g["theta0"] + g["Na"] * q[2] + g["Nb"] * q[5]
         c, s = np.cos(phi), np.sin(phi)
+        xc, xs = xp * c, xp * s
         E = np.empty((3, len(phi)))
-        E[0] = x0 * c + x1 * s - 1.0                             # eps = x' . t - 1
-        E[1] = x1 * c - x0 * s                                   # gam = x' . n
+        E[0] = xc[0] + xs[1] - 1.0                               # eps = x' . t - 1
+        E[1] = xc[1] - xs[0]                                     # gam = x' . n
         E[2] = (q[5] - q[2]) * g["invL"]                         # kap = theta'
         return E, c, s
+
+    def _resultants(self, E, g, dt):
+        """The resultants S = (N, Q, M) (3, m) at the strains E of every row and their moduli
+        C = dS/dE: the elastic beam's S = D E and C = D (3, 1) (what ``return_map`` gives
+        without plastic strains), else the viscoplastic return map from the committed ``ep``."""
+        if self.S0 is None:
+            return g["D"] * E, g["D"]
+        return return_map(E, self.ep.T, g["D"], g["S0"], self.eta, self._dt(dt))[:2]
 
     def _gauss(self):
         """Per-row constants of internal_coo (row k ne + e: point k of element e), made once:
@@ -345,8 +354,8 @@ class Beam:
                         entry[6 * i + j], sign[6 * i + j] = 3 + d % 3 + (2 if th == 5 else 0), side[d]
                     else:
                         entry[6 * i + j] = {(2, 2): 7, (2, 5): 8, (5, 2): 8, (5, 5): 9}[(i, j)]
-            self._g = dict(edofs=np.concatenate([self.edofs.T] * k, axis=1), dX0=tile(self._dX[:, 0]),
-                           dX1=tile(self._dX[:, 1]), invL=invL, theta0=tile(self.theta0), Na=Na, Nb=Nb, wL0=wL0,
+            self._g = dict(edofs=np.concatenate([self.edofs.T] * k, axis=1), dX=np.concatenate([self._dX.T] * k, axis=1),
+                           invL=invL, theta0=tile(self.theta0), Na=Na, Nb=Nb, wL0=wL0,
                            wiL=wL0 * invL, wiL2=wL0 * invL * invL, wNa=wL0 * Na, wNb=wL0 * Nb,
                            wiLNa=wL0 * invL * Na, wiLNb=wL0 * invL * Nb, wNaNa=wL0 * Na * Na,
                            wNaNb=wL0 * Na * Nb, wNbNb=wL0 * Nb * Nb, entry=entry, sign=sign[:, None],
@@ -358,7 +367,7 @@ class Beam:
         (viscoplastic: the resultants of a step of dt from the committed plastic strains).
         All integration points in one pass, the rows of internal_coo."""
         g = self._gauss()
-        S = return_map(self._row_strains(u, g)[0], self.ep.T, g["D"], g["S0"], self.eta, self._dt(dt))[0]
+        S = self._resultants(self._row_strains(u, g)[0], g, dt)[0]
         return float(np.sum(g["wL0"] * (S ** 2 / (2 * g["D"]))))
 
     def commit(self, u, dt=None):
