@@ -272,30 +272,35 @@ class Beam:
         and the points' sums are taken at the end.
         """
         g = self._gauss()
-        E, t = self._row_strains(u, g)
+        E, c, s = self._row_strains(u, g)
         S, C = self._resultants(E, g, dt)
         eps, gam = E[0], E[1]
         N, Q, M = S[0], S[1], S[2]
         C_N, C_Q, C_M = C[0], C[1], C[2]
         e1 = 1 + eps                                             # x'.t
-        n = t[::-1] * g["pm"]                                    # n = e3 x t = (-sin phi, cos phi)
         # residual w L0 B^T S, one row of re per element dof (u_a, theta_a, u_b, theta_b)
+        f0, f1 = N * c - Q * s, N * s + Q * c                    # N t + Q n
         h = N * gam - Q * e1                                     # theta: (N gam - Q (1 + eps)) p
-        re = np.empty((6, len(eps)))
-        re[3:5] = g["wiL"] * (N * t + Q * n)                     # x': N t + Q n
-        re[0:2] = -re[3:5]
-        re[2::3] = g["wNab"] * h + g["wiL"] * M * g["pm"]        # theta_a, theta_b: h N_a - M, h N_b + M
+        wM = g["wiL"] * M
+        re = np.empty((6, len(c)))
+        re[3], re[4] = g["wiL"] * f0, g["wiL"] * f1
+        re[0], re[1] = -re[3], -re[4]
+        re[2], re[5] = g["wNa"] * h - wM, g["wNb"] * h + wM
         # tangent: the ten distinct entries of w L0 K_e (docstring)
-        tt = t * t                                               # (c c, s s)
+        cc, ss, cs = c * c, s * s, c * s
         a1, a2 = C_N * gam - Q, N - C_Q * e1
         alpha = C_N * (gam * gam) + C_Q * (e1 * e1) - N * e1 - Q * gam
-        v = a1 * t + a2 * n                                      # v = (C_N gam - Q) t + (N - C_Q (1 + eps)) n
-        U = np.empty((10, len(eps)))
-        U[0:3:2] = g["wiL2"] * (C_N * tt + C_Q * tt[::-1])       # x'x' (times 1/L0^2): C_N t t^T + C_Q n n^T
-        U[1] = g["wiL2"] * ((C_N - C_Q) * (t[0] * t[1]))
-        U[3:5] = g["wiLNa"] * v                                  # x' theta_a (times 1/L0)
-        U[5:7] = g["wiLNb"] * v                                  # x' theta_b
-        U[7:10] = g["wNN"] * alpha + g["wiL2"] * C_M * g["pmp"]  # theta theta: alpha p p^T + C_M/L0^2 [[1, -1], [-1, 1]]
+        kk = g["wiL2"] * C_M
+        U = np.empty((10, len(c)))
+        U[0] = g["wiL2"] * (C_N * cc + C_Q * ss)                 # x'x' (times 1/L0^2)
+        U[1] = g["wiL2"] * ((C_N - C_Q) * cs)
+        U[2] = g["wiL2"] * (C_N * ss + C_Q * cc)
+        v0, v1 = a1 * c - a2 * s, a1 * s + a2 * c                # v = (C_N gam - Q) t + (N - C_Q (1 + eps)) n
+        U[3], U[4] = g["wiLNa"] * v0, g["wiLNa"] * v1            # x' theta_a (times 1/L0)
+        U[5], U[6] = g["wiLNb"] * v0, g["wiLNb"] * v1            # x' theta_b
+        U[7] = g["wNaNa"] * alpha + kk                           # theta theta
+        U[8] = g["wNaNb"] * alpha - kk
+        U[9] = g["wNbNb"] * alpha + kk
         if len(self.points) > 1:                                 # two points: sum them per element (rows
             ne = self.ne                                         # e and ne + e), before K_e is spread out
             re, U = re[:, :ne] + re[:, ne:], U[:, :ne] + U[:, ne:]
@@ -304,20 +309,18 @@ class Beam:
         return R, self._rows, self._cols, Ke.ravel()
 
     def _row_strains(self, u, g):
-        """The strains E = (eps, gam, kap) (3, m) and the tangent t = (cos phi, sin phi) (2, m) at
-        every row of ``_gauss`` (all integration points of all elements)."""
+        """The strains E = (eps, gam, kap) (3, m) and cos, sin of the angle phi at every row of
+        ``_gauss`` (all integration points of all elements)."""
         q = np.asarray(u, float)[g["edofs"]]                     # (6, m): u_a, theta_a, u_b, theta_b per row
         xp = (g["dX"] + q[3:5] - q[0:2]) * g["invL"]             # x' = (x'_x, x'_y), (2, m)
         phi = g["theta0"] + g["Na"] * q[2] + g["Nb"] * q[5]
-        t = np.empty((2, len(phi)))                              # t = (cos phi, sin phi)
-        np.cos(phi, out=t[0])
-        np.sin(phi, out=t[1])
-        xc, xs = xp * t[0], xp * t[1]
+        c, s = np.cos(phi), np.sin(phi)
+        xc, xs = xp * c, xp * s
         E = np.empty((3, len(phi)))
         E[0] = xc[0] + xs[1] - 1.0                               # eps = x' . t - 1
         E[1] = xc[1] - xs[0]                                     # gam = x' . n
         E[2] = (q[5] - q[2]) * g["invL"]                         # kap = theta'
-        return E, t
+        return E, c, s
 
     def _resultants(self, E, g, dt):
         """The resultants S = (N, Q, M) (3, m) at the strains E of every row and their moduli
@@ -353,11 +356,9 @@ class Beam:
                         entry[6 * i + j] = {(2, 2): 7, (2, 5): 8, (5, 2): 8, (5, 5): 9}[(i, j)]
             self._g = dict(edofs=np.concatenate([self.edofs.T] * k, axis=1), dX=np.concatenate([self._dX.T] * k, axis=1),
                            invL=invL, theta0=tile(self.theta0), Na=Na, Nb=Nb, wL0=wL0,
-                           wiL=wL0 * invL, wiL2=wL0 * invL * invL,
-                           wiLNa=wL0 * invL * Na, wiLNb=wL0 * invL * Nb, wNab=np.array([wL0 * Na, wL0 * Nb]),
-                           wNN=np.array([wL0 * Na * Na, wL0 * Na * Nb, wL0 * Nb * Nb]), entry=entry, sign=sign[:, None],
-                           pm=np.array([[-1.0], [1.0]]),
-                           pmp=np.array([[1.0], [-1.0], [1.0]]),
+                           wiL=wL0 * invL, wiL2=wL0 * invL * invL, wNa=wL0 * Na, wNb=wL0 * Nb,
+                           wiLNa=wL0 * invL * Na, wiLNb=wL0 * invL * Nb, wNaNa=wL0 * Na * Na,
+                           wNaNb=wL0 * Na * Nb, wNbNb=wL0 * Nb * Nb, entry=entry, sign=sign[:, None],
                            D=self.D[:, None], S0=None if self.S0 is None else self.S0[:, None])
         return self._g
 
