@@ -291,7 +291,7 @@ class Beam:
         a1, a2 = C_N * gam - Q, N - C_Q * e1
         alpha = C_N * (gam * gam) + C_Q * (e1 * e1) - N * e1 - Q * gam
         kk = g["wiL2"] * C_M
-        U = np.empty((10, len(c)))
+        U = np.empty((20, len(c)))                               # the ten entries, then their negatives
         U[0] = g["wiL2"] * (C_N * cc + C_Q * ss)                 # x'x' (times 1/L0^2)
         U[1] = g["wiL2"] * ((C_N - C_Q) * cs)
         U[2] = g["wiL2"] * (C_N * ss + C_Q * cc)
@@ -304,7 +304,8 @@ class Beam:
         if len(self.points) > 1:                                 # two points: sum them per element (rows
             ne = self.ne                                         # e and ne + e), before K_e is spread out
             re, U = re[:, :ne] + re[:, ne:], U[:, :ne] + U[:, ne:]
-        Ke = U[g["entry"]] * g["sign"]                           # (36, ne): entry 6 i + j of each element
+        np.negative(U[:10], out=U[10:])
+        Ke = U[g["entry"]]                                       # (36, ne): entry 6 i + j of each element
         R = np.bincount(self._edofs_T, re.ravel(), minlength=self.ndof)
         return R, self._rows, self._cols, Ke.ravel()
 
@@ -312,29 +313,29 @@ class Beam:
         """The strains E = (eps, gam, kap) (3, m) and cos, sin of the angle phi at every row of
         ``_gauss`` (all integration points of all elements)."""
         q = np.asarray(u, float)[g["edofs"]]                     # (6, m): u_a, theta_a, u_b, theta_b per row
-        xp = (g["dX"] + q[3:5] - q[0:2]) * g["invL"]             # x' = (x'_x, x'_y), (2, m)
+        x0, x1 = (g["dX"] + q[3:5] - q[0:2]) * g["invL2"]        # x', both components at once
         phi = g["theta0"] + g["Na"] * q[2] + g["Nb"] * q[5]
         c, s = np.cos(phi), np.sin(phi)
-        xc, xs = xp * c, xp * s
         E = np.empty((3, len(phi)))
-        E[0] = xc[0] + xs[1] - 1.0                               # eps = x' . t - 1
-        E[1] = xc[1] - xs[0]                                     # gam = x' . n
+        E[0] = x0 * c + x1 * s - 1.0                             # eps = x' . t - 1
+        E[1] = x1 * c - x0 * s                                   # gam = x' . n
         E[2] = (q[5] - q[2]) * g["invL"]                         # kap = theta'
         return E, c, s
 
     def _resultants(self, E, g, dt):
         """The resultants S = (N, Q, M) (3, m) at the strains E of every row and their moduli
-        C = dS/dE: the elastic beam's S = D E and C = D (3, 1) (what ``return_map`` gives
-        without plastic strains), else the viscoplastic return map from the committed ``ep``."""
+        C = dS/dE: the elastic beam's S = D E and C = D (what ``return_map`` gives without
+        plastic strains; D at every row, so that no product broadcasts), else the viscoplastic
+        return map from the committed ``ep``."""
         if self.S0 is None:
-            return g["D"] * E, g["D"]
+            return g["Dm"] * E, g["Dm"]
         return return_map(E, self.ep.T, g["D"], g["S0"], self.eta, self._dt(dt))[:2]
 
     def _gauss(self):
         """Per-row constants of internal_coo (row k ne + e: point k of element e), made once:
         the element dofs (6, m), chords, lengths and angles, the shape functions N_a, N_b at
         the point and their products with the weight w L0 and 1/L0, and the map from the ten
-        distinct entries of K_e to its 36 (``entry``, ``sign``)."""
+        distinct entries of K_e and their negatives (rows 10-19) to its 36 (``entry``)."""
         if getattr(self, "_g", None) is None:
             ne, k = len(self.L0), len(self.points)
             xi = np.repeat([x for x, _ in self.points], ne)
@@ -355,10 +356,10 @@ class Beam:
                     else:
                         entry[6 * i + j] = {(2, 2): 7, (2, 5): 8, (5, 2): 8, (5, 5): 9}[(i, j)]
             self._g = dict(edofs=np.concatenate([self.edofs.T] * k, axis=1), dX=np.concatenate([self._dX.T] * k, axis=1),
-                           invL=invL, theta0=tile(self.theta0), Na=Na, Nb=Nb, wL0=wL0,
+                           invL=invL, invL2=np.array([invL, invL]), Dm=self.D[:, None] * np.ones((3, len(xi))), theta0=tile(self.theta0), Na=Na, Nb=Nb, wL0=wL0,
                            wiL=wL0 * invL, wiL2=wL0 * invL * invL, wNa=wL0 * Na, wNb=wL0 * Nb,
                            wiLNa=wL0 * invL * Na, wiLNb=wL0 * invL * Nb, wNaNa=wL0 * Na * Na,
-                           wNaNb=wL0 * Na * Nb, wNbNb=wL0 * Nb * Nb, entry=entry, sign=sign[:, None],
+                           wNaNb=wL0 * Na * Nb, wNbNb=wL0 * Nb * Nb, entry=np.where(sign < 0, entry + 10, entry),
                            D=self.D[:, None], S0=None if self.S0 is None else self.S0[:, None])
         return self._g
 
