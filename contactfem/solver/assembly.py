@@ -155,7 +155,10 @@ class TangentAssembler:
         if hit is not None and hit[0] is rows and hit[1] is cols:
             return hit[2]
         n = self.n
-        flat = np.arange(n) * (n + 1) if rows is None else (rows + offset) * n + (cols + offset)
+        if rows is None:
+            flat = np.arange(n) * (n + 1)
+        else:
+            flat = (rows + offset) * n + (cols + offset) if offset else rows * n + cols
         if key is not None:
             self._cache[key] = (rows, cols, flat)
         return flat

@@ -131,6 +131,7 @@ class System:
             [self.global_dofs(d.body, d.local_dofs) for d in self.fixed] + [np.zeros(0, int)]))
         self.free_dofs = np.setdiff1d(np.arange(self.ndof), self.fixed_dofs)
         self._mass = None
+        self._cM = (None, None)                 # (c, c M) of the last lumped effective tangent
         self._tangent = TangentAssembler(self.ndof, linear_algebra, self.free_dofs)
         self.evaluations = 0
         self.instrument = instrument
@@ -266,8 +267,10 @@ class System:
             diagonal = None
             if mass_coefficient:
                 M = self.mass()
-                if isinstance(M, np.ndarray):
-                    diagonal = mass_coefficient * M
+                if isinstance(M, np.ndarray):                 # c M, made once for each c (a step's)
+                    if self._cM[0] != mass_coefficient:
+                        self._cM = (mass_coefficient, mass_coefficient * M)
+                    diagonal = self._cM[1]
                 else:                                  # consistent: one more constant block, c M
                     r, c, v = self._mass_coo
                     blocks.append((r, c, mass_coefficient * v, 0, "mass"))
