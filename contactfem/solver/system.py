@@ -174,7 +174,8 @@ class System:
     def apply_dirichlet(self, u, t):
         """A copy of u with the prescribed values at time t written in."""
         u = np.array(u, dtype=float)
-        u[self.fixed_dofs] = self.prescribed(t)
+        if self.fixed:
+            u[self.fixed_dofs] = self.prescribed(t)
         return u
 
     # -- assembly ---------------------------------------------------------------
@@ -263,7 +264,8 @@ class System:
                 P += Pl
                 r, c, v = _triplets(r, c, v)
                 blocks.append((r, c, -v, 0, None))
-            G -= P
+            if self.loads:
+                G -= P
             diagonal = None
             if mass_coefficient:
                 M = self.mass()
