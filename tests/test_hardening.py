@@ -198,6 +198,12 @@ def test_outputs_are_renamed_into_place_together(tmp_path):
 
 # ---- Ctrl-C -----------------------------------------------------------------------------
 
+def _sigint_as_in_a_terminal():
+    """Run in the child before it starts: Ctrl-C back to its default. A test suite started in
+    the background of a shell without job control ignores SIGINT, and a child keeps that."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 RING = ["run", "rolling_ring", "--preset", "paper", "--json", "a.json", "--save", "a.npz", "--gif", "a.gif"]
 OUTS = ("a.json", "a.npz", "a.gif")
 
@@ -211,6 +217,7 @@ def _interrupt(folder, delay=None, when_part=False, timeout=300):
     ready = folder.parent / f"{folder.name}.ready"
     env = dict(os.environ, CONTACTFEM_READY_FILE=str(ready))
     p = subprocess.Popen([sys.executable, "-m", "contactfem", *RING], cwd=folder, text=True, env=env,
+                         preexec_fn=_sigint_as_in_a_terminal,
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     t0 = time.monotonic()
     while p.poll() is None and not ready.exists() and time.monotonic() - t0 < timeout:
@@ -252,7 +259,7 @@ def test_ctrl_c_turned_into_another_error_by_a_library_is_still_the_interrupt():
     """A Ctrl-C landing in numpy's import surfaces as an ImportError; the command line
     recorded the interrupt, so the user sees the interrupt's one line and exit code 130,
     not an internal error."""
-    p = subprocess.run([sys.executable, "-c", LIBRARY_TURNS_CTRL_C_INTO_IMPORT_ERROR],
+    p = subprocess.run([sys.executable, "-c", LIBRARY_TURNS_CTRL_C_INTO_IMPORT_ERROR], preexec_fn=_sigint_as_in_a_terminal,
                        capture_output=True, text=True, timeout=120)
     assert p.returncode == 130, p.stderr
     assert p.stderr.strip() == "contactfem: interrupted before the run started; nothing written", p.stderr

@@ -150,7 +150,8 @@ def test_ctrl_c_during_a_parallel_sweep_is_one_line(tmp_path, delay):
     env = dict(os.environ, CONTACTFEM_READY_FILE=str(ready))
     p = subprocess.Popen([sys.executable, "-m", "contactfem", "sweep", "block", "--set", "c_N=1e5,2e5,3e5,4e5,5e5,6e5",
                           "--set", "nx=40", "--jobs", "2", "--out", "s.csv"], cwd=tmp_path, env=env, text=True,
-                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True)
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True,
+                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))   # as from a terminal
     t0 = time.monotonic()
     while p.poll() is None and not ready.exists() and time.monotonic() - t0 < 120:
         time.sleep(0.002)
