@@ -47,9 +47,9 @@ def ones(n):
 
 
 @lru_cache(maxsize=16)
-def zeros(n):
-    """n zeros, made once per n and read-only."""
-    a = np.zeros(n)
+def zeros(n, dtype=float):
+    """n zeros, made once per n and dtype and read-only."""
+    a = np.zeros(n, dtype=dtype)
     a.flags.writeable = False
     return a
 
@@ -188,6 +188,9 @@ class NodeToSegment:
         if self._law is None:
             slip = np.where(k["t_N"] < 0.0, STICK, OPEN)
             return dict(t_T=zero, c_T_s=zero, c_N_s=zero, slip=slip, lam=zero, q=h.q_bar, z=h.z_bar)
+        in_flight = not (k["t_N"] < 0.0).any()             # every node open: the return map's answer,
+        if in_flight and phase is None and (dt is not None or not self._law.needs_dt):   # without calling it
+            return dict(t_T=zero, c_T_s=zero, c_N_s=zero, slip=zeros(nc, int), lam=zero, q=h.q_bar, z=h.z_bar)
         if phase is not None and phase.kind == "normal":   # stick about the frozen state
             slip = np.where(k["t_N"] < 0.0, STICK, OPEN)
             return dict(t_T=phase.t_T + self.c_T * (k["s"] - phase.s), c_T_s=np.full(nc, self.c_T), c_N_s=zero,

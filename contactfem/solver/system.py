@@ -254,7 +254,8 @@ class System:
                 state = contact.evaluate(u, t, dt, u0, None if phases is None else phases[i])
                 Rc, r, c, v = state.scatter(self.ndof)
                 G += Rc
-                blocks.append((*_triplets(r, c, v), 0, None))
+                if len(v):                             # (a contact in flight adds no tangent entries)
+                    blocks.append((*_triplets(r, c, v), 0, None))
                 states.append(state)
 
         with timed(self.instrument, "assembly"):
