@@ -355,7 +355,8 @@ class Beam:
                         entry[6 * i + j], sign[6 * i + j] = 3 + d % 3 + (2 if th == 5 else 0), side[d]
                     else:
                         entry[6 * i + j] = {(2, 2): 7, (2, 5): 8, (5, 2): 8, (5, 5): 9}[(i, j)]
-            self._g = dict(edofs=np.concatenate([self.edofs.T] * k, axis=1), dX=np.concatenate([self._dX.T] * k, axis=1),
+            self._g = dict(edofs=np.concatenate([self.edofs.T] * k, axis=1),
+                           dX=np.concatenate([self._dX.T] * k, axis=1),
                            invL=invL, invL2=np.array([invL, invL]), Dm=self.D[:, None] * np.ones((3, len(xi))),
                            D2=2 * self.D[:, None], theta0=tile(self.theta0), Na=Na, Nb=Nb, wL0=wL0,
                            wiL=wL0 * invL, wiL2=wL0 * invL * invL, wNa=wL0 * Na, wNb=wL0 * Nb,
