@@ -130,6 +130,9 @@ def test_quick_bench_writes_json_and_markdown(tmp_path):
     loads = res["speed"]["startup"]["loads"]           # the start-up account's claims, from the run
     assert loads["run_rings"] == [] and "skfem" in loads["run_block_canonical"]
     assert "What the block's process loads" in md and "The run of rings loads none of" in md
+    lim = res["speed"]["limit"]                        # the account of one iteration against its floor
+    assert lim["n"] == 48 and lim["entries"] == 576 and 0 < lim["assembly_s"] < lim["limit_s"]
+    assert "### Where the microseconds of one iteration go: sloping impact, frictional (48 unknowns" in md
 
     tg = res["tangents"]
     for law, rows in tg["block"].items():

@@ -273,10 +273,10 @@ class Beam:
         """
         g = self._gauss()
         E, c, s = self._row_strains(u, g)
-        S, C, _ = return_map(E, self.ep.T, g["D"], g["S0"], self.eta, self._dt(dt))
+        S, C = self._resultants(E, g, dt)
         eps, gam = E[0], E[1]
-        N, Q, M = S
-        C_N, C_Q, C_M = C
+        N, Q, M = S[0], S[1], S[2]
+        C_N, C_Q, C_M = C[0], C[1], C[2]
         e1 = 1 + eps                                             # x'.t
         # residual w L0 B^T S, one row of re per element dof (u_a, theta_a, u_b, theta_b)
         f0, f1 = N * c - Q * s, N * s + Q * c                    # N t + Q n
@@ -291,7 +291,7 @@ class Beam:
         a1, a2 = C_N * gam - Q, N - C_Q * e1
         alpha = C_N * (gam * gam) + C_Q * (e1 * e1) - N * e1 - Q * gam
         kk = g["wiL2"] * C_M
-        U = np.empty((10, len(c)))
+        U = np.empty((20, len(c)))                               # the ten entries, then their negatives
         U[0] = g["wiL2"] * (C_N * cc + C_Q * ss)                 # x'x' (times 1/L0^2)
         U[1] = g["wiL2"] * ((C_N - C_Q) * cs)
         U[2] = g["wiL2"] * (C_N * ss + C_Q * cc)
@@ -301,9 +301,11 @@ class Beam:
         U[7] = g["wNaNa"] * alpha + kk                           # theta theta
         U[8] = g["wNaNb"] * alpha - kk
         U[9] = g["wNbNb"] * alpha + kk
-        Ke = U[g["entry"]] * g["sign"]                           # (36, m): entry 6 i + j of each row
-        if len(self.points) > 1:                                 # sum the points of each element
-            re, Ke = re.reshape(6, -1, self.ne).sum(axis=1), Ke.reshape(36, -1, self.ne).sum(axis=1)
+        if len(self.points) > 1:                                 # two points: sum them per element (rows
+            ne = self.ne                                         # e and ne + e), before K_e is spread out
+            re, U = re[:, :ne] + re[:, ne:], U[:, :ne] + U[:, ne:]
+        np.negative(U[:10], out=U[10:])
+        Ke = U[g["entry"]]                                       # (36, ne): entry 6 i + j of each element
         R = np.bincount(self._edofs_T, re.ravel(), minlength=self.ndof)
         return R, self._rows, self._cols, Ke.ravel()
 
@@ -311,8 +313,7 @@ class Beam:
         """The strains E = (eps, gam, kap) (3, m) and cos, sin of the angle phi at every row of
         ``_gauss`` (all integration points of all elements)."""
         q = np.asarray(u, float)[g["edofs"]]                     # (6, m): u_a, theta_a, u_b, theta_b per row
-        x0 = (g["dX0"] + q[3] - q[0]) * g["invL"]                # x'
-        x1 = (g["dX1"] + q[4] - q[1]) * g["invL"]
+        x0, x1 = (g["dX"] + q[3:5] - q[0:2]) * g["invL2"]        # x', both components at once
         phi = g["theta0"] + g["Na"] * q[2] + g["Nb"] * q[5]
         c, s = np.cos(phi), np.sin(phi)
         E = np.empty((3, len(phi)))
@@ -321,11 +322,20 @@ class Beam:
         E[2] = (q[5] - q[2]) * g["invL"]                         # kap = theta'
         return E, c, s
 
+    def _resultants(self, E, g, dt):
+        """The resultants S = (N, Q, M) (3, m) at the strains E of every row and their moduli
+        C = dS/dE: the elastic beam's S = D E and C = D (what ``return_map`` gives without
+        plastic strains; D at every row, so that no product broadcasts), else the viscoplastic
+        return map from the committed ``ep``."""
+        if self.S0 is None:
+            return g["Dm"] * E, g["Dm"]
+        return return_map(E, self.ep.T, g["D"], g["S0"], self.eta, self._dt(dt))[:2]
+
     def _gauss(self):
         """Per-row constants of internal_coo (row k ne + e: point k of element e), made once:
         the element dofs (6, m), chords, lengths and angles, the shape functions N_a, N_b at
         the point and their products with the weight w L0 and 1/L0, and the map from the ten
-        distinct entries of K_e to its 36 (``entry``, ``sign``)."""
+        distinct entries of K_e and their negatives (rows 10-19) to its 36 (``entry``)."""
         if getattr(self, "_g", None) is None:
             ne, k = len(self.L0), len(self.points)
             xi = np.repeat([x for x, _ in self.points], ne)
@@ -345,11 +355,13 @@ class Beam:
                         entry[6 * i + j], sign[6 * i + j] = 3 + d % 3 + (2 if th == 5 else 0), side[d]
                     else:
                         entry[6 * i + j] = {(2, 2): 7, (2, 5): 8, (5, 2): 8, (5, 5): 9}[(i, j)]
-            self._g = dict(edofs=np.concatenate([self.edofs.T] * k, axis=1), dX0=tile(self._dX[:, 0]),
-                           dX1=tile(self._dX[:, 1]), invL=invL, theta0=tile(self.theta0), Na=Na, Nb=Nb, wL0=wL0,
+            self._g = dict(edofs=np.concatenate([self.edofs.T] * k, axis=1),
+                           dX=np.concatenate([self._dX.T] * k, axis=1),
+                           invL=invL, invL2=np.array([invL, invL]), Dm=self.D[:, None] * np.ones((3, len(xi))),
+                           D2=2 * self.D[:, None], theta0=tile(self.theta0), Na=Na, Nb=Nb, wL0=wL0,
                            wiL=wL0 * invL, wiL2=wL0 * invL * invL, wNa=wL0 * Na, wNb=wL0 * Nb,
                            wiLNa=wL0 * invL * Na, wiLNb=wL0 * invL * Nb, wNaNa=wL0 * Na * Na,
-                           wNaNb=wL0 * Na * Nb, wNbNb=wL0 * Nb * Nb, entry=entry, sign=sign[:, None],
+                           wNaNb=wL0 * Na * Nb, wNbNb=wL0 * Nb * Nb, entry=np.where(sign < 0, entry + 10, entry),
                            D=self.D[:, None], S0=None if self.S0 is None else self.S0[:, None])
         return self._g
 
@@ -358,8 +370,8 @@ class Beam:
         (viscoplastic: the resultants of a step of dt from the committed plastic strains).
         All integration points in one pass, the rows of internal_coo."""
         g = self._gauss()
-        S = return_map(self._row_strains(u, g)[0], self.ep.T, g["D"], g["S0"], self.eta, self._dt(dt))[0]
-        return float(np.sum(g["wL0"] * (S ** 2 / (2 * g["D"]))))
+        S = self._resultants(self._row_strains(u, g)[0], g, dt)[0]
+        return float(np.sum(g["wL0"] * (S ** 2 / g["D2"])))
 
     def commit(self, u, dt=None):
         """Accept u as converged at the end of a step of dt: store the plastic strains

@@ -25,6 +25,8 @@ compares) and ``integration`` (``standard``: the forces at the end of the step;
 ``energy_consistent``: the discrete-gradient force of the step, contact/conserving.py).
 """
 
+from functools import lru_cache
+
 import numpy as np
 
 from ..laws.protocol import as_friction_law
@@ -34,6 +36,22 @@ from .state import ContactHistory, ContactState
 from .tangents import TANGENTS
 
 INTEGRATIONS = ("standard", "energy_consistent")
+
+
+@lru_cache(maxsize=16)
+def ones(n):
+    """n ones, made once per n and read-only (the closing-step factor r of nodes that did not close)."""
+    a = np.ones(n)
+    a.flags.writeable = False
+    return a
+
+
+@lru_cache(maxsize=16)
+def zeros(n, dtype=float):
+    """n zeros, made once per n and dtype and read-only."""
+    a = np.zeros(n, dtype=dtype)
+    a.flags.writeable = False
+    return a
 
 
 def tributary_lengths(X):
@@ -144,10 +162,11 @@ class NodeToSegment:
         dofs = np.concatenate([self.slave_dofs(), k["master_dofs"]], axis=1) if k["master_dofs"].size else self._dofs
         travel = k["s"] - h.s_bar
         nc = len(g_N)
-        r, dr, dg_T, ddg_T = np.ones(nc), np.zeros(nc), travel, k["ds"]    # r = 1: Delta g_T = travel
+        r, dr, dg_T, ddg_T = ones(nc), zeros(nc), travel, k["ds"]   # r = 1: Delta g_T = travel (read-only)
         closing = (active & (h.g_bar > 0.0)).nonzero()[0] if self.closing_step else ()
         if len(closing):                                    # the closing step (module docstring), at those nodes
             c, gb, g = closing, h.g_bar[closing], g_N[closing]
+            r, dr = np.ones(nc), np.zeros(nc)
             r[c] = -g / (gb - g)
             dr[c] = -gb / (gb - g) ** 2
             dg_T = r * travel
@@ -165,10 +184,13 @@ class NodeToSegment:
         """t_T, c_T^s, c_N^s and the return map's record at the kinematics k: frictionless,
         the return map of eqs 40-48, or a phase of the staggered algorithm (tangents.Phase)."""
         nc = len(k["g_N"])
-        zero = np.zeros(nc)
+        zero = zeros(nc)                                   # read-only
         if self._law is None:
             slip = np.where(k["t_N"] < 0.0, STICK, OPEN)
             return dict(t_T=zero, c_T_s=zero, c_N_s=zero, slip=slip, lam=zero, q=h.q_bar, z=h.z_bar)
+        in_flight = not (k["t_N"] < 0.0).any()             # every node open: the return map's answer,
+        if in_flight and phase is None and (dt is not None or not self._law.needs_dt):   # without calling it
+            return dict(t_T=zero, c_T_s=zero, c_N_s=zero, slip=zeros(nc, int), lam=zero, q=h.q_bar, z=h.z_bar)
         if phase is not None and phase.kind == "normal":   # stick about the frozen state
             slip = np.where(k["t_N"] < 0.0, STICK, OPEN)
             return dict(t_T=phase.t_T + self.c_T * (k["s"] - phase.s), c_T_s=np.full(nc, self.c_T), c_N_s=zero,

@@ -6,6 +6,8 @@ ordered (s_x, s_y, 1_x, 1_y, 2_x, 2_y). All functions return arrays with a leadi
 axis over pairs; 6-vectors are (nc, 6), 6x6 matrices are (nc, 6, 6).
 """
 
+from functools import lru_cache
+
 import numpy as np
 
 
@@ -76,21 +78,34 @@ def line_variations(x_s, point, normal):
     `point` and `normal`: one line (2,) or one per slave (nc, 2) (a rigid polyline's segments).
 
     The first variations are n and t themselves (dg_N is the array n, ds the array t), and
-    d2g_N, d2s one array of zeros: read, never written."""
+    d2g_N, d2s one array of zeros: read, never written. For one line they are the same at
+    every call (``line_frame``: made once per line and number of slaves, read-only)."""
     normal = np.asarray(normal, dtype=float)
     d = x_s - point
     if normal.ndim == 1:                                            # one line: the same n and t for all
-        nt = np.array([[normal[0], normal[1]], [normal[1], -normal[0]]])   # columns n and t (e3 x t = n)
+        nt, n, t, z2 = line_frame(float(normal[0]), float(normal[1]), len(d))
         g_N, s = (d @ nt).T                                         # (x_s - point).n, (x_s - point).t
-        n, t = np.empty((2,) + d.shape)
-        n[:], t[:] = nt[:, 0], nt[:, 1]                             # one row per slave
     else:
         n, t = np.empty_like(d), np.empty_like(d)
         n[:] = normal
         t[:, 0], t[:, 1] = n[:, 1], -n[:, 0]                        # e3 x t = n
         g_N, s = np.einsum("ij,ij->i", d, n), np.einsum("ij,ij->i", d, t)
-    z2 = np.zeros((len(d), 2, 2))
+        z2 = np.zeros((len(d), 2, 2))
     return dict(t=t, n=n, g_N=g_N, s=s, dg_N=n, d2g_N=z2, ds=t, d2s=z2)
+
+
+@lru_cache(maxsize=64)
+def line_frame(n_x, n_y, nc):
+    """The constants of line_variations for the line of unit normal (n_x, n_y) and nc slaves:
+    the matrix nt whose columns are n and t (e3 x t = n), n and t with one row per slave, and
+    the zero second variations (nc, 2, 2). Read-only: states hold them as values."""
+    nt = np.array([[n_x, n_y], [n_y, -n_x]])
+    n, t = np.empty((2, nc, 2))
+    n[:], t[:] = nt[:, 0], nt[:, 1]
+    frame = (nt, n, t, np.zeros((nc, 2, 2)))
+    for a in frame:
+        a.flags.writeable = False
+    return frame
 
 
 def arc_variations(x_s, center, R, inside, theta_ref):

@@ -88,7 +88,9 @@ class RigidLine:
         self.normal = nrm / np.linalg.norm(nrm)
 
     def locate(self, x_s, s_bar, u, t=None, ref=None):
-        return dict(line_variations(x_s, self.point, self.normal), **rigid_fields(len(x_s)))
+        k = line_variations(x_s, self.point, self.normal)
+        k.update(rigid_fields(len(x_s)))
+        return k
 
     def reference(self, u):
         return None

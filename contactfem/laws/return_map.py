@@ -98,10 +98,11 @@ def return_map(law, t_N, dt_N, dg_T, t_T_bar, q_bar, z_bar=None, dt=None, tol=1e
     t_T[c] = t_tr                                                 # stick: the trial state (the slipping
     c_T_s[c] = c_T                                                # nodes are written over below)
     state[c] = STICK
-    z[c] = z0
+    if L.n_state:
+        z[c] = z0
 
-    if slips.any():
-        i = slips.nonzero()[0]
+    i = slips.nonzero()[0]                                        # the slipping nodes, by position in c
+    if i.size:
         c_i, t_tr_i = c[i], t_tr[i]                               # slipping: position in c, node
         a_tr, s, pi, qi, zi = np.abs(t_tr_i), np.sign(t_tr_i), p[i], q_c[i], z_c[i]
         lo, hi = np.zeros(len(i)), a_tr / c_T                     # phi(lo) > 0 >= phi(hi) (Y >= 0)
@@ -122,10 +123,10 @@ def return_map(law, t_N, dt_N, dg_T, t_T_bar, q_bar, z_bar=None, dt=None, tol=1e
 
         for _ in range(maxit):                                     # eq (44): local Newton
             phi, (Y_lam, Y_P), zz = local(lam_i)
+            if (np.abs(phi) <= converged).all():                   # (False where phi is NaN)
+                break
             if not np.isfinite(phi).all():
                 raise ReturnMapError(f"return map: the slip bound of {L.name} is not finite at p = {pi[~np.isfinite(phi)][:3]}")
-            if (np.abs(phi) <= converged).all():
-                break
             lo = np.where(phi > 0.0, lam_i, lo)
             hi = np.where(phi < 0.0, lam_i, hi)
             dphi = -(c_T + Y_lam)
@@ -145,7 +146,8 @@ def return_map(law, t_N, dt_N, dg_T, t_T_bar, q_bar, z_bar=None, dt=None, tol=1e
         c_N_s[c_i] = s * Y_P * (-dt_N[c_i]) * c_T / D             # eq (48)
         lam[c_i] = lam_i
         q[c_i] = qi + lam_i
-        z[c_i] = zz
+        if L.n_state:
+            z[c_i] = zz
     # A law's values are checked where it returns (its adapter); a shipped law returns finite
     # values at finite arguments, and a non-finite argument (a diverging iterate) makes the
     # residual non-finite, which Newton reports: the sums are taken for the other laws only.

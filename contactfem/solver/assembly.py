@@ -155,7 +155,10 @@ class TangentAssembler:
         if hit is not None and hit[0] is rows and hit[1] is cols:
             return hit[2]
         n = self.n
-        flat = np.arange(n) * (n + 1) if rows is None else (rows + offset) * n + (cols + offset)
+        if rows is None:
+            flat = np.arange(n) * (n + 1)
+        else:
+            flat = (rows + offset) * n + (cols + offset) if offset else rows * n + cols
         if key is not None:
             self._cache[key] = (rows, cols, flat)
         return flat
@@ -177,7 +180,7 @@ class TangentAssembler:
             if diagonal is not None:              # the diagonal last: summed after the blocks, as K + diag
                 index.append(self._flat(None, None, 0, "diagonal"))
                 vals.append(diagonal)
-            K = np.bincount(np.concatenate(index + [np.zeros(0, int)]), np.concatenate(vals + [np.zeros(0)]),
+            K = np.bincount(np.concatenate(index or [np.zeros(0, int)]), np.concatenate(vals or [np.zeros(0)]),
                             minlength=n * n).reshape(n, n)
             return K
         if self.keys is None:                     # the first assembly: the whole pattern at once
@@ -197,7 +200,7 @@ class TangentAssembler:
         if diagonal is not None:                  # the diagonal last: summed after the blocks, as K + diag
             pos.append(self.diag_pos)
             vals.append(diagonal)
-        data = np.bincount(np.concatenate(pos + [np.zeros(0, int)]), np.concatenate(vals + [np.zeros(0)]),
+        data = np.bincount(np.concatenate(pos or [np.zeros(0, int)]), np.concatenate(vals or [np.zeros(0)]),
                            minlength=self.keys.size)
         K = shallow_copy(self._template)          # shares the pattern's index arrays (docstring)
         K.data = data

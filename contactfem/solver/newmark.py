@@ -32,6 +32,7 @@ import numpy as np
 
 from .march import acceleration
 from .newton import NewtonError, NewtonResult, newton
+from .system import Evaluation
 
 
 def _check_dt(dt):
@@ -78,9 +79,9 @@ class Newmark:
         u_pred = u + dt * v + dt ** 2 * (0.5 - beta) * a
 
         def effective(u1):                    # eq 29 with a+ = c (u1 - u_pred); tangent K + c M
-            ev = s.evaluate(u1, t1, dt, u, mass_coefficient=c)
+            G, K, contacts, P = s.evaluate(u1, t1, dt, u, mass_coefficient=c)
             du = u1 - u_pred
-            return ev._replace(G=ev.G + (cM * du if lumped else cM @ du))
+            return Evaluation(G + (cM * du if lumped else cM @ du), K, contacts, P)
 
         # initial guess: the acceleration stays a (u + dt v + dt^2 a / 2); multipliers as they were
         guess = s.apply_dirichlet(u_pred + beta * dt ** 2 * a, t1)

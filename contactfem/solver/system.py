@@ -131,6 +131,7 @@ class System:
             [self.global_dofs(d.body, d.local_dofs) for d in self.fixed] + [np.zeros(0, int)]))
         self.free_dofs = np.setdiff1d(np.arange(self.ndof), self.fixed_dofs)
         self._mass = None
+        self._cM = (None, None)                 # (c, c M) of the last lumped effective tangent
         self._tangent = TangentAssembler(self.ndof, linear_algebra, self.free_dofs)
         self.evaluations = 0
         self.instrument = instrument
@@ -173,7 +174,8 @@ class System:
     def apply_dirichlet(self, u, t):
         """A copy of u with the prescribed values at time t written in."""
         u = np.array(u, dtype=float)
-        u[self.fixed_dofs] = self.prescribed(t)
+        if self.fixed:
+            u[self.fixed_dofs] = self.prescribed(t)
         return u
 
     # -- assembly ---------------------------------------------------------------
@@ -252,7 +254,8 @@ class System:
                 state = contact.evaluate(u, t, dt, u0, None if phases is None else phases[i])
                 Rc, r, c, v = state.scatter(self.ndof)
                 G += Rc
-                blocks.append((*_triplets(r, c, v), 0, None))
+                if len(v):                             # (a contact in flight adds no tangent entries)
+                    blocks.append((*_triplets(r, c, v), 0, None))
                 states.append(state)
 
         with timed(self.instrument, "assembly"):
@@ -262,12 +265,15 @@ class System:
                 P += Pl
                 r, c, v = _triplets(r, c, v)
                 blocks.append((r, c, -v, 0, None))
-            G -= P
+            if self.loads:
+                G -= P
             diagonal = None
             if mass_coefficient:
                 M = self.mass()
-                if isinstance(M, np.ndarray):
-                    diagonal = mass_coefficient * M
+                if isinstance(M, np.ndarray):                 # c M, made once for each c (a step's)
+                    if self._cM[0] != mass_coefficient:
+                        self._cM = (mass_coefficient, mass_coefficient * M)
+                    diagonal = self._cM[1]
                 else:                                  # consistent: one more constant block, c M
                     r, c, v = self._mass_coo
                     blocks.append((r, c, mass_coefficient * v, 0, "mass"))

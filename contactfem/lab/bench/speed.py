@@ -33,7 +33,9 @@ import time
 
 PARTS = ("bulk", "contact", "assembly", "solve", "overhead")
 # what the speed work aims at (whole-process and per-iteration times on 2 cores)
-SPEED_TARGETS = dict(list_s=0.25, sloping_impact_iteration_s=0.5e-3, rolling_ring_iteration_s=0.8e-3,
+# (the iterations: wall_time_s / newton_iterations_total of a paper run, about ten times the floor
+# that iteration_limit measures for the sloping impact)
+SPEED_TARGETS = dict(list_s=0.25, sloping_impact_iteration_s=0.25e-3, rolling_ring_iteration_s=0.25e-3,
                      table2_s=60.0, run_block_over_scipy_skfem=1.3, run_block_canonical_over_numpy=1.6)
 # the block's start-up, layer by layer: (key, what the process runs, label)
 STARTUP_LAYERS = (("numpy", ["-c", "import numpy"], "`python -c \"import numpy\"`"),
@@ -118,27 +120,70 @@ def _loads(code):
 
 def iteration_split(scene, preset="paper", overrides=None):
     """Run a scene with an instrument (solver/instrument.py) handed to every System it builds;
-    per-iteration cost of each part (seconds, CPU of the running thread) and the run's totals.
+    per-iteration cost of each part (seconds, CPU of the running thread) and the run's totals
+    (run_wall_s, run_cpu_s of the process, run_thread_s of this thread: modules loaded on first
+    use included; wall_time_s: the run's own wall time, without them).
     bulk, contact: the System's parts; assembly: loads and summing into K; solve: the linear
     solves; overhead: the rest of newton() and the stepper's effective residual."""
     from ...scenes import run_scene
     from ...solver.instrument import Timings
 
     timings = Timings()
-    t0, c0 = time.perf_counter(), time.process_time()
+    t0, c0, h0 = time.perf_counter(), time.process_time(), time.thread_time()
     res = run_scene(scene, preset, dict(overrides or {}), instrument=timings)
-    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    wall, cpu, thread = time.perf_counter() - t0, time.process_time() - c0, time.thread_time() - h0
     sec = timings.seconds
     n = max(timings.solves, 1)
     parts = {k: sec[k] for k in ("bulk", "contact", "assembly", "solve")}
     parts["overhead"] = sec["newton"] - sum(parts.values())
     out = {f"{k}_s": v / n for k, v in parts.items()}
     out.update(iteration_s=sec["newton"] / n, solves=timings.solves, newton_cpu_s=sec["newton"],
-               run_wall_s=wall, run_cpu_s=cpu, linear_algebra=res.get("linear_algebra"),
+               run_wall_s=wall, run_cpu_s=cpu, run_thread_s=thread, linear_algebra=res.get("linear_algebra"),
                ordering=res.get("ordering"), ndof=res.get("unknowns"),
                residual_evaluations=res.get("residual_evaluations"), wall_time_s=res.get("wall_time_s"),
                newton_iterations_total=res.get("newton_iterations_total"))
     return out
+
+
+def iteration_limit(repeat=7, number=200):
+    """The floor of one Newton iteration of the sloping impact (frictional, paper preset: 48
+    unknowns, a ring of 16 beams) in this Python: its ring's 576 tangent entries and the
+    diagonal c M summed into a dense K by one bincount, and K du = -G solved by LAPACK
+    (numpy.linalg.solve), the two calls a dense iteration cannot do without; nothing else.
+    CPU seconds of the thread per call (best of `repeat` loops of `number` calls), of the
+    assembly, the solve and both; and of one small numpy call (numpy_call_s: the product of
+    two arrays of 32 entries, the size of the ring's arrays), the unit of the rest."""
+    import numpy as np
+
+    from ...scenes import get_scene
+
+    scene = get_scene("sloping_impact")
+    params = scene.resolve("paper", {"variant": "frictional"})
+    body = scene.build(params)["system"].bodies[0]
+    n = body.ndof
+    rng = np.random.default_rng(0)
+    u = 1e-3 * rng.standard_normal(n)                   # a deformed ring: a regular K, a non-zero G
+    G, rows, cols, vals = body.internal_coo(u, params["dt"])
+    index = np.concatenate([rows * n + cols, np.arange(n) * (n + 1)])
+    values = np.concatenate([vals, body.mass() / (params["beta_newmark"] * params["dt"] ** 2)])
+
+    def assemble():
+        return np.bincount(index, values, minlength=n * n).reshape(n, n)
+
+    K = assemble()
+
+    def best(call):
+        times = []
+        for _ in range(repeat):
+            t0 = time.thread_time()
+            for _ in range(number):
+                call()
+            times.append((time.thread_time() - t0) / number)
+        return min(times)
+
+    a, b = rng.standard_normal(32), rng.standard_normal(32)
+    return dict(n=n, entries=int(vals.size), assembly_s=best(assemble), solve_s=best(lambda: np.linalg.solve(K, -G)),
+                limit_s=best(lambda: np.linalg.solve(assemble(), -G)), numpy_call_s=best(lambda: a * b))
 
 
 # the paper's scenes at the paper preset (quick: the fast preset)
@@ -223,5 +268,5 @@ def speed_study(quick=False):
         row.update(iteration_split_fresh(scene, preset, over, repeat=1 if quick else 3))
         rows.append(row)
     load = list(os.getloadavg()) if hasattr(os, "getloadavg") else None
-    return dict(preset=preset, iterations=rows, startup=startup_study(repeat=1 if quick else 5),
+    return dict(preset=preset, iterations=rows, limit=iteration_limit(), startup=startup_study(repeat=1 if quick else 5),
                 table2=None if quick else table2_study(), load_average=load)
