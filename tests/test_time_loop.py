@@ -4,6 +4,7 @@ are what the scenes need; a scene records and stops by iterating, so no scene ke
 loop of its own."""
 import ast
 import io
+import math
 from pathlib import Path
 
 import numpy as np
@@ -135,6 +136,23 @@ def test_fixed_steps_snap_to_the_grid_and_cover_a_halved_step():
     assert np.allclose([r.t for r in recs], [0.0, 0.1, 0.15, 0.2, 0.3], rtol=0, atol=1e-15)
     assert recs[3].t == 2 * 0.1 and recs[4].t == 3 * 0.1           # the grid t0 + k dt, exactly
     assert [r.cuts for r in recs] == [0, 0, 1, 0, 0]
+
+
+@pytest.mark.parametrize("dt, t_end", [(0.01, 200.0), (0.001, 50.0), (1e-5, 1.0), (0.1, 1000.0), (0.3, 10.0)])
+def test_fixed_steps_to_t_end_take_exactly_the_steps_that_fit(dt, t_end):
+    """Steps(dt, t_end=...) over tens of thousands of steps: ceil(t_end / dt) steps, each dt but
+    a shorter last one, ending at t_end; no sliver steps of round-off size (a grid time's
+    (t - t0) / dt is its index only to ~k 1e-16), which a Newmark step cannot take."""
+    from types import SimpleNamespace
+
+    s = Steps(dt, t_end=t_end)
+    rec, sizes = SimpleNamespace(k=0, t=0.0, dt=0.0), []
+    while (h := s.next_dt(rec)) is not None and len(sizes) <= s.n_steps:
+        t1 = s.end_time(rec.t, h)
+        sizes.append(t1 - rec.t)
+        rec = SimpleNamespace(k=rec.k + 1, t=t1, dt=t1 - rec.t)
+    assert len(sizes) == math.ceil(t_end / dt - 1e-9) and rec.t == t_end
+    assert min(sizes[:-1]) >= dt * (1 - 1e-9) and sizes[-1] > 0.5 * dt * 1e-9
 
 
 def test_run_cork_progress_shows_a_bar(capsys):

@@ -53,23 +53,28 @@ class Steps(_Cuts):
             self.n_steps = int(n_steps)
             self.t_end = self.t0 + self.n_steps * self.dt
 
+    # times closer than a billionth of a step are the same time: (t - t0) / dt of a grid time
+    # t0 + k dt is k only to round-off, ~k 1e-16, which an absolute 1e-12 would not cover from
+    # k ~ 1e4 on (slivers of 1e-14 and steps that never end); halved steps are >= dt / 2^20
+    SAME = 1e-9
+
     def _target(self, t):
         """The grid time the step from t heads for: the first t0 + k dt beyond t."""
-        k = min(math.floor((t - self.t0) / self.dt + 1e-12) + 1, self.n_steps)
+        k = min(math.floor((t - self.t0) / self.dt + self.SAME) + 1, self.n_steps)
         return min(self.t0 + k * self.dt, self.t_end)
 
     def next_dt(self, rec):
-        if rec.t >= self.t_end - 1e-12 * self.dt:
+        if rec.t >= self.t_end - self.SAME * self.dt:
             return None
         target = self._target(rec.t)
-        on_grid = rec.k == 0 or abs(rec.t - (target - self.dt)) <= 1e-12 * self.dt or rec.t == self.t0
+        on_grid = rec.k == 0 or abs(rec.t - (target - self.dt)) <= self.SAME * self.dt or rec.t == self.t0
         if not on_grid:                                 # within a halved step: go on with its size
             return min(rec.dt, target - rec.t)
         return target - rec.t
 
     def end_time(self, t, dt):
         target = self._target(t)
-        return target if target - (t + dt) < 1e-12 * self.dt else t + dt
+        return target if target - (t + dt) < self.SAME * self.dt else t + dt
 
 
 class Adaptive(_Cuts):
