@@ -21,20 +21,27 @@ NOT_TIMED = nullcontext()          # what an uninstrumented part enters (reusabl
 
 class Timings:
     """CPU seconds of each part (PARTS), summed over every evaluation and Newton solve, and
-    the number of linear solves."""
+    the number of linear solves. ``seconds``: the parts timed inside Newton (its iterations);
+    ``outside``: those timed outside it (the initial state's evaluation, which also pays for
+    what a first evaluation loads and builds: scipy's modules, the tangent's pattern)."""
 
     def __init__(self, clock=time.thread_time):
         self.clock = clock
         self.seconds = dict.fromkeys(PARTS, 0.0)
+        self.outside = dict.fromkeys(PARTS, 0.0)
         self.solves = 0
+        self._newton = 0                # depth of Newton solves in progress
 
     @contextmanager
     def part(self, name):
+        inside = self._newton > 0 or name == "newton"
+        self._newton += name == "newton"
         t0 = self.clock()
         try:
             yield
         finally:
-            self.seconds[name] += self.clock() - t0
+            (self.seconds if inside else self.outside)[name] += self.clock() - t0
+            self._newton -= name == "newton"
 
 
 def timed(instrument, name):

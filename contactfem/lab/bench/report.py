@@ -189,7 +189,9 @@ def speed_section(sp):
               f"imports scipy.sparse.linalg and scikit-fem (target {T['run_block_over_scipy_skfem']}: "
               f"{_f(s['run_block_over_scipy_skfem'] <= T['run_block_over_scipy_skfem'])}).", ""]
     L += startup_account(s)
-    L += ["One Newton iteration, CPU milliseconds of the thread that runs it: the run's totals divided by its linear solves, each scene "
+    L += ["One Newton iteration, CPU milliseconds of the thread that runs it: the run's totals inside Newton divided by its "
+          "linear solves (the initial state's evaluation, before the first step, is not in them: it also pays for what a first "
+          "evaluation loads and builds, scipy's modules and the tangent's pattern), each scene "
           "run in a fresh interpreter, " + ("one run" if sp.get("preset") == "fast" else "best of 3 runs") + " "
           "(contactfem/lab/bench/speed.py). bulk: the bodies' internal forces and tangents; contact: every "
           "contact's residual and tangent; assembly: summing them into K, loads included; solve: factorisation "

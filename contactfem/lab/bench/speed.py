@@ -138,6 +138,7 @@ def iteration_split(scene, preset="paper", overrides=None):
     parts["overhead"] = sec["newton"] - sum(parts.values())
     out = {f"{k}_s": v / n for k, v in parts.items()}
     out.update(iteration_s=sec["newton"] / n, solves=timings.solves, newton_cpu_s=sec["newton"],
+               outside_newton_s=sum(timings.outside.values()),
                run_wall_s=wall, run_cpu_s=cpu, run_thread_s=thread, linear_algebra=res.get("linear_algebra"),
                ordering=res.get("ordering"), ndof=res.get("unknowns"),
                residual_evaluations=res.get("residual_evaluations"), wall_time_s=res.get("wall_time_s"),
