@@ -420,7 +420,7 @@ def build_parser():
     rp.add_argument("--force", action="store_true",
                     help="run even if the estimated size exceeds the limits (2 GB, 1e6 unknowns, 1e6 steps)")
     rp.set_defaults(func=cmd_run)
-    fp = sub.add_parser("figures", help="regenerate every figure and table of the paper into figures/")
+    fp = sub.add_parser("figures", help="regenerate every figure and table of the paper (--preset paper: into figures/; the default fast preset: into figures/fast/)")
     fp.add_argument("--preset", default="fast", choices=["fast", "paper"])
     fp.add_argument("--outdir", default=None,
                     help="default: the repo's figures/ folder for --preset paper (the figures kept with the code), "
@@ -437,7 +437,7 @@ def build_parser():
                     help="values of a parameter, or of a law's field as law.NAME=V1,V2,... (repeatable; at least one)")
     sw.add_argument("--jobs", type=int, default=1, help="local worker processes (joblib)")
     sw.add_argument("--scheduler", default=None, help="Dask scheduler address: run on that cluster instead")
-    sw.add_argument("--out", default="sweep.csv", help="table of results (.csv or .json)")
+    sw.add_argument("--out", default="sweep.csv", help="table of results, .csv or .json (default: sweep.csv)")
     sw.add_argument("--friction", metavar="LAW", help="the friction law of every run, as for run; sweep its fields "
                     "with --set law.NAME=V1,V2,...")
     sw.add_argument("--normal", metavar="LAW", help="the normal law of every run, as for run")

@@ -30,7 +30,9 @@ def check_output_path(path, what, suffixes):
         raise ValueError(f"{what} {path}: is a folder, give a file name")
     folder = p.parent if str(p.parent) else Path(".")
     if not folder.is_dir():
-        raise ValueError(f"{what} {path}: the folder {folder} does not exist")
+        is_file = folder.exists()
+        raise ValueError(f"{what} {path}: {folder} is a file, not a folder" if is_file
+                         else f"{what} {path}: the folder {folder} does not exist")
     probe = folder / f".{p.name}.{secrets.token_hex(4)}.probe"
     try:
         with open(probe, "xb"):
@@ -57,6 +59,13 @@ def check_output_dir(path, what):
         raise ValueError(f"{what} {path}: {parent} is a file, not a folder")
     if not os.access(parent, os.W_OK | os.X_OK):
         raise ValueError(f"{what} {path}: cannot write in {parent} (permission denied)")
+    probe = parent / f".contactfem.{secrets.token_hex(4)}.probe"     # (a special file system may refuse)
+    try:
+        with open(probe, "xb"):
+            pass
+        probe.unlink()
+    except OSError as err:
+        raise ValueError(f"{what} {path}: cannot write in {parent} ({err.strerror or err})") from None
     return p
 
 

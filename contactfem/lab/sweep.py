@@ -24,9 +24,11 @@ def parse_grid(sets):
     """{"n_el": "8,16,32"} -> {"n_el": ["8", "16", "32"]}"""
     grid = {}
     for k, v in sets.items():
-        vals = [x.strip() for x in str(v).split(",") if x.strip()]
-        if not vals:
+        vals = [x.strip() for x in str(v).split(",")]
+        if not any(vals):
             raise ValueError(f"--set {k}= needs at least one value")
+        if not all(vals):
+            raise ValueError(f"--set {k}={v}: an empty value in the list (two commas, or one at an end)")
         grid[k] = vals
     return grid
 

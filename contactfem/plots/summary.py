@@ -209,6 +209,15 @@ def update_readme(readme="README.md", summary_md="figures/summary.md"):
 
 
 if __name__ == "__main__":
+    import argparse
+
     repo = Path(__file__).resolve().parents[2]
-    update_readme(sys.argv[1] if len(sys.argv) > 1 else repo / "README.md",
-                  sys.argv[2] if len(sys.argv) > 2 else repo / "figures" / "summary.md")
+    cli = argparse.ArgumentParser(prog="python -m contactfem.plots.summary",
+                                  description="Copy the table of figures/summary.md into the README, between its markers.")
+    cli.add_argument("readme", nargs="?", default=repo / "README.md")
+    cli.add_argument("summary_md", nargs="?", default=repo / "figures" / "summary.md")
+    args = cli.parse_args()
+    try:
+        update_readme(args.readme, args.summary_md)
+    except (OSError, ValueError) as err:
+        sys.exit(f"python -m contactfem.plots.summary: error: {err}")

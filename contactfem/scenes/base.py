@@ -125,6 +125,11 @@ class Scene:
         overrides = dict(overrides or {})
         for k, v in overrides.items():
             if k not in known:
+                head, dot, field = str(k).partition(".")
+                if dot and head in ("law", "friction", "normal"):   # the command line's --set law.X, from Python
+                    raise ValueError(f"unknown parameter {k!r} for scene {self.name}: from Python a law's fields are "
+                                     f"set on the law object itself, e.g. friction=Coulomb(c_T, mu) "
+                                     f"or dataclasses.replace(law, {field}=...)")
                 raise ValueError(f"unknown parameter {k!r} for scene {self.name}: known are {', '.join(known)}")
             values[k] = v
         values = {k: known[k].parse(v) for k, v in values.items()}

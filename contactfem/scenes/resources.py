@@ -46,10 +46,10 @@ def check_resources(scene, params, force=False):
 def _fmt(key, value):
     if key == "memory_bytes":
         return f"{value / 1e9:.2g} GB" if value >= 1e8 else f"{value / 1e6:.0f} MB"
-    return f"{value:,.0f} {key}"
+    return f"{value:,.0f} {key[:-1] if round(value) == 1 else key}"     # 1 step, 2 steps
 
 
 def describe(est):
-    """'4,000,000 elements, 8,004,002 unknowns, 1 steps, about 21 GB'"""
+    """'4,000,000 elements, 8,004,002 unknowns, 1 step, about 21 GB'"""
     parts = [_fmt(k, est[k]) for k in ("elements", "unknowns", "steps") if k in est]
     return ", ".join(parts) + f", about {_fmt('memory_bytes', est['memory_bytes'])}"
