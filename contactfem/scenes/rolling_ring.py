@@ -131,7 +131,9 @@ def measure(model, params, records):
         v_final, omega_final = float(vc[-1, 0]), float(omega[-1])
 
     floor = np.array([[xc[:, 0].min() - 1.2 * params["R"], 0.0], [xc[:, 0].max() + 1.2 * params["R"], 0.0]])
-    mu, g = model["exact_mu"], params["g"]
+    # Coulomb's mu of the closed forms: build's choice; a model composed by hand (a lecture's)
+    # with the scene's laws: the parameters' mu
+    mu, g = model.get("exact_mu", params.get("mu")), params["g"]
     k2 = ring_gyration_radius2(ring)
     if mu is not None:
         hoop = rigid_ring_exact(v0, mu, g, params["R"], t=t)   # the paper's thin hoop
