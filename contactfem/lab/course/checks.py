@@ -53,7 +53,8 @@ def _args_text(args, kwargs):
     def show(a):
         if isinstance(a, np.ndarray):
             return " ".join(np.array2string(a, precision=4, separator=", ", threshold=8).split())
-        return repr(a)
+        text = repr(a)
+        return type(a).__name__ if " object at 0x" in text else text     # a stepper: its class, not its address
     return ", ".join([show(a) for a in args] + [f"{k}={show(v)}" for k, v in kwargs.items()])
 
 
