@@ -543,14 +543,23 @@ def _on_sigint(signum, frame):
     raise KeyboardInterrupt
 
 
+def _on_sigterm(signum, frame):
+    raise SystemExit(128 + signum)
+
+
 def _catch_interrupts():
     """Record every Ctrl-C before raising it: a library interrupted inside its import may
     turn the KeyboardInterrupt into an error of its own (numpy: "ImportError: numpy._core
-    .multiarray failed to import"); what follows a recorded interrupt is that interrupt."""
+    .multiarray failed to import"); what follows a recorded interrupt is that interrupt.
+    SIGTERM (a `kill`, a job's time limit) ends the program with exit code 143 the way an
+    exception would: the outputs' temporaries are removed and a child process (Sphinx for
+    `site`) is stopped with it, rather than left running."""
     import signal
 
     if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
         signal.signal(signal.SIGINT, _on_sigint)
+    if signal.getsignal(signal.SIGTERM) is signal.SIG_DFL:
+        signal.signal(signal.SIGTERM, _on_sigterm)
 
 
 def _report_ready():

@@ -319,3 +319,24 @@ def test_ctrl_c_while_starting_up_is_one_line_too(tmp_path, delay):
     assert files == [] and "Traceback" not in err, err
     assert rc == 130 and len(err.strip().splitlines()) == 1, err
     assert err.strip().endswith("; nothing written"), err
+
+
+def test_sigterm_ends_a_run_with_143_and_leaves_no_outputs(tmp_path):
+    """SIGTERM (a kill, a job's time limit) while the ring runs: exit code 143, no traceback,
+    none of the outputs and no temporaries (the run unwinds as from an exception)."""
+    ready = tmp_path.parent / f"{tmp_path.name}.ready"
+    env = dict(os.environ, CONTACTFEM_READY_FILE=str(ready))
+    p = subprocess.Popen([sys.executable, "-m", "contactfem", *RING], cwd=tmp_path, text=True, env=env,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    t0 = time.monotonic()
+    while p.poll() is None and not ready.exists() and time.monotonic() - t0 < 300:
+        time.sleep(0.002)
+    time.sleep(0.3)
+    if p.poll() is None:
+        p.terminate()
+    out, err = p.communicate(timeout=300)
+    assert "Traceback" not in err, err
+    if p.returncode == 0:                                       # finished before the signal
+        return
+    assert p.returncode == 143, err
+    assert sorted(f.name for f in tmp_path.iterdir()) == []

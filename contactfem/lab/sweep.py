@@ -67,7 +67,10 @@ def _call(task):
 
 
 def _ignore_interrupts():
+    """A worker: Ctrl-C is the sweep's to handle; SIGTERM (the sweep stopping it) ends it at once,
+    whatever handler the command line gave the process it was forked from."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 def sweep(scene, grid, preset="fast", jobs=1, scheduler=None, friction=None, normal=None, check=True):
