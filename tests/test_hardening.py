@@ -323,7 +323,7 @@ def test_ctrl_c_while_starting_up_is_one_line_too(tmp_path, delay):
 
 def test_sigterm_ends_a_run_with_143_and_leaves_no_outputs(tmp_path):
     """SIGTERM (a kill, a job's time limit) while the ring runs: exit code 143, no traceback,
-    none of the outputs and no temporaries (the run unwinds as from an exception)."""
+    none or all of the outputs and no temporaries (the run unwinds as from an exception)."""
     ready = tmp_path.parent / f"{tmp_path.name}.ready"
     env = dict(os.environ, CONTACTFEM_READY_FILE=str(ready))
     p = subprocess.Popen([sys.executable, "-m", "contactfem", *RING], cwd=tmp_path, text=True, env=env,
@@ -339,4 +339,5 @@ def test_sigterm_ends_a_run_with_143_and_leaves_no_outputs(tmp_path):
     if p.returncode == 0:                                       # finished before the signal
         return
     assert p.returncode == 143, err
-    assert sorted(f.name for f in tmp_path.iterdir()) == []
+    # none or all (a signal after the outputs were renamed into place finds them written), no temporaries
+    assert sorted(f.name for f in tmp_path.iterdir()) in ([], sorted(OUTS))

@@ -33,13 +33,7 @@ def check_output_path(path, what, suffixes):
         is_file = folder.exists()
         raise ValueError(f"{what} {path}: {folder} is a file, not a folder" if is_file
                          else f"{what} {path}: the folder {folder} does not exist")
-    probe = folder / f".{p.name}.{secrets.token_hex(4)}.probe"
-    try:
-        with open(probe, "xb"):
-            pass
-        probe.unlink()
-    except OSError as err:
-        raise ValueError(f"{what} {path}: cannot write in {folder} ({err.strerror or err})") from None
+    _probe(folder, what, path)
     return p
 
 
@@ -59,14 +53,19 @@ def check_output_dir(path, what):
         raise ValueError(f"{what} {path}: {parent} is a file, not a folder")
     if not os.access(parent, os.W_OK | os.X_OK):
         raise ValueError(f"{what} {path}: cannot write in {parent} (permission denied)")
-    probe = parent / f".contactfem.{secrets.token_hex(4)}.probe"     # (a special file system may refuse)
+    _probe(parent, what, path)                  # (a special file system may refuse what access allows)
+    return p
+
+
+def _probe(folder, what, path):
+    """ValueError naming the option unless a file can be created (and removed) in `folder`."""
+    probe = Path(folder) / f".contactfem.{secrets.token_hex(4)}.probe"
     try:
         with open(probe, "xb"):
             pass
         probe.unlink()
     except OSError as err:
-        raise ValueError(f"{what} {path}: cannot write in {parent} ({err.strerror or err})") from None
-    return p
+        raise ValueError(f"{what} {path}: cannot write in {folder} ({err.strerror or err})") from None
 
 
 class Outputs:

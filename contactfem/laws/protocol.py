@@ -508,17 +508,21 @@ class NormalLawView:
                                  "dW/dg_N = t_N (e.g. c_N (-g_N)^(m+1) / (m+1) for eq 4)")
         return getattr(self.law, name)
 
+    def _call(self, method, g):
+        """The law's own `method`(g): an error it raises becomes one LawValueError naming it."""
+        try:
+            return getattr(self.law, method)(g)
+        except LawError:
+            raise
+        except Exception as err:               # noqa: BLE001
+            raise LawValueError(explain_call_error(f"{self.name}.{method}", err)) from None
+
     def traction(self, g_N):
         """(t_N, dt_N/dg_N), each of the shape of g_N."""
         if self.trusted:
             return self.law.traction(g_N)
         g = np.asarray(g_N, dtype=float)
-        try:
-            out = self.law.traction(g)
-        except LawError:
-            raise
-        except Exception as err:               # noqa: BLE001
-            raise LawValueError(explain_call_error(f"{self.name}.traction", err)) from None
+        out = self._call("traction", g)
         if not (isinstance(out, (tuple, list)) and len(out) == 2):
             got = f"{len(out)} values" if isinstance(out, (tuple, list)) else "one value"
             raise LawValueError(f"{self.name}.traction(g_N) returned {got}: it must return the two values "
@@ -545,12 +549,7 @@ class NormalLawView:
         if self.trusted:
             return self.law.energy(g_N)
         g = np.asarray(g_N, dtype=float)
-        try:
-            W = self.law.energy(g)
-        except LawError:
-            raise
-        except Exception as err:               # noqa: BLE001
-            raise LawValueError(explain_call_error(f"{self.name}.energy", err)) from None
+        W = self._call("energy", g)
         W = np.array(_as_array(np.real(W) if np.iscomplexobj(W) else W, g.shape, f"{self.name}.energy"), dtype=float)
         if self.check_values and not _all_finite((W,)):
             bad = ~np.isfinite(W) & np.isfinite(g)
