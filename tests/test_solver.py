@@ -58,10 +58,15 @@ class SpringChain:
     def commit(self, u, dt=None):
         self.commits += 1
 
-    def rigid_modes(self, u):
+    rotation_dofs = np.zeros(0, dtype=int)
+
+    rotation_dofs = np.zeros(0, dtype=int)
+
+    def discrete_gradient(self, u0, u1):
+        from contactfem.bodies.discrete_gradient import gonzalez
         Q = np.zeros((self.ndof, 2))
         Q[0::2, 0] = Q[1::2, 1] = 1.0
-        return Q
+        return gonzalez(self, u0, u1, Q)
 
 
 @dataclass(frozen=True)

@@ -191,15 +191,90 @@ class Beam:
         return _check("dt", dt, 0.0)
 
     def rigid_modes(self, u):
-        """The rigid-body modes energy-consistent stepping keeps its correction off, (ndof, 2): the
-        translations in x and y (its correction then has no resultant: linear momentum is kept).
-        Not the rotation: in a step that turns a stressed body by 2 delta, R(u_mid) does work
-        ~ tan(delta) R . (e3 x d_def) on the rotation's chord, of the order of the deformation
-        increment d_def itself, which a correction kept off the rotation would have to put on
-        d_def alone (c ~ delta |R| / |d_def|: singular for a stressed ring turning nearly rigidly)."""
-        Q = np.zeros((self.ndof, 2))
+        """The rigid-body motions at u, (ndof, 3): the translations in x and y and the rotation
+        about the origin (e3 x x on the positions, 1 on the angles)."""
+        Q = np.zeros((self.ndof, 3))
         Q[0::3, 0] = Q[1::3, 1] = 1.0
+        x = self.positions(u)
+        Q[0::3, 2], Q[1::3, 2], Q[2::3, 2] = -x[:, 1], x[:, 0], 1.0
         return Q
+
+    @property
+    def rotation_dofs(self):
+        """The local dofs of the node angles theta (energy-consistent steps turn them by a
+        Cayley rotation, bodies/discrete_gradient.py)."""
+        return np.arange(2, self.ndof, 3)
+
+    def discrete_gradient(self, u0, u1):
+        """The internal force of an energy-consistent step u0 -> u1, conjugate to the step's
+        increment dq (the angles' phi = 2 tan(Delta theta / 2), discrete_gradient.cayley), with
+        its tangent dF/du1, as (F, rows, cols, vals); elastic beams only. Per integration point
+        (Simo, Tarnow & Doblare 1995, in the plane), with a = x', theta the angle there and
+        sigma = D (Gamma_0 + Gamma_1) / 2, M = EI (kappa_0 + kappa_1) / 2 the mean resultants:
+
+            Gamma_1 - Gamma_0 = cos(Dtheta/2) R(-theta_mid) [Da - psi J a_mid],  psi = 2 tan(Dtheta/2)
+
+        exactly (R(+-Dtheta/2) = cos(Dtheta/2) (I +- tan(Dtheta/2) J)), and psi = phi_bar - (phi_b - phi_a) h
+        with phi_bar = N_a phi_a + N_b phi_b and h a divided difference (equal to it where the
+        nodes turn alike); kappa_1 - kappa_0 = (phi_b - phi_a) k / L0, k = (Dtheta_b - Dtheta_a) /
+        (phi_b - phi_a). So F . dq = sigma . DGamma + M Dkappa summed = W(u1) - W(u0) exactly; no
+        translation enters, and a rigid rotation of the midpoint rule (Da = phi J a_mid, phi the
+        same at every node) is orthogonal to F: no resultant and no moment. The tangent: the
+        complex-step derivative of these element forces (exact to rounding)."""
+        if self.S0 is not None:
+            raise ValueError(f"body {self.name!r}: a discrete gradient needs a stored energy (an elastic beam)")
+        g = self._gauss()
+        e = g["edofs"]
+        q0 = np.asarray(u0, float)[e]
+        q1 = np.asarray(u1, float)[e]
+        F = np.bincount(e.ravel(), self._step_forces(q0, q1, g).ravel(), minlength=self.ndof)
+        step = 1e-30
+        Ke = np.empty((6, 6, e.shape[1]))
+        for j in range(6):
+            q = q1.astype(complex)
+            q[j] += 1j * step
+            Ke[:, j] = self._step_forces(q0, q, g).imag / step
+        rows = np.broadcast_to(e[:, None, :], Ke.shape).ravel()
+        cols = np.broadcast_to(e[None, :, :], Ke.shape).ravel()
+        return F, rows, cols, Ke.ravel()
+
+    def _step_forces(self, q0, q1, g):
+        """The element forces (6, m) of ``discrete_gradient`` at every integration point row,
+        from the element dofs q0, q1 (6, m) at the step's start and end (q1 may be complex)."""
+        Na, Nb, invL = g["Na"], g["Nb"], g["invL"]
+        a0 = (g["dX"] + q0[3:5] - q0[0:2]) * invL                # x' at the start and the end
+        a1 = (g["dX"] + q1[3:5] - q1[0:2]) * invL
+        th0 = g["theta0"] + Na * q0[2] + Nb * q0[5]
+        th1 = g["theta0"] + Na * q1[2] + Nb * q1[5]
+        D = g["D"][:, 0]
+
+        def gamma(a, th):
+            c, s = np.cos(th), np.sin(th)
+            return a[0] * c + a[1] * s - 1.0, a[1] * c - a[0] * s
+
+        (e0, y0), (e1, y1) = gamma(a0, th0), gamma(a1, th1)
+        N, Q = 0.5 * D[0] * (e0 + e1), 0.5 * D[1] * (y0 + y1)
+        dA, dB = q1[2] - q0[2], q1[5] - q0[5]                   # the nodes' Delta theta
+        M = 0.5 * D[2] * (q0[5] - q0[2] + q1[5] - q1[2]) * invL
+        pA, pB = 2.0 * np.tan(0.5 * dA), 2.0 * np.tan(0.5 * dB)  # their phi
+        dth = th1 - th0
+        tm = 0.5 * (th0 + th1)
+        ch = np.cos(0.5 * dth)
+        v = np.array([ch * (N * np.cos(tm) - Q * np.sin(tm)), ch * (N * np.sin(tm) + Q * np.cos(tm))])
+        am = 0.5 * (a0 + a1)
+        m = v[1] * am[0] - v[0] * am[1]                          # v . J a_mid
+        delta = pB - pA
+        pbar = Na * pA + Nb * pB
+        small = np.abs(np.real(delta)) < 1e-6
+        safe = np.where(small, 1.0, delta)
+        # h = (phi_bar - psi) / delta; where the nodes turn alike its first term, from the Taylor
+        # expansion of 2 tan(.../2) about phi_bar: phi_bar / (4 + phi_bar^2) N_a N_b delta
+        h = np.where(small, pbar / (4.0 + pbar * pbar) * Na * Nb * delta, (pbar - 2.0 * np.tan(0.5 * dth)) / safe)
+        k = np.where(small, 1.0 / (1.0 + 0.0625 * (pA + pB) ** 2), (dB - dA) / safe)
+        Mk = M * k * invL
+        w = g["wL0"]
+        return w * np.array([-v[0] * invL, -v[1] * invL, -Na * m - h * m - Mk,
+                             v[0] * invL, v[1] * invL, -Nb * m + h * m + Mk])
 
     # ---- kinematics ----------------------------------------------------------------
     def positions(self, u):

@@ -318,9 +318,8 @@ class Continuum:
         return np.flatnonzero(np.min(self.corner_jacobian_ratios(u), axis=1) <= 0.0)
 
     def rigid_modes(self, u):
-        """The rigid-body modes energy-consistent stepping keeps its correction off, (ndof, k):
-        the translations in x and y (plane), the translation along the axis (axisymmetric: a
-        radial shift strains the hoop). Not the rotation, for the reason Beam.rigid_modes gives."""
+        """The rigid translations, (ndof, k): in x and y (plane), along the axis (axisymmetric: a
+        radial shift strains the hoop)."""
         if self.axi:
             Q = np.zeros((self.ndof, 1))
             Q[self.xdofs[:, 1], 0] = 1.0
@@ -328,6 +327,17 @@ class Continuum:
         Q = np.zeros((self.ndof, 2))
         Q[self.xdofs[:, 0], 0] = Q[self.xdofs[:, 1], 1] = 1.0
         return Q
+
+    rotation_dofs = np.zeros(0, dtype=int)      # no angles among the unknowns
+
+    def discrete_gradient(self, u0, u1):
+        """The internal force of an energy-consistent step u0 -> u1 and its tangent, (F, rows,
+        cols, vals): Gonzalez's discrete gradient kept off the rigid translations
+        (bodies/discrete_gradient.py): no resultant; the angular momentum is kept to the
+        correction's moment, not exactly."""
+        from .discrete_gradient import gonzalez
+
+        return gonzalez(self, u0, u1, self.rigid_modes(u0))
 
     def element_areas(self, u):
         """Current (signed) area of every element in the plane (shoelace formula over its

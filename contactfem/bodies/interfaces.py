@@ -26,6 +26,7 @@ class Body(Protocol):
     hyperelastic: bool          # a stored energy and no history (energy-consistent stepping needs it)
     quadratic_energy: bool      # W(u) quadratic (a linear body): the midpoint rule is energy-exact for it
     mass_matrix: str            # the mass the System uses: "lumped" or "consistent" (MASS_MATRICES)
+    rotation_dofs: np.ndarray   # local dofs that are angles (a beam's theta; none for a continuum)
 
     def mass(self, consistent: bool = False):
         """The lumped (diagonal) mass, (ndof,); with ``consistent=True`` the consistent mass as a
@@ -45,9 +46,11 @@ class Body(Protocol):
     def commit(self, u: np.ndarray, dt=None) -> None:
         """Accept u as converged at the end of a step of dt (history variables)."""
 
-    def rigid_modes(self, u: np.ndarray) -> np.ndarray:
-        """(ndof, k): the rigid-body motions at configuration u (energy-consistent stepping
-        keeps its correction off them, so that momentum is conserved)."""
+    def discrete_gradient(self, u0: np.ndarray, u1: np.ndarray) -> tuple:
+        """(F, rows, cols, vals): the internal force of an energy-consistent step u0 -> u1 and its
+        tangent dF/du1 as COO triplets; F . dq = W(u1) - W(u0) exactly, dq the increment with the
+        angles' 2 tan(Delta theta / 2) (bodies/discrete_gradient.py), and no resultant.
+        Hyperelastic bodies only."""
 
 
 @runtime_checkable

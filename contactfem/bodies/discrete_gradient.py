@@ -1,0 +1,85 @@
+"""Discrete gradients of a body's stored energy W for energy-consistent time stepping
+(solver/conserving.py): the internal force F of a step u_0 -> u_1, conjugate to the step's
+increment dq, with
+
+    F . dq = W(u_1) - W(u_0)      exactly (not to the order of the time step),
+
+and, like the exact internal force, no resultant (and for the beam no moment), so that the
+midpoint rule built on it keeps the momentum.
+
+The increment dq is d = u_1 - u_0 except on the angles of a beam (``rotation_dofs``), whose
+increment Delta theta enters as phi = 2 tan(Delta theta / 2) (``cayley``): the rotation by
+Delta theta is the Cayley transform of phi J, (I - phi/2 J)^-1 (I + phi/2 J), which is what
+the midpoint rule x_1 - x_0 = phi J (x_0 + x_1) / 2 turns a vector by. A rigid rotation
+of the midpoint rule then turns the positions and the angles alike, W does not change in it,
+and a discrete gradient can be orthogonal to it (Simo, Tarnow & Doblare, IJNME 38, 1995,
+for rods; beam.py).
+
+``gonzalez``: any hyperelastic body, from its W and R = dW/du alone (Gonzalez, J Nonlinear
+Sci 6, 1996): F = R(u_mid) + c w, with w the increment without its rigid translations, so
+that F has no resultant; it may have a moment (the correction's, of the order of the energy
+mismatch it removes).
+"""
+import numpy as np
+
+
+def cayley(d, rotations):
+    """The increment dq of the step (module docstring): d with phi = 2 tan(Delta theta / 2) in
+    place of the angle increments Delta theta at ``rotations``; D = d dq / d d (1 + phi^2 / 4
+    there, 1 elsewhere); and chord = Delta theta / phi with its derivative d chord / d Delta theta,
+    the factor that turns a force conjugate to Delta theta into one conjugate to phi. Below
+    |Delta theta| = 1e-2, chord and its derivative are their series (the next term < 1e-17 there;
+    the closed forms cancel). A step must turn a node by less than pi."""
+    dq, D = np.array(d, dtype=float), np.ones(len(d))
+    chord = np.ones(len(d))
+    x = dq[rotations]
+    h = 0.5 * x
+    phi = 2.0 * np.tan(h)
+    dq[rotations] = phi
+    D[rotations] = 1.0 + 0.25 * phi * phi
+    small = np.abs(x) < 1e-2
+    hs = np.where(small, 1.0, h)
+    chord[rotations] = np.where(small, 1.0 - x * x / 12.0 - x ** 4 / 720.0 - x ** 6 / 30240.0, hs / np.tan(hs))
+    dchord = np.where(small, -x / 6.0 - x ** 3 / 180.0 - x ** 5 / 5040.0, 0.5 / np.tan(hs) - 0.5 * hs / np.sin(hs) ** 2)
+    return dq, D, chord, dchord
+
+
+def gonzalez(body, u0, u1, modes):
+    """The discrete gradient F = R(u_mid) + c w of ``body`` for the step u0 -> u1 (local vectors;
+    the body has no rotation dofs: dq = d), with its exact tangent dF/du1, as (F, rows, cols,
+    vals) (the tangent dense over the body's dofs where the correction acts):
+
+        w = (I - Pi) d,  Pi = A (A^T A)^-1 A^T  the projector on the constant rigid ``modes`` A,
+        c = gap / (w . w),  gap = W(u_1) - W(u_0) - R(u_mid) . d,
+        dF/du_1 = K(u_mid) / 2 + w (dc/du_1)^T + c (I - Pi),
+        dc/du_1 = (R(u_1) - R(u_mid) - K(u_mid) d / 2 - 2 c w) / (w . w).
+
+    W does not change under the translations A, so R(u_mid) has no resultant, nor has c w. No
+    correction for a quadratic W (the midpoint rule is exact: gap = 0 up to the rounding of
+    R = K u, a sum of large cancelling terms when the body moves rigidly), nor where the gap
+    is at the rounding of W."""
+    import scipy.sparse as sp     # (imported here: listing the scenes loads no scipy)
+
+    um = 0.5 * (u0 + u1)
+    R, K = body.internal(um)
+    d = u1 - u0
+    W0, W1 = body.strain_energy(u0), body.strain_energy(u1)
+    A = modes
+    AtA_inv = np.linalg.inv(A.T @ A)
+    w = d - A @ (AtA_inv @ (A.T @ d))                    # d without its rigid translation
+    gap = W1 - W0 - R @ d
+    ww = w @ w
+    use = not body.quadratic_energy and ww > 0 and abs(gap) > 1e-13 * (abs(W0) + abs(W1))
+    c = gap / ww if use else 0.0
+    K = sp.coo_matrix(K)
+    rows, cols, vals = [K.row], [K.col], [0.5 * K.data]
+    if c != 0.0:
+        n = body.ndof
+        P = np.eye(n) - A @ AtA_inv @ A.T
+        R1 = body.internal(u1)[0]
+        dc = (R1 - R - 0.5 * (K @ d) - 2.0 * c * w) / ww
+        Z = np.outer(w, dc) + c * P
+        rows.append(np.repeat(np.arange(n), n))
+        cols.append(np.tile(np.arange(n), n))
+        vals.append(Z.ravel())
+    return R + c * w, np.concatenate(rows), np.concatenate(cols), np.concatenate(vals)
