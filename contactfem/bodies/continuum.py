@@ -216,12 +216,17 @@ class Continuum:
         """(W, P, A) at the quadrature points; raises InvertedElementError if det F <= 0."""
         F = self._deformation_gradient(u, basis)
         if self.material != "linear":
-            J = np.linalg.det(np.moveaxis(F, (0, 1), (-2, -1)))
-            if np.any(J <= 0.0) or not np.all(np.isfinite(J)):
-                e = np.unique(np.nonzero(~(J > 0.0))[0])
-                raise InvertedElementError(
-                    f"element volume non-positive (det F <= 0) in body {self.name!r}, elements {e[:10]}")
+            self._check_volume(F)
         return MATERIAL_FUNCTIONS[self.material](F, self.lam, self.mu)
+
+    def _check_volume(self, F):
+        """F, if det F > 0 at every quadrature point; else InvertedElementError naming the elements."""
+        J = np.linalg.det(np.moveaxis(F, (0, 1), (-2, -1)))
+        if np.any(J <= 0.0) or not np.all(np.isfinite(J)):
+            e = np.unique(np.nonzero(~(J > 0.0))[0])
+            raise InvertedElementError(
+                f"element volume non-positive (det F <= 0) in body {self.name!r}, elements {e[:10]}")
+        return F
 
     # -- body interface ----------------------------------------------------
 
@@ -319,7 +324,7 @@ class Continuum:
 
     def rigid_modes(self, u):
         """The rigid translations, (ndof, k): in x and y (plane), along the axis (axisymmetric: a
-        radial shift strains the hoop)."""
+        radial shift strains the hoop): what the linear material's discrete gradient keeps off."""
         if self.axi:
             Q = np.zeros((self.ndof, 1))
             Q[self.xdofs[:, 1], 0] = 1.0
@@ -331,13 +336,31 @@ class Continuum:
     rotation_dofs = np.zeros(0, dtype=int)      # no angles among the unknowns
 
     def discrete_gradient(self, u0, u1):
-        """The internal force of an energy-consistent step u0 -> u1 and its tangent, (F, rows,
-        cols, vals): Gonzalez's discrete gradient kept off the rigid translations
-        (bodies/discrete_gradient.py): no resultant; the angular momentum is kept to the
-        correction's moment, not exactly."""
-        from .discrete_gradient import gonzalez
+        """The internal force of an energy-consistent step u0 -> u1 and its tangent dF/du1,
+        (F, rows, cols, vals): the virtual work of the algorithmic stress P = F_mid S_alg of
+        discrete_gradient.algorithmic_stress at every quadrature point (Gonzalez's discrete
+        gradient in the Green strain): F . d = W(u1) - W(u0) exactly, no resultant and no
+        moment. The tangent: the complex-step derivative of P with respect to F(u1), A = dP/dF1,
+        in the tangent form. The linear material (W quadratic in u, not frame-indifferent):
+        R(u_mid), the midpoint rule is exact for it."""
+        from .discrete_gradient import algorithmic_stress, gonzalez
 
-        return gonzalez(self, u0, u1, self.rigid_modes(u0))
+        if self.material == "linear":
+            return gonzalez(self, u0, u1, self.rigid_modes(u0))
+        u0, u1 = np.asarray(u0, dtype=float), np.asarray(u1, dtype=float)
+        F0 = self._deformation_gradient(u0, self.basis)
+        F1 = self._check_volume(self._deformation_gradient(u1, self.basis))
+        law = MATERIAL_FUNCTIONS[self.material]
+        P = algorithmic_stress(law, F0, F1, self.lam, self.mu)
+        step = 1e-30
+        A = np.zeros((3, 3) + P.shape)
+        for k, l in ((0, 0), (0, 1), (1, 0), (1, 1)) + (((2, 2),) if self.axi else ()):
+            F = F1.astype(complex)
+            F[k, l] += 1j * step
+            A[:, :, k, l] = algorithmic_stress(law, F0, F, self.lam, self.mu).imag / step
+        R = asm(_internal_form, self.basis, P=P, **self._params())
+        K = asm(_tangent_form, self.basis, A=A, **self._params()).tocoo()
+        return R, K.row, K.col, K.data
 
     def element_areas(self, u):
         """Current (signed) area of every element in the plane (shoelace formula over its

@@ -15,12 +15,18 @@ of the midpoint rule then turns the positions and the angles alike, W does not c
 and a discrete gradient can be orthogonal to it (Simo, Tarnow & Doblare, IJNME 38, 1995,
 for rods; beam.py).
 
+``algorithmic_stress``: a continuum's stress of the step, Gonzalez's discrete gradient in
+the Green strain at every quadrature point (Simo & Tarnow, ZAMP 43, 1992): no resultant
+and no moment.
+
 ``gonzalez``: any hyperelastic body, from its W and R = dW/du alone (Gonzalez, J Nonlinear
 Sci 6, 1996): F = R(u_mid) + c w, with w the increment without its rigid translations, so
 that F has no resultant; it may have a moment (the correction's, of the order of the energy
-mismatch it removes).
+mismatch it removes). The linear continuum (c = 0: R(u_mid)) and a body of one's own.
 """
 import numpy as np
+
+from .materials import _eye
 
 
 def cayley(d, rotations):
@@ -83,3 +89,41 @@ def gonzalez(body, u0, u1, modes):
         cols.append(np.tile(np.arange(n), n))
         vals.append(Z.ravel())
     return R + c * w, np.concatenate(rows), np.concatenate(cols), np.concatenate(vals)
+
+
+def algorithmic_stress(material, F0, F1, lam, mu):
+    """The first Piola-Kirchhoff stress of a step F0 -> F1 at every quadrature point, (3, 3,
+    ...), P = F_mid S_alg, with S_alg Gonzalez's discrete gradient of W in the Green strain E
+    (Simo & Tarnow 1992; Gonzalez 2000):
+
+        S_alg = S(E_mid) + [(W(F1) - W(F0) - S(E_mid) : dE) / (dE : dE)] dE,   dE = E1 - E0,
+
+    so that S_alg : dE = W(F1) - W(F0) exactly, and, since dE = sym(F_mid^T (F1 - F0)) exactly,
+    P : (F1 - F0) = W(F1) - W(F0). P : grad(omega e3 x x_mid) = S_alg : F_mid^T W F_mid = 0 (S_alg
+    symmetric, F_mid^T W F_mid skew): no moment. S(E_mid) from the material at the stretch
+    U = sqrt(C_mid) (a function of C alone: the materials are isotropic and frame-indifferent);
+    no correction where dE : dE < 1e-14 (the energy mismatch is of order |dE|^3 there; the
+    quotient would be rounding). F may be complex (the tangent's complex step)."""
+    I = _eye(F0)
+    E0 = 0.5 * (np.einsum("ki...,kj...->ij...", F0, F0) - I)
+    E1 = 0.5 * (np.einsum("ki...,kj...->ij...", F1, F1) - I)
+    C = E0 + E1 + I                                           # C_mid = 2 E_mid + I
+    # U = sqrt(C): the 2x2 in-plane block (B + sqrt(det B) I) / sqrt(tr B + 2 sqrt(det B)), U_33 = sqrt(C_33)
+    s = np.sqrt(C[0, 0] * C[1, 1] - C[0, 1] * C[1, 0])
+    t = np.sqrt(C[0, 0] + C[1, 1] + 2.0 * s)
+    U = np.zeros_like(C)
+    U[:2, :2] = (C[:2, :2] + s * I[:2, :2]) / t
+    U[2, 2] = np.sqrt(C[2, 2])
+    W_mid, P_mid, _ = material(U, lam, mu)
+    Ui = np.zeros_like(U)
+    det = U[0, 0] * U[1, 1] - U[0, 1] * U[1, 0]
+    Ui[0, 0], Ui[1, 1], Ui[0, 1], Ui[1, 0] = U[1, 1] / det, U[0, 0] / det, -U[0, 1] / det, -U[1, 0] / det
+    Ui[2, 2] = 1.0 / U[2, 2]
+    S = np.einsum("ik...,kj...->ij...", Ui, P_mid)
+    S = 0.5 * (S + S.transpose(1, 0, *range(2, S.ndim)))     # symmetric (to rounding already)
+    dE = E1 - E0
+    nn = np.einsum("ij...,ij...->...", dE, dE)
+    gap = material(F1, lam, mu)[0] - material(F0, lam, mu)[0] - np.einsum("ij...,ij...->...", S, dE)
+    use = np.real(nn) > 1e-14
+    S = S + np.where(use, gap / np.where(use, nn, 1.0), 0.0) * dE
+    return np.einsum("ik...,kj...->ij...", 0.5 * (F0 + F1), S)

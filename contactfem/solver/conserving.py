@@ -28,12 +28,12 @@ and the angular momentum about the origin by dt times the moment at the midpoint
 (the angles' part through phi: the rigid rotation of the midpoint rule turns positions and
 angles by the same Cayley rotation). No body's F_int has a resultant, so a body in free
 flight keeps its momentum exactly and, on a frictionless plane, its momentum along the
-plane. The beam's F_int has no moment either (Beam.discrete_gradient, after Simo, Tarnow &
-Doblare 1995): a ring in free flight keeps its angular momentum exactly. A continuum's
-(Gonzalez's discrete gradient kept off the translations) keeps it to the moment of its
-correction, of the order of the energy mismatch the correction removes; for a linear body
-there is no correction (the midpoint rule is the trapezoidal rule of Newmark 1/2, 1/4) and
-only the contact force differs from it.
+plane. Nor has it a moment (the beam: Beam.discrete_gradient, after Simo, Tarnow & Doblare
+1995; a finite-strain continuum: the discrete gradient in the Green strain,
+Continuum.discrete_gradient): a ring in free flight keeps its angular momentum exactly. The
+small-strain linear material is the exception: its energy changes under a finite rotation,
+so R(u_mid) (for it the midpoint rule, the trapezoidal rule of Newmark 1/2, 1/4: only the
+contact force differs from it) has a moment.
 
 Newton's tangent is exact: 2 M D / dt^2 (D = d dq / d u_1, 1 + phi^2 / 4 on an angle) plus the
 bodies' tangents of their discrete gradients, plus X times the contacts' and loads' tangents
