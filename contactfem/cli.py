@@ -19,7 +19,7 @@ import time
 _LOADING = time.perf_counter()
 import argparse  # noqa: E402  (timed: the command line's own import is import time too)
 
-from .clock import imports_timed  # noqa: E402
+from .clock import defer_interrupt, imports_timed  # noqa: E402
 
 _OWN_IMPORT_S = [time.perf_counter() - _LOADING]   # counted once, by the first command of the process
 _CLOCK = {}        # the import clock of the command running (contactfem.clock)
@@ -540,7 +540,8 @@ _INTERRUPTED = []
 
 def _on_sigint(signum, frame):
     _INTERRUPTED.append(True)
-    raise KeyboardInterrupt
+    if not defer_interrupt():            # inside a library's import: raised when it returns
+        raise KeyboardInterrupt
 
 
 def _on_sigterm(signum, frame):

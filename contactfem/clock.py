@@ -9,7 +9,9 @@ it from the run's wall time (``wall_time_s``, the run's own time, in every entry
 and the command line reports what its process spent importing (``import_time_s``).
 
 It wraps ``builtins.__import__`` while active (``importlib.import_module`` is not seen;
-the imports a module's body makes are). Not for threads importing at the same time.
+the imports a module's body makes are). Not for threads importing at the same time. A
+SIGINT handler may hold a Ctrl-C until the import statement it met returns
+(``defer_interrupt``).
 Imports nothing of contactfem (the command line starts it before loading anything else).
 """
 
@@ -21,6 +23,19 @@ from contextlib import contextmanager
 _running = []           # the accumulators ([seconds]) of the clocks active now
 _inside = [False]       # within a timed import statement (its nested imports are its own time)
 _wrapped = [None]       # the __import__ found when the first clock started
+_pending = [False]      # a Ctrl-C met inside a timed import: raised when the import statement returns
+
+
+def defer_interrupt():
+    """Called by a SIGINT handler: True if an import statement is running under a clock, and
+    then its KeyboardInterrupt is raised when that statement returns (a C extension met by
+    the interrupt inside its own import prints a traceback and turns it into an ImportError:
+    numpy's import_array does); False if not, or if an interrupt is already pending (a second
+    Ctrl-C is raised at once)."""
+    if _inside[0] and not _pending[0]:
+        _pending[0] = True
+        return True
+    return False
 
 
 def _timed_import(name, globals=None, locals=None, fromlist=(), level=0):
@@ -40,6 +55,9 @@ def _timed_import(name, globals=None, locals=None, fromlist=(), level=0):
             dt = time.perf_counter() - t0
             for acc in _running:
                 acc[0] += dt
+        if _pending[0]:
+            _pending[0] = False
+            raise KeyboardInterrupt
 
 
 @contextmanager

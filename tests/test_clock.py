@@ -97,3 +97,33 @@ def test_the_command_line_reports_both(tmp_path):
     assert main(["run", "sloping_impact", "--set", "n_steps=3", "--json", str(out)]) == 0
     res = json.loads(out.read_text())
     assert res["wall_time_s"] > 0 and res["import_time_s"] >= 0
+
+
+def test_a_ctrl_c_inside_an_import_is_raised_when_the_import_returns(tmp_path, monkeypatch):
+    """The command line's SIGINT handler holds a Ctrl-C met inside an import statement under
+    the clock until the statement returns (a C extension interrupted in its own import prints
+    a traceback); the module's body runs to its end, then KeyboardInterrupt; a second Ctrl-C
+    while one is held is raised at once."""
+    import signal
+
+    from contactfem import cli
+    (tmp_path / "interrupted_once.py").write_text(
+        "import os, signal\nos.kill(os.getpid(), signal.SIGINT)\nDONE = True\n")
+    (tmp_path / "interrupted_twice.py").write_text(
+        "import os, signal\nos.kill(os.getpid(), signal.SIGINT)\nos.kill(os.getpid(), signal.SIGINT)\nDONE = True\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    old = signal.signal(signal.SIGINT, cli._on_sigint)
+    try:
+        with clock.imports_timed():
+            with pytest.raises(KeyboardInterrupt):
+                import interrupted_once  # noqa: F401
+            assert sys.modules["interrupted_once"].DONE
+            with pytest.raises(KeyboardInterrupt):
+                import interrupted_twice  # noqa: F401
+            assert not hasattr(sys.modules.get("interrupted_twice"), "DONE")
+    finally:
+        signal.signal(signal.SIGINT, old)
+        cli._INTERRUPTED.clear()                 # (it tells the command line an interrupt came)
+        for name in ("interrupted_once", "interrupted_twice"):
+            sys.modules.pop(name, None)
+    assert not clock._pending[0]

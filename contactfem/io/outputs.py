@@ -61,9 +61,10 @@ def _probe(folder, what, path):
     """ValueError naming the option unless a file can be created (and removed) in `folder`."""
     probe = Path(folder) / f".contactfem.{secrets.token_hex(4)}.probe"
     try:
-        with open(probe, "xb"):
-            pass
-        probe.unlink()
+        try:
+            open(probe, "xb").close()
+        finally:
+            probe.unlink(missing_ok=True)        # also when a Ctrl-C comes between the two
     except OSError as err:
         raise ValueError(f"{what} {path}: cannot write in {folder} ({err.strerror or err})") from None
 
