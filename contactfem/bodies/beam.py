@@ -190,15 +190,6 @@ class Beam:
             raise RuntimeError("viscoplastic beam: the step's dt is needed (internal_coo(u, dt), commit(u, dt))")
         return _check("dt", dt, 0.0)
 
-    def rigid_modes(self, u):
-        """The rigid-body motions at u, (ndof, 3): the translations in x and y and the rotation
-        about the origin (e3 x x on the positions, 1 on the angles)."""
-        Q = np.zeros((self.ndof, 3))
-        Q[0::3, 0] = Q[1::3, 1] = 1.0
-        x = self.positions(u)
-        Q[0::3, 2], Q[1::3, 2], Q[2::3, 2] = -x[:, 1], x[:, 0], 1.0
-        return Q
-
     @property
     def rotation_dofs(self):
         """The local dofs of the node angles theta (energy-consistent steps turn them by a
@@ -214,10 +205,10 @@ class Beam:
 
             Gamma_1 - Gamma_0 = cos(Dtheta/2) R(-theta_mid) [Da - psi J a_mid],  psi = 2 tan(Dtheta/2)
 
-        exactly (R(+-Dtheta/2) = cos(Dtheta/2) (I +- tan(Dtheta/2) J)), and psi = phi_bar - (phi_b - phi_a) h
-        with phi_bar = N_a phi_a + N_b phi_b and h a divided difference (equal to it where the
-        nodes turn alike); kappa_1 - kappa_0 = (phi_b - phi_a) k / L0, k = (Dtheta_b - Dtheta_a) /
-        (phi_b - phi_a). So F . dq = sigma . DGamma + M Dkappa summed = W(u1) - W(u0) exactly; no
+        exactly (R(+-Dtheta/2) = cos(Dtheta/2) (I +- tan(Dtheta/2) J)); with phi_bar = N_a phi_a +
+        N_b phi_b, psi = phi_bar - (phi_b - phi_a) h, h = (phi_bar - psi) / (phi_b - phi_a) (psi =
+        phi_bar exactly where the nodes turn alike: then h is its series); kappa_1 - kappa_0 =
+        (phi_b - phi_a) k / L0, k = (Dtheta_b - Dtheta_a) / (phi_b - phi_a). So F . dq = sigma . DGamma + M Dkappa summed = W(u1) - W(u0) exactly; no
         translation enters, and a rigid rotation of the midpoint rule (Da = phi J a_mid, phi the
         same at every node) is orthogonal to F: no resultant and no moment. The tangent: the
         complex-step derivative of these element forces (exact to rounding)."""

@@ -322,17 +322,6 @@ class Continuum:
         """Indices of the elements with a non-positive det J somewhere (corner_jacobian_ratios)."""
         return np.flatnonzero(np.min(self.corner_jacobian_ratios(u), axis=1) <= 0.0)
 
-    def rigid_modes(self, u):
-        """The rigid translations, (ndof, k): in x and y (plane), along the axis (axisymmetric: a
-        radial shift strains the hoop): what the linear material's discrete gradient keeps off."""
-        if self.axi:
-            Q = np.zeros((self.ndof, 1))
-            Q[self.xdofs[:, 1], 0] = 1.0
-            return Q
-        Q = np.zeros((self.ndof, 2))
-        Q[self.xdofs[:, 0], 0] = Q[self.xdofs[:, 1], 1] = 1.0
-        return Q
-
     rotation_dofs = np.zeros(0, dtype=int)      # no angles among the unknowns
 
     def discrete_gradient(self, u0, u1):
@@ -343,21 +332,24 @@ class Continuum:
         moment. The tangent: the complex-step derivative of P with respect to F(u1), A = dP/dF1,
         in the tangent form. The linear material (W quadratic in u, not frame-indifferent):
         R(u_mid), the midpoint rule is exact for it."""
-        from .discrete_gradient import algorithmic_stress, gonzalez
+        from .discrete_gradient import algorithmic_stress
 
-        if self.material == "linear":
-            return gonzalez(self, u0, u1, self.rigid_modes(u0))
         u0, u1 = np.asarray(u0, dtype=float), np.asarray(u1, dtype=float)
+        if self.material == "linear":
+            R, K = self.internal(0.5 * (u0 + u1))
+            K = K.tocoo()
+            return R, K.row, K.col, 0.5 * K.data
         F0 = self._deformation_gradient(u0, self.basis)
         F1 = self._check_volume(self._deformation_gradient(u1, self.basis))
         law = MATERIAL_FUNCTIONS[self.material]
-        P = algorithmic_stress(law, F0, F1, self.lam, self.mu)
+        W0 = law(F0, self.lam, self.mu, tangent=False)[0]
+        P = algorithmic_stress(law, F0, F1, self.lam, self.mu, W0)
         step = 1e-30
         A = np.zeros((3, 3) + P.shape)
         for k, l in ((0, 0), (0, 1), (1, 0), (1, 1)) + (((2, 2),) if self.axi else ()):
             F = F1.astype(complex)
             F[k, l] += 1j * step
-            A[:, :, k, l] = algorithmic_stress(law, F0, F, self.lam, self.mu).imag / step
+            A[:, :, k, l] = algorithmic_stress(law, F0, F, self.lam, self.mu, W0).imag / step
         R = asm(_internal_form, self.basis, P=P, **self._params())
         K = asm(_tangent_form, self.basis, A=A, **self._params()).tocoo()
         return R, K.row, K.col, K.data

@@ -35,10 +35,15 @@ def cayley(d, rotations):
     there, 1 elsewhere); and chord = Delta theta / phi with its derivative d chord / d Delta theta,
     the factor that turns a force conjugate to Delta theta into one conjugate to phi. Below
     |Delta theta| = 1e-2, chord and its derivative are their series (the next term < 1e-17 there;
-    the closed forms cancel). A step must turn a node by less than pi."""
+    the closed forms cancel). A step must turn a node by less than pi: FloatingPointError
+    naming the dof otherwise (Newton reports it; the time loop cuts the step)."""
     dq, D = np.array(d, dtype=float), np.ones(len(d))
     chord = np.ones(len(d))
     x = dq[rotations]
+    if np.any(~(np.abs(x) < np.pi)):
+        i = int(np.argmax(~(np.abs(x) < np.pi)))
+        raise FloatingPointError(f"an angle turns by {x[i]:.3g} rad in one step at dof {int(rotations[i])}: the "
+                                 "Cayley update allows less than pi (a smaller dt)")
     h = 0.5 * x
     phi = 2.0 * np.tan(h)
     dq[rotations] = phi
@@ -91,7 +96,7 @@ def gonzalez(body, u0, u1, modes):
     return R + c * w, np.concatenate(rows), np.concatenate(cols), np.concatenate(vals)
 
 
-def algorithmic_stress(material, F0, F1, lam, mu):
+def algorithmic_stress(material, F0, F1, lam, mu, W0=None):
     """The first Piola-Kirchhoff stress of a step F0 -> F1 at every quadrature point, (3, 3,
     ...), P = F_mid S_alg, with S_alg Gonzalez's discrete gradient of W in the Green strain E
     (Simo & Tarnow 1992; Gonzalez 2000):
@@ -103,7 +108,8 @@ def algorithmic_stress(material, F0, F1, lam, mu):
     symmetric, F_mid^T W F_mid skew): no moment. S(E_mid) from the material at the stretch
     U = sqrt(C_mid) (a function of C alone: the materials are isotropic and frame-indifferent);
     no correction where dE : dE < 1e-14 (the energy mismatch is of order |dE|^3 there; the
-    quotient would be rounding). F may be complex (the tangent's complex step)."""
+    quotient would be rounding). F1 may be complex (the tangent's complex step); W0: W(F0),
+    if already known."""
     I = _eye(F0)
     E0 = 0.5 * (np.einsum("ki...,kj...->ij...", F0, F0) - I)
     E1 = 0.5 * (np.einsum("ki...,kj...->ij...", F1, F1) - I)
@@ -114,7 +120,7 @@ def algorithmic_stress(material, F0, F1, lam, mu):
     U = np.zeros_like(C)
     U[:2, :2] = (C[:2, :2] + s * I[:2, :2]) / t
     U[2, 2] = np.sqrt(C[2, 2])
-    W_mid, P_mid, _ = material(U, lam, mu)
+    P_mid = material(U, lam, mu, tangent=False)[1]
     Ui = np.zeros_like(U)
     det = U[0, 0] * U[1, 1] - U[0, 1] * U[1, 0]
     Ui[0, 0], Ui[1, 1], Ui[0, 1], Ui[1, 0] = U[1, 1] / det, U[0, 0] / det, -U[0, 1] / det, -U[1, 0] / det
@@ -123,7 +129,9 @@ def algorithmic_stress(material, F0, F1, lam, mu):
     S = 0.5 * (S + S.transpose(1, 0, *range(2, S.ndim)))     # symmetric (to rounding already)
     dE = E1 - E0
     nn = np.einsum("ij...,ij...->...", dE, dE)
-    gap = material(F1, lam, mu)[0] - material(F0, lam, mu)[0] - np.einsum("ij...,ij...->...", S, dE)
+    if W0 is None:
+        W0 = material(F0, lam, mu, tangent=False)[0]
+    gap = material(F1, lam, mu, tangent=False)[0] - W0 - np.einsum("ij...,ij...->...", S, dE)
     use = np.real(nn) > 1e-14
     S = S + np.where(use, gap / np.where(use, nn, 1.0), 0.0) * dE
     return np.einsum("ik...,kj...->ij...", 0.5 * (F0 + F1), S)

@@ -124,7 +124,7 @@ def conserving_force(contact, u0, u1, t, h, e1, fr):
     on = e1["inside"] & ((e0["g_N"] < 0.0) | (e1["g_N"] < 0.0))
     g0 = np.where(on, e0["g_N"], 1.0)
     g1 = np.where(on, e1["g_N"], 1.0)
-    phi, dphi = secant(contact.normal, np.minimum(g0, 1.0), np.minimum(g1, 1.0))
+    phi, dphi = secant(contact.normal, g0, g1)
     P = None if contact.master.rigid else translations(d.shape[1])   # a deformable master: no resultant
     gN, DgN = discrete_gradient(e0["g_N"], e1["g_N"], em["dg_N"], e1["dg_N"], em["d2g_N"], d, P)
     R = (w * phi)[:, None] * gN

@@ -88,7 +88,7 @@ class EnergyConsistent:
         t1, tm = t + dt, t + 0.5 * dt
         M = s.mass()                        # lumped (a vector) or consistent (a sparse matrix)
         Msp = sp.diags(M) if isinstance(M, np.ndarray) else M
-        c = 2.0 / dt ** 2
+        c_mass = 2.0 / dt ** 2
         rot = self.rotations
 
         def fun(u1):
@@ -99,25 +99,25 @@ class EnergyConsistent:
             states = []
             # the contacts and loads, conjugate to d: on an angle, their moment times chord is
             # conjugate to dq (chord dq = d there); the derivative of chord on the diagonal
-            Gc, rc, cc, vc = np.zeros(s.ndof), [], [], []
+            Gc, rows_c, cols_c, vals_c = np.zeros(s.ndof), [], [], []
             for ct in s.contacts:
                 state = ct.evaluate(u1, t1, dt, u)
-                Rc, r, c_, vv = state.scatter(s.ndof)
+                Rc, r, c, vv = state.scatter(s.ndof)
                 states.append(state)
                 Gc += Rc
-                rc.append(np.asarray(r, int)), cc.append(np.asarray(c_, int)), vc.append(np.asarray(vv, float))
+                rows_c.append(np.asarray(r, int)), cols_c.append(np.asarray(c, int)), vals_c.append(np.asarray(vv, float))
             for load in s.loads:
-                P, r, c_, vv = load.assemble(um, tm)
+                P, r, c, vv = load.assemble(um, tm)
                 Gc -= P
-                rc.append(np.asarray(r, int)), cc.append(np.asarray(c_, int))
-                vc.append(-0.5 * np.asarray(vv, float))
+                rows_c.append(np.asarray(r, int)), cols_c.append(np.asarray(c, int))
+                vals_c.append(-0.5 * np.asarray(vv, float))
             G += chord * Gc
-            rows += rc + [rot]
-            cols += cc + [rot]
-            vals += [v_ * chord[r_] for r_, v_ in zip(rc, vc)] + [dchord * Gc[rot]]
-            G += s.mass_times(c * (dq - dt * v))
+            rows += rows_c + [rot]
+            cols += cols_c + [rot]
+            vals += [vv * chord[r] for r, vv in zip(rows_c, vals_c)] + [dchord * Gc[rot]]
+            G += s.mass_times(c_mass * (dq - dt * v))
             K = sp.coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                              shape=(s.ndof, s.ndof)).tocsr() + c * (Msp @ sp.diags(D))
+                              shape=(s.ndof, s.ndof)).tocsr() + c_mass * (Msp @ sp.diags(D))
             return Evaluation(G, K, tuple(states))
 
         guess = s.apply_dirichlet(u + dt * v + 0.5 * dt ** 2 * a, t1)
