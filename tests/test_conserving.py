@@ -404,3 +404,13 @@ def test_energy_consistent_step_tangent_with_moments_on_the_angles(rng):
     u1 = captured["guess"] + 1e-2 * rng.standard_normal(system.ndof)
     J = fd_jacobian(lambda x: fun(x).G, u1, h=1e-7)
     assert rel_error(fun(u1).K.toarray(), J) < 1e-6
+
+
+def test_a_step_turning_an_angle_by_pi_is_refused():
+    """The Cayley update phi = 2 tan(Delta theta / 2) holds for |Delta theta| < pi: beyond, one
+    FloatingPointError naming the dof (Newton reports it as a failed iteration)."""
+    from contactfem.bodies.discrete_gradient import cayley
+    dq, D, chord, dchord = cayley(np.array([0.3, 1.0, 0.2]), np.array([1]))
+    assert dq[1] == pytest.approx(2 * np.tan(0.5)) and chord[1] * dq[1] == pytest.approx(1.0)
+    with pytest.raises(FloatingPointError, match="dof 1: the Cayley update allows less than pi"):
+        cayley(np.array([0.3, 3.5, 0.2]), np.array([1]))
