@@ -399,9 +399,10 @@ def build_parser():
     rp.add_argument("--preset", default="fast",
                     help="fast (default): coarse meshes and steps, seconds; paper: the paper's data; "
                          "or a named variant of the scene (listed by show)")
-    rp.add_argument("--set", action="append", metavar="NAME=VALUE",
-                    help="override a parameter, or a field of the --friction / --normal law as law.NAME=VALUE "
-                         "(friction.NAME, normal.NAME where both laws have it) (repeatable)")
+    rp.add_argument("--set", action="extend", nargs="+", metavar="NAME=VALUE",
+                    help="override parameters, or fields of the --friction / --normal law as law.NAME=VALUE "
+                         "(friction.NAME, normal.NAME where both laws have it); several after one --set, or "
+                         "--set repeated")
     rp.add_argument("--friction", metavar="LAW", help="replace the scene's friction law: FILE.py:CLASS (a law file), "
                     "package.module:CLASS, or a shipped law (coulomb, parabolic_slip, slip_hardening, frictionless, "
                     "stribeck, dieterich_ruina, archard_wear)")
@@ -433,8 +434,9 @@ def build_parser():
     sw = sub.add_parser("sweep", help="run a scene over a grid of parameter values, in parallel")
     sw.add_argument("scene")
     sw.add_argument("--preset", default="fast", choices=["fast", "paper"])
-    sw.add_argument("--set", action="append", metavar="NAME=V1,V2,...",
-                    help="values of a parameter, or of a law's field as law.NAME=V1,V2,... (repeatable; at least one)")
+    sw.add_argument("--set", action="extend", nargs="+", metavar="NAME=V1,V2,...",
+                    help="values of parameters, or of a law's field as law.NAME=V1,V2,... (several after one "
+                         "--set, or --set repeated; at least one)")
     sw.add_argument("--jobs", type=int, default=1, help="local worker processes (joblib)")
     sw.add_argument("--scheduler", default=None, help="Dask scheduler address: run on that cluster instead")
     sw.add_argument("--out", default="sweep.csv", help="table of results, .csv or .json (default: sweep.csv)")

@@ -84,3 +84,24 @@ def test_dissipation_mismatch_shrinks_with_dt():
         E = energy(hist)
         gaps.append(abs(hist.dissipation[-1] - (E[0] - E[-1])))
     assert gaps[1] < 0.75 * gaps[0], gaps
+
+
+def test_a_run_that_gains_energy_warns():
+    """The energy balance counts the dissipation and the loads' work, so a run can only lose
+    energy: one that gains more than 1 % (the sloping impact at dt = 5: the trapezoidal rule
+    does not resolve the impact) warns, from Python and on the command line; the paper's
+    preset does not."""
+    import subprocess
+    import sys
+    import warnings
+
+    from contactfem import run_scene
+    with pytest.warns(UserWarning, match=r"the energy grew by \d+\.\d% over the run"):
+        r = run_scene("sloping_impact", "fast", {"dt": 5.0})
+    assert r["energy_error"] > 0.01
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert run_scene("sloping_impact", "fast")["energy_error"] < 0.01
+    p = subprocess.run([sys.executable, "-m", "contactfem", "run", "sloping_impact", "--set", "dt=5"],
+                       capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0 and "contactfem: warning: the energy grew by" in p.stderr, p.stderr

@@ -107,8 +107,10 @@ def algorithmic_stress(material, F0, F1, lam, mu, W0=None):
     P : (F1 - F0) = W(F1) - W(F0). P : grad(omega e3 x x_mid) = S_alg : F_mid^T W F_mid = 0 (S_alg
     symmetric, F_mid^T W F_mid skew): no moment. S(E_mid) from the material at the stretch
     U = sqrt(C_mid) (a function of C alone: the materials are isotropic and frame-indifferent);
-    no correction where dE : dE < 1e-14 (the energy mismatch is of order |dE|^3 there; the
-    quotient would be rounding). F1 may be complex (the tangent's complex step); W0: W(F0),
+    no correction where dE : dE < 1e-9: the energy mismatch is of order (lam + mu) |dE|^3, below
+    3e-14 (lam + mu) there, the rounding of W itself (a neo-Hooke W subtracts terms of order
+    lam + mu), so that the quotient would be rounding over |dE|^2 (and Newton's residual would
+    stall on it). F1 may be complex (the tangent's complex step); W0: W(F0),
     if already known."""
     I = _eye(F0)
     E0 = 0.5 * (np.einsum("ki...,kj...->ij...", F0, F0) - I)
@@ -132,6 +134,6 @@ def algorithmic_stress(material, F0, F1, lam, mu, W0=None):
     if W0 is None:
         W0 = material(F0, lam, mu, tangent=False)[0]
     gap = material(F1, lam, mu, tangent=False)[0] - W0 - np.einsum("ij...,ij...->...", S, dE)
-    use = np.real(nn) > 1e-14
+    use = np.real(nn) > 1e-9
     S = S + np.where(use, gap / np.where(use, nn, 1.0), 0.0) * dE
     return np.einsum("ik...,kj...->ij...", 0.5 * (F0 + F1), S)

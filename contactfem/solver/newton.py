@@ -181,4 +181,19 @@ def _newton(fun, u0, free, atol, rtol, maxit, label, line_search, instrument):
             u = u.copy()
             u[free] += du
 
-    raise NewtonError(f"Newton: no convergence in {maxit} iterations{where}", history, label)
+    raise NewtonError(f"Newton: no convergence in {maxit} iterations{where}{_stall(history, atol + rtol * history[0])}",
+                      history, label)
+
+
+def _stall(history, tol):
+    """': the residual stalls at ...' when the last iterations neither fall nor grow (within a
+    factor 3, 5 or more of them) below 1e-3 of the first residual: Newton sits on the round-off of
+    the residual (its corrections no longer move u), above the tolerance; else ''."""
+    k = len(history)
+    while k > 0 and max(history[k - 1:]) <= 3.0 * min(history[k - 1:]):
+        k -= 1
+    tail = history[k:]
+    if len(tail) < 5 or max(tail) > 1e-3 * history[0]:
+        return ""
+    return (f": the residual stalls near {float(np.median(tail)):.1e} from iteration {k} on, above the tolerance "
+            f"{tol:.1e} (the round-off of this system's residual)")
