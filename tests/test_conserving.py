@@ -137,9 +137,13 @@ def test_bar_impact_energy_any_phase(phase):
 def test_bar_impact_energy_any_penalty(c_N_factor):
     r = bar(phase=0.3, c_N_factor=c_N_factor)
     assert abs(r["energy_error_max"]) < 1e-4, r["energy_error_max"]
-    standard = run_scene("bar_impact", "fast", dict(n_el=20, c_N_factor=c_N_factor, gap=r["parameters"]["gap"]))
+    def standard():
+        return run_scene("bar_impact", "fast", dict(n_el=20, c_N_factor=c_N_factor, gap=r["parameters"]["gap"]))
     if c_N_factor >= 100:
-        assert standard["energy_error"] > 1e-2                  # Newmark 1/2, 1/4 gains energy here
+        with pytest.warns(UserWarning, match="the energy grew by"):       # and says so
+            assert standard()["energy_error"] > 1e-2            # Newmark 1/2, 1/4 gains energy here
+    else:
+        standard()
 
 
 # -- sloping impact ---------------------------------------------------------------------

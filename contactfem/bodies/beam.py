@@ -217,24 +217,25 @@ class Beam:
         g = self._gauss()
         e = g["edofs"]
         q0 = np.asarray(u0, float)[e]
-        q1 = np.asarray(u1, float)[e]
-        F = np.bincount(e.ravel(), self._step_forces(q0, q1, g).ravel(), minlength=self.ndof)
+        # the end state and its six complex steps, one per element dof, in one pass: (6, 7, m)
         step = 1e-30
-        Ke = np.empty((6, 6, e.shape[1]))
-        for j in range(6):
-            q = q1.astype(complex)
-            q[j] += 1j * step
-            Ke[:, j] = self._step_forces(q0, q, g).imag / step
+        q = np.repeat(np.asarray(u1, float)[e][:, None, :], 7, axis=1).astype(complex)
+        q[np.arange(6), np.arange(1, 7)] += 1j * step
+        out = self._step_forces(q0[:, None, :], q, g)
+        F = np.bincount(e.ravel(), out[:, 0].real.ravel(), minlength=self.ndof)
+        Ke = out[:, 1:].imag / step                               # (6, 6, m): d F_i / d q_j
         rows = np.broadcast_to(e[:, None, :], Ke.shape).ravel()
         cols = np.broadcast_to(e[None, :, :], Ke.shape).ravel()
         return F, rows, cols, Ke.ravel()
 
     def _step_forces(self, q0, q1, g):
-        """The element forces (6, m) of ``discrete_gradient`` at every integration point row,
-        from the element dofs q0, q1 (6, m) at the step's start and end (q1 may be complex)."""
+        """The element forces (6, ..., m) of ``discrete_gradient`` at every integration point row,
+        from the element dofs q0, q1 (6, ..., m) at the step's start and end (q1 may be complex;
+        the middle axes broadcast)."""
         Na, Nb, invL = g["Na"], g["Nb"], g["invL"]
-        a0 = (g["dX"] + q0[3:5] - q0[0:2]) * invL                # x' at the start and the end
-        a1 = (g["dX"] + q1[3:5] - q1[0:2]) * invL
+        dX = g["dX"].reshape((2,) + (1,) * (q1.ndim - 2) + (-1,))
+        a0 = (dX + q0[3:5] - q0[0:2]) * invL                      # x' at the start and the end
+        a1 = (dX + q1[3:5] - q1[0:2]) * invL
         th0 = g["theta0"] + Na * q0[2] + Nb * q0[5]
         th1 = g["theta0"] + Na * q1[2] + Nb * q1[5]
         D = g["D"][:, 0]

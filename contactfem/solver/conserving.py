@@ -87,8 +87,10 @@ class EnergyConsistent:
         s = self.system
         t1, tm = t + dt, t + 0.5 * dt
         M = s.mass()                        # lumped (a vector) or consistent (a sparse matrix)
-        Msp = sp.diags(M) if isinstance(M, np.ndarray) else M
         c_mass = 2.0 / dt ** 2
+
+        def inertia(D):                     # d (c_mass M (dq - dt v)) / d u1 = c_mass M diag(D)
+            return sp.diags(c_mass * M * D) if isinstance(M, np.ndarray) else c_mass * (M @ sp.diags(D))
         rot = self.rotations
 
         def fun(u1):
@@ -117,7 +119,7 @@ class EnergyConsistent:
             vals += [vv * chord[r] for r, vv in zip(rows_c, vals_c)] + [dchord * Gc[rot]]
             G += s.mass_times(c_mass * (dq - dt * v))
             K = sp.coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                              shape=(s.ndof, s.ndof)).tocsr() + c_mass * (Msp @ sp.diags(D))
+                              shape=(s.ndof, s.ndof)).tocsr() + inertia(D)
             return Evaluation(G, K, tuple(states))
 
         guess = s.apply_dirichlet(u + dt * v + 0.5 * dt ** 2 * a, t1)
