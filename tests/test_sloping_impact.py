@@ -161,3 +161,16 @@ def test_discretisation_study_kept_with_the_figures_is_the_run():
             for k, v in row.get(variant, {}).items():
                 assert v == pytest.approx(by_label[row["label"]][variant][k], rel=1e-9, abs=1e-12), \
                     (row["label"], variant, k)
+
+
+def test_a_fine_ring_runs():
+    """n_el = 1000 (the range allows 2000): Newton's tolerance follows the round-off of the
+    ring's residual, which grows with n_el (at the fixed 1e-10 Newton stalled just above it
+    after the rebound); the rebound agrees with the paper preset's ring refined, within the
+    discretisation's change (n_el = 16 -> 1000 moves v_y by less than 10 %)."""
+    from contactfem.scenes import get_scene
+    from contactfem.scenes.sloping_impact import newton_atol
+    assert newton_atol(get_scene("sloping_impact").resolve("paper"), 48) == 1e-10    # the presets keep 1e-10
+    fine = run_scene("sloping_impact", "fast", {"n_el": 1000})
+    coarse = run_scene("sloping_impact", "fast")
+    assert fine["rebounded"] and abs(fine["rebound_vy"] - coarse["rebound_vy"]) < 0.1 * abs(coarse["rebound_vy"])
