@@ -50,21 +50,18 @@ def simulate(model, params=None, progress=None):
     return list(watch(records, progress, st.t0, st.schedule.t_end, st.name or model.get("name", "")))
 
 
-# energy_error above which a run warns: the balance counts the dissipation and the loads' work,
-# so a run can only lose energy; a gain of 1 % is no Newton tolerance's share (1e-6 at most)
-ENERGY_GAIN = 0.01
-
-
 def run(scene, params, normal=None, friction=None, progress=None, linear_algebra="auto", instrument=None):
     """Build, simulate and measure a scene with resolved parameters; ``linear_algebra`` and
     ``instrument`` (solver.instrument.Timings) go to every System the scene builds (its
-    ``system_options``). The results come with the
-    run's own wall time (``wall_time_s``: building, solving and measuring, less the time spent
-    loading modules on first use: contactfem.clock), the linear algebra of the Systems it built (``linear_algebra``, ``ordering``,
-    ``unknowns``, ``band_kl``, ``band_ku``) and how often they were evaluated
+    ``system_options``). The results come with the run's own wall time (``wall_time_s``:
+    building, solving and measuring, less the time spent loading modules on first use:
+    contactfem.clock), the linear algebra of the Systems it built (``linear_algebra``,
+    ``ordering``, ``unknowns``, ``band_kl``, ``band_ku``) and how often they were evaluated
     (``residual_evaluations``: System evaluations, one per residual Newton needs;
-    ``contact_evaluations``: contact evaluations, one per contact in each)."""
+    ``contact_evaluations``: contact evaluations, one per contact in each). A run whose
+    energy grew warns (time_integration.warn_energy_gain)."""
     from ..clock import imports_timed
+    from .time_integration import warn_energy_gain
 
     with imports_timed() as imported:              # modules loaded on first use: not the run's time
         t0 = time.perf_counter()
@@ -74,13 +71,7 @@ def run(scene, params, normal=None, friction=None, progress=None, linear_algebra
         results = dict(scene.measure(model, params, records))
         wall = time.perf_counter() - t0
     systems = model["systems"]
-    gain = results.get("energy_error")
-    if isinstance(gain, float) and gain > ENERGY_GAIN:
-        import warnings
-
-        warnings.warn(f"the energy grew by {gain:.1%} over the run (energy_error = {gain:.3g}; dissipation and the "
-                      "loads' work counted): the time integration does not resolve this impact (the README's Known "
-                      "limitations say which settings do)", stacklevel=2)
+    warn_energy_gain(results.get("energy_error"))
     results["wall_time_s"] = wall - imported[0]
     results["linear_algebra"] = "+".join(dict.fromkeys(s.linear_algebra for s in systems)) or None
     results["ordering"] = "+".join(dict.fromkeys(s.ordering for s in systems)) or None
@@ -228,14 +219,6 @@ class Scene:
 # law at; and, for a static body held by friction alone, hold = dict(T=tangential load,
 # N=normal load, L=contact length (sum of the weights), w_min=smallest weight).
 LAW_RANGE_KEYS = ("p", "q", "v", "dt", "g", "hold")
-
-
-def penalty_pressure(energy, c_N, m=1.0, weight=1.0):
-    """The pressure c_N a^m of the penalty law (eq 4) at the penetration a where one node of
-    weight `weight` stores all of `energy`: w c_N a^(m+1) / (m+1) = energy. A bound of the
-    pressures of a run whose energy is `energy` (a scene's law_range)."""
-    a = ((m + 1.0) * energy / (weight * c_N)) ** (1.0 / (m + 1.0))
-    return c_N * a ** m
 
 
 def jsonable(obj, where="result"):

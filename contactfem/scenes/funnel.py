@@ -36,8 +36,8 @@ from ..contact import NodeToSegment, RigidPolyline
 from ..laws import ParabolicSlip, PowerLaw
 from ..solver import Dirichlet, History, Steps, System
 from . import time_integration
-from .base import Param, Scene, Stage, penalty_pressure
-from .rings import MASS_MATRIX_PARAM, RING_PARAMS, ring_history, ring_size, snapshot_indices
+from .base import Param, Scene, Stage
+from .rings import MASS_MATRIX_PARAM, RING_PARAMS, penalty_pressure, ring_history, ring_size, snapshot_indices
 
 VARIANTS = ("frictionless", "frictional")
 

@@ -1,6 +1,7 @@
 """What the ring scenes share (Secs 5.2-5.4; not a scene itself): the ring of Secs 5.3-5.4,
-the size of a ring model, the measures a ring scene reads from its records, and the
-rigid ring's closed form that the rolling ring is compared with.
+the size of a ring model, the measures a ring scene reads from its records, the
+rigid ring's closed form that the rolling ring is compared with, and the bound of an
+impact's penalty pressure (``penalty_pressure``).
 
     history = ring_history(ring, records)     # t, x_c, v_c, omega, n_contact, n_slip per record
     shots = snapshot_indices(history["t"], every=20)   # which records the figures draw
@@ -137,3 +138,11 @@ def ring_gyration_radius2(ring):
     r2 = np.sum((b.X - ring.center) ** 2, axis=1)
     J = M[2::3].sum() if ring.kind == "beam" else 0.0
     return float((mx @ r2 + J) / mx.sum())
+
+
+def penalty_pressure(energy, c_N, m=1.0, weight=1.0):
+    """The pressure c_N a^m of the penalty law (eq 4) at the penetration a where one node of
+    weight `weight` stores all of `energy`: w c_N a^(m+1) / (m+1) = energy. A bound of the
+    pressures of a run whose energy is `energy` (a scene's law_range)."""
+    a = ((m + 1.0) * energy / (weight * c_N)) ** (1.0 / (m + 1.0))
+    return c_N * a ** m

@@ -55,8 +55,8 @@ from ..contact import NodeToSegment, RigidLine
 from ..laws import Coulomb, PowerLaw
 from ..solver import History, Steps, System
 from . import time_integration
-from .base import Param, Scene, Stage, penalty_pressure
-from .rings import MASS_MATRIX_PARAM, detect_rolling, rigid_ring_exact, ring_gyration_radius2, ring_history, ring_size, snapshot_indices  # noqa: F401
+from .base import Param, Scene, Stage
+from .rings import MASS_MATRIX_PARAM, detect_rolling, penalty_pressure, rigid_ring_exact, ring_gyration_radius2, ring_history, ring_size, snapshot_indices  # noqa: F401
 
 # Paper, Fig 9 (bracketed values are the rigid thin-ring solution)
 PAPER = dict(x_roll_exact=229.0, x_roll_computed="23x (scan)", x_end_exact=376.0, x_end_computed=382.0,
