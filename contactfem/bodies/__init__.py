@@ -15,6 +15,11 @@ for a continuum ring and the solver never knows the difference:
                        consistent tangent K = dR/du (scipy.sparse, ndof x ndof)
     body.strain_energy(u) -> float
     body.commit(u)     accept u as converged (history variables; no-op if elastic)
+    body.rotation_dofs local dofs that are angles (a beam's theta; none for a continuum)
+    body.discrete_gradient(u0, u1) -> (F, rows, cols, vals): the internal force of an
+                       energy-consistent step and its tangent (discrete_gradient.py)
+
+(interfaces.py writes the interface down as a Protocol).
 
 `u` is always the body's own (local) displacement vector; the solver's System
 places bodies one after another in the global vector (``body.dof_offset``).
