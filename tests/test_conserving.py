@@ -288,6 +288,26 @@ def test_beam_discrete_gradient_is_exact_and_has_no_resultant_or_moment(rng, int
     assert rel_error(K, J) < 1e-6
 
 
+def step_residual(stepper, u, v, dt):
+    """The residual function (u1 -> Evaluation) that an EnergyConsistent step from (u, v) hands to
+    Newton, and Newton's first guess: taken from the call, which is stopped there."""
+    import contactfem.solver.conserving as conserving
+    captured = {}
+
+    def capture(fun, guess, free, **options):
+        captured["fun"], captured["guess"] = fun, guess
+        raise StopIteration
+
+    real = conserving.newton
+    conserving.newton = capture
+    try:
+        with pytest.raises(StopIteration):
+            stepper.step(0.0, u, v, np.zeros_like(u), dt)
+    finally:
+        conserving.newton = real
+    return captured["fun"], captured["guess"]
+
+
 @pytest.mark.parametrize("variant", ["frictionless", "frictional"])
 def test_energy_consistent_step_tangent_with_a_contact_on_the_ring(rng, variant):
     """The whole residual of an energy-consistent step of the sloping impact's ring pressed
@@ -304,21 +324,8 @@ def test_energy_consistent_step_tangent_with_a_contact_on_the_ring(rng, variant)
     v = ring.initial_velocity((p["vx0"], p["vy0"]), omega=0.1)
     for c in system.contacts:
         c.start(u)
-    captured = {}
-
-    def capture(fun, guess, free, **options):
-        captured["fun"], captured["guess"] = fun, guess
-        raise StopIteration
-
-    real = conserving.newton
-    conserving.newton = capture
-    try:
-        with pytest.raises(StopIteration):
-            stepper.step(0.0, u, v, np.zeros_like(u), p["dt"])
-    finally:
-        conserving.newton = real
-    fun = captured["fun"]
-    u1 = captured["guess"] + 1e-3 * rng.standard_normal(system.ndof)
+    fun, guess = step_residual(stepper, u, v, p["dt"])
+    u1 = guess + 1e-3 * rng.standard_normal(system.ndof)
     u1[ring.body.xdofs[:, 0]] += 0.05                                    # slip along the plane
     ev = fun(u1)
     assert np.any([np.any(c.active) for c in ev.contacts])
@@ -389,21 +396,8 @@ def test_energy_consistent_step_tangent_with_moments_on_the_angles(rng):
     import contactfem.solver.conserving as conserving
     ring, system, v = spun_ring_with_moments()
     stepper = conserving.EnergyConsistent(system)
-    captured = {}
-
-    def capture(fun, guess, free, **options):
-        captured["fun"], captured["guess"] = fun, guess
-        raise StopIteration
-
-    real = conserving.newton
-    conserving.newton = capture
-    try:
-        with pytest.raises(StopIteration):
-            stepper.step(0.0, np.zeros(system.ndof), v, np.zeros(system.ndof), 0.25)
-    finally:
-        conserving.newton = real
-    fun = captured["fun"]
-    u1 = captured["guess"] + 1e-2 * rng.standard_normal(system.ndof)
+    fun, guess = step_residual(stepper, np.zeros(system.ndof), v, 0.25)
+    u1 = guess + 1e-2 * rng.standard_normal(system.ndof)
     J = fd_jacobian(lambda x: fun(x).G, u1, h=1e-7)
     assert rel_error(fun(u1).K.toarray(), J) < 1e-6
 
