@@ -336,38 +336,37 @@ class Beam:
 
         Every quantity is an array over the rows (row j = k ne + e is point k of element e, the
         rows of the plastic strains ``ep``): the element's 36 entries are made from ten arrays,
-        and the points' sums are taken at the end.
+        and the points' sums are taken at the end. A vector over the rows is a (2, m) array (t,
+        n, x', v: both components in one product), and so are the entries that share a form.
         """
         g = self._gauss()
-        E, c, s = self._row_strains(u, g)
+        E, t, n = self._row_strains(u, g)
         S, C = self._resultants(E, g, dt)
         eps, gam = E[0], E[1]
         N, Q, M = S[0], S[1], S[2]
         C_N, C_Q, C_M = C[0], C[1], C[2]
         e1 = 1 + eps                                             # x'.t
+        m = len(eps)
         # residual w L0 B^T S, one row of re per element dof (u_a, theta_a, u_b, theta_b)
-        f0, f1 = N * c - Q * s, N * s + Q * c                    # N t + Q n
+        re = np.empty((6, m))
+        np.multiply(g["wiL"], N * t + Q * n, out=re[3:5])        # x': N t + Q n (times 1/L0 at b)
+        np.negative(re[3:5], out=re[0:2])                        # (times -1/L0 at a)
         h = N * gam - Q * e1                                     # theta: (N gam - Q (1 + eps)) p
         wM = g["wiL"] * M
-        re = np.empty((6, len(c)))
-        re[3], re[4] = g["wiL"] * f0, g["wiL"] * f1
-        re[0], re[1] = -re[3], -re[4]
         re[2], re[5] = g["wNa"] * h - wM, g["wNb"] * h + wM
         # tangent: the ten distinct entries of w L0 K_e (docstring)
-        cc, ss, cs = c * c, s * s, c * s
+        U = np.empty((20, m))                                    # the ten entries, then their negatives
+        tt = np.empty((3, m))                                    # t t^T: (c c, c s, s s)
+        np.multiply(t, t[0], out=tt[0:2])
+        np.multiply(t[1], t[1], out=tt[2])
+        nn = tt[::-1] * g["flip"]                                # n n^T: (s s, -c s, c c)
+        np.multiply(g["wiL2"], C_N * tt + C_Q * nn, out=U[0:3])  # x'x' (times 1/L0^2)
         a1, a2 = C_N * gam - Q, N - C_Q * e1
-        alpha = C_N * (gam * gam) + C_Q * (e1 * e1) - N * e1 - Q * gam
-        kk = g["wiL2"] * C_M
-        U = np.empty((20, len(c)))                               # the ten entries, then their negatives
-        U[0] = g["wiL2"] * (C_N * cc + C_Q * ss)                 # x'x' (times 1/L0^2)
-        U[1] = g["wiL2"] * ((C_N - C_Q) * cs)
-        U[2] = g["wiL2"] * (C_N * ss + C_Q * cc)
-        v0, v1 = a1 * c - a2 * s, a1 * s + a2 * c                # v = (C_N gam - Q) t + (N - C_Q (1 + eps)) n
-        U[3], U[4] = g["wiLNa"] * v0, g["wiLNa"] * v1            # x' theta_a (times 1/L0)
-        U[5], U[6] = g["wiLNb"] * v0, g["wiLNb"] * v1            # x' theta_b
-        U[7] = g["wNaNa"] * alpha + kk                           # theta theta
-        U[8] = g["wNaNb"] * alpha - kk
-        U[9] = g["wNbNb"] * alpha + kk
+        v = a1 * t + a2 * n                                      # v = (C_N gam - Q) t + (N - C_Q (1 + eps)) n
+        np.multiply(g["wiLN"], v, out=U[3:7].reshape(2, 2, m))   # x' theta_a, x' theta_b (times 1/L0)
+        alpha = gam * a1 - e1 * a2                               # = C_N gam^2 + C_Q (1 + eps)^2 - N (1 + eps) - Q gam
+        np.multiply(g["wNN"], alpha, out=U[7:10])                # theta theta: alpha p p^T
+        U[7:10] += g["wiL2pm"] * C_M                             #   + C_M / L0^2 [[1, -1], [-1, 1]]
         if len(self.points) > 1:                                 # two points: sum them per element (rows
             ne = self.ne                                         # e and ne + e), before K_e is spread out
             re, U = re[:, :ne] + re[:, ne:], U[:, :ne] + U[:, ne:]
@@ -377,17 +376,22 @@ class Beam:
         return R, self._rows, self._cols, Ke.ravel()
 
     def _row_strains(self, u, g):
-        """The strains E = (eps, gam, kap) (3, m) and cos, sin of the angle phi at every row of
-        ``_gauss`` (all integration points of all elements)."""
+        """The strains E = (eps, gam, kap) (3, m) and t = (cos, sin), n = (-sin, cos) of the angle
+        phi (each (2, m)) at every row of ``_gauss`` (all integration points of all elements)."""
         q = np.asarray(u, float)[g["edofs"]]                     # (6, m): u_a, theta_a, u_b, theta_b per row
-        x0, x1 = (g["dX"] + q[3:5] - q[0:2]) * g["invL2"]        # x', both components at once
+        x = (g["dX"] + q[3:5] - q[0:2]) * g["invL2"]             # x', both components at once
         phi = g["theta0"] + g["Na"] * q[2] + g["Nb"] * q[5]
-        c, s = np.cos(phi), np.sin(phi)
+        t = np.empty((2, len(phi)))
+        np.cos(phi, out=t[0])
+        np.sin(phi, out=t[1])
+        n = t[::-1] * g["turn"]                                  # n = e3 x t = (-sin, cos)
+        xt, xn = x * t, x * n
         E = np.empty((3, len(phi)))
-        E[0] = x0 * c + x1 * s - 1.0                             # eps = x' . t - 1
-        E[1] = x1 * c - x0 * s                                   # gam = x' . n
-        E[2] = (q[5] - q[2]) * g["invL"]                         # kap = theta'
-        return E, c, s
+        np.add(xt[0], xt[1], out=E[0])                           # eps = x' . t - 1
+        E[0] -= 1.0
+        np.add(xn[0], xn[1], out=E[1])                           # gam = x' . n
+        np.multiply(q[5] - q[2], g["invL"], out=E[2])            # kap = theta'
+        return E, t, n
 
     def _resultants(self, E, g, dt):
         """The resultants S = (N, Q, M) (3, m) at the strains E of every row and their moduli
@@ -401,8 +405,11 @@ class Beam:
     def _gauss(self):
         """Per-row constants of internal_coo (row k ne + e: point k of element e), made once:
         the element dofs (6, m), chords, lengths and angles, the shape functions N_a, N_b at
-        the point and their products with the weight w L0 and 1/L0, and the map from the ten
-        distinct entries of K_e and their negatives (rows 10-19) to its 36 (``entry``)."""
+        the point and their products with the weight w L0 and 1/L0 (stacked as internal_coo
+        uses them: wiLN = w L0 / L0 (N_a, N_b), wNN = w L0 (N_a N_a, N_a N_b, N_b N_b), wiL2pm = w L0
+        / L0^2 (1, -1, 1)), the signs that turn t t^T into n n^T (flip) and t into n (turn), and
+        the map from the ten distinct entries of K_e and their negatives (rows 10-19) to its 36
+        (``entry``)."""
         if getattr(self, "_g", None) is None:
             ne, k = len(self.L0), len(self.points)
             xi = np.repeat([x for x, _ in self.points], ne)
@@ -422,13 +429,18 @@ class Beam:
                         entry[6 * i + j], sign[6 * i + j] = 3 + d % 3 + (2 if th == 5 else 0), side[d]
                     else:
                         entry[6 * i + j] = {(2, 2): 7, (2, 5): 8, (5, 2): 8, (5, 5): 9}[(i, j)]
-            self._g = dict(edofs=np.concatenate([self.edofs.T] * k, axis=1),
-                           dX=np.concatenate([self._dX.T] * k, axis=1),
+            # C order: the rows of the element dofs q = u[edofs] (u_x of node a, ...) and of the
+            # chords are contiguous, so every product over a row runs on contiguous memory
+            self._g = dict(edofs=np.ascontiguousarray(np.concatenate([self.edofs.T] * k, axis=1)),
+                           dX=np.ascontiguousarray(np.concatenate([self._dX.T] * k, axis=1)),
                            invL=invL, invL2=np.array([invL, invL]), Dm=self.D[:, None] * np.ones((3, len(xi))),
                            D2=2 * self.D[:, None], theta0=tile(self.theta0), Na=Na, Nb=Nb, wL0=wL0,
                            wiL=wL0 * invL, wiL2=wL0 * invL * invL, wNa=wL0 * Na, wNb=wL0 * Nb,
-                           wiLNa=wL0 * invL * Na, wiLNb=wL0 * invL * Nb, wNaNa=wL0 * Na * Na,
-                           wNaNb=wL0 * Na * Nb, wNbNb=wL0 * Nb * Nb, entry=np.where(sign < 0, entry + 10, entry),
+                           wiLN=np.array([wL0 * invL * Na, wL0 * invL * Nb])[:, None, :],
+                           wNN=np.array([wL0 * Na * Na, wL0 * Na * Nb, wL0 * Nb * Nb]),
+                           wiL2pm=wL0 * invL * invL * np.array([[1.0], [-1.0], [1.0]]),
+                           flip=np.array([[1.0], [-1.0], [1.0]]), turn=np.array([[-1.0], [1.0]]),
+                           entry=np.where(sign < 0, entry + 10, entry),
                            D=self.D[:, None], S0=None if self.S0 is None else self.S0[:, None])
         return self._g
 
@@ -438,7 +450,7 @@ class Beam:
         All integration points in one pass, the rows of internal_coo."""
         g = self._gauss()
         S = self._resultants(self._row_strains(u, g)[0], g, dt)[0]
-        return float(np.sum(g["wL0"] * (S ** 2 / g["D2"])))
+        return float((g["wL0"] * (S * S / g["D2"])).sum())
 
     def commit(self, u, dt=None):
         """Accept u as converged at the end of a step of dt: store the plastic strains
