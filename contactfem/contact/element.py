@@ -59,7 +59,13 @@ def normal_element(w, t_N, dt_N, dg_N, d2g_N):
 def to_coo(dofs, K):
     """COO triplets (rows, cols, vals) of the element matrices K (nc, k, k) placed at
     global dofs (nc, k)."""
+    return (*coo_indices(dofs), K.ravel())
+
+
+def coo_indices(dofs):
+    """The rows and cols of to_coo: where the entries of element matrices at global dofs
+    (nc, k) go, entry by entry (row-major in each element)."""
     k = dofs.shape[1]
     rows = np.repeat(dofs, k, axis=1).ravel()
     cols = np.concatenate([dofs] * k, axis=1).ravel()          # np.tile(dofs, (1, k)), without its overhead
-    return rows, cols, K.ravel()
+    return rows, cols

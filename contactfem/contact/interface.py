@@ -31,7 +31,7 @@ import numpy as np
 
 from ..laws.protocol import as_friction_law
 from ..laws.return_map import OPEN, STICK, return_map
-from .element import contact_element, normal_element, to_coo
+from .element import contact_element, coo_indices, normal_element, to_coo
 from .state import ContactHistory, ContactState
 from .tangents import TANGENTS
 
@@ -252,6 +252,18 @@ class NodeToSegment:
         if self.tangent == "symmetric":
             K = 0.5 * (K + K.transpose(0, 2, 1))
         return R, K
+
+    def pattern(self, dofs):
+        """The rows and cols of the element tangents at the pairs' dofs (m, k) (element.coo_indices):
+        the same (read-only) arrays as at the last call while the pairs in contact stay the same,
+        so that the System finds their places in K once per change of the contact set, not at
+        every evaluation (assembly.py keeps them by the arrays' identity)."""
+        key = (dofs.shape, dofs.tobytes())
+        if getattr(self, "_pattern", (None,))[0] != key:
+            rows, cols = coo_indices(dofs)
+            rows.flags.writeable = cols.flags.writeable = False
+            self._pattern = (key, rows, cols)
+        return self._pattern[1:]
 
     # -- conveniences (tests, lectures) -------------------------------------------------
     def assemble(self, u, t=0.0, dt=None, u0=None):

@@ -16,7 +16,6 @@ from functools import cached_property
 import numpy as np
 
 from ..laws.return_map import STATE_NAMES
-from .element import to_coo
 
 
 @dataclass(frozen=True)
@@ -88,8 +87,8 @@ class ContactState:
             empty = np.zeros(0, dtype=int)
             return np.zeros(ndof), empty, empty, np.zeros(0)
         R_c = np.bincount(dofs.ravel(), self.R.ravel(), minlength=ndof)
-        rows, cols, vals = to_coo(dofs, self.K)
-        return R_c, rows, cols, vals
+        rows, cols = self.contact.pattern(dofs)
+        return R_c, rows, cols, self.K.ravel()
 
     # -- what the converged state gives (computed on first use) -------------------------
     @cached_property

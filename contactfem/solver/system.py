@@ -68,9 +68,13 @@ class Dirichlet:
 
 
 def _triplets(rows, cols, vals):
-    """COO triplets as three flat arrays (accepts lists and empty inputs)."""
-    return (np.asarray(rows, dtype=int).ravel(), np.asarray(cols, dtype=int).ravel(),
-            np.asarray(vals, dtype=float).ravel())
+    """COO triplets as three flat arrays (accepts lists and empty inputs); flat arrays of the
+    right type are passed on as they are (the same objects: the assembly knows index arrays
+    it has seen before by their identity)."""
+    rows, cols, vals = np.asarray(rows, dtype=int), np.asarray(cols, dtype=int), np.asarray(vals, dtype=float)
+    if rows.ndim != 1 or cols.ndim != 1 or vals.ndim != 1:
+        rows, cols, vals = rows.ravel(), cols.ravel(), vals.ravel()
+    return rows, cols, vals
 
 
 def as_array(K):
@@ -255,16 +259,17 @@ class System:
                 Rc, r, c, v = state.scatter(self.ndof)
                 G += Rc
                 if len(v):                             # (a contact in flight adds no tangent entries)
-                    blocks.append((*_triplets(r, c, v), 0, None))
-                states.append(state)
+                    blocks.append((*_triplets(r, c, v), 0, contact))   # (r, c: the same arrays while
+                states.append(state)                                     # its contact set stays)
 
         with timed(self.instrument, "assembly"):
             P = np.zeros(self.ndof)
             for load in self.loads:                    # loads enter with a minus sign
                 Pl, r, c, v = load.assemble(u, t)
                 P += Pl
-                r, c, v = _triplets(r, c, v)
-                blocks.append((r, c, -v, 0, None))
+                if len(v):                             # (a dead load has no tangent)
+                    r, c, v = _triplets(r, c, v)
+                    blocks.append((r, c, -v, 0, None))
             if self.loads:
                 G -= P
             diagonal = None
