@@ -29,15 +29,14 @@ def contact_element(w, t_N, dt_N, t_T, c_T_s, c_N_s, dg_N, d2g_N, ds, d2s, ddg_T
     their terms t_N d2g_N and t_T d2s are left out, which adds nothing but zeros.
     """
     ddg_T = ds if ddg_T is None else ddg_T
-    W = w[:, None]
-    R = W * (t_N[:, None] * dg_N + t_T[:, None] * ds)
-    K = dt_N[:, None, None] * outer(dg_N, dg_N)
+    R = w[:, None] * (t_N[:, None] * dg_N + t_T[:, None] * ds)
+    # eq (33)'s dt_N dg_N dg_N^T, and the c_T^s and c_N^s terms of eqs (39), (49), (50) in one
+    # product: ds (c_T^s ddg_T + c_N^s dg_N)^T
+    K = outer(dt_N[:, None] * dg_N, dg_N) + outer(ds, c_T_s[:, None] * ddg_T + c_N_s[:, None] * dg_N)
     if d2g_N is not None:
         K += t_N[:, None, None] * d2g_N
-    K += c_T_s[:, None, None] * outer(ds, ddg_T)
     if d2s is not None:
         K += t_T[:, None, None] * d2s
-    K += c_N_s[:, None, None] * outer(ds, dg_N)
     K *= w[:, None, None]
     return R, K
 

@@ -158,12 +158,16 @@ class NodeToSegment:
         g_raw = k["g_N"] - self.offset
         g_N = g_raw + self.gap_offset(h.z_bar) if self._wear else g_raw
         active = k["inside"] & (g_N < 0.0)
-        t_N, dt_N = self.normal.traction(np.where(active, g_N, 1.0))
+        nc = len(g_N)
+        touching = active.any()
+        if touching:
+            t_N, dt_N = self.normal.traction(np.where(active, g_N, 1.0))
+        else:                                               # every node open (a body in flight): a normal
+            t_N = dt_N = zeros(nc)                          # law's t_N is 0 when open (read-only)
         dofs = np.concatenate([self.slave_dofs(), k["master_dofs"]], axis=1) if k["master_dofs"].size else self._dofs
         travel = k["s"] - h.s_bar
-        nc = len(g_N)
         r, dr, dg_T, ddg_T = ones(nc), zeros(nc), travel, k["ds"]   # r = 1: Delta g_T = travel (read-only)
-        closing = (active & (h.g_bar > 0.0)).nonzero()[0] if self.closing_step else ()
+        closing = (active & (h.g_bar > 0.0)).nonzero()[0] if self.closing_step and touching else ()
         if len(closing):                                    # the closing step (module docstring), at those nodes
             c, gb, g = closing, h.g_bar[closing], g_N[closing]
             r, dr = np.ones(nc), np.zeros(nc)

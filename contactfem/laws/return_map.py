@@ -78,12 +78,15 @@ def return_map(law, t_N, dt_N, dg_T, t_T_bar, q_bar, z_bar=None, dt=None, tol=1e
     paper_form = L.arity == 2 and not L.n_state
 
     # open nodes (p = 0) carry nothing and keep their history: integrate the nodes in contact, c
-    t_T, c_T_s, c_N_s, lam = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
-    state, q, z = np.zeros(n, dtype=int), q_bar.copy(), np.array(z_bar, dtype=float)   # state: OPEN (= 0)
+    t_T, c_T_s, c_N_s, lam = np.zeros((4, n))
+    state = np.zeros(n, dtype=int)                                # OPEN (= 0)
+    q = q_bar                                                     # (copied where a node slips)
+    z = np.array(z_bar, dtype=float) if L.n_state else z_bar      # (no variables: nothing to copy)
     c = (t_N < 0.0).nonzero()[0]
     if not c.size:                            # every node open (a body in flight): nothing to integrate
-        return FrictionState(t_T=t_T, c_T_s=c_T_s, c_N_s=c_N_s, state=state, lam=lam, q=q, z=z, v=lam.copy())
-    p, q_c, z_c = -t_N[c], q_bar[c], z_bar[c]
+        return FrictionState(t_T=t_T, c_T_s=c_T_s, c_N_s=c_N_s, state=state, lam=lam, q=q.copy(), z=z, v=lam.copy())
+    p, q_c = -t_N[c], q_bar[c]
+    z_c = z_bar[c] if L.n_state else z_bar[:c.size]
     t_tr = t_T_bar[c] + c_T * dg_T[c]                             # eq (42)
     if paper_form:
         z0 = z_c
@@ -145,6 +148,7 @@ def return_map(law, t_N, dt_N, dg_T, t_T_bar, q_bar, z_bar=None, dt=None, tol=1e
         c_T_s[c_i] = c_T * Y_lam / D                              # eq (48)
         c_N_s[c_i] = s * Y_P * (-dt_N[c_i]) * c_T / D             # eq (48)
         lam[c_i] = lam_i
+        q = q_bar.copy()
         q[c_i] = qi + lam_i
         if L.n_state:
             z[c_i] = zz
