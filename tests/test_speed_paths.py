@@ -443,3 +443,40 @@ def test_a_run_reports_the_band_it_solved():
     assert f"kl={ring['band_kl']}, ku={ring['band_ku']}" in ring["ordering"]
     impact = run_scene("sloping_impact", "fast", {"n_steps": 5})
     assert impact["linear_algebra"] == "dense" and impact["band_kl"] is None and impact["band_ku"] is None
+
+
+@pytest.mark.parametrize("kind", ["dense", "banded", "sparse"])
+def test_a_contact_set_kept_reuses_its_pattern_and_gives_the_same_tangent(kind):
+    """While the pairs in contact stay, a contact hands back the same index arrays and the
+    System reuses their places in K; the tangent is the one a fresh System assembles, before
+    and after the contact set changes."""
+    scene = get_scene("rolling_ring")
+    params = scene.resolve("fast")
+
+    def system():
+        model = scene.build(params, system_options=dict(linear_algebra=kind))
+        s = model["system"]
+        s.start(np.zeros(s.ndof))
+        return s
+
+    s = system()
+    lowest = np.argmin(s.contacts[0].slave.X[s.contacts[0].nodes, 1])   # the node touching the floor
+    dofs = s.contacts[0].slave_dofs()
+    u1 = np.zeros(s.ndof)
+    u1[dofs[lowest, 1]] = -1e-3                                          # one node pressed in
+    u2 = u1.copy()
+    u2[dofs[lowest, 0]] = 2e-4                                           # the same node, moved along
+    u3 = u2.copy()
+    u3[dofs[(lowest + 1) % len(dofs), 1]] -= 5.0                         # and its neighbour pressed in
+    first = s.evaluate(u1, 0.0, params["dt"], u1, mass_coefficient=1.0)
+    runs = []
+    for u in (u2, u3):
+        ev = s.evaluate(u, 0.0, params["dt"], u1, mass_coefficient=1.0)
+        fresh = system().evaluate(u, 0.0, params["dt"], u1, mass_coefficient=1.0)
+        np.testing.assert_array_equal(ev.G, fresh.G)
+        np.testing.assert_allclose(as_array(ev.K), as_array(fresh.K), rtol=0, atol=1e-12 * np.abs(as_array(fresh.K)).max())
+        runs.append(ev)
+    n1, n2, n3 = (e.contacts[0].n_active for e in (first, *runs))
+    assert n1 == n2 == 1 and n3 == 2
+    r1, r2, r3 = (e.contacts[0].scatter(s.ndof)[1] for e in (first, *runs))
+    assert r1 is r2 and r3 is not r2 and not r1.flags.writeable
