@@ -42,6 +42,7 @@ index arrays as before (a body's constant connectivity, ``key`` = the body).
 import numpy as np
 
 from .banded import BANDED_WORK, BandPlan, band_too_wide
+from .dissection import DISSECTION_MIN, DissectionPlan
 from .newton import DENSE_ORDERING, ORDERING
 
 # Up to this many unknowns K is dense. Measured on the paper's ring matrices (banded, 3
@@ -94,6 +95,7 @@ class TangentAssembler:
         self.keys = None            # sparse: sorted pattern keys col * n + row
         self.plan = None            # the BandPlan of the pattern (None where the band cannot be chosen)
         self.banded_plan = None     # the plan of the last K solved banded
+        self.dissection = None      # the DissectionPlan of the pattern, where it is solved sparse and large
         self.used = {}              # kind -> ordering, of every assembly so far
         self._cache = {}            # key -> (rows, cols, positions) of a constant contribution
         self.pattern_builds = 0     # how often the pattern was (re)computed
@@ -129,6 +131,9 @@ class TangentAssembler:
             self.plan = None
         if self.requested in ("auto", "banded"):
             self.kind = choose_linear_algebra(self.n, self.requested, self.plan)
+        n_free = self.n if self.free is None else len(self.free)
+        self.dissection = (DissectionPlan(self.indptr, self.indices, self.n, self.free)
+                           if self.kind == "sparse" and n_free >= DISSECTION_MIN else None)
         self._cache.clear()
         self.pattern_builds += 1
         return where[old.size:]
@@ -207,6 +212,9 @@ class TangentAssembler:
         if self.kind == "banded":
             K.band_plan = self.banded_plan = self.plan
             self.used["banded"] = self.plan.description
+        elif self.dissection is not None:
+            K.dissection_plan = self.dissection
+            self.used["sparse"] = self.dissection.description
         else:
             self.used["sparse"] = ORDERING
         return K
@@ -216,5 +224,6 @@ class TangentAssembler:
         changed as the pattern grew); the current choice before the first one."""
         if not self.used:
             kind = self.kind
-            return kind, {"dense": DENSE_ORDERING, "sparse": ORDERING}.get(kind, "reverse Cuthill-McKee")
+            sparse = ORDERING if self.dissection is None else self.dissection.description
+            return kind, {"dense": DENSE_ORDERING, "sparse": sparse}.get(kind, "reverse Cuthill-McKee")
         return "+".join(self.used), "+".join(self.used.values())

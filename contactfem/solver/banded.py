@@ -78,6 +78,8 @@ def band_too_wide(indptr, indices, n, free=None, work=BANDED_WORK):
         level += 1
         reached += frontier.size
         b = max(b, (reached - 1) / (2 * level))
+        if 2.0 * np.ceil(b) ** 2 > work:            # the bound only grows: no need to search on
+            break
     if 2.0 * np.ceil(b) ** 2 <= work:
         return False
     import scipy.sparse as sp                       # structural symmetry: the pattern equals its transpose
