@@ -264,10 +264,12 @@ class Continuum:
         if last is None or not (last[0] is K.indptr or (np.array_equal(last[0], K.indptr)
                                                         and np.array_equal(last[1], K.indices))):
             last = self._coo = (K.indptr, K.indices, np.repeat(np.arange(K.shape[0]), np.diff(K.indptr)))
+        if K.format == "csc":          # columns by columns: (rows, cols) = (indices, the column of each)
+            return R, last[1], last[2], K.data
         return R, last[2], last[1], K.data
 
     def internal(self, u, dt=None):
-        """Internal force R(u) and consistent tangent K = dR/du (csr)."""
+        """Internal force R(u) and consistent tangent K = dR/du (scipy sparse: CSC for the linear material, CSR else)."""
         u = np.asarray(u, dtype=float)
         if self.material == "linear":
             K = self._linear_stiffness()
@@ -281,7 +283,9 @@ class Continuum:
         """The constant K of the linear material (assembled at the first call; _linear_form:
         C isotropic and the same at every point, no fields evaluated)."""
         if self._K_linear is None:
-            self._K_linear = asm(_linear_form, self.basis, lam=self.lam, mu=self.mu, **self._params()).tocsr()
+            # CSC: its entries in the order of the System's fixed pattern (column by column), so
+            # that placing them there first sorts presorted keys (Hertz on 65k quads: ~0.1 s less)
+            self._K_linear = asm(_linear_form, self.basis, lam=self.lam, mu=self.mu, **self._params()).tocsc()
         return self._K_linear
 
     def strain_energy(self, u, dt=None):
