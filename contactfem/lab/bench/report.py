@@ -64,7 +64,15 @@ OPTIMISATIONS = [
     "| a run of rings loads no scipy or scikit-fem: contactfem.io loads each name on first use, the beam's "
     "lumped mass summed with numpy | io/__init__.py, bodies/beam.py | `contactfem run sloping_impact --set "
     "n_steps=5`, whole process (median of 10, load 11 on 2 cores): 0.73 s CPU | 0.32 s CPU; the ratio of 10 pairs "
-    "(median): CPU 0.46, wall 0.42 |", "",
+    "(median): CPU 0.46, wall 0.42 |",
+    "| the linear material's K from its own form (lam tr eps tr eps + 2 mu eps : eps, no sum over the 16 "
+    "entries of C) and kept as CSC (the pattern's order: its first placement sorts presorted keys); above 1e4 free "
+    "unknowns SuperLU after METIS's nested-dissection renumbering (pymetis) instead of its own minimum-degree "
+    "ordering; below 1e4 free dofs the band plan without the breadth-first bound | bodies/continuum.py, "
+    "solver/dissection.py, solver/assembly.py, solver/banded.py | Hertz, run_scene in one process (wall, best of 3, "
+    "65k: of 2; loaded machine, 2 interleaved runs): 1k quads 34-45 ms, 16k 0.71-0.77 s, 65k 3.9-4.0 s; 65k, "
+    "first run in a fresh process, against the code before the fixed pattern (3 pairs): 8.3-9.3 s "
+    "| 27-36 ms, 0.58-0.63 s, 2.8-3.1 s; 3.5-4.1 s |", "",
     "Not adopted (measured when the solvers were chosen, not by this run): pypardiso (MKL PARDISO, installs "
     "from PyPI, about 0.8 s of import time and a large download): at 1e5 unknowns 1.0-1.4 s against 1.3-1.4 s "
     "for SuperLU with MMD_AT_PLUS_A, slower at the paper sizes; not a clear win. scikit-umfpack did not install "
