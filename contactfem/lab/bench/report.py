@@ -318,7 +318,9 @@ def write_markdown(res):
         L += ["## Cost of one Newton iteration, part by part (isolated calls at one state)", "",
               "Best of a few repeats. bulk: the bodies' R and K as the System evaluates them (a beam's COO triplets, a continuum's sparse K); contact: contact.assemble; "
               "assembly: the rest of System.residual_tangent (loads, summing the triplets into K); solve: factorisation + solve "
-              "of the free block by LAPACK's band LU where the System solves banded (band), else by splu with "
+              "of the free block by LAPACK's band LU where the System solves banded (band), by SuperLU after the "
+              "pattern's nested-dissection renumbering where it has one (ND: from 1e4 free unknowns; METIS's "
+              "ordering, made once per pattern like the band plan, not included), else by splu with "
               "the ordering newton() uses (MMD_AT_PLUS_A); SuperLU with each ordering for comparison (COLAMD is "
               "scipy's default).", "",
               "| case | unknowns | contact nodes | bulk [s] | contact [s] | assembly [s] | solve [s] | "
@@ -326,7 +328,8 @@ def write_markdown(res):
               "|---|---|---|---|---|---|---|---|---|---|---|"]
         for name, r in c["cases"].items():
             tot = r["bulk_s"] + r["contact_s"] + r["assembly_s"] + r["solve_s"]
-            band = " (band)" if r.get("solve_banded_s") is not None else ""
+            band = (" (band)" if r.get("solve_banded_s") is not None
+                    else " (ND)" if r.get("solve_dissection_s") is not None else "")
             L.append(f"| {name} | {r['ndof']} | {r['n_contact_nodes']} | {_f(r['bulk_s'])} | {_f(r['contact_s'])} | "
                      f"{_f(r['assembly_s']) if r['assembly_s'] > 0 else '~0 (noise)'} | {_f(r['solve_s'])}{band} | {_f(r['solve_splu_MMD_AT_PLUS_A_s'])} | "
                      f"{_f(r['solve_splu_COLAMD_s'])} | {_f(r['solve_pypardiso_s'])} | {r['contact_s'] / tot:.1%} |")
