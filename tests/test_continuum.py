@@ -79,6 +79,25 @@ def test_linear_strain_energy_is_the_integral_of_W(kind, tri):
     assert body.strain_energy(u) == pytest.approx(integral, rel=1e-12, abs=0)
 
 
+@pytest.mark.parametrize("tri", [False, True])
+@pytest.mark.parametrize("kind", ["plane_strain", "plane_stress", "axisymmetric"])
+def test_linear_stiffness_is_the_general_tangent_form_with_C(kind, tri):
+    """The linear material's K (its own form: lam tr eps tr eps + 2 mu eps : eps) equals the
+    general tangent form grad v : A : grad du with A = C of materials.linear_elastic, entry by
+    entry, to rounding (sums of a few terms of size ~E: 1e-13 E leaves a factor ~100)."""
+    from skfem import asm
+
+    from contactfem.bodies.continuum import _tangent_form
+    from contactfem.bodies.materials import linear_elastic
+
+    body = Continuum(block(tri=tri), E, NU, 1.0, kind=kind)
+    F = np.broadcast_to(np.eye(3)[:, :, None, None], (3, 3) + body.basis.dx.shape)
+    A = linear_elastic(F, body.lam, body.mu)[2]
+    general = asm(_tangent_form, body.basis, A=A, axi=body.axi, thickness=body.thickness)
+    K = body.internal(np.zeros(body.ndof))[1]
+    assert abs(K - general).max() < 1e-13 * E
+
+
 # -- patch tests -------------------------------------------------------------
 
 @pytest.mark.parametrize("material", ["linear", "svk", "neohooke"])

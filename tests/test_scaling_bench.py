@@ -44,3 +44,17 @@ def test_the_table_prints_the_json(study):
         assert cells[8].startswith(r["linear_algebra"])
         assert float(cells[9]) == pytest.approx(r["error_p0"], rel=5e-3)
         assert float(cells[10]) == pytest.approx(r["p0_difference"], rel=0.05, abs=5e-17)
+        for cell, key in ((cells[11], "process_contactfem_s"), (cells[12], "process_plain_s")):
+            assert float(cell) == pytest.approx(r[key], rel=5e-3)
+        assert float(cells[13]) == pytest.approx(r["process_ratio"], abs=0.005 + 1e-12)
+    assert f"{study['import_floor_s']:.3g} s" in md
+
+
+def test_whole_processes_are_timed(study):
+    """The whole-process columns are times of processes that ran (a failing process raises),
+    each above half the import floor both stand on (half: the floor and the processes are single
+    samples on a shared machine, where one sample may be a few tens of percent off), and their
+    ratio is theirs."""
+    for r in study["rows"]:
+        assert r["process_contactfem_s"] > study["import_floor_s"] * 0.5 < r["process_plain_s"]
+        assert r["process_ratio"] == r["process_contactfem_s"] / r["process_plain_s"]

@@ -395,6 +395,73 @@ def test_the_band_bound_gives_no_verdict_on_an_unsymmetric_pattern():
     assert not band_too_wide(A.indptr, A.indices, n, None, 1.0)
 
 
+# -- nested dissection (METIS) for large sparse tangents ---------------------------------
+
+def test_supervariables_merge_the_dofs_of_a_node():
+    """The two dofs of each node of a quad mesh have the same column in the pattern: one
+    supervariable a node; a pattern whose columns all differ keeps one a dof."""
+    from contactfem.solver.dissection import supervariables
+
+    A = grid_pattern(7)
+    sv, k = supervariables(A.indptr, A.indices, A.shape[0])
+    assert k == 64 and np.array_equal(sv, np.arange(128) // 2)
+    B = sp.csc_matrix(np.eye(5) + np.eye(5, k=1))
+    assert supervariables(B.indptr, B.indices, 5)[1] == 5
+
+
+@pytest.mark.parametrize("free", [None, "some"])
+def test_dissection_solve_matches_superlu(free):
+    """A non-symmetric matrix on a 2-D mesh's pattern: SuperLU after METIS's renumbering
+    (the plan) solves it as SuperLU with its own ordering does, to 1e-10 relative (both are
+    LU with partial pivoting of a matrix of condition ~1e2, in a different order), on all dofs
+    and on a free block; the permutation is one."""
+    from scipy.sparse.linalg import splu
+
+    from contactfem.solver.dissection import DissectionPlan
+
+    A = grid_pattern(40).tocoo()
+    rng = np.random.default_rng(7)
+    A = sp.csc_matrix((rng.normal(size=A.nnz) + 20.0 * (A.row == A.col), (A.row, A.col)), shape=A.shape)
+    A.sort_indices()
+    n = A.shape[0]
+    dofs = np.arange(n) if free is None else np.setdiff1d(np.arange(n), np.arange(0, n, 7))
+    plan = DissectionPlan(A.indptr, A.indices, n, None if free is None else dofs)
+    assert np.array_equal(np.sort(plan.perm), np.arange(len(dofs)))
+    b = rng.normal(size=len(dofs))
+    x = plan.solve(A.data, b)
+    x_ref = splu(A[dofs][:, dofs].tocsc(), permc_spec="MMD_AT_PLUS_A").solve(b)
+    assert np.max(np.abs(x - x_ref)) <= 1e-10 * np.max(np.abs(x_ref))
+
+
+def test_singular_tangent_raises_through_the_dissection_plan():
+    """An exactly singular K (a zero column) raises RuntimeError 'exactly singular' from the
+    renumbered SuperLU as from the others: Newton turns it into a NewtonError."""
+    from contactfem.solver.dissection import DissectionPlan
+
+    A = grid_pattern(10).tocoo()
+    vals = np.where(A.col == 33, 0.0, 1.0 + 5.0 * (A.row == A.col))
+    A = sp.csc_matrix((vals, (A.row, A.col)), shape=A.shape)
+    plan = DissectionPlan(A.indptr, A.indices, A.shape[0])
+    with pytest.raises(RuntimeError, match="exactly singular"):
+        plan.solve(A.data, np.ones(A.shape[0]))
+
+
+def test_hertz_renumbered_by_nested_dissection_is_the_same_run(monkeypatch):
+    """Hertz on 72 x 72 quads (10.4k free unknowns, above DISSECTION_MIN) solves by SuperLU
+    after METIS's renumbering, and agrees with SuperLU's own ordering (DISSECTION_MIN raised)
+    to 1e-10 of each number's largest value (different elimination orders round differently)."""
+    from contactfem.scenes import run_scene
+    from contactfem.solver import assembly
+
+    nd = run_scene("hertz", "paper", {"n_el": 72})
+    monkeypatch.setattr(assembly, "DISSECTION_MIN", 10**9)
+    mmd = run_scene("hertz", "paper", {"n_el": 72})
+    assert nd["ordering"] == "nested dissection (METIS), SuperLU" and mmd["ordering"] == "MMD_AT_PLUS_A"
+    assert nd["newton_iterations_total"] == mmd["newton_iterations_total"]
+    for key in ("p0", "a", "p0_fit", "contact_force", "penetration_max"):
+        assert nd[key] == pytest.approx(mmd[key], rel=1e-10, abs=1e-12)
+
+
 def test_large_pattern_with_int32_indices():
     """Above 46340 unknowns the keys col * n + row pass 2**31: a body's int32 index arrays
     (scipy's) must not overflow them (the cost study's block of 1e5 unknowns)."""

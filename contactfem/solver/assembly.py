@@ -20,9 +20,10 @@ The pattern is built by one sort of the keys and a mask of the first of each run
 keys (Hertz on 65k quads, 2.4M keys: 0.04-0.2 s, where numpy's union1d took 2.5 s).
 
 Banded: when the pattern is (re)built, its free block is renumbered by reverse
-Cuthill-McKee and its band measured (banded.py), unless a breadth-first search shows that
-no numbering can give a band narrow enough (banded.band_too_wide: a fine 2-D mesh, whose
-plan would cost more than the bound's few milliseconds and never be used). If the band LU's work per unknown,
+Cuthill-McKee and its band measured (banded.py), unless (from banded.BOUND_MIN free dofs
+on) a breadth-first search shows that no numbering can give a band narrow enough
+(banded.band_too_wide: a fine 2-D mesh, whose plan would cost more than the bound's few
+milliseconds and never be used). If the band LU's work per unknown,
 kl (kl + ku), is at most banded.BANDED_WORK (a band of up to ~86 on each side), K
 carries that plan (``K.band_plan``) and Newton solves with LAPACK's banded LU instead of
 SuperLU, 3-8x faster: the bar impact (kl = 7), the patch test (47), the paper's rolling
@@ -41,7 +42,8 @@ index arrays as before (a body's constant connectivity, ``key`` = the body).
 
 import numpy as np
 
-from .banded import BANDED_WORK, BandPlan, band_too_wide
+from .banded import BANDED_WORK, BOUND_MIN, BandPlan, band_too_wide
+from .dissection import DISSECTION_MIN, DissectionPlan
 from .newton import DENSE_ORDERING, ORDERING
 
 # Up to this many unknowns K is dense. Measured on the paper's ring matrices (banded, 3
@@ -94,6 +96,7 @@ class TangentAssembler:
         self.keys = None            # sparse: sorted pattern keys col * n + row
         self.plan = None            # the BandPlan of the pattern (None where the band cannot be chosen)
         self.banded_plan = None     # the plan of the last K solved banded
+        self.dissection = None      # the DissectionPlan of the pattern, where it is solved sparse and large
         self.used = {}              # kind -> ordering, of every assembly so far
         self._cache = {}            # key -> (rows, cols, positions) of a constant contribution
         self.pattern_builds = 0     # how often the pattern was (re)computed
@@ -122,13 +125,16 @@ class TangentAssembler:
         self.indices, self.indptr = self._template.indices, self._template.indptr   # scipy's index dtype
         self.indices.flags.writeable = self.indptr.flags.writeable = False          # shared by every K
         self.diag_pos = np.searchsorted(self.keys, diag)
-        if self.requested == "banded" or (self.requested == "auto" and not band_too_wide(
-                self.indptr, self.indices, self.n, self.free, BANDED_WORK)):
+        n_free = self.n if self.free is None else len(self.free)
+        if self.requested == "banded" or (self.requested == "auto" and (n_free < BOUND_MIN or not band_too_wide(
+                self.indptr, self.indices, self.n, self.free, BANDED_WORK))):
             self.plan = BandPlan(self.indptr, self.indices, self.n, self.free)
         else:                                       # no plan where the band cannot be chosen
             self.plan = None
         if self.requested in ("auto", "banded"):
             self.kind = choose_linear_algebra(self.n, self.requested, self.plan)
+        self.dissection = (DissectionPlan(self.indptr, self.indices, self.n, self.free)
+                           if self.kind == "sparse" and n_free >= DISSECTION_MIN else None)
         self._cache.clear()
         self.pattern_builds += 1
         return where[old.size:]
@@ -207,6 +213,9 @@ class TangentAssembler:
         if self.kind == "banded":
             K.band_plan = self.banded_plan = self.plan
             self.used["banded"] = self.plan.description
+        elif self.dissection is not None:
+            K.dissection_plan = self.dissection
+            self.used["sparse"] = self.dissection.description
         else:
             self.used["sparse"] = ORDERING
         return K
@@ -216,5 +225,6 @@ class TangentAssembler:
         changed as the pattern grew); the current choice before the first one."""
         if not self.used:
             kind = self.kind
-            return kind, {"dense": DENSE_ORDERING, "sparse": ORDERING}.get(kind, "reverse Cuthill-McKee")
+            sparse = ORDERING if self.dissection is None else self.dissection.description
+            return kind, {"dense": DENSE_ORDERING, "sparse": sparse}.get(kind, "reverse Cuthill-McKee")
         return "+".join(self.used), "+".join(self.used.values())

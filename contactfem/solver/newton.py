@@ -53,7 +53,7 @@ def solve_free(K, b, free, all_free):
             return np.linalg.solve(Kff, b)
         except np.linalg.LinAlgError as err:           # "Singular matrix"
             raise RuntimeError(f"Factor is exactly singular ({err})") from None
-    plan = getattr(K, "band_plan", None)
+    plan = getattr(K, "band_plan", None) or getattr(K, "dissection_plan", None)
     if plan is not None and plan.fits(K, None if all_free else free):
         return plan.solve(K.data, b)
     import scipy.sparse as sp

@@ -39,7 +39,8 @@ scaling.py, report.py.
                    tractions are from the semi-smooth Newton method's.
 8. scaling         Hertz on 1k, 4k, 16k and 65k quads against the same problem written as a
                    plain scikit-fem script (skfem.asm, scipy's spsolve, Newton on the active
-                   set), in one process: the ratio contactfem / plain per size (scaling.py).
+                   set), in one process and as whole processes (imports included): the ratio
+                   contactfem / plain per size (scaling.py).
 
 ``quick`` shrinks every study (fast presets, fewer points) to seconds in all.
 No timing enters a test: times depend on the machine and its load.

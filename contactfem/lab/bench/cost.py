@@ -16,8 +16,9 @@ def iteration_cost(system, u, t=1.0, repeat=3, solvers=True, dt=None):
     evaluation and scatter), assembly (the whole System.evaluate minus those two: loads,
     summing the triplets into K), solve (splu factor +
     solve of the free block with the default COLAMD and with MMD_AT_PLUS_A ordering, the
-    band LU if the System solves banded, and pypardiso if installed); ``solve_s`` is the
-    solver newton() uses (``linear_algebra``)."""
+    band LU if the System solves banded, SuperLU after its nested-dissection renumbering if
+    the System has one (its METIS ordering, made once per pattern, not included), and
+    pypardiso if installed); ``solve_s`` is the solver newton() uses (``linear_algebra``)."""
     import scipy.sparse as sp
     from scipy.sparse.linalg import splu
 
@@ -40,6 +41,9 @@ def iteration_cost(system, u, t=1.0, repeat=3, solvers=True, dt=None):
     out["linear_algebra"] = system.linear_algebra
     out["solve_banded_s"] = (best_of(lambda: plan.solve(K.data, b), repeat)[1]
                              if plan is not None and plan.fits(K, free) else None)
+    nd = getattr(K, "dissection_plan", None)      # SuperLU after METIS's renumbering (its plan made once)
+    out["solve_dissection_s"] = (best_of(lambda: nd.solve(K.data, b), repeat)[1]
+                                 if nd is not None and nd.fits(K, free) else None)
     try:
         import pypardiso
         A = Kff.tocsr()
@@ -50,8 +54,8 @@ def iteration_cost(system, u, t=1.0, repeat=3, solvers=True, dt=None):
         _, out["solve_pypardiso_s"] = best_of(lambda: (ps.factorize(A), ps.solve(A, b)), repeat)
     except ImportError:
         out["solve_pypardiso_s"] = None
-    out["solve_s"] = (out["solve_banded_s"] if out["solve_banded_s"] is not None    # what newton() uses
-                      else out["solve_splu_MMD_AT_PLUS_A_s"])
+    out["solve_s"] = next(x for x in (out["solve_banded_s"], out["solve_dissection_s"],   # what newton() uses
+                                      out["solve_splu_MMD_AT_PLUS_A_s"]) if x is not None)
     return out
 
 

@@ -64,7 +64,15 @@ OPTIMISATIONS = [
     "| a run of rings loads no scipy or scikit-fem: contactfem.io loads each name on first use, the beam's "
     "lumped mass summed with numpy | io/__init__.py, bodies/beam.py | `contactfem run sloping_impact --set "
     "n_steps=5`, whole process (median of 10, load 11 on 2 cores): 0.73 s CPU | 0.32 s CPU; the ratio of 10 pairs "
-    "(median): CPU 0.46, wall 0.42 |", "",
+    "(median): CPU 0.46, wall 0.42 |",
+    "| the linear material's K from its own form (lam tr eps tr eps + 2 mu eps : eps, no sum over the 16 "
+    "entries of C) and kept as CSC (the pattern's order: its first placement sorts presorted keys); above 1e4 free "
+    "unknowns SuperLU after METIS's nested-dissection renumbering (pymetis) instead of its own minimum-degree "
+    "ordering; below 1e4 free dofs the band plan without the breadth-first bound | bodies/continuum.py, "
+    "solver/dissection.py, solver/assembly.py, solver/banded.py | Hertz, run_scene in one process (wall, best of 3, "
+    "65k: of 2; loaded machine, 2 interleaved runs): 1k quads 34-45 ms, 16k 0.71-0.77 s, 65k 3.9-4.0 s; 65k, "
+    "first run in a fresh process, against the code before the fixed pattern (3 pairs): 8.3-9.3 s "
+    "| 27-36 ms, 0.58-0.63 s, 2.8-3.1 s; 3.5-4.1 s |", "",
     "Not adopted (measured when the solvers were chosen, not by this run): pypardiso (MKL PARDISO, installs "
     "from PyPI, about 0.8 s of import time and a large download): at 1e5 unknowns 1.0-1.4 s against 1.3-1.4 s "
     "for SuperLU with MMD_AT_PLUS_A, slower at the paper sizes; not a clear win. scikit-umfpack did not install "
@@ -310,7 +318,9 @@ def write_markdown(res):
         L += ["## Cost of one Newton iteration, part by part (isolated calls at one state)", "",
               "Best of a few repeats. bulk: the bodies' R and K as the System evaluates them (a beam's COO triplets, a continuum's sparse K); contact: contact.assemble; "
               "assembly: the rest of System.residual_tangent (loads, summing the triplets into K); solve: factorisation + solve "
-              "of the free block by LAPACK's band LU where the System solves banded (band), else by splu with "
+              "of the free block by LAPACK's band LU where the System solves banded (band), by SuperLU after the "
+              "pattern's nested-dissection renumbering where it has one (ND: from 1e4 free unknowns; METIS's "
+              "ordering, made once per pattern like the band plan, not included), else by splu with "
               "the ordering newton() uses (MMD_AT_PLUS_A); SuperLU with each ordering for comparison (COLAMD is "
               "scipy's default).", "",
               "| case | unknowns | contact nodes | bulk [s] | contact [s] | assembly [s] | solve [s] | "
@@ -318,7 +328,8 @@ def write_markdown(res):
               "|---|---|---|---|---|---|---|---|---|---|---|"]
         for name, r in c["cases"].items():
             tot = r["bulk_s"] + r["contact_s"] + r["assembly_s"] + r["solve_s"]
-            band = " (band)" if r.get("solve_banded_s") is not None else ""
+            band = (" (band)" if r.get("solve_banded_s") is not None
+                    else " (ND)" if r.get("solve_dissection_s") is not None else "")
             L.append(f"| {name} | {r['ndof']} | {r['n_contact_nodes']} | {_f(r['bulk_s'])} | {_f(r['contact_s'])} | "
                      f"{_f(r['assembly_s']) if r['assembly_s'] > 0 else '~0 (noise)'} | {_f(r['solve_s'])}{band} | {_f(r['solve_splu_MMD_AT_PLUS_A_s'])} | "
                      f"{_f(r['solve_splu_COLAMD_s'])} | {_f(r['solve_pypardiso_s'])} | {r['contact_s'] / tot:.1%} |")
