@@ -49,6 +49,8 @@ BAD_BEFORE_THE_RUN = [
     (["run", "block", "--set", "law=coulomb", "--set", "mu=0.1"], "no static equilibrium"),
     (["run", "block", "--set", "law=parabolic", "--set", "alpha=0.01", "--set", "beta=0.01"], "no static equilibrium"),
     (["run", "hertz", "--set", "n_el=2000"], "add --force"),
+    (["run", "hertz", "--set", "n_el=3"], "allowed [4, 2000]"),
+    (["run", "hertz", "--set", "P=1e6"], "a/R < 0.5"),
     (["run", "hertz", "--set", "n_el=128", "--linear-algebra", "dense"], "add --force"),     # K alone 8.9 GB
     (["run", "hertz", "--set", "n_el=256", "--linear-algebra", "banded"], "add --force"),    # its band 3.4 GB
     (["sweep", "hertz", "--set", "n_el=512", "--out", "{tmp}/s.csv"], "add --force"),
