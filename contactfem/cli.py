@@ -433,7 +433,9 @@ def build_parser():
     ep.set_defaults(func=cmd_equations)
     sw = sub.add_parser("sweep", help="run a scene over a grid of parameter values, in parallel")
     sw.add_argument("scene")
-    sw.add_argument("--preset", default="fast", choices=["fast", "paper"])
+    sw.add_argument("--preset", default="fast",
+                    help="the preset every run starts from, as for run: fast (default), paper, or a named variant "
+                         "of the scene (listed by show)")
     sw.add_argument("--set", action="extend", nargs="+", metavar="NAME=V1,V2,...",
                     help="values of parameters, or of a law's field as law.NAME=V1,V2,... (several after one "
                          "--set, or --set repeated; at least one)")
@@ -631,7 +633,7 @@ def _main(argv):
         print(f"contactfem: solver failed: {_one_line(exc)}", file=sys.stderr)
         hist = getattr(exc, "history", None)
         if hist is not None:
-            text = " ".join(f"{r:.3e}" for r in hist) if hist else "(empty: the solve failed before its first residual)"
+            text = " ".join(f"{r:.3e}" for r in hist) if hist else "(empty: no finite residual was reached)"
             print(f"residual history: {text}", file=sys.stderr)
         return 1
     return 0
