@@ -130,7 +130,7 @@ def cmd_run(args):
 
             if shutil.which("ffmpeg") is None:
                 raise ValueError(f"--gif {args.gif}: writing .mp4 needs ffmpeg on the PATH; write a .gif instead")
-    est = check_resources(scene, params, args.force)
+    est = check_resources(scene, params, args.force, args.linear_algebra)
     warnings = scene.preflight(params, laws) if laws and not args.no_check else []   # the laws over the scene's range
     for note in notes:                                # (after every refusal: a refusal is one line)
         print(f"contactfem: note: {note}", file=sys.stderr)
@@ -236,7 +236,7 @@ def cmd_sweep(args):
                          "contactfem run")
     _RUN["phase"] = "sweep"
     rows = sweep(args.scene, parse_grid(parse_sets(args.set)), args.preset, args.jobs, args.scheduler,
-                 friction=args.friction, normal=args.normal, check=not args.no_check)
+                 friction=args.friction, normal=args.normal, check=not args.no_check, force=args.force)
     _RUN["phase"] = "write"
     with out:
         write_table(rows, out.temp("--out"))
@@ -433,7 +433,9 @@ def build_parser():
     ep.set_defaults(func=cmd_equations)
     sw = sub.add_parser("sweep", help="run a scene over a grid of parameter values, in parallel")
     sw.add_argument("scene")
-    sw.add_argument("--preset", default="fast", choices=["fast", "paper"])
+    sw.add_argument("--preset", default="fast",
+                    help="the preset every run starts from, as for run: fast (default), paper, or a named variant "
+                         "of the scene (listed by show)")
     sw.add_argument("--set", action="extend", nargs="+", metavar="NAME=V1,V2,...",
                     help="values of parameters, or of a law's field as law.NAME=V1,V2,... (several after one "
                          "--set, or --set repeated; at least one)")
@@ -444,6 +446,9 @@ def build_parser():
                     "with --set law.NAME=V1,V2,...")
     sw.add_argument("--normal", metavar="LAW", help="the normal law of every run, as for run")
     sw.add_argument("--no-check", action="store_true", help="skip the laws' check before the runs, as for run")
+    sw.add_argument("--force", action="store_true",
+                    help="run even if a run's estimated size, or the memory of the runs going at once, exceeds "
+                         "the limits (2 GB, 1e6 unknowns, 1e6 steps)")
     sw.set_defaults(func=cmd_sweep)
     st = sub.add_parser("site", help="build the course website (lectures executed, gallery, equation index, API)")
     st.add_argument("--out", default=None, metavar="DIR", help="output folder, DIR/index.html (default: build/site "
@@ -487,8 +492,9 @@ def build_parser():
     bp.add_argument("--out", default=None,
                     help="folder for bench.json and BENCHMARKS.md (default: . for a full run, bench-quick/ for "
                          "--quick); a quick run never replaces or mixes with a full one")
-    bp.add_argument("--only", action="append", choices=list(BENCH_STUDIES),
-                    help="run only this study (repeatable); the other studies of OUT/bench.json are kept")
+    bp.add_argument("--only", action="extend", nargs="+", choices=list(BENCH_STUDIES), metavar="STUDY",
+                    help="run only these studies (several after one --only, or --only repeated: "
+                         f"{', '.join(BENCH_STUDIES)}); the other studies of OUT/bench.json are kept")
     bp.set_defaults(func=cmd_bench)
     return ap
 
@@ -627,7 +633,7 @@ def _main(argv):
         print(f"contactfem: solver failed: {_one_line(exc)}", file=sys.stderr)
         hist = getattr(exc, "history", None)
         if hist is not None:
-            text = " ".join(f"{r:.3e}" for r in hist) if hist else "(empty: the solve failed before its first residual)"
+            text = " ".join(f"{r:.3e}" for r in hist) if hist else "(empty: no finite residual was reached)"
             print(f"residual history: {text}", file=sys.stderr)
         return 1
     return 0

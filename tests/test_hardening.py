@@ -14,6 +14,7 @@ import zipfile
 import numpy as np
 import pytest
 
+import contactfem.lab.sweep  # noqa: F401  (imported before any test patches scenes.run_scene: it binds the real one)
 from contactfem import cli, scenes
 from contactfem.cli import main, plain_table
 from contactfem.io import Outputs, load_run, save_run
@@ -48,6 +49,12 @@ BAD_BEFORE_THE_RUN = [
     (["run", "block", "--set", "law=coulomb", "--set", "mu=0.1"], "no static equilibrium"),
     (["run", "block", "--set", "law=parabolic", "--set", "alpha=0.01", "--set", "beta=0.01"], "no static equilibrium"),
     (["run", "hertz", "--set", "n_el=2000"], "add --force"),
+    (["run", "hertz", "--set", "n_el=3"], "allowed [4, 2000]"),
+    (["run", "hertz", "--set", "P=1e6"], "a/R < 0.5"),
+    (["run", "hertz", "--set", "n_el=128", "--linear-algebra", "dense"], "add --force"),     # K alone 8.9 GB
+    (["run", "hertz", "--set", "n_el=256", "--linear-algebra", "banded"], "add --force"),    # its band 3.4 GB
+    (["sweep", "hertz", "--set", "n_el=512", "--out", "{tmp}/s.csv"], "add --force"),
+    (["sweep", "hertz", "--set", "n_el=300,310", "--jobs", "2", "--out", "{tmp}/s.csv"], "2 runs at once"),
     (["run", "rolling_ring", "--set", "dt=1e-9"], "steps"),
     (["run", "block", "--preset", "nonsense"], "nonsense"),
     (["run"], "required: scene"),
@@ -75,6 +82,19 @@ def test_resource_guard_names_the_estimate(capsys, no_solve):
     assert main(["run", "hertz", "--set", "n_el=2000"]) == 2
     err = capsys.readouterr().err
     assert "4,000,000 elements" in err and "GB" in err and "limit" in err
+
+
+def test_a_forced_solver_counts_its_own_matrices():
+    """The estimate adds what a forced solver holds: a dense K and its LU copy (16 bytes an
+    entry), a band of about 3 sqrt(n) each side (72 bytes per n^1.5); auto and sparse keep
+    the sparse model (the System chooses dense or banded only where they are small)."""
+    from contactfem.scenes.resources import BAND_BYTES, DENSE_BYTES, estimate
+
+    size = {"elements": 16384, "unknowns": 33282, "steps": 1}
+    auto = estimate(size)["memory_bytes"]
+    assert estimate(size, "sparse")["memory_bytes"] == auto
+    assert estimate(size, "dense")["memory_bytes"] == pytest.approx(auto + DENSE_BYTES * 33282 ** 2, rel=1e-9)
+    assert estimate(size, "banded")["memory_bytes"] == pytest.approx(auto + BAND_BYTES * 33282 ** 1.5, rel=1e-9)   # whole bytes
 
 
 def test_large_meshes_announce_themselves(monkeypatch, capsys):

@@ -73,18 +73,33 @@ def _ignore_interrupts():
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
-def sweep(scene, grid, preset="fast", jobs=1, scheduler=None, friction=None, normal=None, check=True):
+def sweep(scene, grid, preset="fast", jobs=1, scheduler=None, friction=None, normal=None, check=True,
+          force=False):
     """Run `scene` at every point of the grid (parameters and law fields law.NAME, with the
     laws named by ``friction`` / ``normal`` as on the command line); returns a list of row
-    dicts. Every point is validated first (ValueError, one line): its parameters, its laws
-    and, unless ``check`` is False, the laws over the range the scene meets."""
+    dicts. Every point is validated first (ValueError, one line): its parameters, its laws,
+    unless ``check`` is False the laws over the range the scene meets, and unless ``force``
+    its size against the limits of `contactfem run` (resources.LIMITS), the memory of the runs
+    that go at once (``jobs`` of them locally) together."""
+    from ..scenes.resources import LIMITS, check_resources, describe
+
     sc = get_scene(scene)
     points = [dict(zip(grid, combo)) for combo in itertools.product(*grid.values())]
+    largest = None
     for p in points:               # validate every point before starting anything
         overrides, laws = build_laws(scene, preset, p, friction, normal)
         params = sc.resolve(preset, overrides)
+        est = check_resources(sc, params, force)
+        if est is not None and (largest is None or est["memory_bytes"] > largest["memory_bytes"]):
+            largest = est
         if check and laws:
             sc.preflight(params, laws)
+    together = 1 if scheduler else min(jobs, len(points))
+    if not force and largest is not None and together * largest["memory_bytes"] > LIMITS["memory_bytes"]:
+        raise ValueError(f"{sc.name}: {together} runs at once (--jobs {jobs}), the largest needing "
+                         f"{describe(largest)}, would need about {together * largest['memory_bytes'] / 1e9:.2g} GB "
+                         f"together: above the limit of {LIMITS['memory_bytes'] / 1e9:.2g} GB (lower --jobs, "
+                         "or add --force to run it anyway)")
     tasks = [(scene, preset, p, friction, normal) for p in points]
     if scheduler:
         from joblib import Parallel, delayed, parallel_config

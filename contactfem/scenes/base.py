@@ -205,11 +205,11 @@ class Scene:
             return []
         return preflight(laws.get("friction"), laws.get("normal"), **self.law_range(params))
 
-    def estimate(self, params):
+    def estimate(self, params, linear_algebra="auto"):
         """Size of the run from the resolved parameters (resources.estimate), or None."""
         from .resources import estimate
 
-        return None if self.size is None else estimate(self.size(params))
+        return None if self.size is None else estimate(self.size(params), linear_algebra)
 
 
 # What a scene's law_range(params) returns, all maxima of the run (generous bounds from the

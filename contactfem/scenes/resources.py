@@ -5,13 +5,20 @@ the memory a model calibrated on the continuum scenes estimates, against the lim
 import math
 
 
-def estimate(size):
-    """The size {elements, unknowns, steps} as counts, and the memory it needs in bytes (the
-    sparse LU factors and the assembled tangents dominate)."""
+def estimate(size, linear_algebra="auto"):
+    """The size {elements, unknowns, steps} as counts, and the memory it needs in bytes: the
+    sparse LU factors and the assembled tangents dominate, and a solver the user forces adds
+    its own matrices (linear_algebra: dense or banded; auto chooses these only where they are
+    small)."""
     est = {k: _count(v) for k, v in size.items()}
     n = max(est.get("unknowns", 0), 1)
-    est["memory_bytes"] = int(MEMORY_BASE + MEMORY_PER_UNKNOWN * n * math.log2(max(n, 2))
-                              + MEMORY_PER_STEP * est.get("steps", 0))
+    memory = (MEMORY_BASE + MEMORY_PER_UNKNOWN * n * math.log2(max(n, 2))
+              + MEMORY_PER_STEP * est.get("steps", 0))
+    if linear_algebra == "dense":
+        memory += DENSE_BYTES * float(n) ** 2
+    elif linear_algebra == "banded":
+        memory += BAND_BYTES * float(n) ** 1.5
+    est["memory_bytes"] = _count(memory)
     return est
 
 
@@ -28,12 +35,18 @@ MEMORY_BASE = 100e6            # the interpreter with numpy, scipy and scikit-fe
 MEMORY_PER_UNKNOWN = 310.0     # bytes per unknown and per log2(unknowns)
 MEMORY_PER_STEP = 2.0e3        # bytes per time step (recorded histories)
 LIMITS = {"memory_bytes": 2e9, "unknowns": 1e6, "steps": 1e6}
+# A forced dense solve holds K (n x n doubles) and the copy LAPACK factorises: 16 bytes per entry.
+# A forced band LU holds n (2 kl + ku + 1) doubles; a 2-D mesh renumbered by reverse Cuthill-McKee
+# has kl = ku of about 3 sqrt(n) (Hertz: 1026 at n = 132,098, 2.8 sqrt(n); its peak 3.8 GB against
+# 0.8 GB sparse): 8 * 9 = 72 bytes per n^1.5, an upper estimate (a ring's band is a few dofs wide).
+DENSE_BYTES = 16.0
+BAND_BYTES = 72.0
 
 
-def check_resources(scene, params, force=False):
+def check_resources(scene, params, force=False, linear_algebra="auto"):
     """ValueError naming the estimate when a run would exceed LIMITS (unless force);
     returns the estimate (or None for a scene without a size model)."""
-    est = scene.estimate(params)
+    est = scene.estimate(params, linear_algebra)
     if est is None or force:
         return est
     over = [k for k, lim in LIMITS.items() if est.get(k, 0) > lim]
