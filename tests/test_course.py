@@ -350,3 +350,28 @@ def test_a_broken_submission_is_a_row_not_a_crash(course, tmp_path):
     by = {r["submission"]: r for r in rows}
     assert by["01_garbage.ipynb"]["notes"].startswith("not graded") and by["01_garbage.ipynb"]["total"] == "0"
     assert "not a lecture of this course" in by["notes.ipynb"]["notes"]
+
+
+def test_a_kernel_that_dies_at_start_is_started_again(monkeypatch):
+    """A kernel that dies before answering kernel_info never ran the submission (parallel
+    kernels may race for ports): its grading is tried again; other errors are the row's
+    reason at once, and a start that keeps failing is one after KERNEL_START_TRIES."""
+    from contactfem.lab import course
+
+    calls = []
+
+    def flaky(path, zip_path, fail=1, msg="Kernel died before replying to kernel_info"):
+        calls.append(path)
+        if len(calls) <= fail:
+            raise RuntimeError(msg)
+        return {"ex": 1.0}, {"ex": 1.0}, []
+
+    monkeypatch.setattr(course, "_grade_one", flaky)
+    assert course._safe_grade(("a.ipynb", "z.zip")) == ({"ex": 1.0}, {"ex": 1.0}, []) and len(calls) == 2
+    calls.clear()
+    monkeypatch.setattr(course, "_grade_one", lambda p, z: flaky(p, z, fail=99))
+    assert course._safe_grade(("a.ipynb", "z.zip"))[2][0].startswith("not graded: RuntimeError: Kernel died")
+    assert len(calls) == course.KERNEL_START_TRIES
+    calls.clear()
+    monkeypatch.setattr(course, "_grade_one", lambda p, z: flaky(p, z, fail=99, msg="DeadKernelError"))
+    assert "DeadKernelError" in course._safe_grade(("a.ipynb", "z.zip"))[2][0] and len(calls) == 1

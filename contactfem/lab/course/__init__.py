@@ -314,12 +314,22 @@ def _quiet_fds():
             os.close(fd)
 
 
+# A kernel that dies before it answers its first request never ran the submission: with gradings
+# in parallel, two kernels starting at once may pick the same free ports (jupyter_client chooses
+# them before the kernel binds them), and the loser exits. Such a start is tried again, up to
+# KERNEL_START_TRIES times; a kernel that dies while it runs the submission is the submission's.
+KERNEL_START_TRIES = 3
+
+
 def _safe_grade(args):
     path, zip_path = args
-    try:
-        return _grade_one(path, zip_path)
-    except Exception as err:             # a broken submission is a row with its reason, not a crash
-        return None, None, [f"not graded: {type(err).__name__}: {' '.join(str(err).split())[:300]}"]
+    for attempt in range(KERNEL_START_TRIES):
+        try:
+            return _grade_one(path, zip_path)
+        except Exception as err:             # a broken submission is a row with its reason, not a crash
+            if "before replying to kernel_info" in str(err) and attempt + 1 < KERNEL_START_TRIES:
+                continue
+            return None, None, [f"not graded: {type(err).__name__}: {' '.join(str(err).split())[:300]}"]
 
 
 def grade(folder, out_csv, autograders=None, jobs=1, repo=None):
