@@ -85,10 +85,14 @@ class DissectionPlan:
         self.perm = np.lexsort((np.arange(m), place[sv]))        # new -> old: a supervariable's dofs together
         new = np.empty(m, dtype=np.int64)
         new[self.perm] = np.arange(m)
-        # the renumbered block's CSC arrays, and the stored entry each of its entries takes
-        numbered = sp.csc_matrix((entry + 1.0, (new[rows], new[cols])), shape=(m, m))
+        # the renumbered block's CSC arrays, and the stored entry each of its entries takes: its
+        # columns gathered in the new order, then each column's rows sorted (scipy, in C)
+        count = np.diff(b_indptr)[self.perm]
+        p_indptr = np.concatenate([[0], np.cumsum(count)])
+        at = np.repeat(b_indptr[self.perm] - p_indptr[:-1], count) + np.arange(rows.size)
+        numbered = sp.csc_matrix((entry[at].astype(float), new[rows[at]], p_indptr), shape=(m, m))
         numbered.sort_indices()
-        self.take = numbered.data.astype(np.int64) - 1
+        self.take = numbered.data.astype(np.int64)
         self.p_indptr, self.p_indices = numbered.indptr, numbered.indices
         self.description = "nested dissection (METIS), SuperLU"
 
