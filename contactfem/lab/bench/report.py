@@ -134,8 +134,9 @@ def iteration_account(sp):
     L = ["", f"### Where the microseconds of one iteration go: sloping impact, frictional ({r['ndof']} unknowns, "
              f"{r['preset']} preset)", "",
          f"The floor in this Python: the ring's {lim['entries']} tangent entries and its diagonal c M summed into a "
-         f"dense {lim['n']} x {lim['n']} K by one bincount ({us(lim['assembly_s'])} us) and K du = -G solved by "
-         f"LAPACK ({us(lim['solve_s'])} us): {us(lim['limit_s'])} us together (CPU, best of 7 loops of 200 calls; "
+         f"dense {lim['n']} x {lim['n']} K by one bincount ({us(lim['assembly_s'])} us alone) and K du = -G solved by "
+         f"LAPACK ({us(lim['solve_s'])} us alone): {us(lim['limit_s'])} us in one loop doing both (CPU, best of 7 "
+         "loops of 200 calls each; "
          "speed.iteration_limit). One iteration of the run, part by part (the row above, CPU microseconds of "
          f"the thread over its {r['solves']} linear solves; {evals:.2f} residual evaluations per solve, as a "
          "converged step evaluates once more than it solves):", "",
