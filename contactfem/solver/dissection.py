@@ -24,6 +24,8 @@ partial pivoting (the tangent with friction is not symmetric).
 
 import numpy as np
 
+from .banded import BandPlan
+
 DISSECTION_MIN = 10_000        # free unknowns from which the sparse path is renumbered by METIS
 
 
@@ -96,13 +98,9 @@ class DissectionPlan:
         self.p_indptr, self.p_indices = numbered.indptr, numbered.indices
         self.description = "nested dissection (METIS), SuperLU"
 
-    def fits(self, K, free):
-        """Whether K has this plan's pattern (the same index arrays) and free its free dofs."""
-        if K.indptr is not self.indptr or K.indices is not self.indices:
-            return False
-        if self.free is None:
-            return free is None or (len(free) == self.n and np.array_equal(free, np.arange(self.n)))
-        return free is self.free or np.array_equal(free, self.free)
+    # whether K has this plan's pattern and free its free dofs: the band plan's test (the same
+    # attributes: indptr, indices, free, n)
+    fits = BandPlan.fits
 
     def solve(self, data, b):
         """x from A x = b, A the matrix with values ``data`` (of the CSC pattern), on the block.
