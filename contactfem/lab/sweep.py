@@ -145,10 +145,10 @@ def sweep(scene, grid, preset="fast", jobs=1, scheduler=None, friction=None, nor
     that keeps the rows (on disk if it has a path, written as each point ends, and with
     ``resume`` the rows it already holds); ``timeout``: seconds a local run may take before it
     is stopped and recorded as failed."""
-    points = plan(scene, grid, preset, jobs, scheduler, friction, normal, check, force)
+    args = (scene, grid, preset, jobs, scheduler, friction, normal, check, force)
+    points, version = _guarded(_prepare, args, laws_text(friction, normal)) if friction or normal else _prepare(*args)
     table = Table() if table is None else table
-    same = dict(scene=scene, preset=preset, laws=laws_text(friction, normal),
-                code_version=code_version(friction, normal))
+    same = dict(scene=scene, preset=preset, laws=laws_text(friction, normal), code_version=version)
     todo = table.start(points, same)
     tasks = [(i, (scene, preset, points[i], friction, normal)) for i in todo]
     runs = _on_dask(scheduler, tasks) if scheduler else _local(tasks, jobs, timeout)
@@ -156,6 +156,32 @@ def sweep(scene, grid, preset="fast", jobs=1, scheduler=None, friction=None, nor
         for i, row in runs:
             table.add(i, row)
     return table.grid_rows()
+
+
+def _prepare(scene, grid, preset, jobs, scheduler, friction, normal, check, force):
+    return plan(scene, grid, preset, jobs, scheduler, friction, normal, check, force), code_version(friction, normal)
+
+
+def _guarded(fn, args, laws):
+    """fn(*args) in a worker process (it loads and checks the user's laws): its value, or its
+    exception raised here; a worker that dies is one ValueError naming the laws."""
+    from .batch import run_batch
+
+    (outcome,) = run_batch(_capture, [(None, (fn, *args))], retries=0)
+    if not outcome.ok:
+        raise ValueError(f"{laws}: the law's code ended the process that loaded and checked it ({outcome.reason}); "
+                         "with --no-check its check over the scene's range is skipped")
+    ok, value = outcome.value
+    if not ok:
+        raise value
+    return value
+
+
+def _capture(fn, *args):
+    try:
+        return True, fn(*args)
+    except Exception as exc:       # raised again in the sweep's process
+        return False, exc
 
 
 def _local(tasks, jobs, timeout):
