@@ -149,16 +149,34 @@ def test_a_worker_killed_twice_mid_sweep_is_a_failed_row_and_every_other_point_c
 
 
 def test_a_law_that_ends_its_process_fails_its_point_only(tmp_path, law):
-    """The law ends its process (os._exit(7)) above a pressure of 800 that only p_y = 300
-    reaches (the run's largest pressures: about 620, 710 and 910)."""
-    p = sweep(tmp_path, "--friction", law, "--set", "law.p_exit=800", "--set", "p_y=100,200,300", "--jobs", "2")
-    out, err = finish(p, 60)
-    assert p.returncode == 1, err
-    table = {r["param.p_y"]: r for r in rows(tmp_path / "s.csv")}
+    """The README's example, run: the law ends its process (os._exit(7)) above a pressure of
+    800 that only p_y = 300 reaches (the runs' largest pressures: about 620, 710 and 910);
+    the lines it prints are the README's."""
+    readme = (Path(__file__).parents[1] / "README.md").read_text().splitlines()
+    at = next(i for i, line in enumerate(readme) if line.startswith("$ contactfem sweep block --no-check --friction "
+                                                                      "fragile.py:Fragile"))
+    argv = readme[at][len("$ contactfem "):].split()
+    shown = readme[at + 1: readme.index("```", at)]
+    p = subprocess.run([sys.executable, "-m", "contactfem", *argv], cwd=tmp_path, capture_output=True, text=True,
+                       timeout=60)
+    assert p.returncode == 1, p.stderr
+    assert p.stdout.splitlines() == shown
+    table = {r["param.p_y"]: r for r in rows(tmp_path / "sweep.csv")}
     assert table["300"]["error"] == "worker exited with code 7"
     assert table["100"]["error"] == table["200"]["error"] == ""
     assert float(table["200"]["total_normal"]) == pytest.approx(-800, rel=1e-6)     # p_y x width
-    assert "3 points: 2 done, 1 failed, 0 left" in out
+
+
+def test_a_law_that_ends_the_process_checking_it_is_one_line(tmp_path, law):
+    """Without --no-check the law is checked over the scene's range (in a worker process):
+    the sweep stops before the first run, in one line naming the law."""
+    p = subprocess.run([sys.executable, "-m", "contactfem", "sweep", "block", "--friction", law, "--set",
+                        "law.p_exit=800", "--set", "p_y=100,200,300", "--out", "s.csv"], cwd=tmp_path,
+                       capture_output=True, text=True, timeout=60)
+    lines = p.stderr.strip().splitlines()
+    assert p.returncode == 2 and len(lines) == 1, p.stderr
+    assert "--friction" in lines[0] and "ended the process" in lines[0] and "worker exited with code 7" in lines[0]
+    assert not (tmp_path / "s.csv").exists()
 
 
 @pytest.mark.parametrize("sig,code", [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
@@ -290,3 +308,22 @@ def test_a_point_that_keeps_killing_its_dask_workers_is_a_failed_row(tmp_path, l
     table = {r["param.p_y"]: r for r in rows(tmp_path / "s.csv")}
     assert table["300"]["error"].startswith("worker died:") and "KilledWorker" in table["300"]["error"]
     assert table["100"]["error"] == table["200"]["error"] == ""
+
+
+def test_a_table_interrupted_while_it_is_written_keeps_the_last_complete_one(tmp_path, monkeypatch):
+    from contactfem.lab import sweep as sw
+
+    table = sw.Table(tmp_path / "t.csv")
+    table.start([{"a": "1"}, {"a": "2"}], dict(scene="block", preset="fast", laws="", code_version="v"))
+    table.add(0, {"r": 1.0})
+    before = (tmp_path / "t.csv").read_text()
+
+    def interrupted(rows, path):
+        Path(path).write_text("half a ta")
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(sw, "write_table", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        table.add(1, {"r": 2.0})
+    assert (tmp_path / "t.csv").read_text() == before and os.listdir(tmp_path) == ["t.csv"]
+    assert table.written == (1, 0, 1)
