@@ -327,3 +327,52 @@ def test_a_table_interrupted_while_it_is_written_keeps_the_last_complete_one(tmp
         table.add(1, {"r": 2.0})
     assert (tmp_path / "t.csv").read_text() == before and os.listdir(tmp_path) == ["t.csv"]
     assert table.written == (1, 0, 1)
+
+
+def test_a_run_over_the_time_limit_is_a_failed_row(tmp_path, law):
+    p = sweep(tmp_path, "--friction", law, "--set", "law.mu=0.5,0.55", "--set", "law.victim=0.5", "--jobs", "2",
+              "--time-limit", "8", pause=60)
+    out, err = finish(p, 60)
+    assert p.returncode == 1, err
+    table = {r["param.law.mu"]: r for r in rows(tmp_path / "s.csv")}
+    assert table["0.5"]["error"] == "time limit 8 s" and table["0.55"]["error"] == ""
+    assert "2 points: 1 done, 1 failed, 0 left" in out
+
+
+@pytest.mark.parametrize("argv,pattern", [
+    (["--time-limit", "0"], "parameter time-limit = 0 is out of range"),
+    (["--time-limit", "5", "--scheduler", "tcp://127.0.0.1:1"], "--time-limit applies to local workers"),
+    (["--scheduler", "no scheduler"], "--scheduler no scheduler: "),
+])
+def test_bad_limits_and_addresses_are_one_line(tmp_path, capsys, argv, pattern):
+    pytest.importorskip("dask.distributed")
+    from contactfem.cli import main
+
+    assert main(["sweep", "block", "--set", "p_y=100,200", *argv, "--out", str(tmp_path / "s.csv")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and pattern in err[0], err
+    assert not (tmp_path / "s.csv").exists()
+
+
+def test_a_json_table_resumes_too(tmp_path):
+    """The Table alone: a JSON file's rows of the same points and code are kept, a failed row
+    and a row of other code are to run again (kept on disk until their new rows come), rows
+    of other points stay."""
+    import json
+
+    from contactfem.lab.sweep import Table
+
+    same = dict(scene="block", preset="fast", laws="", code_version="v1")
+    earlier = [dict(same, error="", x=1, **{"param.p_y": "100"}),
+               dict(same, error="worker died: signal 9", **{"param.p_y": "200"}),
+               dict(same, error="", x=3, **{"param.p_y": "300", "code_version": "v0"}),
+               dict(same, error="", x=9, **{"param.p_y": "900"})]
+    path = tmp_path / "t.json"
+    path.write_text(json.dumps(earlier))
+    table = Table(path, resume=True)
+    assert table.start([{"p_y": v} for v in ("100", "200", "300", "400")], same) == [1, 2, 3]
+    table.add(3, {"x": 4})
+    on_disk = json.loads(path.read_text())
+    assert [r["param.p_y"] for r in on_disk] == ["100", "200", "300", "400", "900"]
+    assert on_disk[:3] == earlier[:3] and on_disk[4] == earlier[3]
+    assert table.counts() == (2, 0, 2) and table.kept == 1
