@@ -376,3 +376,13 @@ def test_a_json_table_resumes_too(tmp_path):
     assert [r["param.p_y"] for r in on_disk] == ["100", "200", "300", "400", "900"]
     assert on_disk[:3] == earlier[:3] and on_disk[4] == earlier[3]
     assert table.counts() == (2, 0, 2) and table.kept == 1
+
+
+def test_resume_from_a_file_that_is_not_a_table_is_one_line(tmp_path, capsys):
+    from contactfem.cli import main
+
+    (tmp_path / "s.json").write_text("{not json")
+    assert main(["sweep", "block", "--set", "p_y=100", "--resume", "--out", str(tmp_path / "s.json")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "cannot resume from it" in err[0] and "--out" in err[0]
+    assert (tmp_path / "s.json").read_text() == "{not json"
