@@ -111,8 +111,8 @@ def _batch(fn, todo, jobs, timeout, retries, memory_limit, initializer):
                 w.stop(workers)                               # dead: its task (if any) runs again
                 if w.task is not None:
                     key, args, attempts = w.task
-                    if attempts + 1 <= retries:
-                        todo.appendleft((key, args, attempts + 1))
+                    if attempts + 1 <= retries:                   # on a fresh worker, not an idle one
+                        _Worker(ctx, fn, initializer, memory_limit, workers).give((key, args, attempts + 1), todo)
                     else:
                         yield Outcome(key, False, None, _death(w.proc.exitcode), attempts + 1)
         finished = True
