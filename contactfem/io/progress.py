@@ -17,13 +17,14 @@ bars with ``progress=progress_bar`` (one per time loop; solver.march.watch).
 
 import sys
 
-from tqdm.auto import tqdm
+from tqdm import tqdm as text_tqdm
+from tqdm.auto import tqdm as auto_tqdm
 
 FORMAT = "{desc}[{bar}] {percentage:3.0f}%  {where}  {elapsed_s:.1f} s{note}"
 
 
-class _Bar(tqdm):
-    """tqdm with two more fields for the format: where the run is (``where``) and a note."""
+class _Fields:
+    """Two more fields for tqdm's format: where the run is (``where``) and a note."""
 
     where = ""
     note = ""
@@ -31,6 +32,23 @@ class _Bar(tqdm):
     @property
     def format_dict(self):
         return dict(super().format_dict, where=self.where, note=f"  ({self.note})" if self.note else "")
+
+
+class _TextBar(_Fields, text_tqdm):
+    """The text bar, on a stream."""
+
+
+class _AutoBar(_Fields, auto_tqdm):
+    """A widget in Jupyter (with ipywidgets), else the text bar on stderr."""
+
+
+def _bar(stream, **options):
+    if stream is not None:                    # a stream asked for: the text bar on it
+        return _TextBar(file=stream, **options)
+    try:
+        return _AutoBar(file=sys.stderr, **options)
+    except ImportError:                       # Jupyter without ipywidgets: tqdm cannot draw its widget
+        return _TextBar(file=sys.stderr, **options)
 
 
 class ProgressBar:
@@ -47,10 +65,9 @@ class ProgressBar:
         self.total, self.t0, self.t_end = total, float(t0), t_end
         self.n, self.t = 0, float(t0)
         self.closed = False
-        self._bar = _Bar(total=total if total is not None else 1.0, desc=f"{label} " if label else "",
-                         file=stream if stream is not None else sys.stderr, mininterval=float(interval),
-                         miniters=1, ascii=".#", bar_format=FORMAT.replace("{bar}", f"{{bar:{int(width)}}}"),
-                         dynamic_ncols=False)
+        self._bar = _bar(stream, total=total if total is not None else 1.0, desc=f"{label} " if label else "",
+                         mininterval=float(interval), miniters=1, ascii=".#",
+                         bar_format=FORMAT.replace("{bar}", f"{{bar:{int(width)}}}"))
         self._bar.where = f"step 0/{total}" if total is not None else f"t = {self.t:.4g}"
 
     def _to(self, done, force=False):
