@@ -6,7 +6,9 @@ inapplicable parameter, a law that breaks the protocol or returns NaN in the ran
 scene meets, an output that cannot be written, a run too large for this machine), one
 line on stderr, found before any solve; 1 a failed solve, its cause in one line and the
 residual history on the next, or a law that returned a value no law may return during
-the run (one line naming the law, the value and the point), or a sweep with failed runs;
+the run (one line naming the law, the value and the point), a scene file whose own code
+failed during the run (one line naming the file, the function and the line), or a sweep
+with failed runs;
 130 interrupted (Ctrl-C): one line, and none of the run's output files written (a sweep's
 table, written as each point ends, holds the points done); 143 ended by SIGTERM, the same
 without the line.
@@ -637,8 +639,13 @@ def _main(argv):
         if _INTERRUPTED:                              # the interrupt, turned into another error by a library
             print(("\n" if _RUN.get("progress") else "") + interrupted(exc), file=sys.stderr)
             return 130
+        from .scenes import SceneError
         from .solver.newton import NewtonError
 
+        if isinstance(exc, SceneError):              # a scene file's own code failed during the run
+            print(("\n" if _RUN.get("progress") else "") + f"contactfem: scene failed: {_one_line(exc)}",
+                  file=sys.stderr)
+            return 1
         if isinstance(exc, (ZeroDivisionError, OverflowError)):       # Python arithmetic at the float limits
             print(f"contactfem: solver failed: {_one_line(exc)} in {_where(exc)} (parameter values near the limits "
                   "of floating point?)", file=sys.stderr)

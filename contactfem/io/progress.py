@@ -1,4 +1,7 @@
-"""A progress bar for long runs, on stderr, without dependencies.
+"""A progress bar for long runs: tqdm's (``tqdm.auto``: a text bar on stderr, a widget in
+Jupyter), drawn as
+
+    ring [#######.......................]  35%  t = 0.7  12.1 s
 
     bar = ProgressBar(t0=0.0, t_end=2.0, label="ring")
     for rec in march(stepper, Steps(dt, t_end=2.0), 0.0, u0, v0):
@@ -13,13 +16,44 @@ bars with ``progress=progress_bar`` (one per time loop; solver.march.watch).
 """
 
 import sys
-import time
+
+from tqdm import tqdm as text_tqdm
+from tqdm.auto import tqdm as auto_tqdm
+
+FORMAT = "{desc}[{bar}] {percentage:3.0f}%  {where}  {elapsed_s:.1f} s{note}"
+
+
+class _Fields:
+    """Two more fields for tqdm's format: where the run is (``where``) and a note."""
+
+    where = ""
+    note = ""
+
+    @property
+    def format_dict(self):
+        return dict(super().format_dict, where=self.where, note=f"  ({self.note})" if self.note else "")
+
+
+class _TextBar(_Fields, text_tqdm):
+    """The text bar, on a stream."""
+
+
+class _AutoBar(_Fields, auto_tqdm):
+    """A widget in Jupyter (with ipywidgets), else the text bar on stderr."""
+
+
+def _bar(stream, **options):
+    if stream is not None:                    # a stream asked for: the text bar on it
+        return _TextBar(file=stream, **options)
+    try:
+        return _AutoBar(file=sys.stderr, **options)
+    except ImportError:                       # Jupyter without ipywidgets: tqdm cannot draw its widget
+        return _TextBar(file=sys.stderr, **options)
 
 
 class ProgressBar:
-    """`[#######.............]  35%  t = 0.7  12.1 s` on one line of stderr, redrawn at most
-    every `interval` seconds. As an integrate callback it measures progress by the time t
-    between t0 and t_end; with `total` it counts calls of update()."""
+    """As an integrate callback it measures progress by the time t between t0 and t_end; with
+    `total` it counts calls of update(). Redrawn at most every `interval` seconds."""
 
     def __init__(self, total=None, t0=0.0, t_end=None, label="", width=30, stream=None, interval=0.2):
         if (total is None) == (t_end is None):
@@ -28,61 +62,47 @@ class ProgressBar:
             raise ValueError(f"parameter total = {total!r} is out of range: allowed (0, inf)")
         if t_end is not None and not t_end > t0:
             raise ValueError(f"parameter t_end = {t_end!r} must be > t0 = {t0!r}")
-        self.total, self.t0, self.t_end, self.label = total, float(t0), t_end, label
-        self.width, self.interval = int(width), float(interval)
-        self.stream = stream if stream is not None else sys.stderr
-        self.n, self.fraction, self.t = 0, 0.0, float(t0)
-        self.start = time.perf_counter()
-        self._last = -1e300
-        self._drawn_at = None
+        self.total, self.t0, self.t_end = total, float(t0), t_end
+        self.n, self.t = 0, float(t0)
         self.closed = False
-        self.note = ""
+        self._bar = _bar(stream, total=total if total is not None else 1.0, desc=f"{label} " if label else "",
+                         mininterval=float(interval), miniters=1, ascii=".#",
+                         bar_format=FORMAT.replace("{bar}", f"{{bar:{int(width)}}}"))
+        self._bar.where = f"step 0/{total}" if total is not None else f"t = {self.t:.4g}"
 
-    def text(self):
-        f = min(max(self.fraction, 0.0), 1.0)
-        k = int(round(f * self.width))
-        where = f"step {self.n}/{self.total}" if self.total is not None else f"t = {self.t:.4g}"
-        head = f"{self.label} " if self.label else ""
-        note = f"  ({self.note})" if self.note else ""
-        return (f"{head}[{'#' * k}{'.' * (self.width - k)}] {100 * f:3.0f}%  {where}  "
-                f"{time.perf_counter() - self.start:.1f} s{note}")
-
-    def _draw(self, force=False):
-        now = time.perf_counter()
-        if force or now - self._last >= self.interval:
-            self.stream.write("\r" + self.text())
-            self.stream.flush()
-            self._last = now
-            self._drawn_at = self.fraction
+    def _to(self, done, force=False):
+        """Move the bar to `done` (steps, or the fraction of [t0, t_end]) and draw it."""
+        done = min(max(done, 0.0), self._bar.total)
+        self._bar.update(done - self._bar.n)
+        if force:
+            self._bar.refresh()
 
     def update(self, n=1):
         """Count n more steps (with total)."""
         self.n += n
-        self.fraction = self.n / self.total if self.total is not None else self.fraction
-        self._draw(force=self.n >= (self.total or float("inf")))
+        self._bar.where = f"step {self.n}/{self.total}"
+        self._to(self.n, force=self.n >= self.total)
 
     def __call__(self, t, u=None, v=None, a=None):
         """The integrate callback: progress (t - t0) / (t_end - t0)."""
         self.t = float(t)
         self.n += 1
         if self.t_end is not None:
-            self.fraction = (self.t - self.t0) / (self.t_end - self.t0)
-        elif self.total is not None:
-            self.fraction = self.n / self.total
-        self._draw(force=self.fraction >= 1.0)
+            self._bar.where = f"t = {self.t:.4g}"
+            self._to((self.t - self.t0) / (self.t_end - self.t0))
+        else:
+            self._bar.where = f"step {self.n}/{self.total}"
+            self._to(self.n)
 
     def finish(self, note=""):
         """The run is done before t_end by its own rule: draw 100 % with ``note`` saying why."""
-        self.fraction, self.note = 1.0, str(note)
-        self._draw(force=True)
+        self._bar.note = str(note)
+        self._to(self._bar.total, force=True)
 
     def close(self):
         """Draw the final state and end the line."""
         if not self.closed:
-            if self._drawn_at != self.fraction:      # the final state is not on screen yet
-                self._draw(force=True)
-            self.stream.write("\n")
-            self.stream.flush()
+            self._bar.close()
             self.closed = True
 
     def __enter__(self):

@@ -10,6 +10,7 @@ import importlib
 import pkgutil
 
 from .base import Param, Scene, Stage, jsonable, simulate
+from .files import SceneError, is_scene_file, load_scene_file
 
 
 def all_scenes():
@@ -27,7 +28,12 @@ def all_scenes():
 
 def get_scene(name):
     """The Scene called `name`. A scene lives in the module of its name, so only that module
-    is imported (the others only when the name is unknown, to list the known ones)."""
+    is imported (the others only when the name is unknown, to list the known ones). A path
+    ending in .py is a scene file a user wrote (files.py); a Scene is returned as it is."""
+    if isinstance(name, Scene):
+        return name
+    if is_scene_file(name):
+        return load_scene_file(name)
     if isinstance(name, str) and name.isidentifier() and not name.startswith("_") and name != "base":
         module = f"{__name__}.{name}"
         try:
@@ -99,10 +105,12 @@ def run_scene(name, preset="fast", overrides=None, progress=None, friction=None,
         results[f"{kind}_law"] = describe(law)
     if "friction" in laws and scene.law_choice is not None and "variant" in results:
         results["variant"] = scene.variant_of(params, friction)
-    results["scene"] = name
+    results["scene"] = scene.name
+    if is_scene_file(name):
+        results["scene_file"] = str(name)
     results["preset"] = preset
     results["parameters"] = {k: v for k, v in params.items() if scene.law_param_kind(k, v) not in laws}
     return jsonable(results)
 
 
-__all__ = ["Param", "Scene", "Stage", "all_scenes", "get_scene", "run_scene", "check_laws", "jsonable", "simulate"]
+__all__ = ["Param", "Scene", "SceneError", "Stage", "all_scenes", "get_scene", "run_scene", "check_laws", "jsonable", "simulate"]
