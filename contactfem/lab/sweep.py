@@ -34,7 +34,7 @@ import secrets
 from contextlib import closing
 from pathlib import Path
 
-from ..scenes import check_laws, get_scene, run_scene
+from ..scenes import check_laws, get_scene, is_scene_file, run_scene
 
 
 def parse_grid(sets):
@@ -87,9 +87,10 @@ def laws_text(friction=None, normal=None):
 LIBRARY = ("clock.py", "laws", "contact", "bodies", "solver", "scenes")   # the sources a run uses
 
 
-def code_version(friction=None, normal=None):
+def code_version(friction=None, normal=None, scene=None):
     """'0.1.0+1a2b3c4d5e6f': contactfem's version and a digest of the sources a run uses (the
-    library below the lab, and the files of the laws named by ``friction`` / ``normal``)."""
+    library below the lab, the files of the laws named by ``friction`` / ``normal``, and the
+    scene file where ``scene`` is one)."""
     import contactfem
 
     from .lawfile import load_class
@@ -106,6 +107,8 @@ def code_version(friction=None, normal=None):
                 h.update(Path(inspect.getfile(load_class(spec, f"--{kind}"))).read_bytes())
             except (TypeError, OSError):
                 h.update(spec.encode())
+    if is_scene_file(scene):
+        h.update(Path(scene).expanduser().read_bytes())
     return f"{contactfem.__version__}+{h.hexdigest()[:12]}"
 
 
@@ -159,7 +162,7 @@ def sweep(scene, grid, preset="fast", jobs=1, scheduler=None, friction=None, nor
 
 
 def _prepare(scene, grid, preset, jobs, scheduler, friction, normal, check, force):
-    return plan(scene, grid, preset, jobs, scheduler, friction, normal, check, force), code_version(friction, normal)
+    return plan(scene, grid, preset, jobs, scheduler, friction, normal, check, force), code_version(friction, normal, scene)
 
 
 def _guarded(fn, args, laws):

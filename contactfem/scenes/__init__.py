@@ -113,4 +113,4 @@ def run_scene(name, preset="fast", overrides=None, progress=None, friction=None,
     return jsonable(results)
 
 
-__all__ = ["Param", "Scene", "SceneError", "Stage", "all_scenes", "get_scene", "run_scene", "check_laws", "jsonable", "simulate"]
+__all__ = ["Param", "Scene", "SceneError", "Stage", "all_scenes", "is_scene_file", "get_scene", "run_scene", "check_laws", "jsonable", "simulate"]
