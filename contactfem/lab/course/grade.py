@@ -553,6 +553,10 @@ def grade(folder, out_csv, autograders=None, jobs=1, repo=None, roster=None, dea
 
     rel = {p: p.relative_to(folder).as_posix() for p in subs}
     which = {p: lecture or lecture_of(p, names) for p in subs}
+    known = {w for w in which.values() if w}
+    if len(known) == 1:      # a class of one lecture: a notebook that does not say (or cannot be read) is of it
+        lecture = lecture or known.pop()
+        which = {p: w or lecture for p, w in which.items()}
     entries = []        # (student or None, path or None)
     if students:
         by_file = {s.file: s for s in students if s.file}
@@ -591,7 +595,9 @@ def grade(folder, out_csv, autograders=None, jobs=1, repo=None, roster=None, dea
         if interrupted and p is not None and str(p) not in results:
             continue
         row, detail = _row(s, p, rel.get(p, ""), which.get(p) if p is not None else (lecture or ""),
-                           results.get(str(p)), columns, manual, scores_read, deadline, folder)
+                           results.get(str(p)), columns, manual, scores_read, deadline)
+        if students and s is None:
+            row["notes"] = " | ".join(x for x in ("not on the roster", row["notes"]) if x)
         rows.append(row)
         details.append(detail)
     fields = ["id", "name", "submission", "lecture"] + columns + manual + ["total", "possible", "status", "late", "notes"]
@@ -613,12 +619,12 @@ def _write_csv(path, fields, rows):
     os.replace(tmp, path)
 
 
-def _row(student, path, rel, lec, outcome, columns, manual, scores_read, deadline, folder):
+def _row(student, path, rel, lec, outcome, columns, manual, scores_read, deadline):
     from . import checks
 
     row = {"id": student.id if student else "", "name": student.name if student else "", "submission": rel,
            "lecture": lec or ""}
-    notes, parts, answers = [], [], {}
+    notes, parts, answers, stop = [], [], {}, None
     mine = [e for e in columns if checks.EXERCISES[e].lecture == lec]
     my_manual = [m for m in manual if checks.MANUAL[m].lecture == lec]
     status = "graded"
@@ -643,6 +649,7 @@ def _row(student, path, rel, lec, outcome, columns, manual, scores_read, deadlin
         res = outcome.value
         parts, answers = res["parts"], res["manual"]
         if res["stopped"]:
+            status, stop = "stopped", res["stopped"]
             notes.append(res["stopped"])
         notes += res["errors"][:3] + ([f"and {len(res['errors']) - 3} more cells failed"] if len(res["errors"]) > 3 else [])
         if res["printed"] > 2**20:
@@ -653,8 +660,8 @@ def _row(student, path, rel, lec, outcome, columns, manual, scores_read, deadlin
             got = sum(p[2] for p in parts if p[0] == e)
             total += got
             row[e] = f"{got:g}"
-            failed = [p for p in parts if p[0] == e and p[4] != "passed"]
-            if failed and status == "graded":
+            failed = [p for p in parts if p[0] == e and p[4] not in ("passed", stop)]
+            if failed:
                 more = f" (and {len(failed) - 1} more part{'s' if len(failed) > 2 else ''})" if len(failed) > 1 else ""
                 notes.append(f"{e}: {failed[0][4]}{more}")
         else:
@@ -774,5 +781,6 @@ def _write_feedback(feedback, details):
                 lines.append(f"- {part}: {pts:g} of {possible:g}" + ("" if msg == "passed" else f": {msg}"))
         for q in d["manual"]:
             m = checks.MANUAL[q]
-            lines += ["", f"## {q} (written): {r.get(q) or 'to be scored'} of {m.points:g}", m.what]
+            got = f"{r[q]} of {m.points:g}" if r.get(q) else f"to be scored, {m.points:g} points"
+            lines += ["", f"## {q} (written): {got}", m.what]
         (feedback / f"{stem}-{d['lecture'] or 'none'}.md").write_text("\n".join(lines) + "\n")

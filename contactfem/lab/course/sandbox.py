@@ -67,9 +67,28 @@ class _Grader:
     check_all = export = check
 
 
+def _own_builtins():
+    """A copy of the builtins for the notebook (its `import builtins` too): a notebook that
+    replaces isinstance or AssertionError changes its own names, not those this module runs on."""
+    import builtins
+    import types
+
+    mine = types.ModuleType("builtins")
+    mine.__dict__.update(builtins.__dict__)
+    real_import = builtins.__import__
+
+    def imp(name, globals=None, locals=None, fromlist=(), level=0):
+        if name == "builtins" and level == 0:
+            return mine
+        return real_import(name, globals, locals, fromlist, level)
+
+    mine.__import__ = imp
+    return mine.__dict__
+
+
 class Sandbox:
     def __init__(self):
-        self.env = {"__name__": "__main__", "grader": _Grader()}
+        self.env = {"__name__": "__main__", "grader": _Grader(), "__builtins__": _own_builtins()}
         self.refs = {}
         self.used = set()
         self.sink = Sink()
@@ -128,7 +147,8 @@ class Sandbox:
         try:
             exec(compile(code, "<cell>", "exec"), self.env)
         except BaseException as err:          # noqa: BLE001  (sys.exit and KeyboardInterrupt are the cell's too)
-            return {"ok": False, "error": f"{type(err).__name__}: {' '.join(str(err).split())[:200]}",
+            msg = " ".join(str(err).split())[:200]
+            return {"ok": False, "error": f"{type(err).__name__}: {msg}" if msg else type(err).__name__,
                     "printed": self.sink.count}
         return {"ok": True, "printed": self.sink.count}
 

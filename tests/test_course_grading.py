@@ -1,0 +1,300 @@
+"""The grading of a class: a mock class of lecture 01 graded by one command, where every
+submission gets the score intended for it, whatever it does to the grader.
+
+Each submission is a small notebook made here (the lecture's two exercises and its written
+question), not the whole lecture: grading runs the notebook's cells in a process of its own,
+so a notebook of a few cells is graded in about a second.
+"""
+
+import csv
+import os
+import time
+
+import pytest
+
+nbformat = pytest.importorskip("nbformat")
+
+LECTURE = "01_interface_laws"
+HEAD = "import numpy as np\nfrom dataclasses import dataclass"
+PL = '''def power_law(g_N, c_N, m):
+    g_N = np.asarray(g_N, dtype=float)
+    approach = np.where(g_N < 0.0, -g_N, 0.0)
+    return -c_N * approach ** m, np.where(g_N < 0.0, c_N * m * approach ** (m - 1.0), 0.0)'''
+TR = '''@dataclass(frozen=True)
+class Tresca:
+    c_T: float
+    tau_y: float
+
+    def slip_bound(self, p, q):
+        Y = np.full(np.broadcast(p, q).shape, float(self.tau_y))
+        return Y, np.zeros_like(Y), np.zeros_like(Y)'''
+PL_STUB = "def power_law(g_N, c_N, m):\n    ..."
+TR_STUB = "@dataclass(frozen=True)\nclass Tresca:\n    c_T: float\n    tau_y: float\n\n    def slip_bound(self, p, q):\n        ..."
+PL_SIGN = PL.replace("return -c_N", "return c_N")                          # t_N of the wrong sign
+PL_NO_M = PL.replace("c_N * m * approach", "c_N * approach")               # dt_N without the factor m
+PL_C100 = PL.replace("c_N", "100.0").replace("100.0, m", "c_N, m")          # c_N ignored: right only at c_N = 100
+TR_COULOMB = TR.replace("Y = np.full(np.broadcast(p, q).shape, float(self.tau_y))",
+                        "Y = self.tau_y * np.asarray(p, dtype=float) + 0.0 * np.asarray(q)")
+PL_ONE = PL.replace("return -c_N * approach ** m, np.where(g_N < 0.0, c_N * m * approach ** (m - 1.0), 0.0)",
+                    "return -c_N * approach ** m")
+PL_RAISES = "def power_law(g_N, c_N, m):\n    return 1 / 0"
+PL_FOREVER = "import time\n\ndef power_law(g_N, c_N, m):\n    while True:\n        time.sleep(0.01)"
+PL_LIBRARY = '''from contactfem.laws.normal import PowerLaw
+
+def power_law(g_N, c_N, m):
+    return PowerLaw(c_N, m).traction(g_N)'''
+PL_LIBRARY_HIDDEN = '''import importlib
+
+def power_law(g_N, c_N, m):
+    law = getattr(importlib.import_module("contactfem.laws." + "normal"), "Power" + "Law")
+    return law(c_N, m).traction(g_N)'''
+PATCH_CHECKS = '''import contactfem.lab.course.checks as checks
+for name in dir(checks):
+    if not name.startswith("__"):
+        setattr(checks, name, lambda *a, **k: None)'''
+PATCH_NUMPY = '''np.allclose = lambda *a, **k: True
+np.all = lambda *a, **k: True
+np.testing.assert_allclose = lambda *a, **k: None'''
+PATCH_BUILTINS = '''import builtins
+builtins.isinstance = lambda *a: True
+builtins.AssertionError = type("Nothing", (Exception,), {})'''
+PL_ZEROS = "def power_law(g_N, c_N, m):\n    return np.zeros_like(g_N), np.zeros_like(g_N)"
+
+# (name, cells, the scores intended for (ex01_power_law, ex01_tresca), a note the row must hold)
+CLASS = [
+    ("full1", [HEAD, PL, TR], (5, 5), ""),
+    ("full2", [HEAD, TR, PL], (5, 5), ""),
+    ("partial_pl", [HEAD, PL, TR_STUB], (5, 0), "`...`"),
+    ("partial_tr", [HEAD, PL_STUB, TR], (0, 5), "`...`"),
+    ("blank", [HEAD, PL_STUB, TR_STUB], (0, 0), "`...`"),
+    ("empty", [], (0, 0), "is not defined"),
+    ("sign", [HEAD, PL_SIGN, TR], (3, 5), "the sign is wrong"),
+    ("no_m", [HEAD, PL_NO_M, TR], (3, 5), "off by a factor 0.4"),
+    ("coulomb", [HEAD, PL, TR_COULOMB], (5, 2), "grows with the pressure"),
+    ("c_N_ignored", [HEAD, PL_C100, TR], (1, 5), "c_N = 37"),                # passes the public checks only
+    ("one_value", [HEAD, PL_ONE, TR], (0, 5), "should return 2 values"),
+    ("raises", [HEAD, PL_RAISES, TR], (0, 5), "raised ZeroDivisionError"),
+    ("patch_checks", [HEAD, PATCH_CHECKS, "def power_law(g_N, c_N, m):\n    return None", TR_STUB], (0, 0),
+     "returned None"),
+    ("patch_numpy", [HEAD, PATCH_NUMPY, PL_ZEROS, TR_STUB], (1, 0), "expected"),
+    ("patch_builtins", [HEAD, PATCH_BUILTINS, PL_ZEROS, TR_STUB], (1, 0), "expected"),
+    ("library", [HEAD, PL_LIBRARY, TR], (0, 5), "the library's own contactfem.laws.normal.PowerLaw"),
+    ("library_hidden", [HEAD, PL_LIBRARY_HIDDEN, TR], (0, 5), "the library's own contactfem.laws.normal.PowerLaw"),
+    ("endless_cell", [HEAD, PL, "import time\nwhile True:\n    time.sleep(1)", TR], (0, 0), "time limit"),
+    ("endless_answer", [HEAD, PL_FOREVER, TR], (0, 5), "did not return within"),
+    ("sys_exit", [HEAD, PL, TR, "import sys\nsys.exit(3)"], (5, 5), "SystemExit: 3"),
+    ("os_exit", [HEAD, PL, "import os\nos._exit(7)", TR], (0, 0), "exited with code 7"),
+    ("import_error", ["import no_such_package\n" + HEAD, PL, TR], (0, 0), "ModuleNotFoundError"),
+    ("segfault", ["import ctypes\nctypes.string_at(0)", HEAD, PL, TR], (0, 0), "died (signal 11)"),
+    ("flood", [HEAD, PL, 'print("x" * 100_000_000)', TR], (5, 5), "printed 95 MB"),
+    ("memory", [HEAD, PL, "hog = bytearray(3 * 2**30)", TR], (5, 5), "MemoryError"),
+    ("late", [HEAD, PL, TR], (5, 5), "late by 2 h 00 min"),
+    ("magic", [HEAD, "%matplotlib inline\n" + PL, "import otter\ngrader = otter.Notebook('x.ipynb')", TR,
+               'grader.check("ex01_power_law")'], (5, 5), ""),
+    ("tr_only_fields", [HEAD, PL, TR.replace("float(self.tau_y)", "0.2")], (5, 3), "tau_y = 1.3"),
+    ("full3", [HEAD, PL, TR], (5, 5), ""),
+    ("full4", [HEAD, PL, TR], (5, 5), ""),
+]
+CORRUPT = "corrupt"
+MISSING = "absent"
+STRAY = "stray"
+
+
+def _notebook(cells, path, written="Penetration against conditioning."):
+    nb = nbformat.v4.new_notebook()
+    nb.metadata["otter"] = {"assignment_name": LECTURE}
+    nb.cells = [nbformat.v4.new_code_cell(c) for c in cells]
+    nb.cells += [nbformat.v4.new_markdown_cell("<!-- manual: ex01_discussion -->\n**Discuss** c_N."),
+                 nbformat.v4.new_code_cell("stiffness = [1e2, 1e4]"),
+                 nbformat.v4.new_markdown_cell(written)]
+    nbformat.write(nb, path)
+
+
+def make_class(root):
+    """The submissions folder, the roster and the deadline of the mock class."""
+    subs = root / "submissions"
+    subs.mkdir()
+    for name, cells, _, _ in CLASS:
+        _notebook(cells, subs / f"{name}.ipynb", written=f"{name} says: stiff is accurate, soft is well conditioned.")
+    (subs / f"{CORRUPT}.ipynb").write_text('{"cells": [ this is not json')
+    _notebook([HEAD, PL, TR], subs / f"{STRAY}.ipynb")
+    roster = root / "roster.csv"
+    with open(roster, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["id", "name", "file", "submitted"])
+        for i, (name, *_) in enumerate(CLASS):
+            w.writerow([f"u{i:02d}", f"Student {name}", f"{name}.ipynb",
+                        "2026-12-03T14:00:00+00:00" if name == "late" else "2026-12-03T10:00:00+00:00"])
+        w.writerow(["u90", "Student corrupt", f"{CORRUPT}.ipynb", ""])
+        w.writerow(["u91", "Student absent", f"{MISSING}.ipynb", ""])
+    return subs, roster, "2026-12-03T12:00:00+00:00"
+
+
+@pytest.fixture(scope="module")
+def graded(tmp_path_factory):
+    from contactfem.cli import main
+
+    root = tmp_path_factory.mktemp("class")
+    subs, roster, deadline = make_class(root)
+    out = root / "scores.csv"
+    t0 = time.perf_counter()
+    code = main(["course", "grade", str(subs), "--out", str(out), "--roster", str(roster), "--deadline", deadline,
+                 "--jobs", "2", "--notebook-timeout", "20", "--check-timeout", "1", "--memory", "2048"])
+    seconds = time.perf_counter() - t0
+    assert code == 0
+    with open(out) as f:
+        rows = list(csv.DictReader(f))
+    return root, {r["submission"] or r["id"]: r for r in rows}, seconds
+
+
+@pytest.mark.slow
+def test_a_class_of_thirty_gets_the_scores_intended(graded):
+    """Every submission of the mock class gets its intended score and the note that says why;
+    the corrupt file, the missing one and the one not on the roster get their rows."""
+    root, rows, seconds = graded
+    print(f"\ngraded {len(rows)} rows in {seconds:.0f} s")
+    assert len(CLASS) >= 30
+    for name, _, (pl, tr), note in CLASS:
+        r = rows[f"{name}.ipynb"]
+        assert (float(r["ex01_power_law"]), float(r["ex01_tresca"])) == (pl, tr), (name, r["notes"])
+        assert float(r["total"]) == pl + tr and r["possible"] == "12", name
+        assert note in r["notes"], (name, r["notes"])
+        assert r["id"] and r["name"] == f"Student {name}"
+        assert r["late"] == ("yes" if name == "late" else ""), name
+    corrupt = rows[f"{CORRUPT}.ipynb"]
+    assert corrupt["status"] == "not graded" and "not a notebook" in corrupt["notes"]
+    assert rows["u91"]["status"] == "missing" and "no submission" in rows["u91"]["notes"]
+    for r in (corrupt, rows["u91"]):        # the gradebook's columns for every student of the roster
+        assert (r["lecture"], r["total"], r["possible"]) == (LECTURE, "0", "12"), r
+    assert rows[f"{STRAY}.ipynb"]["id"] == "" and "not on the roster" in rows[f"{STRAY}.ipynb"]["notes"]
+    assert rows["endless_cell.ipynb"]["status"] == "stopped"
+    assert len(rows) == len(CLASS) + 3
+    # bounded: two workers, one notebook stopped at its 20 s limit, an answer at 1 s a call
+    assert seconds < 240
+
+
+@pytest.mark.slow
+def test_the_class_review_and_feedback_files_are_complete(graded):
+    root, rows, _ = graded
+    page = (root / "scores-review" / f"{LECTURE}.html").read_text()
+    sheet = list(csv.DictReader(open(root / "scores-review" / f"{LECTURE}-scores.csv")))
+    for name, *_ in CLASS:
+        assert f"{name} says: stiff is accurate" in page, name
+        assert sum(1 for r in sheet if r["submission"] == f"{name}.ipynb") == 1
+    assert page.count("<section") == len(CLASS) + 2          # the class, the stray and the corrupt one
+    assert "stiffness = [1e2, 1e4]" in page
+    files = sorted(p.name for p in (root / "scores-feedback").glob("*.md"))
+    assert len(files) == len(rows)
+    text = (root / "scores-feedback" / f"u{[c[0] for c in CLASS].index('sign'):02d}-{LECTURE}.md").read_text()
+    assert "Total: 8 of 12" in text and "the sign is wrong" in text and "ex01_discussion (written): to be scored, 2 points" in text
+
+
+def test_written_scores_are_read_back_into_the_csv(tmp_path):
+    """The instructor's scores in the review sheet go into the CSV's question column and total."""
+    from contactfem.lab.course import grade
+
+    subs = tmp_path / "subs"
+    subs.mkdir()
+    _notebook([HEAD, PL, TR_STUB], subs / "a.ipynb")
+    _notebook([HEAD, PL_STUB, TR_STUB], subs / "b.ipynb")
+    out = tmp_path / "s.csv"
+    rows = grade(subs, out, jobs=2)
+    assert [r["ex01_discussion"] for r in rows] == ["", ""] and "written answers to score" in rows[0]["notes"]
+    sheet = tmp_path / "s-review" / f"{LECTURE}-scores.csv"
+    lines = list(csv.DictReader(open(sheet)))
+    lines[0]["score"] = "1.5"
+    with open(sheet, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(lines[0]))
+        w.writeheader()
+        w.writerows(lines)
+    rows = grade(subs, out, jobs=2)
+    assert (rows[0]["ex01_discussion"], rows[0]["total"], rows[0]["possible"]) == ("1.5", "6.5", "12")
+    assert rows[1]["ex01_discussion"] == "" and rows[1]["total"] == "0"
+    assert open(sheet).read().count("1.5") == 1             # the instructor's sheet is kept
+
+
+def test_patching_the_checks_in_the_notebook_scores_nothing(tmp_path):
+    """The notebook the issue describes: the checks replaced by do-nothing lambdas, power_law
+    returning None and Tresca blank, scores 0 of 10 (it scored 10 of 10 through otter)."""
+    from contactfem.lab.course import grade
+
+    subs = tmp_path / "subs"
+    subs.mkdir()
+    _notebook([HEAD, PATCH_CHECKS, PATCH_NUMPY, "def power_law(g_N, c_N, m):\n    return None", TR_STUB],
+              subs / "cheat.ipynb")
+    row = grade(subs, tmp_path / "s.csv")[0]
+    assert (row["ex01_power_law"], row["ex01_tresca"], row["total"]) == ("0", "0", "0"), row["notes"]
+
+
+def test_an_answer_that_calls_the_library_scores_zero_with_a_hint(tmp_path):
+    from contactfem.lab.course import grade
+
+    subs = tmp_path / "subs"
+    subs.mkdir()
+    _notebook([HEAD, PL_LIBRARY_HIDDEN, TR], subs / "lib.ipynb")
+    row = grade(subs, tmp_path / "s.csv")[0]
+    assert (row["ex01_power_law"], row["ex01_tresca"]) == ("0", "5"), row["notes"]
+    assert "asks you to implement it yourself" in row["notes"]
+
+
+def test_an_endless_notebook_gets_its_row_and_the_others_are_graded(tmp_path):
+    from contactfem.lab.course import Limits, grade
+
+    subs = tmp_path / "subs"
+    subs.mkdir()
+    _notebook([HEAD, "while True:\n    pass", PL, TR], subs / "a_forever.ipynb")
+    _notebook([HEAD, PL, TR], subs / "b_good.ipynb")
+    t0 = time.perf_counter()
+    rows = grade(subs, tmp_path / "s.csv", jobs=2, limits=Limits(notebook=4.0))
+    assert time.perf_counter() - t0 < 30
+    assert rows[0]["status"] == "stopped" and "time limit 4 s for the notebook" in rows[0]["notes"]
+    assert rows[0]["total"] == "0" and rows[1]["total"] == "10"
+
+
+def test_interrupted_grading_leaves_the_rows_done_and_says_so(tmp_path, monkeypatch):
+    """Ctrl-C during the batch: the CSV holds the rows graded so far, the message says how many."""
+    from contactfem.lab import batch
+    from contactfem.lab.course import GradingInterrupted, grade
+
+    subs = tmp_path / "subs"
+    subs.mkdir()
+    for name in ("a", "b", "c"):
+        _notebook([HEAD, PL, TR], subs / f"{name}.ipynb")
+    real = batch.run_batch
+
+    def interrupted_after_one(*args, **kwargs):
+        gen = real(*args, **kwargs)
+        yield next(gen)
+        gen.close()
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(batch, "run_batch", interrupted_after_one)
+    with pytest.raises(GradingInterrupted, match="1 of 3 notebooks graded; their rows are in"):
+        grade(subs, tmp_path / "s.csv", jobs=1)
+    rows = list(csv.DictReader(open(tmp_path / "s.csv")))
+    assert len(rows) == 1 and rows[0]["total"] == "10"
+
+
+def test_grade_refuses_bad_options(tmp_path, capsys):
+    from contactfem.cli import main
+
+    subs = tmp_path / "subs"
+    subs.mkdir()
+    _notebook([HEAD], subs / "a.ipynb")
+    (tmp_path / "bad_roster.csv").write_text("who,file\n")
+    out = str(tmp_path / "s.csv")
+    cases = [
+        (["--notebook-timeout", "0"], "--notebook-timeout"),
+        (["--check-timeout", "-1"], "--check-timeout"),
+        (["--memory", "10"], "--memory"),
+        (["--roster", str(tmp_path / "none.csv")], "--roster"),
+        (["--roster", str(tmp_path / "bad_roster.csv")], "no column id, name"),
+        (["--deadline", "tomorrow"], "--deadline"),
+        (["--lecture", "99_none"], "--lecture"),
+    ]
+    for extra, what in cases:
+        capsys.readouterr()
+        assert main(["course", "grade", str(subs), "--out", out] + extra) == 2, extra
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and what in err, err
+    assert not os.path.exists(out)
