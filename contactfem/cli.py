@@ -7,7 +7,9 @@ scene meets, an output that cannot be written, a run too large for this machine)
 line on stderr, found before any solve; 1 a failed solve, its cause in one line and the
 residual history on the next, or a law that returned a value no law may return during
 the run (one line naming the law, the value and the point), or a sweep with failed runs;
-130 interrupted (Ctrl-C): one line, and none of the run's output files written.
+130 interrupted (Ctrl-C): one line, and none of the run's output files written (a sweep's
+table, written as each point ends, holds the points done); 143 ended by SIGTERM, the same
+without the line.
 
 $CONTACTFEM_READY_FILE, if set, names a file the command line creates as soon as it
 answers Ctrl-C with its one line (for a supervisor, or a test, that interrupts it)."""
@@ -224,31 +226,35 @@ def cmd_figures(args):
 
 
 def cmd_sweep(args):
-    from .io.outputs import Outputs
-    from .lab.sweep import parse_grid, sweep, write_table
+    from .io.outputs import check_output_path
+    from .lab.sweep import Table, parse_grid, sweep
 
     if args.jobs < 1:
         raise ValueError(f"parameter jobs = {args.jobs} is out of range: allowed [1, inf)")
-    out = Outputs()
-    out.add("--out", args.out, (".csv", ".json"))
+    if args.time_limit is not None and not args.time_limit > 0:
+        raise ValueError(f"parameter time-limit = {args.time_limit:g} is out of range: allowed (0, inf) seconds")
+    if args.time_limit is not None and args.scheduler:
+        raise ValueError("--time-limit applies to local workers; with --scheduler, the cluster's own limits apply")
+    check_output_path(args.out, "--out", (".csv", ".json"))
     if not args.set:
         raise ValueError("sweep needs at least one --set NAME=V1,V2,... (the values to sweep); for one run use "
                          "contactfem run")
-    _RUN["phase"] = "sweep"
-    rows = sweep(args.scene, parse_grid(parse_sets(args.set)), args.preset, args.jobs, args.scheduler,
-                 friction=args.friction, normal=args.normal, check=not args.no_check, force=args.force)
-    _RUN["phase"] = "write"
-    with out:
-        write_table(rows, out.temp("--out"))
-        out.commit()
+    grid = parse_grid(parse_sets(args.set))
+    table = Table(args.out, resume=args.resume)        # with --resume, the rows already done are read now
+    _RUN.update(phase="sweep", table=table)
+    rows = sweep(args.scene, grid, args.preset, args.jobs, args.scheduler, friction=args.friction,
+                 normal=args.normal, check=not args.no_check, force=args.force, table=table,
+                 timeout=args.time_limit)
     _RUN["phase"] = "done"
-    failed = [r for r in rows if r.get("error")]
-    print(f"{len(rows)} runs, {len(rows) - len(failed)} succeeded, {len(failed)} failed -> {args.out}")
-    for r in failed:
-        point = ", ".join(f"{k[6:]}={v}" for k, v in r.items() if k.startswith("param."))
-        print(f"  failed: {point}: {r['error']}")
+    done, failed, left = table.counts()
+    kept = f" ({table.kept} kept from the table)" if table.kept else ""
+    print(f"{len(table.points)} points: {done} done{kept}, {failed} failed, {left} left -> {args.out}")
+    for r in rows:
+        if r.get("error"):
+            point = ", ".join(f"{k[6:]}={v}" for k, v in r.items() if k.startswith("param."))
+            print(f"  failed: {point}: {r['error']}")
     if failed:
-        print(f"contactfem: sweep: {len(failed)} of {len(rows)} runs failed (the table's error column says why)",
+        print(f"contactfem: sweep: {failed} of {len(rows)} points failed (the table's error column says why)",
               file=sys.stderr)
         return 1
     return 0
@@ -448,9 +454,17 @@ def build_parser():
     sw.add_argument("--set", action="extend", nargs="+", metavar="NAME=V1,V2,...",
                     help="values of parameters, or of a law's field as law.NAME=V1,V2,... (several after one "
                          "--set, or --set repeated; at least one)")
-    sw.add_argument("--jobs", type=int, default=1, help="local worker processes (joblib)")
-    sw.add_argument("--scheduler", default=None, help="Dask scheduler address: run on that cluster instead")
-    sw.add_argument("--out", default="sweep.csv", help="table of results, .csv or .json (default: sweep.csv)")
+    sw.add_argument("--jobs", type=int, default=1, help="local worker processes (default 1); a worker that dies "
+                    "is replaced and its point run once more, then recorded as failed with the reason")
+    sw.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                    help="Dask scheduler address (tcp://HOST:PORT): run on that cluster instead")
+    sw.add_argument("--out", default="sweep.csv", help="table of results, .csv or .json (default: sweep.csv), "
+                    "rewritten as each point ends: always a complete table of the points done")
+    sw.add_argument("--resume", action="store_true",
+                    help="keep the points of the --out table done by the same scene, preset, laws and code "
+                         "(its code_version column) and run only the others (failed ones included)")
+    sw.add_argument("--time-limit", type=float, default=None, metavar="SECONDS",
+                    help="stop a run that takes longer and record it as failed (local workers)")
     sw.add_argument("--friction", metavar="LAW", help="the friction law of every run, as for run; sweep its fields "
                     "with --set law.NAME=V1,V2,...")
     sw.add_argument("--normal", metavar="LAW", help="the normal law of every run, as for run")
@@ -543,6 +557,11 @@ def interrupted(exc):
     elif phase == "run":
         where = " during the run"
     elif phase == "sweep":
+        table = _RUN.get("table")
+        if table is not None and table.written is not None:
+            done, failed, left = table.written
+            return (f"contactfem: interrupted during the sweep; {table.path} holds the points done ({done} done, "
+                    f"{failed} failed, {left} left: --resume runs the rest)")
         where = " during the sweep"
     else:
         where = " before the run started"

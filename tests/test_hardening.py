@@ -125,7 +125,7 @@ def test_sweep_counts_its_failures(tmp_path, capsys):
     out = tmp_path / "sw.csv"
     assert main(["sweep", "block", "--set", "law=coulomb", "--set", "maxit=1,40", "--out", str(out)]) == 1
     text = capsys.readouterr().out
-    assert "2 runs, 1 succeeded, 1 failed" in text and "failed: law=coulomb, maxit=1: NewtonError" in text
+    assert "2 points: 1 done, 1 failed, 0 left" in text and "failed: law=coulomb, maxit=1: NewtonError" in text
 
 
 def test_equations_on_a_terminal_are_plain_text():

@@ -1,6 +1,6 @@
-"""Parameter sweeps: the cartesian product of parameter values, each run a scene,
-run in parallel on the local cores (worker processes), or on a Dask cluster when a
-scheduler address is given (joblib's dask backend). Results land in one table.
+"""Parameter sweeps: the cartesian product of parameter values, each run a scene, run in
+worker processes on the local cores (``lab.batch``) or on a Dask cluster when a scheduler
+address is given. Results land in one table, written as each point ends.
 
     contactfem sweep hertz --set n_el=8,16,32 --set penalty=per_length,per_node --jobs 2 --out hertz.csv
     contactfem sweep rolling_ring --friction my_law.py:Saturating --set law.mu0=0.1,0.2,0.3
@@ -8,14 +8,31 @@ scheduler address is given (joblib's dask backend). Results land in one table.
 A law's fields are swept like parameters (``law.NAME``, ``friction.NAME``, ``normal.NAME``);
 each run builds its laws from the same specification as ``contactfem run`` (law file,
 module path or shipped law), so a sweep point equals that run. Every point is validated
-(parameters, laws, the laws' check over the scene's range) before any run starts. The
-worker processes ignore Ctrl-C: the sweep's own process stops them and says so in one line.
+(parameters, laws, the laws' check over the scene's range) before any run starts.
+
+Every run is a task of a worker process, also with one job: a worker that dies (killed by
+the out-of-memory killer, or ended by a law calling ``os._exit``) is replaced and its point
+run once more, then recorded as failed with the reason ("worker died: signal 9", "worker
+exited with code 7"); the other points go on. The workers ignore Ctrl-C: the sweep's own
+process stops them. On a Dask cluster, the scheduler runs the task of a lost worker again
+and gives up on a point whose runs keep killing their workers (KilledWorker: a failed row).
+
+The table on disk (``Table``) is rewritten after every point (a temporary in the same
+folder, renamed onto it), so it is always a complete table of the points done. Each row
+says which code made it (``code_version``: contactfem's version and a digest of the sources
+a run uses, the library's and the law files'); ``resume`` skips the points whose row has
+no error and was made by the same scene, preset, laws and code.
 """
 
 import csv
+import hashlib
+import inspect
 import itertools
 import json
-import signal
+import os
+import secrets
+from contextlib import closing
+from pathlib import Path
 
 from ..scenes import check_laws, get_scene, run_scene
 
@@ -62,25 +79,42 @@ def _one(scene, preset, point, friction=None, normal=None):
     return row
 
 
-def _call(task):
-    return _one(*task)
+def laws_text(friction=None, normal=None):
+    """The laws of a sweep as its table's column ``laws`` records them."""
+    return " ".join(f"--{k} {v}" for k, v in (("friction", friction), ("normal", normal)) if v)
 
 
-def _ignore_interrupts():
-    """A worker: Ctrl-C is the sweep's to handle; SIGTERM (the sweep stopping it) ends it at once,
-    whatever handler the command line gave the process it was forked from."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+LIBRARY = ("clock.py", "laws", "contact", "bodies", "solver", "scenes")   # the sources a run uses
 
 
-def sweep(scene, grid, preset="fast", jobs=1, scheduler=None, friction=None, normal=None, check=True,
-          force=False):
-    """Run `scene` at every point of the grid (parameters and law fields law.NAME, with the
-    laws named by ``friction`` / ``normal`` as on the command line); returns a list of row
-    dicts. Every point is validated first (ValueError, one line): its parameters, its laws,
-    unless ``check`` is False the laws over the range the scene meets, and unless ``force``
-    its size against the limits of `contactfem run` (resources.LIMITS), the memory of the runs
-    that go at once (``jobs`` of them locally) together."""
+def code_version(friction=None, normal=None):
+    """'0.1.0+1a2b3c4d5e6f': contactfem's version and a digest of the sources a run uses (the
+    library below the lab, and the files of the laws named by ``friction`` / ``normal``)."""
+    import contactfem
+
+    from .lawfile import load_class
+
+    root = Path(contactfem.__file__).parent
+    h = hashlib.sha256()
+    for rel in LIBRARY:
+        files = sorted((root / rel).rglob("*.py")) if (root / rel).is_dir() else [root / rel]
+        for f in files:
+            h.update(str(f.relative_to(root)).encode() + b"\0" + f.read_bytes())
+    for kind, spec in (("friction", friction), ("normal", normal)):
+        if spec:
+            try:
+                h.update(Path(inspect.getfile(load_class(spec, f"--{kind}"))).read_bytes())
+            except (TypeError, OSError):
+                h.update(spec.encode())
+    return f"{contactfem.__version__}+{h.hexdigest()[:12]}"
+
+
+def plan(scene, grid, preset="fast", jobs=1, scheduler=None, friction=None, normal=None, check=True,
+         force=False):
+    """The points of the grid (dicts NAME -> value), every one validated (ValueError, one line):
+    its parameters, its laws, unless ``check`` is False the laws over the range the scene meets,
+    and unless ``force`` its size against the limits of `contactfem run` (resources.LIMITS),
+    the memory of the runs that go at once (``jobs`` of them locally) together."""
     from ..scenes.resources import LIMITS, check_resources, describe
 
     sc = get_scene(scene)
@@ -100,45 +134,186 @@ def sweep(scene, grid, preset="fast", jobs=1, scheduler=None, friction=None, nor
                          f"{describe(largest)}, would need about {together * largest['memory_bytes'] / 1e9:.2g} GB "
                          f"together: above the limit of {LIMITS['memory_bytes'] / 1e9:.2g} GB (lower --jobs, "
                          "or add --force to run it anyway)")
-    tasks = [(scene, preset, p, friction, normal) for p in points]
-    if scheduler:
-        from joblib import Parallel, delayed, parallel_config
+    return points
 
+
+def sweep(scene, grid, preset="fast", jobs=1, scheduler=None, friction=None, normal=None, check=True,
+          force=False, table=None, timeout=None):
+    """Run `scene` at every point of the grid (parameters and law fields law.NAME, with the
+    laws named by ``friction`` / ``normal`` as on the command line); returns the list of row
+    dicts, in the grid's order. Every point is validated first (``plan``). ``table``: a Table
+    that keeps the rows (on disk if it has a path, written as each point ends, and with
+    ``resume`` the rows it already holds); ``timeout``: seconds a local run may take before it
+    is stopped and recorded as failed."""
+    points = plan(scene, grid, preset, jobs, scheduler, friction, normal, check, force)
+    table = Table() if table is None else table
+    same = dict(scene=scene, preset=preset, laws=laws_text(friction, normal),
+                code_version=code_version(friction, normal))
+    todo = table.start(points, same)
+    tasks = [(i, (scene, preset, points[i], friction, normal)) for i in todo]
+    runs = _on_dask(scheduler, tasks) if scheduler else _local(tasks, jobs, timeout)
+    with closing(runs):            # an exception here (Ctrl-C, SIGTERM) stops the workers at once
+        for i, row in runs:
+            table.add(i, row)
+    return table.grid_rows()
+
+
+def _local(tasks, jobs, timeout):
+    """(index, row) of each task as it ends, on `jobs` worker processes."""
+    from .batch import run_batch
+
+    if not tasks:
+        return
+    with closing(run_batch(_one, tasks, jobs=min(jobs, len(tasks)), timeout=timeout)) as outcomes:
+        for o in outcomes:
+            yield o.key, o.value if o.ok else {"error": o.reason}
+
+
+def _on_dask(scheduler, tasks):
+    """(index, row) of each task as it ends, on the Dask cluster at `scheduler`."""
+    try:
+        from dask.distributed import as_completed
+    except ImportError:
+        raise ValueError("--scheduler needs dask.distributed: pip install 'dask[distributed]'") from None
+    client = connect(scheduler)
+    try:
+        futures = {client.submit(_one, *args, pure=False): i for i, args in tasks}
+        for fut in as_completed(futures, loop=client.loop):
+            if fut.status == "finished":
+                yield futures[fut], fut.result()
+                continue
+            exc = fut.exception()
+            if type(exc).__name__ == "KilledWorker":
+                reason = "worker died: every Dask worker that ran it died (KilledWorker)"
+            else:
+                reason = f"error: {type(exc).__name__}: {' '.join(str(exc).split())}"
+            yield futures[fut], {"error": reason}
+    finally:
+        client.close()
+
+
+def connect(address, timeout=10):
+    """A dask.distributed Client of the scheduler at `address`, or one ValueError naming
+    --scheduler and the address, at once if nothing listens there."""
+    import socket
+
+    from dask.distributed import Client
+    from distributed.comm import parse_address, parse_host_port
+
+    try:
+        scheme, location = parse_address(address)
+        host, port = parse_host_port(location) if scheme in ("tcp", "tls") else (None, None)
+    except (ValueError, TypeError) as err:
+        raise ValueError(f"--scheduler {address}: not the address of a Dask scheduler, such as "
+                         f"tcp://HOST:8786 ({' '.join(str(err).split())})") from None
+    if host is not None:
         try:
-            from dask.distributed import Client
-        except ImportError:
-            raise ValueError("--scheduler needs dask.distributed: pip install 'dask[distributed]'") from None
-        with Client(scheduler), parallel_config(backend="dask"):
-            return Parallel()(delayed(_one)(*t) for t in tasks)
-    if jobs == 1 or len(tasks) == 1:
-        return [_one(*t) for t in tasks]
-    return _parallel(tasks, min(jobs, len(tasks)))
-
-
-def _parallel(tasks, jobs):
-    """The tasks on `jobs` worker processes that ignore Ctrl-C from their first moment
-    (SIGINT is ignored while they start, a setting a new process keeps), so that an
-    interrupt reaches only this process, which stops them: one line, no worker traceback."""
-    import multiprocessing
-
-    # fork where there is one: the workers start at once with what is loaded, and its semaphores
-    # need no resource tracker (which would warn of them after an interrupt)
-    ctx = multiprocessing.get_context("fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn")
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+            socket.create_connection((host, port), timeout=timeout).close()
+        except OSError as err:
+            raise ValueError(f"--scheduler {address}: no Dask scheduler answers at {host}:{port} "
+                             f"({err.strerror or type(err).__name__})") from None
     try:
-        pool = ctx.Pool(jobs, initializer=_ignore_interrupts)
-    finally:
-        signal.signal(signal.SIGINT, previous)
+        return Client(address, timeout=timeout, set_as_default=False)
+    except (OSError, TimeoutError) as err:
+        raise ValueError(f"--scheduler {address}: no Dask scheduler answers there "
+                         f"({' '.join(str(err).split()) or type(err).__name__})") from None
+
+
+class Table:
+    """A sweep's table: the rows of its points (and, resumed, the rows its file held), on
+    disk at ``path`` (.csv or .json) rewritten after every point, in memory if path is None.
+
+    The file always holds a complete table: the rows of the grid's points done so far in the
+    grid's order, then the rows of other points the file held before. ``resume``: the rows
+    of the file are read first; a point whose row has no error and the same scene, preset,
+    laws and code version is not run again; a row of a point that runs again is replaced
+    when its new row comes. ``written``: (done, failed, left) as on disk, None until this
+    sweep has written the file."""
+
+    def __init__(self, path=None, resume=False):
+        self.path = Path(path) if path is not None else None
+        self.earlier = read_table(self.path) if resume and self.path is not None and self.path.exists() else []
+        self.points = []
+        self.rows = {}             # grid index -> row of this sweep (or kept from the file)
+        self.stale = {}            # grid index -> the file's row of that point, until its new row comes
+        self.others = []           # the file's rows of points outside this grid
+        self.kept = 0              # points not run again (resume)
+        self.same = {}
+        self.written = None
+
+    def start(self, points, same):
+        """The indices of the points to run; ``same``: the columns a kept row must match."""
+        self.points, self.same = list(points), dict(same)
+        index = {_key({f"param.{k}": v for k, v in p.items()}): i for i, p in enumerate(self.points)}
+        for row in self.earlier:
+            i = index.get(_key(row))
+            if i is None:
+                self.others.append(row)
+            elif i not in self.rows and not row.get("error") and \
+                    all(str(row.get(k, "")) == str(v) for k, v in self.same.items()):
+                self.rows[i] = row
+            else:
+                self.stale.setdefault(i, row)
+        self.kept = len(self.rows)
+        return [i for i in range(len(self.points)) if i not in self.rows]
+
+    def add(self, i, row):
+        """The row of point i: its parameters and the sweep's columns added; then written."""
+        row = dict(row)
+        row.setdefault("error", "")
+        row.update({f"param.{k}": v for k, v in self.points[i].items()})
+        for k, v in self.same.items():
+            row.setdefault(k, v)
+        self.rows[i] = row
+        self.write()
+
+    def counts(self):
+        """(done, failed, left) of the grid's points."""
+        failed = sum(1 for r in self.rows.values() if r.get("error"))
+        return len(self.rows) - failed, failed, len(self.points) - len(self.rows)
+
+    def grid_rows(self):
+        return [self.rows[i] for i in range(len(self.points)) if i in self.rows]
+
+    def all_rows(self):
+        mine = [self.rows.get(i, self.stale.get(i)) for i in range(len(self.points))]
+        return [r for r in mine if r is not None] + self.others
+
+    def write(self):
+        """The table to a temporary beside the file, renamed onto it (Ctrl-C held back
+        meanwhile: ``written`` is what the file holds)."""
+        if self.path is None:
+            return
+        from ..io.outputs import hold_interrupts
+
+        temp = self.path.with_name(f".{self.path.stem}.{secrets.token_hex(4)}.part{self.path.suffix}")
+        try:
+            write_table(self.all_rows(), temp)
+            with hold_interrupts():
+                os.replace(temp, self.path)
+                self.written = self.counts()
+        finally:
+            temp.unlink(missing_ok=True)
+
+
+def _key(row):
+    """A point's identity: its swept parameters and their values, as text."""
+    return frozenset((k, str(v)) for k, v in row.items() if k.startswith("param.") and v not in ("", None))
+
+
+def read_table(path):
+    """The rows of a table written by write_table (ValueError naming --out if it cannot be read)."""
     try:
-        result = pool.map_async(_call, tasks, chunksize=1)
-        rows = result.get()
-        pool.close()
-        return rows
-    except BaseException:
-        pool.terminate()
-        raise
-    finally:
-        pool.join()
+        if str(path).endswith(".json"):
+            rows = json.loads(Path(path).read_text())
+            if not isinstance(rows, list) or not all(isinstance(r, dict) for r in rows):
+                raise ValueError("not a list of rows")
+            return rows
+        with open(path, newline="") as fh:
+            return list(csv.DictReader(fh))
+    except (OSError, ValueError, csv.Error, UnicodeDecodeError) as err:
+        raise ValueError(f"--out {path}: cannot resume from it, it is not a sweep's table "
+                         f"({' '.join(str(err).split())})") from None
 
 
 def write_table(rows, path):
