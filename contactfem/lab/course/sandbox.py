@@ -239,7 +239,23 @@ class Handle:
         self.id = i
 
 
+def _watch_parent():
+    """End this process when the grader that started it is gone (whatever the notebook runs)."""
+    import threading
+    import time
+
+    parent = os.getppid()
+
+    def watch():
+        while os.getppid() == parent:
+            time.sleep(1.0)
+        os._exit(0)
+
+    threading.Thread(target=watch, daemon=True).start()
+
+
 def serve(fd_in, fd_out):
+    _watch_parent()
     conn_in, conn_out = Connection(fd_in, writable=False), Connection(fd_out, readable=False)
     box = Sandbox()
     sys.stdout = sys.stderr = box.sink
