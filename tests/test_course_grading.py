@@ -298,3 +298,45 @@ def test_grade_refuses_bad_options(tmp_path, capsys):
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and what in err, err
     assert not os.path.exists(out)
+
+
+def test_implement_exercises_guard_the_library_or_say_they_build_on_it():
+    """An exercise that asks for part of the method has its library counterpart guarded
+    (LIBRARY, names that exist) or says in its prompt that it builds on the library (BUILDS_ON)."""
+    import importlib
+    import re
+
+    from contactfem.lab.course import lecture_sources, questions
+    from contactfem.lab.course.checks import BUILDS_ON, EXERCISES, LIBRARY
+
+    assert not set(LIBRARY) & set(BUILDS_ON)
+    for name in list(LIBRARY) + list(BUILDS_ON):
+        assert EXERCISES[name].implements, name
+    for name, specs in LIBRARY.items():
+        for spec in specs:
+            mod, _, path = spec.partition(":")
+            obj = importlib.import_module(mod)
+            for part in path.split("."):
+                obj = getattr(obj, part)
+    for src in lecture_sources():
+        nb = nbformat.read(src, as_version=4)
+        for name, i in questions(nb):
+            prompt = next(c.source for c in nb.cells[i + 1:] if c.cell_type == "markdown")
+            says = bool(re.search(r"builds on the library on purpose", prompt))
+            assert says == (name in BUILDS_ON), name
+
+
+def test_every_written_question_is_in_its_lecture_with_its_points():
+    from contactfem.lab.course import lecture_sources
+    from contactfem.lab.course.checks import MANUAL
+    from contactfem.lab.course.grade import manual_answers
+
+    found = {}
+    for src in lecture_sources():
+        nb = nbformat.read(src, as_version=4)
+        answers = manual_answers([(c.cell_type, c.source) for c in nb.cells])
+        for name in answers:
+            found[name] = src.stem
+            prompt = next(c.source for c in nb.cells if f"manual: {name}" in c.source)
+            assert f"({MANUAL[name].points:g} points)" in prompt, name
+    assert found == {n: m.lecture for n, m in MANUAL.items()}

@@ -1524,8 +1524,8 @@ EXERCISES = {e.name: e for e in [
 
 # The library's implementation of the part an exercise asks for ("module:Name" or
 # "module:Name.method"): out of reach of the answer while it is graded (an answer that uses it
-# scores zero for the part). The exercises that are not listed, and those with implements=False,
-# build on the library on purpose: their answers call its scenes, steppers and laws.
+# scores zero for the part). Exercise 11.1 and 12.3 have no counterpart in the library (it
+# solves meshes, not one degree of freedom).
 LIBRARY = {
     "ex01_power_law": ("contactfem.laws.normal:PowerLaw",),
     "ex01_tresca": ("contactfem.laws.friction:Coulomb", "contactfem.laws.friction:ParabolicSlip"),
@@ -1539,6 +1539,16 @@ LIBRARY = {
     "ex11_secant_traction": ("contactfem.contact.conserving:secant", "contactfem.contact.conserving:discrete_gradient"),
     "ex12_normal_complementarity": ("contactfem.contact.complementarity:normal_complementarity",),
     "ex12_friction_complementarity": ("contactfem.contact.complementarity:friction_complementarity",),
+    "ex08_gas_pressure": ("contactfem.bodies.loads:GasPressure",),
+}
+
+# The exercises that ask for part of the method on top of the library's own parts (their
+# prompts say so): what the library gives them, and what the student writes.
+BUILDS_ON = {
+    "ex04_slip_margin": "the law's own slip_bound gives the bound Y; the answer is the margin over the nodes",
+    "ex04_load_steps": "the scene's stepper solves each step; the answer is the loop and what it records",
+    "ex05_incline": "the ring, the plane and the stepper are the library's; the answer is the new scene",
+    "ex07_census": "the scene's stepper solves each step; the answer is the loop and its counts",
 }
 
 

@@ -554,9 +554,9 @@ def grade(folder, out_csv, autograders=None, jobs=1, repo=None, roster=None, dea
     rel = {p: p.relative_to(folder).as_posix() for p in subs}
     which = {p: lecture or lecture_of(p, names) for p in subs}
     known = {w for w in which.values() if w}
-    if len(known) == 1:      # a class of one lecture: a notebook that does not say (or cannot be read) is of it
-        lecture = lecture or known.pop()
-        which = {p: w or lecture for p, w in which.items()}
+    if len(known) == 1 and not lecture:     # a class of one lecture: a missing or unreadable notebook is of it
+        lecture = known.pop()
+        which = {p: w or (lecture if not _readable(p) else None) for p, w in which.items()}
     entries = []        # (student or None, path or None)
     if students:
         by_file = {s.file: s for s in students if s.file}
@@ -608,6 +608,14 @@ def grade(folder, out_csv, autograders=None, jobs=1, repo=None, roster=None, dea
     _write_reviews(review, lectures, details, scores_read)
     _write_feedback(feedback, details)
     return rows
+
+
+def _readable(path):
+    try:
+        read_notebook(path)
+        return True
+    except ValueError:
+        return False
 
 
 def _write_csv(path, fields, rows):
@@ -777,6 +785,8 @@ def _write_feedback(feedback, details):
             ps = [p for p in d["parts"] if p[0] == e.name]
             got = sum(p[2] for p in ps)
             lines += ["", f"## {e.name}: {got:g} of {e.points:g}", f"{e.what}", ""]
+            if e.name in checks.BUILDS_ON:
+                lines[-1:] = [f"(It builds on the library on purpose: {checks.BUILDS_ON[e.name]}.)", ""]
             for _, part, pts, possible, msg in ps:
                 lines.append(f"- {part}: {pts:g} of {possible:g}" + ("" if msg == "passed" else f": {msg}"))
         for q in d["manual"]:
