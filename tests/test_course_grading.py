@@ -251,7 +251,7 @@ def test_an_endless_notebook_gets_its_row_and_the_others_are_graded(tmp_path):
     assert rows[0]["total"] == "0" and rows[1]["total"] == "10"
 
 
-def test_interrupted_grading_leaves_the_rows_done_and_says_so(tmp_path, monkeypatch):
+def test_interrupted_grading_leaves_the_rows_done_and_says_so(tmp_path, monkeypatch, capsys):
     """Ctrl-C during the batch: the CSV holds the rows graded so far, the message says how many."""
     from contactfem.lab import batch
     from contactfem.lab.course import GradingInterrupted, grade
@@ -273,6 +273,14 @@ def test_interrupted_grading_leaves_the_rows_done_and_says_so(tmp_path, monkeypa
         grade(subs, tmp_path / "s.csv", jobs=1)
     rows = list(csv.DictReader(open(tmp_path / "s.csv")))
     assert len(rows) == 1 and rows[0]["total"] == "10"
+    from contactfem.cli import main
+
+    (tmp_path / "s.csv").unlink()
+    capsys.readouterr()
+    assert main(["course", "grade", str(subs), "--out", str(tmp_path / "s.csv")]) == 130
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "1 of 3 notebooks graded" in err and "nothing written" not in err, err
+    assert len(list(csv.DictReader(open(tmp_path / "s.csv")))) == 1
 
 
 def test_grade_refuses_bad_options(tmp_path, capsys):
