@@ -348,3 +348,42 @@ def test_every_written_question_is_in_its_lecture_with_its_points():
             prompt = next(c.source for c in nb.cells if f"manual: {name}" in c.source)
             assert f"({MANUAL[name].points:g} points)" in prompt, name
     assert found == {n: m.lecture for n, m in MANUAL.items()}
+
+
+def test_hidden_checks_pass_every_solution_and_cover_the_exercises():
+    """Every hidden check passes the instructor's solution (run here, in one process), and the
+    stub fails the hidden checks of every exercise; every exercise without a scene has some."""
+    import numpy as np
+
+    from contactfem.lab.course import lecture_sources, solution_cells
+    from contactfem.lab.course.checks import EXERCISES
+    from contactfem.lab.course.grade import hidden_checks_file, load_hidden
+
+    hidden = load_hidden(hidden_checks_file())
+    parts = {p.name for e in EXERCISES.values() for p in e.parts}
+    assert set(hidden) <= parts
+    scenes = {"ex04_load_steps", "ex05_incline", "ex07_census"}      # a scene run per check: public only
+    for name, e in EXERCISES.items():
+        assert any(p.name in hidden for p in e.parts) == (name not in scenes), name
+    sols = {}
+    for src in lecture_sources():
+        sols.update(solution_cells(nbformat.read(src, as_version=4)))
+    from dataclasses import dataclass
+
+    from otter.assign.solutions import replace_solutions
+
+    for name, e in EXERCISES.items():
+        env = {"np": np, "dataclass": dataclass}
+        exec(compile("\n".join(sols[name]), f"<{name}>", "exec"), env)
+        stub = {"np": np, "dataclass": dataclass}
+        exec(compile("\n".join("\n".join(replace_solutions(s.split("\n"), "python")) for s in sols[name]),
+                     f"<{name} stub>", "exec"), stub)
+        failed = 0
+        for p in e.parts:
+            for check in hidden.get(p.name, ()):
+                check(**{a: env.get(a) for a in p.answers})
+                try:
+                    check(**{a: stub.get(a) for a in p.answers})
+                except AssertionError:
+                    failed += 1
+        assert failed or name in scenes, f"{name}: no hidden check fails the stub"
