@@ -60,6 +60,7 @@ MANUAL_MARK = re.compile(r"<!--\s*manual:\s*(\w+)\s*-->")
 NOTEBOOK_TIMEOUT = 600.0
 CHECK_TIMEOUT = 20.0
 MEMORY_LIMIT = 4 * 2**30
+MAX_REPLY = 64 * 2**20    # bytes of one answer of the submission (an array of some 6 million numbers)
 GRACE = 5.0          # how long past a check's limit the submission's process may take to answer
 
 
@@ -174,7 +175,10 @@ class Box:
         raise Stopped(reason)
 
     def _gone(self):
-        code = self.proc.wait()
+        try:
+            code = self.proc.wait(timeout=2.0)
+        except subprocess.TimeoutExpired:        # alive, but its connection is broken or garbled
+            self._stop(f"the submission broke its connection to the grader {self.where}")
         what = f"died (signal {-code})" if code < 0 else f"exited with code {code}"
         if code == -9 and self.limits.memory:
             what += " (killed: out of memory?)"
@@ -191,10 +195,10 @@ class Box:
                 if time.monotonic() >= self.deadline:
                     self._stop(f"time limit {self.limits.notebook:g} s for the notebook reached {self.where}")
                 self._stop(f"the submission did not answer within {limit + GRACE:g} s {self.where}")
-            data = self.conn_in.recv_bytes()
-        except (EOFError, BrokenPipeError, ConnectionResetError, OSError):
+            data = self.conn_in.recv_bytes(MAX_REPLY)
+            return json.loads(data)
+        except (EOFError, OSError, ValueError):
             self._gone()
-        return json.loads(data)
 
     def decode(self, v):
         t = v.get("t")
@@ -229,7 +233,9 @@ class Box:
         return None if v.get("t") == "missing" else self.decode(v)
 
     def getattr(self, i, name):
-        v = self.request(("getattr", i, name))
+        from . import checks
+
+        v = self.request(("getattr", i, name), limit=checks.TIME_LIMIT)
         if v.get("t") == "missing":
             raise AttributeError(name)
         return self.decode(v)

@@ -29,7 +29,7 @@ from multiprocessing.connection import Connection
 
 import numpy as np
 
-MAX_REPLY = 256 * 2**20
+MAX_REPLY = 60 * 2**20
 OTTER_LINE = re.compile(r"^\s*(import otter\b.*|grader\s*=\s*otter\.Notebook\(.*\)|grader\.check(_all)?\(.*\)|"
                         r"grader\.export\(.*\))?\s*(#.*)?$")
 MAGIC = re.compile(r"^(\s*)([%!].*)$", re.M)
