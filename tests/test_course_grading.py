@@ -387,3 +387,25 @@ def test_hidden_checks_pass_every_solution_and_cover_the_exercises():
                 except AssertionError:
                     failed += 1
         assert failed or name in scenes, f"{name}: no hidden check fails the stub"
+
+
+def test_what_a_submission_started_ends_with_its_grading(tmp_path):
+    """A notebook that starts a process of its own leaves nothing running after its grading."""
+    from contactfem.lab.course import grade
+
+    subs = tmp_path / "subs"
+    subs.mkdir()
+    pid_file = tmp_path / "pid"
+    _notebook([HEAD, PL, TR, f"import subprocess\nchild = subprocess.Popen(['sleep', '300'])\n"
+                             f"open({str(pid_file)!r}, 'w').write(str(child.pid))"], subs / "a.ipynb")
+    row = grade(subs, tmp_path / "s.csv")[0]
+    assert row["total"] == "10", row["notes"]
+    pid = int(pid_file.read_text())
+    deadline = time.monotonic() + 5
+    while time.monotonic() < deadline:
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return
+        time.sleep(0.1)
+    pytest.fail(f"the submission's child {pid} still runs")

@@ -160,17 +160,25 @@ class Box:
         self.conn_out = Connection(self._req_w, readable=False)
         self.conn_in = Connection(self._rep_r, writable=False)
 
-    def close(self):
+    def _kill(self):
+        """The submission's process and what it started (its process group)."""
+        import signal
+
+        try:
+            os.killpg(self.proc.pid, signal.SIGKILL)
+        except (ProcessLookupError, PermissionError):
+            pass
         if self.proc.poll() is None:
             self.proc.kill()
         self.proc.wait()
+
+    def close(self):
+        self._kill()
         self.conn_out.close()
         self.conn_in.close()
 
     def _stop(self, reason):
-        if self.proc.poll() is None:
-            self.proc.kill()
-        self.proc.wait()
+        self._kill()
         self.dead = reason
         raise Stopped(reason)
 
