@@ -93,6 +93,8 @@ CLASS = [
                'grader.check("ex01_power_law")'], (5, 5), ""),
     ("tr_only_fields", [HEAD, PL, TR.replace("float(self.tau_y)", "0.2")], (5, 3), "tau_y = 1.3"),
     ("full3", [HEAD, PL, TR], (5, 5), ""),
+    ("compares_with_library", [HEAD, PL + "\n\nfrom contactfem.laws import PowerLaw\n"
+                               "print(PowerLaw(100.0, 2.5).traction(-0.1), power_law(-0.1, 100.0, 2.5))", TR], (5, 5), ""),
     ("full4", [HEAD, PL, TR], (5, 5), ""),
 ]
 CORRUPT = "corrupt"
@@ -409,3 +411,16 @@ def test_what_a_submission_started_ends_with_its_grading(tmp_path):
             return
         time.sleep(0.1)
     pytest.fail(f"the submission's child {pid} still runs")
+
+
+def test_the_answers_own_code_is_read_for_the_library_not_the_rest_of_the_cell():
+    from contactfem.lab.course.checks import LIBRARY
+    from contactfem.lab.course.grade import library_named
+
+    guard = LIBRARY["ex01_power_law"]
+    names = {"power_law"}
+    assert library_named(PL_LIBRARY, guard, names) == {"contactfem.laws.normal:PowerLaw"}
+    assert library_named("power_law = lambda g, c, m: PowerLaw(c, m).traction(g)", guard, names)
+    compare = PL + "\n\nfrom contactfem.laws import PowerLaw\nprint(PowerLaw(100.0, 2.5).traction(-0.1))"
+    assert library_named(compare, guard, names) == set()
+    assert library_named(PL_LIBRARY_HIDDEN, guard, names) == set()      # the tripwire catches that one

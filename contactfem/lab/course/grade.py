@@ -315,39 +315,33 @@ def read_notebook(path):
         raise ValueError(f"not a notebook ({type(err).__name__}: {' '.join(str(err).split())[:80]})") from None
 
 
-def _defines(source, names):
-    try:
-        tree = ast.parse(source)
-    except SyntaxError:
-        return False
+def _answer_nodes(tree, names):
+    """The definitions of the answers `names` in a parsed cell: def, class, or assignment."""
     for node in ast.walk(tree):
-        if isinstance(node, (ast.FunctionDef, ast.ClassDef, ast.AsyncFunctionDef)) and node.name in names:
-            return True
-        if isinstance(node, ast.Name) and isinstance(node.ctx, ast.Store) and node.id in names:
-            return True
-    return False
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)) and node.name in names:
+            yield node
+        elif isinstance(node, (ast.Assign, ast.AnnAssign)):
+            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+            if any(isinstance(t, ast.Name) and t.id in names for t in targets) and node.value is not None:
+                yield node.value
 
 
-def library_named(source, guard):
-    """The library names of `guard` ("module:Name.attr") the code names (reads, imports)."""
-    wanted = {}
-    for spec in guard:
-        mod, _, path = spec.partition(":")
-        wanted[path.split(".")[0]] = spec
+def library_named(source, guard, names):
+    """The library names of `guard` ("module:Name.attr") that the definitions of the answers
+    `names` in this code use (other code of the cell, a comparison with the library, is free)."""
+    wanted = {spec.partition(":")[2].split(".")[0]: spec for spec in guard}
     try:
         tree = ast.parse(source)
     except SyntaxError:
         return set()
     found = set()
-    for node in ast.walk(tree):
-        name = (node.id if isinstance(node, ast.Name) else node.attr if isinstance(node, ast.Attribute)
-                else None)
-        if name in wanted:
-            found.add(wanted[name])
-        if isinstance(node, (ast.Import, ast.ImportFrom)):
-            for a in node.names:
-                if a.name.split(".")[-1] in wanted:
-                    found.add(wanted[a.name.split(".")[-1]])
+    for top in _answer_nodes(tree, names):
+        for node in ast.walk(top):
+            name = node.id if isinstance(node, ast.Name) else node.attr if isinstance(node, ast.Attribute) else None
+            if name in wanted:
+                found.add(wanted[name])
+            if isinstance(node, (ast.Import, ast.ImportFrom)):
+                found |= {wanted[a.name.split(".")[-1]] for a in node.names if a.name.split(".")[-1] in wanted}
     return found
 
 
@@ -405,10 +399,7 @@ def grade_notebook(path, lecture, material, limits):
             for e in mine:
                 guard = checks.LIBRARY.get(e.name, ()) if e.implements else ()
                 names = {a for p in e.parts for a in p.answers}
-                named = set()
-                for _, src in code_cells:
-                    if guard and _defines(src, names):
-                        named |= library_named(src, guard)
+                named = set().union(*(library_named(src, guard, names) for _, src in code_cells)) if guard else set()
                 for p in e.parts:
                     out["parts"].append((e.name, p.name, *_grade_part(box, p, hidden.get(p.name, ()), guard, named)))
         finally:
