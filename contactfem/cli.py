@@ -309,12 +309,16 @@ def cmd_course_grade(args):
     limits = course.Limits(notebook=args.notebook_timeout, check=args.check_timeout,
                            memory=int(args.memory * 2**20) if args.memory else None)
     t0 = time.perf_counter()
+
+    def progress(done, total):
+        print(f"\r{done} of {total} notebooks graded", end="\n" if done == total else "", file=sys.stderr, flush=True)
+
     try:
         rows = course.grade(args.folder, args.out, autograders=args.autograders, jobs=args.jobs, roster=args.roster,
                             deadline=args.deadline, lecture=args.lecture, limits=limits, review=args.review,
-                            feedback=args.feedback)
+                            feedback=args.feedback, progress=progress if sys.stderr.isatty() else None)
     except course.GradingInterrupted as exc:
-        print(f"contactfem: {exc.message}", file=sys.stderr)
+        print(f"\ncontactfem: {exc.message}" if sys.stderr.isatty() else f"contactfem: {exc.message}", file=sys.stderr)
         return 130
     count = {s: sum(1 for r in rows if r["status"] == s) for s in ("graded", "stopped", "not graded", "missing")}
     what = ", ".join(f"{n} {s}" for s, n in count.items() if n)

@@ -424,3 +424,20 @@ def test_the_answers_own_code_is_read_for_the_library_not_the_rest_of_the_cell()
     compare = PL + "\n\nfrom contactfem.laws import PowerLaw\nprint(PowerLaw(100.0, 2.5).traction(-0.1))"
     assert library_named(compare, guard, names) == set()
     assert library_named(PL_LIBRARY_HIDDEN, guard, names) == set()      # the tripwire catches that one
+
+
+def test_a_bad_score_in_the_review_sheet_stops_before_any_grading(tmp_path, capsys):
+    from contactfem.cli import main
+
+    subs = tmp_path / "subs"
+    subs.mkdir()
+    _notebook([HEAD, PL, TR], subs / "a.ipynb")
+    (tmp_path / "s-review").mkdir()
+    (tmp_path / "s-review" / f"{LECTURE}-scores.csv").write_text(
+        "submission,id,name,question,points,score\na.ipynb,,,ex01_discussion,2,3\n")
+    t0 = time.perf_counter()
+    assert main(["course", "grade", str(subs), "--out", str(tmp_path / "s.csv")]) == 2
+    assert time.perf_counter() - t0 < 10
+    err = capsys.readouterr().err
+    assert "score 3 of a.ipynb, ex01_discussion is outside 0..2" in err and err.count("\n") == 1
+    assert not (tmp_path / "s.csv").exists()

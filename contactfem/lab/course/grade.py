@@ -572,6 +572,8 @@ def grade(folder, out_csv, autograders=None, jobs=1, repo=None, roster=None, dea
     else:
         entries = [(None, p) for p in subs]
 
+    lectures = sorted({w for w in which.values() if w} | ({lecture} if lecture else set()))
+    scores_read = {lec: _read_manual_scores(review / f"{lec}-scores.csv") for lec in lectures}
     material = hidden_checks_file(autograders, repo)
     tasks, results = [], {}
     for _, p in entries:
@@ -590,11 +592,8 @@ def grade(folder, out_csv, autograders=None, jobs=1, repo=None, roster=None, dea
     finally:
         batch.close()
 
-    lectures = sorted({which[p] for _, p in entries if p is not None and which.get(p)} |
-                      ({lecture} if lecture else set()))
     columns = [e for e in checks.EXERCISES if checks.EXERCISES[e].lecture in lectures]
     manual = [m for m in checks.MANUAL if checks.MANUAL[m].lecture in lectures]
-    scores_read = {lec: _read_manual_scores(review / f"{lec}-scores.csv") for lec in lectures}
     rows, details = [], []
     for s, p in entries:
         if interrupted and p is not None and str(p) not in results:
