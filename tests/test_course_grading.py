@@ -441,3 +441,21 @@ def test_a_bad_score_in_the_review_sheet_stops_before_any_grading(tmp_path, caps
     err = capsys.readouterr().err
     assert "score 3 of a.ipynb, ex01_discussion is outside 0..2" in err and err.count("\n") == 1
     assert not (tmp_path / "s.csv").exists()
+
+
+def test_a_library_object_holding_lambdas_reaches_the_answer(tmp_path):
+    """The checks pass library objects to the answers (a scene's stepper holds lambdas, which
+    pickle refuses): they reach the submission's process, and what comes back is data."""
+    from contactfem.lab.course.grade import Box, Limits
+
+    class Holder:
+        pass
+
+    h = Holder()
+    h.f = lambda x: 2.0 * x
+    box = Box(Limits(), tmp_path)
+    try:
+        assert box.cell(1, "def apply(obj, x):\n    return obj.f(x), [x]")["ok"]
+        assert box.get("apply")(h, 3.0) == (6.0, [3.0])
+    finally:
+        box.close()

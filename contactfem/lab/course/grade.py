@@ -198,7 +198,7 @@ class Box:
         left = self.deadline - time.monotonic()
         wait = left if limit is None else min(left, limit + GRACE)
         try:
-            self.conn_out.send_bytes(pickle.dumps(req))
+            self.conn_out.send_bytes(_dumps(req))
             if not self.conn_in.poll(max(wait, 0.0)):
                 if time.monotonic() >= self.deadline:
                     self._stop(f"time limit {self.limits.notebook:g} s for the notebook reached {self.where}")
@@ -253,10 +253,7 @@ class Box:
 
         limit = checks.CALL_LIMIT[0] or checks.TIME_LIMIT
         self.where = "in a call of the answer"
-        try:
-            reply = self.request(("call", i, _wire(args), _wire(kwargs), limit, tuple(self.guard)), limit=limit)
-        except pickle.PicklingError as err:
-            raise Stopped(f"the grader could not pass its arguments to the submission: {err}") from None
+        reply = self.request(("call", i, _wire(args), _wire(kwargs), limit, tuple(self.guard)), limit=limit)
         self.used.update(reply.get("library", ()))
         if reply.get("timeout"):
             raise checks.Timeout()
@@ -265,6 +262,17 @@ class Box:
         if "exc" in reply:
             raise _error(reply["exc"], reply.get("msg", ""))
         return self.decode(reply["ok"])
+
+
+def _dumps(req):
+    """A request for the submission's process: pickled; a library object that pickle cannot
+    take (a stepper holding lambdas) by dill, which sends functions by value."""
+    try:
+        return pickle.dumps(req)
+    except (pickle.PicklingError, AttributeError, TypeError):
+        import dill
+
+        return dill.dumps(req, recurse=True)
 
 
 def _error(name, msg):
