@@ -459,3 +459,54 @@ def test_a_library_object_holding_lambdas_reaches_the_answer(tmp_path):
         assert box.get("apply")(h, 3.0) == (6.0, [3.0])
     finally:
         box.close()
+
+
+def _sandboxes_of(pid):
+    """The submissions' processes started (through its workers) by process `pid` (Linux)."""
+    found = []
+    for d in os.listdir("/proc"):
+        try:
+            cmd = open(f"/proc/{d}/cmdline", "rb").read()
+            chain, p = [], int(d)
+            while p > 1 and len(chain) < 10:
+                p = int(open(f"/proc/{p}/stat").read().rsplit(")", 1)[1].split()[1])
+                chain.append(p)
+        except (OSError, ValueError):
+            continue
+        if b"lab.course.sandbox" in cmd and pid in chain:
+            found.append(int(d))
+    return found
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc"), reason="finds the processes in /proc")
+def test_ctrl_c_on_the_command_stops_at_once_and_says_what_was_written(tmp_path):
+    """SIGINT to `contactfem course grade` while two endless notebooks run: exit 130 within
+    seconds, one line saying none was graded, a CSV of the rows done (none)."""
+    import signal
+    import subprocess
+    import sys
+
+    subs = tmp_path / "subs"
+    subs.mkdir()
+    for name in ("a", "b"):
+        _notebook([HEAD, "while True:\n    pass"], subs / f"{name}.ipynb")
+    out = tmp_path / "s.csv"
+    proc = subprocess.Popen([sys.executable, "-m", "contactfem.cli", "course", "grade", str(subs), "--out", str(out),
+                             "--jobs", "2", "--notebook-timeout", "300"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while len(_sandboxes_of(proc.pid)) < 2 and time.monotonic() < deadline:     # both notebooks running
+        time.sleep(0.2)
+    running = _sandboxes_of(proc.pid)
+    proc.send_signal(signal.SIGINT)
+    t0 = time.perf_counter()
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert time.perf_counter() - t0 < 20, err
+    assert "0 of 2 notebooks graded; their rows are in" in err and "nothing written" not in err, err
+    assert list(csv.DictReader(open(out))) == []
+    assert len(running) == 2
+    time.sleep(1.5)                       # the submissions' processes end with their workers
+    for pid in running:
+        with pytest.raises(ProcessLookupError):
+            os.kill(pid, 0)

@@ -617,8 +617,12 @@ def grade(folder, out_csv, autograders=None, jobs=1, repo=None, roster=None, dea
     if interrupted:
         raise GradingInterrupted(f"interrupted: {n_done} of {len(tasks)} notebooks graded; their rows are in "
                                  f"{out_csv} (the others are not; no review or feedback files written)")
-    _write_reviews(review, lectures, details, scores_read)
-    _write_feedback(feedback, details)
+    try:
+        _write_reviews(review, lectures, details, scores_read)
+        _write_feedback(feedback, details)
+    except KeyboardInterrupt:
+        raise GradingInterrupted(f"interrupted after every notebook was graded: {out_csv} is complete; the review "
+                                 f"files ({review}) and the feedback files ({feedback}) may be incomplete") from None
     return rows
 
 
