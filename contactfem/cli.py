@@ -507,12 +507,13 @@ def build_parser():
                          "roster's submitted, else the file's modification time)")
     cg.add_argument("--lecture", default=None, metavar="NN_topic",
                     help="the lecture every submission answers (default: from each notebook's metadata or NN_ prefix)")
-    cg.add_argument("--notebook-timeout", type=float, default=600.0, metavar="S",
-                    help="seconds for one notebook, its cells and checks (default 600: ten times the slowest "
-                         "lecture's fast run); a notebook over it gets its row with the reason")
+    cg.add_argument("--notebook-timeout", type=float, default=900.0, metavar="S",
+                    help="seconds for one notebook, its cells and checks (default 900: over three times the slowest "
+                         "lecture's solution graded two at a time on a shared 2-core machine); a notebook over it "
+                         "gets its row with the reason")
     cg.add_argument("--check-timeout", type=float, default=20.0, metavar="S",
-                    help="seconds for one call of a student's function (default 20: several times the slowest "
-                         "solution; checks that run a scene allow more)")
+                    help="seconds for one call of a student's function in a check (default 20: the calls take "
+                         "milliseconds; checks that run a scene allow their calls 60-120 s)")
     cg.add_argument("--memory", type=float, default=4096.0, metavar="MB",
                     help="memory limit of each submission's process in MB (default 4096; 0: none)")
     cg.add_argument("--review", default=None, metavar="DIR",
