@@ -18,9 +18,13 @@ processes that share nothing:
 
 A part of an exercise scores its points when its public check and its hidden checks pass.
 An exercise that asks for part of the method (``implements``) is graded with the library's
-implementation of that part (checks.LIBRARY) out of reach: the answer's cells are read for
-it, and during the calls it is replaced by a tripwire in the submission's process; an answer
-that uses it scores zero for the part, with a hint that says so.
+implementation of that part (checks.LIBRARY) out of reach: the answer's definition is read
+for it, and during the calls it is replaced by a tripwire in the submission's process; an
+answer that uses it scores zero for the part, with a hint that says so.
+
+What a submission can still do, running as the grader's user: end its own process (its row
+says how), kill the worker that grades it (the row says "worker died"), read files. What it
+cannot do is change a reference, a check or a score.
 
 Written answers (checks.MANUAL) are collected into one review file per lecture
 (``REVIEW/LECTURE.html``: one section per student, code and answer side by side); the
@@ -371,7 +375,8 @@ def manual_answers(cells):
             current = None
             continue
         out[current][0 if kind == "code" else 1].append(src.strip())
-    return {k: ("\n\n".join(c for c in code if c), "\n\n".join(t for t in text if t)) for k, (code, text) in out.items()}
+    return {k: ("\n\n".join(c for c in code if c), "\n\n".join(t for t in text if t))
+            for k, (code, text) in out.items()}
 
 
 def library_hint(exercise, used):
@@ -437,7 +442,7 @@ def _grade_part(box, part, hidden, guard, named):
         msg = str(err)
     except LibraryCall:
         pass
-    except Exception as err:         # noqa: BLE001  (an answer the check did not foresee: the part fails, the batch goes on)
+    except Exception as err:         # noqa: BLE001  (an answer the check did not foresee: the part fails)
         msg = f"the check could not use your answer: {type(err).__name__}: {' '.join(str(err).split())[:200]}"
     if box.used:
         return 0.0, part.points, library_hint(part.name, box.used)
@@ -490,8 +495,10 @@ def read_roster(path):
         reader = csv.DictReader(f)
         missing = {"id", "name", "file"} - set(reader.fieldnames or ())
         if missing:
-            raise ValueError(f"--roster {path}: no column {', '.join(sorted(missing))}; give the columns id, name, file")
-        rows = [Student(r["id"].strip(), r["name"].strip(), (r["file"] or "").strip(), (r.get("submitted") or "").strip())
+            raise ValueError(f"--roster {path}: no column {', '.join(sorted(missing))}; "
+                             "give the columns id, name, file")
+        rows = [Student(r["id"].strip(), r["name"].strip(), (r["file"] or "").strip(),
+                        (r.get("submitted") or "").strip())
                 for r in reader]
     ids = [s.id for s in rows]
     if "" in ids or len(set(ids)) != len(ids):
@@ -613,7 +620,8 @@ def grade(folder, out_csv, autograders=None, jobs=1, repo=None, roster=None, dea
             row["notes"] = " | ".join(x for x in ("not on the roster", row["notes"]) if x)
         rows.append(row)
         details.append(detail)
-    fields = ["id", "name", "submission", "lecture"] + columns + manual + ["total", "possible", "status", "late", "notes"]
+    fields = (["id", "name", "submission", "lecture"] + columns + manual
+              + ["total", "possible", "status", "late", "notes"])
     _write_csv(out_csv, fields, rows)
     if interrupted:
         raise GradingInterrupted(f"interrupted: {n_done} of {len(tasks)} notebooks graded; their rows are in "
@@ -669,14 +677,16 @@ def _row(student, path, rel, lec, outcome, columns, manual, scores_read, deadlin
     elif not outcome.ok:
         status = "not graded"
         reason = outcome.reason or ""
-        notes.append(reason.replace("error: ValueError: ", "") if "not a notebook" in reason else f"not graded: {reason}")
+        notes.append(reason.replace("error: ValueError: ", "") if "not a notebook" in reason
+                     else f"not graded: {reason}")
     else:
         res = outcome.value
         parts, answers = res["parts"], res["manual"]
         if res["stopped"]:
             status, stop = "stopped", res["stopped"]
             notes.append(res["stopped"])
-        notes += res["errors"][:3] + ([f"and {len(res['errors']) - 3} more cells failed"] if len(res["errors"]) > 3 else [])
+        more = len(res["errors"]) - 3
+        notes += res["errors"][:3] + ([f"and {more} more cells failed"] if more > 0 else [])
         if res["printed"] > 2**20:
             notes.append(f"printed {res['printed'] / 2**20:.0f} MB (not kept)")
     total = 0.0
