@@ -224,3 +224,19 @@ def test_a_stopped_batch_process_leaves_no_worker(tmp_path, sig, code):
     finally:
         p.kill()
         p.wait()
+
+
+def test_a_task_whose_worker_died_runs_again_on_a_fresh_worker_not_an_idle_one(tmp_path):
+    """Two workers; one task kills its worker on its first attempt while the other worker
+    is idle: the second attempt runs in a process that ran nothing before."""
+    tasks = [("quick", ("pid",)), ("once", ("once", str(tmp_path / "m")))]
+    out = list(run_batch(_pid_and, tasks, jobs=2))
+    first, again = by_key(out)["quick"], by_key(out)["once"]
+    assert again.ok and again.attempts == 2 and again.value[1] == "second time"
+    assert again.value[0] != first.value[0]
+
+
+def _pid_and(how, arg=None):
+    if how == "once":
+        time.sleep(0.3)                      # the other worker is idle by now
+    return os.getpid(), act(how, arg)

@@ -28,12 +28,15 @@ Used by `contactfem sweep` and by the course's grading.
 """
 
 import atexit
+import multiprocessing
+import multiprocessing.util  # noqa: F401  (its exit handler, which joins child processes, runs after ours)
 import os
 import signal
 import threading
 import time
 from collections import deque
 from dataclasses import dataclass
+from multiprocessing.connection import wait
 
 _POLL_S = 1.0            # the longest the batch waits without looking at every worker
 
@@ -74,9 +77,6 @@ def run_batch(fn, tasks, *, jobs=1, timeout=None, retries=1, memory_limit=None, 
 
 
 def _batch(fn, todo, jobs, timeout, retries, memory_limit, initializer):
-    import multiprocessing
-    from multiprocessing.connection import wait
-
     methods = multiprocessing.get_all_start_methods()
     ctx = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
     workers = []
@@ -111,8 +111,8 @@ def _batch(fn, todo, jobs, timeout, retries, memory_limit, initializer):
                 w.stop(workers)                               # dead: its task (if any) runs again
                 if w.task is not None:
                     key, args, attempts = w.task
-                    if attempts + 1 <= retries:
-                        todo.appendleft((key, args, attempts + 1))
+                    if attempts + 1 <= retries:                   # on a fresh worker, not an idle one
+                        _Worker(ctx, fn, initializer, memory_limit, workers).give((key, args, attempts + 1), todo)
                     else:
                         yield Outcome(key, False, None, _death(w.proc.exitcode), attempts + 1)
         finished = True
@@ -183,6 +183,8 @@ class _Worker:
             return self.conn.recv()
         except (EOFError, OSError):        # the worker died, with or before its answer
             return None
+        except Exception as exc:           # an answer that cannot be unpickled here
+            return False, f"error: the value cannot be read back: {_describe(exc)}"
 
     def alive(self):
         return self.proc.exitcode is None

@@ -145,10 +145,10 @@ def sweep(scene, grid, preset="fast", jobs=1, scheduler=None, friction=None, nor
     that keeps the rows (on disk if it has a path, written as each point ends, and with
     ``resume`` the rows it already holds); ``timeout``: seconds a local run may take before it
     is stopped and recorded as failed."""
-    points = plan(scene, grid, preset, jobs, scheduler, friction, normal, check, force)
+    args = (scene, grid, preset, jobs, scheduler, friction, normal, check, force)
+    points, version = _guarded(_prepare, args, laws_text(friction, normal)) if friction or normal else _prepare(*args)
     table = Table() if table is None else table
-    same = dict(scene=scene, preset=preset, laws=laws_text(friction, normal),
-                code_version=code_version(friction, normal))
+    same = dict(scene=scene, preset=preset, laws=laws_text(friction, normal), code_version=version)
     todo = table.start(points, same)
     tasks = [(i, (scene, preset, points[i], friction, normal)) for i in todo]
     runs = _on_dask(scheduler, tasks) if scheduler else _local(tasks, jobs, timeout)
@@ -156,6 +156,32 @@ def sweep(scene, grid, preset="fast", jobs=1, scheduler=None, friction=None, nor
         for i, row in runs:
             table.add(i, row)
     return table.grid_rows()
+
+
+def _prepare(scene, grid, preset, jobs, scheduler, friction, normal, check, force):
+    return plan(scene, grid, preset, jobs, scheduler, friction, normal, check, force), code_version(friction, normal)
+
+
+def _guarded(fn, args, laws):
+    """fn(*args) in a worker process (it loads and checks the user's laws): its value, or its
+    exception raised here; a worker that dies is one ValueError naming the laws."""
+    from .batch import run_batch
+
+    (outcome,) = run_batch(_capture, [(None, (fn, *args))], retries=0)
+    if not outcome.ok:
+        raise ValueError(f"{laws}: the law's code ended the process that loaded and checked it ({outcome.reason}); "
+                         "with --no-check its check over the scene's range is skipped")
+    ok, value = outcome.value
+    if not ok:
+        raise value
+    return value
+
+
+def _capture(fn, *args):
+    try:
+        return True, fn(*args)
+    except Exception as exc:       # raised again in the sweep's process
+        return False, exc
 
 
 def _local(tasks, jobs, timeout):
@@ -182,8 +208,10 @@ def _on_dask(scheduler, tasks):
             if fut.status == "finished":
                 yield futures[fut], fut.result()
                 continue
-            exc = fut.exception()
-            if type(exc).__name__ == "KilledWorker":
+            exc = fut.exception() if fut.status == "error" else None
+            if exc is None:
+                reason = f"error: the Dask task ended {fut.status}"
+            elif type(exc).__name__ == "KilledWorker":
                 reason = "worker died: every Dask worker that ran it died (KilledWorker)"
             else:
                 reason = f"error: {type(exc).__name__}: {' '.join(str(exc).split())}"
@@ -194,7 +222,9 @@ def _on_dask(scheduler, tasks):
 
 def connect(address, timeout=10):
     """A dask.distributed Client of the scheduler at `address`, or one ValueError naming
-    --scheduler and the address, at once if nothing listens there."""
+    --scheduler and the address, at once if nothing listens there (a TCP address is asked for
+    its identity before a Client is made)."""
+    import asyncio
     import socket
 
     from dask.distributed import Client
@@ -205,18 +235,41 @@ def connect(address, timeout=10):
         host, port = parse_host_port(location) if scheme in ("tcp", "tls") else (None, None)
     except (ValueError, TypeError) as err:
         raise ValueError(f"--scheduler {address}: not the address of a Dask scheduler, such as "
-                         f"tcp://HOST:8786 ({' '.join(str(err).split())})") from None
+                         f"tcp://HOST:8786 ({_short(err)})") from None
     if host is not None:
         try:
             socket.create_connection((host, port), timeout=timeout).close()
+            ident = asyncio.run(_identity(address, timeout))
         except OSError as err:
             raise ValueError(f"--scheduler {address}: no Dask scheduler answers at {host}:{port} "
-                             f"({err.strerror or type(err).__name__})") from None
+                             f"({err.strerror or _short(err)})") from None
+        except Exception as err:      # noqa: BLE001 (whatever listens there, its answer)
+            raise ValueError(f"--scheduler {address}: what answers there is not a Dask scheduler "
+                             f"({type(err).__name__}: {_short(err)[:120]})") from None
+        if not isinstance(ident, dict) or ident.get("type") != "Scheduler":
+            raise ValueError(f"--scheduler {address}: what answers there is not a Dask scheduler")
     try:
         return Client(address, timeout=timeout, set_as_default=False)
-    except (OSError, TimeoutError) as err:
+    except Exception as err:          # noqa: BLE001
         raise ValueError(f"--scheduler {address}: no Dask scheduler answers there "
-                         f"({' '.join(str(err).split()) or type(err).__name__})") from None
+                         f"({type(err).__name__}: {_short(err)[:120]})") from None
+
+
+async def _identity(address, timeout):
+    import asyncio
+
+    from distributed.comm import connect as open_comm
+
+    comm = await open_comm(address, timeout=timeout)
+    try:
+        await asyncio.wait_for(comm.write({"op": "identity", "reply": True}), timeout)
+        return await asyncio.wait_for(comm.read(), timeout)
+    finally:
+        comm.abort()
+
+
+def _short(err):
+    return " ".join(str(err).split()) or type(err).__name__
 
 
 class Table:
