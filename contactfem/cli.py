@@ -497,7 +497,9 @@ def build_parser():
     cg.add_argument("folder", help="a folder of submitted notebooks (*.ipynb, subfolders included)")
     cg.add_argument("--out", required=True, metavar="FILE.csv", help="the table of scores")
     cg.add_argument("--autograders", default=None, metavar="DIR",
-                    help="the autograder/ folder of an instructor build (default: built from lectures/)")
+                    help="the instructor's grading material: a folder holding hidden_checks.py (the hidden "
+                         "checks), e.g. the autograder/ folder of an instructor build (default, and where DIR has "
+                         "none: the checkout's lectures/hidden_checks.py)")
     cg.add_argument("--jobs", type=int, default=1, help="submissions graded in parallel (default 1)")
     cg.add_argument("--roster", default=None, metavar="FILE.csv",
                     help="the class: a CSV with the columns id, name, file (the submission's path in FOLDER) and "
