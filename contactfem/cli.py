@@ -308,10 +308,23 @@ def cmd_course_grade(args):
     import time
 
     course = _course_layer()
+    limits = course.Limits(notebook=args.notebook_timeout, check=args.check_timeout,
+                           memory=int(args.memory * 2**20) if args.memory else None)
     t0 = time.perf_counter()
-    rows = course.grade(args.folder, args.out, autograders=args.autograders, jobs=args.jobs)
-    graded = sum(1 for r in rows if not r["notes"].startswith("not graded"))
-    print(f"{len(rows)} submissions ({graded} graded) in {time.perf_counter() - t0:.0f} s -> {args.out}")
+
+    def progress(done, total):
+        print(f"\r{done} of {total} notebooks graded", end="\n" if done == total else "", file=sys.stderr, flush=True)
+
+    try:
+        rows = course.grade(args.folder, args.out, autograders=args.autograders, jobs=args.jobs, roster=args.roster,
+                            deadline=args.deadline, lecture=args.lecture, limits=limits, review=args.review,
+                            feedback=args.feedback, progress=progress if sys.stderr.isatty() else None)
+    except course.GradingInterrupted as exc:
+        print(f"\ncontactfem: {exc.message}" if sys.stderr.isatty() else f"contactfem: {exc.message}", file=sys.stderr)
+        return 130
+    count = {s: sum(1 for r in rows if r["status"] == s) for s in ("graded", "stopped", "not graded", "missing")}
+    what = ", ".join(f"{n} {s}" for s, n in count.items() if n)
+    print(f"{len(rows)} rows ({what}) in {time.perf_counter() - t0:.0f} s -> {args.out}")
 
 
 def cmd_site(args):
@@ -486,8 +499,32 @@ def build_parser():
     cg.add_argument("folder", help="a folder of submitted notebooks (*.ipynb, subfolders included)")
     cg.add_argument("--out", required=True, metavar="FILE.csv", help="the table of scores")
     cg.add_argument("--autograders", default=None, metavar="DIR",
-                    help="the autograder/ folder of an instructor build (default: built from lectures/)")
+                    help="the instructor's grading material: a folder holding hidden_checks.py (the hidden "
+                         "checks), e.g. the autograder/ folder of an instructor build (default, and where DIR has "
+                         "none: the checkout's lectures/hidden_checks.py)")
     cg.add_argument("--jobs", type=int, default=1, help="submissions graded in parallel (default 1)")
+    cg.add_argument("--roster", default=None, metavar="FILE.csv",
+                    help="the class: a CSV with the columns id, name, file (the submission's path in FOLDER) and "
+                         "optionally submitted (ISO time); every student gets a row, missing submissions marked")
+    cg.add_argument("--deadline", default=None, metavar="TIME",
+                    help="ISO time (e.g. 2026-12-03T23:59); a submission after it is flagged late (its time: the "
+                         "roster's submitted, else the file's modification time)")
+    cg.add_argument("--lecture", default=None, metavar="NN_topic",
+                    help="the lecture every submission answers (default: from each notebook's metadata or NN_ prefix)")
+    cg.add_argument("--notebook-timeout", type=float, default=900.0, metavar="S",
+                    help="seconds for one notebook, its cells and checks (default 900: over three times the slowest "
+                         "lecture's solution graded two at a time on a shared 2-core machine); a notebook over it "
+                         "gets its row with the reason")
+    cg.add_argument("--check-timeout", type=float, default=20.0, metavar="S",
+                    help="seconds for one call of a student's function in a check (default 20: the calls take "
+                         "milliseconds; checks that run a scene allow their calls 60-120 s)")
+    cg.add_argument("--memory", type=float, default=4096.0, metavar="MB",
+                    help="memory limit of each submission's process in MB (default 4096; 0: none)")
+    cg.add_argument("--review", default=None, metavar="DIR",
+                    help="the review files of the written answers, one per lecture, and the sheets for their "
+                         "scores (default: next to --out, named after it, with -review)")
+    cg.add_argument("--feedback", default=None, metavar="DIR",
+                    help="one feedback file per student (default: next to --out, named after it, with -feedback)")
     cg.set_defaults(func=cmd_course_grade)
     rc = sub.add_parser("reconstruct", help="the scan's lost values as an inverse problem: run every reading "
                         "the scan allows, record how it ends (converged, no equilibrium, no convergence, "

@@ -18,21 +18,18 @@ writes them into the notebook as otter's test cells and runs ``otter assign``:
   check cells, and in ``autograder/`` otter's grading configuration of each lecture
   (``NN_topic.zip``).
 
-:func:`grade` runs otter's local grader (``otter run``: no server, no Docker) on every
-submitted notebook of a folder and writes one CSV row per submission: the points of
-each exercise, the total, the points possible and the hints of what failed.
+:func:`grade` (:mod:`contactfem.lab.course.grade`) grades every submitted notebook of a
+folder, each in a process of its own apart from the checks, and writes one CSV row per
+submission: the points of each exercise, the total, the points possible and the hints.
 """
 
 import contextlib
-import csv
 import io
 import logging
 import os
 import re
 import shutil
-import sys
 import tempfile
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[3]
@@ -246,146 +243,6 @@ def build_versions(outs, repo=None, only=None):
     return written
 
 
-# -- grading ------------------------------------------------------------------------------
+# -- grading: contactfem.lab.course.grade -------------------------------------------------------
 
-def submissions(folder):
-    """The notebooks of a folder of submissions (subfolders included), sorted."""
-    folder = Path(folder)
-    if not folder.is_dir():
-        raise ValueError(f"course grade: {folder} is not a folder of submitted notebooks")
-    found = sorted(p for p in folder.rglob("*.ipynb") if ".ipynb_checkpoints" not in p.parts)
-    if not found:
-        raise ValueError(f"course grade: no notebooks (*.ipynb) in {folder}")
-    return found
-
-
-def lecture_of(path, names):
-    """The lecture a submitted notebook answers: otter's assignment name in its metadata,
-    else the NN_ prefix of its file name. None if neither names a lecture."""
-    import json
-
-    try:
-        meta = json.loads(Path(path).read_text()).get("metadata", {})
-        name = meta.get("otter", {}).get("assignment_name")
-    except (ValueError, OSError, AttributeError):
-        name = None
-    if name in names:
-        return name
-    m = re.match(r"(\d\d)_", Path(path).name)
-    hits = [n for n in names if m and n.startswith(m.group(1) + "_")]
-    return hits[0] if len(hits) == 1 else None
-
-
-def _grade_one(path, zip_path):
-    """otter's local grading of one notebook: ({exercise: points}, {exercise: possible}, notes)."""
-    import otter.api
-
-    with _quiet(), _quiet_fds():
-        res = otter.api.grade_submission(str(path), str(zip_path), quiet=True)
-    scores, possible, notes = {}, {}, []
-    for name, r in res.results.items():
-        scores[name], possible[name] = float(r.score), float(r.possible)
-        failed = [tcr for tcr in r.test_case_results if not tcr.passed]
-        if failed:      # the first failing part's hint; the others usually repeat it
-            msg = failed[0].message.strip()
-            hint = msg.split("AssertionError: ", 1)[1] if "AssertionError: " in msg else msg.splitlines()[-1]
-            hint = " ".join(hint.split())
-            more = f" (and {len(failed) - 1} more part{'s' if len(failed) > 2 else ''})" if len(failed) > 1 else ""
-            notes.append(f"{name}: {hint}{more}")
-    return scores, possible, notes
-
-
-@contextlib.contextmanager
-def _quiet_fds():
-    """The kernel that otter starts writes its warnings to the process's own stderr: send
-    file descriptors 1 and 2 to /dev/null while it runs."""
-    sys.stdout.flush()
-    sys.stderr.flush()
-    saved = [os.dup(1), os.dup(2)]
-    null = os.open(os.devnull, os.O_WRONLY)
-    try:
-        os.dup2(null, 1)
-        os.dup2(null, 2)
-        yield
-    finally:
-        os.dup2(saved[0], 1)
-        os.dup2(saved[1], 2)
-        for fd in saved + [null]:
-            os.close(fd)
-
-
-# A kernel that dies before it answers its first request never ran the submission: with gradings
-# in parallel, two kernels starting at once may pick the same free ports (jupyter_client chooses
-# them before the kernel binds them), and the loser exits. Such a start is tried again, up to
-# KERNEL_START_TRIES times; a kernel that dies while it runs the submission is the submission's.
-KERNEL_START_TRIES = 3
-
-
-def _safe_grade(args):
-    path, zip_path = args
-    for attempt in range(KERNEL_START_TRIES):
-        try:
-            return _grade_one(path, zip_path)
-        except Exception as err:             # a broken submission is a row with its reason, not a crash
-            if "before replying to kernel_info" in str(err) and attempt + 1 < KERNEL_START_TRIES:
-                continue
-            return None, None, [f"not graded: {type(err).__name__}: {' '.join(str(err).split())[:300]}"]
-
-
-def grade(folder, out_csv, autograders=None, jobs=1, repo=None):
-    """Grade every notebook in `folder` with otter (locally, no Docker) and write `out_csv`:
-    one row per submission, one column per exercise, then total, possible and notes (the
-    hints of the parts that failed). `autograders`: a folder of NN_topic.zip (the instructor
-    build's autograder/); default: built here from the lectures. Returns the rows."""
-    from ...io.outputs import check_output_path
-    from .checks import EXERCISES
-
-    subs = submissions(folder)
-    out_csv = check_output_path(out_csv, "--out", (".csv",))
-    if jobs < 1:
-        raise ValueError(f"--jobs {jobs}: give a number of parallel gradings >= 1")
-    names = [s.stem for s in lecture_sources(repo)]
-    if autograders is not None:
-        autograders = Path(autograders)
-        if not autograders.is_dir() or not list(autograders.glob("*.zip")):
-            raise ValueError(f"--autograders {autograders}: no grading configurations (*.zip) there; "
-                             "give the autograder/ folder of `contactfem course build --instructor`")
-    which = {p: lecture_of(p, names) for p in subs}
-    with tempfile.TemporaryDirectory(prefix="contactfem-grade-") as tmp:
-        if autograders is None:
-            needed = sorted({w for w in which.values() if w})
-            build(Path(tmp) / "instructor", instructor=True, repo=repo, only=needed)
-            autograders = Path(tmp) / "instructor" / "autograder"
-        todo = [(p, autograders / f"{w}.zip") for p, w in which.items() if w and (autograders / f"{w}.zip").exists()]
-        if jobs > 1 and len(todo) > 1:
-            with ProcessPoolExecutor(max_workers=jobs) as pool:
-                done = dict(zip([p for p, _ in todo], pool.map(_safe_grade, todo)))
-        else:
-            done = {p: _safe_grade((p, z)) for p, z in todo}
-    columns = [e for e in EXERCISES if EXERCISES[e].lecture in set(which.values())]
-    rows = []
-    for p in subs:
-        lec = which[p]
-        row = {"submission": str(p.relative_to(folder)), "lecture": lec or ""}
-        if lec is None:
-            scores, possible, notes = {}, {}, ["not graded: not a lecture of this course (no otter assignment "
-                                               "name in its metadata, no NN_ prefix)"]
-        elif p not in done:
-            scores, possible, notes = {}, {}, [f"not graded: lecture {lec} has no exercises"]
-        else:
-            scores, possible, notes = done[p]
-            scores, possible = scores or {}, possible or {}
-        for e in columns:
-            row[e] = f"{scores[e]:g}" if e in scores else ("0" if EXERCISES[e].lecture == lec else "")
-        mine = [e for e in EXERCISES if EXERCISES[e].lecture == lec]
-        row["total"] = f"{sum(scores.get(e, 0.0) for e in mine):g}"
-        row["possible"] = f"{sum(EXERCISES[e].points for e in mine):g}"
-        row["notes"] = " | ".join(notes)
-        rows.append(row)
-    tmp_csv = out_csv.with_name(f".{out_csv.name}.part")
-    with open(tmp_csv, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=["submission", "lecture"] + columns + ["total", "possible", "notes"])
-        w.writeheader()
-        w.writerows(rows)
-    os.replace(tmp_csv, out_csv)
-    return rows
+from .grade import GradingInterrupted, Limits, grade, lecture_of, submissions  # noqa: E402,F401

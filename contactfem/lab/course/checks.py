@@ -67,21 +67,31 @@ def defined(obj, name, what="function"):
     return obj
 
 
-def call(fun, name, *args, timeout=20.0, **kwargs):
+TIME_LIMIT = 20.0     # seconds a call of the student's code may take (the grader sets its own)
+CALL_LIMIT = [None]   # the limit of the call under way (a call in the submission's process reads it)
+
+
+def call(fun, name, *args, timeout=None, **kwargs):
     """fun(*args, **kwargs), the student's function `name`: its value, or AssertionError
-    with one sentence saying what went wrong."""
+    with one sentence saying what went wrong. A function of the submission's process (the
+    grader's) keeps its time limit there."""
     defined(fun, name)
     if not callable(fun):
         raise AssertionError(f"`{name}` should be a function, but it is {type(fun).__name__}: {fun!r:.60}")
+    timeout = TIME_LIMIT if timeout is None else timeout
     where = f"{name}({_args_text(args, kwargs)})"
+    local = not getattr(type(fun), "remote", False)
+    timeout = CALL_LIMIT[0] = timeout if local else max(timeout, TIME_LIMIT)
     try:
-        with np.errstate(all="ignore"), _time_limit(timeout):
+        with np.errstate(all="ignore"), _time_limit(timeout if local else None):
             out = fun(*args, **kwargs)
     except Timeout:
         raise AssertionError(f"{where} did not return within {timeout:g} s: an endless loop? "
                              "(bound every loop, e.g. by max_updates)") from None
     except Exception as err:
         raise AssertionError(f"{where} raised {type(err).__name__}: {err}") from None
+    finally:
+        CALL_LIMIT[0] = None
     if out is None:
         raise AssertionError(f"{where} returned None: {STILL_DOTS} (and end it with `return`)")
     if out is Ellipsis or (isinstance(out, tuple) and any(o is Ellipsis for o in out)):
@@ -1507,4 +1517,54 @@ EXERCISES = {e.name: e for e in [
     _ex("ex12_semismooth_1dof", "12_beyond_node_to_segment", "medium", True,
         "a semi-smooth Newton method on a one-degree-of-freedom contact",
         (ssn_contact, 2), (ssn_open, 1), (ssn_iterations, 2)),
+]}
+
+
+# -- implement, don't import ---------------------------------------------------------------------
+
+# The library's implementation of the part an exercise asks for ("module:Name" or
+# "module:Name.method"): out of reach of the answer while it is graded (an answer that uses it
+# scores zero for the part). Exercise 11.1 and 12.3 have no counterpart in the library (it
+# solves meshes, not one degree of freedom).
+LIBRARY = {
+    "ex01_power_law": ("contactfem.laws.normal:PowerLaw",),
+    "ex01_tresca": ("contactfem.laws.friction:Coulomb", "contactfem.laws.friction:ParabolicSlip"),
+    "ex02_circle_gap": ("contactfem.contact.masters:RigidArc", "contactfem.contact.kinematics:arc_variations"),
+    "ex02_normal_tangent": ("contactfem.contact.element:normal_element", "contactfem.contact.element:contact_element"),
+    "ex03_coulomb_return": ("contactfem.laws.return_map:return_map",),
+    "ex03_slip_moduli": ("contactfem.laws.return_map:return_map",),
+    "ex08_hardening_return": ("contactfem.laws.return_map:return_map", "contactfem.laws.friction:SlipHardening"),
+    "ex10_linear_hardening": ("contactfem.laws.friction:SlipHardening",),
+    "ex10_quadratic_normal": ("contactfem.laws.normal:PowerLaw",),
+    "ex11_secant_traction": ("contactfem.contact.conserving:secant", "contactfem.contact.conserving:discrete_gradient"),
+    "ex12_normal_complementarity": ("contactfem.contact.complementarity:normal_complementarity",),
+    "ex12_friction_complementarity": ("contactfem.contact.complementarity:friction_complementarity",),
+    "ex08_gas_pressure": ("contactfem.bodies.loads:GasPressure",),
+}
+
+# The exercises that ask for part of the method on top of the library's own parts (their
+# prompts say so): what the library gives them, and what the student writes.
+BUILDS_ON = {
+    "ex04_slip_margin": "the law's own slip_bound gives the bound Y; the answer is the margin over the nodes",
+    "ex04_load_steps": "the scene's stepper solves each step; the answer is the loop and what it records",
+    "ex05_incline": "the ring, the plane and the stepper are the library's; the answer is the new scene",
+    "ex07_census": "the scene's stepper solves each step; the answer is the loop and its counts",
+}
+
+
+# -- written answers ---------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Manual:
+    """A written question of a lecture, scored by the instructor: its prompt is a markdown
+    cell holding ``<!-- manual: NAME -->``; the cells after it are the answer."""
+    name: str
+    lecture: str
+    points: float
+    what: str
+
+
+MANUAL = {m.name: m for m in [
+    Manual("ex01_discussion", "01_interface_laws", 2,
+           "a short discussion: what the penalty law's stiffness c_N trades off (penetration against conditioning)"),
 ]}
