@@ -221,8 +221,8 @@ def build_versions(outs, repo=None, only=None, force=False, work=None, on_write=
     notebooks are made and before any is written (see :mod:`.handout`); the notebooks of
     all versions are then written together, with Ctrl-C held back. `work`: the folder for
     otter's work (default: a temporary folder of the system); `on_write`: called with no
-    argument just before the first file is written (the command line's account of what an
-    interrupt leaves)."""
+    argument once the writing has begun, with Ctrl-C held back until every file is written
+    (the command line's account of what an interrupt leaves)."""
     import nbformat
 
     from ...io.outputs import hold_interrupts
@@ -263,9 +263,9 @@ def build_versions(outs, repo=None, only=None, force=False, work=None, on_write=
             for v, names in found.items():
                 if names:
                     raise ValueError(handout.refusal(outs[v], names))
-        if on_write:
-            on_write()
         with hold_interrupts():                  # all notebooks of the build, or none of them
+            if on_write:
+                on_write()
             for version, out in outs.items():
                 out.mkdir(parents=True, exist_ok=True)
                 if found[version]:
