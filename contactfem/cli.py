@@ -317,7 +317,13 @@ def cmd_site(args):
 
     out = check_out(args.out or default_out(args.instructor))
     pages = f"the site in {out} is unchanged" if (out / "index.html").exists() else f"no page written in {out}"
-    _RUN["said"] = f"during the site build; {pages} (notebooks executed so far are cached in {work_dir(out)})"
+
+    def said():                                    # read when the interrupt is reported, after the clean-up
+        cache = work_dir(out) / "cache"
+        return f"during the site build; {pages}" + (f" (notebooks executed so far are cached in {work_dir(out)})"
+                                                     if cache.is_dir() else "")
+
+    _RUN["said"] = said
     try:
         index = build(out, instructor=args.instructor, on_write=lambda: _RUN.update(phase="done"))
     except RuntimeError as err:                    # Sphinx's own messages, then one line of ours
@@ -513,13 +519,15 @@ def build_parser():
 def interrupted(exc):
     """The one line of a Ctrl-C: where the run was, and what was written (nothing, unless
     the outputs were already complete). A command whose outputs are not all or nothing sets
-    _RUN["said"] to its own account ("during the site build; the site in X is unchanged"),
-    and _RUN["phase"] = "done" once its outputs are complete."""
+    _RUN["said"] to its own account ("during the site build; the site in X is unchanged"), a
+    text or a function that returns it (called when the interrupt is reported), and
+    _RUN["phase"] = "done" once its outputs are complete."""
     phase = _RUN.get("phase")
     if phase == "done":
         return "contactfem: interrupted after the outputs were written"
-    if _RUN.get("said"):                 # a command's own account: where it was, what is on disk
-        return f"contactfem: interrupted {_RUN['said']}"
+    said = _RUN.get("said")              # a command's own account: where it was, what is on disk
+    if said:
+        return f"contactfem: interrupted {said() if callable(said) else said}"
     if getattr(exc, "step", None) is not None:
         of = f" of {exc.n_steps}" if getattr(exc, "n_steps", None) else " (adaptive steps)"
         where = f" at t = {exc.t:.6g}, step {exc.step}{of}"

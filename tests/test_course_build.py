@@ -217,7 +217,7 @@ def test_the_readmes_send_students_to_the_handout():
     readme = (REPO / "README.md").read_text()
     guide = (REPO / "lectures" / "README.md").read_text()
     assert "**This repository holds the solutions.**" in readme
-    assert "**This folder holds the solutions**" in guide
+    assert "**This folder of the repository, `lectures/`, holds the solutions**" in guide
     for text in (readme, guide):
         assert STUDENT_ZIP in text
         assert re.search(r"[Ii]nstructors work in a checkout", text)

@@ -112,8 +112,9 @@ One notebook per lecture, in course order, without the solutions. Each exercise 
 where your answer goes (`...` marks what to write) and, after it, a check cell
 `grader.check("exNN_...")` that runs the exercise's checks and shows your score and hints.
 
-You need the package with its course extra (your instructor tells you where to install it
-from; for example `python -m pip install "contactfem[course]"`), then:
+You need the package with its course extra, installed as your instructor tells you (for
+example from the wheel file they hand out:
+`python -m pip install "contactfem-VERSION-py3-none-any.whl[course]"`), then, in this folder:
 
     jupyter lab
 

@@ -8,13 +8,14 @@ paper's examples, the equation index linked into the API reference, the benchmar
 ``build`` stages a Sphinx source folder (:mod:`contactfem.lab.site.pages`), with the
 configuration in ``lectures/_site/conf.py``, and runs Sphinx with warnings as errors.
 Every file it writes is under DIR: the pages, the student handout (a zip of the student
-version, linked from the index), and its own work in ``DIR/.contactfem-site`` (the staged
-sources, the figures the lectures draw, the executed notebooks and Sphinx's read pages, kept
-so that a rebuild takes seconds, and emptied when the code of the package changes). DIR is
-new, empty, or a site built before; the new pages replace the old ones only once the build
-has succeeded. The published pages carry no absolute path of the machine that built them
-(``scrub``). :mod:`contactfem.lab.site.browser` checks the built site in headless Chromium
-as a reader would.
+version, linked from the index), and its own work in ``DIR/.contactfem-site``: the staged
+sources, the figures the lectures draw and the executed notebooks while it runs (removed
+after), and its cache, kept so that a rebuild runs only the notebooks that changed (MyST-NB's
+cache of executed notebooks and Sphinx's read pages; emptied when the code of the package
+changes). DIR is new, empty, or a site built before; the new pages replace the old ones only
+once the build has succeeded. The published pages carry no absolute path of the machine
+that built them (``scrub``). :mod:`contactfem.lab.site.browser` checks the built site in
+headless Chromium as a reader would.
 
 Needs the ``site`` extra (``pip install -e ".[site]"``) and a checkout of the repository
 (the lectures are not part of the installed package).
