@@ -77,9 +77,10 @@ def test_a_rebuild_refuses_to_overwrite_an_answered_notebook(tmp_path, capsys):
 
 def test_a_folder_of_work_is_not_built_over(tmp_path):
     """--out on a folder that holds a notebook of a lecture's name that the build did not
-    write: refused after the notebooks are made and before anything is written; a copy that
-    is exactly what the build writes is replaced without fuss."""
-    from contactfem.lab.course import build
+    write: refused after the notebooks are made and before anything is written. Replaced
+    without fuss: a copy that is exactly what the build writes, and a notebook an earlier
+    build wrote that nobody changed since (the lecture did)."""
+    from contactfem.lab.course import build, handout
 
     made = build(tmp_path / "made", only=[LEC])[0]
     work = tmp_path / "work"
@@ -94,6 +95,12 @@ def test_a_folder_of_work_is_not_built_over(tmp_path):
     same.mkdir()
     shutil.copy2(made, same / made.name)
     assert build(same, only=[LEC]) == [same / made.name]
+    older = tmp_path / "older"                 # what an earlier build wrote, untouched: the lecture changed since
+    older.mkdir()
+    (older / made.name).write_text('{"an": "older build"}')
+    handout.write_manifest(older, "student", [made.name])
+    assert build(older, only=[LEC]) == [older / made.name]
+    assert (older / made.name).read_bytes() == made.read_bytes() and not list(older.glob("backup-*"))
 
 
 def _no_work(*args, **kwargs):
