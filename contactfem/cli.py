@@ -9,9 +9,9 @@ residual history on the next, or a law that returned a value no law may return d
 the run (one line naming the law, the value and the point), a scene file whose own code
 failed during the run (one line naming the file, the function and the line), or a sweep
 with failed runs;
-130 interrupted (Ctrl-C): one line, and none of the run's output files written (a sweep's
-table, written as each point ends, holds the points done); 143 ended by SIGTERM, the same
-without the line.
+130 interrupted (Ctrl-C): one line saying where and what was written (a run writes none of its
+output files unless all were complete; a sweep's table, written as each point ends, holds the
+points done); 143 ended by SIGTERM, the same without the line.
 
 $CONTACTFEM_READY_FILE, if set, names a file the command line creates as soon as it
 answers Ctrl-C with its one line (for a supervisor, or a test, that interrupts it)."""
@@ -298,10 +298,15 @@ def _course_layer():
 
 def cmd_course_build(args):
     course = _course_layer()
+    from .lab.course.handout import STUDENT_ZIP
+
     out = course.check_out_dir(args.out or course.default_out(args.instructor))
-    written = course.build(out, instructor=args.instructor)
-    version = "instructor (solutions, check cells, autograder/)" if args.instructor else "student (no solutions)"
-    print(f"{len(written)} lectures, {version} -> {out}")
+    _RUN["said"] = f"during the course build; nothing written in {out}"
+    written = course.build_versions({"instructor" if args.instructor else "student": out}, force=args.force,
+                                    on_write=lambda: _RUN.update(phase="done"))
+    version = "instructor (solutions, check cells, autograder/)" if args.instructor else \
+        f"student (no solutions; the handout: {out / STUDENT_ZIP})"
+    print(f"{len(next(iter(written.values())))} lectures, {version} -> {out}")
 
 
 def cmd_course_grade(args):
@@ -328,12 +333,19 @@ def cmd_course_grade(args):
 
 
 def cmd_site(args):
-    from .io.outputs import check_output_dir
-    from .lab.site import build, default_out
+    from .lab.site import build, check_out, default_out, work_dir
 
-    check_output_dir(args.out or default_out(args.instructor), "--out")
+    out = check_out(args.out or default_out(args.instructor))
+    pages = f"the site in {out} is unchanged" if (out / "index.html").exists() else f"no page written in {out}"
+
+    def said():                                    # read when the interrupt is reported, after the clean-up
+        cache = work_dir(out) / "cache"
+        return f"during the site build; {pages}" + (f" (notebooks executed so far are cached in {work_dir(out)})"
+                                                     if cache.is_dir() else "")
+
+    _RUN["said"] = said
     try:
-        index = build(args.out, instructor=args.instructor)
+        index = build(out, instructor=args.instructor, on_write=lambda: _RUN.update(phase="done"))
     except RuntimeError as err:                    # Sphinx's own messages, then one line of ours
         head, _, detail = str(err).partition("\n")
         head = head.rstrip(":")
@@ -481,8 +493,8 @@ def build_parser():
     sw.set_defaults(func=cmd_sweep)
     st = sub.add_parser("site", help="build the course website (lectures executed, gallery, equation index, API)")
     st.add_argument("--out", default=None, metavar="DIR", help="output folder, DIR/index.html (default: build/site "
-                    "in the checkout, build/site-instructor with --instructor); the build's own files go to "
-                    "$CONTACTFEM_CACHE/site (default ~/.cache/contactfem/site)")
+                    "in the checkout, build/site-instructor with --instructor): new, empty, or a site built "
+                    "before; every file of the build is written there, its cache in DIR/.contactfem-site")
     st.add_argument("--instructor", action="store_true",
                     help="the instructor version of the lectures (with the solutions) instead of the student version")
     st.set_defaults(func=cmd_site)
@@ -492,7 +504,11 @@ def build_parser():
                          "instructor version (solutions, checks and the grading configurations)")
     cb.add_argument("--instructor", action="store_true", help="the instructor version")
     cb.add_argument("--out", default=None, metavar="DIR",
-                    help="output folder (default: build/course/student or build/course/instructor)")
+                    help="output folder (default: build/course/student or build/course/instructor); the student "
+                         "version also goes into one zip there, the handout")
+    cb.add_argument("--force", action="store_true",
+                    help="replace notebooks that differ from what the build writes (answered or edited ones), "
+                         "after moving them to DIR/backup-TIME/ (without --force the build refuses)")
     cb.set_defaults(func=cmd_course_build)
     cg = csub.add_parser("grade", help="grade a folder of submitted notebooks into a CSV: one row per submission, "
                          "one column per exercise, the total and the hints of what failed")
@@ -554,10 +570,16 @@ def build_parser():
 
 def interrupted(exc):
     """The one line of a Ctrl-C: where the run was, and what was written (nothing, unless
-    the outputs were already complete)."""
+    the outputs were already complete). A command whose outputs are not all or nothing sets
+    _RUN["said"] to its own account ("during the site build; the site in X is unchanged"), a
+    text or a function that returns it (called when the interrupt is reported), and
+    _RUN["phase"] = "done" once its outputs are complete."""
     phase = _RUN.get("phase")
     if phase == "done":
         return "contactfem: interrupted after the outputs were written"
+    said = _RUN.get("said")              # a command's own account: where it was, what is on disk
+    if said:
+        return f"contactfem: interrupted {said() if callable(said) else said}"
     if getattr(exc, "step", None) is not None:
         of = f" of {exc.n_steps}" if getattr(exc, "n_steps", None) else " (adaptive steps)"
         where = f" at t = {exc.t:.6g}, step {exc.step}{of}"

@@ -7,9 +7,9 @@ import pytest
 
 
 def pytest_configure(config):
-    """The tests' own caches: $CONTACTFEM_CACHE (the inverse study's results, the site's
-    build) is a temporary folder for the session, so no test reads or writes the user's
-    ~/.cache/contactfem (and a later command never answers from the tests' cache)."""
+    """The tests' own caches: $CONTACTFEM_CACHE (the inverse study's results) is a temporary
+    folder for the session, so no test reads or writes the user's ~/.cache/contactfem (and a
+    later command never answers from the tests' cache)."""
     config._contactfem_cache = tempfile.mkdtemp(prefix="contactfem-test-cache-")
     os.environ["CONTACTFEM_CACHE"] = config._contactfem_cache
 

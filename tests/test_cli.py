@@ -81,7 +81,7 @@ def test_a_closed_pipe_is_not_an_error():
 def test_a_failed_site_build_shows_sphinx_then_one_line(monkeypatch, capsys):
     import contactfem.lab.site as site
 
-    def broken(out=None, instructor=False):
+    def broken(out=None, instructor=False, **kwargs):
         raise RuntimeError("the site build failed (Sphinx exit code 1):\nlectures/03.ipynb:12: WARNING: undefined label")
 
     monkeypatch.setattr(site, "build", broken)

@@ -7,9 +7,14 @@ they skip where either is missing, except under CONTACTFEM_REQUIRE_BROWSER=1 (se
 .ci/run, which installs both), where a missing piece is a failure.
 """
 
+import json
 import os
 import re
 import shutil
+import signal
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -139,18 +144,23 @@ def test_checker_fails_on_dead_links_and_offsite_scripts(mathjax_dir, chromium):
 
 # -- the real site --------------------------------------------------------------------
 
-@pytest.fixture(scope="module")
-def site(chromium, tmp_path_factory):
+def _site_extra():
     pytest.importorskip("nbclient")
     try:
         import myst_nb  # noqa: F401
+        import otter  # noqa: F401
         import sphinx  # noqa: F401
     except ImportError:
         _require(False, "the site extra is not installed: pip install -e '.[site]'")
+
+
+@pytest.fixture(scope="module")
+def site(chromium, tmp_path_factory):
+    _site_extra()
     from contactfem.lab.site import build
 
     before = _tree(REPO)
-    index = build(tmp_path_factory.mktemp("site") / "out")    # its own files: $CONTACTFEM_CACHE/site (conftest)
+    index = build(tmp_path_factory.mktemp("site") / "out")    # all its files under out (its cache: out/.contactfem-site)
     assert _tree(REPO) == before, "the site build wrote into the checkout"
     return index.parent
 
@@ -169,9 +179,9 @@ def test_site_pages_carry_no_absolute_path(site):
     """No page shows a path of the machine that built it: the checkout, the cache, home, /tmp."""
     import tempfile
 
-    from contactfem.lab.site import cache_dir
+    from contactfem.lab.site import work_dir
 
-    needles = {str(REPO), str(cache_dir()), str(Path.home()) + "/", tempfile.gettempdir() + "/"}
+    needles = {str(REPO), str(work_dir(site)), str(Path.home()) + "/", tempfile.gettempdir() + "/"}
     for page in site.rglob("*.html"):
         text = page.read_text()
         found = [n for n in needles if n in text]
@@ -208,6 +218,29 @@ def test_site_publishes_the_student_version(site):
             assert line not in text, f"{nb_path.stem}.html shows the solution line {line!r}"
         for name, _ in questions(nb):
             assert f'grader.check("{name}")' in text, f"{nb_path.stem}.html: no check cell for {name}"
+    _assert_student_zip(site, LECTURES)
+
+
+def _assert_student_zip(site, lectures):
+    """The front page links the student handout; the zip holds the student notebooks of
+    `lectures` and no line of their solutions, nor any solution marker."""
+    import zipfile
+
+    import nbformat
+
+    from contactfem.lab.course import solution_lines
+    from contactfem.lab.course.handout import STUDENT_ZIP
+
+    link = re.search(rf'href="(_downloads/[^"]+/{re.escape(STUDENT_ZIP)})"', (site / "index.html").read_text())
+    assert link, "the front page does not link the student zip"
+    with zipfile.ZipFile(site / link.group(1)) as z:
+        files = {Path(n).name: z.read(n).decode() for n in z.namelist()}
+    assert sorted(files) == sorted(["README.md"] + [nb.name for nb in lectures])
+    for nb_path in lectures:
+        text = files[nb_path.name]
+        assert not re.search(r"BEGIN\s+SOLUTION", text, re.I), nb_path.name
+        for line in solution_lines(nbformat.read(nb_path, as_version=4)):
+            assert line not in text and json.dumps(line)[1:-1] not in text, f"the zip's {nb_path.name} holds {line!r}"
 
 
 def test_equation_index_links_every_entry_to_the_api(site):
@@ -307,3 +340,86 @@ def test_site_command_line():
     args = build_parser().parse_args(["site", "--out", "somewhere"])
     assert args.out == "somewhere" and args.func.__name__ == "cmd_site" and not args.instructor
     assert build_parser().parse_args(["site", "--instructor"]).instructor
+
+
+# -- every file under --out -------------------------------------------------------------
+
+def _everything(root, skip=None):
+    """Every path under `root` (folders too), with each file's size, outside `skip`."""
+    out = set()
+    for dirpath, dirnames, filenames in os.walk(root):
+        if skip is not None:
+            dirnames[:] = [d for d in dirnames if Path(dirpath, d) != skip]
+        out |= {(os.path.join(dirpath, d), None) for d in dirnames}
+        out |= {(os.path.join(dirpath, f), os.path.getsize(os.path.join(dirpath, f))) for f in filenames}
+    return out
+
+
+@pytest.mark.slow
+def test_an_instructor_site_writes_nothing_outside_out(tmp_path):
+    """`site --instructor --out X` (one lecture, in its own process) on a fresh folder tree:
+    home, temporary folder, $CONTACTFEM_CACHE and working folder all inside one parent,
+    which holds exactly what it held before outside X (the checkout too); X holds the pages,
+    the executed solutions among them, and of the build's work only its cache."""
+    _site_extra()
+    import nbformat
+
+    from contactfem.lab.course import solution_lines
+
+    lecture = REPO / "lectures" / "01_interface_laws.ipynb"
+    parent = tmp_path / "fresh"
+    for d in ("home", "tmp", "cache", "cwd"):
+        (parent / d).mkdir(parents=True)
+    out = parent / "X"
+    env = dict(os.environ, HOME=str(parent / "home"), TMPDIR=str(parent / "tmp"), PYTHONPATH=str(REPO),
+               CONTACTFEM_CACHE=str(parent / "cache"), MPLBACKEND="Agg")
+    env.pop("MPLCONFIGDIR", None)
+    env.pop("IPYTHONDIR", None)
+    # the tools' own per-user caches exist on any machine that ran matplotlib once: made here first
+    subprocess.run([sys.executable, "-c", "import matplotlib.font_manager"], env=env, cwd=parent / "cwd", check=True)
+    before, checkout = _everything(parent), _tree(REPO)
+    t0 = time.monotonic()
+    p = subprocess.run([sys.executable, "-c", "from contactfem.lab.site import build; "
+                        f"build({str(out)!r}, instructor=True, only=[{lecture.stem!r}])"],
+                       env=env, cwd=parent / "cwd", capture_output=True, text=True, timeout=1200)
+    print(f"\ninstructor site of one lecture built in {time.monotonic() - t0:.0f} s")
+    assert p.returncode == 0, p.stderr[-3000:]
+    assert _everything(parent, skip=out) == before, sorted(_everything(parent, skip=out) ^ before)[:20]
+    assert _tree(REPO) == checkout, "the site build wrote into the checkout"
+    assert all(out in q.parents for q in parent.rglob("jupyter_execute"))
+    assert sorted(q.name for q in (out / ".contactfem-site").iterdir()) == ["cache"]
+    import html
+
+    page = html.unescape(re.sub(r"<[^>]+>", "", (out / f"{lecture.stem}.html").read_text()))
+    lines = solution_lines(nbformat.read(lecture, as_version=4))
+    assert all(ln in page for ln in lines), "the instructor page lacks solution lines"
+    _assert_student_zip(out, [lecture])
+
+
+def test_ctrl_c_during_the_site_build_leaves_the_old_pages(tmp_path):
+    """SIGINT (to the whole process group, as from a terminal) while Sphinx runs: one line
+    that says the site in OUT is unchanged, exit 130; the old pages are there as they were
+    and of the new build only the cache is left."""
+    _site_extra()
+    out = tmp_path / "X"
+    out.mkdir()
+    (out / ".buildinfo").write_text("# an earlier build\n")
+    (out / "index.html").write_text("<p>the old site</p>")
+    env = dict(os.environ, PYTHONPATH=str(REPO), TMPDIR=str(tmp_path))
+    p = subprocess.Popen([sys.executable, "-m", "contactfem", "site", "--out", str(out)], env=env, text=True,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True,
+                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    stamp = out / ".contactfem-site" / "cache" / "contactfem-code.txt"       # Sphinx starts next
+    t0 = time.monotonic()
+    while p.poll() is None and not stamp.exists() and time.monotonic() - t0 < 300:
+        time.sleep(0.05)
+    time.sleep(2.0)
+    assert p.poll() is None, p.communicate()
+    os.killpg(p.pid, signal.SIGINT)
+    _, err = p.communicate(timeout=120)
+    assert p.returncode == 130, err
+    assert err.strip() == (f"contactfem: interrupted during the site build; the site in {out} is unchanged "
+                           f"(notebooks executed so far are cached in {out / '.contactfem-site'})"), err
+    assert sorted(q.name for q in out.iterdir()) == [".buildinfo", ".contactfem-site", "index.html"]
+    assert (out / "index.html").read_text() == "<p>the old site</p>"
+    assert sorted(q.name for q in (out / ".contactfem-site").iterdir()) == ["cache"]

@@ -191,55 +191,89 @@ def default_out(instructor):
 
 
 def check_out_dir(out, option="--out"):
-    """A folder that can be written (made, with its parents, if missing); a file there, or a
-    place where nothing can be written, is bad input."""
-    out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise ValueError(f"{option} {out}: is a file; give a folder")
-    existing = out
-    while not existing.exists():
-        existing = existing.parent
-    if not existing.is_dir():
-        raise ValueError(f"{option} {out}: {existing} is a file, not a folder")
-    if not os.access(existing, os.W_OK):
-        raise ValueError(f"{option} {out}: cannot write in {existing}")
-    return out
+    """A folder that can be written (made, with its parents, if missing; a file is created and
+    removed there to be sure); a file there, or a place where nothing can be written, is bad
+    input (ValueError naming the option). Makes nothing."""
+    from ...io.outputs import check_output_dir
+
+    return check_output_dir(out, option)
 
 
-def build(out=None, instructor=False, repo=None, only=None):
+def build(out=None, instructor=False, repo=None, only=None, force=False):
     """Write the student version (or the instructor version) of every lecture into `out`;
     returns the notebooks written. Lectures without exercises are copied as they are.
-    `only`: lecture names (stems) to build, default all."""
+    `only`: lecture names (stems) to build, default all. The student version also goes into
+    one zip, OUT/contactfem-course-student.zip. A notebook in `out` that differs from what
+    the build would write, and is not unchanged since an earlier build wrote it, is not
+    overwritten: ValueError naming it, nothing written; with `force` it is moved to
+    OUT/backup-<time>/ first."""
     version = "instructor" if instructor else "student"
-    return build_versions({version: out or default_out(instructor)}, repo=repo, only=only)[version]
+    return build_versions({version: out or default_out(instructor)}, repo=repo, only=only, force=force)[version]
 
 
-def build_versions(outs, repo=None, only=None):
+def build_versions(outs, repo=None, only=None, force=False, work=None, on_write=None):
     """Both versions in one pass (otter assign runs once per lecture): `outs` maps
-    "student" and/or "instructor" to a folder. Returns {version: [notebooks written]}."""
+    "student" and/or "instructor" to a folder. Returns {version: [notebooks written]}.
+    Every folder is checked before any work, and every notebook it would replace after the
+    notebooks are made and before any is written (see :mod:`.handout`); the notebooks of
+    all versions are then written together, with Ctrl-C held back. `work`: the folder for
+    otter's work (default: a temporary folder of the system); `on_write`: called with no
+    argument once the writing has begun, with Ctrl-C held back until every file is written
+    (the command line's account of what an interrupt leaves)."""
     import nbformat
 
-    sources = [s for s in lecture_sources(repo) if only is None or s.stem in only]
+    from ...io.outputs import hold_interrupts
+    from . import handout
+
     outs = {v: check_out_dir(o) for v, o in outs.items()}
+    sources = [s for s in lecture_sources(repo) if only is None or s.stem in only]
+    for version, out in outs.items():
+        handout.check_version(out, version)
+    if not force:                                # a notebook changed since the last build: refused before work
+        for out in outs.values():
+            changed = handout.changed_since_built(out, [s.name for s in sources])
+            if changed:
+                raise ValueError(handout.refusal(out, changed))
+    if work is not None:
+        Path(work).mkdir(parents=True, exist_ok=True)
     written = {v: [] for v in outs}
-    for o in outs.values():
-        o.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory(prefix="contactfem-course-") as tmp:
+    with tempfile.TemporaryDirectory(prefix="contactfem-course-", dir=work) as tmp:
+        plan = {v: {} for v in outs}             # version: {name in out: file made here}
         for src in sources:
             built = None
             if questions(nbformat.read(src, as_version=4)):
                 built = _assign(src, Path(tmp))
-            for version, out in outs.items():
-                dst = out / src.name
+            for version in outs:
                 if built is None:
-                    shutil.copy2(src, dst)
+                    plan[version][src.name] = src
                 elif version == "student":
-                    shutil.copy2(built[0], dst)
+                    plan[version][src.name] = built[0]
                 else:
-                    shutil.copy2(built[1], dst)
-                    (out / "autograder").mkdir(exist_ok=True)
-                    shutil.copy2(built[2], out / "autograder" / f"{src.stem}.zip")
-                written[version].append(dst)
+                    plan[version][src.name] = built[1]
+                    plan[version][f"autograder/{src.stem}.zip"] = built[2]
+        if "student" in plan:
+            notebooks = [p for n, p in plan["student"].items() if n.endswith(".ipynb")]
+            plan["student"][handout.STUDENT_ZIP] = handout.student_zip(notebooks, Path(tmp) / handout.STUDENT_ZIP)
+        guarded = {v: {n: p for n, p in files.items() if not n.startswith("autograder/")} for v, files in plan.items()}
+        found = {v: handout.conflicts(outs[v], guarded[v]) for v in outs}
+        if not force:
+            for v, names in found.items():
+                if names:
+                    raise ValueError(handout.refusal(outs[v], names))
+        with hold_interrupts():                  # all notebooks of the build, or none of them
+            if on_write:
+                on_write()
+            for version, out in outs.items():
+                out.mkdir(parents=True, exist_ok=True)
+                if found[version]:
+                    kept = handout.back_up(out, found[version])
+                    print(f"contactfem: note: {len(found[version])} changed file(s) kept in {kept}", file=sys.stderr)
+                for name, made in plan[version].items():
+                    (out / name).parent.mkdir(parents=True, exist_ok=True)
+                    shutil.copy2(made, out / name)
+                    if name.endswith(".ipynb"):
+                        written[version].append(out / name)
+                handout.write_manifest(out, version, guarded[version])
     return written
 
 

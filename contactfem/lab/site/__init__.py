@@ -7,12 +7,15 @@ paper's examples, the equation index linked into the API reference, the benchmar
 
 ``build`` stages a Sphinx source folder (:mod:`contactfem.lab.site.pages`), with the
 configuration in ``lectures/_site/conf.py``, and runs Sphinx with warnings as errors.
-It writes only into DIR and into its cache folder, ``$CONTACTFEM_CACHE/site`` (default
-``~/.cache/contactfem/site``): the staged sources, the figures the lectures draw, and the
-executed notebooks (emptied when the code of the package changes, so a rebuild takes
-seconds). The published pages carry no absolute path of the machine that built them
-(``scrub``). :mod:`contactfem.lab.site.browser` checks the built site in headless
-Chromium as a reader would.
+Every file it writes is under DIR: the pages, the student handout (a zip of the student
+version, linked from the index), and its own work in ``DIR/.contactfem-site``: the staged
+sources, the figures the lectures draw and the executed notebooks while it runs (removed
+after), and its cache, kept so that a rebuild runs only the notebooks that changed (MyST-NB's
+cache of executed notebooks and Sphinx's read pages; emptied when the code of the package
+changes). DIR is new, empty, or a site built before; the new pages replace the old ones only
+once the build has succeeded. The published pages carry no absolute path of the machine
+that built them (``scrub``). :mod:`contactfem.lab.site.browser` checks the built site in
+headless Chromium as a reader would.
 
 Needs the ``site`` extra (``pip install -e ".[site]"``) and a checkout of the repository
 (the lectures are not part of the installed package).
@@ -34,9 +37,29 @@ def default_out(instructor=False):
     return REPO / "build" / ("site-instructor" if instructor else "site")
 
 
-def cache_dir():
-    """The site's work and cache folder: $CONTACTFEM_CACHE/site, default ~/.cache/contactfem/site."""
-    return Path(os.environ.get("CONTACTFEM_CACHE") or Path.home() / ".cache" / "contactfem") / "site"
+WORK = ".contactfem-site"
+# the parts of the work folder a build makes afresh (removed after it; "cache" is kept)
+TRANSIENT = ("src", "course", "html", "jupyter_execute", "kernel", "runtime", "ipython", "figures")
+
+
+def work_dir(out):
+    """The build's own folder inside the site folder `out`: OUT/.contactfem-site."""
+    return Path(out) / WORK
+
+
+def check_out(out, option="--out"):
+    """The site folder `out`, checked before any work (ValueError naming the option): a folder
+    that can be written, and new, empty, or a site built before (it has the build's work
+    folder, or Sphinx's .buildinfo): the build never writes its pages among other files."""
+    from ...io.outputs import check_output_dir
+
+    out = check_output_dir(out, option)
+    if out.is_dir() and not (work_dir(out).is_dir() or (out / ".buildinfo").is_file()):
+        other = sorted(p.name for p in out.iterdir())
+        if other:
+            raise ValueError(f"{option} {out}: holds files that are not a site built by contactfem site "
+                             f"({', '.join(other[:3])}{', ...' if len(other) > 3 else ''}): give a new or empty folder")
+    return out
 
 
 def scrub(out, replacements):
@@ -91,33 +114,58 @@ def _kernel_env(work, env):
     env["PYTHONPATH"] = os.pathsep.join([str(REPO)] + [p for p in [env.get("PYTHONPATH")] if p])
 
 
-def build(out=None, repo=None, quiet=True, instructor=False):
+def build(out=None, repo=None, quiet=True, instructor=False, only=None, on_write=None):
     """Build the site into `out` (default: build/site of the checkout, build/site-instructor
     for the instructor version); returns the path of its index.html. The lectures are the
-    course's student version (no solutions) unless `instructor`. Its own files go to
-    cache_dir(). Raises RuntimeError with Sphinx's output if the build fails (a warning, a
+    course's student version (no solutions) unless `instructor`; `only`: the lectures (file
+    stems) to put on the site, default all. Every file of the build is written under `out`:
+    the pages, and in OUT/.contactfem-site the build's work (staged sources, the executed
+    notebooks and Sphinx's read pages, kept for the next build, the lectures' figures). The
+    pages are built there and moved into `out` at the end, together, with Ctrl-C held back
+    (`on_write` is called first): an interrupted or failed build leaves the pages in `out` as
+    they were. Raises RuntimeError with Sphinx's output if the build fails (a warning, a
     failing notebook cell, a missing reference)."""
+    from ...io.outputs import hold_interrupts
+
     repo = Path(repo or REPO)
     if not (repo / "lectures" / "_site" / "conf.py").exists():
         raise RuntimeError(f"contactfem site needs a checkout of the repository: no lectures/_site in {repo}")
-    work = cache_dir()
-    out = Path(out) if out else default_out(instructor)
-    version = "site-instructor" if instructor else "site"
-    src, cache = work / f"{version}-src", work / "cache"
+    out = check_out(out or default_out(instructor))
+    work = work_dir(out)
+    src, cache, html = work / "src", work / "cache", work / "html"
     from .pages import stage
 
-    stage(repo, src, instructor=instructor)
-    _prepare_cache(cache)
-    env = dict(os.environ)
-    _kernel_env(work / "kernel", env)
-    env.update(CONTACTFEM_PRESET="fast", CONTACTFEM_FIGURES=str(work / "figures"),
-               CONTACTFEM_SITE_CACHE=str(cache / "notebooks"), MPLBACKEND="module://matplotlib_inline.backend_inline")
-    cmd = [sys.executable, "-m", "sphinx", "-b", "html", "-W", "--keep-going", "-q",
-           "-d", str(cache / "doctrees"), str(src), str(out)]   # read pages live with the cache
-    proc = subprocess.run(cmd, env=env, cwd=str(src), capture_output=quiet, text=True)
-    if proc.returncode != 0:
-        msg = (proc.stdout or "")[-6000:] + (proc.stderr or "")[-6000:] if quiet else ""
-        raise RuntimeError(f"the site build failed (Sphinx exit code {proc.returncode}):\n{msg}")
-    scrub(out, {work.resolve(): "$CONTACTFEM_CACHE/site", work: "$CONTACTFEM_CACHE/site",
-                repo.resolve(): ".", Path.home(): "~"})
+    try:
+        stage(repo, src, instructor=instructor, only=only, work=work / "course")
+        _prepare_cache(cache)
+        env = dict(os.environ)
+        _kernel_env(work / "kernel", env)
+        env.update(CONTACTFEM_PRESET="fast", CONTACTFEM_FIGURES=str(work / "figures"),
+                   CONTACTFEM_SITE_CACHE=str(cache / "notebooks"), MPLBACKEND="module://matplotlib_inline.backend_inline",
+                   JUPYTER_RUNTIME_DIR=str(work / "runtime"), IPYTHONDIR=str(work / "ipython"))
+        if html.exists():                     # what an interrupted build left
+            shutil.rmtree(html)
+        # Sphinx writes into work/html; MyST-NB puts its executed notebooks beside that, in
+        # work/jupyter_execute, and its cache and Sphinx its read pages in work/cache
+        cmd = [sys.executable, "-m", "sphinx", "-b", "html", "-W", "--keep-going", "-q",
+               "-d", str(cache / "doctrees"), str(src), str(html)]
+        proc = subprocess.run(cmd, env=env, cwd=str(src), capture_output=quiet, text=True)
+        if proc.returncode != 0:
+            msg = (proc.stdout or "")[-6000:] + (proc.stderr or "")[-6000:] if quiet else ""
+            raise RuntimeError(f"the site build failed (Sphinx exit code {proc.returncode}):\n{msg}")
+        scrub(html, {(work / "figures").resolve(): "figures", work / "figures": "figures", work.resolve(): WORK,
+                     work: WORK, out.resolve(): ".", repo.resolve(): ".", Path.home(): "~"})
+        with hold_interrupts():               # the new pages replace the old ones together
+            if on_write:
+                on_write()
+            for page in sorted(html.iterdir()):
+                dst = out / page.name
+                if dst.is_dir() and not dst.is_symlink():
+                    shutil.rmtree(dst)
+                elif dst.exists() or dst.is_symlink():
+                    dst.unlink()
+                os.replace(page, dst)
+    finally:                              # keep the cache only: the rest is made again by the next build
+        for part in TRANSIENT:
+            shutil.rmtree(work / part, ignore_errors=True)
     return out / "index.html"

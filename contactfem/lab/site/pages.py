@@ -3,7 +3,9 @@
 ``stage(repo, dst)`` lays out a Sphinx source folder in `dst`: every notebook of
 ``lectures/`` (glob, so a new lecture appears by itself) in its student version (the
 course's build: no solutions, a check cell after each exercise), the hand-written pages and
-the configuration of ``lectures/_site/``, and four generated pages:
+the configuration of ``lectures/_site/``, the student handout (the zip of the student
+version that ``contactfem course build`` writes, linked from the index), and four
+generated pages:
 
 * ``gallery.md``   -- the README's table of the paper's examples, each row with the
   paper's value beside ours and its figures shown (copied from ``figures/``);
@@ -228,24 +230,32 @@ def copy_mathjax(dst):
     return "tex-chtml.js"
 
 
-def stage(repo, dst, instructor=False):
+def stage(repo, dst, instructor=False, only=None, work=None):
     """Lay out the Sphinx source folder `dst` from the repository `repo` (see the module
     docstring): the lectures in their student version (no solutions; with `instructor`,
-    the instructor version), built by :func:`contactfem.lab.course.build`. Returns the
-    list of lecture notebooks staged."""
+    the instructor version), built by :func:`contactfem.lab.course.build_versions`, and the
+    student handout (the zip of the student version) for the index to link. `only`: the
+    lectures (stems) to stage, default all; `work`: a folder for the course build's work
+    (default: beside `dst`). Returns the list of lecture notebooks staged."""
+    from ..course import build_versions
+    from ..course.handout import MANIFEST, STUDENT_ZIP
+
     repo, dst = Path(repo), Path(dst)
+    work = Path(work) if work else dst.parent / f"{dst.name}-course"
     lectures = repo / "lectures"
-    if dst.exists():
-        shutil.rmtree(dst)
+    for folder in (dst, work):
+        if folder.exists():
+            shutil.rmtree(folder)
     dst.mkdir(parents=True)
     shutil.copytree(lectures / "_site", dst, dirs_exist_ok=True)
-    nbs = notebooks(lectures)
-    if not nbs:
+    if not notebooks(lectures):
         raise RuntimeError(f"no notebooks in {lectures}")
-    from ..course import build as course_build
-
-    course_build(dst, instructor=instructor, repo=repo)     # the student (or instructor) version
+    outs = {"instructor": dst, "student": work / "student"} if instructor else {"student": dst}
+    nbs = build_versions(outs, repo=repo, only=only, work=work)["instructor" if instructor else "student"]
+    if instructor:
+        shutil.copy2(work / "student" / STUDENT_ZIP, dst / STUDENT_ZIP)
     shutil.rmtree(dst / "autograder", ignore_errors=True)   # grading configurations: not pages
+    (dst / MANIFEST).unlink(missing_ok=True)
     shutil.copy2(lectures / "README.md", dst / "course.md")
     gallery = gallery_page(repo)
     (dst / "gallery.md").write_text(gallery)
