@@ -175,14 +175,16 @@ def _case(preset, over):
     try:
         r = result(preset, **over)
     except Exception as err:                        # a NewtonError is a row of the table, not hidden
-        return dict(v=f"solver failed ({type(err).__name__})", F=None, p=None)
+        return dict(v=f"solver failed ({type(err).__name__})", F=None, p=None, exit_velocity_m_s=None)
     v = f"{r['exit_velocity_m_s']:.1f}" if r["exited"] else "stays in"
-    return dict(v=v, F=r["press_fit_normal_force_N"], p=r["breakaway_pressure_MPa"])
+    return dict(v=v, F=r["press_fit_normal_force_N"], p=r["breakaway_pressure_MPa"],
+                exit_velocity_m_s=r["exit_velocity_m_s"] if r["exited"] else None)
 
 
-def sensitivity_rows(preset="fast", cases=SENSITIVITY, jobs=2):
-    """One row per case: label, press-fit force, and the outcome for each n_ramp of
-    P0_STEPS; the runs in parallel on `jobs` cores (joblib, if installed; else one by one)."""
+def sensitivity_runs(preset="fast", cases=SENSITIVITY, jobs=2):
+    """The outcome of each case at each n_ramp of P0_STEPS (case, overrides, the run's exit
+    velocity and press-fit force; "v": as the table prints it); the runs in parallel on `jobs`
+    cores (joblib, if installed; else one by one)."""
     todo = [(label, dict(over, n_ramp=n)) for label, over in cases for n in P0_STEPS]
     try:
         from joblib import Parallel, delayed
@@ -190,6 +192,13 @@ def sensitivity_rows(preset="fast", cases=SENSITIVITY, jobs=2):
         out = [_case(preset, over) for _, over in todo]
     else:
         out = Parallel(n_jobs=jobs)(delayed(_case)(preset, over) for _, over in todo)
+    return [dict(x, case=label, overrides=over) for (label, over), x in zip(todo, out)]
+
+
+def sensitivity_rows(preset="fast", cases=SENSITIVITY, jobs=2, runs=None):
+    """One row per case: label, press-fit force, and the outcome for each n_ramp of
+    P0_STEPS (``runs``: sensitivity_runs made before, else made here)."""
+    out = runs or sensitivity_runs(preset, cases, jobs)
     rows = []
     for i, (label, _) in enumerate(cases):
         res = out[i * len(P0_STEPS):(i + 1) * len(P0_STEPS)]
@@ -216,11 +225,11 @@ def table_cork_sensitivity(preset="fast", outdir=None):
 
     path = Path(outdir or default_outdir(preset)) / "table_cork_sensitivity.md"
     path.parent.mkdir(parents=True, exist_ok=True)
-    rows = sensitivity_rows(preset)
-    path.write_text(sensitivity_markdown(rows, preset))
-    data = dict(preset=preset, rows=[dict(case=label, press_fit_normal_force_N=F,
-                                          exit_velocity_m_s=dict(zip((f"{0.1 * n:.1f} MPa" for n in P0_STEPS), vs)))
-                                     for label, F, vs in rows])
+    runs = sensitivity_runs(preset)
+    path.write_text(sensitivity_markdown(sensitivity_rows(preset, runs=runs), preset))
+    data = dict(preset=preset, runs=[dict(case=x["case"], overrides=x["overrides"], exit_velocity_m_s=x["exit_velocity_m_s"],
+                                          outcome=x["v"], press_fit_normal_force_N=x["F"],
+                                          breakaway_pressure_MPa=x["p"]) for x in runs])
     parameters = dict(get_scene("cork").resolve(preset), cases=dict(SENSITIVITY), n_ramp=P0_STEPS)
     return [str(path), write_data(path.with_suffix(".json"), data, parameters)]
 
