@@ -57,12 +57,19 @@ def test_differences_find_a_changed_number_and_ignore_roundoff_and_version():
 
 # -- the committed figures' data against fresh runs ---------------------------------------------
 # Each figure function is called again (paper preset, into a temporary folder) and the NAME.json
-# it writes is compared with figures/NAME.json by plots.data.differences (rtol 1e-8: see
-# plots.data.RTOL). The runs are shared within the session (plots.cached_run; the session's
-# $CONTACTFEM_CACHE is a fresh folder, tests/conftest.py, so nothing comes from an earlier run).
-# FAST: runs that fit in the suite (seconds each, or shared with test_cork / test_published_tables:
-# the paper cork run behind Figs 14-17). SLOW (@pytest.mark.slow, `pytest -m slow`): studies of
-# many runs (minutes each); `contactfem figures --preset paper` makes them all.
+# it writes is compared with figures/NAME.json by plots.data.differences: every number to rtol
+# 1e-8 (plots.data.RTOL: two decades above what another BLAS or summation order can move in a
+# run, four below what a changed parameter or formula moves), keys, lengths, strings and bools
+# exactly; the code version is reported, not compared. The session's $CONTACTFEM_CACHE is a fresh
+# folder (tests/conftest.py): nothing comes from an earlier run; within the session the figures
+# share runs (plots.cached_run) with test_cork, test_published_tables and test_rolling_ring.
+#   FAST: in every run of the suite, seconds each on a quiet machine; the slowest is Figs 14-17's
+#         paper cork run (shared with test_cork and test_published_tables).
+#   SLOW: @pytest.mark.slow, in CI's full run (`python -m pytest -q`; `-m "not slow"` leaves them
+#         out): the studies of many runs. Measured on the shared 2-core machine under a load of
+#         about 12: fig09b (ten ring runs) 56 s, the discretisation study about 2 min, the cork's
+#         sensitivity table (ten cork runs) about 6 min, the knife edge (nine press fits and eight
+#         runs) about 5 min, the full exit-time study (38 cork runs) about 25 min.
 from pathlib import Path  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
