@@ -192,17 +192,16 @@ def block_case_outcome(case, height):
     return "converged"
 
 
-def fig8_remark(conical, parabolic, drop=0.05):
-    """Fig 8's remark at the nodes in the top quartile of the conical normal pressure:
-    fraction of them where the parabolic |t_T| is at least ``drop`` below the conical one,
-    and the smallest relative reduction there."""
+def fig8_remark(conical, parabolic):
+    """Fig 8's remark on the two solves of a reading (``scenes.block_params.fig8_remark``, the
+    measure the figures use): the fraction of the nodes in the top quartile of the conical
+    normal pressure where the parabolic |t_T| is at least 5 % below the conical one, and the
+    smallest relative reduction there."""
+    from ..scenes.block_params import fig8_remark as measure
+
     if not (conical.get("converged") and parabolic.get("converged")):
         return 0.0, float("nan")
-    pN = np.abs(conical["t_N"])
-    top = pN >= np.quantile(pN, 0.75)
-    tc, tp = np.abs(np.asarray(conical["t_T"]))[top], np.abs(np.asarray(parabolic["t_T"]))[top]
-    reduction = 1 - tp / np.maximum(tc, 1e-300)
-    return float(np.mean(reduction >= drop)), float(np.min(reduction))
+    return measure(conical["t_N"], conical["t_T"], parabolic["t_T"])[:2]
 
 
 def score_block(reading, conical, parabolic):

@@ -176,7 +176,11 @@ SCENE = Scene(
     # reconstruction study (no node slips with the conical law)
     presets={"fast": {}, "paper": {},
              "canonical": {"width": 4.0, "height": 3.5, "nx": 20, "ny": 10, "p_x_face": "right", "c_T": 5.0e4,
-                           "plane": "strain"}},
+                           "plane": "strain"},
+             # the best-ranked reading of `contactfem reconstruct block` that shows Fig 8's remark (none
+             # that shows it has Table 1's conical residuals and slip): Fig 8 of it beside the preset's
+             "fig8": {"width": 4.0, "height": 3.0, "nx": 25, "ny": 8, "p_x_face": "right", "free_end_nodes": 1,
+                      "c_N": 1.0e6, "penalty": "per_node", "plane": "strain"}},
     notes=("Read from the scan: E, nu, p_y = 200, p_x = 60, 200 elements, c_T = 1e4, m, the laws, one load step.\n"
            "FITTED to Table 1 (the scan lost them; contactfem reconstruct block ranks every reading): width 4, "
            "height 3.25, 25 x 8 elements, p_x on the left side (it pushes the block: this CONTRADICTS the "

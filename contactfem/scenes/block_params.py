@@ -25,6 +25,8 @@ height 3.5, 20 x 10, p_x on the right side, c_T = 5e4 per length, plane strain; 
 node slips with the conical law) is the preset ``canonical``.
 """
 
+import numpy as np
+
 from ..bodies.materials import MATERIALS
 from ..contact.tangents import TANGENTS
 from ..laws.friction import Coulomb, ParabolicSlip
@@ -164,6 +166,26 @@ def friction_law(params):
     if law == "coulomb":
         return Coulomb(c_T=c_T, mu=params["mu"])
     raise ValueError(f"parameter law = {law!r} is not allowed: one of {'|'.join(LAWS)}")
+
+
+# Fig 8's remark, "a considerable reduction of the frictional stress in the region of higher
+# normal pressure", as a test a reading passes or fails: at every contact node in the top quartile
+# of the conical normal pressure the parabolic |t_T| is at least FIG8_DROP below the conical one
+# (5 %: far above Newton's tolerance and round-off, and below any reduction a reader of the
+# paper's Fig 8 would call considerable).
+FIG8_DROP = 0.05
+
+
+def fig8_remark(t_N_conical, t_T_conical, t_T_parabolic, drop=FIG8_DROP):
+    """Fig 8's remark on the conical and parabolic runs of one reading: (the fraction of the
+    nodes in the top quartile of the conical |t_N| where the parabolic |t_T| is at least ``drop``
+    below the conical one, the smallest relative reduction there, the number of those nodes).
+    The remark holds when the fraction is 1."""
+    pN = np.abs(np.asarray(t_N_conical, dtype=float))
+    top = pN >= np.quantile(pN, 0.75)
+    tc, tp = (np.abs(np.asarray(t, dtype=float))[top] for t in (t_T_conical, t_T_parabolic))
+    reduction = 1 - tp / np.maximum(tc, 1e-300)
+    return float(np.mean(reduction >= drop)), float(np.min(reduction)), int(top.sum())
 
 
 def law_range(params):
