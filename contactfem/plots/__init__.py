@@ -68,16 +68,50 @@ def pyplot():
     return plt
 
 
-@lru_cache(maxsize=64)
-def _cached(scene, preset, changed):
+def cache_dir():
+    """Where the figures keep their runs between processes: $CONTACTFEM_CACHE/figures (default
+    ~/.cache/contactfem/figures)."""
+    return Path(os.environ.get("CONTACTFEM_CACHE") or Path.home() / ".cache" / "contactfem") / "figures"
+
+
+def stored(fn):
+    """``fn`` with its results kept on disk (joblib.Memory in ``cache_dir()``), keyed on its
+    arguments and the hash of the package's sources (plots.data.source_hash): a later process
+    with the same code answers from the disk, a change of the code anywhere runs it again. ``fn``
+    must be a module-level function of JSON-like arguments."""
+    from joblib import Memory
+
+    from .data import source_hash
+
+    kept = Memory(str(cache_dir()), verbose=0).cache(_with_code)
+
+    def call(*args, **kwargs):
+        return kept(fn, source_hash(), args, kwargs)
+    call.__wrapped__ = fn
+    return call
+
+
+def _with_code(fn, code, args, kwargs):
+    """What ``stored`` keeps: fn(*args, **kwargs); ``code`` is only part of the key."""
+    return fn(*args, **kwargs)
+
+
+def _run(scene, preset, changed):
     from ..scenes import run_scene
 
     return run_scene(scene, preset, dict(changed))
 
 
+@lru_cache(maxsize=64)
+def _cached(scene, preset, changed):
+    return stored(_run)(scene, preset, changed)
+
+
 def cached_run(scene, preset="fast", **overrides):
     """A scene's result dict, cached on the resolved parameters: figures, tables and
-    lectures share runs, and an override equal to the preset's value is no new run."""
+    lectures share runs, and an override equal to the preset's value is no new run. Kept in
+    the process and on disk for the same code (``stored``): a second ``contactfem figures``
+    reads the runs of the first."""
     from ..scenes import get_scene
 
     sc = get_scene(scene)

@@ -1,0 +1,163 @@
+"""The numbers behind every figure: ``NAME.json`` beside ``NAME.png``.
+
+A figure function puts what it plots into a dict, its headline numbers under the run's own
+JSON keys (the rolling ring's ``v_final``, the block's ``n_slip``) and the series it draws,
+builds its title and labels from that dict, and hands figure, dict and parameters to
+``save_figure``, which writes both files. Besides the data's own keys the JSON holds:
+
+    figure         the file's stem (NAME)
+    code_version   contactfem's version and a short hash of the package's sources
+                   ("0.1.0+src.1a2b3c4d5e"): the same code gives the same string
+    parameters     the inputs behind the figure (a scene's resolved parameters; for a study,
+                   its grid as well)
+
+``differences`` lists where two such files disagree (a changed number, key or length) to the
+tolerance argued at ``RTOL``; the code version is reported, not compared.
+"""
+
+import hashlib
+import json
+from functools import lru_cache
+from pathlib import Path
+
+RESERVED = ("figure", "code_version", "parameters")
+
+# Two numbers of a figure's data agree to RTOL, relative to the larger of the two or, inside a
+# list, to the largest number of that list (a slip speed of 1e-9 cm/s on a ring rolling at
+# 150 cm/s is zero, not a result). Why 1e-8: a run marches the same model to the same records
+# bit for bit on one machine; another BLAS or summation order moves the last digits (1e-16
+# relative), which the Newton tolerances (1e-10 of the first residual and below) and a few hundred
+# steps can grow to about 1e-10; a changed parameter, law or formula moves the numbers the
+# figures print (3-4 digits) by 1e-4 or more. 1e-8 sits two decades above the first and four
+# below the second.
+RTOL = 1e-8
+# A number below ROUNDOFF in both files is the rounding of a run, not its result (residual
+# norms and equilibrium errors of 1e-12 where the loads are 1e2-1e3); both below it agree.
+ROUNDOFF = 1e-9
+
+
+@lru_cache(maxsize=1)
+def source_hash():
+    """The first 10 hex digits of the SHA-1 of every .py file of the package (paths and
+    contents, in sorted order): any change of the code changes it."""
+    root = Path(__file__).resolve().parents[1]
+    h = hashlib.sha1()
+    for f in sorted(root.rglob("*.py")):
+        h.update(str(f.relative_to(root)).encode())
+        h.update(f.read_bytes())
+    return h.hexdigest()[:10]
+
+
+def code_version():
+    """contactfem's version and the hash of its sources, e.g. "0.1.0+src.1a2b3c4d5e"."""
+    from .. import __version__
+
+    return f"{__version__}+src.{source_hash()}"
+
+
+def dumps(record):
+    """JSON text with one top-level key a line (the series compact), for short diffs."""
+    return "{\n" + ",\n".join(f" {json.dumps(k)}: {json.dumps(v)}" for k, v in record.items()) + "\n}\n"
+
+
+def figure_record(stem, data, parameters):
+    """The dict written to NAME.json: figure, code_version, parameters, then ``data``'s keys
+    (numpy values made plain; a key of RESERVED in ``data`` is a ValueError)."""
+    from ..scenes.base import jsonable
+
+    clash = [k for k in data if k in RESERVED]
+    if clash:
+        raise ValueError(f"figure data of {stem} uses the reserved key(s) {', '.join(clash)}")
+    return dict(figure=stem, code_version=code_version(), parameters=jsonable(parameters or {}),
+                **jsonable(dict(data), where=stem))
+
+
+def write_data(path_json, data, parameters):
+    """Write ``path_json`` (NAME.json) holding ``data`` and ``parameters`` (see the module's
+    docstring); returns its path as a string."""
+    path = Path(path_json)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(dumps(figure_record(path.stem, data, parameters)))
+    return str(path)
+
+
+def save_figure(fig, path_png, data, parameters):
+    """Save the matplotlib figure ``fig`` as ``path_png`` (NAME.png, 110 dpi) and close it, and
+    write NAME.json beside it with the numbers it plots.
+
+    ``data``: dict of what the figure shows, its headline numbers under the run's own JSON keys
+    (e.g. ``v_final``) and the series it draws; numpy arrays and scalars are fine; the keys
+    "figure", "code_version" and "parameters" are reserved. ``parameters``: dict of the inputs
+    behind it (a scene's resolved parameters, a study's grid). Draw titles and labels from
+    ``data``, so the picture and the file say the same. ``fig`` None: only the JSON (a table
+    written as markdown). Returns [png path, json path] (only the JSON's for ``fig`` None)."""
+    path = Path(path_png)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    json_path = write_data(path.with_suffix(".json"), data, parameters)
+    if fig is None:
+        return [json_path]
+    import matplotlib.pyplot as plt
+
+    fig.savefig(path, dpi=110, bbox_inches="tight")
+    plt.close(fig)
+    return [str(path), json_path]
+
+
+def load(path):
+    """A figure's JSON as a dict."""
+    return json.loads(Path(path).read_text())
+
+
+def _scale(values):
+    """The largest |number| in a (nested) list, not looking into dicts."""
+    out = 0.0
+    for v in values:
+        if isinstance(v, list):
+            out = max(out, _scale(v))
+        elif isinstance(v, (int, float)) and not isinstance(v, bool):
+            out = max(out, abs(float(v)))
+    return out
+
+
+def _number_differs(a, b, rtol, scale):
+    a, b = float(a), float(b)
+    if abs(a) < ROUNDOFF and abs(b) < ROUNDOFF:
+        return False
+    return abs(a - b) > rtol * max(abs(a), abs(b), scale)
+
+
+def _compare(a, b, where, rtol, scale, out):
+    if isinstance(a, dict) and isinstance(b, dict):
+        for k in list(a) + [k for k in b if k not in a]:
+            key = f"{where}.{k}" if where else k
+            if not where and k == "code_version":
+                continue
+            if k not in b:
+                out.append(f"{key}: in the file, not from the run")
+            elif k not in a:
+                out.append(f"{key}: not in the file, from the run")
+            else:
+                _compare(a[k], b[k], key, rtol, None, out)
+    elif isinstance(a, list) and isinstance(b, list):
+        if len(a) != len(b):
+            out.append(f"{where}: {len(a)} entries in the file, {len(b)} from the run")
+            return
+        s = _scale(a + b) if scale is None else scale
+        for i, (x, y) in enumerate(zip(a, b)):
+            _compare(x, y, f"{where}[{i}]", rtol, s, out)
+    elif (isinstance(a, (int, float)) and isinstance(b, (int, float))
+          and not isinstance(a, bool) and not isinstance(b, bool)):
+        if _number_differs(a, b, rtol, scale or 0.0):
+            out.append(f"{where}: {a!r} in the file, {b!r} from the run")
+    elif a != b:
+        out.append(f"{where}: {a!r} in the file, {b!r} from the run")
+
+
+def differences(written, fresh, rtol=RTOL):
+    """Where two figure records disagree, one line each ("v_final: 149.2 in the file, 149.3
+    from the run"): a key or a length that differs, a string, bool or None that differs, a
+    number that differs beyond ``rtol`` (see RTOL and ROUNDOFF). ``code_version`` is not
+    compared. [] when they agree."""
+    out = []
+    _compare(written, fresh, "", rtol, None, out)
+    return out
