@@ -113,8 +113,8 @@ def test_the_friction_law_barely_changes_the_normal_stress(results):
     of 50; 1 % is what "small" means against the tractions' spread of tens of percent).
     (Fig 8's remark, a lower friction stress where the pressure is high, is a property of the
     parabolic slip surface at equal pressure: test_laws.py,
-    test_parabolic_lowers_friction_coefficient_at_high_pressure; the block's run does not show it at
-    the highest pressures, see the README.)"""
+    test_parabolic_lowers_friction_coefficient_at_high_pressure; the preset's run does not show it at
+    the highest pressures, the preset fig8 does: test_reconstruct.py and the README.)"""
     c = results["parabolic"]["contact"]
     p_m = 800.0 / 3.4
     mu_m = 0.3 + 0.2 / np.sqrt(p_m)

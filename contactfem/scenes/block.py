@@ -188,7 +188,8 @@ SCENE = Scene(
            "free_end_nodes 2, c_N 1e5 per length, "
            "penalty per_length, plane stress. First residual 171.88 (paper 171.37, +0.30 %: no uniform mesh "
            "reaches the printed digits); conical 4 residuals with slip, parabolic 7 (paper 4 and 7). "
-           "Fig 8's remark is reproduced by no block-shaped reading."),
+           "Fig 8's remark is shown by no reading that meets Table 1's conical facts (4 residuals, nodes "
+           "slipping); preset fig8, a reading without them, shows it."),
     reports=("newton_residuals", "iterations", "total_normal", "total_tangential", "equilibrium_error",
              "n_stick", "n_slip", "contact"),
     check=check,

@@ -18,9 +18,11 @@ best readings (module ``contactfem.lab.reconstruct``):
     per unit length, plane stress.
 
 With it the conical law needs 4 residuals (paper: 4) and 2 nodes slip; the parabolic
-law 7 (paper: 7). Fig 8's remark (lower friction where the pressure is highest) is
-not reproduced by any block-shaped reading: the highest pressure sits at the far
-corner, where the nodes stick under both laws. The earlier canonical choice (width 4,
+law 7 (paper: 7). Fig 8's remark (lower friction where the pressure is highest) is shown
+by no reading that meets Table 1's conical facts (4 residuals, nodes slipping): the highest
+pressure sits at the far corner, where the nodes stick under both laws. A reading without
+them shows it (preset ``fig8``: 4 x 3, 25 x 8, p_x pulling on the right side, 1 free end node,
+c_N = 1e6 per node, plane strain; ``fig8_remark`` measures it). The earlier canonical choice (width 4,
 height 3.5, 20 x 10, p_x on the right side, c_T = 5e4 per length, plane strain; no
 node slips with the conical law) is the preset ``canonical``.
 """
