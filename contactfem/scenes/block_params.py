@@ -80,9 +80,9 @@ PARAMS = (
               "paper's 'pulled')"),
     Param("c_N", 1.0e5, "F/L^2", 0.0, low_open=True,
           doc="normal penalty per unit length (eq 4). The scan lost it (it reads 'lo*', 10^2 if '*' is a garbled "
-              "superscript 2); 1e5 FITTED to Table 1 (contactfem reconstruct block). It gives a largest "
-              "penetration of 7.1e-3 at the corner where the pressure peaks (the run reports max_penetration), "
-              "two orders below the elastic settlement"),
+              "superscript 2); 1e5 FITTED to Table 1 (contactfem reconstruct block). The largest penetration, "
+              "|t_N| / c_N (eq 4) at the corner where the pressure peaks (the run reports max_penetration), stays "
+              "below 2 % of the block's elastic settlement p_y height / E"),
     Param("penalty", "per_length", choices=PENALTIES,
           doc=PENALTY_DOC + " (here converted to per length by the bottom element length width/nx; the scan "
               "gives no unit; per_length FITTED)"),
