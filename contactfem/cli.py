@@ -116,11 +116,11 @@ def cmd_run(args):
     overrides, laws, notes = laws_from_args(args)      # law.NAME=... go to --friction / --normal
     params = scene.resolve(args.preset, overrides)
     out = Outputs()                                   # every output checked before the run
-    if args.json:
+    if args.json is not None:                         # (an empty name is refused, not skipped)
         out.add("--json", args.json, (".json",))
-    if args.save:
+    if args.save is not None:
         out.add("--save", args.save, (".json", ".npz"))
-    if args.gif:
+    if args.gif is not None:
         out.add("--gif", args.gif, (".gif", ".mp4"))
         if not scene.outlines:
             animated = ", ".join(n for n, s in scenes.all_scenes().items() if s.outlines)
@@ -149,15 +149,15 @@ def cmd_run(args):
         res["import_time_s"] = _CLOCK["imported"][0] + _CLOCK["own"]
     _RUN["phase"] = "write"
     with out:                                         # temporaries first, then all renamed at once
-        if args.json:
+        if args.json is not None:
             import json
 
             out.temp("--json").write_text(json.dumps(res, indent=1, allow_nan=False))
-        if args.save:
+        if args.save is not None:
             from .io import as_arrays, save_run
 
             save_run(as_arrays(res), out.temp("--save"))
-        if args.gif:
+        if args.gif is not None:
             write_animation(res, out.temp("--gif"))
         out.commit()
     _RUN["phase"] = "done"
@@ -213,7 +213,7 @@ def cmd_figures(args):
     from .io.outputs import check_output_dir
     from .plots import default_outdir
 
-    check_output_dir(args.outdir or default_outdir(args.preset), "--outdir")       # before anything heavy
+    check_output_dir(default_outdir(args.preset) if args.outdir is None else args.outdir, "--outdir")  # before anything heavy
     from .lab.bench import figures as _bench  # noqa: F401  (registers the bench figures)
     from .plots import load_all, make_all
 
@@ -289,7 +289,11 @@ def _course_layer():
 
 
 def cmd_course_build(args):
+    from .io.outputs import check_output_dir
+
     course = _course_layer()
+    if args.out is not None:
+        check_output_dir(args.out, "--out")
     out = course.check_out_dir(args.out or course.default_out(args.instructor))
     written = course.build(out, instructor=args.instructor)
     version = "instructor (solutions, check cells, autograder/)" if args.instructor else "student (no solutions)"
@@ -299,7 +303,10 @@ def cmd_course_build(args):
 def cmd_course_grade(args):
     import time
 
+    from .io.outputs import check_output_path, make_parents
+
     course = _course_layer()
+    make_parents(check_output_path(args.out, "--out", (".csv",)))     # the table's folder, as every output's
     t0 = time.perf_counter()
     rows = course.grade(args.folder, args.out, autograders=args.autograders, jobs=args.jobs)
     graded = sum(1 for r in rows if not r["notes"].startswith("not graded"))
@@ -310,7 +317,7 @@ def cmd_site(args):
     from .io.outputs import check_output_dir
     from .lab.site import build, default_out
 
-    check_output_dir(args.out or default_out(args.instructor), "--out")
+    check_output_dir(default_out(args.instructor) if args.out is None else args.out, "--out")
     try:
         index = build(args.out, instructor=args.instructor)
     except RuntimeError as err:                    # Sphinx's own messages, then one line of ours
@@ -327,7 +334,7 @@ def cmd_site(args):
 def cmd_reconstruct(args):
     from .io.outputs import check_output_path
 
-    if args.json:
+    if args.json is not None:
         check_output_path(args.json, "--json", (".json",))      # before anything heavy
     from .lab.reconstruct import main as reconstruct
 
@@ -347,7 +354,7 @@ def cmd_bench(args):
 
     from .io.outputs import check_output_dir
 
-    out = args.out or ("bench-quick" if args.quick else ".")
+    out = ("bench-quick" if args.quick else ".") if args.out is None else args.out
     if Path(out).exists() and not Path(out).is_dir():
         raise ValueError(f"--out {out}: is a file; give a folder (it gets bench.json and BENCHMARKS.md)")
     check_output_dir(out, "--out")

@@ -709,7 +709,10 @@ def main(scene, quick=False, top=25, json_path=None, cache=True):
                    text=SLOPING_TEXT, readings=rows)
     else:
         raise ValueError(f"parameter scene = {scene!r} is not allowed: one of block|sloping_impact")
-    if json_path:
+    if json_path is not None:
+        from ..io.outputs import make_parents
+
+        make_parents(json_path)
         with open(json_path, "w") as fh:
             json.dump(_finite(out), fh, indent=1)
     return rows
