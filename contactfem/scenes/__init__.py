@@ -82,7 +82,13 @@ def run_scene(name, preset="fast", overrides=None, progress=None, friction=None,
     from ..laws.protocol import as_normal_law, describe
     from ..solver.assembly import KINDS
 
+    from .base import check_overrides
+
     scene = get_scene(name)
+    overrides = check_overrides(overrides)
+    if progress is not None and not callable(progress):
+        raise TypeError(f"parameter progress must be None or a callable progress(t0, t_end, label) (e.g. "
+                        f"contactfem.io.progress_bar), got {type(progress).__name__} {progress!r}")
     laws = {k: v for k, v in (("friction", friction), ("normal", normal)) if v is not None}
     check_laws(scene, laws, overrides)
     params = scene.resolve(preset, overrides)

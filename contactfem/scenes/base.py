@@ -86,6 +86,22 @@ def run(scene, params, normal=None, friction=None, progress=None, linear_algebra
     return results
 
 
+def check_overrides(overrides):
+    """``overrides`` as a dict (None: no overrides); TypeError naming it unless it is a mapping of
+    parameter names to values (e.g. {"nx": 12})."""
+    from collections.abc import Mapping
+
+    if overrides is None:
+        return {}
+    if not isinstance(overrides, Mapping):
+        raise TypeError(f"parameter overrides must be a dict of parameter name -> value (e.g. {{'nx': 12}}), got "
+                        f"{type(overrides).__name__} {overrides!r}"[:200])
+    bad = [k for k in overrides if not isinstance(k, str)]
+    if bad:
+        raise TypeError(f"parameter overrides: the names must be strings, got {bad[0]!r}")
+    return dict(overrides)
+
+
 @dataclass(frozen=True)
 class Scene:
     name: str
@@ -125,7 +141,7 @@ class Scene:
         known = {p.name: p for p in self.params}
         values = {p.name: p.default for p in self.params}
         values.update(self.presets.get(preset, {}))
-        overrides = dict(overrides or {})
+        overrides = check_overrides(overrides)
         for k, v in overrides.items():
             if k not in known:
                 head, dot, field = str(k).partition(".")
