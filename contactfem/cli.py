@@ -428,7 +428,11 @@ def build_parser():
     rp.add_argument("--force", action="store_true",
                     help="run even if the estimated size exceeds the limits (2 GB, 1e6 unknowns, 1e6 steps)")
     rp.set_defaults(func=cmd_run)
-    fp = sub.add_parser("figures", help="regenerate every figure and table of the paper (--preset paper: into figures/; the default fast preset: into figures/fast/)")
+    fp = sub.add_parser("figures", help="regenerate every figure and table of the paper, each with NAME.json beside it (the "
+                                        "numbers it plots, its parameters and the code version); --preset paper: into "
+                                        "figures/; the default fast preset: into figures/fast/. The runs are kept in "
+                                        "$CONTACTFEM_CACHE/figures (default ~/.cache/contactfem/figures) and reused by the "
+                                        "same code")
     fp.add_argument("--preset", default="fast", choices=["fast", "paper"])
     fp.add_argument("--outdir", default=None,
                     help="default: the repo's figures/ folder for --preset paper (the figures kept with the code), "

@@ -53,3 +53,80 @@ def test_differences_find_a_changed_number_and_ignore_roundoff_and_version():
     del extra["x"]
     assert D.differences(a, extra) == ["x: in the file, not from the run", "new: not in the file, from the run"]
     assert D.differences(a, dict(a, v_final=149.3 * (1 + 1e-7))) != []
+
+
+# -- the committed figures' data against fresh runs ---------------------------------------------
+# Each figure function is called again (paper preset, into a temporary folder) and the NAME.json
+# it writes is compared with figures/NAME.json by plots.data.differences (rtol 1e-8: see
+# plots.data.RTOL). The runs are shared within the session (plots.cached_run; the session's
+# $CONTACTFEM_CACHE is a fresh folder, tests/conftest.py, so nothing comes from an earlier run).
+# FAST: runs that fit in the suite (seconds each, or shared with test_cork / test_published_tables:
+# the paper cork run behind Figs 14-17). SLOW (@pytest.mark.slow, `pytest -m slow`): studies of
+# many runs (minutes each); `contactfem figures --preset paper` makes them all.
+from pathlib import Path  # noqa: E402
+
+REPO = Path(__file__).resolve().parents[1]
+FIGURES = REPO / "figures"
+FAST = ("bench_cost", "bench_speed", "bench_tangents", "bench_work_precision",
+        "fig01_true_contact_area", "fig02_force_vs_microdisplacement", "fig03_shear_vs_normal",
+        "fig04_parabolic_slip_surface", "fig06_block_mesh_deformed", "fig07_block_conical_stresses",
+        "fig08_block_parabolic_stresses", "table1_block_newton_residuals", "fig09_rolling_ring",
+        "fig10_sloping_impact_frictionless", "fig11a_sloping_impact_frictional",
+        "fig11b_sloping_impact_viscoplastic", "table2_sloping_impact", "fig12_funnel_frictionless",
+        "fig13_funnel_frictional", "fig14_cork_mesh", "fig15_cork_configurations", "fig16_cork_pressure",
+        "fig17_cork_displacement", "verif_bar_impact", "verif_hertz_pressure", "verif_hertz_refinement",
+        "verif_patch")
+SLOW = ("fig09b_rolling_ring_convergence", "table_sloping_impact_discretisation", "table_cork_sensitivity",
+        "cork_knife_edge", "cork_exit_time")
+# the committed exit-time study is the full one (every case); the others are the default profiles
+SLOW_ENV = {"cork_exit_time": "1"}
+
+
+def registry():
+    from contactfem.lab.bench import figures as _bench  # noqa: F401  (registers the bench figures)
+    from contactfem.plots import load_all
+
+    return load_all()
+
+
+def fresh_data(stem, folder, monkeypatch):
+    """Draw figure ``stem`` again (paper preset) into ``folder``; its NAME.json as a dict."""
+    if stem in SLOW_ENV:
+        monkeypatch.setenv("CONTACTFEM_SLOW", SLOW_ENV[stem])
+    else:
+        monkeypatch.delenv("CONTACTFEM_SLOW", raising=False)
+    monkeypatch.delenv("CONTACTFEM_BENCH", raising=False)
+    registry()[stem][1](preset="paper", outdir=str(folder))
+    return D.load(Path(folder) / f"{stem}.json")
+
+
+def assert_same_data(stem, folder, monkeypatch):
+    written = D.load(FIGURES / f"{stem}.json")
+    fresh = fresh_data(stem, folder, monkeypatch)
+    problems = D.differences(written, fresh)
+    env = f"CONTACTFEM_SLOW={SLOW_ENV[stem]} " if stem in SLOW_ENV else ""
+    assert not problems, (
+        f"figures/{stem}.json (code {written['code_version']}) is not what the code computes today (code "
+        f"{fresh['code_version']}), {len(problems)} difference(s); regenerate it with "
+        f"`{env}contactfem figures --preset paper --only {stem}`:\n  " + "\n  ".join(problems[:20]))
+
+
+def test_every_figure_has_committed_data_and_a_test():
+    stems = set(registry()) - {"summary"}               # summary.md: tests/test_summary.py
+    assert set(FAST) | set(SLOW) == stems and not set(FAST) & set(SLOW)
+    missing = [s for s in sorted(stems) if not (FIGURES / f"{s}.json").exists()]
+    assert not missing, f"no committed data for {missing}: `contactfem figures --preset paper`"
+    for s in sorted(stems):
+        d = D.load(FIGURES / f"{s}.json")
+        assert d["figure"] == s and d["code_version"].startswith("0.") and isinstance(d["parameters"], dict)
+
+
+@pytest.mark.parametrize("stem", FAST)
+def test_committed_figure_data_is_a_fresh_run(stem, tmp_path, monkeypatch):
+    assert_same_data(stem, tmp_path, monkeypatch)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("stem", SLOW)
+def test_committed_study_data_is_a_fresh_run(stem, tmp_path, monkeypatch):
+    assert_same_data(stem, tmp_path, monkeypatch)

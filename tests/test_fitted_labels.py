@@ -2,6 +2,8 @@
 values, taken from the run's JSON (``fitted``), in its title or a label. The figures are drawn
 here (fast preset, into a temporary folder) and their text is read before saving."""
 
+from pathlib import Path
+
 import matplotlib
 import pytest
 
@@ -26,12 +28,12 @@ def drawn(monkeypatch, tmp_path):
     seen = {}
 
     def capture(module):
-        real = module.savefig
+        real = module.save_figure
 
-        def save(fig, outdir, stem):
-            seen[stem] = _texts(fig)
-            return real(fig, str(tmp_path), stem)
-        monkeypatch.setattr(module, "savefig", save)
+        def save(fig, path_png, data, parameters):
+            seen[Path(path_png).stem] = _texts(fig)
+            return real(fig, tmp_path / Path(path_png).name, data, parameters)
+        monkeypatch.setattr(module, "save_figure", save)
     capture(block)
     capture(sloping_impact)
     return seen

@@ -26,17 +26,24 @@ def test_summary_has_one_row_per_example():
     assert "--preset paper" in (REPO / "figures" / "summary.md").read_text()
 
 
-def test_ours_is_computed_from_the_run(monkeypatch):
-    # change what the block run returns: the row changes with it (nothing typed)
-    def fake(scene, preset="fast", law="conical", **kw):
-        assert scene == "block"
-        return dict(newton_residuals=[171.37, 3.2, 4e-12] if law == "conical" else [171.37] + [1.0] * 6,
-                    n_slip=7 if law == "conical" else 9, equilibrium_error=3e-13, total_normal=-123.0,
-                    total_tangential=45.0)
-    monkeypatch.setattr(S, "cached_run", fake)
-    row = S.row_table1("paper")
+def test_ours_is_computed_from_the_figures_data():
+    # change the figures' data: the row changes with it (nothing typed)
+    data = {"fig07_block_conical_stresses": dict(n_slip=7, equilibrium_error=3e-13, total_normal=-123.0,
+                                                 total_tangential=45.0),
+            "table1_block_newton_residuals": dict(conical=[171.37, 3.2, 4e-12], parabolic=[171.37] + [1.0] * 6)}
+    row = S.row_table1("paper", data.get)
     assert "conical 3 (7 nodes slip), parabolic 7" in row[3] and "first 171.37" in row[3]
-    assert "(123 down, 45 along)" in S.row_block_equilibrium("paper")[3]
+    assert "(123 down, 45 along)" in S.row_block_equilibrium("paper", data.get)[3]
+
+
+def test_readme_table_is_the_committed_figures_data():
+    """The README's table (and summary.md) made again from the JSON files beside the committed
+    figures: every "ours" cell is a number the figures carry (test_figure_data keeps those
+    files equal to fresh runs)."""
+    readme = S.table_lines((REPO / "README.md").read_text(), prefix="figures/")
+    assert readme == S.summary_table("paper", S.committed(REPO / "figures")), (
+        "README.md's table is not what figures/*.json hold: regenerate with `contactfem figures --preset paper` "
+        "and copy it with `python -m contactfem.plots.summary`")
 
 
 def test_update_readme_round_trip(tmp_path):

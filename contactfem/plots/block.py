@@ -23,7 +23,8 @@ import numpy as np
 from ..scenes.block import SCENE, solve
 from ..scenes.block_params import FIG8_DROP, PAPER_TABLE1, PAPER_TABLE1_UNCERTAIN, fig8_remark
 from ..solver.newton import NewtonError
-from . import cached_run, default_outdir, describe_newton, figure, fitted_words, pyplot, savefig
+from . import cached_run, default_outdir, describe_newton, figure, fitted_words, pyplot, savefig  # noqa: F401
+from .data import save_figure
 
 STATE_COLORS = {"stick": "tab:blue", "slip": "tab:red", "open": "0.6"}
 
@@ -81,8 +82,10 @@ def fig06(preset="fast", outdir=None, law="conical", params=None, body=None, rec
         sel = rep["state"] == state
         if sel.any():
             ax.plot(rep["x"][sel, 0], rep["x"][sel, 1], "o", ms=4, color=color, label=state)
+    data = dict(law=law, X=X, x=x, max_displacement=float(np.linalg.norm(u[body.xdofs], axis=1).max()),
+                contact=dict(X=Xs, x=rep["x"], state=[str(v) for v in rep["state"]]))
     ax.set_title(f"deformed ({law} law), displacements at true scale (x1):\nmax |u| = "
-                 f"{np.linalg.norm(u[body.xdofs], axis=1).max():.2f}; grey: undeformed", fontsize=9)
+                 f"{data['max_displacement']:.2f}; grey: undeformed", fontsize=9)
     ax.legend(loc="lower left", fontsize=8)
     for ax in axes:
         ax.axhline(0.0, color="k", lw=2.5)
@@ -92,7 +95,17 @@ def fig06(preset="fast", outdir=None, law="conical", params=None, body=None, rec
         ax.set_aspect("equal")
     fig.suptitle("Fig 6: elastic block on a rigid rough foundation, whole load in one step", fontsize=10)
     fig.tight_layout()
-    return [savefig(fig, outdir or default_outdir(preset), "fig06_block_mesh_deformed")]
+    return save_figure(fig, Path(outdir or default_outdir(preset)) / "fig06_block_mesh_deformed.png", data, P)
+
+
+STRESS_KEYS = ("total_normal", "total_tangential", "equilibrium_error", "n_slip", "n_stick", "n_open", "fitted")
+
+
+def stress_data(r):
+    """What Figs 7 and 8 draw of a block run: STRESS_KEYS and the contact side's x, t_N, t_T,
+    slip bound and states."""
+    return dict({k: r.get(k) for k in STRESS_KEYS},
+                contact={k: r["contact"][k] for k in ("x", "t_N", "t_T", "slip_bound", "state")})
 
 
 def draw_stresses(ax, r, label="", style="-", faint=False):
@@ -136,7 +149,8 @@ def fig07(preset="fast", outdir=None, r=None):
                      f"(n = 1, alpha + beta = {P['alpha'] + P['beta']:g})\n"
                      f"sum |t_N| w = {-r['total_normal']:.6g}, sum t_T w = {r['total_tangential']:.6g}; "
                      + slip_words(r) + _fitted_line(r))
-    return [savefig(fig, outdir or default_outdir(preset), "fig07_block_conical_stresses")]
+    return save_figure(fig, Path(outdir or default_outdir(preset)) / "fig07_block_conical_stresses.png",
+                       stress_data(r), P)
 
 
 @figure("fig08_block_parabolic_stresses", "Fig 8")
@@ -153,7 +167,8 @@ def fig08(preset="fast", outdir=None, r=None, conical=None):
     _stress_axes(ax, "Fig 8: stresses on the contact area, parabolic slip surface "
                      f"(n = {P['n']:g}, alpha = {P['alpha']:g}, beta = {P['beta']:g})\n"
                      f"{slip_words(r)}; grey: the conical case (Fig 7)" + _fitted_line(r))
-    return [savefig(fig, outdir or default_outdir(preset), "fig08_block_parabolic_stresses")]
+    return save_figure(fig, Path(outdir or default_outdir(preset)) / "fig08_block_parabolic_stresses.png",
+                       dict(stress_data(r), conical=stress_data(rc)), P)
 
 
 def fig8_reading_data(preset="fast", other="fig8"):
@@ -325,4 +340,5 @@ def table1(preset="fast", outdir=None, results=None):
     ax.legend(fontsize=7)
     ax.set_title("Table 1: residual norm per Newton iteration, whole load in one step"
                  + _fitted_line(dict(fitted=hist["fitted"])), fontsize=9)
-    return [str(md), savefig(fig, outdir, "table1_block_newton_residuals")]
+    data = {k: v for k, v in hist.items() if k != "parameters"}
+    return [str(md), *save_figure(fig, Path(outdir) / "table1_block_newton_residuals.png", data, hist["parameters"])]

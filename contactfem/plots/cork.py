@@ -19,12 +19,26 @@ axis to show the whole cork and both sides of the neck.
 
 
 import os
+from pathlib import Path
 
 import numpy as np
 
 from ..contact.masters import bottle_neck
-from ..scenes.base import jsonable
-from . import cached_run, default_outdir, figure, pyplot, savefig
+from . import cached_run, default_outdir, figure, pyplot, stored
+from .data import save_figure, write_data
+
+# the cork run's headline numbers, in the data of each of Figs 14-17 (the summary's row reads them)
+CORK_KEYS = ("exited", "exit_time_ms", "exit_velocity_m_s", "press_fit_normal_force_N", "press_fit_calibrated",
+             "breakaway_pressure_static_MPa", "applied_pressure_MPa", "breakaway_margin_MPa")
+
+
+def cork_data(r, *keys):
+    """CORK_KEYS and ``keys`` of a cork result ``r``."""
+    return {k: r.get(k) for k in CORK_KEYS + keys}
+
+
+def _save(fig, r, outdir, preset, stem, data):
+    return save_figure(fig, Path(outdir or default_outdir(preset)) / f"{stem}.png", data, r["parameters"])
 
 
 def result(preset="fast", **overrides):
@@ -78,7 +92,8 @@ def fig14_cork_mesh(preset="fast", outdir=None, r=None):
         ax.set_xlabel("r (mm)")
     axes[0].set_ylabel("z (mm)")
     fig.suptitle(f"Fig 14: the cork (axisymmetric, the meridian mirrored; R_tip = {r['parameters']['R_tip']:g} mm)")
-    return [savefig(fig, outdir or default_outdir(preset), "fig14_cork_mesh")]
+    return _save(fig, r, outdir, preset, "fig14_cork_mesh",
+                 dict(cork_data(r, "n_elements"), x_free=mesh.p.T, x_pressed=r["snapshots_x"][0]))
 
 
 @figure("fig15_cork_configurations", "Fig 15")
@@ -100,7 +115,8 @@ def fig15_cork_configurations(preset="fast", outdir=None, r=None):
     v = r["exit_velocity_m_s"]
     fig.suptitle("Fig 15: the cork leaving the bottle"
                  + (f"; exit velocity {v:.1f} m/s (paper ~28 m/s)" if v is not None else "; it did not leave"))
-    return [savefig(fig, outdir or default_outdir(preset), "fig15_cork_configurations")]
+    return _save(fig, r, outdir, preset, "fig15_cork_configurations",
+                 cork_data(r, "snapshot_times_ms", "snapshot_paper_times_ms", "snapshots_x"))
 
 
 @figure("fig16_cork_pressure", "Fig 16")
@@ -120,7 +136,9 @@ def fig16_cork_pressure(preset="fast", outdir=None, r=None):
     ax.set_ylabel("p (MPa)")
     ax.set_title("Fig 16: the pressure on the cork")
     ax.legend(fontsize=8)
-    return [savefig(fig, outdir or default_outdir(preset), "fig16_cork_pressure")]
+    return _save(fig, r, outdir, preset, "fig16_cork_pressure",
+                 dict(cork_data(r, "gas_release_time_ms", "time_ms", "pressure_MPa"),
+                      boyle_pressure_MPa=p0 * gas / (gas + L)))
 
 
 @figure("fig17_cork_displacement", "Fig 17")
@@ -136,7 +154,8 @@ def fig17_cork_displacement(preset="fast", outdir=None, r=None):
     ax.set_ylabel("axial displacement (mm)")
     ax.set_title("Fig 17: the displacement of the cork")
     ax.legend(fontsize=8)
-    return [savefig(fig, outdir or default_outdir(preset), "fig17_cork_displacement")]
+    return _save(fig, r, outdir, preset, "fig17_cork_displacement",
+                 cork_data(r, "time_ms", "displacement_bottom_mm", "displacement_cm_mm", "displacement_top_mm"))
 
 
 # The sensitivity study of lecture 08: one reconstructed datum changed at a time, each
@@ -156,14 +175,16 @@ def _case(preset, over):
     try:
         r = result(preset, **over)
     except Exception as err:                        # a NewtonError is a row of the table, not hidden
-        return dict(v=f"solver failed ({type(err).__name__})", F=None, p=None)
+        return dict(v=f"solver failed ({type(err).__name__})", F=None, p=None, exit_velocity_m_s=None)
     v = f"{r['exit_velocity_m_s']:.1f}" if r["exited"] else "stays in"
-    return dict(v=v, F=r["press_fit_normal_force_N"], p=r["breakaway_pressure_MPa"])
+    return dict(v=v, F=r["press_fit_normal_force_N"], p=r["breakaway_pressure_MPa"],
+                exit_velocity_m_s=r["exit_velocity_m_s"] if r["exited"] else None)
 
 
-def sensitivity_rows(preset="fast", cases=SENSITIVITY, jobs=2):
-    """One row per case: label, press-fit force, and the outcome for each n_ramp of
-    P0_STEPS; the runs in parallel on `jobs` cores (joblib, if installed; else one by one)."""
+def sensitivity_runs(preset="fast", cases=SENSITIVITY, jobs=2):
+    """The outcome of each case at each n_ramp of P0_STEPS (case, overrides, the run's exit
+    velocity and press-fit force; "v": as the table prints it); the runs in parallel on `jobs`
+    cores (joblib, if installed; else one by one)."""
     todo = [(label, dict(over, n_ramp=n)) for label, over in cases for n in P0_STEPS]
     try:
         from joblib import Parallel, delayed
@@ -171,6 +192,13 @@ def sensitivity_rows(preset="fast", cases=SENSITIVITY, jobs=2):
         out = [_case(preset, over) for _, over in todo]
     else:
         out = Parallel(n_jobs=jobs)(delayed(_case)(preset, over) for _, over in todo)
+    return [dict(x, case=label, overrides=over) for (label, over), x in zip(todo, out)]
+
+
+def sensitivity_rows(preset="fast", cases=SENSITIVITY, jobs=2, runs=None):
+    """One row per case: label, press-fit force, and the outcome for each n_ramp of
+    P0_STEPS (``runs``: sensitivity_runs made before, else made here)."""
+    out = runs or sensitivity_runs(preset, cases, jobs)
     rows = []
     for i, (label, _) in enumerate(cases):
         res = out[i * len(P0_STEPS):(i + 1) * len(P0_STEPS)]
@@ -192,13 +220,18 @@ def sensitivity_markdown(rows, preset):
 
 @figure("table_cork_sensitivity", "Sec 5.5")
 def table_cork_sensitivity(preset="fast", outdir=None):
-    """Markdown table of the exit velocity against the reconstructed data."""
-    from pathlib import Path
+    """Markdown table of the exit velocity against the reconstructed data (and its numbers, .json)."""
+    from ..scenes import get_scene
 
     path = Path(outdir or default_outdir(preset)) / "table_cork_sensitivity.md"
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(sensitivity_markdown(sensitivity_rows(preset), preset))
-    return [str(path)]
+    runs = sensitivity_runs(preset)
+    path.write_text(sensitivity_markdown(sensitivity_rows(preset, runs=runs), preset))
+    data = dict(preset=preset, runs=[dict(case=x["case"], overrides=x["overrides"], exit_velocity_m_s=x["exit_velocity_m_s"],
+                                          outcome=x["v"], press_fit_normal_force_N=x["F"],
+                                          breakaway_pressure_MPa=x["p"]) for x in runs])
+    parameters = dict(get_scene("cork").resolve(preset), cases=dict(SENSITIVITY), n_ramp=P0_STEPS)
+    return [str(path), write_data(path.with_suffix(".json"), data, parameters)]
 
 
 # The knife's edge. The static breakaway margin needs only the press fit (a few seconds a
@@ -225,7 +258,7 @@ def _margin_case(preset, over):
     from ..scenes.cork import press_fit_only
 
     try:
-        return dict(over, **press_fit_only(get_scene("cork").resolve(preset, over)), error=None)
+        return dict(over, **stored(press_fit_only)(get_scene("cork").resolve(preset, over)), error=None)
     except Exception as err:                        # a failed press fit is a point of the figure, not hidden
         return dict(over, breakaway_margin_MPa=None, error=type(err).__name__)
 
@@ -323,13 +356,10 @@ def cork_knife_edge(preset="fast", outdir=None, data=None):
     fig.suptitle(f"The cork's knife edge (preset {d['preset']}: the paper's mesh and press fit). "
                  "The press-fit force is fitted through R_tip", fontsize=10)
     fig.tight_layout()
-    import json
-    from pathlib import Path
+    from ..scenes import get_scene
 
-    out = Path(outdir or default_outdir(preset))
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "cork_knife_edge.json").write_text(json.dumps(jsonable(d), indent=1))   # the data, to redraw
-    return [savefig(fig, str(out), "cork_knife_edge"), str(out / "cork_knife_edge.json")]
+    return save_figure(fig, Path(outdir or default_outdir(preset)) / "cork_knife_edge.png", d,
+                       dict(get_scene("cork").resolve(d["preset"]), grid=knife_grid()))
 
 
 # The exit time. The paper reports the exit "between 2.6 and 2.7 ms"; what moves ours? The
@@ -426,11 +456,16 @@ def _exit_key(case, preset):
     return json.dumps([preset, case], sort_keys=True)
 
 
+def stored_exit_case(case, preset=EXIT_PRESET):
+    """``exit_case``, kept on disk for the same code (plots.stored)."""
+    return stored(exit_case)(case, preset)
+
+
 def cached_exit_case(case, preset=EXIT_PRESET):
     """``exit_case``, run once per process for each case and preset (a copy of the row)."""
     key = _exit_key(case, preset)
     if key not in _EXIT_RUNS:
-        _EXIT_RUNS[key] = exit_case(case, preset)
+        _EXIT_RUNS[key] = stored_exit_case(case, preset)
     return dict(_EXIT_RUNS[key])
 
 
@@ -442,9 +477,9 @@ def exit_time_data(cases=None, jobs=2):
     try:
         from joblib import Parallel, delayed
     except ImportError:
-        rows = [exit_case(c) for c in todo]
+        rows = [stored_exit_case(c) for c in todo]
     else:
-        rows = Parallel(n_jobs=jobs)(delayed(exit_case)(c) for c in todo)
+        rows = Parallel(n_jobs=jobs)(delayed(stored_exit_case)(c) for c in todo)
     _EXIT_RUNS.update({_exit_key(c, EXIT_PRESET): r for c, r in zip(todo, rows)})
     return dict(preset=EXIT_PRESET, slow=cases is EXIT_CASES_SLOW, cases=[cached_exit_case(c) for c in cases])
 
@@ -524,8 +559,7 @@ def cork_exit_time(preset="fast", outdir=None, data=None):
     """Exit time of every case of the study (filled: with the closing step, hollow: without),
     the paper's window shaded; the markdown table and the data beside it. Always the paper
     preset (EXIT_PRESET), whatever `preset`."""
-    import json
-    from pathlib import Path
+    from ..scenes import get_scene
 
     plt = pyplot()
     d = data or exit_time_data()
@@ -562,6 +596,6 @@ def cork_exit_time(preset="fast", outdir=None, data=None):
     fig.tight_layout()
     out = Path(outdir or default_outdir(EXIT_PRESET))
     out.mkdir(parents=True, exist_ok=True)
-    (out / "cork_exit_time.json").write_text(json.dumps(jsonable(d), indent=1))
     (out / "cork_exit_time.md").write_text(exit_time_markdown(d))
-    return [savefig(fig, str(out), "cork_exit_time"), str(out / "cork_exit_time.md"), str(out / "cork_exit_time.json")]
+    png, data = save_figure(fig, out / "cork_exit_time.png", dict(d, summary=s), get_scene("cork").resolve(d["preset"]))
+    return [png, str(out / "cork_exit_time.md"), data]

@@ -11,9 +11,24 @@ Each draws a result it is given (``r=``: a lecture's own time loop) or runs the 
 """
 
 
+from pathlib import Path
+
 import numpy as np
 
-from . import cached_run, default_outdir, figure, pyplot, savefig
+from . import cached_run, default_outdir, figure, pyplot
+from .data import save_figure
+
+# what Figs 12-13 show of a run: the outcome (headline) and the drawn series
+FUNNEL_KEYS = ("variant", "stuck", "v_c_final", "max_deformation", "y_c_start", "y_c_min", "t_y_c_min", "t", "y_c",
+               "v_c", "outline_t", "outlines", "wall")
+
+
+def funnel_data(r):
+    """The numbers a funnel figure draws from a result ``r`` (FUNNEL_KEYS), and its verdict:
+    "sticks" or "rebounds at 0.84 v0" (the summary's row reads the same)."""
+    d = {k: r.get(k) for k in FUNNEL_KEYS}
+    d["verdict"] = "sticks" if r["stuck"] else f"rebounds at {r['v_c_final'] / r['parameters']['v0']:.2f} v0"
+    return d
 
 
 def result(variant, preset="fast", **overrides):
@@ -54,7 +69,7 @@ def draw_funnel(r, title):
     ac2 = ac.twinx()
     ac2.plot(r["t"], r["v_c"], color="tab:red", lw=0.8, label="v_c")
     ac2.set_ylabel("v_c", color="tab:red")
-    ac.set_title(f"stuck = {r['stuck']}; max deformation {r['max_deformation']:.2f} R", fontsize=9)
+    ac.set_title(f"{funnel_data(r)['verdict']}; max deformation {r['max_deformation']:.2f} R", fontsize=9)
     ac.grid(alpha=0.3)
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
@@ -66,7 +81,8 @@ def fig12(preset="fast", outdir=None, r=None):
     r = r or result("frictionless", preset)
     fig = draw_funnel(r, f"Fig 12: ring falling into a funnel, frictionless (funnel wall at "
                          f"{r['parameters']['phi_deg']:g} deg from the vertical: chosen)")
-    return [savefig(fig, outdir or default_outdir(preset), "fig12_funnel_frictionless")]
+    return save_figure(fig, Path(outdir or default_outdir(preset)) / "fig12_funnel_frictionless.png", funnel_data(r),
+                       r["parameters"])
 
 
 @figure("fig13_funnel_frictional", "Fig 13")
@@ -75,4 +91,4 @@ def fig13(preset="fast", outdir=None, r=None):
     p = r["parameters"]
     fig = draw_funnel(r, f"Fig 13: ring falling into a funnel, frictional eq (10): n = {p['n']:g}, "
                          f"alpha = {p['alpha']:g}, beta = {p['beta']:g} (wall at {p['phi_deg']:g} deg: chosen)")
-    return [savefig(fig, outdir or default_outdir(preset), "fig13_funnel_frictional")]
+    return save_figure(fig, Path(outdir or default_outdir(preset)) / "fig13_funnel_frictional.png", funnel_data(r), p)

@@ -9,12 +9,19 @@ need (eqs 3, 6-9, 13); the laws used in computations live in contactfem.laws.
     fig04_parabolic_slip_surface       Fig 4, eq (10) with the return-mapping geometry (eqs 13, 14)
 """
 
+from pathlib import Path
+
 import numpy as np
 
 from ..laws.return_map import return_map
 from ..laws import Coulomb, ParabolicSlip, SlipHardening
 from ..laws.validation import require
-from . import default_outdir, figure, pyplot, savefig
+from . import default_outdir, figure, pyplot
+from .data import save_figure
+
+
+def _save(fig, outdir, preset, stem, data, parameters):
+    return save_figure(fig, Path(outdir or default_outdir(preset)) / f"{stem}.png", data, parameters)
 
 
 # -- formulas of Sec. 2 used only by the figures ------------------------------
@@ -93,15 +100,17 @@ def fig01_true_contact_area(preset="fast", outdir=None):
     plt = pyplot()
     p = np.geomspace(1e-4, 1.0, 200)
     fig, ax = plt.subplots(figsize=(5.0, 4.0))
-    for n, label in ((2 / 3, "n = 2/3 (elastic, Tabor)"), (0.8, "n = 0.8"), (0.9, "n = 0.9 (Kragelski, elastic)"),
-                     (1.0, "n = 1 (plastic, Meyer)")):
-        ax.loglog(p, true_contact_area_ratio(p, n), label=label)
+    ns = ((2 / 3, "n = 2/3 (elastic, Tabor)"), (0.8, "n = 0.8"), (0.9, "n = 0.9 (Kragelski, elastic)"),
+          (1.0, "n = 1 (plastic, Meyer)"))
+    data = dict(p_over_H=p, area_ratio={label: true_contact_area_ratio(p, n) for n, label in ns})
+    for n, label in ns:
+        ax.loglog(p, data["area_ratio"][label], label=label)
     ax.set_xlabel(r"dimensionless pressure $|t_N| / (A H)$")
     ax.set_ylabel(r"true contact area ratio $A_r / A$")
     ax.set_title(r"Fig 1: $A_r/A = (|t_N|/(AH))^n$, eq (3)")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
-    return [savefig(fig, outdir or default_outdir(preset), "fig01_true_contact_area")]
+    return _save(fig, outdir, preset, "fig01_true_contact_area", data, dict(n=[n for n, _ in ns]))
 
 
 def fig02_history(n_up=60, n_back=60):
@@ -120,10 +129,12 @@ def fig02_force_vs_microdisplacement(preset="fast", outdir=None):
     g_stick = mu * p / c_T
     g = fig02_history() * g_stick
     fig, ax = plt.subplots(figsize=(5.5, 4.0))
+    data = dict(g_T_over_g_stick=g / g_stick, t_T_over_mu_p={})
     for law, label in ((Coulomb(c_T=c_T, mu=mu), "Coulomb, eq (11)"),
                        (SlipHardening(c_T=c_T, mu=mu, h=5.0), "slip hardening, h = 5"),
                        (SlipHardening(c_T=c_T, mu=mu, h=-5.0), "slip softening, h = -5")):
         t_T, state, _ = drive_slip_history(law, p, g)
+        data["t_T_over_mu_p"][label] = t_T / (mu * p)
         ax.plot(g / g_stick, t_T / (mu * p), label=label)
     ax.axhline(1.0, color="0.6", lw=0.8, ls=":")
     ax.axhline(-1.0, color="0.6", lw=0.8, ls=":")
@@ -136,7 +147,7 @@ def fig02_force_vs_microdisplacement(preset="fast", outdir=None):
     ax.set_title("Fig 2: tangential force vs micro-displacement")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="lower right")
-    return [savefig(fig, outdir or default_outdir(preset), "fig02_force_vs_microdisplacement")]
+    return _save(fig, outdir, preset, "fig02_force_vs_microdisplacement", data, dict(c_T=c_T, mu=mu, p=p, h=[5.0, -5.0]))
 
 
 @figure("fig03_shear_vs_normal", "Fig 3")
@@ -148,6 +159,8 @@ def fig03_shear_vs_normal(preset="fast", outdir=None):
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(11.0, 4.2), layout="constrained")
     H, tau_0, beta = 1.0, 0.1, 0.2
     p_r = np.linspace(0.02, 1.0, 200) * H
+    data = dict(p_r_over_H=p_r / H, tau_over_H=junction_shear_strength(p_r, tau_0, beta) / H,
+                mu=friction_coefficient(p_r, tau_0, beta))
     a1.plot(p_r / H, junction_shear_strength(p_r, tau_0, beta) / H, label=r"$\tau = \tau_0 + \beta p_r$ (eq 6)")
     a1.set_xlabel(r"real pressure $p_r / H$")
     a1.set_ylabel(r"shear strength $\tau / H$")
@@ -162,6 +175,7 @@ def fig03_shear_vs_normal(preset="fast", outdir=None):
     alpha, beta2 = 0.2, 0.3
     for n in (1.0, 0.8, 0.5):
         Y, _, _ = ParabolicSlip(c_T=1.0, alpha=alpha, beta=beta2, n=n).slip_bound(p, 0 * p)
+        data.setdefault("slip_bound", {})[f"n = {n:g}"] = Y
         a2.plot(p, Y, label=f"n = {n:g}" + (" (Coulomb, eq 11)" if n == 1 else " (eq 10)"))
     a2.set_xlabel(r"normal stress $|t_N|$")
     a2.set_ylabel(r"shear stress $|t_T|$ at slip")
@@ -169,7 +183,9 @@ def fig03_shear_vs_normal(preset="fast", outdir=None):
     a2.grid(True, alpha=0.3)
     a2.legend(fontsize=8)
     fig.suptitle("Fig 3: shear vs normal stress")
-    return [savefig(fig, outdir or default_outdir(preset), "fig03_shear_vs_normal")]
+    data["t_N_abs"] = p
+    return _save(fig, outdir, preset, "fig03_shear_vs_normal", data,
+                 dict(H=H, tau_0=tau_0, beta_junction=beta, alpha=alpha, beta=beta2, n=[1.0, 0.8, 0.5]))
 
 
 def fig04_geometry(law, t_N, t_T_trial):
@@ -223,6 +239,8 @@ def fig04_parabolic_slip_surface(preset="fast", outdir=None):
     ax.set_ylim(-2.0, 2.6)
     ax.set_xlabel(r"normal traction $t_N$ (compression < 0)")
     ax.set_ylabel(r"tangential traction $t_T$")
-    ax.set_title(r"Fig 4: parabolic slip surface, $\alpha = 0.2$, $\beta = 0.3$")
+    ax.set_title(rf"Fig 4: parabolic slip surface, $\alpha = {law.alpha:g}$, $\beta = {law.beta:g}$")
     ax.legend(fontsize=7, loc="lower left")
-    return [savefig(fig, outdir or default_outdir(preset), "fig04_parabolic_slip_surface")]
+    return _save(fig, outdir, preset, "fig04_parabolic_slip_surface", dict(g, t_N_abs=p, slip_bound=Y, coulomb=Yc),
+                 dict(c_T=law.c_T, alpha=law.alpha, beta=law.beta, n=law.n, mu_coulomb=coul.mu, t_N=-2.0,
+                      t_T_trial=1.9))

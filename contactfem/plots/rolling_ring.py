@@ -13,10 +13,13 @@ v* = 150 cm/s, and x(2 s) = 376.5 cm.
 """
 
 
+from pathlib import Path
+
 import numpy as np
 
 from ..scenes.rings import rigid_ring_exact
-from . import cached_run, default_outdir, figure, pyplot, savefig
+from . import cached_run, default_outdir, figure, pyplot
+from .data import save_figure
 
 
 def result(preset="fast", **overrides):
@@ -51,6 +54,28 @@ def convergence_study(preset="fast"):
                 dt_step=np.array(step_refinement(preset)), x_err_step=xs, v_err_step=vs,
                 iterations_joint=np.array([r["newton_iterations_total"] for r in joint]),
                 iterations_step=np.array([r["newton_iterations_total"] for r in steps]))
+
+
+def slip_after_rolling(r):
+    """The largest |slip velocity| of the contact point once rolling (0.1 s after t_roll), or
+    None if the ring did not roll."""
+    if not r["rolled"]:
+        return None
+    late = np.asarray(r["t"]) > r["t_roll"] + 0.1
+    return float(np.max(np.abs(np.asarray(r["slip_velocity"])[late]), initial=0.0))
+
+
+# what Fig 9 shows of a run: its headline numbers (the run's own keys) and the drawn series
+FIG09_KEYS = ("kind", "rolled", "t_roll", "x_roll", "v_final", "omega_final", "x_end", "t_star_exact", "x_roll_exact",
+              "v_final_exact", "x_end_exact", "exact_mu", "rolling_radius", "t", "x_c", "y_c", "vx_c", "omega",
+              "slip_velocity", "vx_exact", "omega_exact", "outline_t", "outlines", "outline_vc", "outline_omega",
+              "outline_node_y", "outline_node_vx")
+
+
+def fig09_data(r):
+    """The numbers Fig 9 draws from a rolling-ring result ``r``: FIG09_KEYS and
+    ``slip_after_rolling`` (the summary's row reads the same)."""
+    return dict({k: r.get(k) for k in FIG09_KEYS}, slip_after_rolling=slip_after_rolling(r))
 
 
 def draw_rolling(r, title):
@@ -120,8 +145,7 @@ def draw_rolling(r, title):
     ap.legend(fontsize=7)
     ap.grid(alpha=0.3)
     if r["rolled"]:
-        late = np.asarray(r["t"]) > r["t_roll"] + 0.1
-        s_late = np.max(np.abs(np.asarray(r["slip_velocity"])[late]), initial=0.0)
+        s_late = slip_after_rolling(r)
         verdict = f"once rolling, the contact point slips at most {s_late:.2g} cm/s ({100 * s_late / prm['v0']:.1g} % of v0)"
     else:
         verdict = "the ring did not start rolling"
@@ -149,12 +173,12 @@ def fig09(preset="fast", outdir=None, r=None, **overrides):
     """Fig 9 from a rolling-ring result ``r`` (a lecture's own run), else from the scene's run
     with ``overrides``."""
     r = r or result(preset, **overrides)
-    p = r["parameters"]
-    title = (f"Fig 9: ring sliding then rolling ({r['kind']}, {p['n_el']} elements, dt = {p['dt']:g} s, "
-             f"mu = {p['mu']:g}); v_final = {r['v_final']:.1f} cm/s (exact {r['v_final_exact']:.0f})")
+    p, d = r["parameters"], fig09_data(r)
+    title = (f"Fig 9: ring sliding then rolling ({d['kind']}, {p['n_el']} elements, dt = {p['dt']:g} s, "
+             f"mu = {p['mu']:g}); v_final = {d['v_final']:.1f} cm/s (exact {d['v_final_exact']:.0f})")
     stem = "fig09_rolling_ring" + ("" if not overrides else "_" + "_".join(f"{k}{v}" for k, v in sorted(overrides.items())))
-    fig = draw_rolling(r, title)
-    return [savefig(fig, outdir or default_outdir(preset), stem)]
+    fig = draw_rolling(dict(r, **d), title)
+    return save_figure(fig, Path(outdir or default_outdir(preset)) / f"{stem}.png", d, p)
 
 
 @figure("fig09b_rolling_ring_convergence", "Fig 9 (convergence)")
@@ -183,6 +207,9 @@ def fig09b(preset="fast", outdir=None):
     a2.invert_xaxis()
     a2.grid(alpha=0.3, which="both")
     a2.legend(fontsize=8)
-    fig.suptitle("Rolling ring: error of the start of rolling x_roll and of the rolling speed v_final", fontsize=10)
+    fig.suptitle("Rolling ring: error of the start of rolling x_roll and of the rolling speed v_final; at dt = "
+                 f"{d[0]:g} s on 120 elements |v_final error| = {abs(c['v_err_step'][0]):.3f}", fontsize=10)
     fig.tight_layout()
-    return [savefig(fig, outdir or default_outdir(preset), "fig09b_rolling_ring_convergence")]
+    return save_figure(fig, Path(outdir or default_outdir(preset)) / "fig09b_rolling_ring_convergence.png", c,
+                       dict(result(preset)["parameters"], joint_n_el=c["n_el"], joint_dt=c["dt_joint"],
+                            step_n_el=120, step_dt=c["dt_step"]))

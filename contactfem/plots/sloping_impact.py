@@ -13,10 +13,27 @@ the scene.
 """
 
 
+from pathlib import Path
+
 import numpy as np
 
 from ..scenes.sloping_impact import PAPER_TABLE2
-from . import cached_run, default_outdir, figure, fitted_words, pyplot, savefig
+from . import cached_run, default_outdir, figure, fitted_words, pyplot
+from .data import save_figure, write_data
+
+# what Figs 10-11b show of a run: the rebound (headline) and the drawn series
+IMPACT_KEYS = ("variant", "rebound_vx", "rebound_vy", "rebound_angle_deg", "rebound_spin", "fitted", "t", "x_c", "y_c",
+               "outline_t", "outlines", "energy_kinetic", "energy_strain", "energy_contact", "energy_dissipation",
+               "energy_total")
+
+
+def impact_data(r):
+    """The numbers a sloping-impact figure draws from a result ``r`` (IMPACT_KEYS)."""
+    return {k: r.get(k) for k in IMPACT_KEYS}
+
+
+def _save(fig, r, outdir, preset, stem):
+    return save_figure(fig, Path(outdir or default_outdir(preset)) / f"{stem}.png", impact_data(r), r["parameters"])
 
 
 def result(variant, preset="fast", **overrides):
@@ -27,6 +44,7 @@ def result(variant, preset="fast", **overrides):
 def draw_impact(r, title):
     """Outlines over the plane (top) and energy histories (bottom); returns the figure."""
     plt = pyplot()
+    r = impact_data(r)
     fig, (ax, ae) = plt.subplots(2, 1, figsize=(9, 7.5), gridspec_kw=dict(height_ratios=[1.6, 1]))
     outlines, times = np.asarray(r["outlines"]), np.asarray(r["outline_t"])
     colors = plt.cm.viridis(np.linspace(0, 0.9, len(outlines)))
@@ -65,7 +83,7 @@ def fig10(preset="fast", outdir=None, r=None):
     p = r["parameters"]
     fig = draw_impact(r, f"Fig 10: sloping impact, frictionless contact (Newmark {p['delta']:g}/{p['beta_newmark']:g}, "
                          f"dt = {p['dt']:g})")
-    return [savefig(fig, outdir or default_outdir(preset), "fig10_sloping_impact_frictionless")]
+    return _save(fig, r, outdir, preset, "fig10_sloping_impact_frictionless")
 
 
 @figure("fig11a_sloping_impact_frictional", "Fig 11a")
@@ -74,7 +92,7 @@ def fig11a(preset="fast", outdir=None, r=None):
     p = r["parameters"]
     fig = draw_impact(r, f"Fig 11a: sloping impact, frictional contact (eq 10: n = {p['n']:g}, alpha = {p['alpha']:g}, "
                          f"beta = {p['beta']:g})")
-    return [savefig(fig, outdir or default_outdir(preset), "fig11a_sloping_impact_frictional")]
+    return _save(fig, r, outdir, preset, "fig11a_sloping_impact_frictional")
 
 
 @figure("fig11b_sloping_impact_viscoplastic", "Fig 11b")
@@ -83,7 +101,7 @@ def fig11b(preset="fast", outdir=None, r=None):
     eta = r["parameters"]["eta"]
     fig = draw_impact(r, "Fig 11b: frictional contact, viscoplastic ring (N0 = 1, Q0 = 0.5, M0 = 0.25; "
                          f"eta = {eta:g} chosen)")
-    return [savefig(fig, outdir or default_outdir(preset), "fig11b_sloping_impact_viscoplastic")]
+    return _save(fig, r, outdir, preset, "fig11b_sloping_impact_viscoplastic")
 
 
 def table2_rows(preset="fast", refined_n_el=32, results=None):
@@ -154,8 +172,6 @@ def table2(preset="fast", outdir=None, refined_n_el=32, results=None):
     n_el = rows[0]["n_el"]
     head, body = table2_cells(rows)
     out = outdir or default_outdir(preset)
-    from pathlib import Path
-
     Path(out).mkdir(parents=True, exist_ok=True)
     md = Path(out) / "table2_sloping_impact.md"
     md.write_text(table2_markdown(preset, refined_n_el, results))
@@ -171,7 +187,9 @@ def table2(preset="fast", outdir=None, refined_n_el=32, results=None):
     ax.set_title(f"Table 2: rebound after the sloping impact, ours ({n_el} and {refined_n_el} elements) vs paper"
                  + (f"\nours, frictionless and frictional rows: {fitted} (points per beam element)" if fitted else ""),
                  fontsize=9)
-    return [str(md), savefig(fig, out, "table2_sloping_impact")]
+    return [str(md), *save_figure(fig, Path(out) / "table2_sloping_impact.png",
+                                  dict(rows=rows, fitted=ours("frictionless").get("fitted")),
+                                  ours("frictionless")["parameters"])]
 
 
 # The discretisation study of lecture 06: the one-point ring (integration = 1) of the paper's run,
@@ -235,16 +253,13 @@ def discretisation_markdown(rows):
 def table_sloping_impact_discretisation(preset="fast", outdir=None, rows=None):
     """The discretisation study (.md, and .json with its numbers); ``rows``: discretisation_rows
     computed before (default: computed here, about a minute)."""
-    import json
-    from pathlib import Path
-
-    from ..scenes.base import jsonable
+    from ..scenes import get_scene
 
     rows = rows if rows is not None else discretisation_rows(preset)
     out = Path(outdir or default_outdir(preset))
     out.mkdir(parents=True, exist_ok=True)
     md = out / "table_sloping_impact_discretisation.md"
     md.write_text(discretisation_markdown(rows))
-    data = out / "table_sloping_impact_discretisation.json"
-    data.write_text(json.dumps(jsonable(dict(preset=preset, rows=rows)), indent=1) + "\n")
-    return [str(md), str(data)]
+    base = get_scene("sloping_impact").resolve(preset, {"variant": "frictionless"})
+    return [str(md), write_data(out / "table_sloping_impact_discretisation.json", dict(preset=preset, rows=rows),
+                                dict(base, rows=[row["overrides"] for row in rows]))]

@@ -1,5 +1,5 @@
 """The README's table of the paper's examples, ours beside the paper's: every "ours"
-cell is computed here from the runs the figures use (``cached_run``), never typed.
+cell is computed here from the figures' data (the runs the figures use), never typed.
 
     summary     figures/summary.md: one row per example of the paper
 
@@ -10,9 +10,16 @@ carries the same table between the markers ``<!-- summary:start -->`` and
 
 The "paper's value" column quotes the paper (NOTES.md); where the scan lost a digit it
 says so. Which rows depend on which scene and preset: ``ROWS`` below (one function a row).
+
+The rows read the figures' data (plots.data: what NAME.json holds beside NAME.png): a row
+function takes ``record(stem)``, the data of the figure ``stem``: ``fresh(preset)`` computes it
+from this code's runs as the figure does, ``committed(folder)`` reads the figures' JSON files,
+so the README's table is the committed figures' numbers (tests/test_summary.py).
 """
 
+import json
 import sys
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -29,14 +36,61 @@ def _links(*pairs):
     return " ".join(f"[{label}]({stem})" for label, stem in pairs)
 
 
-def row_laws(preset):
+def fresh(preset):
+    """record(stem): the data of figure ``stem`` computed from this code's runs (the same
+    functions the figures write their JSON with), with its ``parameters``."""
+    from . import block, cork, funnel, rolling_ring, sloping_impact
+
+    def with_parameters(data, r):
+        return dict(data, parameters=r["parameters"])
+
+    def blk(law):
+        return cached_run("block", preset, law=law)
+
+    def ring(scene, variant):
+        return cached_run(scene, preset, variant=variant)
+
+    def exit_rows():
+        from .cork import EXIT_CASES_QUICK, cached_exit_case
+
+        return dict(cases=[cached_exit_case(c) for c in EXIT_CASES_QUICK if c[4] is not None])
+    makers = {
+        "fig07_block_conical_stresses": lambda: with_parameters(block.stress_data(blk("conical")), blk("conical")),
+        "fig08_block_parabolic_stresses": lambda: with_parameters(
+            dict(block.stress_data(blk("parabolic")), conical=block.stress_data(blk("conical"))), blk("parabolic")),
+        "table1_block_newton_residuals": lambda: block.residual_histories(preset),
+        "fig09_rolling_ring": lambda: with_parameters(rolling_ring.fig09_data(cached_run("rolling_ring", preset)),
+                                                      cached_run("rolling_ring", preset)),
+        "fig10_sloping_impact_frictionless": lambda: with_parameters(
+            sloping_impact.impact_data(ring("sloping_impact", "frictionless")), ring("sloping_impact", "frictionless")),
+        "fig11a_sloping_impact_frictional": lambda: with_parameters(
+            sloping_impact.impact_data(ring("sloping_impact", "frictional")), ring("sloping_impact", "frictional")),
+        "fig12_funnel_frictionless": lambda: with_parameters(funnel.funnel_data(ring("funnel", "frictionless")),
+                                                             ring("funnel", "frictionless")),
+        "fig13_funnel_frictional": lambda: with_parameters(funnel.funnel_data(ring("funnel", "frictional")),
+                                                           ring("funnel", "frictional")),
+        "fig14_cork_mesh": lambda: with_parameters(cork.cork_data(cached_run("cork", preset)), cached_run("cork", preset)),
+        "cork_exit_time": exit_rows,
+    }
+    return lru_cache(maxsize=None)(lambda stem: makers[stem]())
+
+
+def committed(folder):
+    """record(stem): the data of figure ``stem`` as written in ``folder``/stem.json."""
+    @lru_cache(maxsize=None)
+    def record(stem):
+        return json.loads((Path(folder) / f"{stem}.json").read_text())
+    return record
+
+
+def row_laws(preset, record=None):
     return ("Figs 1-4", "interface laws, slip surface, return-mapping geometry", "-", "-",
             _links(("1", "fig01_true_contact_area.png"), ("2", "fig02_force_vs_microdisplacement.png"),
                    ("3", "fig03_shear_vs_normal.png"), ("4", "fig04_parabolic_slip_surface.png")))
 
 
-def row_block_equilibrium(preset):
-    r = cached_run("block", preset, law="conical")
+def row_block_equilibrium(preset, record=None):
+    r = (record or fresh(preset))("fig07_block_conical_stresses")
     ours = (f"equilibrium to {r['equilibrium_error']:.0e} ({-r['total_normal']:.0f} down, "
             f"{r['total_tangential']:.0f} along)")
     what = "block on a rough foundation, whole load in one step"
@@ -46,10 +100,11 @@ def row_block_equilibrium(preset):
             _links(("6", "fig06_block_mesh_deformed.png")))
 
 
-def fig8_remark(preset):
+def fig8_remark(preset, record=None):
     """The paper's Fig 8 remark, measured: at the contact nodes in the top quartile of
     normal pressure (parabolic run), the parabolic |t_T| relative to the conical one."""
-    par, con = cached_run("block", preset, law="parabolic"), cached_run("block", preset, law="conical")
+    par = (record or fresh(preset))("fig08_block_parabolic_stresses")
+    con = par["conical"]
     p = -np.asarray(par["contact"]["t_N"])
     top = p >= np.quantile(p[p > 0], 0.75) if np.any(p > 0) else np.zeros_like(p, bool)
     tp, tc = (np.abs(np.asarray(r["contact"]["t_T"]))[top] for r in (par, con))
@@ -59,8 +114,8 @@ def fig8_remark(preset):
                 n_slip_conical=con["n_slip"])
 
 
-def row_block_stresses(preset):
-    f = fig8_remark(preset)
+def row_block_stresses(preset, record=None):
+    f = fig8_remark(preset, record)
     ours = (f"at the {f['n_top']} nodes of highest pressure (top quartile) the parabolic friction stress "
             f"differs from the conical by {100 * f['change_min']:+.0f} % to {100 * f['change_max']:+.0f} %; nodes slipping: "
             f"conical {f['n_slip_conical']}, parabolic {f['n_slip_parabolic']}")
@@ -69,9 +124,10 @@ def row_block_stresses(preset):
             _links(("7", "fig07_block_conical_stresses.png"), ("8", "fig08_block_parabolic_stresses.png")))
 
 
-def row_table1(preset):
-    c, p = (cached_run("block", preset, law=law) for law in ("conical", "parabolic"))
-    rc, rp = c["newton_residuals"], p["newton_residuals"]
+def row_table1(preset, record=None):
+    record = record or fresh(preset)
+    c, t = record("fig07_block_conical_stresses"), record("table1_block_newton_residuals")
+    rc, rp = t["conical"], t["parabolic"]
     ours = (f"conical {len(rc)} ({c['n_slip']} nodes slip), parabolic {len(rp)}; "
             f"first {rc[0]:.2f}; last {rc[-1]:.0e} and {rp[-1]:.0e}")
     return ("Table 1", "residual norms of Newton, one load step" + (" (reading FITTED to this table)" if c.get("fitted") else ""),
@@ -80,8 +136,8 @@ def row_table1(preset):
             _links(("table", "table1_block_newton_residuals.md")))
 
 
-def row_rolling_ring(preset):
-    r = cached_run("rolling_ring", preset)
+def row_rolling_ring(preset, record=None):
+    r = (record or fresh(preset))("fig09_rolling_ring")
     x_roll = "did not roll" if not r["rolled"] else f"x_roll = {r['x_roll']:.1f} cm"
     ours = f"{x_roll}, x(2 s) = {r['x_end']:.1f} cm, v = {r['v_final']:.1f} cm/s"
     return ("Sec. 5.2, Fig 9", "ring sliding, then rolling (exact: rigid thin ring)",
@@ -89,14 +145,16 @@ def row_rolling_ring(preset):
             _links(("9", "fig09_rolling_ring.png"), ("conv.", "fig09b_rolling_ring_convergence.png")))
 
 
-def row_sloping_impact(preset):
+def row_sloping_impact(preset, record=None):
+    record = record or fresh(preset)
     parts = []
-    for variant in ("frictionless", "frictional"):
-        r = cached_run("sloping_impact", preset, variant=variant)
+    for variant, stem in (("frictionless", "fig10_sloping_impact_frictionless"),
+                          ("frictional", "fig11a_sloping_impact_frictional")):
+        r = record(stem)
         parts.append(f"{variant} ({r['rebound_vx']:.2f}, {r['rebound_vy']:.2f}), {r['rebound_angle_deg']:.1f} deg")
-    n_el = cached_run("sloping_impact", preset, variant="frictionless")["parameters"]["n_el"]
+    n_el = record("fig10_sloping_impact_frictionless")["parameters"]["n_el"]
     ours = "; ".join(parts) + f" ({n_el} elements)"
-    fitted = cached_run("sloping_impact", preset, variant="frictionless").get("fitted") or {}
+    fitted = record("fig10_sloping_impact_frictionless").get("fitted") or {}
     what = "sloping impact, rebound" + (f" (beam integration FITTED to this table: {fitted['integration']} points)"
                                         if "integration" in fitted else "")
     return ("Sec. 5.3, Table 2", what,
@@ -105,34 +163,35 @@ def row_sloping_impact(preset):
                    ("11b", "fig11b_sloping_impact_viscoplastic.png"), ("table", "table2_sloping_impact.md")))
 
 
-def row_funnel(preset):
-    f, g = (cached_run("funnel", preset, variant=v) for v in ("frictionless", "frictional"))
+def row_funnel(preset, record=None):
+    record = record or fresh(preset)
+    f, g = record("fig12_funnel_frictionless"), record("fig13_funnel_frictional")
     phi = f["parameters"]["phi_deg"]
-
-    def verdict(r):
-        if r["stuck"]:
-            return "sticks"
-        return f"rebounds at {r['v_c_final'] / r['parameters']['v0']:.2f} v0"
     return ("Sec. 5.4, Figs 12-13", f"ring into a funnel (angle chosen: {phi:g} deg)",
-            "frictionless rebounds, frictional sticks", f"{verdict(f)}; {verdict(g)}",
+            "frictionless rebounds, frictional sticks", f"{f['verdict']}; {g['verdict']}",
             _links(("12", "fig12_funnel_frictionless.png"), ("13", "fig13_funnel_frictional.png")))
 
 
-def cork_refined_exit(preset):
+def cork_refined_exit(preset, record=None):
     """The cork's exit time with the time step in the neck refined (the pressure ramp kept), with
-    and without the closing step: the refined cases of the exit-time study (plots.cork)."""
-    from .cork import EXIT_CASES_QUICK, cached_exit_case
+    and without the closing step: the refined cases of the exit-time study (plots.cork), as the
+    study's data ``record("cork_exit_time")`` holds them."""
+    from .cork import EXIT_CASES_QUICK
 
     cases = [c for c in EXIT_CASES_QUICK if c[4] is not None]
-    return [cached_exit_case(c, preset) for c in cases], cases[0][2]["dt"]
+    rows = (record or fresh(preset))("cork_exit_time")["cases"]
+    key = lambda g, label, fit, pop: (g, label, bool(fit), bool(pop))           # noqa: E731
+    by_key = {key(r["group"], r["label"], r["closing_step_press_fit"], r["closing_step_pop"]): r for r in rows}
+    return [by_key[key(c[0], c[1], *c[3])] for c in cases], cases[0][2]["dt"]
 
 
-def row_cork(preset):
-    r = cached_run("cork", preset)
+def row_cork(preset, record=None):
+    record = record or fresh(preset)
+    r = record("fig14_cork_mesh")
     exit_text = (f"exit {r['exit_time_ms']:.2f} ms at {r['exit_velocity_m_s']:.1f} m/s" if r["exited"]
                  else "the cork stays in")
     if r["exited"] and preset == "paper":
-        fine, dt = cork_refined_exit(preset)
+        fine, dt = cork_refined_exit(preset, record)
         t = [f["exit_time_ms"] for f in fine if f["exited"]]
         if len(t) == len(fine):
             rules = ("with or without the closing step" if f"{min(t):.2f}" == f"{max(t):.2f}"
@@ -164,20 +223,23 @@ ROWS = (
 )
 
 
-def summary_table(preset="paper"):
-    """The table's lines (head and one row per example), every "ours" cell from a run."""
+def summary_table(preset="paper", record=None):
+    """The table's lines (head and one row per example), every "ours" cell from the figures'
+    data: ``record`` (default ``fresh(preset)``: this code's runs; ``committed(folder)``: the
+    JSON files beside the figures)."""
+    record = record or fresh(preset)
     lines = list(HEAD)
     for fn, _ in ROWS:
-        cells = [str(c).replace("|", "/") for c in fn(preset)]
+        cells = [str(c).replace("|", "/") for c in fn(preset, record)]
         lines.append("| " + " | ".join(cells) + " |")
     return lines
 
 
-def summary_markdown(preset="paper"):
+def summary_markdown(preset="paper", record=None):
     return "\n".join(["# The paper's examples: ours beside the paper's", "",
                       f"Written by `contactfem figures --preset {preset}` (contactfem/plots/summary.py): "
                       "every value in the column 'ours' is computed by the run behind the figures.", "",
-                      *summary_table(preset), ""])
+                      *summary_table(preset, record), ""])
 
 
 def table_lines(text, prefix=""):

@@ -6,10 +6,21 @@
     verif_patch              patch: interface pressure of one- and two-pass node-to-segment
 """
 
+from pathlib import Path
+
 import numpy as np
 
-from ..scenes import run_scene
-from . import default_outdir, figure, pyplot, savefig
+from . import cached_run, default_outdir, figure, pyplot
+from .data import save_figure
+
+
+def run_scene(scene, preset, overrides=None):
+    """The scene's run, shared and kept on disk (plots.cached_run)."""
+    return cached_run(scene, preset, **(overrides or {}))
+
+
+def _save(fig, outdir, preset, stem, data, parameters):
+    return save_figure(fig, Path(outdir or default_outdir(preset)) / f"{stem}.png", data, parameters)
 
 
 @figure("verif_hertz_pressure", "verification")
@@ -29,7 +40,9 @@ def verif_hertz_pressure(preset="fast", outdir=None):
     ax.set_title(f"Hertz line contact: $p_0$ error {100 * r['error_p0']:+.2f} %, "
                  f"$a$ (fit) error {100 * r['error_a']:+.2f} %", fontsize=10)
     ax.legend()
-    return [savefig(fig, outdir or default_outdir(preset), "verif_hertz_pressure")]
+    return _save(fig, outdir, preset, "verif_hertz_pressure",
+                 {k: r[k] for k in ("a_exact", "p0_exact", "error_p0", "error_a", "n_quads", "profile_x", "profile_p")},
+                 r["parameters"])
 
 
 def hertz_refinement_data(preset="fast", c_N=1e7):
@@ -73,7 +86,8 @@ def verif_hertz_refinement(preset="fast", outdir=None):
     fig.suptitle("Hertz under mesh refinement: p0 error " + "; ".join(
         f"{k.replace('_', ' ')} {e[k][0]:+.2f} % -> {e[k][-1]:+.2f} %" for k in ("per_length", "nodal")),
         fontsize=10)
-    return [savefig(fig, outdir or default_outdir(preset), "verif_hertz_refinement")]
+    return _save(fig, outdir, preset, "verif_hertz_refinement", dict(d, penetration_slope=slope),
+                 dict(run_scene("hertz", preset)["parameters"], n_el=d["n_el"], c_N=d["c_N"]))
 
 
 @figure("verif_bar_impact", "verification")
@@ -95,15 +109,20 @@ def verif_bar_impact(preset="fast", outdir=None):
     ax2.set_xlabel("$t / (2L/c)$")
     ax2.set_ylabel("$(E - E_0) / E_0$")
     ax2.set_title("total energy (kinetic + strain + penalty)", fontsize=10)
-    return [savefig(fig, outdir or default_outdir(preset), "verif_bar_impact")]
+    return _save(fig, outdir, preset, "verif_bar_impact",
+                 {k: r[k] for k in ("duration_exact", "stress_exact", "error_duration", "error_stress_mean",
+                                    "error_rebound", "time", "contact_stress", "energy_total")}, r["parameters"])
 
 
 @figure("verif_patch", "verification")
 def verif_patch(preset="fast", outdir=None):
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(6, 3.6))
+    data = {}
     for passes, style in ((1, "o-"), (2, "s--")):
         r = run_scene("patch", preset, {"passes": passes})
+        data[f"passes_{passes}"] = {k: r[k] for k in ("pressure_deviation_max", "stress_deviation_max", "interface_x",
+                                                       "interface_pressure")}
         p = r["parameters"]["p"]
         ax.plot(r["interface_x"], np.asarray(r["interface_pressure"]) / p, style,
                 label=f"{passes}-pass: max deviation {100 * r['pressure_deviation_max']:.2f} %, "
@@ -113,4 +132,4 @@ def verif_patch(preset="fast", outdir=None):
     ax.set_ylabel("interface pressure / $p$")
     ax.set_title("Contact patch test, non-matching meshes", fontsize=10)
     ax.legend(fontsize=8)
-    return [savefig(fig, outdir or default_outdir(preset), "verif_patch")]
+    return _save(fig, outdir, preset, "verif_patch", data, dict(r["parameters"], passes=[1, 2]))

@@ -11,7 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ...plots import default_outdir, figure, pyplot, savefig
+from ...plots import default_outdir, figure, pyplot
+from ...plots.data import save_figure
 
 _CACHE = {}
 
@@ -64,7 +65,17 @@ def bench_tangents(preset="fast", outdir=None):
     np.atleast_1d(axes)[0].set_ylabel("linear solves to convergence")
     fig.suptitle("The consistent non-symmetric tangent (eqs 49-50) against the alternatives")
     fig.tight_layout()
-    return [savefig(fig, outdir or default_outdir(preset), "bench_tangents")]
+    return _save(fig, outdir, preset, "bench_tangents", "tangents")
+
+
+def _save(fig, outdir, preset, stem, section):
+    """NAME.png and NAME.json: the bench's ``section`` (the numbers drawn), with the bench's
+    source, kind and machine as the parameters."""
+    b = load_bench(preset)
+    path = bench_json_path()
+    parameters = dict(source=path.name if path.exists() else "a quick bench run", quick=b.get("quick"),
+                      machine=b.get("machine"))
+    return save_figure(fig, Path(outdir or default_outdir(preset)) / f"{stem}.png", {section: b[section]}, parameters)
 
 
 def _rows(block):
@@ -142,7 +153,7 @@ def bench_work_precision(preset="fast", outdir=None):
     ax.set_ylabel("|duration / (2L/c) - 1|")
     ax.legend(fontsize=8)
     fig.tight_layout()
-    return [savefig(fig, outdir or default_outdir(preset), "bench_work_precision")]
+    return _save(fig, outdir, preset, "bench_work_precision", "work_precision")
 
 
 @figure("bench_cost", "bench")
@@ -178,7 +189,7 @@ def bench_cost(preset="fast", outdir=None):
     ax2.legend(fontsize=8)
     ax2.set_title("contact cost is linear in the contact nodes")
     fig.tight_layout()
-    return [savefig(fig, outdir or default_outdir(preset), "bench_cost")]
+    return _save(fig, outdir, preset, "bench_cost", "cost")
 
 
 @figure("bench_speed", "bench")
@@ -240,4 +251,4 @@ def bench_speed(preset="fast", outdir=None):
     ax2.set_title(f"start-up: list {st['list_over_python']:.1f} x python, run block "
                   f"{st['run_block_over_scipy_skfem']:.2f} x scipy + skfem", fontsize=9)
     fig.tight_layout()
-    return [savefig(fig, outdir or default_outdir(preset), "bench_speed")]
+    return _save(fig, outdir, preset, "bench_speed", "speed")
