@@ -110,7 +110,7 @@ def test_run_block_json_reports_slip_and_fitted_values(tmp_path):
     path = tmp_path / "block.json"
     assert main(["run", "block", "--preset", "paper", "--json", str(path)]) == 0
     r = json.loads(path.read_text())
-    assert r["parameters"]["law"] == "conical" and r["n_slip"] > 0
+    assert r["parameters"]["law"] == "conical" and r["n_slip"] == r["contact"]["state"].count("slip")
     assert set(r["fitted"]) >= {"width", "height", "c_N"} and "reconstruct block" in r["fitted_to"]
 
 
@@ -324,14 +324,18 @@ def test_sloping_study_records_every_outcome(study):
             assert max(gains) > rc.ENERGY_GAIN_TOL
 
 
-def test_sloping_study_no_reading_meets_table2(study):
-    """No ranked reading (admissible, with the paper's mass and integrator) brings any of Table 2's
-    three informative numbers within 10 %; every two-point reading ranks above every one-point
-    one (why the preset uses two points);
+def test_sloping_study_against_the_readme(study):
+    """The README says 'out of reach' (no ranked reading, admissible and with the paper's mass and
+    integrator, brings any of Table 2's three informative numbers within 10 %) exactly when the
+    study finds it; every two-point reading ranks above every one-point one (why the preset uses
+    two points);
     the README's Table 2 section prints the study's rows (preset, midpoint, closest)."""
     rows = [r for r in study("sloping_impact")["readings"] if r["rank"]]
     assert len(rows) >= 40
-    assert max(r["n_facts"] for r in rows) == 0
+    best = max(r["n_facts"] for r in rows)            # the README's claim, whichever way the study moves
+    text = " ".join(README[README.index("### Table 2"):README.index("Verification problems")].split())
+    assert ("**Out of reach**: no reading that keeps the paper's mass and integrator brings any of the three "
+            "within 10 % of the paper's" in text) == (best == 0)
     last2 = max(r["rank"] for r in rows if r["integration"] == "2")
     first1 = min(r["rank"] for r in rows if r["integration"] == "1")
     assert last2 < first1

@@ -201,8 +201,6 @@ def fig08b(preset="fast", outdir=None, other="fig8"):
     `contactfem reconstruct block` that shows the paper's remark); the nodes in the top quartile
     of the conical pressure, where the remark is measured, shaded. Writes NAME.json beside the
     PNG (plots.data)."""
-    from .data import save_figure
-
     plt = pyplot()
     data, params = fig8_reading_data(preset, other)
     fig, axes = plt.subplots(1, 2, figsize=(14, 5.8))
