@@ -64,6 +64,9 @@ def run_scene(name, preset="fast", overrides=None, progress=None, friction=None,
     dense|banded|sparse, joined by + if they differ; ``ordering``; ``unknowns``, the largest
     System's; ``band_kl``, ``band_ku``: the half-bandwidths of a banded K, else None), and how
     often they were evaluated (``residual_evaluations``, ``contact_evaluations``).
+    ``overrides``: {parameter name: value}, a value given as a number or as the text of one (the
+    same rule as the command line's --set: an integer parameter takes 12, 12.0 or "12"; see
+    scenes.params); a TypeError names ``overrides`` or ``progress`` given as anything else.
     ``linear_algebra``: auto|dense|banded|sparse for every System the scene builds (None: auto,
     chosen by size and band width), to compare the solvers on one scene.
     ``progress(t0, t_end, label)``: a progress-callback factory for the scene's time loops
@@ -82,7 +85,7 @@ def run_scene(name, preset="fast", overrides=None, progress=None, friction=None,
     from ..laws.protocol import as_normal_law, describe
     from ..solver.assembly import KINDS
 
-    from .base import check_overrides
+    from .params import check_overrides
 
     scene = get_scene(name)
     overrides = check_overrides(overrides)

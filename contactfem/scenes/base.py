@@ -18,7 +18,7 @@ from typing import Callable
 
 import numpy as np
 
-from .params import Param  # noqa: F401  (scene modules take it from here)
+from .params import Param, check_overrides  # noqa: F401  (scene modules take Param from here)
 from .resources import check_resources, describe  # noqa: F401  (the command line takes them from here)
 
 PENALTIES = ("per_length", "per_node")
@@ -84,22 +84,6 @@ def run(scene, params, normal=None, friction=None, progress=None, linear_algebra
     results["contact_evaluations"] = int(sum(c.evaluations for c in contacts.values()))
     results.setdefault("newton_iterations_total", 0)
     return results
-
-
-def check_overrides(overrides):
-    """``overrides`` as a dict (None: no overrides); TypeError naming it unless it is a mapping of
-    parameter names to values (e.g. {"nx": 12})."""
-    from collections.abc import Mapping
-
-    if overrides is None:
-        return {}
-    if not isinstance(overrides, Mapping):
-        raise TypeError(f"parameter overrides must be a dict of parameter name -> value (e.g. {{'nx': 12}}), got "
-                        f"{type(overrides).__name__} {overrides!r}"[:200])
-    bad = [k for k in overrides if not isinstance(k, str)]
-    if bad:
-        raise TypeError(f"parameter overrides: the names must be strings, got {bad[0]!r}")
-    return dict(overrides)
 
 
 @dataclass(frozen=True)

@@ -88,3 +88,19 @@ class Param:
         if not f.is_integer():
             raise bad
         return int(f)
+
+
+def check_overrides(overrides):
+    """``overrides`` as a dict (None: no overrides); TypeError naming it unless it is a mapping of
+    parameter names to values (e.g. {"nx": 12})."""
+    from collections.abc import Mapping
+
+    if overrides is None:
+        return {}
+    if not isinstance(overrides, Mapping):
+        raise TypeError(f"parameter overrides must be a dict of parameter name -> value (e.g. {{'nx': 12}}), got "
+                        f"{type(overrides).__name__} {overrides!r}"[:200])
+    bad = [k for k in overrides if not isinstance(k, str)]
+    if bad:
+        raise TypeError(f"parameter overrides: the names must be strings, got {bad[0]!r}")
+    return dict(overrides)
