@@ -229,7 +229,8 @@ def fig08b(preset="fast", outdir=None, other="fig8"):
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7)
     fig.suptitle("Fig 8's remark, 'a considerable reduction of the frictional stress in the region of higher "
-                 "normal pressure', on two readings of the block (both FITTED values, not the paper's)", fontsize=10)
+                 "normal pressure', on two readings of the values the scan lost\n(neither is the paper's: the preset "
+                 "FITTED to Table 1, preset fig8 the study's best-ranked reading that shows the remark)", fontsize=10)
     fig.tight_layout()
     outdir = outdir or default_outdir(preset)
     return save_figure(fig, Path(outdir) / "fig08b_block_fig8_readings.png", data, params)
