@@ -16,15 +16,10 @@ def test_load_is_transmitted(results):
 
 
 @pytest.fixture(scope="module")
-def stiffer():
+def stiffer(results):
     """The same runs with c_N ten times the preset's."""
-    return {n: run_scene("patch", "fast", {"passes": n, "c_N": 10 * results_c_N()}) for n in (1, 2)}
-
-
-def results_c_N():
-    from contactfem.scenes import get_scene
-
-    return get_scene("patch").resolve("fast")["c_N"]
+    c_N = results[1]["parameters"]["c_N"]
+    return {n: run_scene("patch", "fast", {"passes": n, "c_N": 10 * c_N}) for n in (1, 2)}
 
 
 def test_one_pass_misses_the_patch_test_by_its_load_transfer(results, stiffer):
