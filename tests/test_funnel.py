@@ -112,4 +112,5 @@ def test_bad_input():
 
 def test_figures(tmp_path):
     files = plots.fig12(outdir=tmp_path) + plots.fig13(outdir=tmp_path)
-    assert len(files) == 2 and all((tmp_path / f).exists() for f in files)
+    assert sorted(f.rsplit(".", 1)[1] for f in files) == ["json", "json", "png", "png"]     # each PNG with its data
+    assert all((tmp_path / f).exists() for f in files)
