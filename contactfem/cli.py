@@ -120,11 +120,11 @@ def cmd_run(args):
     overrides, laws, notes = laws_from_args(args)      # law.NAME=... go to --friction / --normal
     params = scene.resolve(args.preset, overrides)
     out = Outputs()                                   # every output checked before the run
-    if args.json:
+    if args.json is not None:                         # (an empty name is refused, not skipped)
         out.add("--json", args.json, (".json",))
-    if args.save:
+    if args.save is not None:
         out.add("--save", args.save, (".json", ".npz"))
-    if args.gif:
+    if args.gif is not None:
         out.add("--gif", args.gif, (".gif", ".mp4"))
         if not scene.outlines:
             animated = ", ".join(n for n, s in scenes.all_scenes().items() if s.outlines)
@@ -153,15 +153,15 @@ def cmd_run(args):
         res["import_time_s"] = _CLOCK["imported"][0] + _CLOCK["own"]
     _RUN["phase"] = "write"
     with out:                                         # temporaries first, then all renamed at once
-        if args.json:
+        if args.json is not None:
             import json
 
             out.temp("--json").write_text(json.dumps(res, indent=1, allow_nan=False))
-        if args.save:
+        if args.save is not None:
             from .io import as_arrays, save_run
 
             save_run(as_arrays(res), out.temp("--save"))
-        if args.gif:
+        if args.gif is not None:
             write_animation(res, out.temp("--gif"))
         out.commit()
     _RUN["phase"] = "done"
@@ -217,7 +217,7 @@ def cmd_figures(args):
     from .io.outputs import check_output_dir
     from .plots import default_outdir
 
-    check_output_dir(args.outdir or default_outdir(args.preset), "--outdir")       # before anything heavy
+    check_output_dir(default_outdir(args.preset) if args.outdir is None else args.outdir, "--outdir")  # before anything heavy
     from .lab.bench import figures as _bench  # noqa: F401  (registers the bench figures)
     from .plots import load_all, make_all
 
@@ -297,10 +297,14 @@ def _course_layer():
 
 
 def cmd_course_build(args):
+    from .io.outputs import check_output_dir
+
     course = _course_layer()
+    if args.out is not None:
+        check_output_dir(args.out, "--out")
     from .lab.course.handout import STUDENT_ZIP
 
-    out = course.check_out_dir(args.out or course.default_out(args.instructor))
+    out = course.check_out_dir(course.default_out(args.instructor) if args.out is None else args.out)
     _RUN["said"] = f"during the course build; nothing written in {out}"
     written = course.build_versions({"instructor" if args.instructor else "student": out}, force=args.force,
                                     on_write=lambda: _RUN.update(phase="done"))
@@ -312,9 +316,12 @@ def cmd_course_build(args):
 def cmd_course_grade(args):
     import time
 
+    from .io.outputs import check_output_path, make_parents
+
     course = _course_layer()
     limits = course.Limits(notebook=args.notebook_timeout, check=args.check_timeout,
                            memory=int(args.memory * 2**20) if args.memory else None)
+    make_parents(check_output_path(args.out, "--out", (".csv",)))     # the table's folder, as every output's
     t0 = time.perf_counter()
 
     def progress(done, total):
@@ -335,7 +342,7 @@ def cmd_course_grade(args):
 def cmd_site(args):
     from .lab.site import build, check_out, default_out, work_dir
 
-    out = check_out(args.out or default_out(args.instructor))
+    out = check_out(default_out(args.instructor) if args.out is None else args.out)
     pages = f"the site in {out} is unchanged" if (out / "index.html").exists() else f"no page written in {out}"
 
     def said():                                    # read when the interrupt is reported, after the clean-up
@@ -360,7 +367,7 @@ def cmd_site(args):
 def cmd_reconstruct(args):
     from .io.outputs import check_output_path
 
-    if args.json:
+    if args.json is not None:
         check_output_path(args.json, "--json", (".json",))      # before anything heavy
     from .lab.reconstruct import main as reconstruct
 
@@ -380,7 +387,7 @@ def cmd_bench(args):
 
     from .io.outputs import check_output_dir
 
-    out = args.out or ("bench-quick" if args.quick else ".")
+    out = ("bench-quick" if args.quick else ".") if args.out is None else args.out
     if Path(out).exists() and not Path(out).is_dir():
         raise ValueError(f"--out {out}: is a file; give a folder (it gets bench.json and BENCHMARKS.md)")
     check_output_dir(out, "--out")

@@ -20,6 +20,22 @@ def pytest_unconfigure(config):
         shutil.rmtree(folder, ignore_errors=True)
 
 
+def _skip_reason(report):
+    """The reason a skipped test report gives ('Chromium not installed ...')."""
+    lr = report.longrepr
+    text = lr[2] if isinstance(lr, tuple) and len(lr) == 3 else str(lr or "")
+    return text.removeprefix("Skipped: ").strip()
+
+
+def pytest_report_teststatus(report, config):
+    """A skipped browser test (marked `site`) is counted under its reason, so that pytest's last
+    line says why ("15 skipped (Chromium not installed (apt-get install -y chromium))"), not a
+    bare "15 skipped"; .ci/run sets CONTACTFEM_REQUIRE_BROWSER=1, which makes it a failure."""
+    if report.skipped and "site" in report.keywords and not hasattr(report, "wasxfail"):
+        return f"skipped ({_skip_reason(report)})", "s", "SKIPPED"
+    return None
+
+
 class PointCloud:
     """A minimal body for contact tests: free nodes, two dofs each, no stiffness."""
 

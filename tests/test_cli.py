@@ -1,5 +1,6 @@
 """The command line: list/show/run, and bad input as one clear line with exit code 2."""
 
+import importlib
 import json
 import re
 import subprocess
@@ -7,6 +8,7 @@ import sys
 
 import pytest
 
+from contactfem import scenes
 from contactfem.cli import main
 from contactfem.scenes import all_scenes
 
@@ -104,13 +106,18 @@ def _no_work(*args, **kwargs):
     (["site", "--out", "{file}"], ("contactfem.lab.site", "build"), r"--out .*: is a file, give a folder"),
     (["figures", "--outdir", "{file}"], ("contactfem.plots", "make_all"), r"--outdir .*: is a file, give a folder"),
     (["figures", "--outdir", "{file}/sub"], ("contactfem.plots", "make_all"), r"--outdir .*/sub: .* is a file"),
-    (["reconstruct", "block", "--quick", "--json", "/missing/x.json"], ("contactfem.lab.reconstruct", "main"),
-     r"--json /missing/x.json: the folder /missing does not exist"),
+    (["reconstruct", "block", "--quick", "--json", "{file}/x.json"], ("contactfem.lab.reconstruct", "main"),
+     r"--json .*/x.json: .*a_file is a file, not a folder"),
+    (["reconstruct", "block", "--quick", "--json", ""], ("contactfem.lab.reconstruct", "main"),
+     r"--json: empty file name"),
+    (["figures", "--outdir", ""], ("contactfem.plots", "make_all"), r"--outdir: empty folder name"),
+    (["site", "--out", ""], ("contactfem.lab.site", "build"), r"--out: empty folder name"),
     (["reconstruct", "block", "--quick", "--json", "{dir}/r.txt"], ("contactfem.lab.reconstruct", "main"),
      r"--json .*r.txt: the file name must end in .json"),
     (["bench", "--quick", "--out", "{file}/sub"], ("contactfem.lab.bench", "run_bench"), r"--out .*/sub: .* is a file"),
-    (["sweep", "block", "--set", "mu=0.3", "--out", "/missing/s.csv"], ("contactfem.lab.sweep", "sweep"),
-     r"--out /missing/s.csv: the folder /missing does not exist"),
+    (["sweep", "block", "--set", "mu=0.3", "--out", "{file}/sub/s.csv"], ("contactfem.lab.sweep", "sweep"),
+     r"--out .*/sub/s.csv: .*a_file is a file, not a folder"),
+    (["sweep", "block", "--set", "mu=0.3", "--out", ""], ("contactfem.lab.sweep", "sweep"), r"--out: empty file name"),
 ])
 def test_every_command_checks_its_outputs_before_any_work(argv, target, pattern, tmp_path, monkeypatch, capsys):
     import importlib
@@ -122,6 +129,32 @@ def test_every_command_checks_its_outputs_before_any_work(argv, target, pattern,
     assert main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and re.search(pattern, err[0]), err
+
+
+def test_one_rule_for_missing_folders(tmp_path, monkeypatch, capsys):
+    """Every command's outputs make the missing folders of their path when written (README's
+    promises): run --json as figures --outdir and site --out do; a run that writes nothing
+    (refused, or failed) leaves no folder behind."""
+    target = tmp_path / "a" / "b" / "r.json"
+    assert main(["run", "block", "--preset", "canonical", "--json", str(target)]) == 0
+    assert json.loads(target.read_text())["parameters"]["width"] == 4.0
+    gone = tmp_path / "c" / "d" / "r.json"
+    monkeypatch.setattr(scenes, "run_scene", lambda *a, **k: (_ for _ in ()).throw(FloatingPointError("boom")))
+    assert main(["run", "block", "--json", str(gone)]) == 1
+    assert not (tmp_path / "c").exists()
+    made = []
+    monkeypatch.setattr(importlib.import_module("contactfem.plots"), "make_all",
+                        lambda preset, outdir, only: made.append(outdir) or [])
+    assert main(["figures", "--outdir", str(tmp_path / "e" / "f")]) == 0 and made == [str(tmp_path / "e" / "f")]
+    capsys.readouterr()
+
+
+def test_an_empty_output_name_is_refused(capsys):
+    """`--json ""` is bad input naming --json (it used to write nothing and exit 0)."""
+    for argv in (["run", "block", "--json", ""], ["run", "block", "--save", ""]):
+        assert main(argv) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and f"{argv[-2]}: empty file name" in err[0], err
 
 
 def test_help_names_every_command():

@@ -40,13 +40,14 @@ def test_penetration_stays_below_two_percent_of_the_radius(fast):
     assert fast["max_penetration_ratio"] < 0.02, fast["max_penetration_ratio"]
 
 
-def test_fast_preset_exit_velocity_is_near_the_paper(fast):
+def test_fast_preset_exit_velocity_is_near_the_paper(fast, paper):
     # paper "about 28 m/s" (two digits: +-2 %). The fast preset differs from the paper preset
     # only by its coarser steps around the exit (dt_fine 2e-5 instead of 5e-6 s, 1 mm of travel
-    # per step instead of 0.5, fewer press-fit increments): about 7 % faster than the paper
-    # preset when this was written, a time discretisation error. Tolerance 15 %: that error
-    # twice, plus the paper's rounding
-    v = fast["exit_velocity_m_s"]
+    # per step instead of 0.5, fewer press-fit increments): a time-discretisation error, held
+    # here to half the tolerance against the paper preset's run. Tolerance 15 %: that error at
+    # most twice, plus the paper's rounding
+    v, v_paper = fast["exit_velocity_m_s"], paper["exit_velocity_m_s"]
+    assert abs(v - v_paper) / v_paper < 0.075, f"fast {v:.2f} m/s, paper preset {v_paper:.2f} m/s"
     assert abs(v - PAPER_V) / PAPER_V < 0.15, f"paper {PAPER_V} m/s, ours {v:.2f} m/s, tolerance 15 %"
 
 
@@ -230,21 +231,25 @@ def test_the_closing_step_is_the_converged_rule(exit_study):
     assert abs(s["exit_without_ms"] - fit["without"]) > 10 * ONE_STEP_MS
 
 
-def test_exit_time_against_the_paper_or_the_study(exit_study, paper):
-    """Inside the paper's window, or outside it for the reason the study documents: the paper's
-    time step in the neck leaves a discretisation error in the stall after the ramp; refined
-    (the ramp kept), both rules give the same exit, and the paper's window lies within that
-    error of it."""
+def test_refined_exit_lies_within_the_paper_steps_error_of_the_window(exit_study, paper):
+    """The README and lecture 08: refined in the neck (the ramp kept), both rules leave at the same
+    time, and the paper's window lies within the discretisation error of the paper's own step
+    (1e-4 s, the paper preset's: the paper's run carries an error of that size) of that exit:
+    the gap between the refined exit and the window (0 inside it) is at most the difference
+    between the exit at the paper's step and the refined one. A model whose refined exit falls
+    inside the window passes; one further from it than that error fails. Both rules agree to two
+    steps of the recording near the exit (ONE_STEP_MS each). The README says 'just past the
+    paper's window' exactly when the refined exit lies outside it."""
+    from pathlib import Path
+
     d, s = exit_study
-    t = paper["exit_time_ms"]
-    if PAPER_WINDOW_MS[0] <= t <= PAPER_WINDOW_MS[1]:
-        return
     on, off = s["refined_ms"]["with"], s["refined_ms"]["without"]
     assert abs(on - off) < 2 * ONE_STEP_MS
-    error = abs(t - on)                              # the paper step's discretisation error
-    assert error > 10 * ONE_STEP_MS
+    error = abs(paper["exit_time_ms"] - on)            # the paper step's discretisation error
     gap = max(PAPER_WINDOW_MS[0] - on, on - PAPER_WINDOW_MS[1], 0.0)
     assert gap <= error, (gap, error)
+    readme = " ".join((Path(__file__).resolve().parents[1] / "README.md").read_text().split())
+    assert ("both rules leave just past the paper's window" in readme) == (gap > 0)
 
 
 def test_published_exit_numbers_are_the_run(exit_study, paper):

@@ -33,7 +33,7 @@ def no_solve(monkeypatch):
 
 
 BAD_BEFORE_THE_RUN = [
-    (["run", "block", "--json", "/nonexistent/dir/x.json"], "the folder /nonexistent/dir does not exist"),
+    (["run", "block", "--json", "/proc/nonexistent/dir/x.json"], "cannot write in /proc"),
     (["run", "block", "--json", "{tmp}"], "--json"),
     (["run", "block", "--save", "/proc/x.npz"], "cannot write in /proc"),
     (["run", "rolling_ring", "--gif", "{tmp}/y.png"], "must end in .gif or .mp4"),
@@ -74,7 +74,7 @@ def test_bad_input_is_one_line_before_any_solve(args, needle, tmp_path, capsys, 
 
 
 def test_bad_input_from_a_real_process_has_no_traceback():
-    out = run_cli("run", "block", "--json", "/nonexistent/dir/x.json")
+    out = run_cli("run", "block", "--json", "/proc/nonexistent/dir/x.json")
     assert out.returncode == 2 and len(out.stderr.strip().splitlines()) == 1 and "Traceback" not in out.stderr
 
 

@@ -60,26 +60,21 @@ def test_a_frictionless_plane_keeps_v_x(over):
     assert np.allclose(r["vx_c"], 2.0, rtol=1e-8, atol=0)               # at every step, through the impact
 
 
-def test_table2_velocities_out_of_reach_are_documented(res):
-    """The frictionless v_y and the frictional v_x, v_y are 14-18 % below the paper's 1.7,
-    1.2, 1.7 (outside the 10 % above) with every reading `contactfem reconstruct
-    sloping_impact` ranks (those with the paper's mass and integrator); the README states this
-    with the study's numbers. Checked: each
-    velocity against the paper with the 10 % criterion, and the README's numbers against
-    this run (to the two printed decimals), so that neither can drift silently."""
+def test_readme_table2_row_is_the_run(res):
+    """The README's Table 2 row of the preset (FITTED: two-point beam) states this run's
+    velocities and angles (to the printed decimals) and how many of Table 2's three scored numbers
+    (rc.TABLE2_SCORED) lie within the 10 % above: counted here from the run, so the row holds
+    whichever way a change moves the model (a better model, within 10 %, updates the count).
+    The frictionless v_x is no test of a reading (test_a_frictionless_plane_keeps_v_x)."""
     readme = (Path(__file__).parents[1] / "README.md").read_text()
-    section = readme[readme.index("### Table 2"):]
-    section = section[:section.index("\n## ")] if "\n## " in section else section
+    row = next(ln for ln in readme[readme.index("### Table 2"):].splitlines()
+               if ln.startswith("| two-point beam (preset `paper`"))
     for v in ("frictionless", "frictional"):
-        r, p = res[v], PAPER_TABLE2[v]
-        for q in ("vx", "vy"):
-            ours = abs(r[f"rebound_{q}"])
-            within = abs(ours / p[q] - 1) <= VELOCITY_TOL
-            if v == "frictionless" and q == "vx":
-                assert within
-                continue
-            assert not within, f"{v} {q} = {ours:.3f} now within 10 % of {p[q]}: update the README"
-            assert f"{ours:.2f}" in section, f"README Table 2 section lacks {v} {q} = {ours:.2f}"
+        r = res[v]
+        text = f"{abs(r['rebound_vx']):.2f}, {abs(r['rebound_vy']):.2f}, {r['rebound_angle_deg']:.1f} deg"
+        assert text in row, f"README's Table 2 row lacks {v} {text!r}: {row}"
+    within = sum(abs(abs(res[v][f"rebound_{q}"]) / PAPER_TABLE2[v][q] - 1) <= VELOCITY_TOL for v, q in rc.TABLE2_SCORED)
+    assert f"| {within} of {len(rc.TABLE2_SCORED)} |" in row, row
 
 
 def test_friction_slows_and_spins_the_ring(res):

@@ -7,6 +7,8 @@
         write_json(out.temp("--json"))             # each file goes to a temporary beside its target
         out.commit()                               # then all are renamed into place together
 
+Missing folders of an output path are made when it is written (and removed again if the
+run writes nothing); the nearest existing one must be a folder where files can be created.
 A file is never seen half written: each is written under a temporary name in the target's
 folder (``.<name>.<random>.part<suffix>``) and renamed (``os.replace``, atomic on one file
 system) only when every output is complete. During the renames Ctrl-C is held back, so an
@@ -20,30 +22,46 @@ import threading
 from pathlib import Path
 
 
+# One rule for every command's outputs (files and folders alike): the folders of an output path
+# that do not exist yet are made, as a file manager's "save as" makes a new folder; what must
+# already exist is their nearest existing parent, a folder where files can be created. The
+# check comes before any work; the folders are made when the output is written.
+
+
 def check_output_path(path, what, suffixes):
-    """ValueError (one line naming the option) unless `path` can be written: an allowed
-    suffix, not a folder, in an existing folder where a file can be created."""
+    """ValueError (one line naming the option) unless `path` can be written: not empty, an
+    allowed suffix, not a folder, and in a folder that exists or can be made (its nearest
+    existing parent a folder where files can be created). Makes nothing (``make_parents``
+    does, when the file is written)."""
+    if not str(path).strip():
+        raise ValueError(f"{what}: empty file name; give a file name{' ending in ' + ' or '.join(suffixes) if suffixes else ''}")
     p = Path(path)
     if suffixes and p.suffix.lower() not in suffixes:
         raise ValueError(f"{what} {path}: the file name must end in {' or '.join(suffixes)}")
     if p.is_dir():
         raise ValueError(f"{what} {path}: is a folder, give a file name")
     folder = p.parent if str(p.parent) else Path(".")
-    if not folder.is_dir():
-        is_file = folder.exists()
-        raise ValueError(f"{what} {path}: {folder} is a file, not a folder" if is_file
-                         else f"{what} {path}: the folder {folder} does not exist")
-    _probe(folder, what, path)
+    if folder.exists() and not folder.is_dir():
+        raise ValueError(f"{what} {path}: {folder} is a file, not a folder")
+    _writable_ancestor(folder, what, path)
     return p
 
 
 def check_output_dir(path, what):
     """ValueError (one line naming the option) unless `path` is a folder that exists or can
-    be made: not a file, and its nearest existing parent a folder where files can be
-    created. Makes nothing."""
+    be made: not empty, not a file, and its nearest existing parent a folder where files can
+    be created. Makes nothing."""
+    if not str(path).strip():
+        raise ValueError(f"{what}: empty folder name; give a folder")
     p = Path(path)
     if p.exists() and not p.is_dir():
         raise ValueError(f"{what} {path}: is a file, give a folder")
+    _writable_ancestor(p, what, path)
+    return p
+
+
+def _writable_ancestor(p, what, path):
+    """The nearest existing folder of ``p`` (``p`` itself if it exists), checked writable."""
     parent = p
     while not parent.exists():
         if parent.parent == parent:
@@ -54,7 +72,18 @@ def check_output_dir(path, what):
     if not os.access(parent, os.W_OK | os.X_OK):
         raise ValueError(f"{what} {path}: cannot write in {parent} (permission denied)")
     _probe(parent, what, path)                  # (a special file system may refuse what access allows)
-    return p
+    return parent
+
+
+def make_parents(path):
+    """Make the missing folders above the output file ``path``; returns those made (outermost
+    first), for a writer that removes them again if it writes nothing."""
+    made, folder = [], Path(path).parent
+    while str(folder) and not folder.exists():
+        made.append(folder)
+        folder = folder.parent
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    return made[::-1]
 
 
 def _probe(folder, what, path):
@@ -77,6 +106,7 @@ class Outputs:
     def __init__(self):
         self.paths = {}          # option -> target Path
         self.temps = {}          # option -> temporary Path
+        self.made = []           # folders made for the outputs (removed again if nothing is written)
         self.committed = False
 
     def add(self, what, path, suffixes=()):
@@ -90,6 +120,7 @@ class Outputs:
     def temp(self, what):
         """The temporary file name to write the output `what` to (same folder, same suffix)."""
         p = self.paths[what]
+        self.made += make_parents(p)
         t = p.with_name(f".{p.stem}.{secrets.token_hex(4)}.part{p.suffix}")
         self.temps[what] = t
         return t
@@ -114,6 +145,11 @@ class Outputs:
         for t in self.temps.values():
             try:
                 t.unlink(missing_ok=True)
+            except OSError:
+                pass
+        for folder in reversed(self.made):      # innermost first; only if still empty
+            try:
+                folder.rmdir()
             except OSError:
                 pass
 

@@ -128,7 +128,7 @@ def _from_module(module, name, option, spec):
         raise ValueError(f"{option} expects FILE.py:CLASS or package.module:CLASS, got class name {name!r}")
     try:
         mod = importlib.import_module(module)
-    except Exception as err:                          # noqa: BLE001 (anything in the user's module)
+    except (Exception, SystemExit) as err:            # noqa: BLE001 (anything in the user's module, even exit)
         raise ValueError(f"{option} {spec}: cannot import {module} ({_cause(err)})") from None
     cls = getattr(mod, name, None)
     if cls is None or not isinstance(cls, type):
@@ -150,6 +150,10 @@ def _from_file(file, name, option):
     sys.modules[mod_name] = module                     # dataclasses look the module up
     try:
         mspec.loader.exec_module(module)
+    except SystemExit as err:                         # sys.exit() in the file: bad input, not our exit
+        sys.modules.pop(mod_name, None)
+        raise ValueError(f"{_where(path, err)}: the law file calls sys.exit({err.code!r}) when it is imported; a law "
+                         "file only defines its law") from None
     except Exception as err:                          # noqa: BLE001 (anything in the user's file)
         sys.modules.pop(mod_name, None)
         raise ValueError(f"{_where(path, err)}: {_cause(err)}") from None

@@ -112,6 +112,22 @@ def _num(x):
     return f"{x.real:.6g}"
 
 
+def _real(value, what, where=lambda i: ""):
+    """``value`` (a law's output at real arguments) as real numbers: a zero imaginary part is
+    dropped, a nonzero one is a LawValueError (one line: the value and, via ``where(i)``, the point)."""
+    if not np.iscomplexobj(value):
+        return value
+    a = np.asarray(value)
+    bad = np.imag(a) != 0
+    if np.any(bad):
+        i = np.unravel_index(int(np.argmax(bad)), a.shape) if a.ndim else ()
+        at = where(i[0] if len(i) == 1 else 0)
+        raise LawValueError(f"{what} is complex, {_num(a[i])}{' at ' + at if at else ''}: a law returns real numbers "
+                            "at real arguments (a square root or a fractional power of a negative number? "
+                            "clip it with np.maximum(x, 0) first)")
+    return np.real(a)
+
+
 def check_fields(law):
     """LawError unless every number among a dataclass law's fields is finite (checked when
     an adapter is made: a NaN field would only come back as NaN values during the run)."""
@@ -282,7 +298,7 @@ class FrictionLaw:
             return fn()
         except (LawError, ComplexWarning):
             raise
-        except Exception as err:               # noqa: BLE001 (a student's law may raise anything)
+        except (Exception, SystemExit) as err:  # noqa: BLE001 (a student's law may raise anything, even exit)
             raise LawValueError(explain_call_error(f"{self.name}.{what}", err)) from None
 
     # -- the slip bound -----------------------------------------------------
@@ -291,7 +307,7 @@ class FrictionLaw:
             return self.law.slip_bound(*args[:self.arity])
         except (LawError, ComplexWarning):
             raise
-        except Exception as err:               # noqa: BLE001 (a student's law may raise anything)
+        except (Exception, SystemExit) as err:  # noqa: BLE001 (a student's law may raise anything, even exit)
             raise LawValueError(explain_call_error(f"{self.name}.slip_bound", err)) from None
 
     def _split(self, out, n):
@@ -356,8 +372,9 @@ class FrictionLaw:
             rest = (np.zeros(n), np.zeros((n, k)))[self.arity - 2:]
             return (*out, *rest)
         Y, ders = self._split(self._call(args, ""), n)
-        if np.iscomplexobj(Y):
-            Y = np.real(Y)
+        at = lambda i: self._where(p, q, v, z, i)          # noqa: E731
+        Y = _real(Y, f"{self.name}.slip_bound: Y", at)
+        self._one_for_all(Y, args, n)
         Y = np.array(_as_array(Y, (n,), f"{self.name}.slip_bound: Y"), dtype=float)
         if any(d is None for d in ders):        # Y first: the missing derivatives are computed from it
             self._guard_slip_bound(args, (Y,))
@@ -370,6 +387,7 @@ class FrictionLaw:
             d = ders[j]
             if d is not None:
                 shape = (n, k) if j == 3 else (n,)
+                d = _real(d, f"{self.name}.slip_bound: {name}", at)
                 res.append(np.array(_as_array(d, shape, f"{self.name}.slip_bound: {name}"), dtype=float))
                 self.supplied.add(name)
             elif j == 3:
@@ -382,6 +400,29 @@ class FrictionLaw:
         out = (Y, *res)
         self._guard_slip_bound(args, out)
         return out
+
+    def _one_for_all(self, Y, args, n):
+        """LawValueError if slip_bound returned one number for all n > 1 nodes that depends on
+        their values (``mu * np.mean(p)``): Y must be one value per node, each from that node's own
+        arguments. One number that does not change with them (a constant Y) is one for every node."""
+        if n < 2 or np.ndim(Y) != 0 or np.asarray(Y).dtype.kind not in "biuf":
+            return                             # (not a number: _as_array says so)
+        moved = [np.array(a, dtype=float) for a in args]     # the first node's arguments moved
+        moved[0][0] = 2.0 * moved[0][0] + 1.0
+        for a in moved[1:]:
+            if a.size:
+                a[0] = a[0] + 1.0
+        try:
+            Y2, _ = self._split(self._call(moved, ""), n)
+        except LawError:
+            return
+        Y2 = np.asarray(Y2)
+        if Y2.ndim == 0 and Y2.dtype.kind in "biufc" and not np.array_equal(Y2, np.asarray(Y), equal_nan=True):
+            names = ", ".join(ARG_NAMES[:self.arity])
+            raise LawValueError(
+                f"{self.name}.slip_bound returned one number for all {n} contact nodes (shape ()), and it changes "
+                f"with the values at one node: it must return one value per node, shape ({n},), each from that "
+                f"node's own {names} (e.g. mu * p, not mu * np.mean(p))")
 
     def _guard_slip_bound(self, args, out):
         """LawValueError at the first node where the law returned NaN/inf or Y < 0 (nodes whose
@@ -413,7 +454,7 @@ class FrictionLaw:
             return self.law.evolve(z_bar, p, lam, dt)
         except (LawError, ComplexWarning):
             raise
-        except Exception as err:               # noqa: BLE001
+        except (Exception, SystemExit) as err:  # noqa: BLE001
             raise LawValueError(explain_call_error(f"{self.name}.evolve(z_bar, p, lam, dt)", err)) from None
 
     def evolve(self, z_bar, p, lam, dt):
@@ -432,11 +473,12 @@ class FrictionLaw:
             z, dz_p, dz_lam = out
         else:
             z, dz_p, dz_lam = out, None, None
-        z = np.array(_as_array(np.real(z) if np.iscomplexobj(z) else z, (n, k), f"{self.name}.evolve: z"), dtype=float)
+        z = np.array(_as_array(_real(z, f"{self.name}.evolve: z"), (n, k), f"{self.name}.evolve: z"), dtype=float)
         res = []
         for name, d, x in (("dz/dp", dz_p, 1), ("dz/dlam", dz_lam, 2)):
             if d is not None:
-                res.append(np.array(_as_array(d, (n, k), f"{self.name}.evolve: {name}"), dtype=float))
+                res.append(np.array(_as_array(_real(d, f"{self.name}.evolve: {name}"), (n, k),
+                                              f"{self.name}.evolve: {name}"), dtype=float))
                 self.supplied.add(name)
                 continue
             a = [z_bar, np.asarray(p, dtype=float), np.asarray(lam, dtype=float), dt]
@@ -514,7 +556,7 @@ class NormalLawView:
             return getattr(self.law, method)(g)
         except LawError:
             raise
-        except Exception as err:               # noqa: BLE001
+        except (Exception, SystemExit) as err:  # noqa: BLE001
             raise LawValueError(explain_call_error(f"{self.name}.{method}", err)) from None
 
     def traction(self, g_N):
@@ -527,7 +569,8 @@ class NormalLawView:
             got = f"{len(out)} values" if isinstance(out, (tuple, list)) else "one value"
             raise LawValueError(f"{self.name}.traction(g_N) returned {got}: it must return the two values "
                                 "(t_N, dt_N/dg_N)")
-        t, dt = (np.array(_as_array(np.real(a) if np.iscomplexobj(a) else a, g.shape, f"{self.name}.traction: {w}"),
+        at = lambda i: f"g_N = {_num(g.ravel()[i])}" if g.size else ""       # noqa: E731
+        t, dt = (np.array(_as_array(_real(a, f"{self.name}.traction: {w}", at), g.shape, f"{self.name}.traction: {w}"),
                           dtype=float) for a, w in zip(out, ("t_N", "dt_N/dg_N")))
         if self.check_values and t.size and not (_all_finite((t, dt)) and (t.max() <= 0.0 or not np.any((t > 0.0) & (g < 0.0)))):
             ok = np.isfinite(g)
@@ -550,7 +593,7 @@ class NormalLawView:
             return self.law.energy(g_N)
         g = np.asarray(g_N, dtype=float)
         W = self._call("energy", g)
-        W = np.array(_as_array(np.real(W) if np.iscomplexobj(W) else W, g.shape, f"{self.name}.energy"), dtype=float)
+        W = np.array(_as_array(_real(W, f"{self.name}.energy"), g.shape, f"{self.name}.energy"), dtype=float)
         if self.check_values and not _all_finite((W,)):
             bad = ~np.isfinite(W) & np.isfinite(g)
             if np.any(bad):

@@ -4,6 +4,8 @@ foundation (Sec. 5.1), whole load in one step.
     fig06_block_mesh_deformed         Fig 6: system, discretisation, deformed configuration
     fig07_block_conical_stresses      Fig 7: normal and friction stress on the contact side, conical slip surface
     fig08_block_parabolic_stresses    Fig 8: the same for the parabolic slip surface
+    fig08b_block_fig8_readings        Fig 8 of the preset beside Fig 8 of the reading (preset fig8)
+                                      that shows the paper's remark (figures/NAME.json: the numbers)
     table1_block_newton_residuals     Table 1: ||G|| per Newton iteration, ours beside the paper's (.md and .png)
 
 Each function draws from results it is given (a lecture passes the result of its own
@@ -19,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from ..scenes.block import SCENE, solve
-from ..scenes.block_params import PAPER_TABLE1, PAPER_TABLE1_UNCERTAIN
+from ..scenes.block_params import FIG8_DROP, PAPER_TABLE1, PAPER_TABLE1_UNCERTAIN, fig8_remark
 from ..solver.newton import NewtonError
 from . import cached_run, default_outdir, describe_newton, figure, fitted_words, pyplot, savefig  # noqa: F401
 from .data import save_figure
@@ -167,6 +169,71 @@ def fig08(preset="fast", outdir=None, r=None, conical=None):
                      f"{slip_words(r)}; grey: the conical case (Fig 7)" + _fitted_line(r))
     return save_figure(fig, Path(outdir or default_outdir(preset)) / "fig08_block_parabolic_stresses.png",
                        dict(stress_data(r), conical=stress_data(rc)), P)
+
+
+def fig8_reading_data(preset="fast", other="fig8"):
+    """What fig08b draws, for the block's ``preset`` and the reading of preset ``other``: per
+    reading the measure of Fig 8's remark (scenes.block_params.fig8_remark: fig8_fraction,
+    fig8_min_reduction, fig8_nodes), each law's n_slip and newton_residuals, and the stresses along
+    the contact side; and the parameters of both runs."""
+    data, params = {"fig8_drop": FIG8_DROP, "readings": {}}, {}
+    for name in (preset, other):
+        runs = {law: result(name, law=law) for law in ("conical", "parabolic")}
+        c, p = runs["conical"]["contact"], runs["parabolic"]["contact"]
+        frac, red, n_top = fig8_remark(c["t_N"], c["t_T"], p["t_T"])
+        data["readings"][name] = dict(
+            fig8_fraction=frac, fig8_min_reduction=red, fig8_nodes=n_top,
+            **{law: dict(n_slip=r["n_slip"], newton_residuals=r["newton_residuals"]) for law, r in runs.items()},
+            x=c["x"], t_N_conical=c["t_N"], t_T_conical=c["t_T"], t_T_parabolic=p["t_T"])
+        params[name] = {k: v for k, v in runs["conical"]["parameters"].items() if k != "law"}
+    return data, params
+
+
+def _reading_words(P):
+    return (f"{P['width']:g} x {P['height']:g}, {P['nx']} x {P['ny']}, p_x on the {P['p_x_face']} side, "
+            f"{P['free_end_nodes']} free end node{'s' if P['free_end_nodes'] > 1 else ''}, c_N = {P['c_N']:g} "
+            f"{P['penalty'].replace('_', ' ')}, plane {P['plane']}")
+
+
+@figure("fig08b_block_fig8_readings", "Fig 8")
+def fig08b(preset="fast", outdir=None, other="fig8"):
+    """Fig 8 of the block's ``preset`` beside Fig 8 of preset ``other`` (the best-ranked reading of
+    `contactfem reconstruct block` that shows the paper's remark); the nodes in the top quartile
+    of the conical pressure, where the remark is measured, shaded. Writes NAME.json beside the
+    PNG (plots.data)."""
+    plt = pyplot()
+    data, params = fig8_reading_data(preset, other)
+    fig, axes = plt.subplots(1, 2, figsize=(14, 5.8))
+    for ax, (name, d) in zip(axes, data["readings"].items()):
+        P = params[name]
+        x, pN = np.asarray(d["x"]), np.abs(np.asarray(d["t_N_conical"]))
+        tc, tp = np.abs(d["t_T_conical"]), np.abs(d["t_T_parabolic"])
+        top = pN >= np.quantile(pN, 0.75)
+        ax.plot(x, pN, "k+-", lw=1.1, ms=6, label="|t_N| (conical)")
+        ax.plot(x, tc, ":", color="0.5", marker="x", ms=4, label="|t_T| conical")
+        ax.plot(x, tp, "-", color="tab:red", marker="o", ms=3, label="|t_T| parabolic")
+        for xi in x[top]:
+            ax.axvspan(xi - 0.04, xi + 0.04, color="gold", alpha=0.35, lw=0)
+        holds = d["fig8_fraction"] == 1.0
+        ax.set_title(f"preset {name}: {_reading_words(P)}\nthe {d['fig8_nodes']} nodes of highest conical pressure "
+                     f"(shaded): parabolic |t_T| lower\nby at least {100 * data['fig8_drop']:g} % at "
+                     f"{round(d['fig8_fraction'] * d['fig8_nodes'])} of them, smallest reduction "
+                     f"{100 * d['fig8_min_reduction']:+.1f} %\nremark {'SHOWN' if holds else 'not shown'}; Newton: "
+                     f"conical {len(d['conical']['newton_residuals'])}, parabolic "
+                     f"{len(d['parabolic']['newton_residuals'])} residuals (Table 1: "
+                     f"{len(PAPER_TABLE1['conical'])}, {len(PAPER_TABLE1['parabolic'])}); nodes slipping: conical "
+                     f"{d['conical']['n_slip']}, parabolic {d['parabolic']['n_slip']}", fontsize=8)
+        ax.set_xlabel("x-coordinate (reference)")
+        ax.set_ylabel("contact stress (force / length)")
+        ax.set_ylim(0, None)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.suptitle("Fig 8's remark, 'a considerable reduction of the frictional stress in the region of higher "
+                 "normal pressure', on two readings of the values the scan lost\n(neither is the paper's: the preset "
+                 "FITTED to Table 1, preset fig8 the study's best-ranked reading that shows the remark)", fontsize=10)
+    fig.tight_layout()
+    outdir = outdir or default_outdir(preset)
+    return save_figure(fig, Path(outdir) / "fig08b_block_fig8_readings.png", data, params)
 
 
 def _fitted_line(r):

@@ -70,6 +70,9 @@ def run_scene(name, preset="fast", overrides=None, progress=None, friction=None,
     dense|banded|sparse, joined by + if they differ; ``ordering``; ``unknowns``, the largest
     System's; ``band_kl``, ``band_ku``: the half-bandwidths of a banded K, else None), and how
     often they were evaluated (``residual_evaluations``, ``contact_evaluations``).
+    ``overrides``: {parameter name: value}, a value given as a number or as the text of one (the
+    same rule as the command line's --set: an integer parameter takes 12, 12.0 or "12"; see
+    scenes.params); a TypeError names ``overrides`` or ``progress`` given as anything else.
     ``linear_algebra``: auto|dense|banded|sparse for every System the scene builds (None: auto,
     chosen by size and band width), to compare the solvers on one scene.
     ``progress(t0, t_end, label)``: a progress-callback factory for the scene's time loops
@@ -88,7 +91,13 @@ def run_scene(name, preset="fast", overrides=None, progress=None, friction=None,
     from ..laws.protocol import as_normal_law, describe
     from ..solver.assembly import KINDS
 
+    from .params import check_overrides
+
     scene = get_scene(name)
+    overrides = check_overrides(overrides)
+    if progress is not None and not callable(progress):
+        raise TypeError(f"parameter progress must be None or a callable progress(t0, t_end, label) (e.g. "
+                        f"contactfem.io.progress_bar), got {type(progress).__name__} {progress!r}")
     laws = {k: v for k, v in (("friction", friction), ("normal", normal)) if v is not None}
     check_laws(scene, laws, overrides)
     params = scene.resolve(preset, overrides)

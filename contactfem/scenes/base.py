@@ -18,7 +18,7 @@ from typing import Callable
 
 import numpy as np
 
-from .params import Param  # noqa: F401  (scene modules take it from here)
+from .params import Param, check_overrides  # noqa: F401  (scene modules take Param from here)
 from .resources import check_resources, describe  # noqa: F401  (the command line takes them from here)
 
 PENALTIES = ("per_length", "per_node")
@@ -125,7 +125,7 @@ class Scene:
         known = {p.name: p for p in self.params}
         values = {p.name: p.default for p in self.params}
         values.update(self.presets.get(preset, {}))
-        overrides = dict(overrides or {})
+        overrides = check_overrides(overrides)
         for k, v in overrides.items():
             if k not in known:
                 head, dot, field = str(k).partition(".")
