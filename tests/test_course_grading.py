@@ -92,6 +92,8 @@ CLASS = [
     ("magic", [HEAD, "%matplotlib inline\n" + PL, "import otter\ngrader = otter.Notebook('x.ipynb')", TR,
                'grader.check("ex01_power_law")'], (5, 5), ""),
     ("tr_only_fields", [HEAD, PL, TR.replace("float(self.tau_y)", "0.2")], (5, 3), "tau_y = 1.3"),
+    ("kills_the_grader", [HEAD, PL, TR, "import os, signal\nos.kill(os.getppid(), signal.SIGKILL)"], (0, 0),
+     "worker died: signal 9"),                                            # it can stop its grading, not score
     ("full3", [HEAD, PL, TR], (5, 5), ""),
     ("compares_with_library", [HEAD, PL + "\n\nfrom contactfem.laws import PowerLaw\n"
                                "print(PowerLaw(100.0, 2.5).traction(-0.1), power_law(-0.1, 100.0, 2.5))", TR], (5, 5), ""),

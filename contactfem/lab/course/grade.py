@@ -387,8 +387,8 @@ def library_hint(exercise, used):
 
 def grade_notebook(path, lecture, material, limits):
     """Grade one notebook (the function the batch's workers run): a dict with the parts
-    [(exercise, part, points scored, points possible, message)], the cells that failed, the
-    written answers, and `stopped` (why the submission's process ended early, or None)."""
+    [(exercise, part, points scored, points possible, message)], the cells that failed, what
+    it printed, and `stopped` (why the submission's process ended early, or None)."""
     from . import checks
 
     t0 = time.monotonic()
@@ -398,7 +398,7 @@ def grade_notebook(path, lecture, material, limits):
     checks._MEMO.clear()
     mine = [e for e in checks.EXERCISES.values() if e.lecture == lecture]
     code_cells = [(i, src) for i, (kind, src) in enumerate(cells, 1) if kind == "code"]
-    out = {"parts": [], "errors": [], "stopped": None, "printed": 0, "manual": manual_answers(cells)}
+    out = {"parts": [], "errors": [], "stopped": None, "printed": 0}
     with tempfile.TemporaryDirectory(prefix="contactfem-submission-") as work:
         box = Box(limits, work)
         try:
@@ -681,7 +681,7 @@ def _row(student, path, rel, lec, outcome, columns, manual, scores_read, deadlin
                      else f"not graded: {reason}")
     else:
         res = outcome.value
-        parts, answers = res["parts"], res["manual"]
+        parts = res["parts"]
         if res["stopped"]:
             status, stop = "stopped", res["stopped"]
             notes.append(res["stopped"])
@@ -689,6 +689,11 @@ def _row(student, path, rel, lec, outcome, columns, manual, scores_read, deadlin
         notes += res["errors"][:3] + ([f"and {more} more cells failed"] if more > 0 else [])
         if res["printed"] > 2**20:
             notes.append(f"printed {res['printed'] / 2**20:.0f} MB (not kept)")
+    if path is not None and lec:      # the written answers, read here: a notebook stopped early has them too
+        try:
+            answers = manual_answers(read_notebook(path)[0])
+        except ValueError:
+            pass
     total = 0.0
     for e in columns:
         if e in mine:
