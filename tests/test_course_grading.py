@@ -516,3 +516,22 @@ def _alive(pid):
         return open(f"/proc/{pid}/stat").read().rsplit(")", 1)[1].split()[0] not in "ZX"
     except OSError:
         return False
+
+
+def test_the_hidden_checks_are_not_in_the_package():
+    """The installed package (contactfem/) holds no hidden check: not the file, not one of its
+    functions; the grader finds them in the instructor's material (the checkout's lectures/)."""
+    from pathlib import Path
+
+    import contactfem
+    from contactfem.lab.course.grade import hidden_checks_file, load_hidden
+
+    path = hidden_checks_file()
+    assert path is not None and path.parent.name == "lectures"
+    names = {f.__name__ for fs in load_hidden(path).values() for f in fs}
+    assert len(names) >= 20
+    package = Path(contactfem.__file__).parent
+    assert not list(package.rglob("hidden_checks*"))
+    for f in package.rglob("*.py"):
+        text = f.read_text()
+        assert not [n for n in names if f"def {n}(" in text or f" {n}," in text], f
