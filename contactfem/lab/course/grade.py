@@ -126,16 +126,22 @@ class Handle:
 
 
 def _set_limits(memory):
+    """What the submission's process sets up before it starts (POSIX): death with the worker
+    (Linux), its memory limit (where the platform allows one), a process group of its own (its
+    children end with it; a signal to the worker's group does not reach it)."""
     def limit():
         import ctypes
         import resource
 
-        try:        # die with the worker that started it (Linux)
-            ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, 9)
+        try:
+            ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, 9)      # PR_SET_PDEATHSIG, SIGKILL
         except (OSError, AttributeError):
             pass
         if memory:
-            resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+            try:
+                resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+            except (ValueError, OSError):
+                pass
         os.setpgrp()
     return limit
 
@@ -157,7 +163,8 @@ class Box:
         code = f"from contactfem.lab.course.sandbox import serve; serve({req_r}, {rep_w})"
         self.proc = subprocess.Popen([sys.executable, "-c", code], pass_fds=(req_r, rep_w), cwd=workdir, env=env,
                                      stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                                     stderr=subprocess.DEVNULL, preexec_fn=_set_limits(limits.memory))
+                                     stderr=subprocess.DEVNULL,
+                                     preexec_fn=_set_limits(limits.memory) if os.name == "posix" else None)
         os.close(req_r)
         os.close(rep_w)
         from multiprocessing.connection import Connection
@@ -171,7 +178,7 @@ class Box:
 
         try:
             os.killpg(self.proc.pid, signal.SIGKILL)
-        except (ProcessLookupError, PermissionError):
+        except (ProcessLookupError, PermissionError, AttributeError):      # AttributeError: not POSIX
             pass
         if self.proc.poll() is None:
             self.proc.kill()
