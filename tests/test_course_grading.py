@@ -151,7 +151,6 @@ def graded(tmp_path_factory):
     return root, {r["submission"] or r["id"]: r for r in rows}, seconds
 
 
-@pytest.mark.slow
 def test_a_class_of_thirty_gets_the_scores_intended(graded):
     """Every submission of the mock class gets its intended score and the note that says why;
     the corrupt file, the missing one and the one not on the roster get their rows."""
@@ -177,7 +176,6 @@ def test_a_class_of_thirty_gets_the_scores_intended(graded):
     assert seconds < 240
 
 
-@pytest.mark.slow
 def test_the_class_review_and_feedback_files_are_complete(graded):
     root, rows, _ = graded
     page = (root / "scores-review" / f"{LECTURE}.html").read_text()
