@@ -354,7 +354,8 @@ def test_every_written_question_is_in_its_lecture_with_its_points():
 
 def test_hidden_checks_pass_every_solution_and_cover_the_exercises():
     """Every hidden check passes the instructor's solution (run here, in one process), and the
-    stub fails the hidden checks of every exercise; every exercise without a scene has some."""
+    stub fails the hidden checks of every exercise; every exercise but one (two long scene runs)
+    has some."""
     import numpy as np
 
     from contactfem.lab.course import lecture_sources, solution_cells
@@ -364,7 +365,7 @@ def test_hidden_checks_pass_every_solution_and_cover_the_exercises():
     hidden = load_hidden(hidden_checks_file())
     parts = {p.name for e in EXERCISES.values() for p in e.parts}
     assert set(hidden) <= parts
-    scenes = {"ex04_load_steps", "ex05_incline", "ex07_census"}      # a scene run per check: public only
+    scenes = {"ex05_incline"}          # two scene runs of 120 s allowed each: public only
     for name, e in EXERCISES.items():
         assert any(p.name in hidden for p in e.parts) == (name not in scenes), name
     sols = {}
