@@ -320,6 +320,56 @@ def ssn_other(semismooth_1dof):
     compare("p (k = 40, P = 30, g0 = 0.25)", p, P - k * g0, at)
 
 
+# -- the time loops (lectures 04 and 07): another number of steps ------------------------------------
+
+def load_steps_two(load_steps):
+    from contactfem.lab.course.checks import _load_steps, _load_steps_ref
+
+    t, its, slip = _load_steps(load_steps, 2)
+    want = _load_steps_ref(2)
+    if t.size != 2:
+        raise AssertionError(f"load_steps(stepper, 2) should give one entry per load step, 2, got {t.size}")
+    compare("the load in two steps: (t, solves, slipping nodes)", np.r_[t, its, slip],
+            np.r_[want[0], want[1], want[2]], {"entry": ["t1", "t2", "solves1", "solves2", "slip1", "slip2"]},
+            rule="Steps(1 / n, n_steps=n), rec.iterations, the SLIP states of each record")
+
+
+def _census_short(census):
+    """The census of the funnel's first 12 steps (its schedule's step, fewer of them)."""
+    from contactfem.lab.course.checks import _as_list, _counts, _scene_model, memo
+    from contactfem.solver import Steps
+    from contactfem.solver.march import march
+
+    def stage():
+        model, _ = _scene_model("funnel", {"variant": "frictional"})
+        st = model["stage"]
+        return st, Steps(st.schedule.dt, n_steps=12, t0=st.schedule.t0)
+
+    def student():
+        st, short = stage()
+        return call(census, "census", st.stepper, short, st.u0, st.v0, timeout=120.0)
+
+    def reference():
+        st, short = stage()
+        recs = list(march(st.stepper, short, st.t0, st.u0, st.v0))
+        c = np.array([_counts(r) for r in recs], float)
+        return np.array([r.t for r in recs]), c[:, 0], c[:, 1]
+
+    got = _as_list(memo(("census_short", census), student), 3, "census", "times, contact and slip counts")
+    return got, memo(("census_short_ref",), reference)
+
+
+def census_short(census):
+    (t, n_c, n_s), (w_t, w_c, w_s) = _census_short(census)
+    if t.size != w_t.size:
+        raise AssertionError(f"on a schedule of 12 steps your census has {t.size} entries, the run {w_t.size} "
+                             "records (the initial state included): loop over the schedule you are given")
+    at = {"record": np.arange(t.size)}
+    compare("time of each record (12 steps)", t, w_t, at)
+    compare("nodes in contact (12 steps)", n_c, w_c, at)
+    compare("slipping nodes (12 steps)", n_s, w_s, at)
+
+
 HIDDEN = {
     "power_law_open": [power_law_open_far],
     "power_law_traction": [power_law_traction_other],
@@ -358,4 +408,9 @@ HIDDEN = {
     "ct_stick_slip": [ct_other],
     "ct_derivatives": [ct_other],
     "ssn_contact": [ssn_other],
+    "load_steps_times": [load_steps_two],
+    "load_steps_slipping": [load_steps_two],
+    "census_times": [census_short],
+    "census_contact": [census_short],
+    "census_slip": [census_short],
 }

@@ -92,6 +92,8 @@ CLASS = [
     ("magic", [HEAD, "%matplotlib inline\n" + PL, "import otter\ngrader = otter.Notebook('x.ipynb')", TR,
                'grader.check("ex01_power_law")'], (5, 5), ""),
     ("tr_only_fields", [HEAD, PL, TR.replace("float(self.tau_y)", "0.2")], (5, 3), "tau_y = 1.3"),
+    ("kills_the_grader", [HEAD, PL, TR, "import os, signal\nos.kill(os.getppid(), signal.SIGKILL)"], (0, 0),
+     "worker died: signal 9"),                                            # it can stop its grading, not score
     ("full3", [HEAD, PL, TR], (5, 5), ""),
     ("compares_with_library", [HEAD, PL + "\n\nfrom contactfem.laws import PowerLaw\n"
                                "print(PowerLaw(100.0, 2.5).traction(-0.1), power_law(-0.1, 100.0, 2.5))", TR], (5, 5), ""),
@@ -149,7 +151,6 @@ def graded(tmp_path_factory):
     return root, {r["submission"] or r["id"]: r for r in rows}, seconds
 
 
-@pytest.mark.slow
 def test_a_class_of_thirty_gets_the_scores_intended(graded):
     """Every submission of the mock class gets its intended score and the note that says why;
     the corrupt file, the missing one and the one not on the roster get their rows."""
@@ -175,7 +176,6 @@ def test_a_class_of_thirty_gets_the_scores_intended(graded):
     assert seconds < 240
 
 
-@pytest.mark.slow
 def test_the_class_review_and_feedback_files_are_complete(graded):
     root, rows, _ = graded
     page = (root / "scores-review" / f"{LECTURE}.html").read_text()
@@ -354,7 +354,8 @@ def test_every_written_question_is_in_its_lecture_with_its_points():
 
 def test_hidden_checks_pass_every_solution_and_cover_the_exercises():
     """Every hidden check passes the instructor's solution (run here, in one process), and the
-    stub fails the hidden checks of every exercise; every exercise without a scene has some."""
+    stub fails the hidden checks of every exercise; every exercise but one (two long scene runs)
+    has some."""
     import numpy as np
 
     from contactfem.lab.course import lecture_sources, solution_cells
@@ -364,7 +365,7 @@ def test_hidden_checks_pass_every_solution_and_cover_the_exercises():
     hidden = load_hidden(hidden_checks_file())
     parts = {p.name for e in EXERCISES.values() for p in e.parts}
     assert set(hidden) <= parts
-    scenes = {"ex04_load_steps", "ex05_incline", "ex07_census"}      # a scene run per check: public only
+    scenes = {"ex05_incline"}          # two scene runs of 120 s allowed each: public only
     for name, e in EXERCISES.items():
         assert any(p.name in hidden for p in e.parts) == (name not in scenes), name
     sols = {}
@@ -514,3 +515,22 @@ def _alive(pid):
         return open(f"/proc/{pid}/stat").read().rsplit(")", 1)[1].split()[0] not in "ZX"
     except OSError:
         return False
+
+
+def test_the_hidden_checks_are_not_in_the_package():
+    """The installed package (contactfem/) holds no hidden check: not the file, not one of its
+    functions; the grader finds them in the instructor's material (the checkout's lectures/)."""
+    from pathlib import Path
+
+    import contactfem
+    from contactfem.lab.course.grade import hidden_checks_file, load_hidden
+
+    path = hidden_checks_file()
+    assert path is not None and path.parent.name == "lectures"
+    names = {f.__name__ for fs in load_hidden(path).values() for f in fs}
+    assert len(names) >= 20
+    package = Path(contactfem.__file__).parent
+    assert not list(package.rglob("hidden_checks*"))
+    for f in package.rglob("*.py"):
+        text = f.read_text()
+        assert not [n for n in names if f"def {n}(" in text or f" {n}," in text], f

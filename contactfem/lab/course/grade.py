@@ -126,16 +126,22 @@ class Handle:
 
 
 def _set_limits(memory):
+    """What the submission's process sets up before it starts (POSIX): death with the worker
+    (Linux), its memory limit (where the platform allows one), a process group of its own (its
+    children end with it; a signal to the worker's group does not reach it)."""
     def limit():
         import ctypes
         import resource
 
-        try:        # die with the worker that started it (Linux)
-            ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, 9)
+        try:
+            ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, 9)      # PR_SET_PDEATHSIG, SIGKILL
         except (OSError, AttributeError):
             pass
         if memory:
-            resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+            try:
+                resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+            except (ValueError, OSError):
+                pass
         os.setpgrp()
     return limit
 
@@ -157,7 +163,8 @@ class Box:
         code = f"from contactfem.lab.course.sandbox import serve; serve({req_r}, {rep_w})"
         self.proc = subprocess.Popen([sys.executable, "-c", code], pass_fds=(req_r, rep_w), cwd=workdir, env=env,
                                      stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                                     stderr=subprocess.DEVNULL, preexec_fn=_set_limits(limits.memory))
+                                     stderr=subprocess.DEVNULL,
+                                     preexec_fn=_set_limits(limits.memory) if os.name == "posix" else None)
         os.close(req_r)
         os.close(rep_w)
         from multiprocessing.connection import Connection
@@ -171,7 +178,7 @@ class Box:
 
         try:
             os.killpg(self.proc.pid, signal.SIGKILL)
-        except (ProcessLookupError, PermissionError):
+        except (ProcessLookupError, PermissionError, AttributeError):      # AttributeError: not POSIX
             pass
         if self.proc.poll() is None:
             self.proc.kill()
@@ -387,8 +394,8 @@ def library_hint(exercise, used):
 
 def grade_notebook(path, lecture, material, limits):
     """Grade one notebook (the function the batch's workers run): a dict with the parts
-    [(exercise, part, points scored, points possible, message)], the cells that failed, the
-    written answers, and `stopped` (why the submission's process ended early, or None)."""
+    [(exercise, part, points scored, points possible, message)], the cells that failed, what
+    it printed, and `stopped` (why the submission's process ended early, or None)."""
     from . import checks
 
     t0 = time.monotonic()
@@ -398,7 +405,7 @@ def grade_notebook(path, lecture, material, limits):
     checks._MEMO.clear()
     mine = [e for e in checks.EXERCISES.values() if e.lecture == lecture]
     code_cells = [(i, src) for i, (kind, src) in enumerate(cells, 1) if kind == "code"]
-    out = {"parts": [], "errors": [], "stopped": None, "printed": 0, "manual": manual_answers(cells)}
+    out = {"parts": [], "errors": [], "stopped": None, "printed": 0}
     with tempfile.TemporaryDirectory(prefix="contactfem-submission-") as work:
         box = Box(limits, work)
         try:
@@ -681,7 +688,7 @@ def _row(student, path, rel, lec, outcome, columns, manual, scores_read, deadlin
                      else f"not graded: {reason}")
     else:
         res = outcome.value
-        parts, answers = res["parts"], res["manual"]
+        parts = res["parts"]
         if res["stopped"]:
             status, stop = "stopped", res["stopped"]
             notes.append(res["stopped"])
@@ -689,6 +696,11 @@ def _row(student, path, rel, lec, outcome, columns, manual, scores_read, deadlin
         notes += res["errors"][:3] + ([f"and {more} more cells failed"] if more > 0 else [])
         if res["printed"] > 2**20:
             notes.append(f"printed {res['printed'] / 2**20:.0f} MB (not kept)")
+    if path is not None and lec:      # the written answers, read here: a notebook stopped early has them too
+        try:
+            answers = manual_answers(read_notebook(path)[0])
+        except ValueError:
+            pass
     total = 0.0
     for e in columns:
         if e in mine:
