@@ -251,6 +251,9 @@ def build_versions(outs, repo=None, only=None, force=False, work=None, on_write=
                 else:
                     plan[version][src.name] = built[1]
                     plan[version][f"autograder/{src.stem}.zip"] = built[2]
+        hidden = Path(repo or REPO) / "lectures" / "hidden_checks.py"
+        if "instructor" in plan and hidden.is_file():   # the hidden checks: instructor material only
+            plan["instructor"]["autograder/hidden_checks.py"] = hidden
         if "student" in plan:
             notebooks = [p for n, p in plan["student"].items() if n.endswith(".ipynb")]
             plan["student"][handout.STUDENT_ZIP] = handout.student_zip(notebooks, Path(tmp) / handout.STUDENT_ZIP)
