@@ -651,6 +651,9 @@ def _readable(path):
 
 
 def _write_csv(path, fields, rows):
+    from ...io.outputs import make_parents
+
+    make_parents(path)                        # the folders the output names, made when it is written
     tmp = path.with_name(f".{path.name}.part")
     with open(tmp, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields)
