@@ -1,0 +1,73 @@
+"""The run as a value: what a run remembers from step to step is the SystemState the records
+carry, never the bodies, contacts or loads. So marching the same model twice gives the same
+records bit for bit, and a run resumed from any of its records goes on exactly as it went."""
+import numpy as np
+import pytest
+
+from contactfem.scenes import get_scene
+from contactfem.scenes.base import simulate
+from contactfem.solver.march import resume
+
+# every scene whose model is one Stage (the cork's two stages: test_cork_twice_gives_the_same_records)
+CASES = [("bar_impact", {}), ("block", {}), ("block", {"law": "parabolic"}), ("funnel", {}), ("hertz", {}),
+         ("patch", {}), ("rolling_ring", {}), ("sloping_impact", {}), ("sloping_impact", {"variant": "frictional"})]
+
+
+def same(r, q):
+    """Two records equal bit for bit: state of motion, energies, Newton's residuals, contact states."""
+    assert (r.k, r.t, r.dt, r.cuts) == (q.k, q.t, q.dt, q.cuts)
+    for a, b in ((r.u, q.u), (r.v, q.v), (r.a, q.a)):
+        assert np.array_equal(a, b)
+    assert r.energy == q.energy and r.residuals == q.residuals
+    for cs, ds in zip(r.contacts, q.contacts):
+        for name in ("g_N", "t_N", "t_T"):
+            if hasattr(cs, name):
+                assert np.array_equal(getattr(cs, name), getattr(ds, name))
+
+
+def model_of(name, over):
+    scene = get_scene(name)
+    params = scene.resolve("fast", over)
+    return scene, params, scene.build(params)
+
+
+@pytest.mark.parametrize("name,over", CASES, ids=[f"{n}{'-' + '-'.join(map(str, o.values())) if o else ''}"
+                                                  for n, o in CASES])
+def test_marching_the_same_model_twice_gives_the_same_records(name, over):
+    scene, params, model = model_of(name, over)
+    run = scene.simulate or simulate
+    first, second = run(model, params), run(model, params)
+    assert len(first) == len(second) > 1
+    for r, q in zip(first, second):
+        same(r, q)
+
+
+@pytest.mark.parametrize("name,over", [("sloping_impact", {"variant": "frictional"}), ("block", {"n_steps": 4}),
+                                       ("rolling_ring", {})])
+def test_a_run_resumed_from_its_kth_record_goes_on_as_it_went(name, over):
+    scene, params, model = model_of(name, over)
+    records = simulate(model, params)
+    st = model["stage"]
+    k = len(records) // 2
+    rest = list(resume(st.stepper, st.schedule, records[k], label=st.label))
+    assert len(rest) == len(records) - k - 1
+    for r, q in zip(rest, records[k + 1:]):
+        same(r, q)
+
+
+def test_the_block_of_lecture_04_twice():
+    """Table 1 of the block: the same residuals at a second march of the same model."""
+    scene, params, model = model_of("block", {"law": "coulomb"})
+    res = [r.residuals for r in simulate(model, params)[1:]]
+    again = [r.residuals for r in simulate(model, params)[1:]]
+    assert res == again and len(res[0]) > 2
+
+
+def test_a_contact_keeps_nothing_of_a_run():
+    scene, params, model = model_of("sloping_impact", {"variant": "frictional"})
+    before = {c.name: dict(vars(c)) for c in model["system"].contacts}
+    simulate(model, params)
+    for c in model["system"].contacts:
+        after = vars(c)
+        changed = [k for k in after if k != "evaluations" and after[k] is not before[c.name].get(k)]
+        assert not changed, f"contact {c.name!r} changed {changed} during a run"
