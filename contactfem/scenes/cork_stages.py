@@ -14,7 +14,7 @@ nodes slip and its Newton iteration chatters between stick and slip.)
 Stage 2 (pop, ``Newmark`` delta = 0.7, beta = 0.4): a follower pressure p on the
 cork's bottom face, raised by p_step per step of dt for n_ramp steps, then Boyle's
 law evaluated ONCE PER STEP from the last converged state (explicit coupling, as
-the paper; in the loop over the records, ``gas.update``): p = p0 V0 / V, V0 = pi R_neck^2 * gas_column, V = V0 + (volume swept
+the paper; the gas pressure load's state, GasPressure.update at each commit): p = p0 V0 / V, V0 = pi R_neck^2 * gas_column, V = V0 + (volume swept
 by the bottom face since the start of stage 2), i.e. V0 + pi R^2 * (its axial
 displacement). When the bottom corner of the cork reaches the mouth (z = 24 mm)
 the gas escapes: p = 0 from then on (ambient; no gas jet is modelled).
