@@ -71,3 +71,55 @@ def test_a_contact_keeps_nothing_of_a_run():
         after = vars(c)
         changed = [k for k in after if k != "evaluations" and after[k] is not before[c.name].get(k)]
         assert not changed, f"contact {c.name!r} changed {changed} during a run"
+
+
+# -- the lectures' march cells ---------------------------------------------------------------
+
+LECTURE_DIR = __import__("pathlib").Path(__file__).resolve().parents[1] / "lectures"
+
+
+def _march_twice(name, monkeypatch):
+    """Run the lecture's code cells in order up to the first one that marches (its records
+    captured through contactfem.solver.march), then run that cell again in the same namespace,
+    on the same model objects, as a student re-running it would: the two runs' records."""
+    jupytext = pytest.importorskip("jupytext")
+    import sys
+
+    import contactfem.solver as solver
+    march_module = sys.modules["contactfem.solver.march"]
+
+    runs, real = [], march_module.march
+
+    def recording(*args, **kwargs):
+        runs.append(records := [])
+        for rec in real(*args, **kwargs):
+            records.append(rec)
+            yield rec
+
+    monkeypatch.setattr(solver, "march", recording)
+    monkeypatch.setattr(march_module, "march", recording)
+    monkeypatch.setenv("CONTACTFEM_PRESET", "fast")
+    monkeypatch.chdir(LECTURE_DIR)
+    cells = [c.source for c in jupytext.read(LECTURE_DIR / f"{name}.md").cells if c.cell_type == "code"]
+    namespace = {"__name__": "__lecture__"}
+    for source in cells:
+        exec(compile(source, name, "exec"), namespace)
+        if runs:
+            first = list(runs)
+            runs.clear()
+            exec(compile(source, name, "exec"), namespace)
+            return first, list(runs)
+    pytest.fail(f"{name}: no cell marches")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["04_block", "05_rolling_ring", "06_sloping_impact", "07_funnel",
+                                  "10_write_your_own_law"])
+def test_a_lectures_march_cell_run_twice_gives_the_same_records(name, monkeypatch, tmp_path):
+    monkeypatch.setenv("CONTACTFEM_FIGURES", str(tmp_path))
+    first, second = _march_twice(name, monkeypatch)
+    assert len(first) == len(second) >= 1
+    for a, b in zip(first, second):
+        assert len(a) == len(b) > 1
+        for r, q in zip(a, b):
+            same(r, q)
