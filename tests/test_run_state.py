@@ -4,13 +4,18 @@ records bit for bit, and a run resumed from any of its records goes on exactly a
 import numpy as np
 import pytest
 
+from contactfem.io import load_record, save_record
 from contactfem.scenes import get_scene
 from contactfem.scenes.base import simulate
 from contactfem.solver.march import resume
 
 # every scene whose model is one Stage (the cork's two stages: test_cork_twice_gives_the_same_records)
-CASES = [("bar_impact", {}), ("block", {}), ("block", {"law": "parabolic"}), ("funnel", {}), ("hertz", {}),
-         ("patch", {}), ("rolling_ring", {}), ("sloping_impact", {}), ("sloping_impact", {"variant": "frictional"})]
+CASES = [("bar_impact", {}), ("bar_impact", {"contact_integration": "energy_consistent"}), ("block", {}),
+         ("block", {"law": "parabolic"}), ("block", {"enforcement": "augmented"}), ("block", {"enforcement": "lagrange"}),
+         ("funnel", {}), ("hertz", {}), ("hertz", {"enforcement": "augmented"}), ("patch", {}),
+         ("patch", {"enforcement": "lagrange"}), ("rolling_ring", {}), ("rolling_ring", {"kind": "continuum"}),
+         ("sloping_impact", {}), ("sloping_impact", {"variant": "frictional"}),
+         ("sloping_impact", {"variant": "viscoplastic"}), ("sloping_impact", {"contact_integration": "energy_consistent"})]
 
 
 def same(r, q):
@@ -53,6 +58,31 @@ def test_a_run_resumed_from_its_kth_record_goes_on_as_it_went(name, over):
     assert len(rest) == len(records) - k - 1
     for r, q in zip(rest, records[k + 1:]):
         same(r, q)
+
+
+@pytest.mark.parametrize("name,over,suffix", [("sloping_impact", {"variant": "viscoplastic"}, ".json"),
+                                              ("bar_impact", {"enforcement": "augmented"}, ".npz"),
+                                              ("sloping_impact", {"variant": "frictional"}, ".npz")])
+def test_a_run_restarted_from_its_saved_kth_record_goes_on_as_it_went(name, over, suffix, tmp_path):
+    """The record saved to a file and read back (its SystemState: plastic strains, multipliers,
+    contact histories) resumes the run exactly: the same records from k on, bit for bit."""
+    scene, params, model = model_of(name, over)
+    records = simulate(model, params)
+    st = model["stage"]
+    k = len(records) // 2
+    loaded = load_record(save_record(records[k], tmp_path / f"record{suffix}"))
+    same(loaded, records[k])
+    rest = list(resume(st.stepper, st.schedule, loaded, label=st.label))
+    assert len(rest) == len(records) - k - 1 > 0
+    for r, q in zip(rest, records[k + 1:]):
+        same(r, q)
+
+
+def test_a_record_that_is_not_one_is_refused(tmp_path):
+    from contactfem.io import save_run
+    path = save_run({"x": 1.0}, tmp_path / "run.json")
+    with pytest.raises(ValueError, match="not a saved record"):
+        load_record(path)
 
 
 def test_the_block_of_lecture_04_twice():
