@@ -176,7 +176,7 @@ class GasState:
     k: int = 0
     value: float = 0.0
     released: bool = False
-    released_at: float = None
+    released_at: float | None = None
 
 
 class GasPressure(Pressure):

@@ -57,8 +57,8 @@ def augments_normal(law):
 class AugmentedHistory(ContactHistory):
     """A ContactHistory with the multipliers the next solve holds fixed: lam_N (normal, 0 when
     the normal law is not augmented) and lam_T (tangential), per slave node."""
-    lam_N: np.ndarray = None
-    lam_T: np.ndarray = None
+    lam_N: np.ndarray | None = None
+    lam_T: np.ndarray | None = None
 
 
 class AugmentedNodeToSegment(NodeToSegment):

@@ -97,8 +97,8 @@ class LagrangeState(ContactState):
     the closed set of the complementarity function, ``slip`` OPEN/STICK/SLIP; ``lam`` the
     slip |Delta g_T| of slipping nodes. The complementarity rows: C (the scaled C_N, C_T at
     ``ncp_dofs``) and the triplets ``ncp_coo`` of the multipliers' columns and rows."""
-    C: np.ndarray = None
-    ncp_dofs: np.ndarray = None
+    C: np.ndarray | None = None
+    ncp_dofs: np.ndarray | None = None
     ncp_coo: tuple = ()
 
     def scatter(self, ndof):

@@ -43,7 +43,7 @@ class MortarHistory:
     D: np.ndarray
     M: np.ndarray
     w: np.ndarray
-    x: np.ndarray = None        # the interface positions (slave, master) of the converged state
+    x: np.ndarray | None = None        # the interface positions (slave, master) of the converged state
 
 
 @dataclass(frozen=True)

@@ -77,7 +77,7 @@ class ContactState:
     R: np.ndarray
     K: np.ndarray
     element_dofs: np.ndarray
-    work_T: np.ndarray = None       # energy-consistent: the friction force's work over the step
+    work_T: np.ndarray | None = None       # energy-consistent: the friction force's work over the step
 
     # -- assembly ---------------------------------------------------------------------
     def scatter(self, ndof):

@@ -66,7 +66,7 @@ from .rate_state import ArchardWear, DieterichRuina, Stribeck
 try:                                           # numpy >= 1.25
     from numpy.exceptions import ComplexWarning
 except ImportError:                            # pragma: no cover
-    from numpy import ComplexWarning
+    from numpy import ComplexWarning  # type: ignore[attr-defined,no-redef]
 
 H_CS = 1e-30                                   # complex step
 ARG_NAMES = ("p", "q", "v", "z")

@@ -186,21 +186,21 @@ def watch(records, progress, t0, t_end, name):
 class History:
     """A march collected into arrays (``integrate``): one entry per record, entry 0 the
     initial state. ``records`` keeps the records themselves."""
-    t: np.ndarray = None
-    dt: np.ndarray = None
-    iterations: np.ndarray = None
-    cuts: np.ndarray = None
-    kinetic: np.ndarray = None
-    strain: np.ndarray = None
-    contact: np.ndarray = None
-    dissipation: np.ndarray = None
-    external_work: np.ndarray = None
+    t: np.ndarray | None = None
+    dt: np.ndarray | None = None
+    iterations: np.ndarray | None = None
+    cuts: np.ndarray | None = None
+    kinetic: np.ndarray | None = None
+    strain: np.ndarray | None = None
+    contact: np.ndarray | None = None
+    dissipation: np.ndarray | None = None
+    external_work: np.ndarray | None = None
     residuals: list = field(default_factory=list)
     failures: list = field(default_factory=list)
     records: list = field(default_factory=list)
-    u: np.ndarray = None
-    v: np.ndarray = None
-    a: np.ndarray = None
+    u: np.ndarray | None = None
+    v: np.ndarray | None = None
+    a: np.ndarray | None = None
     result: object = None
 
     @classmethod

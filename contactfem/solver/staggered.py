@@ -50,7 +50,7 @@ class StaggeredResult:
     u: np.ndarray
     residuals: list = field(default_factory=list)
     iterations: int = 0
-    G: np.ndarray = None
+    G: np.ndarray | None = None
     evaluation: object = None
     evaluations: int = 0
     cycles: int = 0

@@ -64,8 +64,8 @@ class Evaluation(NamedTuple):
     G: np.ndarray
     K: object
     contacts: tuple = ()
-    P: np.ndarray = None
-    state: SystemState = None
+    P: np.ndarray | None = None
+    state: SystemState | None = None
 
 
 class Dirichlet:

@@ -45,7 +45,7 @@ class UzawaResult:
     u: np.ndarray
     residuals: list = field(default_factory=list)
     iterations: int = 0
-    G: np.ndarray = None
+    G: np.ndarray | None = None
     evaluation: object = None
     evaluations: int = 0
     uzawa_iterations: int = 0
