@@ -160,6 +160,7 @@ class System:
         self.free_dofs = np.setdiff1d(np.arange(self.ndof), self.fixed_dofs)
         self._mass = None
         self._cM = (None, None)                 # (c, c M) of the last lumped effective tangent
+        self._requested = linear_algebra
         self._tangent = TangentAssembler(self.ndof, linear_algebra, self.free_dofs)
         self.evaluations = 0
         self.instrument = instrument
@@ -328,8 +329,11 @@ class System:
     # -- the state carried from step to step ----------------------------------------------
     def start(self, u, t=0.0):
         """The SystemState at the initial state (u, t): each contact's, body's and load's own
-        ``start``. Nothing is kept: every call gives a fresh state."""
+        ``start``. The System's assembly plan starts afresh too (the sparsity pattern of K grows
+        with the contact set during a run: a run starts from the pattern of its own initial
+        state, whatever ran before), so every run from the start is solved the same way."""
         u = np.asarray(u, dtype=float)
+        self._tangent = TangentAssembler(self.ndof, self._requested, self.free_dofs)
         return SystemState(contacts=tuple(c.start(u, t) for c in self.contacts),
                            bodies=tuple(b.start(self.local(b, u).copy()) for b in self.bodies),
                            loads=tuple(ld.start(u, t) for ld in self.loads))
