@@ -27,19 +27,22 @@ def test_the_core_type_checks(tmp_path):
     assert "no issues found" in run.stdout
 
 
+def offenders(text):
+    """(line number, line) of an object's ``__getattr__`` (a module's PEP 562 lazy import is
+    not one: it loads a name once) or a use of ``builtins``."""
+    return [(n, line.strip()) for n, line in enumerate(text.splitlines(), 1)
+            if re.search(r"\bbuiltins\b", line) or re.match(r"\s+def __getattr__\(self", line)]
+
+
 def test_no_attribute_forwarding_and_no_swapped_builtins():
-    """An object's ``__getattr__`` (a module's PEP 562 lazy import excepted: it loads a name,
-    once) and any use of ``builtins`` are refused in the library."""
-    found = []
-    for path in sorted((REPO / "contactfem").rglob("*.py")):
-        text = path.read_text()
-        for n, line in enumerate(text.splitlines(), 1):
-            if re.search(r"\bbuiltins\b", line) or re.match(r"\s+def __getattr__\(self", line):
-                found.append(f"{path.relative_to(REPO)}:{n}: {line.strip()}")
+    found = [f"{path.relative_to(REPO)}:{n}: {line}" for path in sorted((REPO / "contactfem").rglob("*.py"))
+             for n, line in offenders(path.read_text())]
     assert not found, "\n".join(found)
 
 
-def test_the_check_finds_a_forwarding_view(tmp_path):
-    bad = "class View:\n    def __getattr__(self, name):\n        return getattr(self.law, name)\n"
-    assert re.search(r"\s+def __getattr__\(self", bad.splitlines()[1])
-    assert re.search(r"\bbuiltins\b", "import builtins")
+def test_the_check_finds_a_forwarding_view_and_a_swapped_import():
+    view = "class View:\n    def __getattr__(self, name):\n        return getattr(self.law, name)\n"
+    swap = "import builtins\nbuiltins.__import__ = mine\n"
+    lazy = "def __getattr__(name):\n    return load(name)\n"
+    assert [n for n, _ in offenders(view)] == [2] and [n for n, _ in offenders(swap)] == [1, 2]
+    assert offenders(lazy) == []
