@@ -125,6 +125,14 @@ class NodeToSegment:
         other.closing_step = closing_step
         return other
 
+    def with_master(self, master):
+        """A new contact of the same configuration against another master (e.g. the same
+        obstacle at rest after a prescribed motion); this one is left as it is."""
+        other = copy.copy(self)
+        other.master = master
+        other._straight = bool(getattr(master, "straight", False))
+        return other
+
     # -- the history ------------------------------------------------------------------
     def start(self, u, t=0.0):
         """The history at the initial state u (a ContactHistory, kept by the caller): the

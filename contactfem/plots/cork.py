@@ -396,7 +396,6 @@ def exit_case(case, preset=EXIT_PRESET):
         model["contacts"] = [c.with_closing_step(fit_rule) for c in model["contacts"]]
         fit_last, _ = press_fit(model, P)
         model["contacts"] = [c.with_closing_step(pop_rule) for c in model["contacts"]]
-        model["neck"].motion = None                  # the press fit is done (as simulate)
         records, pressures, exit_time, gas = pop(model, P, fit_last.u, histories=fit_last.state.contacts)
     except Exception as err:                        # a failed run is a row of the study, not hidden
         return dict(row, exited=None, error=f"{type(err).__name__}: {str(err).splitlines()[0][:100]}")

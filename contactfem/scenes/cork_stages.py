@@ -82,7 +82,9 @@ def pop(model, P, u0, progress=None, histories=None):
     from (the press fit's last record's, ``record.state.contacts``; None: started at u0).
     Returns the records, the gas pressure that acted in each step, the exit time and the gas
     state at the end (GasState: ``released``, ``released_at``)."""
-    cork, contacts, gas = model["cork"], model["contacts"], model["gas"]
+    cork, gas, neck = model["cork"], model["gas"], model["neck"]
+    rest = neck.without_motion()                             # the press fit is done: the neck stays at r = R_neck
+    contacts = [c.with_master(rest) if c.master is neck else c for c in model["contacts"]]
     t_ramp = P["n_ramp"] * P["dt"]
     system = System([cork], contacts, [gas], [Dirichlet(cork, cork.xdofs[model["axis"], 0], 0.0)],
                     **model["system_options"])
@@ -133,7 +135,6 @@ def simulate(model, P, progress=None):
     fit.update(contact_forces(fit_last.contacts))
     areas = model["cork"].element_areas
     fit["min_area_ratio"] = float(np.min(areas(fit_last.u) / areas(0 * fit_last.u)))
-    model["neck"].motion = None                          # the press fit is done: the neck stays at r = R_neck
     records, pressures, exit_time, gas = pop(model, P, fit_last.u, progress, fit_last.state.contacts)
     exited = bool(gas.released and records[-1].contacts[0].n_active == 0)
     return dict(fit_last=fit_last, fit=fit, records=records, pressures=pressures, exited=exited,
