@@ -123,6 +123,7 @@ class NodeToSegment:
             raise ValueError(f"parameter closing_step = {closing_step!r} is not allowed: True or False")
         other = copy.copy(self)
         other.closing_step = closing_step
+        other.evaluations = 0
         return other
 
     def with_master(self, master):
@@ -131,6 +132,7 @@ class NodeToSegment:
         other = copy.copy(self)
         other.master = master
         other._straight = bool(getattr(master, "straight", False))
+        other.evaluations = 0
         return other
 
     # -- the history ------------------------------------------------------------------
