@@ -7,6 +7,8 @@
   6 multiplier updates at the scene's c_N, and the results (p0, totals, nodal tractions)
   the same to 1e-6 with c_N 100 times smaller and larger.
 """
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from conftest import PointCloud
@@ -24,13 +26,13 @@ FRICTIONS = {"none": None, "coulomb": Coulomb(c_T=30.0, mu=0.3),
              "parabolic": ParabolicSlip(c_T=30.0, alpha=0.2, beta=0.3, n=0.5)}
 
 
-def with_multipliers(iface, rng, u):
-    """Multipliers as after some Uzawa updates: lam_N < 0 (compressive), lam_T of either sign
-    inside the slip bound (a tenth of the pressure)."""
+def with_multipliers(iface, rng, u, h):
+    """The history h with multipliers as after some Uzawa updates: lam_N < 0 (compressive),
+    lam_T of either sign inside the slip bound (a tenth of the pressure)."""
     n = len(iface.nodes)
     if iface.augment_normal:
-        iface.lam_N = -rng.uniform(0.5, 1.5, n)
-    iface.lam_T = 0.1 * np.abs(iface.evaluate(u, dt=DT).t_N) * rng.choice([-1.0, 1.0], n)
+        h = replace(h, lam_N=-rng.uniform(0.5, 1.5, n))
+    return replace(h, lam_T=0.1 * np.abs(iface.evaluate(u, dt=DT, history=h).t_N) * rng.choice([-1.0, 1.0], n))
 
 
 @pytest.mark.parametrize("master", ["line", "tilted_polyline", "arc_outside", "arc_inside"])
@@ -42,13 +44,12 @@ def test_augmented_rigid_master_tangent(rng, master, nlaw, flaw, regime):
     iface = AugmentedNodeToSegment(body, np.arange(4), make_master(master), normal=NORMALS[nlaw],
                                    friction=FRICTIONS[flaw], weights=rng.uniform(0.5, 1.5, 4))
     dg = {"stick": 1e-6, "slip+": 0.5, "slip-": -0.5}[regime]
-    set_history(iface, u, t_T_bar=0.0, dg=dg)
-    with_multipliers(iface, rng, u)
-    e = iface.evaluate(u, dt=DT)
+    h = with_multipliers(iface, rng, u, set_history(iface, u, t_T_bar=0.0, dg=dg))
+    e = iface.evaluate(u, dt=DT, history=h)
     assert np.all(e.active)
     if FRICTIONS[flaw] is not None:
         assert np.all(e.slip == (STICK if regime == "stick" else SLIP))
-    check_tangent(iface, u)
+    check_tangent(iface, u, h)
 
 
 @pytest.mark.parametrize("flaw", list(FRICTIONS))
@@ -65,11 +66,11 @@ def test_augmented_deformable_master_tangent(rng, flaw, regime):
                                    weights=0.7)
     u_old = u.copy()
     u_old[:mb.ndof] *= 0.3
-    set_history(iface, u, t_T_bar=0.01, dg={"stick": 1e-6, "slip+": 0.5, "slip-": -0.5}[regime],
-                master=surface.reference(u_old))
-    with_multipliers(iface, rng, u)
-    assert np.all(iface.evaluate(u, dt=DT).active)
-    check_tangent(iface, u)
+    h = set_history(iface, u, t_T_bar=0.01, dg={"stick": 1e-6, "slip+": 0.5, "slip-": -0.5}[regime],
+                    master=surface.reference(u_old))
+    h = with_multipliers(iface, rng, u, h)
+    assert np.all(iface.evaluate(u, dt=DT, history=h).active)
+    check_tangent(iface, u, h)
 
 
 def test_multiplier_opens_and_closes_contact(rng):
@@ -80,17 +81,16 @@ def test_multiplier_opens_and_closes_contact(rng):
     u = np.array([0.0, 0.01, 0.0, -0.01, 0.0, 0.01])
     iface = AugmentedNodeToSegment(body, np.arange(3), make_master("line"), normal=PowerLaw(50.0),
                                    friction=Coulomb(30.0, 0.3))
-    iface.start(u)
-    iface.lam_N = np.array([-1.0, 0.0, 0.0])
-    e = iface.evaluate(u)
+    h = replace(iface.start(u), lam_N=np.array([-1.0, 0.0, 0.0]))
+    e = iface.evaluate(u, history=h)
     assert list(e.active) == [True, True, False]
     assert np.isclose(e.t_N[0], -1.0 + 50.0 * 0.01) and np.isclose(e.t_N[1], -0.5)
     R, rows, cols, vals = e.scatter(len(u))
     assert np.all(R[4:] == 0) and not np.any(np.isin(rows, [4, 5]))
     v = iface.violation(e)
-    iface.update_multipliers(e)
+    h = iface.update_multipliers(e)
     assert np.isclose(v["penetration"], 0.01)
-    assert np.allclose(iface.lam_N, [-0.5, -0.5, 0.0])
+    assert np.allclose(h.lam_N, [-0.5, -0.5, 0.0])
 
 
 def test_constitutive_power_law_keeps_its_meaning():
@@ -99,12 +99,12 @@ def test_constitutive_power_law_keeps_its_meaning():
                                    friction=Coulomb(30.0, 0.3))
     assert not iface.augment_normal
     u = np.array([0.0, -0.1])
-    iface.start(u)
-    e = iface.evaluate(u)
+    h = iface.start(u)
+    e = iface.evaluate(u, history=h)
     v = iface.violation(e)
-    iface.update_multipliers(e)
-    assert v["penetration"] == 0.0 and np.all(iface.lam_N == 0.0)
-    assert np.isclose(iface.evaluate(u).t_N[0], -80.0 * 0.1 ** 2.5)
+    h = iface.update_multipliers(e)
+    assert v["penetration"] == 0.0 and np.all(h.lam_N == 0.0)
+    assert np.isclose(iface.evaluate(u, history=h).t_N[0], -80.0 * 0.1 ** 2.5)
 
 
 def test_bad_enforcement_raises():

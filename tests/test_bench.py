@@ -30,9 +30,9 @@ def _block_staggered(params, max_cycles=200):
     stepper = Staggered(Static(system, atol=params["atol"], rtol=params["rtol"], maxit=params["maxit"]),
                         max_cycles=max_cycles)
     u = np.zeros(system.ndof)
-    system.start(u)
-    u1, _, _, res = stepper.step(0.0, u, u, u, 1.0)
-    return b, system, u1, res
+    state = system.start(u)
+    u1, _, _, res = stepper.step(0.0, u, u, u, 1.0, state=state)
+    return dict(b, start=state), system, u1, res
 
 
 @pytest.mark.parametrize("law", ["coulomb", "parabolic"])
@@ -43,7 +43,7 @@ def test_staggered_converges_to_the_newton_solution_with_more_solves(law):
     # same solution: both satisfy the same full residual to 1e-10 relative
     scale = np.max(np.abs(ref["u"]))
     assert np.max(np.abs(u - ref["u"])) < 1e-8 * scale, "staggered and Newton solutions differ"
-    G, _ = system.residual_tangent(u, 1.0)
+    G, _ = system.residual_tangent(u, 1.0, state=b["start"])
     assert np.linalg.norm(G) <= params["atol"] + params["rtol"] * res.residuals[0]
     # more work: consistent Newton 5-6 solves, staggered ~ 3x (linear convergence of the cycles)
     assert res.iterations > ref["result"].iterations, (res.iterations, ref["result"].iterations)
@@ -66,11 +66,11 @@ def test_frictionless_contact_is_the_same_in_every_phase():
     c = NodeToSegment(body, np.arange(4), RigidLine((0.0, 0.0), (0.0, 1.0)), normal=PowerLaw(50.0, 1.0))
     u = np.zeros(body.ndof)
     u[1::2] = -0.01
-    c.start(np.zeros(body.ndof))
-    state = c.evaluate(u)
+    h = c.start(np.zeros(body.ndof))
+    state = c.evaluate(u, history=h)
     full = state.scatter(len(u))
     for phase in ("normal", "friction"):
-        for a, b in zip(c.evaluate(u, phase=freeze(state, phase)).scatter(len(u)), full):
+        for a, b in zip(c.evaluate(u, phase=freeze(state, phase), history=h).scatter(len(u)), full):
             np.testing.assert_array_equal(a, b)
 
 
@@ -84,18 +84,18 @@ def test_phase_tangents_match_finite_differences(phase, friction):
     c = NodeToSegment(body, np.arange(5), RigidLine((0.0, 0.0), (0.0, 1.0)), normal=PowerLaw(50.0, 1.0),
                       friction=friction)
     u0 = np.zeros(body.ndof)
-    c.start(u0)
+    h = c.start(u0)
     u = u0.copy()
     u[1::2] = -0.05 * (0.5 + rng.random(5))
     u[0::2] = 0.02 * rng.standard_normal(5)        # some nodes slip, some stick
-    frozen = freeze(c.evaluate(u + 0.003 * rng.standard_normal(len(u))), phase)   # frozen data from another state
-    _, rows, cols, vals = c.evaluate(u, phase=frozen).scatter(len(u))
+    frozen = freeze(c.evaluate(u + 0.003 * rng.standard_normal(len(u)), history=h), phase)   # frozen data from another state
+    _, rows, cols, vals = c.evaluate(u, phase=frozen, history=h).scatter(len(u))
     K = np.zeros((len(u), len(u)))
     np.add.at(K, (rows, cols), vals)
-    Kfd = fd_jacobian(lambda v: c.evaluate(v, phase=frozen).scatter(len(u))[0], u)
+    Kfd = fd_jacobian(lambda v: c.evaluate(v, phase=frozen, history=h).scatter(len(u))[0], u)
     assert rel_error(K, Kfd) < 1e-6
     if phase == "friction":        # no coupling c_N^s C: the tangent differs from the consistent one
-        _, r2, c2, v2 = c.evaluate(u).scatter(len(u))
+        _, r2, c2, v2 = c.evaluate(u, history=h).scatter(len(u))
         K2 = np.zeros_like(K)
         np.add.at(K2, (r2, c2), v2)
         assert rel_error(K, K2) > 1e-3
@@ -104,9 +104,9 @@ def test_phase_tangents_match_finite_differences(phase, friction):
 def test_a_bad_phase_is_refused():
     params = get_scene("block").resolve("paper")
     b = block.build(params)
-    b["system"].start(np.zeros(b["system"].ndof))
+    state = b["system"].start(np.zeros(b["system"].ndof))
     with pytest.raises(ValueError, match="phase"):
-        freeze(b["contact"].evaluate(np.zeros(b["system"].ndof)), "tangential")
+        freeze(b["contact"].evaluate(np.zeros(b["system"].ndof), history=state.contacts[0]), "tangential")
 
 
 def test_observed_order_of_a_power_law():

@@ -56,15 +56,15 @@ def pair(master, friction, phase, rng):
     u1[off + 1::2] = y1 + 0.003 * rng.standard_normal(2)
     if master == "body":
         u1[:off] = 0.003 * rng.standard_normal(off)
-    iface.start(u_prev)
-    iface.commit(iface.evaluate(u_prev))
-    iface.commit(iface.evaluate(u0))
-    return iface, u0, u1
+    h = iface.start(u_prev)
+    h = iface.commit(iface.evaluate(u_prev, history=h))
+    h = iface.commit(iface.evaluate(u0, history=h))
+    return iface, u0, u1, h
 
 
-def force(iface, u0, u1):
-    """The step force (residual and tangent, dense) of the step u0 -> u1."""
-    G, rows, cols, vals = iface.evaluate(u1, u0=u0).scatter(len(u1))
+def force(iface, u0, u1, h):
+    """The step force (residual and tangent, dense) of the step u0 -> u1 from the history h."""
+    G, rows, cols, vals = iface.evaluate(u1, u0=u0, history=h).scatter(len(u1))
     Kg = np.zeros((len(u1), len(u1)))
     np.add.at(Kg, (rows, cols), vals)
     return G, Kg
@@ -74,10 +74,10 @@ def force(iface, u0, u1):
 @pytest.mark.parametrize("fric", list(FRICTIONS))
 @pytest.mark.parametrize("phase", list(PHASES))
 def test_step_force_tangent(rng, master, fric, phase):
-    iface, u0, u1 = pair(master, FRICTIONS[fric], phase, rng)
-    G, K = force(iface, u0, u1)
+    iface, u0, u1, h = pair(master, FRICTIONS[fric], phase, rng)
+    G, K = force(iface, u0, u1, h)
     assert np.linalg.norm(K) > 0, "no force: the test is vacuous"
-    Kfd = fd_jacobian(lambda w: force(iface, u0, w)[0], u1, h=1e-7)
+    Kfd = fd_jacobian(lambda w: force(iface, u0, w, h)[0], u1, h=1e-7)
     assert rel_error(K, Kfd) < 1e-6, rel_error(K, Kfd)
 
 
@@ -85,11 +85,11 @@ def test_step_force_tangent(rng, master, fric, phase):
 @pytest.mark.parametrize("fric", list(FRICTIONS))
 @pytest.mark.parametrize("phase", list(PHASES))
 def test_step_work_is_energy_change_plus_dissipation(rng, master, fric, phase):
-    iface, u0, u1 = pair(master, FRICTIONS[fric], phase, rng)
-    G, _ = force(iface, u0, u1)
-    W0 = iface.evaluate(u0).energy             # interface energy at the committed state
-    W1 = iface.evaluate(u1).energy             # at the end (not committed: t_T from the return map)
-    D = iface.evaluate(u1, u0=u0).dissipation  # of the step
+    iface, u0, u1, h = pair(master, FRICTIONS[fric], phase, rng)
+    G, _ = force(iface, u0, u1, h)
+    W0 = iface.evaluate(u0, history=h).energy             # interface energy at the committed state
+    W1 = iface.evaluate(u1, history=h).energy             # at the end (not committed: t_T from the return map)
+    D = iface.evaluate(u1, u0=u0, history=h).dissipation  # of the step
     assert D >= -1e-14
     assert G @ (u1 - u0) == pytest.approx(W1 - W0 + D, rel=1e-10, abs=1e-14)
 
@@ -302,7 +302,7 @@ def step_residual(stepper, u, v, dt):
     conserving.newton = capture
     try:
         with pytest.raises(StopIteration):
-            stepper.step(0.0, u, v, np.zeros_like(u), dt)
+            stepper.step(0.0, u, v, np.zeros_like(u), dt, state=stepper.system.start(u))
     finally:
         conserving.newton = real
     return captured["fun"], captured["guess"]
@@ -322,8 +322,6 @@ def test_energy_consistent_step_tangent_with_a_contact_on_the_ring(rng, variant)
     u = np.zeros(system.ndof)
     u[ring.body.xdofs[:, 1]] = -(p["gap0"] + 0.02)                      # the lowest nodes pressed in
     v = ring.initial_velocity((p["vx0"], p["vy0"]), omega=0.1)
-    for c in system.contacts:
-        c.start(u)
     fun, guess = step_residual(stepper, u, v, p["dt"])
     u1 = guess + 1e-3 * rng.standard_normal(system.ndof)
     u1[ring.body.xdofs[:, 0]] += 0.05                                    # slip along the plane

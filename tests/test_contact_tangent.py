@@ -27,12 +27,12 @@ FRICTIONS = {"none": None, "coulomb": Coulomb(c_T=30.0, mu=0.3),
 DT = 0.1
 
 
-def check_tangent(iface, u, tol=1e-6, dt=DT):
-    R0, rows, cols, vals = iface.assemble(u, dt=dt)
+def check_tangent(iface, u, h, tol=1e-6, dt=DT):
+    R0, rows, cols, vals = iface.assemble(u, dt=dt, history=h)
     n = len(u)
     K = np.zeros((n, n))
     np.add.at(K, (rows, cols), vals)
-    Kfd = fd_jacobian(lambda v: iface.assemble(v, dt=dt)[0], u)
+    Kfd = fd_jacobian(lambda v: iface.assemble(v, dt=dt, history=h)[0], u)
     assert np.linalg.norm(K) > 0, "nothing in contact: the test is vacuous"
     err = rel_error(K, Kfd)
     assert err < tol, f"tangent mismatch {err:.2e}"
@@ -51,17 +51,15 @@ def slave_cloud(rng, n=4, y=-0.05):
 def set_history(iface, u, t_T_bar, dg, master=None):
     """History such that the slip increment is dg: s_bar = s(u) - dg (``master``: the
     master's remembered reference, e.g. a deformable master's earlier positions)."""
-    iface.start(u)
-    h = iface.history
+    h = iface.start(u)
     if master is not None:
         h = replace(h, master=master)
-        iface.history = h
-        h = replace(h, s_bar=iface.evaluate(u, dt=DT).s)
+        h = replace(h, s_bar=iface.evaluate(u, dt=DT, history=h).s)
     n = len(iface.nodes)
     z = h.z_bar
     if iface.friction is not None and iface._law.n_state:     # a state reached by earlier slip (wear: 0.01 deep)
         z = iface._law.evolve(h.z_bar, np.ones(n), np.full(n, 0.05), DT)[0]
-    iface.history = replace(h, s_bar=h.s_bar - dg, t_T_bar=np.full(n, t_T_bar), z_bar=z)
+    return replace(h, s_bar=h.s_bar - dg, t_T_bar=np.full(n, t_T_bar), z_bar=z)
 
 
 MASTERS = ["line", "tilted_polyline", "arc_outside", "arc_inside"]
@@ -87,15 +85,15 @@ def test_rigid_master_tangent(rng, master, nlaw, flaw, regime):
     iface = NodeToSegment(body, np.arange(4), make_master(master), normal=NORMALS[nlaw], friction=FRICTIONS[flaw],
                           weights=rng.uniform(0.5, 1.5, 4))
     dg = {"stick": 1e-6, "slip+": 0.5, "slip-": -0.5}[regime]
-    set_history(iface, u, t_T_bar=0.0, dg=dg)
-    e = iface.evaluate(u, dt=DT)
+    h = set_history(iface, u, t_T_bar=0.0, dg=dg)
+    e = iface.evaluate(u, dt=DT, history=h)
     assert np.all(e.active)
     if FRICTIONS[flaw] is not None:
         expected = STICK if regime == "stick" else SLIP
         assert np.all(e.slip == expected)
         if regime != "stick":
             assert np.all(np.sign(e.t_T) == np.sign(dg))
-    check_tangent(iface, u)
+    check_tangent(iface, u, h)
 
 
 @pytest.mark.parametrize("flaw", list(FRICTIONS))
@@ -115,10 +113,10 @@ def test_deformable_master_tangent(rng, flaw, regime, nlaw):
     u_old = u.copy()
     u_old[: master_body.ndof] *= 0.3
     dg = {"stick": 1e-6, "slip+": 0.5, "slip-": -0.5}[regime]
-    set_history(iface, u, t_T_bar=0.01, dg=dg, master=surface.reference(u_old))
-    e = iface.evaluate(u, dt=DT)
+    h = set_history(iface, u, t_T_bar=0.01, dg=dg, master=surface.reference(u_old))
+    e = iface.evaluate(u, dt=DT, history=h)
     assert np.all(e.active)
-    K = check_tangent(iface, u)
+    K = check_tangent(iface, u, h)
     if FRICTIONS[flaw] is not None and regime != "stick":
         assert not np.allclose(K, K.T), "the slip tangent is non-symmetric (eq 50)"
 
@@ -126,10 +124,10 @@ def test_deformable_master_tangent(rng, flaw, regime, nlaw):
 def test_open_node_has_no_force_nor_tangent(rng):
     body, u = slave_cloud(rng, y=+0.05)
     iface = NodeToSegment(body, np.arange(4), RigidLine(), normal=NORMALS["penalty"], friction=FRICTIONS["coulomb"])
-    iface.start(u)
-    R, rows, cols, vals = iface.assemble(u)
+    h = iface.start(u)
+    R, rows, cols, vals = iface.assemble(u, history=h)
     assert np.all(R == 0) and len(vals) == 0
-    assert np.all(iface.evaluate(u).slip == OPEN)
+    assert np.all(iface.evaluate(u, history=h).slip == OPEN)
 
 
 def test_node_switches_segment_and_keeps_history(rng):
@@ -140,17 +138,17 @@ def test_node_switches_segment_and_keeps_history(rng):
     body = PointCloud([[0.9, 0.0]], "slave")
     iface = NodeToSegment(body, [0], master, normal=NORMALS["penalty"], friction=Coulomb(c_T=100.0, mu=10.0))
     u = np.array([0.0, -0.01])
-    iface.start(u)
-    iface.commit(iface.evaluate(u))
-    e0 = iface.evaluate(u)
+    h = iface.start(u)
+    h = iface.commit(iface.evaluate(u, history=h))
+    e0 = iface.evaluate(u, history=h)
     assert e0.seg[0] == 0
     u1 = np.array([0.2, -0.01 + 0.1 * 0.1])     # now above segment 1
-    e1 = iface.evaluate(u1)
+    e1 = iface.evaluate(u1, history=h)
     assert e1.seg[0] == 1
     L1 = np.hypot(1.0, 0.1)
     alpha = ((np.array([1.1, e1.x_s[0, 1]]) - [1.0, 0.0]) @ np.array([1.0, 0.1]) / L1) / L1
     assert np.isclose(e1.dg_T[0], 0.1 + alpha * L1)
-    check_tangent(iface, u1)
+    check_tangent(iface, u1, h)
 
 
 def test_deformable_master_node_switch_tangent(rng):
@@ -162,19 +160,19 @@ def test_deformable_master_node_switch_tangent(rng):
                           friction=ParabolicSlip(c_T=40.0, alpha=0.2, beta=0.3, n=0.5))
     u = np.zeros(mb.ndof + 2)
     u[-1] = -0.03
-    iface.start(u)
-    iface.commit(iface.evaluate(u))
+    h = iface.start(u)
+    h = iface.commit(iface.evaluate(u, history=h))
     u2 = u.copy()
     u2[-2] = 0.12                     # slides past the middle master node
     u2[:mb.ndof] = 0.01 * rng.standard_normal(mb.ndof)
-    e = iface.evaluate(u2)
+    e = iface.evaluate(u2, history=h)
     assert e.seg[0] == 1 and e.slip[0] == SLIP
-    check_tangent(iface, u2)
+    check_tangent(iface, u2, h)
 
 
 def test_offset_surface_contacts_earlier():
     body = PointCloud([[0.0, 0.4]], "beam")
     iface = NodeToSegment(body, [0], RigidLine(), normal=NORMALS["penalty"], offset=0.5)
-    iface.start(np.zeros(2))
-    e = iface.evaluate(np.zeros(2))
+    h = iface.start(np.zeros(2))
+    e = iface.evaluate(np.zeros(2), history=h)
     assert e.active[0] and np.isclose(e.g_N[0], -0.1)

@@ -85,17 +85,17 @@ def make(kind, master_kind, friction, kinematics="finite"):
     return c, nb
 
 
-def gaps_and_slips(contact, u):
-    st = contact.evaluate(u, 0.0, DT)
-    dg_T = st.dg_T if hasattr(st, "integrals") else st.s - contact.history.s_bar
+def gaps_and_slips(contact, u, h):
+    st = contact.evaluate(u, 0.0, DT, history=h)
+    dg_T = st.dg_T if hasattr(st, "integrals") else st.s - h.s_bar
     return st.g_N, dg_T
 
 
-def with_sets(contact, u, nb, sets):
+def with_sets(contact, u, nb, sets, h):
     """u with multipliers that put node j in sets[j] (open, stick, slip+, slip-), each at
     least 0.2 (in traction) away from a switch."""
     nc = len(contact.nodes)
-    g, dg = gaps_and_slips(contact, u)
+    g, dg = gaps_and_slips(contact, u, h)
     p = np.where(np.array(sets) == "open", C_N * g - 0.5, C_N * np.maximum(g, 0.0) + 1.0 + np.arange(nc) * 0.3)
     assert np.all(p[np.array(sets) == "open"] >= 0.0), "an open node must have a positive gap here"
     u = u.copy()
@@ -110,12 +110,12 @@ def with_sets(contact, u, nb, sets):
     return u
 
 
-def check_jacobian(contact, u):
+def check_jacobian(contact, u, h):
     n = len(u)
-    R, rows, cols, vals = contact.evaluate(u, 0.0, DT).scatter(n)
+    R, rows, cols, vals = contact.evaluate(u, 0.0, DT, history=h).scatter(n)
     K = np.zeros((n, n))
     np.add.at(K, (rows, cols), vals)
-    Kfd = fd_jacobian(lambda v: contact.evaluate(v, 0.0, DT).scatter(n)[0], u, h=H)
+    Kfd = fd_jacobian(lambda v: contact.evaluate(v, 0.0, DT, history=h).scatter(n)[0], u, h=H)
     err = rel_error(K, Kfd)
     assert err < TOL, f"Jacobian mismatch {err:.2e}"
     return err
@@ -137,12 +137,12 @@ def test_jacobian_matches_finite_differences(rng, kind, master, kinematics, law,
     contact, nb = make(kind, master, FRICTIONS[law], kinematics)
     u = np.zeros(nb + contact.unknowns)
     u[:nb] = 0.003 * rng.standard_normal(nb)
-    contact.start(u)
+    h = contact.start(u)
     u[0:8:2] += 0.02                                        # the slave slides along x (a slip of the step)
     wanted = SETS[sets]
     u[1:8:2] += np.where(np.array(wanted) == "open", 0.06, -0.02)    # open nodes lifted, the others pressed in
-    u = with_sets(contact, u, nb, wanted)
-    st = contact.evaluate(u, 0.0, DT)
+    u = with_sets(contact, u, nb, wanted, h)
+    st = contact.evaluate(u, 0.0, DT, history=h)
     expected = {"open": OPEN, "stick": STICK, "slip+": SLIP, "slip-": SLIP}
     got = st.slip
     want = [expected[s] if law != "frictionless" else (OPEN if s == "open" else STICK) for s in wanted]
@@ -150,8 +150,8 @@ def test_jacobian_matches_finite_differences(rng, kind, master, kinematics, law,
     if law != "frictionless" and "slip" in sets:
         sign = 1.0 if sets == "slip+" else -1.0
         on = np.array(wanted) == sets
-        assert np.all(np.sign(u[nb + 4:][on] + C_T * gaps_and_slips(contact, u)[1][on]) == sign)
-    check_jacobian(contact, u)
+        assert np.all(np.sign(u[nb + 4:][on] + C_T * gaps_and_slips(contact, u, h)[1][on]) == sign)
+    check_jacobian(contact, u, h)
 
 
 # -- bad input ------------------------------------------------------------------------------
@@ -169,6 +169,6 @@ def test_laws_it_cannot_take_are_refused():
 
 def test_outside_a_system_it_says_so():
     c = LagrangeNodeToSegment(PointCloud(X_SLAVE), np.arange(4), RigidLine(), normal=PowerLaw(c_N=1.0))
-    c.start(np.zeros(8))
+    h = c.start(np.zeros(8))
     with pytest.raises(ValueError, match="put it in a System"):
-        c.evaluate(np.zeros(12))
+        c.evaluate(np.zeros(12), history=h)

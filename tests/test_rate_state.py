@@ -70,12 +70,13 @@ def test_rate_law_return_map_and_history():
 def test_history_is_committed_only_on_convergence():
     params = block.SCENE.resolve("fast", {"law": "coulomb", "n_steps": 2})
     s = block.solve(params, friction=RATE_LAWS["wear"])
-    c = s["contact"]
-    h = c.history
+    c, last = s["contact"], s["records"][-1]
+    h = last.state.contacts[0]
     assert np.all(h.z_bar >= 0) and h.z_bar.max() > 0                          # worn where it slipped
     assert np.all(h.z_bar[h.q_bar == 0] == 0)                                  # no wear without slip
-    c.evaluate(s["u"] * 1.01, dt=0.5)                                         # evaluations leave it alone
-    assert c.history is h
+    before = h.z_bar.copy()
+    c.evaluate(s["u"] * 1.01, dt=0.5, history=h)                              # evaluations leave it alone
+    assert last.state.contacts[0] is h and np.array_equal(h.z_bar, before)
 
 
 def test_wear_moves_the_surface():
@@ -84,14 +85,14 @@ def test_wear_moves_the_surface():
     body = PointCloud(np.array([[0.0, 0.0], [1.0, 0.0]]), "slave")
     iface = NodeToSegment(body, [0, 1], RigidLine(), normal=PowerLaw(c_N=100.0), friction=law)
     u = np.array([0.0, -0.02, 0.0, -0.02])
-    iface.start(u)
-    t0 = iface.evaluate(u, dt=1.0).t_N.copy()
+    h = iface.start(u)
+    t0 = iface.evaluate(u, dt=1.0, history=h).t_N.copy()
     u1 = u.copy()
     u1[0] = 0.3                                                               # node 0 slides
-    iface.commit(iface.evaluate(u1, dt=1.0))
-    w = iface.history.z_bar[:, 0]
+    h = iface.commit(iface.evaluate(u1, dt=1.0, history=h))
+    w = h.z_bar[:, 0]
     assert w[0] > 0 and w[1] == 0
-    e = iface.evaluate(u1, dt=1.0)
+    e = iface.evaluate(u1, dt=1.0, history=h)
     assert np.isclose(e.g_N[0], -0.02 + w[0]) and e.t_N[0] > t0[0]           # less compressive
     assert e.t_N[1] == t0[1]
 
@@ -138,16 +139,16 @@ def test_block_tangent_against_finite_differences(name):
     c1, system = sc["contact"], sc["system"]
     st = Static(system, atol=params["atol"], rtol=params["rtol"], maxit=40)
     u = np.zeros(system.ndof)
-    system.start(u)
-    u, _, _, res = st.step(0.0, u, u, u, 0.5)
-    system.commit(res.evaluation, u, 0.5, 0.5)
-    u, *_ = st.step(0.5, u, u, u, 0.5)
+    state = system.start(u)
+    u, _, _, res = st.step(0.0, u, u, u, 0.5, state=state)
+    state = system.commit(res.evaluation, u, 0.5, 0.5)
+    u, *_ = st.step(0.5, u, u, u, 0.5, state=state)
     assert np.allclose(u, s["u"], atol=1e-9)
-    state = c1.evaluate(u, 1.0, 0.5).slip
-    assert np.any(state == STICK) and np.any(state == SLIP)
+    slip = c1.evaluate(u, 1.0, 0.5, history=state.contacts[0]).slip
+    assert np.any(slip == STICK) and np.any(slip == SLIP)
     cols = c1.slave_dofs().ravel()
-    K = system.residual_tangent(u, 1.0, dt=0.5)[1].toarray()[:, cols]
-    K_fd = fd_jacobian(lambda w: system.residual_tangent(w, 1.0, dt=0.5)[0], u, cols, h=1e-7)
+    K = system.residual_tangent(u, 1.0, dt=0.5, state=state)[1].toarray()[:, cols]
+    K_fd = fd_jacobian(lambda w: system.residual_tangent(w, 1.0, dt=0.5, state=state)[0], u, cols, h=1e-7)
     assert rel_error(K, K_fd) < 1e-6
 
 

@@ -22,7 +22,6 @@ class SpringChain:
         self.X = np.c_[np.arange(n, dtype=float), np.zeros(n)]
         self.ndof = 2 * n
         self.xdofs = np.arange(2 * n).reshape(n, 2)
-        self.commits = 0
         self.dt = None
         self.dof_offset = 0
         self.hyperelastic = True
@@ -32,13 +31,13 @@ class SpringChain:
     def mass(self, consistent=False):
         return sp.diags(np.full(self.ndof, self.m)).tocsr() if consistent else np.full(self.ndof, self.m)
 
-    def internal_coo(self, u, dt=None):
+    def internal_coo(self, u, dt=None, state=None):
         self.dt = dt                      # like a rate-dependent body: the step's dt
         R, K = self.internal(u)
         K = K.tocoo()
         return R, K.row, K.col, K.data
 
-    def internal(self, u, dt=None):
+    def internal(self, u, dt=None, state=None):
         U = u.reshape(-1, 2)
         d = U[1:] - U[:-1]
         f = self.k * d + self.k3 * d ** 3
@@ -51,12 +50,15 @@ class SpringChain:
                           shape=(self.ndof, self.ndof))
         return R.ravel(), K.tocsr()
 
-    def strain_energy(self, u, dt=None):
+    def strain_energy(self, u, dt=None, state=None):
         d = np.diff(u.reshape(-1, 2), axis=0)
         return float(np.sum(self.k * d ** 2 / 2 + self.k3 * d ** 4 / 4))
 
-    def commit(self, u, dt=None):
-        self.commits += 1
+    def start(self, u):
+        return 0                          # its state: how many steps were committed
+
+    def commit(self, u, dt=None, state=None):
+        return state + 1
 
     rotation_dofs = np.zeros(0, dtype=int)
 
@@ -92,26 +94,27 @@ class WallState:
 
 class Wall:
     """Penalty wall y >= y_wall for one node: R_c = c g on its y dof when g < 0; its history
-    is the number of commits, and every step dissipates ``dissipation_per_commit``."""
+    is the number of commits (a value, in the SystemState), and every step dissipates
+    ``dissipation_per_commit``."""
     integration = "standard"
     unknowns = 0
 
     def __init__(self, body, node, y_wall, c, dissipation_per_commit=0.0):
         self.body, self.node, self.y_wall, self.c = body, node, y_wall, c
         self.per_commit = dissipation_per_commit
-        self.name, self.history, self.evaluations = "wall", None, 0
+        self.name, self.evaluations = "wall", 0
 
     def start(self, u, t=0.0):
-        self.history = 0
+        return 0
 
-    def evaluate(self, u, t=0.0, dt=None, u0=None, phase=None):
+    def evaluate(self, u, t=0.0, dt=None, u0=None, phase=None, *, history):
         self.evaluations += 1
         dof = self.body.dof_offset + self.body.xdofs[self.node, 1]
         return WallState(dof, self.body.X[self.node, 1] + u[dof] - self.y_wall, self.c,
-                         self.per_commit, (self.history or 0) + 1)
+                         self.per_commit, history + 1)
 
     def commit(self, state):
-        self.history = state.next_history
+        return state.next_history
 
 
 class DeadLoad:
@@ -121,13 +124,16 @@ class DeadLoad:
         self.body, self.local_dofs, self.f = body, np.asarray(local_dofs), f
         self.value = np.asarray(value, dtype=float)
 
-    def assemble(self, u, t):
+    def start(self, u, t=0.0):
+        return None
+
+    def assemble(self, u, t, state=None):
         P = np.zeros(u.size)
         P[self.body.dof_offset + self.local_dofs] = self.value * self.f(t)
         return P, [], [], []
 
-    def commit(self, u, t):
-        pass
+    def commit(self, u, t, state=None):
+        return state
 
 
 class SpringLoad:
@@ -136,14 +142,17 @@ class SpringLoad:
     def __init__(self, body, local_dof, f0, kl):
         self.body, self.local_dof, self.f0, self.kl = body, local_dof, f0, kl
 
-    def assemble(self, u, t):
+    def start(self, u, t=0.0):
+        return None
+
+    def assemble(self, u, t, state=None):
         g = self.body.dof_offset + self.local_dof
         P = np.zeros(u.size)
         P[g] = self.f0 - self.kl * u[g]
         return P, [g], [g], [-self.kl]
 
-    def commit(self, u, t):
-        pass
+    def commit(self, u, t, state=None):
+        return state
 
 
 def test_the_fakes_are_what_the_solver_asks_for():
@@ -184,20 +193,21 @@ def test_tangent_matches_finite_differences(linear_algebra):
     a, b = SpringChain(3, k=2.0, k3=5.0, name="a"), SpringChain(2, k=1.0, k3=1.0, name="b")
     s = System([a, b], contacts=[Wall(b, 1, y_wall=0.0, c=30.0)],
                loads=[SpringLoad(a, 4, f0=1.0, kl=3.0), DeadLoad(b, [2], 0.7)], linear_algebra=linear_algebra)
-    s.start(np.zeros(s.ndof))
+    state = s.start(np.zeros(s.ndof))
     u = np.random.default_rng(0).normal(scale=0.3, size=s.ndof)
     u[s.global_dofs(b, b.xdofs[1, 1])] = -0.4            # wall contact active
-    G, K = s.residual_tangent(u, 0.0)
+    G, K = s.residual_tangent(u, 0.0, state=state)
     assert sp.issparse(K) == (linear_algebra != "dense")
     assert hasattr(K, "band_plan") == (linear_algebra == "banded")
     h, K_fd = 1e-6, np.zeros((s.ndof, s.ndof))
     for j in range(s.ndof):
         e = np.zeros(s.ndof)
         e[j] = h
-        K_fd[:, j] = (s.residual_tangent(u + e, 0.0)[0] - s.residual_tangent(u - e, 0.0)[0]) / (2 * h)
+        K_fd[:, j] = (s.residual_tangent(u + e, 0.0, state=state)[0]
+                      - s.residual_tangent(u - e, 0.0, state=state)[0]) / (2 * h)
     assert np.linalg.norm(as_array(K) - K_fd) <= 1e-6 * np.linalg.norm(K_fd)
     # the effective tangent of a time stepper: K + c M on the diagonal
-    _, K_eff = s.residual_tangent(u, 0.0, mass_coefficient=7.0)
+    _, K_eff = s.residual_tangent(u, 0.0, mass_coefficient=7.0, state=state)
     assert np.allclose(as_array(K_eff), as_array(K) + 7.0 * np.diag(s.mass()), rtol=1e-14, atol=1e-12)
 
 
@@ -208,7 +218,7 @@ def test_initial_acceleration_solves_M_a_equals_P_minus_R():
     u0[:2] = 0.0
     a0 = initial_acceleration(s, 0.0, u0)
     R, _ = body.internal(u0)
-    P = s.external_force(u0, 0.0)
+    P = s.external_force(u0, 0.0, s.start(u0))
     assert np.allclose((s.mass() * a0)[s.free_dofs], (P - R)[s.free_dofs])
     assert np.all(a0[s.fixed_dofs] == 0)
 
@@ -223,11 +233,12 @@ def nonlinear_chain():
 
 def test_newton_converges_quadratically():
     s = nonlinear_chain()
-    res = newton(lambda u: s.residual_tangent(u, 0.0), np.zeros(s.ndof), s.free_dofs)
+    state = s.start(np.zeros(s.ndof))
+    res = newton(lambda u: s.residual_tangent(u, 0.0, state=state), np.zeros(s.ndof), s.free_dofs)
     r = np.array(res.residuals)
     assert res.iterations == len(r) - 1 >= 4
     assert r[-1] <= 1e-10 * r[0] + 1e-10
-    G, _ = s.residual_tangent(res.u, 0.0)
+    G, _ = s.residual_tangent(res.u, 0.0, state=state)
     assert np.linalg.norm(G[s.free_dofs]) == pytest.approx(r[-1])
     # asymptotic quadratic rate: r_k+1 / r_k^2 bounded in the last iterations
     tail = [k for k in range(len(r) - 1) if r[k] < 1.0 and r[k + 1] > 1e-13]  # above roundoff
@@ -238,7 +249,7 @@ def test_newton_converges_quadratically():
 def test_newton_error_on_maxit_carries_history():
     s = nonlinear_chain()
     with pytest.raises(NewtonError, match="step 7") as info:
-        newton(lambda u: s.residual_tangent(u, 0.0), np.zeros(s.ndof), s.free_dofs,
+        newton(lambda u: s.residual_tangent(u, 0.0, state=s.start(u)), np.zeros(s.ndof), s.free_dofs,
                maxit=2, label="step 7, t = 0.7")
     assert len(info.value.history) == 3
     assert np.all(np.isfinite(info.value.history))
@@ -325,7 +336,7 @@ def test_dirichlet_values_are_honoured():
     hist = integrate(Newmark(s), 0.0, np.zeros(s.ndof), n_steps=20, dt=0.1)
     for r in hist.records:
         assert np.allclose(r.u[[0, 1, 5]], move(r.t) + [0.3])
-    u = Static(s).step(0.0, np.zeros(s.ndof), None, None, 1.0)[0]
+    u = Static(s).step(0.0, np.zeros(s.ndof), None, None, 1.0, state=s.start(np.zeros(s.ndof)))[0]
     assert np.allclose(u[[0, 1, 5]], move(1.0) + [0.3])
 
 
@@ -352,7 +363,7 @@ def test_static_penalty_wall_and_dissipation_bookkeeping():
     assert uy + 2 * uy ** 3 + 100 * (uy + 0.1) == pytest.approx(-2.0, abs=1e-9)
     assert hist.contact[-1] == pytest.approx(50 * (uy + 0.1) ** 2)
     assert np.allclose(hist.dissipation, [0, 0.125, 0.25, 0.375])
-    assert body.commits == 3 and wall.history == 3        # committed once per step
+    assert hist.records[-1].state.bodies == (3,) and hist.records[-1].state.contacts == (3,)   # once per step
 
 
 def test_central_difference_oscillator():
@@ -373,10 +384,10 @@ class FussyNewmark(Newmark):
     """Fails (like a diverging Newton) whenever dt exceeds max_dt."""
     max_dt = 0.03
 
-    def step(self, t, u, v, a, dt, label=""):
+    def step(self, t, u, v, a, dt, label="", *, state):
         if dt > self.max_dt:
             raise NewtonError(f"too large ({label})", [1.0, 2.0], label)
-        return super().step(t, u, v, a, dt, label=label)
+        return super().step(t, u, v, a, dt, label=label, state=state)
 
 
 def test_cutback_halves_the_step_and_keeps_the_time_grid():
@@ -385,7 +396,7 @@ def test_cutback_halves_the_step_and_keeps_the_time_grid():
                      cutback=True, max_cuts=4)
     assert np.allclose(hist.dt[1:], 0.025) and len(hist.t) == 1 + 3 * 4
     assert hist.t[-1] == pytest.approx(0.3) and hist.cuts[1] == 2 and hist.cuts.sum() == 3 * 2
-    assert body.commits == 12 and body.dt == pytest.approx(0.025)       # the body was given the cut dt
+    assert hist.records[-1].state.bodies == (12,) and body.dt == pytest.approx(0.025)       # the body was given the cut dt
     with pytest.raises(NewtonError, match="step 1") as info:
         integrate(FussyNewmark(s), 0.0, np.zeros(4), n_steps=3, dt=0.1, cutback=True, max_cuts=1)
     assert info.value.history == [1.0, 2.0] and len(info.value.partial.t) == 1
@@ -401,7 +412,7 @@ def test_bad_input_raises():
         with pytest.raises(ValueError, match="dt"):
             integrate(Newmark(s), 0.0, np.zeros(4), n_steps=2, dt=dt)
         with pytest.raises(ValueError, match="dt"):
-            Newmark(s).step(0.0, np.zeros(4), np.zeros(4), np.zeros(4), dt)
+            Newmark(s).step(0.0, np.zeros(4), np.zeros(4), np.zeros(4), dt, state=s.start(np.zeros(4)))
     for beta in (0.0, -0.1, 0.6):
         with pytest.raises(ValueError, match="beta"):
             Newmark(s, beta=beta)

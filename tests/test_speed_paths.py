@@ -7,6 +7,8 @@ import json
 import subprocess
 import sys
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -126,8 +128,9 @@ def test_dense_and_sparse_paths_give_the_same_run():
 def test_effective_tangent_is_the_same_matrix_dense_and_sparse():
     s_d, h = impact("dense", n_steps=8)
     s_s = System(s_d.bodies, s_d.contacts, linear_algebra="sparse")
-    _, K_d = s_d.residual_tangent(h.u, 0.8, mass_coefficient=250.0, dt=0.1)
-    _, K_s = s_s.residual_tangent(h.u, 0.8, mass_coefficient=250.0, dt=0.1)
+    state = h.records[-1].state
+    _, K_d = s_d.residual_tangent(h.u, 0.8, mass_coefficient=250.0, dt=0.1, state=state)
+    _, K_s = s_s.residual_tangent(h.u, 0.8, mass_coefficient=250.0, dt=0.1, state=replace(state, loads=()))
     assert isinstance(K_d, np.ndarray) and sp.issparse(K_s)
     assert np.allclose(K_d, as_array(K_s), rtol=1e-15, atol=1e-13 * np.abs(K_d).max())
 
@@ -523,10 +526,9 @@ def test_a_contact_set_kept_reuses_its_pattern_and_gives_the_same_tangent(kind):
     def system():
         model = scene.build(params, system_options=dict(linear_algebra=kind))
         s = model["system"]
-        s.start(np.zeros(s.ndof))
-        return s
+        return s, s.start(np.zeros(s.ndof))
 
-    s = system()
+    s, state = system()
     lowest = np.argmin(s.contacts[0].slave.X[s.contacts[0].nodes, 1])   # the node touching the floor
     dofs = s.contacts[0].slave_dofs()
     u1 = np.zeros(s.ndof)
@@ -535,11 +537,12 @@ def test_a_contact_set_kept_reuses_its_pattern_and_gives_the_same_tangent(kind):
     u2[dofs[lowest, 0]] = 2e-4                                           # the same node, moved along
     u3 = u2.copy()
     u3[dofs[(lowest + 1) % len(dofs), 1]] -= 5.0                         # and its neighbour pressed in
-    first = s.evaluate(u1, 0.0, params["dt"], u1, mass_coefficient=1.0)
+    first = s.evaluate(u1, 0.0, params["dt"], u1, mass_coefficient=1.0, state=state)
     runs = []
     for u in (u2, u3):
-        ev = s.evaluate(u, 0.0, params["dt"], u1, mass_coefficient=1.0)
-        fresh = system().evaluate(u, 0.0, params["dt"], u1, mass_coefficient=1.0)
+        ev = s.evaluate(u, 0.0, params["dt"], u1, mass_coefficient=1.0, state=state)
+        other, other_state = system()
+        fresh = other.evaluate(u, 0.0, params["dt"], u1, mass_coefficient=1.0, state=other_state)
         np.testing.assert_array_equal(ev.G, fresh.G)
         np.testing.assert_allclose(as_array(ev.K), as_array(fresh.K), rtol=0, atol=1e-12 * np.abs(as_array(fresh.K)).max())
         runs.append(ev)

@@ -61,29 +61,31 @@ class Spring:
         return np.array(u, dtype=float)
 
     def start(self, u, t=0.0):
-        pass
+        from contactfem.solver.system import SystemState
+        return SystemState()
 
-    def evaluate(self, u, t, dt=None, u0=None, mass_coefficient=0.0, phases=None):
+    def evaluate(self, u, t, dt=None, u0=None, mass_coefficient=0.0, phases=None, *, state):
         import scipy.sparse as sp
 
         from contactfem.solver import Evaluation
-        return Evaluation(self.k * u - t, sp.csr_matrix([[self.k]]), (), np.array([t]))
+        return Evaluation(self.k * u - t, sp.csr_matrix([[self.k]]), (), np.array([t]), state)
 
-    def energies(self, u, v, evaluation, dt=None):
+    def energies(self, u, v, evaluation, dt=None, state=None):
         return dict(kinetic=0.0, strain=0.5 * self.k * float(u @ u), contact=0.0)
 
     def commit(self, evaluation, u, t, dt=None):
         self.commits.append(float(u[0]))
+        return evaluation.state
 
     def mass(self):
         return np.zeros(1)
 
 
 class FailingStatic(Static):
-    def step(self, t, u, v, a, dt, label=""):
+    def step(self, t, u, v, a, dt, label="", *, state):
         if self.system.fail(t + dt, dt):
             raise NewtonError(f"no convergence ({label})", [1.0], label)
-        return super().step(t, u, v, a, dt, label=label)
+        return super().step(t, u, v, a, dt, label=label, state=state)
 
 
 def test_adaptive_rule_cutback_growth():

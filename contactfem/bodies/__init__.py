@@ -11,10 +11,13 @@ for a continuum ring and the solver never knows the difference:
     body.mass()        (ndof,) lumped (diagonal) mass; body.mass(consistent=True): the
                        consistent mass, a scipy sparse matrix; body.mass_matrix says which
                        the solver uses ("lumped" or "consistent")
-    body.internal(u)   -> (R, K): internal force vector R(u) (ndof,) and its
-                       consistent tangent K = dR/du (scipy.sparse, ndof x ndof)
-    body.strain_energy(u) -> float
-    body.commit(u)     accept u as converged (history variables; no-op if elastic)
+    body.internal(u, dt, state) -> (R, K): internal force vector R(u) (ndof,) and its
+                       consistent tangent K = dR/du (scipy.sparse, ndof x ndof), with the
+                       body's internal variables ``state`` (None for an elastic body)
+    body.strain_energy(u, dt, state) -> float
+    body.start(u)      the internal variables at the initial state (None if elastic)
+    body.commit(u, dt, state) -> the internal variables after u converged (the body
+                       keeps nothing: the System carries them in its SystemState)
     body.rotation_dofs local dofs that are angles (a beam's theta; none for a continuum)
     body.discrete_gradient(u0, u1) -> (F, rows, cols, vals): the internal force of an
                        energy-consistent step and its tangent (discrete_gradient.py)

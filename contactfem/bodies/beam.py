@@ -167,9 +167,12 @@ class Beam:
         g = 1 / np.sqrt(3.0)
         # (natural coordinate xi in [-1, 1], weight as a fraction of L0)
         self.points = ((0.0, 1.0),) if integration == 1 else ((-g, 0.5), (g, 0.5))
-        # committed plastic strains (eps_p, gam_p, kap_p) per integration point: rows k ne .. (k+1) ne - 1
-        # belong to point k
-        self.ep = np.zeros((len(self.points) * ne, 3))
+        # plastic strains (eps_p, gam_p, kap_p) per integration point, the beam's internal variables
+        # (its state, from ``start`` and ``commit``): rows k ne .. (k+1) ne - 1 belong to point k
+        self._ep0 = np.zeros((len(self.points) * ne, 3))
+        self._ep0.flags.writeable = False
+        self._g = None                  # the constants of internal_coo (``_gauss``), made on first use
+        self._mass = None               # the lumped mass, made on first use
         self.rotary_inertia = bool(rotary_inertia)
         if mass_matrix not in MASS_MATRICES:
             raise ValueError(f"parameter mass_matrix = {mass_matrix!r} is not allowed: one of {'|'.join(MASS_MATRICES)}")
@@ -289,28 +292,32 @@ class Beam:
         E[:, 2] = (U[b, 2] - U[a, 2]) / self.L0                           # kap = theta'
         return E, t, n
 
-    def resultants(self, u, xi=0.0, k=0, E=None, dt=None):
+    def resultants(self, u, xi=0.0, k=0, E=None, dt=None, state=None):
         """(N, Q, M) per element at xi (integration point k), (ne, 3), with the algorithmic
         moduli dS/dE and new plastic strains (E: the strains there, if already computed; dt: the
-        step, viscoplastic only)."""
+        step, viscoplastic only; state: the committed plastic strains, None for the initial ones)."""
         if E is None:
             E = self.strains(u, xi)[0]
         ne = len(self.L0)
-        return return_map(E, self.ep[k * ne:(k + 1) * ne], self.D, self.S0, self.eta, self._dt(dt))
+        return return_map(E, self._ep(state)[k * ne:(k + 1) * ne], self.D, self.S0, self.eta, self._dt(dt))
+
+    def _ep(self, state):
+        """The committed plastic strains: the state, or the initial (zero) ones for None."""
+        return self._ep0 if state is None else state
 
     # ---- body interface ------------------------------------------------------------
-    def internal(self, u, dt=None):
+    def internal(self, u, dt=None, state=None):
         """Internal force R = dW/du and consistent tangent K = dR/du (CSR); see internal_coo."""
         from scipy.sparse import coo_matrix
 
-        R, rows, cols, vals = self.internal_coo(u, dt)
+        R, rows, cols, vals = self.internal_coo(u, dt, state)
         return R, coo_matrix((vals, (rows, cols)), shape=(self.ndof, self.ndof)).tocsr()
 
-    def internal_coo(self, u, dt=None):
+    def internal_coo(self, u, dt=None, state=None):
         """Internal force R = dW/du and consistent tangent K = dR/du (virtual work, midpoint rule,
         or two-point Gauss with ``integration=2``), K as COO triplets (rows, cols, vals) on the
-        fixed element connectivity (the same index arrays at every call). dt: the step
-        (viscoplastic only).
+        fixed element connectivity (the same index arrays at every call). dt: the step and
+        state: the committed plastic strains (viscoplastic only; None: the initial ones).
 
         Per element and point, with q = (u_a, theta_a, u_b, theta_b) and B = dE/dq (3 x 6):
             r_e = w L0 B^T S,     K_e = w L0 (B^T C B + N d2eps/dq2 + Q d2gam/dq2)
@@ -341,7 +348,7 @@ class Beam:
         """
         g = self._gauss()
         E, t, n = self._row_strains(u, g)
-        S, C = self._resultants(E, g, dt)
+        S, C = self._resultants(E, g, dt, state)
         eps, gam = E[0], E[1]
         N, Q, M = S[0], S[1], S[2]
         C_N, C_Q, C_M = C[0], C[1], C[2]
@@ -393,14 +400,14 @@ class Beam:
         np.multiply(q[5] - q[2], g["invL"], out=E[2])            # kap = theta'
         return E, t, n
 
-    def _resultants(self, E, g, dt):
+    def _resultants(self, E, g, dt, state=None):
         """The resultants S = (N, Q, M) (3, m) at the strains E of every row and their moduli
         C = dS/dE: the elastic beam's S = D E and C = D (what ``return_map`` gives without
         plastic strains; D at every row, so that no product broadcasts), else the viscoplastic
-        return map from the committed ``ep``."""
+        return map from the committed plastic strains ``state``."""
         if self.S0 is None:
             return g["Dm"] * E, g["Dm"]
-        return return_map(E, self.ep.T, g["D"], g["S0"], self.eta, self._dt(dt))[:2]
+        return return_map(E, self._ep(state).T, g["D"], g["S0"], self.eta, self._dt(dt))[:2]
 
     def _gauss(self):
         """Per-row constants of internal_coo (row k ne + e: point k of element e), made once:
@@ -410,7 +417,7 @@ class Beam:
         / L0^2 (1, -1, 1)), the signs that turn t t^T into n n^T (flip) and t into n (turn), and
         the map from the ten distinct entries of K_e and their negatives (rows 10-19) to its 36
         (``entry``)."""
-        if getattr(self, "_g", None) is None:
+        if self._g is None:
             ne, k = len(self.L0), len(self.points)
             xi = np.repeat([x for x, _ in self.points], ne)
             weight = np.repeat([w for _, w in self.points], ne)
@@ -444,19 +451,24 @@ class Beam:
                            D=self.D[:, None], S0=None if self.S0 is None else self.S0[:, None])
         return self._g
 
-    def strain_energy(self, u, dt=None):
+    def strain_energy(self, u, dt=None, state=None):
         """Stored (elastic) energy sum_e L0 sum_k S_k^2 / (2 D_k); elastic case: L0 D E^2 / 2
         (viscoplastic: the resultants of a step of dt from the committed plastic strains).
         All integration points in one pass, the rows of internal_coo."""
         g = self._gauss()
-        S = self._resultants(self._row_strains(u, g)[0], g, dt)[0]
+        S = self._resultants(self._row_strains(u, g)[0], g, dt, state)[0]
         return float((g["wL0"] * (S * S / g["D2"])).sum())
 
-    def commit(self, u, dt=None):
-        """Accept u as converged at the end of a step of dt: store the plastic strains
-        (no-op if elastic)."""
-        if self.S0 is not None:
-            self.ep = np.concatenate([self.resultants(u, xi, k, dt=dt)[2] for k, (xi, _) in enumerate(self.points)])
+    def start(self, u):
+        """The internal variables at the initial state: no plastic strain (None if elastic)."""
+        return None if self.S0 is None else self._ep0
+
+    def commit(self, u, dt=None, state=None):
+        """The internal variables after a step of dt converged at u from ``state``: the plastic
+        strains (None if elastic). The beam keeps nothing."""
+        if self.S0 is None:
+            return None
+        return np.concatenate([self.resultants(u, xi, k, dt=dt, state=state)[2] for k, (xi, _) in enumerate(self.points)])
 
     @property
     def mesh(self):
@@ -493,7 +505,7 @@ class Beam:
                 vals += [2 * e, e, e, 2 * e]
             return coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                               shape=(self.ndof, self.ndof)).tocsr()
-        if getattr(self, "_mass", None) is None:   # computed once, then reused
+        if self._mass is None:                     # computed once, then reused
             length = np.bincount(self.conn.ravel(), np.repeat(0.5 * self.L0, 2), minlength=self.X.shape[0])
             J = self.I * length if self.rotary_inertia else 0.0 * length
             self._mass = (self.rho * np.column_stack([self.A * length, self.A * length, J])).ravel()
@@ -539,16 +551,23 @@ class BeamGravity:
         if g.shape != (2,) or not np.all(np.isfinite(g)):
             raise ValueError(f"parameter g must be a finite number or 2-vector, got {g!r}")
         self.beam, self.g = beam, g
+        self._P = (None, None)              # (where, triplets): P made for one place of the beam
 
-    def commit(self, u, t):
+    def start(self, u, t=0.0):
+        """A dead load has no state."""
+        return None
+
+    def commit(self, u, t, state=None):
         """A dead load keeps no history."""
+        return state
 
-    def assemble(self, u_global, t):
+    def assemble(self, u_global, t, state=None):
         """(P, rows, cols, vals): the dead load and an empty tangent. P is made once for the
-        beam's place in the global vector (read-only: a dead load does not change)."""
+        beam's place in the global vector (read-only: a dead load does not change; a pure
+        function of the beam and the vector's size)."""
         b = self.beam
         where = (b.dof_offset, np.size(u_global))
-        if getattr(self, "_P", (None,))[0] != where:
+        if self._P[0] != where:
             P = np.zeros(where[1])
             P[b.dof_offset + b.xdofs] = b.mass()[b.xdofs] * self.g
             empty_i, empty_v = np.zeros(0, dtype=int), np.zeros(0)

@@ -255,7 +255,7 @@ class Continuum:
         """W(u) is quadratic (the linear material): the midpoint rule conserves its energy exactly."""
         return self.material == "linear"
 
-    def internal_coo(self, u, dt=None):
+    def internal_coo(self, u, dt=None, state=None):
         """R(u) and K = dR/du as COO triplets (rows, cols, vals): the CSR tangent's entries, its
         index arrays kept (the same objects) while its pattern stays the same (scikit-fem's
         assembly gives the same pattern at every call), so that the System places them once."""
@@ -268,7 +268,7 @@ class Continuum:
             return R, last[1], last[2], K.data
         return R, last[2], last[1], K.data
 
-    def internal(self, u, dt=None):
+    def internal(self, u, dt=None, state=None):
         """Internal force R(u) and consistent tangent K = dR/du (scipy sparse: CSC for the linear material, CSR else)."""
         u = np.asarray(u, dtype=float)
         if self.material == "linear":
@@ -288,7 +288,7 @@ class Continuum:
             self._K_linear = asm(_linear_form, self.basis, lam=self.lam, mu=self.mu, **self._params()).tocsc()
         return self._K_linear
 
-    def strain_energy(self, u, dt=None):
+    def strain_energy(self, u, dt=None, state=None):
         """Stored energy int W dV (2 pi r dA for axisymmetric). Linear material: u.K u / 2,
         the same integral on the same quadrature (W = eps:C:eps / 2, K = int grad v:C:grad du),
         without evaluating the fields at the quadrature points (Hertz on 65k quads: 0.1-0.4 s
@@ -312,8 +312,13 @@ class Continuum:
             self._mass = np.asarray(self.mass(consistent=True).sum(axis=1)).ravel()
         return self._mass.copy()
 
-    def commit(self, u, dt=None):
-        """Elastic: no history to update."""
+    def start(self, u):
+        """Elastic: no internal variables (None)."""
+        return None
+
+    def commit(self, u, dt=None, state=None):
+        """Elastic: no internal variables (None)."""
+        return None
 
     def corner_jacobian_ratios(self, u):
         """det J of the element map in the deformed configuration X + u at every corner of

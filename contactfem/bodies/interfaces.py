@@ -5,6 +5,11 @@ continuum, the loads of loads.py and a student's own); the solver never asks wha
 or load can do (no ``hasattr``). ``u`` is always the body's own (local) displacement vector
 for a body, the global one for a load; ``dt`` is the step being taken (only a body with a
 rate-dependent law, the viscoplastic beam, needs it).
+
+Bodies and loads hold their configuration only. What they remember from step to step (a
+viscoplastic beam's plastic strains, a gas pressure's value) is their ``state``, a value:
+``start`` gives the first, ``commit`` returns the next, the System carries it (its
+SystemState, solver/system.py) and passes it to every call that needs it.
 """
 from typing import Protocol, runtime_checkable
 
@@ -33,18 +38,22 @@ class Body(Protocol):
         scipy sparse matrix (ndof, ndof), whose row sums are the lumped mass (asked for only of a
         body whose ``mass_matrix`` is "consistent")."""
 
-    def internal_coo(self, u: np.ndarray, dt=None) -> tuple:
-        """(R, rows, cols, vals): internal forces R(u) and the tangent dR/du as COO triplets;
-        rows and cols the same objects from call to call while the pattern is the same."""
+    def start(self, u: np.ndarray) -> object:
+        """The internal variables at the initial state u (None for an elastic body)."""
 
-    def internal(self, u: np.ndarray, dt=None) -> tuple:
+    def internal_coo(self, u: np.ndarray, dt: float | None = None, state: object = None) -> tuple:
+        """(R, rows, cols, vals): internal forces R(u) and the tangent dR/du as COO triplets,
+        with the committed internal variables ``state``; rows and cols the same objects from
+        call to call while the pattern is the same."""
+
+    def internal(self, u: np.ndarray, dt: float | None = None, state: object = None) -> tuple:
         """(R, K) with K a scipy sparse matrix."""
 
-    def strain_energy(self, u: np.ndarray, dt=None) -> float:
+    def strain_energy(self, u: np.ndarray, dt: float | None = None, state: object = None) -> float:
         """The stored energy at u."""
 
-    def commit(self, u: np.ndarray, dt=None) -> None:
-        """Accept u as converged at the end of a step of dt (history variables)."""
+    def commit(self, u: np.ndarray, dt: float | None = None, state: object = None) -> object:
+        """The internal variables after a step of dt from ``state`` converged at u."""
 
     def discrete_gradient(self, u0: np.ndarray, u1: np.ndarray) -> tuple:
         """(F, rows, cols, vals): the internal force of an energy-consistent step u0 -> u1 and its
@@ -57,8 +66,12 @@ class Body(Protocol):
 class Load(Protocol):
     """An external load (see bodies/loads.py)."""
 
-    def assemble(self, u: np.ndarray, t: float) -> tuple:
-        """(P, rows, cols, vals): the external forces (global) and dP/du as COO triplets."""
+    def start(self, u: np.ndarray, t: float = 0.0) -> object:
+        """The load's state at the initial state (u, t) (None for a load without one)."""
 
-    def commit(self, u: np.ndarray, t: float) -> None:
-        """Accept the converged state u at time t (a gas pressure updates its value)."""
+    def assemble(self, u: np.ndarray, t: float, state: object = None) -> tuple:
+        """(P, rows, cols, vals): the external forces (global) and dP/du as COO triplets, with
+        the load's ``state``."""
+
+    def commit(self, u: np.ndarray, t: float, state: object = None) -> object:
+        """The load's state after the converged state u at time t (a gas pressure's next value)."""

@@ -1,13 +1,18 @@
 """External loads on a ``Continuum`` body.
 
-Each load has ``assemble(u_global, t) -> (P, rows, cols, vals)``: the external
+Each load has ``assemble(u_global, t, state) -> (P, rows, cols, vals)``: the external
 force vector P (ndof_global,) and dP/du as COO triplets in global numbering
-(empty for dead loads). The body's dofs start at ``body.dof_offset``.
+(empty for dead loads). The body's dofs start at ``body.dof_offset``. A load holds its
+configuration only; what it remembers from step to step (the gas pressure's value) is its
+state, a value the System carries (``start(u, t)``, ``commit(u, t, state)``; None for the
+loads without one).
 ``total_force(u_global, t)`` sums the nodal forces: the resultant (Fx, Fy).
 
 Axisymmetric bodies integrate over the full ring (2 pi r), plane bodies over
 the thickness, exactly as in ``Continuum``.
 """
+from dataclasses import dataclass, replace
+
 import numpy as np
 from skfem import FacetBasis, LinearForm, asm
 
@@ -39,22 +44,27 @@ class _Load:
     def __init__(self, body):
         self.body = body
 
-    def _local(self, u, t):
+    def _local(self, u, t, state=None):
         raise NotImplementedError
 
-    def commit(self, u_global, t):
-        """Accept the converged state u at time t (a load with no history ignores it)."""
+    def start(self, u_global, t=0.0):
+        """The load's state at the initial state: None (no history)."""
+        return None
 
-    def assemble(self, u_global, t):
+    def commit(self, u_global, t, state=None):
+        """The load's state after the converged state u at time t: unchanged (no history)."""
+        return state
+
+    def assemble(self, u_global, t, state=None):
         off, n = self.body.dof_offset, self.body.ndof
-        P_local, rows, cols, vals = self._local(np.asarray(u_global)[off:off + n], t)
+        P_local, rows, cols, vals = self._local(np.asarray(u_global)[off:off + n], t, state)
         P = np.zeros(len(u_global))
         P[off:off + n] = P_local
         return P, rows + off, cols + off, vals
 
-    def total_force(self, u_global, t):
+    def total_force(self, u_global, t, state=None):
         """Resultant (sum of the nodal forces) in x and y."""
-        P = self.assemble(u_global, t)[0]
+        P = self.assemble(u_global, t, state)[0]
         dofs = self.body.xdofs + self.body.dof_offset
         return np.array([P[dofs[:, 0]].sum(), P[dofs[:, 1]].sum()])
 
@@ -69,7 +79,7 @@ class BodyForce(_Load):
         params = dict(axi=body.axi, thickness=body.thickness)
         self._unit = [asm(_unit_load, body.basis, comp=c, **params) for c in (0, 1)]
 
-    def _local(self, u, t):
+    def _local(self, u, t, state=None):
         b = _value(self.b, t)
         return b[0] * self._unit[0] + b[1] * self._unit[1], *_EMPTY
 
@@ -85,7 +95,7 @@ class Traction(_Load):
         params = dict(axi=body.axi, thickness=body.thickness)
         self._unit = [asm(_unit_load, fb, comp=c, **params) for c in (0, 1)]
 
-    def _local(self, u, t):
+    def _local(self, u, t, state=None):
         tr = _value(self.traction, t)
         return tr[0] * self._unit[0] + tr[1] * self._unit[1], *_EMPTY
 
@@ -120,8 +130,12 @@ class Pressure(_Load):
             fb = FacetBasis(body.mesh, body.element, facets=facets)
             self._unit = asm(_unit_pressure, fb, axi=body.axi, thickness=body.thickness)
 
-    def _local(self, u, t):
-        p = float(_value(self.p, t))
+    def _value(self, t, state):
+        """The pressure at time t."""
+        return float(_value(self.p, t))
+
+    def _local(self, u, t, state=None):
+        p = self._value(t, state)
         if not self.follower:
             return p * self._unit, *_EMPTY
         x = self._X + u[self._dofs]             # current (x_a, y_a, x_b, y_b), (nf, 4)
@@ -153,6 +167,18 @@ def swept_volume(x):
     return float(np.sum(2.0 * np.pi * (r2 - r1) * (2 * r1 * z1 + r1 * z2 + r2 * z1 + 2 * r2 * z2) / 6.0))
 
 
+@dataclass(frozen=True)
+class GasState:
+    """What the gas column remembers (GasPressure): the swept volume S0 of the initial state,
+    the number k of pressures set, the value set from the last converged state, whether the
+    gas has escaped and when."""
+    S0: float
+    k: int = 0
+    value: float = 0.0
+    released: bool = False
+    released_at: float | None = None
+
+
 class GasPressure(Pressure):
     """The pressure of a gas column under the face ``boundary_name`` of an axisymmetric
     body (the champagne under the cork): a follower ``Pressure`` whose value is
@@ -162,59 +188,65 @@ class GasPressure(Pressure):
                 V = V0 + the volume swept by the face since ``start``)
         open:   p = 0 once the face's outer edge has reached z_release (the gas escapes).
 
-    Explicit coupling: ``update(u)`` sets the Boyle value and the release from the last
-    converged state, once per step (the before-step hook of ``integrate``); the pressure
-    is then constant over the step (``value``). ``face_nodes`` are the nodes of that face.
+    Explicit coupling: each converged state (the initial one too) sets the Boyle value and
+    the release for the next step (``update``, the load's ``commit``); the pressure is then
+    constant over the step (``GasState.value``). ``face_nodes`` are the nodes of that face.
+    The state is a GasState value, carried by the System like a contact's history.
     """
 
     def __init__(self, body, boundary_name, face_nodes, area, column, p_step, n_ramp, dt_ramp, z_release):
-        super().__init__(body, boundary_name, self.pressure, follower=True)
+        super().__init__(body, boundary_name, None, follower=True)
         self.face = np.asarray(face_nodes)
         self.V0 = area * column
         self.p_step, self.n_ramp, self.dt_ramp, self.z_release = p_step, n_ramp, dt_ramp, z_release
         self.p0 = p_step * n_ramp
-        self.value, self.k, self.released = 0.0, 0, False
-        self.released_at = None
-        self.S0 = None
 
     def face_positions(self, u):
         b = self.body
         x = b.X[self.face] + u[b.dof_offset + b.xdofs[self.face]]
         return x[np.argsort(b.X[self.face, 0])]
 
-    def start(self, u):
-        """The state u where the gas column has its volume V0."""
-        self.S0 = swept_volume(self.face_positions(u))
+    def start(self, u, t=0.0):
+        """The GasState at the initial state u (where the gas column has its volume V0), with
+        the pressure of the first step set from it (``update``)."""
+        return self.update(u, t, GasState(S0=swept_volume(self.face_positions(u))))
 
-    def volume(self, u):
-        return self.V0 + swept_volume(self.face_positions(u)) - self.S0
+    def commit(self, u, t, state):
+        """The GasState after the converged state u at time t: the next step's pressure."""
+        return self.update(u, t, state)
+
+    def volume(self, u, state):
+        return self.V0 + swept_volume(self.face_positions(u)) - state.S0
 
     def edge_z(self, u):
         """Height of the face's outer edge (the gas escapes when it reaches z_release)."""
         return self.face_positions(u)[-1, 1]
 
-    def update(self, u, t=None):
-        """Pressure for the next step from the converged u (explicit coupling); t, when
-        given, is recorded as ``released_at`` at the release."""
-        self.k += 1
-        if not self.released and self.edge_z(u) >= self.z_release:
-            self.released = True
-            self.released_at = t
-        if self.released:
-            self.value = 0.0
-        elif self.k <= self.n_ramp:
-            self.value = self.p_step * self.k
+    def update(self, u, t, state):
+        """The GasState with the pressure for the next step from the converged u (explicit
+        coupling); t is recorded as ``released_at`` at the release."""
+        k, released, released_at = state.k + 1, state.released, state.released_at
+        if not released and self.edge_z(u) >= self.z_release:
+            released, released_at = True, t
+        if released:
+            value = 0.0
+        elif k <= self.n_ramp:
+            value = self.p_step * k
         else:
-            self.value = self.p0 * self.V0 / self.volume(u)
-        return self.value
+            value = self.p0 * self.V0 / self.volume(u, state)
+        return replace(state, k=k, value=value, released=released, released_at=released_at)
 
-    def pressure(self, t):
-        """The value at time t: the ramp by time, then the value set by ``update``."""
-        if self.released:
+    def pressure(self, t, state):
+        """The value at time t with the GasState ``state``: the ramp by time, then the value
+        set by ``update``."""
+        if state.released:
             return 0.0
         if t <= self.n_ramp * self.dt_ramp * (1 + 1e-9):
             return self.p_step * np.ceil(t / self.dt_ramp - 1e-6)
-        return self.value
+        return state.value
+
+    def _value(self, t, state):
+        return float(self.pressure(t, state))
 
 
 class OverhangPressure:
@@ -238,10 +270,15 @@ class OverhangPressure:
         self.local = np.zeros(body.ndof)
         self.local[body.xdofs[nodes, 1]] = -p * f * body.thickness
 
-    def commit(self, u_global, t):
-        """A dead load keeps no history."""
+    def start(self, u_global, t=0.0):
+        """A dead load has no state."""
+        return None
 
-    def assemble(self, u_global, t):
+    def commit(self, u_global, t, state=None):
+        """A dead load keeps no history."""
+        return state
+
+    def assemble(self, u_global, t, state=None):
         P = np.zeros(len(u_global))
         P[self.body.dof_offset:self.body.dof_offset + self.body.ndof] = self.local
         e = np.zeros(0, dtype=int)

@@ -35,6 +35,7 @@ rigid-body measures refer to the full (mirrored) ring: centre x = x_c, centre
 velocity (0, v_y), spin 0.
 """
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -175,12 +176,15 @@ class RingModel:
         lumped mass, the consistent mass's row sums; computed once (the mass is constant). The
         centre of mass and its velocity are the same sums for either mass (M is symmetric: the
         momentum 1^T M v is the row sums times v)."""
-        if getattr(self, "_masses", None) is None:
-            M = self.body.mass()
-            m = M[self.body.xdofs[:, 0]]
-            J = M[2::3] if self.kind == "beam" else np.zeros_like(m)
-            self._masses = (m, J)
         return self._masses
+
+    @cached_property
+    def _masses(self):
+        """(m, J) of ``_mass_split``: a pure function of the body, made on first use."""
+        M = self.body.mass()
+        m = M[self.body.xdofs[:, 0]]
+        J = M[2::3] if self.kind == "beam" else np.zeros_like(m)
+        return m, J
 
     def _second_moments(self, r, w, theta_dot=None):
         """sum_ij M_ij (r_i x w_j) and sum_ij M_ij (r_i . r_j) over the nodes, plus the rotary

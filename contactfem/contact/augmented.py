@@ -32,13 +32,17 @@ lam_N stays 0) while the friction is still augmented: only the stick spring c_T 
 treated as a penalty. ``gap_violation`` counts the augmented normal interfaces only.
 
 Step history: at the start of a step lam_T is the converged t_T (warm start: the first
-outer iteration is exactly the penalty step); lam_N carries over from the last step.
+outer iteration is exactly the penalty step); lam_N carries over from the last step. The
+multipliers are part of the history (AugmentedHistory), a value: ``update_multipliers``
+returns the history with the new ones, and the contact keeps nothing.
 """
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..laws.normal import PowerLaw
 from .interface import NodeToSegment
+from .state import ContactHistory
 
 ENFORCEMENTS = ("penalty", "augmented")
 
@@ -49,24 +53,29 @@ def augments_normal(law):
     return isinstance(law, PowerLaw) and law.m == 1.0
 
 
+@dataclass(frozen=True)
+class AugmentedHistory(ContactHistory):
+    """A ContactHistory with the multipliers the next solve holds fixed: lam_N (normal, 0 when
+    the normal law is not augmented) and lam_T (tangential), per slave node."""
+    lam_N: np.ndarray | None = None
+    lam_T: np.ndarray | None = None
+
+
 class AugmentedNodeToSegment(NodeToSegment):
     """NodeToSegment (same arguments) with normal and tangential multipliers (module
-    docstring), held fixed during a Newton solve: ``update_multipliers(state)`` is the Uzawa
-    update from a converged inner state; everything else is used by the solver exactly like
-    the penalty interface."""
+    docstring) in its history (AugmentedHistory), held fixed during a Newton solve:
+    ``update_multipliers(state)`` is the Uzawa update from a converged inner state; everything
+    else is used by the solver exactly like the penalty interface."""
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
-        nc = len(self.nodes)
-        self.lam_N = np.zeros(nc)
-        self.lam_T = np.zeros(nc)
         self.augment_normal = augments_normal(self.normal)
-        self.updates = 0                    # multiplier updates since construction
 
-    def start_step(self):
-        """lam_T = the converged traction t_T_bar (called at the start of every step, so a
-        step retried after a cut-back starts again from the committed state)."""
-        self.lam_T = self.history.t_T_bar.copy()
+    def start(self, u, t=0.0):
+        """The penalty interface's initial history with zero multipliers."""
+        h = super().start(u, t)
+        nc = len(self.nodes)
+        return AugmentedHistory(**vars(h), lam_N=np.zeros(nc), lam_T=np.zeros(nc))
 
     def kinematics(self, u, t, h):
         """As NodeToSegment.kinematics, with the penalty law evaluated at the shifted gap
@@ -74,49 +83,47 @@ class AugmentedNodeToSegment(NodeToSegment):
         e = super().kinematics(u, t, h)
         if not self.augment_normal:
             return e
-        g_eff = e["g_N"] + self.lam_N / self.normal.c_N
+        g_eff = e["g_N"] + h.lam_N / self.normal.c_N
         active = e["inside"] & (g_eff < 0.0)
         t_N, dt_N = self.normal.traction(np.where(active, g_eff, 1.0))
         return dict(e, active=active, t_N=t_N, dt_N=dt_N, g_eff=g_eff)
 
     def predictor(self, h):
         """The return mapping (eqs 40-44) starts from the multiplier lam_T (module docstring)."""
-        return self.lam_T
+        return h.lam_T
 
     def violation(self, state):
         """What the next update would change at a converged inner state, in length units:
         max |t - lam| / c over the slave nodes, normal (= the penetration of an active node)
         and tangential (= the stick creep |s - s_bar| of a sticking node); and the largest
         penetration (augmented normal only; 0 otherwise)."""
-        on = state.active
+        on, h = state.active, state.history
         dN = pen = 0.0
         if self.augment_normal:
             t_N = np.where(on, state.t_N, 0.0)
-            dN = float(np.max(np.abs(t_N - self.lam_N), initial=0.0)) / self.normal.c_N
+            dN = float(np.max(np.abs(t_N - h.lam_N), initial=0.0)) / self.normal.c_N
             pen = float(np.max(np.where(state.inside, -state.g_N, 0.0), initial=0.0))
         dT = 0.0
         if self.friction is not None:
             t_T = np.where(on, state.t_T, 0.0)
-            dT = float(np.max(np.abs(t_T - self.lam_T), initial=0.0)) / self.c_T
+            dT = float(np.max(np.abs(t_T - h.lam_T), initial=0.0)) / self.c_T
         return dict(change=max(dN, dT, 0.0), normal=dN, tangential=dT, penetration=max(pen, 0.0))
 
     def update_multipliers(self, state):
-        """The Uzawa update lam <- t at a converged inner state (module docstring)."""
-        on = state.active
-        if self.augment_normal:
-            self.lam_N = np.where(on, state.t_N, 0.0)
-        if self.friction is not None:
-            self.lam_T = np.where(on, state.t_T, 0.0)
-        self.updates += 1
+        """The history of the state with the Uzawa update lam <- t at a converged inner state
+        (module docstring): the next outer iteration of the same step is evaluated with it."""
+        on, h = state.active, state.history
+        lam_N = np.where(on, state.t_N, 0.0) if self.augment_normal else h.lam_N
+        lam_T = np.where(on, state.t_T, 0.0) if self.friction is not None else h.lam_T
+        return replace(h, lam_N=lam_N, lam_T=lam_T)
 
     def commit(self, state):
-        """The penalty interface's commit (t_T_bar = t_T, accumulated slip, projection); then
-        lam_T = t_T_bar so the next step starts from the converged traction, and lam_N = t_N
-        (warm start of the next step)."""
-        super().commit(state)
-        self.lam_T = self.history.t_T_bar.copy()
-        if self.augment_normal:
-            self.lam_N = np.where(state.active, state.t_N, 0.0)
+        """The penalty interface's next history (t_T_bar = t_T, accumulated slip, projection)
+        with lam_T = t_T_bar, so the next step starts from the converged traction, and
+        lam_N = t_N (warm start of the next step)."""
+        h = state.next_history
+        lam_N = np.where(state.active, state.t_N, 0.0) if self.augment_normal else state.history.lam_N
+        return AugmentedHistory(**vars(h), lam_N=lam_N, lam_T=h.t_T_bar.copy())
 
 
 def make_interface(enforcement, *args, **kwargs):

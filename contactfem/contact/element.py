@@ -1,6 +1,8 @@
 """The contact element: residual (eq 28) and consistent tangent (eqs 33, 39, 49, 50),
 vectorised over contact pairs, returned as COO triplets ready to add to a global matrix."""
 
+from functools import lru_cache
+
 import numpy as np
 
 from .kinematics import outer
@@ -67,4 +69,20 @@ def coo_indices(dofs):
     k = dofs.shape[1]
     rows = np.repeat(dofs, k, axis=1).ravel()
     cols = np.concatenate([dofs] * k, axis=1).ravel()          # np.tile(dofs, (1, k)), without its overhead
+    return rows, cols
+
+
+def pattern(dofs):
+    """coo_indices(dofs) as read-only arrays, the same objects for the same dofs while they stay
+    among the last few asked for: a pure function of the contact set (the pairs' global dofs),
+    so the System's assembly finds their places in K once per change of the set (assembly.py
+    keeps index arrays by identity). Nothing of a run is kept: equal dofs give equal arrays."""
+    dofs = np.asarray(dofs)
+    return _pattern(dofs.shape, dofs.dtype.str, dofs.tobytes())
+
+
+@lru_cache(maxsize=64)
+def _pattern(shape, dtype, data):
+    rows, cols = coo_indices(np.frombuffer(data, dtype=dtype).reshape(shape))
+    rows.flags.writeable = cols.flags.writeable = False
     return rows, cols

@@ -3,21 +3,23 @@ history (paper Sec. 4.3, step 4: per slave node, check the gap -> normal force -
 friction -> slip check -> stick or return map -> tangents).
 
     contact = NodeToSegment(body, nodes, RigidLine(), normal=PowerLaw(c_N), friction=Coulomb(c_T, mu))
-    contact.start(u0)                           # the history at the initial state
-    state = contact.evaluate(u, t, dt)          # a ContactState (contact/state.py): nothing changes
+    history = contact.start(u0)                 # the history at the initial state (a value)
+    state = contact.evaluate(u, t, dt, history=history)   # a ContactState (contact/state.py)
     R_c, rows, cols, vals = state.scatter(len(u))
-    contact.commit(state)                       # a converged state's history is kept
+    history = contact.commit(state)             # the history after a converged state
 
-``evaluate`` is a pure function of u and the committed ``history`` (a ContactHistory value);
-only ``commit`` changes the history, with the converged state's ``next_history``.
+A contact holds its configuration only (body, nodes, master, laws, weights): ``evaluate`` is
+a pure function of u and the ``history`` it is given (a ContactHistory value), and ``commit``
+returns the next history without keeping it. The System carries the histories from step to
+step in its SystemState (solver/system.py).
 
 The closing step: a node open at the start of a step (committed gap g_bar > 0) that is in
 contact at its end touched the master at the fraction theta = g_bar / (g_bar - g_N) of the
 step (the gap interpolated linearly). Its stick spring starts there: the slip increment is
 the travel after touching, Delta g_T = r (s - s_bar) with r = 1 - theta = -g_N / (g_bar - g_N),
 not the whole travel of the step (which would load the spring with the tangential motion
-made while still open). ``NodeToSegment.closing_step = False`` (per contact) drops the
-rule, to study what it changes (the cork's exit time, lecture 08).
+made while still open). ``NodeToSegment(..., closing_step=False)`` drops the rule, to study
+what it changes (the cork's exit time, lecture 08).
 
 Strategies the contact is built with (not wrappers): ``tangent`` (contact/tangents.py: the
 consistent tangent of eqs 33, 39, 49-50, or the symmetric and frozen variants the paper
@@ -25,13 +27,14 @@ compares) and ``integration`` (``standard``: the forces at the end of the step;
 ``energy_consistent``: the discrete-gradient force of the step, contact/conserving.py).
 """
 
+import copy
 from functools import lru_cache
 
 import numpy as np
 
 from ..laws.protocol import as_friction_law
 from ..laws.return_map import OPEN, STICK, return_map
-from .element import contact_element, coo_indices, normal_element, to_coo
+from .element import contact_element, normal_element, pattern, to_coo
 from .state import ContactHistory, ContactState
 from .tangents import TANGENTS
 
@@ -80,13 +83,14 @@ class NodeToSegment:
     the step's dt from ``evaluate`` and keeps its variables z per slave node in the
     history; a law with ``gap_offset(z)`` (wear) moves the surface by the committed z
     (the wear of a step acts from the next step on).
+    closing_step: True (default) for the closing step of the module docstring; False: the
+              slip increment of a closing node is the whole travel of the step
     """
 
-    closing_step = True     # the closing step of the module docstring; False: the whole travel
     unknowns = 0                            # no unknowns of its own (contact/interfaces.py)
 
     def __init__(self, slave, nodes, master, *, normal, friction=None, weights=1.0, offset=0.0, name="contact",
-                 tangent="consistent", integration="standard"):
+                 tangent="consistent", integration="standard", closing_step=True):
         if tangent not in TANGENTS:
             raise ValueError(f"parameter tangent = {tangent!r} is not allowed: one of {'|'.join(TANGENTS)}")
         if integration not in INTEGRATIONS:
@@ -96,6 +100,9 @@ class NodeToSegment:
                              "(an energy method)")
         self.slave, self.master, self.normal, self.friction, self.name = slave, master, normal, friction, name
         self.tangent, self.integration = tangent, integration
+        if not isinstance(closing_step, bool):
+            raise ValueError(f"parameter closing_step = {closing_step!r} is not allowed: True or False")
+        self.closing_step = closing_step
         self.nodes = np.asarray(nodes, dtype=int)
         self.weights = np.broadcast_to(np.asarray(weights, dtype=float), self.nodes.shape).copy()
         if np.any(self.weights <= 0):
@@ -106,35 +113,49 @@ class NodeToSegment:
         self._wear = self._law is not None and self._law.n_state > 0   # gap_offset(z) may move the surface
         self._straight = bool(getattr(master, "straight", False))      # zero second variations (masters.py)
         self._has_energy = hasattr(normal, "energy")
-        self.history = None                 # ContactHistory, from start() and every commit()
+        self._X_s = self.slave.X[self.nodes]                          # the slaves' reference positions
         self.evaluations = 0                # how often evaluate() ran (instrumentation)
+
+    def with_closing_step(self, closing_step):
+        """A new contact of the same configuration with the closing step on (True) or off
+        (False); this one is left as it is."""
+        if not isinstance(closing_step, bool):
+            raise ValueError(f"parameter closing_step = {closing_step!r} is not allowed: True or False")
+        other = copy.copy(self)
+        other.closing_step = closing_step
+        other.evaluations = 0
+        return other
+
+    def with_master(self, master):
+        """A new contact of the same configuration against another master (e.g. the same
+        obstacle at rest after a prescribed motion); this one is left as it is."""
+        other = copy.copy(self)
+        other.master = master
+        other._straight = bool(getattr(master, "straight", False))
+        other.evaluations = 0
+        return other
 
     # -- the history ------------------------------------------------------------------
     def start(self, u, t=0.0):
-        """The history at the initial state u: the projections there are the reference of the
-        first slip increment, no traction, no slip, the law's initial variables."""
+        """The history at the initial state u (a ContactHistory, kept by the caller): the
+        projections there are the reference of the first slip increment, no traction, no slip,
+        the law's initial variables."""
         nc = len(self.nodes)
         ref = self.master.reference(u)
         k = self.master.locate(self.slave_positions(u), np.zeros(nc), u, t=t, ref=ref)
         z = self._law.initial_state(nc) if self._law is not None else np.zeros((nc, 0))
         g = k["g_N"] - self.offset + self.gap_offset(z)
-        self.history = ContactHistory(s_bar=k["s"], g_bar=g, t_T_bar=np.zeros(nc), q_bar=np.zeros(nc), z_bar=z,
-                                      master=ref)
+        return ContactHistory(s_bar=k["s"], g_bar=g, t_T_bar=np.zeros(nc), q_bar=np.zeros(nc), z_bar=z, master=ref)
 
     def commit(self, state):
-        """Accept a converged state: its history (t_T, accumulated slip, law variables, the
-        projection and the master's metric) becomes the committed one."""
-        self.history = state.next_history
+        """The history after a converged state (t_T, accumulated slip, law variables, the
+        projection and the master's metric): ``state.next_history``; the contact keeps nothing."""
+        return state.next_history
 
     # -- kinematics -------------------------------------------------------------------
     def slave_dofs(self):
-        """Global (u_x, u_y) dofs of the slave nodes, (nc, 2); kept while the slave body
-        stays at the same place in the global vector."""
-        offset = self.slave.dof_offset
-        if getattr(self, "_dofs_at", None) != offset:
-            self._dofs, self._dofs_at = offset + self.slave.xdofs[self.nodes], offset
-            self._X_s = self.slave.X[self.nodes]
-        return self._dofs
+        """Global (u_x, u_y) dofs of the slave nodes, (nc, 2)."""
+        return self.slave.dof_offset + self.slave.xdofs[self.nodes]
 
     def slave_positions(self, u):
         dofs = self.slave_dofs()
@@ -164,7 +185,8 @@ class NodeToSegment:
             t_N, dt_N = self.normal.traction(np.where(active, g_N, 1.0))
         else:                                               # every node open (a body in flight): a normal
             t_N = dt_N = zeros(nc)                          # law's t_N is 0 when open (read-only)
-        dofs = np.concatenate([self.slave_dofs(), k["master_dofs"]], axis=1) if k["master_dofs"].size else self._dofs
+        slave_dofs = self.slave_dofs()
+        dofs = np.concatenate([slave_dofs, k["master_dofs"]], axis=1) if k["master_dofs"].size else slave_dofs
         travel = k["s"] - h.s_bar
         r, dr, dg_T, ddg_T = ones(nc), zeros(nc), travel, k["ds"]   # r = 1: Delta g_T = travel (read-only)
         closing = (active & (h.g_bar > 0.0)).nonzero()[0] if self.closing_step and touching else ()
@@ -207,14 +229,16 @@ class NodeToSegment:
         return dict(t_T=fr.t_T, c_T_s=fr.c_T_s, c_N_s=fr.c_N_s, slip=fr.state, lam=fr.lam, q=fr.q, z=fr.z)
 
     # -- one evaluation ------------------------------------------------------------------
-    def evaluate(self, u, t=0.0, dt=None, u0=None, phase=None):
+    def evaluate(self, u, t=0.0, dt=None, u0=None, phase=None, *, history):
         """The ContactState at the trial displacement u of the step (t - dt, t] that starts
-        from u0 (needed by energy-consistent integration), with the committed history:
-        kinematics, tractions, return mapping, element residuals and tangents. ``phase``:
-        a phase of the staggered algorithm (contact/tangents.py), None for the contact as it is."""
-        h = self.history
-        if h is None:
-            raise ValueError(f"contact {self.name!r}: call start(u) before evaluating it (the initial history)")
+        from u0 (needed by energy-consistent integration), with the committed ``history`` (from
+        ``start`` or ``commit``): kinematics, tractions, return mapping, element residuals and
+        tangents. ``phase``: a phase of the staggered algorithm (contact/tangents.py), None for
+        the contact as it is."""
+        h = history
+        if not isinstance(h, ContactHistory):
+            raise ValueError(f"contact {self.name!r}: history must be a ContactHistory (from start(u) or "
+                             f"commit(state)), got {type(h).__name__}")
         self.evaluations += 1
         k = self.kinematics(u, t, h)
         fr = self.friction_state(k, h, dt, phase)
@@ -258,21 +282,16 @@ class NodeToSegment:
         return R, K
 
     def pattern(self, dofs):
-        """The rows and cols of the element tangents at the pairs' dofs (m, k) (element.coo_indices):
-        the same (read-only) arrays as at the last call while the pairs in contact stay the same,
-        so that the System finds their places in K once per change of the contact set, not at
-        every evaluation (assembly.py keeps them by the arrays' identity)."""
-        key = (dofs.shape, dofs.tobytes())
-        if getattr(self, "_pattern", (None,))[0] != key:
-            rows, cols = coo_indices(dofs)
-            rows.flags.writeable = cols.flags.writeable = False
-            self._pattern = (key, rows, cols)
-        return self._pattern[1:]
+        """The rows and cols of the element tangents at the pairs' dofs (m, k) (element.coo_indices,
+        read-only): the same arrays as at the last call while the pairs in contact stay the same
+        (``pattern``, contact/element.py), so that the System finds their places in K once per
+        change of the contact set, not at every evaluation (assembly.py keeps them by identity)."""
+        return pattern(dofs)
 
     # -- conveniences (tests, lectures) -------------------------------------------------
-    def assemble(self, u, t=0.0, dt=None, u0=None):
+    def assemble(self, u, t=0.0, dt=None, u0=None, *, history):
         """Global contact residual R_c (eq 28) and tangent triplets (eqs 33, 39, 49) at u."""
-        return self.evaluate(u, t, dt, u0).scatter(len(u))
+        return self.evaluate(u, t, dt, u0, history=history).scatter(len(u))
 
 
 def element_triplets(state):

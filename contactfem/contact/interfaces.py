@@ -27,10 +27,13 @@ class Master(Protocol):
 
 @runtime_checkable
 class Contact(Protocol):
-    """A contact interface (contact/interface.py: NodeToSegment and its augmented form).
+    """A contact interface (contact/interface.py: NodeToSegment and its augmented form; the
+    mortar and Lagrange contacts).
 
-    ``evaluate`` is pure: a state (contact/state.py) from u and the committed history;
-    ``commit`` keeps a converged state's history; nothing else changes a contact.
+    A contact holds its configuration only. ``start`` gives the history of the initial state,
+    ``evaluate`` is pure: a state (contact/state.py) from u and the ``history`` it is given;
+    ``commit`` returns the history after a converged state. The System carries the histories
+    in its SystemState (solver/system.py); nothing changes a contact.
 
     ``unknowns``: how many unknowns of its own the contact carries (the Lagrange multipliers
     of contact/lagrange.py; 0 for penalty contacts). The System places them after the
@@ -38,15 +41,38 @@ class Contact(Protocol):
     give their rows of the residual and the tangent like any other."""
 
     name: str
-    history: object
     integration: str            # "standard" | "energy_consistent"
     unknowns: int               # unknowns of its own (0: only the bodies' dofs)
 
-    def start(self, u: np.ndarray, t: float = 0.0) -> None:
-        """The history at the initial state u."""
+    def start(self, u: np.ndarray, t: float = 0.0) -> object:
+        """The history at the initial state u (a value)."""
 
-    def evaluate(self, u: np.ndarray, t: float = 0.0, dt=None, u0=None, phase=None):
-        """The ContactState at the trial u of the step (t - dt, t] that starts from u0."""
+    def evaluate(self, u: np.ndarray, t: float = 0.0, dt: float | None = None, u0: np.ndarray | None = None,
+                 phase: object = None, *, history: object) -> object:
+        """The contact's state at the trial u of the step (t - dt, t] that starts from u0, with
+        the committed ``history``."""
 
-    def commit(self, state) -> None:
-        """Keep the converged state's history."""
+    def commit(self, state: object) -> object:
+        """The history after the converged ``state``."""
+
+
+@runtime_checkable
+class NodeToSegmentContact(Contact, Protocol):
+    """What a node-to-segment contact's states (contact/state.py: ContactState) read of the
+    contact that made them, besides the Contact protocol: where the slaves are, the weights
+    and stick stiffness of its energies, and the functions of its laws."""
+
+    slave: object               # the slave body (contactfem.bodies.interfaces.Body)
+    nodes: np.ndarray           # (nc,) slave node numbers
+    master: Master
+    weights: np.ndarray         # (nc,) per-slave weights of the tractions
+    c_T: float                  # stick stiffness of the friction law (0: frictionless)
+
+    def pattern(self, dofs: np.ndarray) -> tuple:
+        """(rows, cols) of the element tangents at the pairs' dofs (m, k)."""
+
+    def gap_offset(self, z: np.ndarray) -> np.ndarray:
+        """How far the friction law's internal variables z have moved the surface, (nc,)."""
+
+    def normal_energy(self, g_N: np.ndarray) -> np.ndarray:
+        """The normal law's potential at g_N (0 for a law without one)."""

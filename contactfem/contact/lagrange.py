@@ -97,8 +97,8 @@ class LagrangeState(ContactState):
     the closed set of the complementarity function, ``slip`` OPEN/STICK/SLIP; ``lam`` the
     slip |Delta g_T| of slipping nodes. The complementarity rows: C (the scaled C_N, C_T at
     ``ncp_dofs``) and the triplets ``ncp_coo`` of the multipliers' columns and rows."""
-    C: np.ndarray = None
-    ncp_dofs: np.ndarray = None
+    C: np.ndarray | None = None
+    ncp_dofs: np.ndarray | None = None
     ncp_coo: tuple = ()
 
     def scatter(self, ndof):
@@ -128,11 +128,9 @@ class LagrangeNodeToSegment(NodeToSegment):
                              f"integration = standard (got {self.tangent}, {self.integration})")
         _lagrange_checks(self)
 
-    def evaluate(self, u, t=0.0, dt=None, u0=None, phase=None):
-        """The LagrangeState at u (displacements and multipliers) with the committed history."""
-        h = self.history
-        if h is None:
-            raise ValueError(f"contact {self.name!r}: call start(u) before evaluating it (the initial history)")
+    def evaluate(self, u, t=0.0, dt=None, u0=None, phase=None, *, history):
+        """The LagrangeState at u (displacements and multipliers) with the committed ``history``."""
+        h = history
         if phase is not None:
             raise ValueError(f"contact {self.name!r}: enforcement = lagrange has no staggered phases")
         self.evaluations += 1
@@ -187,10 +185,10 @@ class LagrangeMortar(MortarContact):
         L = np.linalg.norm(np.diff(X, axis=0), axis=1)
         self.row_weights = np.concatenate([[0.0], L / 2]) + np.concatenate([L / 2, [0.0]])
 
-    def evaluate(self, u, t=0.0, dt=None, u0=None, phase=None):
-        """The MortarState at u (displacements and multipliers): the virtual work of the
-        multipliers and the complementarity rows (module docstring)."""
-        h = self._check(phase)
+    def evaluate(self, u, t=0.0, dt=None, u0=None, phase=None, *, history):
+        """The MortarState at u (displacements and multipliers) with the committed ``history``:
+        the virtual work of the multipliers and the complementarity rows (module docstring)."""
+        h = self._check(phase, history)
         k = self.kinematics_at(u, h)
         mi, slip = k["mi"], k["slip"]
         t_N, t_T, dN, dT = multipliers(self, u)

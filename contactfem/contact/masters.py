@@ -26,6 +26,7 @@ the last converged configuration, s = S_bar[j] + alpha l_bar[j] on segment j
 neighbouring segment keeps its friction history.
 """
 
+import copy
 from functools import lru_cache
 
 import numpy as np
@@ -258,6 +259,13 @@ class RigidComposite:
         self.S = np.concatenate([[0.0], np.cumsum([p["length"] for p in self.pieces])])
         self.offset = np.asarray(offset, dtype=float)
         self.motion = motion
+
+    def without_motion(self):
+        """A new master of the same pieces and offset that stays where its offset puts it (no
+        ``motion``); this one is left as it is."""
+        other = copy.copy(self)
+        other.motion = None
+        return other
 
     def position(self, t=None):
         """The translation of the master at time t: offset + motion(t)."""

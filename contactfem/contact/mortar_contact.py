@@ -4,9 +4,9 @@ contact/mortar.py, the segmentation contact/segmentation.py).
 
 The protocol (tentative, as the solver's contact protocol is being settled):
 
-    contact.start(u, t)                    the history of the initial state
-    state = contact.evaluate(u, t, dt)     pure: a frozen MortarState, nothing changes
-    contact.commit(state)                  the state's history becomes the committed one
+    h = contact.start(u, t)                the history of the initial state (a value)
+    state = contact.evaluate(u, t, dt, history=h)   pure: a frozen MortarState
+    h = contact.commit(state)              the history after it (the contact keeps nothing)
 
 A converged step is evaluated once; what is recorded reads that state, and commit takes
 the history it carries (no re-evaluation).
@@ -43,7 +43,7 @@ class MortarHistory:
     D: np.ndarray
     M: np.ndarray
     w: np.ndarray
-    x: np.ndarray = None        # the interface positions (slave, master) of the converged state
+    x: np.ndarray | None = None        # the interface positions (slave, master) of the converged state
 
 
 @dataclass(frozen=True)
@@ -181,7 +181,6 @@ class MortarContact:
         self.unbounded = isinstance(master, RigidLine)
         self._law = None if friction is None else as_friction_law(friction)
         self._reference = None              # small kinematics: the integrals of the reference configuration
-        self.history = None
         self.evaluations = 0                # a counter for the benchmarks (not part of any result)
 
     # -- where the interface's unknowns are ----------------------------------------
@@ -219,8 +218,8 @@ class MortarContact:
         mi = self._integrals(xs, xm) if self.kinematics == "finite" else self._reference
         ns = len(self.nodes)
         z = self._law.initial_state(ns) if self._law is not None else np.zeros((ns, 0))
-        self.history = MortarHistory(t_T=np.zeros(ns), q=np.zeros(ns), z=z, pairs=mi.pairs, D=mi.D, M=mi.M,
-                                     w=mi.w, x=np.concatenate([xs.ravel(), xm.ravel()]))
+        return MortarHistory(t_T=np.zeros(ns), q=np.zeros(ns), z=z, pairs=mi.pairs, D=mi.D, M=mi.M,
+                             w=mi.w, x=np.concatenate([xs.ravel(), xm.ravel()]))
 
     def kinematics_at(self, u, h):
         """Segmentation, mortar integrals, nodal gaps and slip increments at u with the
@@ -242,12 +241,12 @@ class MortarContact:
         return dict(xs=xs, xm=xm, x=x, mi=mi, offset=offset, g_N=g_N, covered=covered, dg_N=dg_N, slip=slip,
                     dg_T=dg_T)
 
-    def evaluate(self, u, t=0.0, dt=None, u0=None, phase=None):
-        """Everything at u with the committed history: segmentation, mortar integrals,
+    def evaluate(self, u, t=0.0, dt=None, u0=None, phase=None, *, history):
+        """Everything at u with the committed ``history``: segmentation, mortar integrals,
         tractions (penalty and return map), residual and tangent. Pure (u0 is not needed:
         the history holds the reference of the slip). ``phase``: the staggered algorithm's
         phases are not offered for mortar contact (None only)."""
-        h = self._check(phase)
+        h = self._check(phase, history)
         k = self.kinematics_at(u, h)
         mi, slip, g_N, dg_T = k["mi"], k["slip"], k["g_N"], k["dg_T"]
         t_N, dt_N, fr = penalty_tractions(self.normal, self.friction, g_N, dg_T, h.t_T, h.q,
@@ -262,18 +261,19 @@ class MortarContact:
                            history=history, integrals=mi, energy=self._energy(g_N, mi.w, fr.t_T),
                            dissipation=float(np.sum(h.w * 0.5 * (h.t_T + fr.t_T) * fr.lam * np.sign(fr.t_T))))
 
-    def _check(self, phase):
+    def _check(self, phase, history):
         """The committed history, after the checks every evaluation makes; counts the evaluation."""
         if phase is not None:
             raise ValueError(f"{self.name}: mortar contact has no staggered phases (phase={phase!r})")
-        if self.history is None:
-            raise RuntimeError(f"{self.name}: MortarContact.evaluate before start(u)")
+        if not isinstance(history, MortarHistory):
+            raise ValueError(f"{self.name}: history must be a MortarHistory (from start(u) or commit(state)), "
+                             f"got {type(history).__name__}")
         self.evaluations += 1
-        return self.history
+        return history
 
     def commit(self, state):
-        """Accept a converged state: its history is the next step's."""
-        self.history = state.history
+        """The history after a converged state (the next step's); the contact keeps nothing."""
+        return state.history
 
     # -- helpers -------------------------------------------------------------------
     def _energy(self, g_N, w, t_T):

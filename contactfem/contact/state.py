@@ -1,9 +1,9 @@
 """What a contact knows, as values: its committed history and the state of one evaluation.
 
-    history = contact.history                  # ContactHistory: the last converged step
-    state = contact.evaluate(u, t, dt)         # ContactState at a trial u: nothing is changed
+    history = contact.start(u0)                # ContactHistory: what the next step starts from
+    state = contact.evaluate(u, t, dt, history=history)   # ContactState at a trial u
     R_c, rows, cols, vals = state.scatter(ndof)   # its residual (eq 28) and tangent, assembled
-    contact.commit(state)                      # a converged state: its next_history is kept
+    history = contact.commit(state)            # a converged state: its next_history
 
 A ContactState is evaluated once per Newton iteration; the converged one is what energies,
 reports, recordings and the commit read (``energy``, ``dissipation``, ``next_history`` are
@@ -77,7 +77,7 @@ class ContactState:
     R: np.ndarray
     K: np.ndarray
     element_dofs: np.ndarray
-    work_T: np.ndarray = None       # energy-consistent: the friction force's work over the step
+    work_T: np.ndarray | None = None       # energy-consistent: the friction force's work over the step
 
     # -- assembly ---------------------------------------------------------------------
     def scatter(self, ndof):

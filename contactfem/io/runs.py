@@ -16,6 +16,12 @@ interrupted save never leaves a half-written file.
 ``compare_runs(mine, ref)`` says how far two results of one scene are apart: the largest
 relative difference over every number both hold (a lecture's own time loop against the
 scene's run, a reloaded run against the one saved).
+
+``save_record(record, path)`` saves one record of a march (contactfem.solver.march) with its
+SystemState, and ``load_record(path)`` gives it back, every number bit for bit, to go on from:
+
+    save_record(records[k], "step.npz")
+    rest = resume(stepper, schedule, load_record("step.npz"))   # the run from k on, as it went
 """
 
 import json
@@ -299,3 +305,80 @@ def _rectangular(lst):
     except (TypeError, ValueError):
         return False
     return a.dtype.kind == "f"
+
+
+# -- one record of a march, to resume from -----------------------------------------------------
+
+_STATE = "__state__"
+
+
+def _state_types():
+    """The value types a SystemState may hold, by name (load_record builds only these)."""
+    from ..bodies.loads import GasState
+    from ..contact.augmented import AugmentedHistory
+    from ..contact.mortar import Pairs
+    from ..contact.mortar_contact import MortarHistory
+    from ..contact.state import ContactHistory
+    from ..solver.system import SystemState
+
+    return {t.__name__: t for t in (SystemState, ContactHistory, AugmentedHistory, MortarHistory, Pairs, GasState)}
+
+
+def _state_to_plain(obj, where, types):
+    import dataclasses
+
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        name = type(obj).__name__
+        if types.get(name) is not type(obj):
+            raise TypeError(f"record state {where} is a {name}, which save_record cannot save")
+        return {_STATE: name, **{f.name: _state_to_plain(getattr(obj, f.name), f"{where}.{f.name}", types)
+                                 for f in dataclasses.fields(obj)}}
+    if isinstance(obj, tuple):
+        return {_STATE: "tuple", "items": [_state_to_plain(v, f"{where}[{i}]", types) for i, v in enumerate(obj)]}
+    return obj
+
+
+def _state_from_plain(obj, types):
+    if isinstance(obj, dict) and _STATE in obj:
+        name = obj[_STATE]
+        if name == "tuple":
+            return tuple(_state_from_plain(v, types) for v in obj["items"])
+        if name not in types:
+            raise ValueError(f"a saved record holds a state of type {name!r}, which load_record does not build")
+        return types[name](**{k: _state_from_plain(v, types) for k, v in obj.items() if k != _STATE})
+    return obj
+
+
+def save_record(record, path):
+    """Write one record of a march (k, t, dt, u, v, a, energies, Newton's residuals, the
+    reactions and loads the next step's work needs, and its SystemState) to `path` (.json or
+    .npz, as save_run). Returns the path as a string."""
+    ev, result = record.evaluation, record.result
+    G = result.G if result is not None else ev.G          # the prescribed-dof part: the reactions
+    doc = dict(k=int(record.k), t=float(record.t), dt=float(record.dt), u=record.u, v=record.v, a=record.a,
+               energy={k: float(v) for k, v in record.energy.items()}, cuts=int(record.cuts),
+               failures=list(record.failures), G=np.asarray(G), P=np.asarray(ev.P) if ev.P is not None else None,
+               iterations=int(record.iterations), residuals=[float(r) for r in record.residuals],
+               state=_state_to_plain(record.state, "state", _state_types()))
+    return save_run({"record": doc}, path)
+
+
+def load_record(path):
+    """The record save_record wrote, to resume a march from (contactfem.solver.march.resume):
+    its numbers bit for bit, its SystemState, the residual and loads of its evaluation (no
+    tangent, no contact states: those of the steps after it are recomputed)."""
+    from ..solver.march import Record
+    from ..solver.newton import NewtonResult
+    from ..solver.system import Evaluation
+
+    doc = load_run(path, arrays=False)
+    if "record" not in doc:
+        raise ValueError(f"{path} is a saved run, not a saved record (save_record)")
+    r = doc["record"]
+    state = _state_from_plain(r["state"], _state_types())
+    ev = Evaluation(G=r["G"], K=None, contacts=(), P=r["P"], state=state)
+    result = (NewtonResult(u=r["u"], residuals=list(r["residuals"]), iterations=int(r["iterations"]), G=r["G"],
+                           evaluation=ev) if r["k"] > 0 else None)
+    return Record(k=int(r["k"]), t=float(r["t"]), dt=float(r["dt"]), u=r["u"], v=r["v"], a=r["a"], evaluation=ev,
+                  energy=dict(r["energy"]), result=result, cuts=int(r["cuts"]), failures=tuple(r["failures"]),
+                  state=state)

@@ -159,7 +159,8 @@ def _from_file(file, name, option):
         raise ValueError(f"{_where(path, err)}: {_cause(err)}") from None
     cls = getattr(module, name, None)
     if cls is None or not isinstance(cls, type):
-        found = sorted(k for k, v in vars(module).items() if isinstance(v, type) and v.__module__ == mod_name)
+        found = sorted(k for k, v in vars(module).items()                 # the law classes it holds
+                       if isinstance(v, type) and (hasattr(v, "traction") or hasattr(v, "slip_bound")))
         raise ValueError(f"law file {path.name} has no class {name}" + (f" (it defines: {', '.join(found)})" if found else ""))
     cls._contactfem_file = str(file)
     return cls

@@ -264,8 +264,8 @@ def _check_friction_law(law, normal, scale, rtol, dt, p_max, q_max, v_max):
             for a, b in ((dg + h_g, p), (dg - h_g, p), (dg, p + h_p), (dg, p - h_p)):
                 same &= rm(-b, dt_N, a).state == fr.state
             for an, fd in ((fr.c_T_s, d_T_fd), (fr.c_N_s, d_N_fd)):
-                err = np.abs(an - fd) / (np.abs(fd) + np.abs(an) + 1e-3 * c_T)
-                worst_tan = max(worst_tan, float(np.max(np.where(same, err, 0.0))))
+                rel = np.abs(an - fd) / (np.abs(fd) + np.abs(an) + 1e-3 * c_T)
+                worst_tan = max(worst_tan, float(np.max(np.where(same, rel, 0.0))))
     except LawValueError as err:          # a value no law may return, within the range
         rep.add(False, "", str(err), fatal=True)
         return rep
@@ -315,10 +315,10 @@ def check_normal_law(law, scale=1.0, rtol=1e-6, g_max=None):
         try:      # relative errors, with a floor of 1e-9 of the largest value (round-off near g_N = 0)
             ts, ds = N.traction(gs)
             fd = (N.traction(gs + h)[0] - N.traction(gs - h)[0]) / (2 * h)
-            err = np.abs(fd - ds) / (np.abs(ds) + np.abs(fd) + 1e-9 * np.max(np.abs(ds)) + 1e-300)
-            i = int(np.argmax(err))
-            rep.add(err[i] < 1e-5, f"dt_N/dg_N matches finite differences (worst relative error {err[i]:.1e})",
-                    f"dt_N/dg_N does not match finite differences: worst relative error {err[i]:.2e} at g_N = "
+            rel = np.abs(fd - ds) / (np.abs(ds) + np.abs(fd) + 1e-9 * np.max(np.abs(ds)) + 1e-300)
+            i = int(np.argmax(rel))
+            rep.add(rel[i] < 1e-5, f"dt_N/dg_N matches finite differences (worst relative error {rel[i]:.1e})",
+                    f"dt_N/dg_N does not match finite differences: worst relative error {rel[i]:.2e} at g_N = "
                     f"{gs[i]:.3g} (returned {ds[i]:.6g}, finite differences {fd[i]:.6g})")
             if not N.has_energy:
                 rep.add(True, "no energy(g_N) (only contact_integration = energy_consistent needs the potential)", "")

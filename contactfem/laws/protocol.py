@@ -59,15 +59,21 @@ import warnings
 
 import numpy as np
 
+from .friction import Coulomb, Frictionless, ParabolicSlip, SlipHardening
+from .normal import ExponentialLaw, PowerLaw
+from .rate_state import ArchardWear, DieterichRuina, Stribeck
+
 try:                                           # numpy >= 1.25
     from numpy.exceptions import ComplexWarning
 except ImportError:                            # pragma: no cover
-    from numpy import ComplexWarning
+    from numpy import ComplexWarning  # type: ignore[attr-defined,no-redef]
 
 H_CS = 1e-30                                   # complex step
 ARG_NAMES = ("p", "q", "v", "z")
-# the modules of the shipped laws: their adapters skip the guards (module docstring)
-SHIPPED_MODULES = frozenset({"contactfem.laws.friction", "contactfem.laws.normal", "contactfem.laws.rate_state"})
+# the shipped law classes themselves: their adapters skip the guards (module docstring); a class
+# is trusted by what it is, never by the name of the module that defines it
+SHIPPED_LAWS = frozenset({PowerLaw, ExponentialLaw, ParabolicSlip, Coulomb, SlipHardening, Frictionless, Stribeck,
+                          DieterichRuina, ArchardWear})
 
 
 class LawError(ValueError):
@@ -97,8 +103,9 @@ def _name(law):
 
 
 def is_shipped(law):
-    """Whether law is one of contactfem's own laws (exactly: a subclass is the user's)."""
-    return type(law).__module__ in SHIPPED_MODULES
+    """Whether law is one of contactfem's own laws (its class exactly one of SHIPPED_LAWS: a
+    subclass, or a class of the same name from elsewhere, is the user's)."""
+    return type(law) in SHIPPED_LAWS
 
 
 def _num(x):
@@ -523,8 +530,8 @@ class NormalLawView:
     (``hasattr(view, "energy")`` is False, and reading it raises an AttributeError that
     says so). Every value returned is checked (``LawValueError`` naming the law, the
     method, the value and g_N): finite, t_N <= 0 where g_N < 0 (compressive), the shape
-    of g_N; the shipped laws are called directly (``trusted``). Other attributes (c_N,
-    m, ...) are the law's own."""
+    of g_N; the shipped laws are called directly (``trusted``). The law's own fields (c_N,
+    m, ...) are read from the law itself, ``view.law``."""
 
     def __init__(self, law):
         self.law = law
@@ -539,16 +546,15 @@ class NormalLawView:
         check_fields(law)
         self.has_energy = callable(getattr(law, "energy", None))
         self.check_values = True               # False: only the protocol (shapes, numbers), not the values
-        if self.has_energy:
-            self.energy = self._energy
 
-    def __getattr__(self, name):               # the law's own fields (c_N, m, ...) read through the view
-        if name in ("law", "name", "has_energy", "check_values", "trusted"):
-            raise AttributeError(name)
-        if name == "energy":
+    @property
+    def energy(self):
+        """The law's potential, ``energy(g_N) -> W`` (checked); an AttributeError that says so for a
+        law without one (so ``hasattr(view, "energy")`` is False)."""
+        if not self.has_energy:
             raise AttributeError(f"{self.name} has no method energy(g_N): this use needs the law's potential W, "
                                  "dW/dg_N = t_N (e.g. c_N (-g_N)^(m+1) / (m+1) for eq 4)")
-        return getattr(self.law, name)
+        return self._energy
 
     def _call(self, method, g):
         """The law's own `method`(g): an error it raises becomes one LawValueError naming it."""

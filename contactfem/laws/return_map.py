@@ -30,8 +30,8 @@ class FrictionState:
     state: np.ndarray  # OPEN, STICK or SLIP
     lam: np.ndarray    # slip increment lambda >= 0 (eq 45)
     q: np.ndarray      # accumulated slip after the step
-    z: np.ndarray = None   # the law's internal variables after the step (n, k)
-    v: np.ndarray = None   # slip rate lambda / dt of the step
+    z: np.ndarray | None = None   # the law's internal variables after the step (n, k)
+    v: np.ndarray | None = None   # slip rate lambda / dt of the step
 
     @property
     def dissipation(self):

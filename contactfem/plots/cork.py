@@ -423,16 +423,13 @@ def exit_case(case, preset=EXIT_PRESET):
         model = build(P)
         if ramp is not None:
             model["gas"].dt_ramp = ramp
-        for c in model["contacts"]:
-            c.closing_step = fit_rule
+        model["contacts"] = [c.with_closing_step(fit_rule) for c in model["contacts"]]
         fit_last, _ = press_fit(model, P)
-        for c in model["contacts"]:
-            c.closing_step = pop_rule
-        model["neck"].motion = None                  # the press fit is done (as simulate)
-        records, pressures, exit_time, _ = pop(model, P, fit_last.u)
+        model["contacts"] = [c.with_closing_step(pop_rule) for c in model["contacts"]]
+        records, pressures, exit_time, gas = pop(model, P, fit_last.u, histories=fit_last.state.contacts)
     except Exception as err:                        # a failed run is a row of the study, not hidden
         return dict(row, exited=None, error=f"{type(err).__name__}: {str(err).splitlines()[0][:100]}")
-    exited = bool(model["gas"].released and records[-1].contacts[0].n_active == 0)
+    exited = bool(gas.released and records[-1].contacts[0].n_active == 0)
     h = history(model, dict(records=records, pressures=pressures))
     t_ramp = P["n_ramp"] * (ramp or P["dt"])
     after = np.flatnonzero(h["t"] > t_ramp * (1 + 1e-9))

@@ -61,7 +61,7 @@ def history(model, out):
     rows = []
     for rec in records:
         f = contact_forces(rec.contacts)
-        rows.append(dict(t=rec.t, dt=rec.dt, volume=gas.volume(rec.u), u_bottom=rec.u[uz[centre]] - u0[uz[centre]],
+        rows.append(dict(t=rec.t, dt=rec.dt, volume=gas.volume(rec.u, rec.state.loads[0]), u_bottom=rec.u[uz[centre]] - u0[uz[centre]],
                          u_top=rec.u[uz[top]] - u0[uz[top]], u_cm=float(np.sum(M * (rec.u - u0)[uz]) / np.sum(M)),
                          v_cm=centre_of_mass_velocity(cork, rec.v) / 1e3, normal_force=f["normal"],
                          friction_force=f["tangential"], n_contact=f["n_active"], n_slip=f["n_slip"],

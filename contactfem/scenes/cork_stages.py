@@ -14,7 +14,7 @@ nodes slip and its Newton iteration chatters between stick and slip.)
 Stage 2 (pop, ``Newmark`` delta = 0.7, beta = 0.4): a follower pressure p on the
 cork's bottom face, raised by p_step per step of dt for n_ramp steps, then Boyle's
 law evaluated ONCE PER STEP from the last converged state (explicit coupling, as
-the paper; in the loop over the records, ``gas.update``): p = p0 V0 / V, V0 = pi R_neck^2 * gas_column, V = V0 + (volume swept
+the paper; the gas pressure load's state, GasPressure.update at each commit): p = p0 V0 / V, V0 = pi R_neck^2 * gas_column, V = V0 + (volume swept
 by the bottom face since the start of stage 2), i.e. V0 + pi R^2 * (its axial
 displacement). When the bottom corner of the cork reaches the mouth (z = 24 mm)
 the gas escapes: p = 0 from then on (ambient; no gas jet is modelled).
@@ -27,6 +27,8 @@ then the NewtonError is raised with its residual history.
 
 What the scene measures of both stages (the exit, the breakaway) is in cork_measure.py.
 """
+
+from dataclasses import replace
 
 import numpy as np
 
@@ -73,21 +75,27 @@ def choose_dt(P, t, gap_to_mouth, released_at, v_cm):
     return max(dt, P["dt_fine"])
 
 
-def pop(model, P, u0, progress=None):
+def pop(model, P, u0, progress=None, histories=None):
     """Stage 2: the gas drives the cork out (Newmark; explicit Boyle coupling: the gas pressure
-    of the next step from each converged step; adaptive dt with cutback). Runs to t_end, or
-    t_flight after the exit. Returns the records, the gas pressure that acted in each step, the
-    exit time and the gas release time."""
-    cork, contacts, gas = model["cork"], model["contacts"], model["gas"]
+    of the next step from each converged step, the load's state; adaptive dt with cutback).
+    Runs to t_end, or t_flight after the exit. ``histories``: the contacts' histories to start
+    from (the press fit's last record's, ``record.state.contacts``; None: started at u0).
+    Returns the records, the gas pressure that acted in each step, the exit time and the gas
+    state at the end (GasState: ``released``, ``released_at``)."""
+    cork, gas, neck = model["cork"], model["gas"], model["neck"]
+    rest = neck.without_motion()                             # the press fit is done: the neck stays at r = R_neck
+    contacts = [c.with_master(rest) if c.master is neck else c for c in model["contacts"]]
     t_ramp = P["n_ramp"] * P["dt"]
     system = System([cork], contacts, [gas], [Dirichlet(cork, cork.xdofs[model["axis"], 0], 0.0)],
                     **model["system_options"])
     model["systems"].append(system)
-    gas.start(u0)
+    state = system.start(u0, 0.0)
+    if histories is not None:                                # the contacts go on from the press fit
+        state = replace(state, contacts=tuple(histories))
 
-    def dt_rule(rec):
+    def dt_rule(rec):                                        # rec.state: the gas after the step
         v_cm = centre_of_mass_velocity(cork, rec.v) / 1e3 if rec.k else 0.0
-        h = choose_dt(P, rec.t, P["L_neck"] - gas.edge_z(rec.u), gas.released_at, v_cm)
+        h = choose_dt(P, rec.t, P["L_neck"] - gas.edge_z(rec.u), rec.state.loads[0].released_at, v_cm)
         return min(h, t_ramp - rec.t) if rec.t < t_ramp * (1 - 1e-9) else h
 
     # the press fit is a static state: start at rest with a0 = 0 (M^-1 G would put the hold's
@@ -95,17 +103,17 @@ def pop(model, P, u0, progress=None):
     zero = np.zeros(system.ndof)
     stepper = Newmark(system, delta=P["delta"], beta=P["beta_newmark"], **_newton_options(P))
     schedule = Adaptive(dt_rule, t_end=P["t_end"], dt=P["dt"], max_cuts=P["max_cuts"])
-    records, pressures, exit_time, touching = [], [], None, None
+    records, pressures, exit_time, touching, acting = [], [], None, None, None
     bar = progress(0.0, P["t_end"], "cork: pop") if progress is not None else None
     try:
-        for rec in march(stepper, schedule, 0.0, u0.copy(), zero, a0=zero,
+        for rec in march(stepper, schedule, 0.0, u0.copy(), zero, a0=zero, state=state,
                          label=lambda k, t1, h: f"cork t = {t1 * 1e3:.5f} ms, dt = {h:.2e}"):
             if bar is not None:
                 bar(rec.t, rec.u, rec.v, rec.a)
             records.append(rec)
-            pressures.append(gas.pressure(rec.t) if rec.k else 0.0)
+            pressures.append(gas.pressure(rec.t, acting) if rec.k else 0.0)   # the gas the step was taken with
             n_contact = sum(st.n_active for st in rec.contacts)
-            if rec.k and gas.released and n_contact == 0 and (exit_time is None or touching):
+            if rec.k and acting.released and n_contact == 0 and (exit_time is None or touching):
                 exit_time = rec.t                            # the last time the contact opened
             touching = n_contact > 0
             if exit_time is not None and rec.t >= exit_time + P["t_flight"] * (1 - 1e-9):
@@ -113,11 +121,11 @@ def pop(model, P, u0, progress=None):
                     bar.finish(f"the cork left at {exit_time * 1e3:.3f} ms; the run stops t_flight = "
                                f"{P['t_flight'] * 1e3:g} ms later")
                 break                                        # t_flight after the exit: stop
-            gas.update(rec.u, rec.t)                         # explicit coupling: the next step's pressure
+            acting = rec.state.loads[0]                      # explicit coupling: the next step's pressure
     finally:
         if hasattr(bar, "close"):
             bar.close()
-    return records, np.array(pressures), exit_time, gas.released_at
+    return records, np.array(pressures), exit_time, acting
 
 
 def simulate(model, P, progress=None):
@@ -127,11 +135,10 @@ def simulate(model, P, progress=None):
     fit.update(contact_forces(fit_last.contacts))
     areas = model["cork"].element_areas
     fit["min_area_ratio"] = float(np.min(areas(fit_last.u) / areas(0 * fit_last.u)))
-    model["neck"].motion = None                          # the press fit is done: the neck stays at r = R_neck
-    records, pressures, exit_time, released_at = pop(model, P, fit_last.u, progress)
-    exited = bool(model["gas"].released and records[-1].contacts[0].n_active == 0)
+    records, pressures, exit_time, gas = pop(model, P, fit_last.u, progress, fit_last.state.contacts)
+    exited = bool(gas.released and records[-1].contacts[0].n_active == 0)
     return dict(fit_last=fit_last, fit=fit, records=records, pressures=pressures, exited=exited,
-                exit_time=exit_time if exited else None, released_at=released_at)
+                exit_time=exit_time if exited else None, released_at=gas.released_at)
 
 
 def press_fit_only(params):

@@ -2,10 +2,12 @@
 step, the time steppers and the time loop (paper Sec. 4.1, 4.3).
 
     system = System(bodies, contacts, loads, fixed=[Dirichlet(body, dofs, value)])
-    ev = system.evaluate(u, t, dt)            # G = R + R_c - P (eq 29 without M a), K, contact states
+    state = system.start(u0, t0)              # SystemState: contact histories, body and load states
+    ev = system.evaluate(u, t, dt, state=state)   # G = R + R_c - P (eq 29 without M a), K, contact states
+    state = system.commit(ev, u, t, dt)       # the next SystemState, after a converged u
     stepper = Newmark(system, delta=0.7, beta=0.4)   # or Static(system), CentralDifference, EnergyConsistent
     for rec in march(stepper, Steps(dt=0.1, n_steps=200), t0, u0, v0):
-        rec.t, rec.u, rec.v, rec.contacts, rec.energy, rec.iterations
+        rec.t, rec.u, rec.v, rec.contacts, rec.energy, rec.iterations, rec.state
     hist = integrate(stepper, t0, u0, v0, n_steps=200, dt=0.1)   # the same, collected into arrays
 
 ``march`` is the one time loop of every scene (march.py): a generator of records, each the

@@ -80,7 +80,7 @@ class EnergyConsistent:
             vals.append(np.asarray(v, float))
         return G, rows, cols, vals
 
-    def step(self, t, u, v, a, dt, label=""):
+    def step(self, t, u, v, a, dt, label="", *, state):
         import scipy.sparse as sp
 
         _check_dt(dt)
@@ -102,14 +102,14 @@ class EnergyConsistent:
             # the contacts and loads, conjugate to d: on an angle, their moment times chord is
             # conjugate to dq (chord dq = d there); the derivative of chord on the diagonal
             Gc, rows_c, cols_c, vals_c = np.zeros(s.ndof), [], [], []
-            for ct in s.contacts:
-                state = ct.evaluate(u1, t1, dt, u)
-                Rc, r, c, vv = state.scatter(s.ndof)
-                states.append(state)
+            for ct, h in zip(s.contacts, state.contacts):
+                cs = ct.evaluate(u1, t1, dt, u, history=h)
+                Rc, r, c, vv = cs.scatter(s.ndof)
+                states.append(cs)
                 Gc += Rc
                 rows_c.append(np.asarray(r, int)), cols_c.append(np.asarray(c, int)), vals_c.append(np.asarray(vv, float))
-            for load in s.loads:
-                P, r, c, vv = load.assemble(um, tm)
+            for load, ls in zip(s.loads, state.loads):
+                P, r, c, vv = load.assemble(um, tm, ls)
                 Gc -= P
                 rows_c.append(np.asarray(r, int)), cols_c.append(np.asarray(c, int))
                 vals_c.append(-0.5 * np.asarray(vv, float))
@@ -120,13 +120,13 @@ class EnergyConsistent:
             G += s.mass_times(c_mass * (dq - dt * v))
             K = sp.coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                               shape=(s.ndof, s.ndof)).tocsr() + inertia(D)
-            return Evaluation(G, K, tuple(states))
+            return Evaluation(G, K, tuple(states), None, state)
 
         guess = s.apply_dirichlet(u + dt * v + 0.5 * dt ** 2 * a, t1)
         result = newton(fun, guess, s.free_dofs, instrument=s.instrument, label=label or f"t = {t1:.6g}, dt = {dt:.3g}",
                         **self.newton_options)
         u1 = result.u
-        result.evaluation = result.evaluation._replace(P=s.external_force(u1, t1))   # the loads' work
+        result.evaluation = result.evaluation._replace(P=s.external_force(u1, t1, state))   # the loads' work
         v1 = 2.0 * cayley(u1 - u, rot)[0] / dt - v
         a1 = (v1 - v) / dt
         return u1, v1, a1, result

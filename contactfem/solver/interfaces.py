@@ -14,10 +14,22 @@ class Stepper(Protocol):
     system: object              # the System it steps
     dynamic: bool               # inertia (v, a) or quasi-static
 
-    def step(self, t: float, u: np.ndarray, v: np.ndarray, a: np.ndarray, dt: float, label: str = "") -> tuple:
-        """(u1, v1, a1, result) of the step of size dt from the converged (t, u, v, a); commits
-        nothing; ``result.evaluation`` is the System's converged evaluation, ``result.G`` the
-        residual whose prescribed-dof part are the reactions. Raises NewtonError."""
+    def step(self, t: float, u: np.ndarray, v: np.ndarray, a: np.ndarray, dt: float, label: str = "", *,
+             state: object) -> tuple:
+        """(u1, v1, a1, result) of the step of size dt from the converged (t, u, v, a) with the
+        committed SystemState ``state``; commits nothing; ``result.evaluation`` is the System's
+        converged evaluation, ``result.G`` the residual whose prescribed-dof part are the
+        reactions. Raises NewtonError."""
+
+
+@runtime_checkable
+class ImplicitStepper(Stepper, Protocol):
+    """A stepper whose step equation others solve differently (the staggered algorithm,
+    staggered.py, reads Newmark's constants; the Uzawa loop, uzawa.py, its Newton options)."""
+
+    beta: float                 # Newmark's beta (and delta): the step equation's constants
+    delta: float
+    newton_options: dict        # atol, rtol, maxit, ... of its Newton solves
 
 
 @runtime_checkable

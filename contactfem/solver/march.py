@@ -5,9 +5,16 @@
 
 ``march`` yields one ``Record`` per accepted step, the initial state first (k = 0). A
 record is a value: the converged state of the step (u, v, a), the System's converged
-evaluation (residual and the contacts' states, contact/state.py), the energies and the
-Newton iterations. The loop commits the converged evaluation before it yields the record,
-so a scene reads the step from the record, never by evaluating the contact again.
+evaluation (residual and the contacts' states, contact/state.py), the energies, the Newton
+iterations and the SystemState the next step starts from (``state``: the contacts'
+histories, the bodies' internal variables, the loads' states; solver/system.py). The loop
+commits the converged evaluation into that state before it yields the record, so a scene
+reads the step from the record, never by evaluating the contact again.
+
+Nothing of a run is kept on the System or its parts: marching the same model twice gives
+the same records, bit for bit, and ``resume(stepper, schedule, record)`` continues a run from
+any of its records (a saved one too: contactfem.io.runs.save_record) exactly as the
+uninterrupted run went on.
 
 The schedule (schedule.py) decides the step sizes: fixed steps, or an adaptive rule of
 the last record, with the halving of a failed step; the scene decides when to stop, by
@@ -19,6 +26,7 @@ import numpy as np
 
 from .newton import NewtonError
 from .schedule import Steps
+from .system import SystemState
 
 
 @dataclass(frozen=True, eq=False)
@@ -32,6 +40,8 @@ class Record:
                     external_work (both summed since the start)
     result          the stepper's NewtonResult (None at k = 0)
     cuts, failures  halvings before the step converged, the first line of each failure
+    state           the SystemState after the step (solver/system.py): what the next step
+                    starts from
     """
     k: int
     t: float
@@ -44,6 +54,7 @@ class Record:
     result: object = None
     cuts: int = 0
     failures: tuple = ()
+    state: object = None
 
     @property
     def contacts(self):
@@ -59,21 +70,32 @@ class Record:
         return list(self.result.residuals) if self.result is not None else []
 
 
-def march(stepper, schedule, t0, u0, v0=None, *, a0=None, label=None):
+def march(stepper, schedule, t0, u0, v0=None, *, a0=None, label=None, state=None):
     """Step from (t0, u0, v0) as the schedule says; yield the initial Record, then one per
     accepted step. A step whose Newton fails is retried with the size ``schedule.cut`` gives,
     until it gives None: then the NewtonError is raised with the last record as ``record``.
     ``a0``: the initial acceleration (default: M a0 = -G(u0), eq 29; 0 for a static stepper).
-    ``label(k, t1, dt)``: the text naming a step in an error (default: step k, t, dt)."""
-    rec = initial(stepper, schedule, t0, u0, v0, a0)
+    ``label(k, t1, dt)``: the text naming a step in an error (default: step k, t, dt).
+    ``state``: the SystemState to start from (default: ``system.start(u0, t0)``; e.g. the
+    contacts' histories a previous stage ended with)."""
+    rec = initial(stepper, schedule, t0, u0, v0, a0, state)
     yield rec
+    yield from resume(stepper, schedule, rec, label=label)
+
+
+def resume(stepper, schedule, record, *, label=None):
+    """The records after ``record`` (not itself), stepped as ``march`` steps: from a record of
+    a run (its u, v, a, energies, reactions and SystemState), the rest of that run exactly."""
+    rec = record
+    if not isinstance(rec.state, SystemState):
+        raise ValueError(f"record {rec.k} has no SystemState to resume from (state = {type(rec.state).__name__})")
     try:
         while (dt := schedule.next_dt(rec)) is not None:
             cuts, failures = 0, []
             while True:
                 name = label(rec.k + 1, rec.t + dt, dt) if label else f"step {rec.k + 1}, t = {rec.t + dt:.6g}, dt = {dt:.3g}"
                 try:
-                    trial = stepper.step(rec.t, rec.u, rec.v, rec.a, dt, name)
+                    trial = stepper.step(rec.t, rec.u, rec.v, rec.a, dt, name, state=rec.state)
                     break
                 except NewtonError as err:
                     failures.append(str(err).splitlines()[0][:200] if str(err) else "Newton failed")
@@ -90,26 +112,26 @@ def march(stepper, schedule, t0, u0, v0=None, *, a0=None, label=None):
         raise
 
 
-def initial(stepper, schedule, t0, u0, v0=None, a0=None):
-    """The Record of the initial state: the contacts' histories started at u0, one evaluation
-    (with the schedule's first dt, for rate-dependent bodies and laws), a0 from eq 29."""
+def initial(stepper, schedule, t0, u0, v0=None, a0=None, state=None):
+    """The Record of the initial state: the SystemState started at u0 (or ``state``), one
+    evaluation (with the schedule's first dt, for rate-dependent bodies and laws), a0 from eq 29."""
     s = stepper.system
     dt = schedule.dt
     u = s.apply_dirichlet(u0, t0)
-    s.start(u, t0)
-    ev = s.evaluate(u, t0, dt)
+    state = s.start(u, t0) if state is None else state
+    ev = s.evaluate(u, t0, dt, state=state)
     v = np.zeros(s.ndof) if v0 is None else np.array(v0, dtype=float)
     if a0 is not None:
         a = np.array(a0, dtype=float)
     else:
         a = acceleration(s, ev.G) if stepper.dynamic else np.zeros(s.ndof)
     energy = dict(s.energies(u, v, ev, dt), dissipation=0.0, external_work=0.0)
-    return Record(k=0, t=t0, dt=0.0, u=u, v=v, a=a, evaluation=ev, energy=energy)
+    return Record(k=0, t=t0, dt=0.0, u=u, v=v, a=a, evaluation=ev, energy=energy, state=state)
 
 
 def accept(system, rec, t1, dt, trial, cuts=0, failures=()):
-    """Commit a converged step and make its Record: the System keeps the converged evaluation's
-    histories; the energies are those of the converged state, the dissipation that of its
+    """Commit a converged step and make its Record: the next SystemState from the converged
+    evaluation; the energies are those of the converged state, the dissipation that of its
     contact states, the external work the trapezoidal rule 1/2 (F_n + F_n+1) . (u_n+1 - u_n)
     over the loads P and the support reactions (the prescribed-dof part of G)."""
     u1, v1, a1, result = trial
@@ -120,10 +142,10 @@ def accept(system, rec, t1, dt, trial, cuts=0, failures=()):
     P1, F1 = ev.P, result.G[fixed]
     work = rec.energy["external_work"] + 0.5 * (P0 + P1) @ du + 0.5 * (F0 + F1) @ du[fixed]
     dissipation = rec.energy["dissipation"] + sum(st.dissipation for st in ev.contacts)
-    system.commit(ev, u1, t1, dt)
-    energy = dict(system.energies(u1, v1, ev, dt), dissipation=dissipation, external_work=float(work))
+    state = system.commit(ev, u1, t1, dt)
+    energy = dict(system.energies(u1, v1, ev, dt, state), dissipation=dissipation, external_work=float(work))
     return Record(k=rec.k + 1, t=t1, dt=dt, u=u1, v=v1, a=a1, evaluation=ev, energy=energy, result=result,
-                  cuts=cuts, failures=tuple(failures))
+                  cuts=cuts, failures=tuple(failures), state=state)
 
 
 def acceleration(system, G):
@@ -164,21 +186,21 @@ def watch(records, progress, t0, t_end, name):
 class History:
     """A march collected into arrays (``integrate``): one entry per record, entry 0 the
     initial state. ``records`` keeps the records themselves."""
-    t: np.ndarray = None
-    dt: np.ndarray = None
-    iterations: np.ndarray = None
-    cuts: np.ndarray = None
-    kinetic: np.ndarray = None
-    strain: np.ndarray = None
-    contact: np.ndarray = None
-    dissipation: np.ndarray = None
-    external_work: np.ndarray = None
+    t: np.ndarray | None = None
+    dt: np.ndarray | None = None
+    iterations: np.ndarray | None = None
+    cuts: np.ndarray | None = None
+    kinetic: np.ndarray | None = None
+    strain: np.ndarray | None = None
+    contact: np.ndarray | None = None
+    dissipation: np.ndarray | None = None
+    external_work: np.ndarray | None = None
     residuals: list = field(default_factory=list)
     failures: list = field(default_factory=list)
     records: list = field(default_factory=list)
-    u: np.ndarray = None
-    v: np.ndarray = None
-    a: np.ndarray = None
+    u: np.ndarray | None = None
+    v: np.ndarray | None = None
+    a: np.ndarray | None = None
     result: object = None
 
     @classmethod

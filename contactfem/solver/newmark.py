@@ -32,7 +32,6 @@ import numpy as np
 
 from .march import acceleration
 from .newton import NewtonError, NewtonResult, newton
-from .system import Evaluation
 
 
 def _check_dt(dt):
@@ -40,10 +39,12 @@ def _check_dt(dt):
         raise ValueError(f"dt must be a finite number > 0, got {dt}")
 
 
-def initial_acceleration(system, t, u, dt=None):
-    """a0 from M a0 = P(u0, t0) - R(u0) - R_c(u0) (eq 29 at t0).
-    Prescribed dofs get 0 (their acceleration is not known from the data)."""
-    return acceleration(system, system.evaluate(u, t, dt).G)
+def initial_acceleration(system, t, u, dt=None, state=None):
+    """a0 from M a0 = P(u0, t0) - R(u0) - R_c(u0) (eq 29 at t0), with the SystemState ``state``
+    (default: ``system.start(u, t)``). Prescribed dofs get 0 (their acceleration is not known
+    from the data)."""
+    state = system.start(u, t) if state is None else state
+    return acceleration(system, system.evaluate(u, t, dt, state=state).G)
 
 
 class Newmark:
@@ -69,7 +70,7 @@ class Newmark:
         self.system, self.delta, self.beta = system, delta, beta
         self.newton_options = newton_options
 
-    def step(self, t, u, v, a, dt, label=""):
+    def step(self, t, u, v, a, dt, label="", *, state):
         _check_dt(dt)
         s, beta, delta = self.system, self.beta, self.delta
         t1 = t + dt
@@ -79,9 +80,9 @@ class Newmark:
         u_pred = u + dt * v + dt ** 2 * (0.5 - beta) * a
 
         def effective(u1):                    # eq 29 with a+ = c (u1 - u_pred); tangent K + c M
-            G, K, contacts, P = s.evaluate(u1, t1, dt, u, mass_coefficient=c)
+            ev = s.evaluate(u1, t1, dt, u, mass_coefficient=c, state=state)
             du = u1 - u_pred
-            return Evaluation(G + (cM * du if lumped else cM @ du), K, contacts, P)
+            return ev._replace(G=ev.G + (cM * du if lumped else cM @ du))
 
         # initial guess: the acceleration stays a (u + dt v + dt^2 a / 2); multipliers as they were
         guess = s.apply_dirichlet(u_pred + beta * dt ** 2 * a, t1)
@@ -106,10 +107,10 @@ class Static:
     def __init__(self, system, **newton_options):
         self.system, self.newton_options = system, newton_options
 
-    def step(self, t, u, v, a, dt, label=""):
+    def step(self, t, u, v, a, dt, label="", *, state):
         _check_dt(dt)
         s, t1 = self.system, t + dt
-        result = newton(lambda w: s.evaluate(w, t1, dt, u), s.apply_dirichlet(u, t1),
+        result = newton(lambda w: s.evaluate(w, t1, dt, u, state=state), s.apply_dirichlet(u, t1),
                         s.free_dofs, instrument=s.instrument, label=label or f"t = {t1:.6g}", **self.newton_options)
         zero = np.zeros(s.ndof)
         return result.u, zero, zero.copy(), result
@@ -132,11 +133,11 @@ class CentralDifference:
             raise ValueError("CentralDifference needs mass > 0 on every free dof")
         self.system = system
 
-    def step(self, t, u, v, a, dt, label=""):
+    def step(self, t, u, v, a, dt, label="", *, state):
         _check_dt(dt)
         s, t1 = self.system, t + dt
         u1 = s.apply_dirichlet(u + dt * v + 0.5 * dt ** 2 * a, t1)
-        ev = s.evaluate(u1, t1, dt, u)
+        ev = s.evaluate(u1, t1, dt, u, state=state)
         a1 = acceleration(s, ev.G)
         v1 = v + 0.5 * dt * (a + a1)
         v1[s.fixed_dofs] = (u1 - u)[s.fixed_dofs] / dt

@@ -82,7 +82,7 @@ class NewtonResult:
     u: np.ndarray                                 # the converged solution
     residuals: list = field(default_factory=list)  # ||G|| of every iterate, first = initial guess
     iterations: int = 0                           # number of linear solves
-    G: np.ndarray = None                          # full residual at u (its fixed-dof part = reactions)
+    G: np.ndarray | None = None                          # full residual at u (its fixed-dof part = reactions)
     evaluation: object = None                     # what fun returned at u (G, K, contact states, ...)
     evaluations: int = 0                          # calls of fun (residuals + line-search trials)
 

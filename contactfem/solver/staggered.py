@@ -50,7 +50,7 @@ class StaggeredResult:
     u: np.ndarray
     residuals: list = field(default_factory=list)
     iterations: int = 0
-    G: np.ndarray = None
+    G: np.ndarray | None = None
     evaluation: object = None
     evaluations: int = 0
     cycles: int = 0
@@ -113,12 +113,12 @@ class Staggered:
         if self.dynamic and not hasattr(stepper, "beta"):
             raise ValueError("parameter stepper must be a Newmark or Static stepper (an implicit one)")
 
-    def step(self, t, u, v, a, dt, label=""):
+    def step(self, t, u, v, a, dt, label="", *, state):
         st, s = self.stepper, self.system
         t1 = t + dt
         opts = dict(st.newton_options, instrument=s.instrument)
         if not self.dynamic:
-            res = staggered(lambda w, ph: s.evaluate(w, t1, dt, u, phases=ph), s.apply_dirichlet(u, t1),
+            res = staggered(lambda w, ph: s.evaluate(w, t1, dt, u, phases=ph, state=state), s.apply_dirichlet(u, t1),
                             s.free_dofs, max_cycles=self.max_cycles, label=label, **opts)
             zero = np.zeros(s.ndof)
             return res.u, zero, zero.copy(), res
@@ -127,7 +127,7 @@ class Staggered:
         u_pred = u + dt * v + dt ** 2 * (0.5 - beta) * a
 
         def effective(u1, phases):                           # as Newmark.step
-            ev = s.evaluate(u1, t1, dt, u, mass_coefficient=c, phases=phases)
+            ev = s.evaluate(u1, t1, dt, u, mass_coefficient=c, phases=phases, state=state)
             return ev._replace(G=ev.G + s.mass_times(c * (u1 - u_pred)))
 
         guess = s.apply_dirichlet(u_pred + beta * dt ** 2 * a, t1)

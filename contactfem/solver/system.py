@@ -24,10 +24,18 @@ K is a dense numpy array for small systems and a scipy CSC matrix on a fixed spa
 pattern above, solved by LAPACK's banded LU where the pattern is a narrow band after
 renumbering, else by SuperLU (``System.linear_algebra``, chosen automatically: assembly.py).
 
-One evaluation of the System at a trial u is a value, ``Evaluation(G, K, contacts, P)``:
-the contacts' states (contact/state.py) travel with it, so the converged one is what the
-time loop commits, records and reports (solver/march.py); nothing evaluates it again.
+What a run remembers from step to step is a value too, a ``SystemState``: the contacts'
+histories, the bodies' internal variables and the loads' states. ``start(u0, t0)`` gives the
+first, ``evaluate(u, t, ..., state=state)`` reads it, ``commit(evaluation, u, t, dt)`` returns
+the next; bodies, contacts and loads hold their configuration only, so marching the same
+System twice, or from any record's state, gives the same records.
+
+One evaluation of the System at a trial u is a value, ``Evaluation(G, K, contacts, P, state)``:
+the contacts' states (contact/state.py) travel with it, and the SystemState it was evaluated
+with, so the converged one is what the time loop commits, records and reports
+(solver/march.py); nothing evaluates it again.
 """
+from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
@@ -36,13 +44,28 @@ from .assembly import TangentAssembler
 from .instrument import timed
 
 
+@dataclass(frozen=True, eq=False)
+class SystemState:
+    """What a run carries from one converged step to the next (``System.start``, ``commit``):
+
+    contacts  one history per contact (contact/state.py: ContactHistory, ...)
+    bodies    one per body: its internal variables (a viscoplastic beam's plastic strains;
+              None for an elastic body)
+    loads     one per load: its state (the gas pressure's value; None for most loads)
+    """
+    contacts: tuple = ()
+    bodies: tuple = ()
+    loads: tuple = ()
+
+
 class Evaluation(NamedTuple):
-    """The System at one trial u: residual G, tangent K, the contacts' states and the loads P
-    (a tuple, so ``G, K = evaluation[:2]`` reads as before)."""
+    """The System at one trial u: residual G, tangent K, the contacts' states, the loads P and
+    the SystemState it was evaluated with (a tuple, so ``G, K = evaluation[:2]`` reads as before)."""
     G: np.ndarray
     K: object
     contacts: tuple = ()
-    P: np.ndarray = None
+    P: np.ndarray | None = None
+    state: SystemState | None = None
 
 
 class Dirichlet:
@@ -89,10 +112,11 @@ class System:
     ----------
     bodies   : list of bodies (the interface of contactfem.bodies)
     bodies   : list of bodies (contactfem.bodies.interfaces.Body)
-    contacts : list of contacts (contactfem.contact.interfaces.Contact): ``evaluate(u, t, dt, u0)``
-               gives a state, ``state.scatter(ndof) -> (R_c, rows, cols, vals)``; each contact
-               gets ``dof_offset``, where its own ``unknowns`` (if any) start
-    loads    : list of loads, ``assemble(u, t) -> (P, rows, cols, vals)``
+    contacts : list of contacts (contactfem.contact.interfaces.Contact): ``evaluate(u, t, dt, u0,
+               history=h)`` gives a state, ``state.scatter(ndof) -> (R_c, rows, cols, vals)``; each
+               contact gets ``dof_offset``, where its own ``unknowns`` (if any) start
+    loads    : list of loads (contactfem.bodies.interfaces.Load), ``assemble(u, t, state) -> (P,
+               rows, cols, vals)``
     fixed    : list of Dirichlet conditions
     linear_algebra : "auto" (default: dense up to assembly.DENSE_MAX unknowns; above, banded where
                the band LU is cheap, else sparse), "dense", "sparse" or "banded"
@@ -136,6 +160,7 @@ class System:
         self.free_dofs = np.setdiff1d(np.arange(self.ndof), self.fixed_dofs)
         self._mass = None
         self._cM = (None, None)                 # (c, c M) of the last lumped effective tangent
+        self._requested = linear_algebra
         self._tangent = TangentAssembler(self.ndof, linear_algebra, self.free_dofs)
         self.evaluations = 0
         self.instrument = instrument
@@ -220,16 +245,27 @@ class System:
         M = self.mass()
         return M if isinstance(M, np.ndarray) else np.asarray(M.sum(axis=1)).ravel()
 
-    def external_force(self, u, t):
-        """P(u, t), the sum of all loads (ndof,)."""
+    def external_force(self, u, t, state):
+        """P(u, t), the sum of all loads (ndof,), with the loads' states of the SystemState."""
         P = np.zeros(self.ndof)
-        for load in self.loads:
-            P += load.assemble(u, t)[0]
+        for load, ls in zip(self.loads, state.loads):
+            P += load.assemble(u, t, ls)[0]
         return P
 
-    def evaluate(self, u, t, dt=None, u0=None, mass_coefficient=0.0, phases=None):
-        """The System at u, time t, at the end of a step of dt from u0: an Evaluation with
-        G = R(u) + R_c(u) - P(u, t) (static part of eq 29), K = dG/du and the contacts' states.
+    def _check_state(self, state):
+        if not isinstance(state, SystemState):
+            raise ValueError(f"state must be a SystemState (System.start or commit), got {type(state).__name__}")
+        if (len(state.contacts), len(state.bodies), len(state.loads)) != (len(self.contacts), len(self.bodies),
+                                                                           len(self.loads)):
+            raise ValueError(f"state has {len(state.contacts)} contacts, {len(state.bodies)} bodies and "
+                             f"{len(state.loads)} loads; the System {len(self.contacts)}, {len(self.bodies)} and "
+                             f"{len(self.loads)}")
+        return state
+
+    def evaluate(self, u, t, dt=None, u0=None, mass_coefficient=0.0, phases=None, *, state):
+        """The System at u, time t, at the end of a step of dt from u0 with the committed
+        ``state`` (a SystemState): an Evaluation with G = R(u) + R_c(u) - P(u, t) (static part
+        of eq 29), K = dG/du, the contacts' states and ``state``.
 
         With ``mass_coefficient`` c > 0, K + c M is returned instead (M lumped or consistent:
         ``mass``): the effective tangent of an implicit time stepper (Newmark: c = 1 / (beta dt^2)). ``phases``:
@@ -241,31 +277,32 @@ class System:
         u = np.asarray(u, dtype=float)
         if u.shape != (self.ndof,):
             raise ValueError(f"u must have shape ({self.ndof},), got {u.shape}")
+        self._check_state(state)
         self.evaluations += 1
         G = np.zeros(self.ndof)
         blocks = []                                    # (rows, cols, vals, offset, key)
 
         with timed(self.instrument, "bulk"):
-            for body in self.bodies:                   # block diagonal: internal forces
+            for body, bs in zip(self.bodies, state.bodies):   # block diagonal: internal forces
                 off = body.dof_offset
-                R, rows, cols, vals = body.internal_coo(u[off:off + body.ndof], dt)
+                R, rows, cols, vals = body.internal_coo(u[off:off + body.ndof], dt, bs)
                 G[off:off + body.ndof] += R
                 blocks.append((rows, cols, vals, off, body))
 
         states = []
         with timed(self.instrument, "contact"):
-            for i, contact in enumerate(self.contacts):   # contact residual eq 28 and its tangent
-                state = contact.evaluate(u, t, dt, u0, None if phases is None else phases[i])
-                Rc, r, c, v = state.scatter(self.ndof)
+            for i, (contact, h) in enumerate(zip(self.contacts, state.contacts)):   # eq 28 and its tangent
+                cs = contact.evaluate(u, t, dt, u0, None if phases is None else phases[i], history=h)
+                Rc, r, c, v = cs.scatter(self.ndof)
                 G += Rc
                 if len(v):                             # (a contact in flight adds no tangent entries)
                     blocks.append((*_triplets(r, c, v), 0, contact))   # (r, c: the same arrays while
-                states.append(state)                                     # its contact set stays)
+                states.append(cs)                                        # its contact set stays)
 
         with timed(self.instrument, "assembly"):
             P = np.zeros(self.ndof)
-            for load in self.loads:                    # loads enter with a minus sign
-                Pl, r, c, v = load.assemble(u, t)
+            for load, ls in zip(self.loads, state.loads):   # loads enter with a minus sign
+                Pl, r, c, v = load.assemble(u, t, ls)
                 P += Pl
                 if len(v):                             # (a dead load has no tangent)
                     r, c, v = _triplets(r, c, v)
@@ -283,35 +320,42 @@ class System:
                     r, c, v = self._mass_coo
                     blocks.append((r, c, mass_coefficient * v, 0, "mass"))
             K = self._tangent.assemble(blocks, diagonal)
-        return Evaluation(G, K, tuple(states), P)
+        return Evaluation(G, K, tuple(states), P, state)
 
-    def residual_tangent(self, u, t, mass_coefficient=0.0, dt=None, u0=None):
+    def residual_tangent(self, u, t, mass_coefficient=0.0, dt=None, u0=None, *, state):
         """(G, K) of ``evaluate`` (for a quick look; the solver keeps the whole Evaluation)."""
-        return self.evaluate(u, t, dt, u0, mass_coefficient)[:2]
+        return self.evaluate(u, t, dt, u0, mass_coefficient, state=state)[:2]
 
-    # -- history ----------------------------------------------------------------------
+    # -- the state carried from step to step ----------------------------------------------
     def start(self, u, t=0.0):
-        """The initial history of every contact that has none yet (``contact.start``)."""
-        for contact in self.contacts:
-            if contact.history is None:
-                contact.start(u, t)
+        """The SystemState at the initial state (u, t): each contact's, body's and load's own
+        ``start``. The System's assembly plan starts afresh too (the sparsity pattern of K grows
+        with the contact set during a run: a run starts from the pattern of its own initial
+        state, whatever ran before), so every run from the start is solved the same way."""
+        u = np.asarray(u, dtype=float)
+        self._tangent = TangentAssembler(self.ndof, self._requested, self.free_dofs)
+        return SystemState(contacts=tuple(c.start(u, t) for c in self.contacts),
+                           bodies=tuple(b.start(self.local(b, u).copy()) for b in self.bodies),
+                           loads=tuple(ld.start(u, t) for ld in self.loads))
 
     def commit(self, evaluation, u, t, dt=None):
-        """Accept a converged step ending at (u, t): the bodies and loads update their history
-        at u, the contacts keep their converged states' histories."""
-        for body in self.bodies:
-            body.commit(self.local(body, u).copy(), dt)
-        for contact, state in zip(self.contacts, evaluation.contacts):
-            contact.commit(state)
-        for load in self.loads:
-            load.commit(u, t)
+        """The SystemState after a converged step ending at (u, t) (``evaluation`` the converged
+        one, evaluated with the step's committed state): the bodies' internal variables and the
+        loads' states updated at u, the contacts' histories from their converged states."""
+        state = self._check_state(evaluation.state)
+        return SystemState(
+            contacts=tuple(c.commit(cs) for c, cs in zip(self.contacts, evaluation.contacts)),
+            bodies=tuple(b.commit(self.local(b, u).copy(), dt, bs) for b, bs in zip(self.bodies, state.bodies)),
+            loads=tuple(ld.commit(u, t, ls) for ld, ls in zip(self.loads, state.loads)))
 
     # -- energies ------------------------------------------------------------------
-    def energies(self, u, v, evaluation, dt=None):
+    def energies(self, u, v, evaluation, dt=None, state=None):
         """Kinetic (1/2 v.M v), strain and interface energy of a converged state, as a dict
-        of floats; the interface energy is read from the evaluation's contact states."""
+        of floats; the interface energy is read from the evaluation's contact states, the strain
+        energy with the bodies' internal variables ``state`` (default: the evaluation's)."""
+        state = evaluation.state if state is None else state
         return {
             "kinetic": 0.5 * float(np.dot(v, self.mass_times(v))),
-            "strain": float(sum(b.strain_energy(self.local(b, u), dt) for b in self.bodies)),
+            "strain": float(sum(b.strain_energy(self.local(b, u), dt, bs) for b, bs in zip(self.bodies, state.bodies))),
             "contact": float(sum(st.energy for st in evaluation.contacts)),
         }

@@ -1,7 +1,7 @@
 """The Uzawa (outer) loop of augmented-Lagrangian contact (contact/augmented.py).
 
     stepper = Uzawa(Static(system, ...), contacts, length=a, tol=1e-9)
-    u1, v1, a1, result = stepper.step(t, u, v, a, dt)    # works with march like any stepper
+    u1, v1, a1, result = stepper.step(t, u, v, a, dt, state=state)   # works with march like any stepper
 
 One step: solve the step equation by the wrapped stepper's Newton method (the same
 consistent tangent as the penalty method) with the multipliers held fixed; measure what
@@ -23,10 +23,12 @@ iterations instead of between accuracy and conditioning.
 A static step restarts Newton from the last outer iterate; a dynamic step (Newmark) from
 its own predictor (its equation depends on the start of the step). The violation and the
 update read the contact states of each converged inner solve (its evaluation), so nothing
-is evaluated twice; the interfaces' histories are committed by the time loop (march.py)
-after the last outer iteration, as for any stepper.
+is evaluated twice. The multipliers are part of the interfaces' histories (a value in the
+SystemState, contact/augmented.py): each update gives the next outer iteration a new state
+to solve with, and the time loop (march.py) commits the last one, as for any stepper.
 """
-from dataclasses import dataclass, field
+import copy
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -43,7 +45,7 @@ class UzawaResult:
     u: np.ndarray
     residuals: list = field(default_factory=list)
     iterations: int = 0
-    G: np.ndarray = None
+    G: np.ndarray | None = None
     evaluation: object = None
     evaluations: int = 0
     uzawa_iterations: int = 0
@@ -76,53 +78,50 @@ class Uzawa:
         if not self.contacts:
             raise ValueError("Uzawa needs at least one augmented interface (enforcement = 'augmented')")
         self.system, self.dynamic = stepper.system, stepper.dynamic
-        self.results = []                # UzawaResult of every converged step
 
-    def step(self, t, u, v, a, dt, label=""):
-        for c in self.contacts:
-            c.start_step()                # a retried (cut back) step starts from the committed state
-        start = u
-        residuals, per_outer, viols, self._gaps, self._calls = [], [], [], [], 0
-        opts = getattr(self.stepper, "newton_options", None)
-        saved = dict(opts) if opts is not None else None
-        try:
-            for k in range(self.max_updates + 1):
-                u1, v1, a1, res = self.stepper.step(t, start, v, a, dt,
-                                                    label=f"{label} (outer iteration {k + 1})" if label else "")
-                if k == 0 and opts is not None and res.residuals:
-                    # later solves start close to the solution: keep the tolerance of the first
-                    # (atol + rtol ||G_0|| with the step's own G_0), not one relative to a tiny G_0
-                    opts.update(atol=saved.get("atol", 1e-10) + saved.get("rtol", 1e-10) * res.residuals[0], rtol=0.0)
-                out = self._outer(k, u1, v1, a1, res, residuals, per_outer, viols)
-                if out is not None:
-                    return out
-                if not self.dynamic:
-                    start = u1                # warm start of the next static solve
-        finally:
-            if opts is not None:
-                opts.clear()
-                opts.update(saved)
+    def step(self, t, u, v, a, dt, label="", *, state):
+        start, stepper = u, self.stepper
+        residuals, per_outer, viols, gaps, calls = [], [], [], [], [0]
+        for k in range(self.max_updates + 1):
+            u1, v1, a1, res = stepper.step(t, start, v, a, dt, label=f"{label} (outer iteration {k + 1})" if label else "",
+                                           state=state)
+            if k == 0 and res.residuals:
+                # later solves start close to the solution: keep the tolerance of the first
+                # (atol + rtol ||G_0|| with the step's own G_0), not one relative to a tiny G_0: a copy
+                # of the wrapped stepper with those options (the wrapped one is left as it is)
+                opts = self.stepper.newton_options
+                stepper = copy.copy(self.stepper)
+                stepper.newton_options = dict(opts, atol=opts.get("atol", 1e-10) + opts.get("rtol", 1e-10) * res.residuals[0],
+                                              rtol=0.0)
+            out = self._outer(k, u1, v1, a1, res, residuals, per_outer, viols, gaps, calls)
+            if isinstance(out, tuple):
+                return out
+            state = out                       # the same step again, with the updated multipliers
+            if not self.dynamic:
+                start = u1                    # warm start of the next static solve
         raise NewtonError(f"Uzawa: contact violation {viols[-1]:.3e} > uzawa_tol = {self.tol:.1e} after "
                           f"{self.max_updates} multiplier updates ({label}); violations "
                           f"{', '.join(f'{x:.2e}' for x in viols[-5:])} (last 5)", residuals, label)
 
-    def _outer(self, k, u1, v1, a1, res, residuals, per_outer, viols):
-        """Book-keeping of outer iteration k: the step's result if converged, else update."""
+    def _outer(self, k, u1, v1, a1, res, residuals, per_outer, viols, gaps, calls):
+        """Book-keeping of outer iteration k: the step's result if converged, else the SystemState
+        with the updated multipliers."""
         residuals += list(res.residuals)
         per_outer.append(res.iterations)
-        self._calls += res.evaluations
+        calls[0] += res.evaluations
         states = dict(zip(self.system.contacts, res.evaluation.contacts))
         checks = [c.violation(states[c]) for c in self.contacts]
         viol = max(c["change"] for c in checks) / self.length
         gap = max(c["penetration"] for c in checks) / self.length
         viols.append(viol)
-        self._gaps.append(gap)
+        gaps.append(gap)
         if viol <= self.tol:
             result = UzawaResult(u=u1, residuals=residuals, iterations=sum(per_outer), G=res.G,
-                                 evaluation=res.evaluation, evaluations=self._calls, uzawa_iterations=k + 1, updates=k, newton_per_outer=per_outer,
-                                 violations=viols, gap_violation=gap, gap_violations=list(self._gaps))
-            self.results.append(result)
+                                 evaluation=res.evaluation, evaluations=calls[0], uzawa_iterations=k + 1, updates=k,
+                                 newton_per_outer=per_outer, violations=viols, gap_violation=gap, gap_violations=list(gaps))
             return u1, v1, a1, result
-        for c in self.contacts:
-            c.update_multipliers(states[c])
-        return None
+        ours = set(map(id, self.contacts))
+        ev = res.evaluation
+        histories = tuple(c.update_multipliers(st) if id(c) in ours else h
+                          for c, st, h in zip(self.system.contacts, ev.contacts, ev.state.contacts))
+        return replace(ev.state, contacts=histories)

@@ -10,7 +10,7 @@ import numpy as np
 from ...scenes import get_scene
 from .common import best_of
 
-def iteration_cost(system, u, t=1.0, repeat=3, solvers=True, dt=None):
+def iteration_cost(system, u, t=1.0, repeat=3, solvers=True, dt=None, state=None):
     """Wall times (best of `repeat`) of the parts of one Newton iteration at u:
     bulk (every body.internal_coo, as the System calls it), contact (every contact's
     evaluation and scatter), assembly (the whole System.evaluate minus those two: loads,
@@ -22,11 +22,14 @@ def iteration_cost(system, u, t=1.0, repeat=3, solvers=True, dt=None):
     import scipy.sparse as sp
     from scipy.sparse.linalg import splu
 
+    state = system.start(u, t) if state is None else state        # the SystemState evaluated with
     out = dict(ndof=int(system.ndof))
     # each body as the System evaluates it (a beam's COO triplets, a continuum's sparse K)
-    _, out["bulk_s"] = best_of(lambda: [b.internal_coo(system.local(b, u), dt) for b in system.bodies], repeat)
-    _, out["contact_s"] = best_of(lambda: [c.evaluate(u, t, dt).scatter(system.ndof) for c in system.contacts], repeat)
-    (G, K), total = best_of(lambda: system.residual_tangent(u, t, dt=dt), repeat)
+    _, out["bulk_s"] = best_of(lambda: [b.internal_coo(system.local(b, u), dt, bs)
+                                        for b, bs in zip(system.bodies, state.bodies)], repeat)
+    _, out["contact_s"] = best_of(lambda: [c.evaluate(u, t, dt, history=h).scatter(system.ndof)
+                                           for c, h in zip(system.contacts, state.contacts)], repeat)
+    (G, K), total = best_of(lambda: system.residual_tangent(u, t, dt=dt, state=state), repeat)
     out["assembly_s"] = max(total - out["bulk_s"] - out["contact_s"], 0.0)
     out["residual_tangent_s"] = total
     free = system.free_dofs
@@ -69,10 +72,10 @@ def _block_system(nx, ny, material="linear", width=None):
         p.update(width=width, height=width * ny / nx)  # square elements
     b = block.build(p)
     u = np.zeros(b["system"].ndof)
-    b["system"].start(u)
+    state = b["system"].start(u)
     # a state with every slave in contact: the block pushed down by 1e-3 (stick)
     u[b["body"].xdofs[:, 1]] = -1e-3
-    return b["system"], u
+    return b["system"], u, state
 
 
 def cost_study(quick=False):
@@ -81,30 +84,29 @@ def cost_study(quick=False):
 
     cases = {}
     for material in ("linear", "svk"):
-        system, u = _block_system(20, 10, material)
-        cases[f"block 20x10 ({material})"] = iteration_cost(system, u)
+        system, u, state = _block_system(20, 10, material)
+        cases[f"block 20x10 ({material})"] = iteration_cost(system, u, state=state)
     hz = get_scene("hertz")
     m = hertz.build(hz.resolve("paper", {"n_el": 32 if quick else 64}))
     u = np.zeros(m["system"].ndof)
     u[m["body"].xdofs[:, 1]] = -m["a_exact"] ** 2 / (2 * 10.0)
-    m["system"].start(u)
     cases[f"hertz {m['body'].mesh.t.shape[1]} quads"] = iteration_cost(m["system"], u)
     ring = rolling_ring.build(get_scene("rolling_ring").resolve("paper"))
     u = np.zeros(ring["system"].ndof)
-    ring["system"].start(u)
     cases["rolling ring 120 beams"] = iteration_cost(ring["system"], u, t=0.0)
     n_big = 64 if quick else 223                        # 2 (n + 1)^2 = 100352 unknowns
     for material in ("linear",) if quick else ("linear", "svk"):
-        system, u = _block_system(n_big, n_big, material)
-        system.residual_tangent(u, 1.0)                 # the linear body caches its K
-        cases[f"block {n_big}x{n_big} ({material})"] = iteration_cost(system, u, repeat=1 if not quick else 2)
+        system, u, state = _block_system(n_big, n_big, material)
+        system.residual_tangent(u, 1.0, state=state)    # the linear body caches its K
+        cases[f"block {n_big}x{n_big} ({material})"] = iteration_cost(system, u, repeat=1 if not quick else 2,
+                                                                      state=state)
 
     # contact cost against the number of contact nodes (a one-element-high strip)
     scaling = []
     for nx in ((50, 200, 800) if quick else (50, 200, 800, 1600, 3200)):
-        system, u = _block_system(nx, 1, width=4.0)
+        system, u, state = _block_system(nx, 1, width=4.0)
         c = system.contacts[0]
-        _, t_c = best_of(lambda: c.evaluate(u, 1.0).scatter(system.ndof), 5)
+        _, t_c = best_of(lambda: c.evaluate(u, 1.0, history=state.contacts[0]).scatter(system.ndof), 5)
         scaling.append(dict(n_contact_nodes=int(len(c.nodes)), contact_s=t_c))
     slope = float(np.polyfit(np.log([r["n_contact_nodes"] for r in scaling[1:]]),
                              np.log([r["contact_s"] for r in scaling[1:]]), 1)[0])

@@ -26,8 +26,7 @@ def _block_variant(params, variant):
             stepper = Staggered(Static(system, atol=params["atol"], rtol=params["rtol"], maxit=params["maxit"]),
                                 max_cycles=200)
             u = np.zeros(system.ndof)
-            system.start(u)
-            u, _, _, res = stepper.step(0.0, u, u, u, 1.0, label="block, staggered")
+            u, _, _, res = stepper.step(0.0, u, u, u, 1.0, label="block, staggered", state=system.start(u))
             extra = dict(cycles=res.cycles, phase_iterations=res.phase_iterations)
         else:
             s = block.solve(dict(params, tangent=variant))

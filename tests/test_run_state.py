@@ -1,0 +1,190 @@
+"""The run as a value: what a run remembers from step to step is the SystemState the records
+carry, never the bodies, contacts or loads. So marching the same model twice gives the same
+records bit for bit, and a run resumed from any of its records goes on exactly as it went."""
+import numpy as np
+import pytest
+
+from contactfem.io import load_record, save_record
+from contactfem.scenes import get_scene
+from contactfem.scenes.base import simulate
+from contactfem.solver.march import resume
+
+# every scene whose model is one Stage (the cork's two stages: test_cork_twice_gives_the_same_records)
+CASES = [("bar_impact", {}), ("bar_impact", {"contact_integration": "energy_consistent"}), ("block", {}),
+         ("block", {"law": "parabolic"}), ("block", {"enforcement": "augmented"}), ("block", {"enforcement": "lagrange"}),
+         ("funnel", {}), ("hertz", {}), ("hertz", {"enforcement": "augmented"}), ("patch", {}),
+         ("patch", {"enforcement": "lagrange"}), ("rolling_ring", {}), ("rolling_ring", {"kind": "continuum"}),
+         ("sloping_impact", {}), ("sloping_impact", {"variant": "frictional"}),
+         ("sloping_impact", {"variant": "viscoplastic"}), ("sloping_impact", {"contact_integration": "energy_consistent"})]
+
+
+def same(r, q):
+    """Two records equal bit for bit: state of motion, energies, Newton's residuals, contact states."""
+    assert (r.k, r.t, r.dt, r.cuts) == (q.k, q.t, q.dt, q.cuts)
+    for a, b in ((r.u, q.u), (r.v, q.v), (r.a, q.a)):
+        assert np.array_equal(a, b)
+    assert r.energy == q.energy and r.residuals == q.residuals
+    for cs, ds in zip(r.contacts, q.contacts):
+        for name in ("g_N", "t_N", "t_T"):
+            if hasattr(cs, name):
+                assert np.array_equal(getattr(cs, name), getattr(ds, name))
+
+
+def model_of(name, over):
+    scene = get_scene(name)
+    params = scene.resolve("fast", over)
+    return scene, params, scene.build(params)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name,over", CASES, ids=[f"{n}{'-' + '-'.join(map(str, o.values())) if o else ''}"
+                                                  for n, o in CASES])
+def test_marching_the_same_model_twice_gives_the_same_records(name, over):
+    scene, params, model = model_of(name, over)
+    run = scene.simulate or simulate
+    first, second = run(model, params), run(model, params)
+    assert len(first) == len(second) > 1
+    for r, q in zip(first, second):
+        same(r, q)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name,over", [("sloping_impact", {"variant": "frictional"}), ("block", {"n_steps": 4}),
+                                       ("rolling_ring", {})])
+def test_a_run_resumed_from_its_kth_record_goes_on_as_it_went(name, over):
+    scene, params, model = model_of(name, over)
+    records = simulate(model, params)
+    st = model["stage"]
+    k = len(records) // 2
+    rest = list(resume(st.stepper, st.schedule, records[k], label=st.label))
+    assert len(rest) == len(records) - k - 1
+    for r, q in zip(rest, records[k + 1:]):
+        same(r, q)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name,over,suffix", [("sloping_impact", {"variant": "viscoplastic"}, ".json"),
+                                              ("bar_impact", {"enforcement": "augmented"}, ".npz"),
+                                              ("sloping_impact", {"variant": "frictional"}, ".npz")])
+def test_a_run_restarted_from_its_saved_kth_record_goes_on_as_it_went(name, over, suffix, tmp_path):
+    """The record saved to a file and read back (its SystemState: plastic strains, multipliers,
+    contact histories) resumes the run exactly: the same records from k on, bit for bit."""
+    scene, params, model = model_of(name, over)
+    records = simulate(model, params)
+    st = model["stage"]
+    k = len(records) // 2
+    loaded = load_record(save_record(records[k], tmp_path / f"record{suffix}"))
+    same(loaded, records[k])
+    rest = list(resume(st.stepper, st.schedule, loaded, label=st.label))
+    assert len(rest) == len(records) - k - 1 > 0
+    for r, q in zip(rest, records[k + 1:]):
+        same(r, q)
+
+
+def test_a_record_that_is_not_one_is_refused(tmp_path):
+    from contactfem.io import save_run
+    path = save_run({"x": 1.0}, tmp_path / "run.json")
+    with pytest.raises(ValueError, match="not a saved record"):
+        load_record(path)
+
+
+def test_the_block_of_lecture_04_twice():
+    """Table 1 of the block: the same residuals at a second march of the same model."""
+    scene, params, model = model_of("block", {"law": "coulomb"})
+    res = [r.residuals for r in simulate(model, params)[1:]]
+    again = [r.residuals for r in simulate(model, params)[1:]]
+    assert res == again and len(res[0]) > 2
+
+
+def test_a_contact_keeps_nothing_of_a_run():
+    scene, params, model = model_of("sloping_impact", {"variant": "frictional"})
+    before = {c.name: dict(vars(c)) for c in model["system"].contacts}
+    simulate(model, params)
+    for c in model["system"].contacts:
+        after = vars(c)
+        changed = [k for k in after if k != "evaluations" and after[k] is not before[c.name].get(k)]
+        assert not changed, f"contact {c.name!r} changed {changed} during a run"
+
+
+# -- the lectures' march cells ---------------------------------------------------------------
+
+LECTURE_DIR = __import__("pathlib").Path(__file__).resolve().parents[1] / "lectures"
+
+
+def _march_twice(name, monkeypatch):
+    """Run the lecture's code cells in order up to the first one that marches (its records
+    captured through contactfem.solver.march), then run that cell again in the same namespace,
+    on the same model objects, as a student re-running it would: the two runs' records."""
+    jupytext = pytest.importorskip("jupytext")
+    import sys
+
+    import contactfem.solver as solver
+    march_module = sys.modules["contactfem.solver.march"]
+
+    runs, real = [], march_module.march
+
+    def recording(*args, **kwargs):
+        runs.append(records := [])
+        for rec in real(*args, **kwargs):
+            records.append(rec)
+            yield rec
+
+    monkeypatch.setattr(solver, "march", recording)
+    monkeypatch.setattr(march_module, "march", recording)
+    monkeypatch.setenv("CONTACTFEM_PRESET", "fast")
+    monkeypatch.chdir(LECTURE_DIR)
+    cells = [c.source for c in jupytext.read(LECTURE_DIR / f"{name}.md").cells if c.cell_type == "code"]
+    namespace = {"__name__": "__lecture__"}
+    for source in cells:
+        exec(compile(source, name, "exec"), namespace)
+        if runs:
+            first = list(runs)
+            runs.clear()
+            exec(compile(source, name, "exec"), namespace)
+            return first, list(runs)
+    pytest.fail(f"{name}: no cell marches")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["04_block", "05_rolling_ring", "06_sloping_impact", "07_funnel",
+                                  "10_write_your_own_law"])
+def test_a_lectures_march_cell_run_twice_gives_the_same_records(name, monkeypatch, tmp_path):
+    monkeypatch.setenv("CONTACTFEM_FIGURES", str(tmp_path))
+    first, second = _march_twice(name, monkeypatch)
+    assert len(first) == len(second) >= 1
+    for a, b in zip(first, second):
+        assert len(a) == len(b) > 1
+        for r, q in zip(a, b):
+            same(r, q)
+
+
+def test_the_readme_example_resumes_a_run(tmp_path, monkeypatch):
+    """The README's example, run as written (in a scratch folder): the rest of the run from its
+    saved record 10 is the run's records 11 on."""
+    import re
+    from pathlib import Path
+
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    block = next(b for b in re.findall(r"```python\n(.*?)```", readme, re.S) if "save_record" in b)
+    monkeypatch.chdir(tmp_path)
+    namespace = {}
+    exec(compile(block, "README.md", "exec"), namespace)
+    rest, records = namespace["rest"], namespace["records"]
+    assert len(rest) == len(records) - 11 > 0
+    for r, q in zip(rest, records[11:]):
+        same(r, q)
+
+
+@pytest.mark.slow
+def test_the_cork_twice_gives_the_same_records():
+    """Both stages of the cork (press fit, pop) run twice on the same model: the same records;
+    the model is not changed by a run (the pop's neck at rest is a new master)."""
+    scene, params, model = model_of("cork", {"t_end": 0.0004, "n_press": 2})
+    motion = model["neck"].motion
+    first, second = scene.simulate(model, params), scene.simulate(model, params)
+    assert model["neck"].motion is motion is not None
+    same(first["fit_last"], second["fit_last"])
+    assert len(first["records"]) == len(second["records"]) > 1
+    for r, q in zip(first["records"], second["records"]):
+        same(r, q)
+    assert np.array_equal(first["pressures"], second["pressures"])
