@@ -201,10 +201,11 @@ def laws_from_args(args, sets=None):
     from .lab.lawfile import laws_from_options, load_class, split_sets
 
     overrides, law_sets = split_sets(parse_sets(args.set) if sets is None else sets)
-    if not (args.friction or args.normal or any(law_sets.values())):
+    if args.friction is None and args.normal is None and not any(law_sets.values()):
         return overrides, {}, []
     scene = scenes.get_scene(args.scene)
-    classes = {k: load_class(s, f"--{k}") for k, s in (("friction", args.friction), ("normal", args.normal)) if s}
+    classes = {k: load_class(s, f"--{k}") for k, s in (("friction", args.friction), ("normal", args.normal))
+               if s is not None}
     scenes.check_laws(scene, classes, overrides)
     params = scene.resolve(args.preset, overrides)
     from_scene = {k: {n: params[n] for n in scene.law_params.get(k, ()) if n in params} for k in classes}

@@ -275,7 +275,7 @@ def laws_from_options(friction=None, normal=None, law_sets=None, scene_params=No
     {kind: law} for the laws given."""
     law_sets = law_sets or {"law": {}, "friction": {}, "normal": {}}
     specs = {"friction": friction, "normal": normal}
-    classes = {k: load_class(s, f"--{k}") for k, s in specs.items() if s}
+    classes = {k: load_class(s, f"--{k}") for k, s in specs.items() if s is not None}
     fields = {k: {f.name for f in dataclasses.fields(c)} if dataclasses.is_dataclass(c) else set()
               for k, c in classes.items()}
     values = {k: dict(law_sets.get(k, {})) for k in KINDS}

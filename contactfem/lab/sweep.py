@@ -55,7 +55,7 @@ def build_laws(scene, preset, point, friction=None, normal=None, notes=None):
     from .lawfile import laws_from_options, load_class, split_sets
 
     overrides, law_sets = split_sets(point)
-    if not (friction or normal or any(law_sets.values())):
+    if friction is None and normal is None and not any(law_sets.values()):
         return overrides, {}
     sc = get_scene(scene)
     classes = {k: load_class(s, f"--{k}") for k, s in (("friction", friction), ("normal", normal)) if s}
@@ -149,9 +149,10 @@ def sweep(scene, grid, preset="fast", jobs=1, scheduler=None, friction=None, nor
     ``resume`` the rows it already holds); ``timeout``: seconds a local run may take before it
     is stopped and recorded as failed."""
     args = (scene, grid, preset, jobs, scheduler, friction, normal, check, force)
-    points, version = _guarded(_prepare, args, laws_text(friction, normal)) if friction or normal else _prepare(*args)
+    points, version = _guarded(_prepare, args, laws_text(friction, normal)) \
+        if friction is not None or normal is not None else _prepare(*args)
     table = Table() if table is None else table
-    same = dict(scene=scene, preset=preset, laws=laws_text(friction, normal), code_version=version)
+    same = dict(scene=get_scene(scene).name, preset=preset, laws=laws_text(friction, normal), code_version=version)
     todo = table.start(points, same)
     tasks = [(i, (scene, preset, points[i], friction, normal)) for i in todo]
     runs = _on_dask(scheduler, tasks) if scheduler else _local(tasks, jobs, timeout)
@@ -342,6 +343,9 @@ class Table:
             return
         from ..io.outputs import hold_interrupts
 
+        from ..io.outputs import make_parents
+
+        make_parents(self.path)                # the folders --out names, made when the table is first written
         temp = self.path.with_name(f".{self.path.stem}.{secrets.token_hex(4)}.part{self.path.suffix}")
         try:
             write_table(self.all_rows(), temp)

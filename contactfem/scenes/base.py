@@ -82,7 +82,8 @@ def run(scene, params, normal=None, friction=None, progress=None, linear_algebra
     results["residual_evaluations"] = int(sum(s.evaluations for s in systems))
     contacts = {id(c): c for s in systems for c in s.contacts}
     results["contact_evaluations"] = int(sum(c.evaluations for c in contacts.values()))
-    results.setdefault("newton_iterations_total", 0)
+    results.setdefault("newton_iterations_total",          # a scene that does not count them itself
+                       int(sum(getattr(r, "iterations", 0) for r in records)))
     return results
 
 
