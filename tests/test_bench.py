@@ -115,6 +115,7 @@ def test_observed_order_of_a_power_law():
     assert observed_order(h[:1], h[:1]) is None
 
 
+@pytest.mark.slow
 def test_quick_bench_writes_json_and_markdown(tmp_path):
     """The quick bench (seconds) through the CLI; its tangent study shows the
     paper's claim: the consistent tangent needs the fewest linear solves, the staggered

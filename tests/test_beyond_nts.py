@@ -62,6 +62,7 @@ def hertz_elastic():
             for d in ("node_to_segment", "mortar") for e in ("penalty", "lagrange")}
 
 
+@pytest.mark.slow
 def test_mortar_hertz_on_non_matching_meshes(hertz_elastic):
     for e in ("penalty", "lagrange"):
         m, n = hertz_elastic[("mortar", e)], hertz_elastic[("node_to_segment", e)]

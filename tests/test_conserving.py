@@ -146,6 +146,7 @@ def test_bar_impact_energy_any_penalty(c_N_factor):
 
 # -- sloping impact ---------------------------------------------------------------------
 
+@pytest.mark.slow
 def test_sloping_impact_frictionless_conserves_energy():
     r = run_scene("sloping_impact", "fast", {"contact_integration": "energy_consistent"})
     assert r["rebounded"]
@@ -228,6 +229,7 @@ def test_frictionless_rebound_keeps_the_velocity_along_the_plane():
     assert r["rebounded"] and abs(r["rebound_vx"] - 2.0) <= 1e-8, r["rebound_vx"]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", ["beam", "continuum"])
 @pytest.mark.parametrize("wobble", [0.0, 0.3])
 def test_free_flight_keeps_the_angular_momentum(kind, wobble):

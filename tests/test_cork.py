@@ -28,6 +28,7 @@ def fast():
     return run_scene("cork", "fast")
 
 
+@pytest.mark.slow
 def test_fast_run_completes_and_the_cork_leaves(fast):
     # InvertedElementError (det F <= 0) would have ended the run as a NewtonError
     assert fast["exited"], "the cork did not leave the bottle in the fast preset"
@@ -68,6 +69,7 @@ def test_fast_preset_leaves_by_static_breakaway(fast):
     assert fast["exited"]
 
 
+@pytest.mark.slow
 def test_the_knife_edge_more_friction_and_the_cork_stays_in():
     # mu = 0.105 instead of 0.1: the static breakaway rises above 0.8 MPa (margin < 0) and
     # the whole run confirms it: the cork does not leave
@@ -76,6 +78,7 @@ def test_the_knife_edge_more_friction_and_the_cork_stays_in():
     assert not r["exited"] and r["exit_velocity_m_s"] is None
 
 
+@pytest.mark.slow
 def test_press_fit_only_gives_the_same_margin(fast):
     from contactfem.scenes.cork import SCENE, press_fit_only
 
@@ -153,6 +156,7 @@ def paper():
     return cached_run("cork", "paper")
 
 
+@pytest.mark.slow
 def test_paper_preset_leaves_by_static_breakaway_near_28_m_s(paper):
     r = paper
     assert r["press_fit_calibrated"] is True
@@ -208,6 +212,7 @@ def exit_study():
     return d, F.exit_time_summary(d)
 
 
+@pytest.mark.slow
 def test_exit_study_reads_the_scene(exit_study, paper):
     """The study's paper-preset case (the stages with the closing step on) is the scene's own
     run: the same exit time and velocity."""

@@ -88,6 +88,7 @@ def _wrong(name):
 
 # -- the course's shape ---------------------------------------------------------------------
 
+@pytest.mark.slow
 def test_every_lecture_opens_with_objectives_prerequisites_and_time():
     nbformat = _nbformat()
     for src in _sources():
@@ -165,6 +166,7 @@ def _run(name, code):
     return sum(r[1] for r in res), next((r[2] for r in res if r[2] != "passed"), "")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", EXERCISE_NAMES)
 def test_checks_solution_stub_and_wrong_answer(name):
     require("otter")
@@ -241,6 +243,7 @@ def _row(graded, lecture, kind):
     return graded[1][f"{lecture}/{kind}.ipynb"]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", GRADED_NAMES)
 def test_graded_solution_stub_and_wrong_answer(course, name):
     e = _exercises()[name]
@@ -288,6 +291,7 @@ def test_student_version_holds_no_solution_text(course):
             assert json.dumps(ln)[1:-1] in teacher, f"{src.name}: the instructor version lacks {ln!r}"
 
 
+@pytest.mark.slow
 def test_grade_a_folder_of_three_from_the_command_line(course, tmp_path, capsys):
     """`contactfem course grade`: a solution, a stub and a mix (one answer right, one wrong)
     of lecture 01 into a CSV with one row per submission and one column per exercise; the

@@ -20,6 +20,8 @@ from pathlib import Path
 
 import pytest
 
+pytestmark = pytest.mark.slow      # end-to-end: command lines and processes (the fast tier leaves them out)
+
 ON_CI = os.environ.get("CI", "").lower() in ("true", "1", "yes")
 REPO = Path(__file__).resolve().parents[1]
 LEC = "01_interface_laws"

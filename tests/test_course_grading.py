@@ -12,6 +12,8 @@ import time
 
 import pytest
 
+pytestmark = pytest.mark.slow      # end-to-end: command lines and processes (the fast tier leaves them out)
+
 nbformat = pytest.importorskip("nbformat")
 
 LECTURE = "01_interface_laws"

@@ -32,6 +32,7 @@ def energy(hist):
     return hist.kinetic + hist.strain + hist.contact
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("master", [None, RigidArc((0.5, -5.0), 5.0)], ids=["plane", "cylinder"])
 def test_frictionless_trapezoidal_conserves_energy(master):
     assert omega_dt(1e2, 0.01) <= 0.15
@@ -42,6 +43,7 @@ def test_frictionless_trapezoidal_conserves_energy(master):
     assert err <= 2e-3, f"energy error {err:.2e} > bound 2e-3"
 
 
+@pytest.mark.slow
 def test_energy_error_falls_with_the_step():
     errs = []
     for dt in (0.004, 0.002):
@@ -86,6 +88,7 @@ def test_dissipation_mismatch_shrinks_with_dt():
     assert gaps[1] < 0.75 * gaps[0], gaps
 
 
+@pytest.mark.slow
 def test_a_run_that_gains_energy_warns():
     """The energy balance counts the dissipation and the loads' work, so a run can only lose
     energy: one that gains more than 1 % (the sloping impact at dt = 5: the trapezoidal rule

@@ -11,6 +11,7 @@ def study():
     return enforcement_study(quick=True)
 
 
+@pytest.mark.slow
 def test_augmented_meets_the_target_at_every_penalty(study):
     for scene, s in study["scenes"].items():
         assert [r["c_N_factor"] for r in s["rows"]] == [0.01, 1.0, 100.0]
@@ -42,6 +43,7 @@ def ssn_study():
     return semismooth_study(quick=True)
 
 
+@pytest.mark.slow
 def test_semismooth_newton_meets_the_target_in_fewer_solves_than_uzawa(ssn_study):
     from contactfem.lab.bench.semismooth import TARGET
 

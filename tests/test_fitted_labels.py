@@ -39,6 +39,7 @@ def drawn(monkeypatch, tmp_path):
     return seen
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("draw,stem,scene,over,to", [
     (block.fig07, "fig07_block_conical_stresses", "block", dict(law="conical"), "Table 1"),
     (block.fig08, "fig08_block_parabolic_stresses", "block", dict(law="parabolic"), "Table 1"),
@@ -58,6 +59,7 @@ def test_fitted_reading_is_labelled(drawn, tmp_path, draw, stem, scene, over, to
     assert " ".join(fitted_words(dict(fitted=fitted), to).split()) in text
 
 
+@pytest.mark.slow
 def test_no_fitted_label_without_fitted_values(drawn, tmp_path):
     # the viscoplastic ring keeps the paper's separate element (one point): nothing fitted
     r = cached_run("sloping_impact", "fast", variant="viscoplastic")

@@ -17,6 +17,7 @@ def res():
     return {v: plots.result(v, "fast") for v in ("frictionless", "frictional")}
 
 
+@pytest.mark.slow
 def test_json_and_history(res):
     for r in res.values():
         n = r["parameters"]["n_steps"] + 1
@@ -110,6 +111,7 @@ def test_bad_input():
         SCENE.resolve("fast", {"variant": "viscoplastic"})
 
 
+@pytest.mark.slow
 def test_figures(tmp_path):
     files = plots.fig12(outdir=tmp_path) + plots.fig13(outdir=tmp_path)
     assert sorted(f.rsplit(".", 1)[1] for f in files) == ["json", "json", "png", "png"]     # each PNG with its data

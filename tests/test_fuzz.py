@@ -248,6 +248,7 @@ def _cost(name, preset, sets):
     return est["steps"] * max(1.0, est["unknowns"] / 100)
 
 
+@pytest.mark.slow
 @settings(max_examples=EXAMPLES["params"], **SETTINGS)
 @given(case=param_cases())
 def test_fuzz_parameters(case, tmp_path_factory):
@@ -286,6 +287,7 @@ def command_lines(draw):
     return tail
 
 
+@pytest.mark.slow
 @settings(max_examples=EXAMPLES["cli"], **SETTINGS)
 @given(argv=command_lines())
 def test_fuzz_command_lines(argv, tmp_path_factory):
@@ -309,6 +311,7 @@ def corrupt(draw):
     return suffix, how, draw(st.integers(0, 10**6)), draw(st.binary(min_size=1, max_size=16)), draw(json_values)
 
 
+@pytest.mark.slow
 @settings(max_examples=EXAMPLES["files"], **SETTINGS)
 @given(case=corrupt())
 def test_fuzz_saved_runs(case, tmp_path_factory):
@@ -529,6 +532,7 @@ def _bad_values(module):
     return bad
 
 
+@pytest.mark.slow
 @settings(max_examples=EXAMPLES["lawfiles"], **SETTINGS)
 @given(case=law_files())
 def test_fuzz_law_files(case, tmp_path_factory):

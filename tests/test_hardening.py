@@ -294,6 +294,7 @@ def ring_run(tmp_path_factory):
     return out, time.monotonic() - t0, folder
 
 
+@pytest.mark.slow
 def test_the_whole_ring_run_writes_all_three(ring_run):
     out, _, folder = ring_run
     assert out.returncode == 0, out.stderr
@@ -307,6 +308,7 @@ def test_the_whole_ring_run_writes_all_three(ring_run):
     assert len(anim["marks"]) == gif.n_frames and anim["obstacles"][0].shape == (2, 2)   # a spoke, a floor
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fraction", [0.15, 0.35, 0.55, 0.75, 0.9, "writing"])
 def test_ctrl_c_leaves_none_or_all_of_the_outputs(ring_run, tmp_path, fraction):
     _, whole, _ = ring_run

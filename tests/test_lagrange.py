@@ -131,6 +131,7 @@ CASES = [("node_to_segment", m, "finite") for m in ("line", "polyline", "deforma
         [("mortar", m, "small") for m in ("line", "deformable")]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind, master, kinematics", CASES, ids=["-".join(c) for c in CASES])
 @pytest.mark.parametrize("law, sets", LAWS_SETS, ids=["-".join(c) for c in LAWS_SETS])
 def test_jacobian_matches_finite_differences(rng, kind, master, kinematics, law, sets):

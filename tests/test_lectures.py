@@ -110,6 +110,7 @@ def test_every_text_has_its_notebook():
     assert not orphans, f"text lectures without a notebook: {orphans} (`jupytext --sync` on each makes it)"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("path", LECTURES, ids=[p.name for p in LECTURES])
 def test_lecture_runs(path, kernel_env):
     nbformat = require("nbformat")

@@ -176,6 +176,7 @@ def same_run(a, b):
             assert np.max(np.abs(np.subtract(a[k], b[k]))) <= tol, k
 
 
+@pytest.mark.slow
 def test_consistent_mass_continuum_is_the_same_banded_and_sparse():
     """A continuum ring (above the dense limit) in a frictional impact with the consistent mass:
     banded and sparse (and dense) give the same run, to 1e-12."""

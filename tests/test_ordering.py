@@ -65,6 +65,7 @@ def run(rng=None, shuffle_slaves=False, deformable=False):
     return out, hist
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("deformable", [False, True], ids=["rigid_plane", "deformable_master"])
 def test_order_and_numbering_do_not_matter(deformable):
     ref, h0 = run(deformable=deformable)

@@ -108,6 +108,7 @@ def test_the_comparison_finds_a_changed_number_and_ignores_roundoff():
                          "| paper | ours |\n|---|---|\n| Table 2 | (2.00, 1.45) |\n")
 
 
+@pytest.mark.slow
 def test_summary_md_is_what_the_paper_preset_runs_give():
     """Every row of figures/summary.md (and so of the README's table) from paper-preset runs.
     The cork's row is the slowest part: its paper run and the two refined exit cases are
@@ -125,6 +126,7 @@ def test_table1_md_is_what_the_block_runs_give():
                      table1_markdown(residual_histories("paper")))
 
 
+@pytest.mark.slow
 def test_table2_md_is_what_the_ring_runs_give():
     from contactfem.plots.sloping_impact import table2_markdown
 
@@ -132,6 +134,7 @@ def test_table2_md_is_what_the_ring_runs_give():
                      table2_markdown("paper"))
 
 
+@pytest.mark.slow
 def test_cork_sensitivity_md_as_chosen_row_is_the_run():
     """The quick profile of the sensitivity table: its "as chosen" row (the paper run at
     p0 = 0.8 MPa, shared, and one more run at 0.9 MPa). The other rows change one

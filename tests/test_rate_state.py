@@ -32,6 +32,7 @@ SMALL = [Stribeck(c_T=30.0, mu_s=0.5, mu_d=0.3, v_s=0.1, mu_v=0.05), Stribeck(c_
          ArchardWear(c_T=30.0, mu=0.3, k_w=1e-3)]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("dt", [1.0, 1e-3])
 @pytest.mark.parametrize("law", SMALL, ids=repr)
 def test_shipped_rate_and_state_laws_pass_the_checker(law, dt):

@@ -161,6 +161,7 @@ def _check_outcomes(out, kinds, eligible=lambda r: True):
     assert key == sorted(key)                                   # most facts, then nearest, first
 
 
+@pytest.mark.slow
 def test_block_study_records_every_outcome(study):
     out = study("block")
     _check_outcomes(out, rc.OUTCOMES)
@@ -309,6 +310,7 @@ def test_readme_block_residuals_are_the_run(block_paper):
         assert text in section, f"README's block section lacks {text!r}"
 
 
+@pytest.mark.slow
 def test_sloping_study_records_every_outcome(study):
     out = study("sloping_impact")
     _check_outcomes(out, rc.SLOPING_OUTCOMES, rc.follows_text)
@@ -416,6 +418,7 @@ def test_sloping_study_mass_and_integration_against_the_text(study):
         assert t in text, f"README's Table 2 section lacks {t!r}"
 
 
+@pytest.mark.slow
 def test_cli_reconstruct(capsys, tmp_path):
     path = tmp_path / "r.json"
     assert main(["reconstruct", "sloping_impact", "--quick", "--top", "2", "--json", str(path)]) == 0

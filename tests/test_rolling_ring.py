@@ -92,6 +92,7 @@ def test_refinement_reduces_the_error(fast):
         f"v error {fine['v_final_rel_err']:.4f} (80 el) vs {fast['v_final_rel_err']:.4f} (40 el)"
 
 
+@pytest.mark.slow
 def test_continuum_ring_rolls_too():
     # a short, coarse continuum run: rolling starts near the rigid-ring point
     r = run_scene("rolling_ring", "fast", {"kind": "continuum", "n_radial": 1, "n_el": 24,
@@ -105,6 +106,7 @@ def test_bad_parameter():
         get_scene("rolling_ring").resolve("fast", {"mu": -0.1})
 
 
+@pytest.mark.slow
 def test_fig09_draws_from_the_result(fast, tmp_path):
     import matplotlib
     matplotlib.use("Agg")

@@ -15,6 +15,7 @@ def study():
     return scaling_study(quick=True)
 
 
+@pytest.mark.slow
 def test_the_plain_script_solves_the_same_problem(study):
     """Both solve one linear system (the same active set, found from the same initial guess).
     p0 = c_N (-g), g = Y + u_y + R: the sum alone rounds at eps R / |g| = 2.2e-16 * 10 / 3.7e-6

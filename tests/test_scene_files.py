@@ -22,6 +22,8 @@ LAW = '''
 from dataclasses import dataclass
 import numpy as np
 
+pytestmark = pytest.mark.slow      # end-to-end: command lines and processes (the fast tier leaves them out)
+
 @dataclass(frozen=True)
 class Weakening:
     c_T: float = 1e3

@@ -51,6 +51,7 @@ def _cli(*args, cwd=REPO):
     return subprocess.run([sys.executable, "-m", "contactfem", *args], capture_output=True, text=True, cwd=cwd)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("scene", SCENES)
 def test_cli_runs_every_scene_with_a_law_file(scene, tmp_path):
     """contactfem run SCENE --friction tests/data/saturating.py:Saturating: exit 0, the JSON
@@ -70,6 +71,7 @@ def test_cli_runs_every_scene_with_a_law_file(scene, tmp_path):
         assert res["variant"] == "Saturating"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("scene", SCENES)
 def test_a_coulomb_law_file_equals_the_built_in_law(scene):
     over, mu_from = COULOMB_SETUPS[scene]
@@ -111,6 +113,7 @@ def test_a_shipped_law_object_from_python():
     assert a["total_tangential"] == b["total_tangential"] and a["newton_residuals"] == b["newton_residuals"]
 
 
+@pytest.mark.slow
 def test_cli_law_fields_and_errors(tmp_path):
     out = tmp_path / "b.json"
     ok = _cli("run", "block", "--friction", "tests/data/saturating.py:Saturating", "--set", "law.mu0=0.6",

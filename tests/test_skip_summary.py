@@ -10,7 +10,7 @@ TESTS = Path(__file__).resolve().parent
 SKIPPING = '''
 import pytest
 
-pytestmark = pytest.mark.site
+pytestmark = [pytest.mark.site, pytest.mark.slow]
 
 
 @pytest.mark.parametrize("k", range(3))

@@ -49,6 +49,7 @@ def test_rebound_angle_definition():
 VELOCITY_TOL = rc.TABLE2_VELOCITY_TOL
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("over", [{}, {"integration": "1"}, {"mass_matrix": "consistent"},
                                   {"contact_integration": "energy_consistent"}, {"kind": "continuum", "n_el": 24}])
 def test_a_frictionless_plane_keeps_v_x(over):
@@ -123,6 +124,7 @@ def test_bad_input():
         run_scene("sloping_impact", "fast", {"variant": "viscoplastic", "kind": "continuum"})
 
 
+@pytest.mark.slow
 def test_figures_and_table(tmp_path):
     files = plots.fig10(outdir=tmp_path) + plots.table2(outdir=tmp_path)
     assert all((tmp_path / f).exists() for f in files)
@@ -130,6 +132,7 @@ def test_figures_and_table(tmp_path):
     assert "| frictionless |" in md and "50" in md and "35" in md
 
 
+@pytest.mark.slow
 def test_discretisation_study_kept_with_the_figures_is_the_run():
     """figures/table_sloping_impact_discretisation.{md,json} (lecture 06 reads its conclusions from
     it) are the study's run: the markdown is its JSON's, and its 16-element rows are recomputed
@@ -158,6 +161,7 @@ def test_discretisation_study_kept_with_the_figures_is_the_run():
                     (row["label"], variant, k)
 
 
+@pytest.mark.slow
 def test_a_fine_ring_runs():
     """n_el = 1000 (the range allows 2000): Newton's tolerance follows the round-off of the
     ring's residual, which grows with n_el (at the fixed 1e-10 Newton stalled just above it

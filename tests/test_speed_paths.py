@@ -52,6 +52,7 @@ def test_an_unknown_scene_name_lists_the_known_ones(name):
         get_scene(name)
 
 
+@pytest.mark.slow
 def test_building_a_scene_loads_what_it_needs():
     """scikit-fem comes in when a scene builds a continuum, not before; a ring of beams
     (its mass summed with numpy) needs none of the heavy libraries."""
@@ -61,6 +62,7 @@ def test_building_a_scene_loads_what_it_needs():
     assert heavy_modules_after(code.format("sloping_impact")) == []
 
 
+@pytest.mark.slow
 def test_a_dense_run_from_the_command_line_loads_no_heavy_library(tmp_path):
     """The sloping impact (48 unknowns: a dense K, LAPACK through numpy) from the command
     line, its JSON written: no scipy, scikit-fem, matplotlib or joblib."""
@@ -300,6 +302,7 @@ def scene_run(scene, preset):
     return run_scene(scene, preset, {})
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("run, args, kl", [(scene_run, ("rolling_ring", "fast"), 8),
                                            (scene_run, ("rolling_ring", "paper"), 8),
                                            (scene_run, ("block", "paper"), 35),
@@ -449,6 +452,7 @@ def test_singular_tangent_raises_through_the_dissection_plan():
         plan.solve(A.data, np.ones(A.shape[0]))
 
 
+@pytest.mark.slow
 def test_hertz_renumbered_by_nested_dissection_is_the_same_run(monkeypatch):
     """Hertz on 72 x 72 quads (10.4k free unknowns, above DISSECTION_MIN) solves by SuperLU
     after METIS's renumbering, and agrees with SuperLU's own ordering (DISSECTION_MIN raised)

@@ -60,6 +60,7 @@ def test_sweep_on_a_dask_cluster_is_the_local_sweep(tmp_path):
         [{k: v for k, v in r.items() if k not in drop} for r in b]
 
 
+@pytest.mark.slow
 def test_run_animates_saves_and_reloads(tmp_path, capsys):
     gif, saved = tmp_path / "ring.gif", tmp_path / "ring.json"
     assert main(["run", "sloping_impact", "--gif", str(gif), "--save", str(saved), "--progress"]) == 0
@@ -143,6 +144,7 @@ def test_sweep_refuses_a_law_that_lies_before_any_run(tmp_path, capsys):
     assert not (tmp_path / "s.csv").exists()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("delay", [0.0, 0.3, 1.0, 2.5])
 def test_ctrl_c_during_a_parallel_sweep_is_one_line(tmp_path, delay):
     """SIGINT to the sweep's process (and, as a terminal sends it, to its whole process

@@ -24,6 +24,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+pytestmark = pytest.mark.slow      # end-to-end: command lines and processes (the fast tier leaves them out)
+
 
 @dataclass(frozen=True)
 class Fragile:

@@ -164,6 +164,7 @@ def test_run_cork_progress_shows_a_bar(capsys):
     assert "cork: press fit [" in err and "cork: pop [" in err and "100%" in err
 
 
+@pytest.mark.slow
 def test_a_run_that_ends_before_t_end_finishes_its_bar_and_says_why(capsys, tmp_path):
     """The cork stops t_flight after it has left the bottle, before t_end: its bar ends at 100 %
     with that reason, which names the run's exit time."""
