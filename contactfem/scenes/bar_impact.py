@@ -110,7 +110,7 @@ def build(params, *, normal=None, friction=None, system_options=None):
         stepper = CentralDifference(system)
     else:
         F_scale = ex["stress"] * H
-        stepper = time_integration.make_stepper(params, system, atol=1e-9 * F_scale, rtol=1e-12, maxit=30)
+        stepper = time_integration.make_stepper(params, system, atol=1e-9 * F_scale, maxit=30)
     stepper = enforcement.wrap(params, stepper, [contact], length=L / n)     # gap_violation: penetration / h_x
     v0_vec = np.zeros(system.ndof)
     v0_vec[body.xdofs[:, 0]] = -v0

@@ -137,7 +137,7 @@ def build(params, *, normal=None, friction=None, system_options=None):
     # penetration p / c_N, so the interface is active and the first tangent regular
     u0 = np.zeros(system.ndof)
     u0[upper.dof_offset + upper.xdofs[:, 1]] = -2.0 * p / params["c_N"]
-    stepper = Static(system, atol=1e-10 * p * params["W"], rtol=1e-12, maxit=30)
+    stepper = Static(system, atol=1e-12 * p * params["W"], maxit=30)      # Newton's force test; atol: a floor
     stepper = enforcement.wrap(params, stepper, contacts, length=H)     # gap_violation: penetration / H
     return dict(lower=lower, upper=upper, contacts=contacts, system=system, systems=[system], bottom_upper=bottom_upper,
                 stage=Stage(stepper, Steps(1.0, n_steps=1), u0, name="patch"))
@@ -181,6 +181,23 @@ def law_range(params):
     """Normal law only: probed down to a penetration of the blocks' height."""
     return dict(g=params["H"])
 
+def check(params):
+    """enforcement.check, and a penalty (or Lagrange's steering c_N) that round-off can resolve."""
+    enforcement.check(params)
+    enforcement.check_roundoff(params["c_N"], params["p"], max(params["W"], 2.0 * params["H"]))
+    stiff = LAGRANGE_STEERING * min(params["E"], params["E_upper"]) / params["H"]
+    if params["enforcement"] == "lagrange" and params["contact_discretization"] == "node_to_segment" \
+            and params["c_N"] > stiff:
+        raise ValueError(f"parameter c_N = {params['c_N']:g} is out of range for enforcement = lagrange with "
+                         f"node_to_segment: allowed (0, {stiff:.3g}] ({LAGRANGE_STEERING:g} E / H: above it the "
+                         "semi-smooth Newton's active set cycles; use mortar, or a smaller c_N, which only steers the "
+                         "iterates)")
+
+
+# Lagrange node-to-segment converges (with its line search) up to c_N = 1e10 = 5e6 E/H and cycles at 1e11
+LAGRANGE_STEERING = 1e6
+
+
 SCENE = Scene(
     name="patch",
     title="Contact patch test: stacked blocks, non-matching meshes, uniform pressure (exact: uniform)",
@@ -203,7 +220,7 @@ SCENE = Scene(
               doc="Coulomb friction coefficient of the interface (eq 11, c_T = c_N); 0: frictionless"),
         *enforcement.ENFORCEMENT_PARAMS,
     ),
-    check=enforcement.check,
+    check=check,
     build=build,
     measure=measure,
     presets={"fast": {}, "paper": {"nx_lower": 8, "nx_upper": 13, "ny": 4}},

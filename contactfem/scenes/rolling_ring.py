@@ -81,7 +81,7 @@ def build(params, *, normal=None, friction=None, system_options=None):
                             friction=friction or Coulomb(params["c_T"], params["mu"]), weights=1.0, offset=ring.offset,
                             name="plane", integration=time_integration.contact_integration(params))
     system = System([ring.body], [contact], [ring.gravity(params["g"])], **(system_options or {}))
-    stepper = time_integration.make_stepper(params, system, atol=1e-6, rtol=1e-10, maxit=30)
+    stepper = time_integration.make_stepper(params, system, atol=1e-6, maxit=30)
     stage = Stage(stepper, Steps(params["dt"], t_end=params["t_end"], max_cuts=8), np.zeros(ring.body.ndof),
                   ring.initial_velocity((params["v0"], 0.0)), name="rolling_ring")
     # the closed forms hold for Coulomb friction: the scene's, or a Coulomb law given with its own mu

@@ -49,7 +49,7 @@ def initial_acceleration(system, t, u, dt=None):
 class Newmark:
     """Implicit Newmark stepper (paper Sec. 4.1), full Newton within the step.
 
-    ``newton_options`` (atol, rtol, maxit) are passed on to ``newton``.
+    ``newton_options`` (atol, rtol, ctol, maxit) are passed on to ``newton``.
     """
     dynamic = True
 
@@ -79,15 +79,16 @@ class Newmark:
         u_pred = u + dt * v + dt ** 2 * (0.5 - beta) * a
 
         def effective(u1):                    # eq 29 with a+ = c (u1 - u_pred); tangent K + c M
-            G, K, contacts, P = s.evaluate(u1, t1, dt, u, mass_coefficient=c)
+            G, K, contacts, P = s.evaluate(u1, t1, dt, u, mass_coefficient=c)[:4]
             du = u1 - u_pred
-            return Evaluation(G + (cM * du if lumped else cM @ du), K, contacts, P)
+            inertia = cM * du if lumped else cM @ du
+            return Evaluation(G + inertia, K, contacts, P, inertia)
 
         # initial guess: the acceleration stays a (u + dt v + dt^2 a / 2); multipliers as they were
         guess = s.apply_dirichlet(u_pred + beta * dt ** 2 * a, t1)
         own = s.contact_dofs
         guess[own] = u[own]
-        result = newton(effective, guess, s.free_dofs, instrument=s.instrument,
+        result = newton(effective, guess, s.free_dofs, instrument=s.instrument, start=u,
                         label=label or f"t = {t1:.6g}, dt = {dt:.3g}", **self.newton_options)
         u1 = result.u
         a1 = c * (u1 - u_pred)
@@ -110,7 +111,8 @@ class Static:
         _check_dt(dt)
         s, t1 = self.system, t + dt
         result = newton(lambda w: s.evaluate(w, t1, dt, u), s.apply_dirichlet(u, t1),
-                        s.free_dofs, instrument=s.instrument, label=label or f"t = {t1:.6g}", **self.newton_options)
+                        s.free_dofs, instrument=s.instrument, label=label or f"t = {t1:.6g}", start=u,
+                        **self.newton_options)
         zero = np.zeros(s.ndof)
         return result.u, zero, zero.copy(), result
 

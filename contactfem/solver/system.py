@@ -38,11 +38,13 @@ from .instrument import timed
 
 class Evaluation(NamedTuple):
     """The System at one trial u: residual G, tangent K, the contacts' states and the loads P
-    (a tuple, so ``G, K = evaluation[:2]`` reads as before)."""
+    (a tuple, so ``G, K = evaluation[:2]`` reads as before); a time stepper's effective
+    evaluation also carries the inertia M a it added to G (Newton's force scale reads it)."""
     G: np.ndarray
     K: object
     contacts: tuple = ()
     P: np.ndarray = None
+    inertia: np.ndarray = None
 
 
 class Dirichlet:

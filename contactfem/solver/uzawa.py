@@ -83,25 +83,14 @@ class Uzawa:
             c.start_step()                # a retried (cut back) step starts from the committed state
         start = u
         residuals, per_outer, viols, self._gaps, self._calls = [], [], [], [], 0
-        opts = getattr(self.stepper, "newton_options", None)
-        saved = dict(opts) if opts is not None else None
-        try:
-            for k in range(self.max_updates + 1):
-                u1, v1, a1, res = self.stepper.step(t, start, v, a, dt,
-                                                    label=f"{label} (outer iteration {k + 1})" if label else "")
-                if k == 0 and opts is not None and res.residuals:
-                    # later solves start close to the solution: keep the tolerance of the first
-                    # (atol + rtol ||G_0|| with the step's own G_0), not one relative to a tiny G_0
-                    opts.update(atol=saved.get("atol", 1e-10) + saved.get("rtol", 1e-10) * res.residuals[0], rtol=0.0)
-                out = self._outer(k, u1, v1, a1, res, residuals, per_outer, viols)
-                if out is not None:
-                    return out
-                if not self.dynamic:
-                    start = u1                # warm start of the next static solve
-        finally:
-            if opts is not None:
-                opts.clear()
-                opts.update(saved)
+        for k in range(self.max_updates + 1):
+            u1, v1, a1, res = self.stepper.step(t, start, v, a, dt,
+                                                label=f"{label} (outer iteration {k + 1})" if label else "")
+            out = self._outer(k, u1, v1, a1, res, residuals, per_outer, viols)
+            if out is not None:
+                return out
+            if not self.dynamic:
+                start = u1                # warm start of the next static solve
         raise NewtonError(f"Uzawa: contact violation {viols[-1]:.3e} > uzawa_tol = {self.tol:.1e} after "
                           f"{self.max_updates} multiplier updates ({label}); violations "
                           f"{', '.join(f'{x:.2e}' for x in viols[-5:])} (last 5)", residuals, label)
