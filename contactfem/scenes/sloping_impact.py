@@ -109,7 +109,9 @@ def build(params, *, normal=None, friction=None, system_options=None):
                                             maxit=30)
     stage = Stage(stepper, Steps(params["dt"], n_steps=params["n_steps"], max_cuts=6), np.zeros(ring.body.ndof),
                   ring.initial_velocity((params["vx0"], params["vy0"])), name="sloping_impact")
-    return dict(ring=ring, contact=contact, system=system, systems=[system], plane=plane, stage=stage)
+    return dict(ring=ring, contact=contact, system=system, systems=[system], plane=plane, stage=stage,
+                plastic=params["variant"] == "viscoplastic",      # its plastic work is no integrator's loss
+                sizes=dict(element=params["thickness"], body=2.0 * params["R"]))
 
 
 def measure(model, params, records):

@@ -99,7 +99,7 @@ class NewtonResult:
     evaluation: object = None                     # what fun returned at u (G, K, contact states, ...)
     evaluations: int = 0                          # calls of fun (residuals + line-search trials)
     force_scale: float = 0.0                      # F at u (module docstring)
-    residual_ratio: float = 0.0                   # max |G_f| / F at u: what the test accepted
+    residual_ratio: float = 0.0                   # (max |G_f| - atol)+ / F at u: what the test accepted above atol
     correction_ratio: float = 0.0                 # the last correction / the step's increment (0 at k = 0)
     ratios: list = field(default_factory=list)    # max |G_f| / F of every iterate
 
@@ -211,7 +211,7 @@ def _newton(fun, u0, free, atol, rtol, maxit, label, line_search, instrument, ct
         if r_max <= tol or (stalled and r_max <= atol + max(rtol, ROUNDOFF_RTOL) * F):
             if k == 0 or r_max <= atol or c_ratio <= ctol or stalled:
                 return NewtonResult(u=u, residuals=history, iterations=k, G=G, evaluation=out, evaluations=calls,
-                                    force_scale=F, residual_ratio=r_max / F if F > 0 else 0.0,
+                                    force_scale=F, residual_ratio=max(r_max - atol, 0.0) / F if F > 0 else 0.0,
                                     correction_ratio=c_ratio if k else 0.0, ratios=ratios)
         if k == maxit:
             break
