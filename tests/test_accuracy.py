@@ -100,3 +100,13 @@ def test_cli_strict_exits_1_with_one_line_per_indicator(tmp_path):
     out = subprocess.run([sys.executable, "-m", "contactfem", "run", "block", "--set", "c_N=10"], capture_output=True,
                          text=True)
     assert out.returncode == 0
+
+
+@pytest.mark.parametrize("lower, upper, off", [(11, 5, 1.0), (17, 3, 3.78)])
+def test_patch_pressure_covers_both_blocks(lower, upper, off):
+    r, flagged = _run("patch", {"nx_lower": lower, "nx_upper": upper})
+    assert r["pressure_deviation_lower"] == pytest.approx(off, rel=0.01)    # master nodes that get no load
+    assert r["pressure_deviation_max"] >= r["pressure_deviation_lower"]
+    assert "pressure_deviation" in flagged
+    mortar, flagged = _run("patch", {"nx_lower": lower, "nx_upper": upper, "contact_discretization": "mortar"})
+    assert mortar["pressure_deviation_max"] < 1e-9 and not flagged       # mortar passes on both blocks
