@@ -63,7 +63,7 @@ def collect(model, params, records, results):
                                        "Newton's round-off tolerance (solver.newton.ROUNDOFF_RTOL); its own tolerance is "
                                        "1e-8")
     sizes = model.get("sizes") or {}
-    deepest = _deepest(records)
+    deepest = _deepest(records[1:] or records)      # (a scene's initial guess may overlap on purpose: hertz)
     if deepest is not None and sizes.get("element"):
         out["penetration"] = indicator(deepest / sizes["element"], PENETRATION_ELEMENT,
                                        f"largest penetration / local element size ({sizes['element']:.3g})",
