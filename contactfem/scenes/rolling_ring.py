@@ -87,6 +87,8 @@ def build(params, *, normal=None, friction=None, system_options=None):
     # the closed forms hold for Coulomb friction: the scene's, or a Coulomb law given with its own mu
     exact_mu = params["mu"] if friction is None else (friction.mu if isinstance(friction, Coulomb) else None)
     return dict(ring=ring, contact=contact, system=system, systems=[system], plane=plane, stage=stage,
+                sizes=dict(element=2.0 * np.pi * params["R"] / params["n_el"], body=2.0 * params["R"]),   # accuracy:
+                # a beam element's size is its length (the thickness is its section's)
                 exact_mu=exact_mu)
 
 
