@@ -101,6 +101,21 @@ def check_roundoff(c_N, traction, length, unit=""):
                          f"traction {traction:.3g}{unit})")
 
 
+def check_steering(params, stiffness, name):
+    """ValueError (one line) for Lagrange node-to-segment with a steering c_N above LAGRANGE_STEERING
+    times the bodies' stiffness (``name``): there its semi-smooth Newton's active set cycles."""
+    limit = LAGRANGE_STEERING * stiffness
+    if params["enforcement"] == "lagrange" and params["contact_discretization"] == "node_to_segment" \
+            and params["c_N"] > limit:
+        raise ValueError(f"parameter c_N = {params['c_N']:g} is out of range for enforcement = lagrange with "
+                         f"node_to_segment: allowed (0, {limit:.3g}] ({LAGRANGE_STEERING:g} {name}: above it the "
+                         "semi-smooth Newton's active set cycles; use mortar, or a smaller c_N, which only steers the "
+                         "iterates)")
+
+
+# measured on the patch: Lagrange node-to-segment converges (with its line search) up to c_N = 1e10 =
+# 5e6 E/H and cycles at 1e11
+LAGRANGE_STEERING = 1e6
 ROUNDOFF_SHARE = 4.0    # measured: the limit is within a factor 4 above the c_N where Newton stops converging
 
 

@@ -55,6 +55,7 @@ from ..contact import NodeToSegment, RigidLine
 from ..laws import Coulomb, PowerLaw
 from ..solver import History, Steps, System
 from . import time_integration
+from .accuracy import V_FINAL_TOL, references
 from .base import Param, Scene, Stage
 from .rings import MASS_MATRIX_PARAM, detect_rolling, penalty_pressure, rigid_ring_exact, ring_gyration_radius2, ring_history, ring_size, snapshot_indices  # noqa: F401
 
@@ -87,8 +88,7 @@ def build(params, *, normal=None, friction=None, system_options=None):
     # the closed forms hold for Coulomb friction: the scene's, or a Coulomb law given with its own mu
     exact_mu = params["mu"] if friction is None else (friction.mu if isinstance(friction, Coulomb) else None)
     return dict(ring=ring, contact=contact, system=system, systems=[system], plane=plane, stage=stage,
-                sizes=dict(element=2.0 * np.pi * params["R"] / params["n_el"], body=2.0 * params["R"]),   # accuracy:
-                # a beam element's size is its length (the thickness is its section's)
+                sizes=dict(element=2.0 * np.pi * params["R"] / params["n_el"], body=2.0 * params["R"]),  # (elements' length)
                 exact_mu=exact_mu)
 
 
@@ -155,16 +155,9 @@ def measure(model, params, records):
             x_exact=hoop["x"], vx_exact=hoop["v"], omega_exact=hoop["omega"])
     else:                                   # a friction law other than Coulomb: no closed form
         closed = dict.fromkeys(CLOSED_FORM_KEYS)
-    accuracy = {}
-    if mu is not None:
-        from .accuracy import indicator
-
-        accuracy["v_final"] = indicator(abs(closed["v_final_rel_err"]), V_FINAL_TOL, "|v_final / the rigid hoop's "
-                                        "closed form - 1| (rolling, sliding or the transition)",
-                                        "measured: the elastic ring differs from the rigid hoop by 6 % at the fast "
-                                        "preset")
-        accuracy["x_end"] = indicator(abs(closed["x_end_rel_err"]), V_FINAL_TOL, "|x_end / the rigid hoop's closed form "
-                                      "- 1|", "as v_final")
+    accuracy = {} if mu is None else references(dict(v_final=closed["v_final_rel_err"], x_end=closed["x_end_rel_err"]),
+                                                V_FINAL_TOL, "the rigid hoop's (sliding, rolling or the transition); "
+                                                "the elastic ring differs by 6 % at the fast preset")
     return dict(
         kind=params["kind"], rolled=rolled,
         t_roll=t_roll, x_roll=x_roll, v_final=v_final, omega_final=omega_final,
@@ -184,9 +177,6 @@ def measure(model, params, records):
         step_cuts_total=int(np.sum(hist.cuts)),
         accuracy=accuracy,
     )
-
-
-V_FINAL_TOL = 0.1     # the elastic ring against the rigid hoop's closed form: 6 % at the fast preset
 
 
 def law_range(params):

@@ -111,8 +111,7 @@ def build(params, *, normal=None, friction=None, system_options=None):
                   ring.initial_velocity((params["vx0"], params["vy0"])), name="sloping_impact")
     return dict(ring=ring, contact=contact, system=system, systems=[system], plane=plane, stage=stage,
                 plastic=params["variant"] == "viscoplastic",      # its plastic work is no integrator's loss
-                sizes=dict(element=2.0 * np.pi * params["R"] / params["n_el"], body=2.0 * params["R"]))   # accuracy:
-                # a beam element's size is its length (the thickness is its section's)
+                sizes=dict(element=2.0 * np.pi * params["R"] / params["n_el"], body=2.0 * params["R"]))  # (elements' length)
 
 
 def measure(model, params, records):
