@@ -110,3 +110,20 @@ def test_patch_pressure_covers_both_blocks(lower, upper, off):
     assert "pressure_deviation" in flagged
     mortar, flagged = _run("patch", {"nx_lower": lower, "nx_upper": upper, "contact_discretization": "mortar"})
     assert mortar["pressure_deviation_max"] < 1e-9 and not flagged       # mortar passes on both blocks
+
+
+def test_hertz_mortar_half_width_from_the_forces_moments():
+    m, flagged = _run("hertz", {"contact_discretization": "mortar"})
+    n, _ = _run("hertz", {})
+    assert abs(m["error_a_fit"]) > 0.04                    # the fit through mortar's smeared edge tractions
+    assert abs(m["error_a"]) < 0.03 and m["a"] == m["a_moments"] and not flagged
+    assert n["a"] == n["a_fit"] and abs(n["error_a_moments"]) < 5e-3      # node-to-segment: both agree with Hertz
+
+
+@pytest.mark.parametrize("ext", ["json", "npz"])
+def test_a_saved_run_carries_its_accuracy(tmp_path, ext):
+    from contactfem.io import as_arrays, load_run, save_run
+
+    r, _ = _run("block", {"c_N": 10})
+    save_run(as_arrays(r), tmp_path / f"run.{ext}")
+    assert load_run(tmp_path / f"run.{ext}")["accuracy"] == r["accuracy"]
