@@ -79,8 +79,7 @@ def collect(model, params, records, results):
     ratios = [getattr(r.result, "residual_ratio", 0.0) for r in steps]
     if ratios:
         out["equilibrium"] = indicator(max(ratios), EQUILIBRIUM, "largest converged residual / the step's force scale",
-                                       "Newton's round-off tolerance (solver.newton.ROUNDOFF_RTOL); its own tolerance is "
-                                       "1e-8")
+                                       "Newton's round-off tolerance (solver.newton.ROUNDOFF_RTOL); its own is 1e-8")
     sizes = model.get("sizes") or {}
     deepest = _deepest(records[1:] or records)      # (a scene's initial guess may overlap on purpose: hertz)
     if deepest is not None and sizes.get("element"):
@@ -148,11 +147,12 @@ def _time_resolution(model, records, beta):
                                          "mass at the stiffest contact node", "Newmark's period error passes 25 % "
                                          "above 2; the presets' impacts stay below 4")
     if beta is not None and len(records) > 2:
-        e = max(float(np.max(np.abs(b.a - a.a))) * b.dt ** 2 * abs(beta - 1.0 / 6.0) for a, b in zip(records, records[1:]))
-        du = max(float(np.max(np.abs(b.u - a.u))) for a, b in zip(records, records[1:]))
+        pairs = list(zip(records, records[1:]))
+        e = max(float(np.max(np.abs(b.a - a.a))) * b.dt ** 2 * abs(beta - 1.0 / 6.0) for a, b in pairs)
+        du = max(float(np.max(np.abs(b.u - a.u))) for a, b in pairs)
         if du > 0:
-            out["local_error"] = indicator(e / du, LOCAL_ERROR, "Zienkiewicz-Xie local error dt^2 |beta - 1/6| |a+ - a| "
-                                           "/ the largest increment", "measured: the presets stay below 0.25")
+            out["local_error"] = indicator(e / du, LOCAL_ERROR, "Zienkiewicz-Xie local error dt^2 |beta - 1/6| "
+                                           "|a+ - a| / the largest increment", "measured: the presets stay below 0.25")
     return out
 
 

@@ -89,7 +89,7 @@ def build(params, *, normal=None, friction=None, system_options=None):
     # the closed forms hold for Coulomb friction: the scene's, or a Coulomb law given with its own mu
     exact_mu = params["mu"] if friction is None else (friction.mu if isinstance(friction, Coulomb) else None)
     return dict(ring=ring, contact=contact, system=system, systems=[system], plane=plane, stage=stage,
-                sizes=dict(element=2.0 * np.pi * params["R"] / params["n_el"], body=2.0 * params["R"]),  # (elements' length)
+                sizes=dict(element=2.0 * np.pi * params["R"] / params["n_el"], body=2.0 * params["R"]),  # (their length)
                 exact_mu=exact_mu)
 
 

@@ -262,7 +262,9 @@ def _correction(du, u_f, u_start):
 
 def _at_roundoff(du, u_f):
     """Whether the last correction is at the round-off of u itself."""
-    return du is not None and float(np.max(np.abs(du), initial=0.0)) <= ROUNDOFF * float(np.max(np.abs(u_f), initial=0.0))
+    if du is None:
+        return False
+    return float(np.max(np.abs(du), initial=0.0)) <= ROUNDOFF * float(np.max(np.abs(u_f), initial=0.0))
 
 
 def _stall(history, tol):
