@@ -174,6 +174,8 @@ def cmd_run(args):
             print(f"{k}: [{', '.join(f'{x:.6g}' for x in v)}]")
     for what, path in out.paths.items():
         print(f"{what} -> {path}")
+    if args.strict and any(note.startswith("accuracy:") for note in notes):
+        return 1                                      # an accuracy indicator past its threshold
 
 
 def run_quietly(fn):
@@ -458,6 +460,9 @@ def build_parser():
     rp.add_argument("--linear-algebra", default=None, choices=["auto", "dense", "banded", "sparse"],
                     help="how K is stored and factorised (default auto: dense up to 100 unknowns, banded where "
                          "the band is narrow, else sparse); the JSON's linear_algebra says what was used")
+    rp.add_argument("--strict", action="store_true",
+                    help="exit with code 1 when an accuracy indicator of the run is past its threshold (each one "
+                         "prints a warning line either way)")
     rp.add_argument("--save", metavar="FILE", help="save the run (.json or .npz) for contactfem.io.load_run")
     rp.add_argument("--force", action="store_true",
                     help="run even if the estimated size exceeds the limits (2 GB, 1e6 unknowns, 1e6 steps)")

@@ -247,7 +247,8 @@ def test_banded_tangent_is_the_sparse_matrix():
 # Numbers that are differences of nearly equal numbers (relative errors against the exact
 # solution, the cork's margin over its static estimate) or rounding-level by construction
 # (the block's equilibrium error): their inputs are compared instead.
-DERIVED = ("x_roll_rel_err", "v_final_rel_err", "x_end_rel_err", "breakaway_margin_MPa", "equilibrium_error")
+DERIVED = ("x_roll_rel_err", "v_final_rel_err", "x_end_rel_err", "breakaway_margin_MPa", "equilibrium_error",
+           "accuracy")        # (the indicators: relative errors and ratios, derived like the rel_err)
 
 
 # Components of one vector are compared against the vector's size: the rolling ring's

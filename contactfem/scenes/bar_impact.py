@@ -110,14 +110,14 @@ def build(params, *, normal=None, friction=None, system_options=None):
         stepper = CentralDifference(system)
     else:
         F_scale = ex["stress"] * H
-        stepper = time_integration.make_stepper(params, system, atol=1e-9 * F_scale, rtol=1e-12, maxit=30)
+        stepper = time_integration.make_stepper(params, system, atol=1e-9 * F_scale, maxit=30)
     stepper = enforcement.wrap(params, stepper, [contact], length=L / n)     # gap_violation: penetration / h_x
     v0_vec = np.zeros(system.ndof)
     v0_vec[body.xdofs[:, 0]] = -v0
     stage = Stage(stepper, Steps(dt, t_end=t_end, max_cuts=0 if explicit else 4), np.zeros(system.ndof), v0_vec,
                   name="bar_impact")
     return dict(body=body, contact=contact, system=system, systems=[system], nodes=nodes, w=w, c_N=c_N,
-                stage=stage, dt=dt)
+                stage=stage, dt=dt, sizes=dict(element=L / n, body=L))     # the accuracy indicators' lengths
 
 
 def measure(m, params, records):

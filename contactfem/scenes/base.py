@@ -59,9 +59,10 @@ def run(scene, params, normal=None, friction=None, progress=None, linear_algebra
     ``ordering``, ``unknowns``, ``band_kl``, ``band_ku``) and how often they were evaluated
     (``residual_evaluations``: System evaluations, one per residual Newton needs;
     ``contact_evaluations``: contact evaluations, one per contact in each). A run whose
-    energy grew warns (time_integration.warn_energy_gain)."""
+    The results carry an ``accuracy`` section (scenes/accuracy.py: the generic indicators and the
+    scene's own); every indicator past its threshold warns (AccuracyWarning)."""
     from ..clock import imports_timed
-    from .time_integration import warn_energy_gain
+    from .accuracy import collect, warn
 
     with imports_timed() as imported:              # modules loaded on first use: not the run's time
         t0 = time.perf_counter()
@@ -71,7 +72,10 @@ def run(scene, params, normal=None, friction=None, progress=None, linear_algebra
         results = dict(scene.measure(model, params, records))
         wall = time.perf_counter() - t0
     systems = model["systems"]
-    warn_energy_gain(results.get("energy_error"))
+    accuracy = collect(model, params, records, results)
+    accuracy.update(results.pop("accuracy", None) or {})     # the scene's own (its references)
+    results["accuracy"] = accuracy
+    warn(accuracy, stacklevel=3)
     results["wall_time_s"] = wall - imported[0]
     results["linear_algebra"] = "+".join(dict.fromkeys(s.linear_algebra for s in systems)) or None
     results["ordering"] = "+".join(dict.fromkeys(s.ordering for s in systems)) or None

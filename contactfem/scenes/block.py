@@ -81,7 +81,8 @@ def build(params, *, normal=None, friction=None, system_options=None):
     stage = Stage(stepper, Steps(1.0 / n, n_steps=n), np.zeros(system.ndof), name="block",
                   label=lambda k, t1, dt: f"block, load step {k} of {n}")
     return dict(body=body, contact=contact, loads=loads, system=system, systems=[system], slaves=slaves,
-                stepper=stepper, stage=stage, element_size=h)
+                stepper=stepper, stage=stage, element_size=h,
+                sizes=dict(element=min(h, params["height"] / params["ny"]), body=min(params["width"], params["height"])))
 
 
 def converged(model, records):

@@ -104,8 +104,9 @@ PARAMS = (
           doc="load steps of a pseudo-time ramp (the paper: the whole load in ONE step). Note: with the "
               "finite-strain materials the paper's loads (compressive strain ~20%, dead top load near the block's "
               "shear-buckling load) invert elements; they converge up to about p_y = 50, p_x = 15"),
-    Param("rtol", 1e-10, "", 0.0, 1e-3, low_open=True, doc="Newton: ||G_k|| <= atol + rtol ||G_0||"),
-    Param("atol", 1e-12, "F", 0.0, doc="Newton absolute tolerance"),
+    Param("rtol", 1e-10, "", 0.0, 1e-3, low_open=True,
+          doc="Newton: largest residual <= atol + rtol * the step's force scale (loads, reactions, contact forces; tighter than the solver's 1e-8: the block's tables read the residuals to 1e-10)"),
+    Param("atol", 1e-12, "F", 0.0, doc="Newton absolute tolerance (a floor for a step without forces)"),
     Param("maxit", 40, "", 1, 500, doc="Newton: maximal number of linear solves"),
     *enforcement.ENFORCEMENT_PARAMS,
 )

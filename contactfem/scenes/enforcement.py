@@ -80,8 +80,49 @@ def interface(params, slave, nodes, master, *, normal, friction=None, weights=1.
                kinematics="small" if material == "linear" else "finite")
 
 
+# Lagrange's semi-smooth Newton: step halvings of its line search. A steering c_N far above the
+# bodies' stiffness makes full steps cycle between two active sets (the patch at c_N = 1e8, 5e4 E/H);
+# backtracking on the residual ends the cycle, and near the solution full steps are taken.
+LAGRANGE_LINE_SEARCH = 8
+
+
+def check_roundoff(c_N, traction, length, unit=""):
+    """ValueError (one line, before any work) when one round-off of a position (eps * length, the
+    size of the coordinates) times the penalty c_N is a traction above ROUNDOFF_SHARE times
+    Newton's round-off tolerance (solver.newton.ROUNDOFF_RTOL) of the scene's traction: Newton's
+    force test cannot be met, and the answer is round-off (penalty, and Lagrange's steering c_N)."""
+    from ..solver.newton import ROUNDOFF_RTOL as RTOL
+
+    limit = ROUNDOFF_SHARE * RTOL * traction / (np.finfo(float).eps * length)
+    if c_N > limit:
+        raise ValueError(f"parameter c_N = {c_N:g} is out of range for this run: allowed (0, {limit:.2g}] "
+                         f"(one round-off of a position, eps x {length:g}, times c_N is a traction of "
+                         f"{c_N * np.finfo(float).eps * length:.2g}{unit}, above Newton's tolerance {RTOL:g} of the "
+                         f"traction {traction:.3g}{unit})")
+
+
+def check_steering(params, stiffness, name):
+    """ValueError (one line) for Lagrange node-to-segment with a steering c_N above LAGRANGE_STEERING
+    times the bodies' stiffness (``name``): there its semi-smooth Newton's active set cycles."""
+    limit = LAGRANGE_STEERING * stiffness
+    if params["enforcement"] == "lagrange" and params["contact_discretization"] == "node_to_segment" \
+            and params["c_N"] > limit:
+        raise ValueError(f"parameter c_N = {params['c_N']:g} is out of range for enforcement = lagrange with "
+                         f"node_to_segment: allowed (0, {limit:.3g}] ({LAGRANGE_STEERING:g} {name}: above it the "
+                         "semi-smooth Newton's active set cycles; use mortar, or a smaller c_N, which only steers the "
+                         "iterates)")
+
+
+# measured on the patch: Lagrange node-to-segment converges (with its line search) up to c_N = 1e10 =
+# 5e6 E/H and cycles at 1e11
+LAGRANGE_STEERING = 1e6
+ROUNDOFF_SHARE = 4.0    # measured: the limit is within a factor 4 above the c_N where Newton stops converging
+
+
 def wrap(params, stepper, contacts, length):
-    """The stepper itself (penalty, lagrange) or wrapped in the Uzawa loop (augmented)."""
+    """The stepper itself (penalty, lagrange: with a line search) or wrapped in the Uzawa loop (augmented)."""
+    if params["enforcement"] == "lagrange" and hasattr(stepper, "newton_options"):
+        stepper.newton_options.setdefault("line_search", LAGRANGE_LINE_SEARCH)
     if params["enforcement"] != "augmented":
         return stepper
     return Uzawa(stepper, contacts, length, tol=params["uzawa_tol"], max_updates=params["uzawa_max_updates"])

@@ -68,10 +68,12 @@ def build(params, *, normal=None, friction=None, system_options=None):
                             integration=time_integration.contact_integration(params))
     symmetry = Dirichlet(ring.body, ring.symmetry_dofs(), 0.0)
     system = System([ring.body], [contact], fixed=[symmetry], **(system_options or {}))
-    stepper = time_integration.make_stepper(params, system, atol=1e-10, rtol=1e-10, maxit=30)
+    stepper = time_integration.make_stepper(params, system, atol=1e-10, maxit=30)
     stage = Stage(stepper, Steps(params["dt"], n_steps=params["n_steps"], max_cuts=6), np.zeros(ring.body.ndof),
                   ring.initial_velocity((0.0, -params["v0"])), name="funnel")
-    return dict(ring=ring, wall=wall, contact=contact, system=system, systems=[system], stage=stage)
+    return dict(ring=ring, wall=wall, contact=contact, system=system, systems=[system], stage=stage,
+                sizes=dict(element=np.pi * R / params["n_el"], body=2.0 * R))    # the accuracy indicators' lengths (n_el on the half ring):
+                # a beam element's size is its length (the thickness is its section's)
 
 
 def radial_deviation(ring, u, center):

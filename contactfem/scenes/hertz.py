@@ -23,13 +23,13 @@ Contact: the nodes of the arc near B against RigidLine y = -R, penalty law eq (4
 With `per_node` the effective interface stiffness per unit length, c_N / w_i, grows as the
 mesh is refined and varies along a graded mesh: the answer depends on the mesh.
 
-The pressure at each contact node is p_i = -f_i / w_i (for both penalty kinds). Reported:
-p0 (largest nodal pressure, at x = 0) and a, p0 from a least-squares fit of
-p^2 = p0^2 (1 - x^2/a^2) (linear in x^2) over the nodes in contact, at their positions
-in the REFERENCE configuration: Hertz's theory is a small-strain theory, its a and p(x)
-live on the undeformed surface (the deformed positions are shifted outwards by the
-lateral expansion, about nu a / R of a: -0.8 % on a if they were used). The errors against the closed
-form fall under refinement (tests/test_hertz.py). One Newton iteration: the overlap a^2 / 2R guesses the active set.
+The pressure at each contact node is p_i = -f_i / w_i (for both penalty kinds). Reported: p0 (largest
+nodal pressure, at x = 0) and a, p0 from a least-squares fit of p^2 = p0^2 (1 - x^2/a^2) (linear in x^2)
+over the nodes in contact (mortar: a from the moments of its nodal forces), at their positions in the
+REFERENCE configuration: Hertz's theory is a small-strain theory, its a and p(x) live on the undeformed
+surface (the deformed positions are shifted outwards by the lateral expansion, about nu a / R of a: -0.8 %
+on a if they were used). The errors against the closed form fall under refinement (tests/test_hertz.py).
+Two Newton iterations: the overlap a^2 / 2R guesses the active set.
 
 An elastic foundation (``foundation = elastic``) instead of the rigid plane: the quarter
 block [0, R] x [-2R, -R] (u_x = 0 on x = 0, u_y = 0 below) of modulus E_foundation, its
@@ -48,6 +48,7 @@ from ..contact import RigidLine, tributary_lengths
 from ..laws import PowerLaw
 from ..solver import Dirichlet, History, Static, Steps, System
 from . import enforcement
+from .accuracy import HERTZ_SOURCE, HERTZ_TOL, hertz_half_width, references
 from .base import PENALTIES, PENALTY_DOC, Param, Scene, Stage
 
 
@@ -78,8 +79,7 @@ def foundation(params, h, a):
 
 
 def fit_hertz(x, p):
-    """Least squares of p^2 = p0^2 - (p0/a)^2 x^2 over the nodes with p > 0: (a, p0).
-    Needs at least two loaded nodes."""
+    """Least squares of p^2 = p0^2 - (p0/a)^2 x^2 over the nodes with p > 0 (two at least): (a, p0)."""
     on = p > 0.0
     if np.count_nonzero(on) < 2:
         raise ValueError("fewer than two contact nodes carry pressure: refine the mesh (n_el)")
@@ -133,17 +133,12 @@ def build(params, *, normal=None, friction=None, system_options=None):
     # so that the first tangent is not singular (the plane is the only vertical support)
     u0 = np.zeros(system.ndof)
     u0[body.xdofs[:, 1]] = -a_ex**2 / (2.0 * R)
-    scale = P                                               # force scale of the residual
-    # the residual cannot fall below roundoff of the stiffest contact spring (c_N w, nodal
-    # force per unit gap) times the displacement scale R: a floor for very stiff penalties
-    k_c = params["c_N"] * (np.max(w) if params["penalty"] == "per_length" else 1.0)
-    atol = max(1e-10 * scale, 1e-15 * k_c * R)
-    stepper = enforcement.wrap(params, Static(system, atol=atol, rtol=1e-12, maxit=40), [contact],
+    stepper = enforcement.wrap(params, Static(system, atol=1e-12 * P, maxit=40), [contact],   # (atol: a floor)
                                length=a_ex)                  # gap_violation: penetration / a
     n = params["n_steps"]
     stage = Stage(stepper, Steps(1.0 / n, n_steps=n, max_cuts=6), u0, name="hertz")
     return dict(body=body, contact=contact, system=system, systems=[system], nodes=nodes, w=w, a_exact=a_ex,
-                p0_exact=p0_ex, grading_k=k, stage=stage)
+                p0_exact=p0_ex, grading_k=k, stage=stage, sizes=dict(element=float(np.min(w[w > 0])), body=R))
 
 
 def oscillations(x, p, p_exact, a, p0):
@@ -167,6 +162,8 @@ def check(params):
     if not a < 0.5 * params["R"]:        # the graded mesh puts 1.5 a on the quarter arc; Hertz's theory a << R
         raise ValueError(f"parameter P = {params['P']:g} gives Hertz's a = {a:.4g}, a/R = {a / params['R']:.2g}: "
                          "Hertz's small-strain theory needs a/R < 0.5 (a << R): lower P or raise E")
+    per_length = params["c_N"] if params["penalty"] == "per_length" else 0.0   # (per_node: c_N / w is above it)
+    enforcement.check_roundoff(per_length, 2.0 * params["P"] / (np.pi * a), params["R"], " MPa")   # against p0
     if params["contact_discretization"] == "mortar" and params["penalty"] != "per_length":
         raise ValueError("parameter penalty = per_node does not apply to contact_discretization = mortar (its "
                          "tractions are per unit length): use penalty = per_length")
@@ -191,10 +188,14 @@ def measure(m, params, records):
     h_c = float(np.median(np.diff(np.sort(x))[: max(2, np.count_nonzero(in_contact))]))
     c_eff = params["c_N"] if params["penalty"] == "per_length" else params["c_N"] / w[in_contact]
     profile_exact = p0_ex * np.sqrt(np.clip(1 - (x / a_ex) ** 2, 0, None))
+    a_mom = hertz_half_width(x, -rep["f_N"])     # mortar's nodal tractions are smeared where the zone ends: its a
+    a = a_mom if params["contact_discretization"] == "mortar" else a_fit
     return dict(
         **oscillations(x, p, profile_exact, a_ex, p0_ex),
-        a=a_fit, p0=p0_max, p0_fit=p0_fit, a_exact=a_ex, p0_exact=m["p0_exact"],
-        error_a=(a_fit - a_ex) / a_ex, error_p0=(p0_max - p0_ex) / p0_ex, error_p0_fit=(p0_fit - p0_ex) / p0_ex,
+        a=a, p0=p0_max, p0_fit=p0_fit, a_exact=a_ex, p0_exact=m["p0_exact"], a_fit=a_fit, a_moments=a_mom,
+        error_a=(a - a_ex) / a_ex, error_a_fit=(a_fit - a_ex) / a_ex, error_a_moments=(a_mom - a_ex) / a_ex,
+        error_p0=(p0_max - p0_ex) / p0_ex, error_p0_fit=(p0_fit - p0_ex) / p0_ex, accuracy=references(
+            dict(a=(a - a_ex) / a_ex, p0=(p0_max - p0_ex) / p0_ex), HERTZ_TOL, HERTZ_SOURCE),
         contact_force=float(-rep["f_N"].sum()), half_load=P / 2.0,
         n_quads=int(body.mesh.t.shape[1]), n_dofs=int(body.ndof),
         n_contact_nodes=int(np.count_nonzero(in_contact)), h_contact=h_c,
@@ -244,7 +245,6 @@ SCENE = Scene(
     size=lambda p: dict(elements=p["n_el"] ** 2 * (2.5 if p["foundation"] == "elastic" else 1),
                         unknowns=2 * (p["n_el"] + 1) ** 2 * (2.5 if p["foundation"] == "elastic" else 1),
                         steps=p["n_steps"]),
-    laws=("normal",),
-    law_params={"normal": ("c_N",)},
+    laws=("normal",), law_params={"normal": ("c_N",)},
     law_range=lambda params: dict(g=0.1 * params["R"]),    # the normal law probed to a tenth of R deep
 )

@@ -105,11 +105,13 @@ def build(params, *, normal=None, friction=None, system_options=None):
                             friction=friction, weights=weights, offset=offset, name="plane",
                             tangent=params["tangent"], integration=time_integration.contact_integration(params))
     system = System([ring.body], [contact], **(system_options or {}))
-    stepper = time_integration.make_stepper(params, system, atol=newton_atol(params, ring.body.ndof), rtol=1e-10,
+    stepper = time_integration.make_stepper(params, system, atol=newton_atol(params, ring.body.ndof),
                                             maxit=30)
     stage = Stage(stepper, Steps(params["dt"], n_steps=params["n_steps"], max_cuts=6), np.zeros(ring.body.ndof),
                   ring.initial_velocity((params["vx0"], params["vy0"])), name="sloping_impact")
-    return dict(ring=ring, contact=contact, system=system, systems=[system], plane=plane, stage=stage)
+    return dict(ring=ring, contact=contact, system=system, systems=[system], plane=plane, stage=stage,
+                plastic=params["variant"] == "viscoplastic",      # its plastic work is no integrator's loss
+                sizes=dict(element=2.0 * np.pi * params["R"] / params["n_el"], body=2.0 * params["R"]))  # (elements' length)
 
 
 def measure(model, params, records):

@@ -40,18 +40,3 @@ def energy_error(hist):
     balance = E + hist.dissipation - hist.external_work
     E0 = E[0]
     return float((balance[-1] - E0) / E0), float(np.max(np.abs(balance - E0)) / E0)
-
-
-# energy_error above which a run warns: the balance counts the dissipation and the loads' work,
-# so a run can only lose energy; a gain of 1 % is no Newton tolerance's share (1e-6 at most)
-ENERGY_GAIN = 0.01
-
-
-def warn_energy_gain(gain):
-    """A UserWarning when a run's energy_error (``gain``) says its energy grew by more than ENERGY_GAIN."""
-    if isinstance(gain, float) and gain > ENERGY_GAIN:
-        import warnings
-
-        warnings.warn(f"the energy grew by {gain:.1%} over the run (energy_error = {gain:.3g}; dissipation and the "
-                      "loads' work counted): the time integration does not resolve this impact (the README's Known "
-                      "limitations say which settings do)", stacklevel=3)

@@ -108,23 +108,26 @@ class EnergyConsistent:
                 states.append(cs)
                 Gc += Rc
                 rows_c.append(np.asarray(r, int)), cols_c.append(np.asarray(c, int)), vals_c.append(np.asarray(vv, float))
+            Pm = np.zeros(s.ndof)
             for load, ls in zip(s.loads, state.loads):
                 P, r, c, vv = load.assemble(um, tm, ls)
                 Gc -= P
+                Pm += P
                 rows_c.append(np.asarray(r, int)), cols_c.append(np.asarray(c, int))
                 vals_c.append(-0.5 * np.asarray(vv, float))
             G += chord * Gc
             rows += rows_c + [rot]
             cols += cols_c + [rot]
             vals += [vv * chord[r] for r, vv in zip(rows_c, vals_c)] + [dchord * Gc[rot]]
-            G += s.mass_times(c_mass * (dq - dt * v))
+            ma = s.mass_times(c_mass * (dq - dt * v))
+            G += ma
             K = sp.coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                               shape=(s.ndof, s.ndof)).tocsr() + inertia(D)
-            return Evaluation(G, K, tuple(states), None, state)
+            return Evaluation(G, K, tuple(states), Pm, state, ma)
 
         guess = s.apply_dirichlet(u + dt * v + 0.5 * dt ** 2 * a, t1)
         result = newton(fun, guess, s.free_dofs, instrument=s.instrument, label=label or f"t = {t1:.6g}, dt = {dt:.3g}",
-                        **self.newton_options)
+                        start=u, **self.newton_options)
         u1 = result.u
         result.evaluation = result.evaluation._replace(P=s.external_force(u1, t1, state))   # the loads' work
         v1 = 2.0 * cayley(u1 - u, rot)[0] / dt - v

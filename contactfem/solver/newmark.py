@@ -50,7 +50,7 @@ def initial_acceleration(system, t, u, dt=None, state=None):
 class Newmark:
     """Implicit Newmark stepper (paper Sec. 4.1), full Newton within the step.
 
-    ``newton_options`` (atol, rtol, maxit) are passed on to ``newton``.
+    ``newton_options`` (atol, rtol, ctol, maxit) are passed on to ``newton``.
     """
     dynamic = True
 
@@ -82,13 +82,14 @@ class Newmark:
         def effective(u1):                    # eq 29 with a+ = c (u1 - u_pred); tangent K + c M
             ev = s.evaluate(u1, t1, dt, u, mass_coefficient=c, state=state)
             du = u1 - u_pred
-            return ev._replace(G=ev.G + (cM * du if lumped else cM @ du))
+            inertia = cM * du if lumped else cM @ du
+            return ev._replace(G=ev.G + inertia, inertia=inertia)
 
         # initial guess: the acceleration stays a (u + dt v + dt^2 a / 2); multipliers as they were
         guess = s.apply_dirichlet(u_pred + beta * dt ** 2 * a, t1)
         own = s.contact_dofs
         guess[own] = u[own]
-        result = newton(effective, guess, s.free_dofs, instrument=s.instrument,
+        result = newton(effective, guess, s.free_dofs, instrument=s.instrument, start=u,
                         label=label or f"t = {t1:.6g}, dt = {dt:.3g}", **self.newton_options)
         u1 = result.u
         a1 = c * (u1 - u_pred)
@@ -111,7 +112,8 @@ class Static:
         _check_dt(dt)
         s, t1 = self.system, t + dt
         result = newton(lambda w: s.evaluate(w, t1, dt, u, state=state), s.apply_dirichlet(u, t1),
-                        s.free_dofs, instrument=s.instrument, label=label or f"t = {t1:.6g}", **self.newton_options)
+                        s.free_dofs, instrument=s.instrument, label=label or f"t = {t1:.6g}", start=u,
+                        **self.newton_options)
         zero = np.zeros(s.ndof)
         return result.u, zero, zero.copy(), result
 

@@ -60,12 +60,15 @@ class SystemState:
 
 class Evaluation(NamedTuple):
     """The System at one trial u: residual G, tangent K, the contacts' states, the loads P and
-    the SystemState it was evaluated with (a tuple, so ``G, K = evaluation[:2]`` reads as before)."""
+    the SystemState it was evaluated with (a tuple, so ``G, K = evaluation[:2]`` reads as before);
+    a time stepper's effective evaluation also carries the inertia M a it added to G (Newton's
+    force scale reads it)."""
     G: np.ndarray
     K: object
     contacts: tuple = ()
     P: np.ndarray | None = None
     state: SystemState | None = None
+    inertia: np.ndarray | None = None
 
 
 class Dirichlet:

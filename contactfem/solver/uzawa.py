@@ -27,7 +27,6 @@ is evaluated twice. The multipliers are part of the interfaces' histories (a val
 SystemState, contact/augmented.py): each update gives the next outer iteration a new state
 to solve with, and the time loop (march.py) commits the last one, as for any stepper.
 """
-import copy
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -80,19 +79,12 @@ class Uzawa:
         self.system, self.dynamic = stepper.system, stepper.dynamic
 
     def step(self, t, u, v, a, dt, label="", *, state):
-        start, stepper = u, self.stepper
+        start = u
         residuals, per_outer, viols, gaps, calls = [], [], [], [], [0]
         for k in range(self.max_updates + 1):
-            u1, v1, a1, res = stepper.step(t, start, v, a, dt, label=f"{label} (outer iteration {k + 1})" if label else "",
-                                           state=state)
-            if k == 0 and res.residuals:
-                # later solves start close to the solution: keep the tolerance of the first
-                # (atol + rtol ||G_0|| with the step's own G_0), not one relative to a tiny G_0: a copy
-                # of the wrapped stepper with those options (the wrapped one is left as it is)
-                opts = self.stepper.newton_options
-                stepper = copy.copy(self.stepper)
-                stepper.newton_options = dict(opts, atol=opts.get("atol", 1e-10) + opts.get("rtol", 1e-10) * res.residuals[0],
-                                              rtol=0.0)
+            u1, v1, a1, res = self.stepper.step(t, start, v, a, dt,
+                                                label=f"{label} (outer iteration {k + 1})" if label else "",
+                                                state=state)
             out = self._outer(k, u1, v1, a1, res, residuals, per_outer, viols, gaps, calls)
             if isinstance(out, tuple):
                 return out
