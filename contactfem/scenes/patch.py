@@ -173,7 +173,7 @@ def measure(m, params, records):
     # 1, slave forces of pass 2) and the overhang's load, over the tributary lengths of its top
     top = m["top_lower"]
     dofs = lower.dof_offset + lower.xdofs[top, 1]
-    f_lower = sum(st.scatter(len(u))[0][dofs] for st in states) - m["system"].external_force(u, 1.0)[dofs]
+    f_lower = sum(st.scatter(len(u))[0][dofs] for st in states) - m["system"].external_force(u, 1.0, records[-1].state)[dofs]
     pressure_lower = f_lower / tributary_lengths(lower.X[top])
     result["lower_interface_x"] = lower.X[top, 0]
     result["lower_interface_pressure"] = pressure_lower
