@@ -333,7 +333,7 @@ def test_course_command_line_refuses_bad_input(tmp_path, capsys):
         (["course", "grade", str(tmp_path / "none"), "--out", "x.csv"], "is not a folder"),
         (["course", "grade", str(tmp_path / "empty"), "--out", "x.csv"], "no notebooks"),
         (["course", "grade", str(tmp_path / "subs"), "--out", str(tmp_path / "x.txt")], "must end in .csv"),
-        (["course", "grade", str(tmp_path / "subs"), "--out", str(tmp_path / "no" / "x.csv")], "does not exist"),
+        (["course", "grade", str(tmp_path / "subs"), "--out", str(tmp_path / "file" / "x.csv")], "is a file"),
         (["course", "grade", str(tmp_path / "subs"), "--out", str(tmp_path / "x.csv"), "--jobs", "0"], "--jobs"),
         (["course", "grade", str(tmp_path / "subs"), "--out", str(tmp_path / "x.csv"), "--autograders",
           str(tmp_path / "empty")], "no grading configurations"),

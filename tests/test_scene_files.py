@@ -14,6 +14,8 @@ import pytest
 from contactfem import run_scene
 from contactfem.scenes import SceneError, get_scene
 
+pytestmark = pytest.mark.slow      # end-to-end: command lines and processes (the fast tier leaves them out)
+
 REPO = Path(__file__).resolve().parents[1]
 EXAMPLE = REPO / "lectures" / "examples" / "disc_wall.py"
 SHORT = {"n_steps": 40}          # the throw up to and through the first touch: a second's run
@@ -21,8 +23,6 @@ SHORT = {"n_steps": 40}          # the throw up to and through the first touch: 
 LAW = '''
 from dataclasses import dataclass
 import numpy as np
-
-pytestmark = pytest.mark.slow      # end-to-end: command lines and processes (the fast tier leaves them out)
 
 @dataclass(frozen=True)
 class Weakening:

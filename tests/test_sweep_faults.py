@@ -13,6 +13,8 @@ from pathlib import Path
 
 import pytest
 
+pytestmark = pytest.mark.slow      # end-to-end: command lines and processes (the fast tier leaves them out)
+
 # Coulomb with mu, and two faults: os._exit(7) above the pressure p_exit; and, for the run whose
 # mu is `victim`, its process id in the file $FRAGILE_MARK and a pause of $FRAGILE_PAUSE seconds in
 # every call of the run (a run slow enough to be killed from outside while it runs; not in the
@@ -23,8 +25,6 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-
-pytestmark = pytest.mark.slow      # end-to-end: command lines and processes (the fast tier leaves them out)
 
 
 @dataclass(frozen=True)

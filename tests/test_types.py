@@ -34,8 +34,15 @@ def offenders(text):
             if re.search(r"\bbuiltins\b", line) or re.match(r"\s+def __getattr__\(self", line)]
 
 
+# The grader's sandbox is the one place that must do both: it gives a submission a copy of the
+# builtins of its own (so that patching them changes nothing outside it), and the checks reach the
+# submission's objects through handles that forward to its process.
+SANDBOX = ("contactfem/lab/course/sandbox.py", "contactfem/lab/course/grade.py")
+
+
 def test_no_attribute_forwarding_and_no_swapped_builtins():
     found = [f"{path.relative_to(REPO)}:{n}: {line}" for path in sorted((REPO / "contactfem").rglob("*.py"))
+             if path.relative_to(REPO).as_posix() not in SANDBOX
              for n, line in offenders(path.read_text())]
     assert not found, "\n".join(found)
 
