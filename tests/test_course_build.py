@@ -153,7 +153,8 @@ def test_the_student_zip_holds_no_solution(tmp_path):
     with zipfile.ZipFile(outs["student"] / STUDENT_ZIP) as z:
         files = {Path(n).name: z.read(n).decode() for n in z.namelist()}
     sources = lecture_sources()
-    assert sorted(files) == sorted(["README.md"] + [s.name for s in sources])
+    examples = sorted(f.name for f in (REPO / "lectures" / "examples").glob("*.*"))
+    assert sorted(files) == sorted(["README.md"] + [s.name for s in sources] + examples)   # the lectures' example files too
     nbs = {s.name: nbformat.read(s, as_version=4) for s in sources}
     public = {name: _public_text(nb) for name, nb in nbs.items()}   # a lecture may show another's line as text
     searched = 0

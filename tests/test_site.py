@@ -235,7 +235,8 @@ def _assert_student_zip(site, lectures):
     assert link, "the front page does not link the student zip"
     with zipfile.ZipFile(site / link.group(1)) as z:
         files = {Path(n).name: z.read(n).decode() for n in z.namelist()}
-    assert sorted(files) == sorted(["README.md"] + [nb.name for nb in lectures])
+    examples = [f.name for f in (REPO / "lectures" / "examples").glob("*.*")]     # the files lectures read
+    assert sorted(files) == sorted(["README.md"] + [nb.name for nb in lectures] + examples)
     for nb_path in lectures:
         text = files[nb_path.name]
         assert not re.search(r"BEGIN\s+SOLUTION", text, re.I), nb_path.name

@@ -33,6 +33,11 @@ def get_scene(name):
     if isinstance(name, Scene):
         return name
     if is_scene_file(name):
+        from pathlib import Path
+
+        if not Path(name).expanduser().is_file():
+            raise ValueError(f"unknown scene {str(name)!r}: no scene file there (a path to a .py file that defines "
+                             f"SCENE); known are {', '.join(all_scenes())}")
         return load_scene_file(name)
     if isinstance(name, str) and name.isidentifier() and not name.startswith("_") and name != "base":
         module = f"{__name__}.{name}"

@@ -252,12 +252,17 @@ def build_versions(outs, repo=None, only=None, force=False, work=None, on_write=
                 else:
                     plan[version][src.name] = built[1]
                     plan[version][f"autograder/{src.stem}.zip"] = built[2]
+        examples = sorted((Path(repo or REPO) / "lectures" / "examples").glob("*.*"))
+        for version in plan:                      # the files the lectures read (a scene file, its mesh)
+            plan[version].update({f"examples/{f.name}": f for f in examples if f.is_file()})
         hidden = Path(repo or REPO) / "lectures" / "hidden_checks.py"
         if "instructor" in plan and hidden.is_file():   # the hidden checks: instructor material only
             plan["instructor"]["autograder/hidden_checks.py"] = hidden
         if "student" in plan:
             notebooks = [p for n, p in plan["student"].items() if n.endswith(".ipynb")]
-            plan["student"][handout.STUDENT_ZIP] = handout.student_zip(notebooks, Path(tmp) / handout.STUDENT_ZIP)
+            extras = [(n, p) for n, p in plan["student"].items() if n.startswith("examples/")]
+            plan["student"][handout.STUDENT_ZIP] = handout.student_zip(notebooks, Path(tmp) / handout.STUDENT_ZIP,
+                                                                       extras)
         guarded = {v: {n: p for n, p in files.items() if not n.startswith("autograder/")} for v, files in plan.items()}
         found = {v: handout.conflicts(outs[v], guarded[v]) for v in outs}
         if not force:

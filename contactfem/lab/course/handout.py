@@ -123,14 +123,16 @@ before you hand it in, and hand in the .ipynb file.
 """
 
 
-def student_zip(notebooks, path):
-    """The student handout: `notebooks` (the student version) and a README, in one zip at `path`
-    (the same bytes for the same notebooks: no time stamps). Returns `path`."""
+def student_zip(notebooks, path, extras=()):
+    """The student handout: `notebooks` (the student version), a README and `extras` (name, file:
+    the lectures' example files), in one zip at `path` (the same bytes for the same notebooks: no
+    time stamps). Returns `path`."""
     path = Path(path)
     tmp = path.with_name(f".{path.name}.part")
     with zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_DEFLATED) as z:
         entries = [("contactfem-course/README.md", STUDENT_README.encode())]
         entries += [(f"contactfem-course/{Path(nb).name}", Path(nb).read_bytes()) for nb in sorted(notebooks)]
+        entries += [(f"contactfem-course/{name}", Path(f).read_bytes()) for name, f in sorted(extras)]
         for name, data in entries:
             info = zipfile.ZipInfo(name, date_time=(1980, 1, 1, 0, 0, 0))
             info.compress_type = zipfile.ZIP_DEFLATED
