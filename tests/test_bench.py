@@ -18,6 +18,7 @@ from contactfem.laws import Coulomb, ParabolicSlip, PowerLaw
 from contactfem.scenes import block, get_scene
 from contactfem.contact.tangents import freeze
 from contactfem.solver import NewtonError, Static
+from contactfem.solver.newton import force_scale
 from contactfem.solver.staggered import Staggered
 from contactfem.lab.bench import observed_order, write_markdown
 
@@ -43,15 +44,18 @@ def test_staggered_converges_to_the_newton_solution_with_more_solves(law):
     # same solution: both satisfy the same full residual to 1e-10 relative
     scale = np.max(np.abs(ref["u"]))
     assert np.max(np.abs(u - ref["u"])) < 1e-8 * scale, "staggered and Newton solutions differ"
-    G, _ = system.residual_tangent(u, 1.0, state=b["start"])
-    assert np.linalg.norm(G) <= params["atol"] + params["rtol"] * res.residuals[0]
+    # converged by newton's own test in force units: the largest free residual against the force scale
+    ev = system.evaluate(u, 1.0, 1.0, state=b["start"])
+    free = system.free_dofs
+    assert np.max(np.abs(ev.G[free])) <= params["atol"] + params["rtol"] * force_scale(ev, free)
     # more work: consistent Newton 5-6 solves, staggered ~ 3x (linear convergence of the cycles)
     assert res.iterations > ref["result"].iterations, (res.iterations, ref["result"].iterations)
     assert res.cycles >= 3
     assert res.iterations == sum(res.phase_iterations)
-    # the cycles converge linearly: the contraction factor stays well below 1
+    # the cycles converge linearly: the contraction factor stays well below 1 (but for the last
+    # cycle, which may only move the residual within its round-off, ~1e-8 here, below the tolerance)
     r = np.asarray(res.residuals)
-    assert np.all(r[2:] < 0.5 * r[1:-1]), r
+    assert np.all(r[2:-1] < 0.5 * r[1:-2]), r
 
 
 def test_staggered_raises_after_max_cycles():

@@ -42,10 +42,8 @@ from .rings import MASS_MATRIX_PARAM, RING_PARAMS, penalty_pressure, ring_histor
 VARIANTS = ("frictionless", "frictional", "viscoplastic")
 
 # Paper, Table 2: rebound velocity components and angle of reflection (from the normal)
-PAPER_TABLE2 = {
-    "frictionless": dict(vx=2.0, vy=1.7, angle_deg=50.0),
-    "frictional": dict(vx=1.2, vy=1.7, angle_deg=35.0),
-}
+PAPER_TABLE2 = {"frictionless": dict(vx=2.0, vy=1.7, angle_deg=50.0),
+                "frictional": dict(vx=1.2, vy=1.7, angle_deg=35.0)}
 
 
 def rebound_angle(vx, vy):

@@ -26,8 +26,9 @@ loads P, the support reactions (G at the prescribed dofs), the contact forces an
 M a (what the evaluation carries of them), never the first residual: a first guess with a
 deep penetration (a huge spurious contact force) does not loosen the test. ``u_start`` is the
 state at the step's start (``start``; default the initial guess). The correction test is
-waived at k = 0, when the residual is below atol, and when the correction is at the round-off
-of u (1e3 machine epsilon of max |u_k|); there the residual cannot fall further, and
+waived at k = 0, when the residual is below atol or NEGLIGIBLE (1e-3) times its tolerance (the
+iterate's own error, K^-1 G, is then negligible whatever the last correction was), and when the
+correction is at the round-off of u (1e3 machine epsilon of max |u_k|); there the residual cannot fall further, and
 ROUNDOFF_RTOL F is accepted instead of rtol F (a very stiff penalty: one round-off of a gap is a
 force; ``residual_ratio`` says what was reached). atol (force units) is a floor for a step in
 which nothing carries a force. ``residuals`` keeps the Euclidean norms ||G_k|| for reports.
@@ -112,6 +113,9 @@ RTOL = 1e-8            # the largest residual over the step's force scale
 CTOL = 1e-6            # the largest correction over the step's largest increment
 ROUNDOFF = 1e3 * np.finfo(float).eps   # a correction below this times max |u| is at u's round-off
 ROUNDOFF_RTOL = 1e-6   # accepted when the corrections are at u's round-off: Newton can do no better
+NEGLIGIBLE = 1e-3      # a residual this far below its tolerance: the iterate's own error (K^-1 G) is negligible
+                       # whatever the last correction was; one more iteration could only flip a contact
+                       # node sitting at g_N = 0 (and cycle: a disc on a polyline wall did)
 
 
 def force_scale(evaluation, free):
@@ -212,7 +216,7 @@ def _newton(fun, u0, free, atol, rtol, maxit, label, line_search, instrument, ct
         c_ratio = _correction(du, u[free], u_start)
         stalled = _at_roundoff(du, u[free])           # the corrections no longer move u
         if r_max <= tol or (stalled and r_max <= atol + max(rtol, ROUNDOFF_RTOL) * F):
-            if k == 0 or r_max <= atol or c_ratio <= ctol or stalled:
+            if k == 0 or r_max <= atol or r_max <= NEGLIGIBLE * tol or c_ratio <= ctol or stalled:
                 return NewtonResult(u=u, residuals=history, iterations=k, G=G, evaluation=out, evaluations=calls,
                                     force_scale=F, residual_ratio=max(r_max - atol, 0.0) / F if F > 0 else 0.0,
                                     correction_ratio=c_ratio if k else 0.0, ratios=ratios)

@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..contact.tangents import freeze
-from .newton import NewtonError, newton
+from .newton import RTOL, NewtonError, force_scale, newton
 
 @dataclass
 class StaggeredResult:
@@ -57,12 +57,14 @@ class StaggeredResult:
     phase_iterations: list = field(default_factory=list)
 
 
-def staggered(fun, u0, free, atol=1e-10, rtol=1e-10, maxit=25, max_cycles=60, label="", instrument=None):
+def staggered(fun, u0, free, atol=1e-12, rtol=RTOL, maxit=25, max_cycles=60, label="", instrument=None,
+              **newton_options):
     """The staggered iteration (module docstring) on fun(u, phases) -> the (effective)
     Evaluation of a System, ``phases`` one per contact (None: the full contacts).
 
-    Converged when the full residual satisfies ||G|| <= atol + rtol ||G_0|| (the test of
-    ``newton``); each phase is solved by ``newton`` to that same absolute tolerance.
+    Converged when the full residual passes ``newton``'s test in force units: max |G_f| <=
+    atol + rtol F, F the force scale of the full evaluation (newton.force_scale); each phase is
+    solved by ``newton`` to that same absolute tolerance (its other options: ``newton_options``).
     Raises NewtonError after ``max_cycles`` cycles or if a phase fails.
     """
     free = np.asarray(free)
@@ -70,20 +72,26 @@ def staggered(fun, u0, free, atol=1e-10, rtol=1e-10, maxit=25, max_cycles=60, la
     u = np.array(u0, dtype=float)
     ev = fun(u, None)
     calls = 1
-    history = [float(np.linalg.norm(ev.G[free]))]
-    tol = atol + rtol * history[0]
+    history = [float(np.linalg.norm(ev.G[free]))]        # ||G_f|| of every cycle, for reports
+
+    def tolerance(ev):                                     # newton's test: the full residual's force scale
+        return atol + rtol * force_scale(ev, free)
+
+    def converged(ev):
+        return float(np.max(np.abs(ev.G[free]), initial=0.0)) <= tolerance(ev)
+
     solves, per_phase = 0, []
     for cycle in range(1, max_cycles + 1):
-        if history[-1] <= tol:
+        if converged(ev):
             return StaggeredResult(u=u, residuals=history, iterations=solves, G=ev.G, evaluation=ev,
                                    evaluations=calls, cycles=cycle - 1, phase_iterations=per_phase)
         for kind in ("normal", "friction"):
             if kind == "friction":               # freeze from the full state at the end of the normal phase
                 ev, calls = fun(u, None), calls + 1
-            phases = [freeze(state, kind) for state in ev.contacts]
+            phases, tol = [freeze(state, kind) for state in ev.contacts], tolerance(ev)
             try:
                 res = newton(lambda w: fun(w, phases), u, free, atol=tol, rtol=0.0, maxit=maxit,
-                             label=f"{kind} phase{where}", instrument=instrument)
+                             label=f"{kind} phase{where}", instrument=instrument, **newton_options)
             except NewtonError as err:
                 raise NewtonError(f"staggered: {kind} phase of cycle {cycle} failed{where}: {err}",
                                   history, label) from err
@@ -94,7 +102,7 @@ def staggered(fun, u0, free, atol=1e-10, rtol=1e-10, maxit=25, max_cycles=60, la
         if not np.isfinite(r):
             raise NewtonError(f"staggered: residual is NaN/inf after cycle {cycle}{where}", history, label)
         history.append(r)
-    if history[-1] <= tol:
+    if converged(ev):
         return StaggeredResult(u=u, residuals=history, iterations=solves, G=ev.G, evaluation=ev, evaluations=calls,
                                cycles=max_cycles, phase_iterations=per_phase)
     raise NewtonError(f"staggered: no convergence in {max_cycles} cycles{where}; full residuals "
