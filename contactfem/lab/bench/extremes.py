@@ -63,6 +63,8 @@ class Spec:
     exact: dict = None               # headline -> the result key of its closed form
     reference: dict = field(default_factory=dict)  # what the reference adds (the block: lagrange)
     c_N_factors: tuple = None        # the penalty factors, where not C_N / C_N_DYN (the cork: cost)
+    physical: tuple = ()             # numerical elsewhere, part of the problem here (the block's nx)
+    ref_mesh: dict = field(default_factory=dict)   # the reference's mesh at least this fine (else the preset's)
 
 
 SCENES = {
@@ -72,12 +74,13 @@ SCENES = {
                            {"enforcement": "lagrange"}, {"enforcement": "lagrange", "contact_discretization": "mortar"},
                            {"enforcement": "lagrange", "c_N": 1e5}, {"enforcement": "lagrange", "c_N": 1e27},
                            {"enforcement": "augmented", "contact_discretization": "mortar"})),
-    # static: the largest displacement against the same block solved with Lagrange multipliers
+    # static: the largest displacement against the same block solved with Lagrange multipliers and 16
+    # elements through its height; nx is the problem's own (the free ends are free_end_nodes of nx)
     "block": Spec(("max_displacement",), mesh=({"nx": 3, "ny": 1}, {"nx": 3, "ny": 1, "free_end_nodes": 1}, {"nx": 100, "ny": 32}),
                   mu=({"law": "coulomb", "mu": 0.0}, {"law": "coulomb", "mu": 2.0}),
                   methods=({"contact_discretization": "mortar"}, {"enforcement": "augmented"},
                            {"enforcement": "lagrange"}, {"law": "coulomb", "enforcement": "lagrange"}),
-                  reference={"enforcement": "lagrange"}),
+                  reference={"enforcement": "lagrange"}, physical=("nx",), ref_mesh={"ny": 16}),
     # static, closed form: the uniform pressure on both blocks (pressure_deviation_max is the error)
     "patch": Spec(("pressure",), mesh=({"nx_lower": 1, "nx_upper": 1, "ny": 1}, {"nx_lower": 11, "nx_upper": 5},
                                        {"nx_lower": 17, "nx_upper": 3}, {"nx_lower": 64, "nx_upper": 117, "ny": 16}),
@@ -168,7 +171,7 @@ def _text(over):
 def reference_overrides(scene, over):
     """The overrides of the refined reference of a run (module docstring)."""
     spec = SCENES[scene]
-    ref = {k: v for k, v in over.items() if k not in NUMERICAL}
+    ref = {k: v for k, v in over.items() if k not in NUMERICAL or k in spec.physical}
     ref.update(spec.base)
     ref.update(spec.reference)
     if scene == "cork":
@@ -181,9 +184,9 @@ def reference_overrides(scene, over):
     if over.get("enforcement", "penalty") == "penalty":
         c0 = _default(scene, spec.c_N)
         ref[spec.c_N] = max(float(over.get(spec.c_N, c0)), c0)
-    for k in NUMERICAL & set(over) & {"n_el", "nx", "ny", "nx_lower", "nx_upper", "n_r", "n_z"}:
-        if over[k] > _default(scene, k):
-            ref[k] = over[k]
+    for k in {"n_el", "nx", "ny", "nx_lower", "nx_upper", "n_r", "n_z"} - set(spec.physical):
+        if k in over or k in spec.ref_mesh:
+            ref[k] = max(over.get(k, 0), spec.ref_mesh.get(k, 0), _default(scene, k))
     return ref
 
 
