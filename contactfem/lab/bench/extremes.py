@@ -15,7 +15,8 @@ run past its time limit are counted apart; they must stay empty too.
 The reference of a run is its closed form where the scene has one for the headline (Hertz's a,
 p0; the patch's uniform pressure), else the same physical problem with the numerical settings
 refined: the step REFINE times the scene's, the penalty max(the run's, the scene's) (the scene's is
-argued stiff enough; a stiffer one is nearer the constraint), the mesh the finer of the run's and
+argued stiff enough; a stiffer one is nearer the constraint; a run finer still is checked against
+that converged answer), the mesh the finer of the run's and
 the preset's, the scene's default enforcement, discretisation and integrator; the static block
 uses Lagrange multipliers (no penalty error at all). A headline quantity near zero is compared
 with a scale of the scene (its initial speed) instead of itself.
@@ -42,7 +43,7 @@ TIME_LIMIT = 240.0  # seconds one run may take before it counts as past its time
 C_N = (1e-4, 1e-2, 1.0, 1e2, 1e4, 1e9, 1e18)     # penalty factors on the static scenes
 C_N_DYN = (1e-4, 1e-2, 1.0, 1e4, 1e18)           # and on the dynamic ones, crossed with DT
 DT = (1.0, 10.0)                                  # step factors crossed with the penalty
-DT_ALONE = (1e-3, 0.1)                            # step factors at the scene's penalty only
+DT_ALONE = 0.1                                    # a step factor at the scene's penalty only, beside Spec.tiny
 NUMERICAL = {"c_N", "c_N_factor", "dt", "dt_fine", "courant", "n_steps", "t_end", "enforcement",
              "contact_discretization", "contact_integration", "integrator", "passes", "n_el", "nx", "ny",
              "nx_lower", "nx_upper", "n_r", "n_z", "uzawa_tol", "travel_max"}
@@ -64,6 +65,7 @@ class Spec:
     reference: dict = field(default_factory=dict)  # what the reference adds (the block: lagrange)
     c_N_factors: tuple = None        # the penalty factors, where not C_N / C_N_DYN (the cork: cost)
     physical: tuple = ()             # numerical elsewhere, part of the problem here (the block's nx)
+    tiny: tuple = (1e-3, {})         # the smallest step factor and what makes it affordable (shared by its reference)
     ref_mesh: dict = field(default_factory=dict)   # the reference's mesh at least this fine (else the preset's)
 
 
@@ -76,7 +78,8 @@ SCENES = {
                            {"enforcement": "augmented", "contact_discretization": "mortar"})),
     # static: the largest displacement against the same block solved with Lagrange multipliers and 16
     # elements through its height; nx is the problem's own (the free ends are free_end_nodes of nx)
-    "block": Spec(("max_displacement",), mesh=({"nx": 3, "ny": 1}, {"nx": 3, "ny": 1, "free_end_nodes": 1}, {"nx": 100, "ny": 32}),
+    "block": Spec(("max_displacement",), mesh=({"nx": 3, "ny": 1}, {"nx": 3, "ny": 1, "free_end_nodes": 1},
+                                                {"nx": 100, "ny": 32}),
                   mu=({"law": "coulomb", "mu": 0.0}, {"law": "coulomb", "mu": 2.0}),
                   methods=({"contact_discretization": "mortar"}, {"enforcement": "augmented"},
                            {"enforcement": "lagrange"}, {"law": "coulomb", "enforcement": "lagrange"}),
@@ -89,8 +92,9 @@ SCENES = {
                            {"enforcement": "lagrange"}, {"enforcement": "lagrange", "contact_discretization": "mortar"},
                            {"enforcement": "lagrange", "c_N": 1e10}, {"enforcement": "lagrange", "c_N": 1e24},
                            {"contact_discretization": "mortar", "nx_lower": 17, "nx_upper": 3})),
-    # the rebound is over by t = 2.4 (the paper's step: contact from 0.1 to 2.4): end at 4
+    # the rebound is over by t = 2.4 (the paper's step: contact from 0.1 to 2.4): end at 4; dt / 1000 ends at 3
     "sloping_impact": Spec(("rebound_vx", "rebound_vy"), scale={"rebound_vx": 2.83, "rebound_vy": 2.83},
+                           tiny=(1e-3, {"n_steps": 30000}),
                            dt="dt", steps=4.0, mesh=({"n_el": 3}, {"n_el": 400}),
                            mu=({"variant": "frictional", "alpha": 0.0, "beta": 0.0},
                                {"variant": "frictional", "alpha": 0.0, "beta": 2.0}),
@@ -99,11 +103,14 @@ SCENES = {
                                     {"variant": "frictional"}, {"variant": "viscoplastic"},
                                     {"kind": "continuum"})),
     # rolling starts near t = 1.02 s (mu = 0.15) and v_final is read after it: 1.5 s of the 2
+    # dt / 1000: mu = 2 rolls from t = 0.076 s, so 0.2 s of it (10,000 steps) decides v_final
     "rolling_ring": Spec(("v_final", "x_end"), base={"t_end": 1.5}, scale={"v_final": 300.0}, dt="dt",
+                         tiny=(1e-3, {"mu": 2.0, "t_end": 0.2}),
                          mesh=({"n_el": 8}, {"n_el": 480}), mu=({"mu": 1e-9}, {"mu": 2.0}),
                          methods=({"contact_integration": "energy_consistent"}, {"kind": "continuum"})),
     # one impact: contact lasts 2L/c, the run ends at 1.5 of it (the preset)
-    "bar_impact": Spec(("duration", "rebound_velocity"), c_N="c_N_factor", dt="courant",
+    # courant / 1000 on 4 elements (12,000 steps; 40 elements would take 120,000)
+    "bar_impact": Spec(("duration", "rebound_velocity"), c_N="c_N_factor", dt="courant", tiny=(1e-3, {"n_el": 4}),
                        mesh=({"n_el": 2}, {"n_el": 400}),
                        methods=({"integrator": "central_difference", "courant": 0.5},
                                 {"contact_integration": "energy_consistent"}, {"contact_discretization": "mortar"},
@@ -111,7 +118,8 @@ SCENES = {
                                 {"enforcement": "lagrange", "c_N_factor": 1e-4},
                                 {"enforcement": "lagrange", "c_N_factor": 1e18})),
     # the lowest point is reached at t = 4.4 and the ring has left the wall by 7: end at 8
-    "funnel": Spec(("y_c_min", "v_c_final"), scale={"v_c_final": 4.0}, dt="dt", steps=8.0,
+    # dt / 100 (8,000 steps): dt / 1000 would take 80,000
+    "funnel": Spec(("y_c_min", "v_c_final"), scale={"v_c_final": 4.0}, dt="dt", steps=8.0, tiny=(1e-2, {}),
                    mesh=({"n_el": 2}, {"n_el": 240}), mu=({"variant": "frictional", "alpha": 0.0, "beta": 0.0},
                                                            {"variant": "frictional", "alpha": 0.0, "beta": 2.0}),
                    methods=({"contact_integration": "energy_consistent"}, {"variant": "frictional"})),
@@ -132,15 +140,19 @@ def _with_step(spec, scene, over, factor):
         out.update(dt=_default(scene, "dt") * factor, dt_fine=_default(scene, "dt_fine") * factor)
     elif spec.dt:
         out[spec.dt] = _default(scene, spec.dt) * factor
-        if spec.steps:
+        if spec.steps and "n_steps" not in over:
             out["n_steps"] = max(1, round(spec.steps / out[spec.dt]))
     return out
 
 
 def grid(quick=False):
-    """The runs: a list of (scene, overrides, axis)."""
+    """The runs: a list of (scene, overrides, axis, what the reference shares)."""
     if quick:
-        return list(QUICK)
+        return [(s, o, a, {}) for s, o, a in QUICK]
+    return [p if len(p) == 4 else p + ({},) for p in _points()]
+
+
+def _points():
     points = []
     for scene, spec in SCENES.items():
         base = _with_step(spec, scene, spec.base, 1.0)
@@ -150,8 +162,11 @@ def grid(quick=False):
             for d in (DT if spec.dt else (1.0,)):
                 points.append((scene, dict(_with_step(spec, scene, spec.base, d), **{spec.c_N: c0 * f}),
                                f"c_N x {f:g}" + (f", dt x {d:g}" if spec.dt else "")))
-        for d in (DT_ALONE if spec.dt else ()):
-            points.append((scene, _with_step(spec, scene, spec.base, d), f"dt x {d:g}"))
+        if spec.dt:
+            points.append((scene, _with_step(spec, scene, spec.base, DT_ALONE), f"dt x {DT_ALONE:g}"))
+            f, keep = spec.tiny
+            points.append((scene, _with_step(spec, scene, dict(spec.base, **keep), f),
+                           f"dt x {f:g}" + (f" ({_text(keep)})" if keep else ""), keep))
         for over in spec.mesh:
             points.append((scene, dict(base, **over), "mesh " + _text(over)))
         for over in spec.mu:
@@ -168,23 +183,26 @@ def _text(over):
     return ", ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in over.items())
 
 
-def reference_overrides(scene, over):
-    """The overrides of the refined reference of a run (module docstring)."""
+def reference_overrides(scene, over, keep=None):
+    """The overrides of the refined reference of a run (module docstring); `keep`: what it shares
+    with the run whatever the rules (the smallest step's shortened problem)."""
     spec = SCENES[scene]
     ref = {k: v for k, v in over.items() if k not in NUMERICAL or k in spec.physical}
     ref.update(spec.base)
+    ref.update(keep or {})
     ref.update(spec.reference)
     if scene == "cork":
         ref.update(dt=_default(scene, "dt") * REFINE, dt_fine=_default(scene, "dt_fine") * REFINE)
     elif spec.dt:
-        step = min(float(over.get(spec.dt, _default(scene, spec.dt))), _default(scene, spec.dt) * REFINE)
+        step = _default(scene, spec.dt) * REFINE         # a run finer than that is checked against it
         ref[spec.dt] = step
-        if spec.steps:
-            ref["n_steps"] = max(1, round(spec.steps / step))
+        if spec.steps:                                  # the run's end time, in the reference's steps
+            end = float(over[spec.dt]) * over["n_steps"] if "n_steps" in over else spec.steps
+            ref["n_steps"] = max(1, round(end / step))
     if over.get("enforcement", "penalty") == "penalty":
         c0 = _default(scene, spec.c_N)
         ref[spec.c_N] = max(float(over.get(spec.c_N, c0)), c0)
-    for k in {"n_el", "nx", "ny", "nx_lower", "nx_upper", "n_r", "n_z"} - set(spec.physical):
+    for k in {"n_el", "nx", "ny", "nx_lower", "nx_upper", "n_r", "n_z"} - set(spec.physical) - set(keep or {}):
         if k in over or k in spec.ref_mesh:
             ref[k] = max(over.get(k, 0), spec.ref_mesh.get(k, 0), _default(scene, k))
     return ref
@@ -273,11 +291,11 @@ OUTCOMES = ("within", "flagged (off)", "flagged (within)", "refused", "stopped",
 def extremes_study(quick=False, progress=None, seconds=TIME_LIMIT):
     """Run the grid (``quick``: the test suite's slice); rows and counts."""
     refs, rows = {}, []
-    for scene, over, axis in grid(quick):
+    for scene, over, axis, keep in grid(quick):
         run = attempt(scene, over, seconds)
         ref = None
         if needs_reference(scene) and run["outcome"] == "ran":
-            key = (scene, tuple(sorted(reference_overrides(scene, over).items())))
+            key = (scene, tuple(sorted(reference_overrides(scene, over, keep).items())))
             if key not in refs:
                 refs[key] = attempt(scene, dict(key[1]), seconds)
             ref = refs[key]
