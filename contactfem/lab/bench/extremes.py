@@ -197,7 +197,8 @@ def reference_overrides(scene, over, keep=None):
         step = _default(scene, spec.dt) * REFINE         # a run finer than that is checked against it
         ref[spec.dt] = step
         if spec.steps:                                  # the run's end time, in the reference's steps
-            end = float(over[spec.dt]) * over["n_steps"] if "n_steps" in over else spec.steps
+            end = float(over.get(spec.dt, _default(scene, spec.dt))) * over["n_steps"] if "n_steps" in over \
+                else spec.steps
             ref["n_steps"] = max(1, round(end / step))
     if over.get("enforcement", "penalty") == "penalty":
         c0 = _default(scene, spec.c_N)
@@ -323,6 +324,8 @@ QUICK = [
     ("block", {"c_N": 10.0}, "c_N x 1e-4"),
     ("block", {"c_N": 1e23}, "c_N x 1e18"),
     ("block", {"nx": 3, "ny": 1}, "mesh nx=3, ny=1"),
+    ("block", {"nx": 3, "ny": 1, "free_end_nodes": 1}, "mesh nx=3, ny=1, free_end_nodes=1"),
+    ("sloping_impact", {"n_el": 3, "n_steps": 40}, "mesh n_el=3"),
     ("hertz", {"c_N": 1e27}, "c_N x 1e18"),
     ("hertz", {"n_el": 4}, "mesh n_el=4"),
     ("patch", {"nx_lower": 11, "nx_upper": 5}, "mesh nx_lower=11, nx_upper=5"),
