@@ -106,3 +106,17 @@ def test_benchmarks_md_shows_the_committed_extremes_grid():
     assert not ex["quick"] and ex["runs"] == len(grid()) == len(ex["rows"])
     assert all(ex["counts"][k] == 0 for k in ("wrong", "crashed", "late", "no reference")), ex["counts"]
     assert "\n".join(extremes_markdown(ex)) in (REPO / "BENCHMARKS.md").read_text()
+
+
+def test_a_halved_step_is_not_halved_without_end():
+    """The funnel at 1e18 times its penalty: each part of a halved step was cut again with a fresh
+    count, down to 1e-11 of the step, and the run never ended; now the step stops at dt / 2^max_cuts
+    and the run stops in one line."""
+    from contactfem.solver.newton import NewtonError
+    from contactfem.solver.schedule import Steps
+
+    steps = Steps(0.1, n_steps=10, max_cuts=2)
+    assert steps.cut(0.1, 0) == 0.05 and steps.cut(0.05, 0) == 0.025 and steps.cut(0.025, 0) is None
+    with pytest.raises(NewtonError) as err:
+        run_scene("funnel", "fast", {"c_N": 1e19, "n_steps": 40})
+    assert "\n" not in str(err.value) and "dt = 0.00156" in str(err.value)
