@@ -374,6 +374,16 @@ def extremes_markdown(res):
          "contactfem/lab/bench/extremes.py.", "",
          "| outcome | runs |", "|---|---|"]
     L += [f"| {k} | {c.get(k, 0)} |" for k in OUTCOMES]
+    L += ["", "Each scene's part of the grid (contactfem/lab/bench/extremes.py, SCENES: every run at the fast "
+          "preset; the penalty and the step crossed on the dynamic scenes, each other axis alone):", "",
+          "| scene | headline quantities | reference | coarsest and fine meshes | smallest step |",
+          "|---|---|---|---|---|"]
+    for scene, spec in SCENES.items():
+        ref = "closed form" if not needs_reference(scene) else "refined run" + (
+            f" ({_text(spec.reference)})" if spec.reference else "")
+        tiny = "-" if not spec.dt else f"{spec.tiny[0]:g} x" + (f" ({_text(spec.tiny[1])})" if spec.tiny[1] else "")
+        meshes = "; ".join(_text(m) for m in spec.mesh)
+        L.append(f"| {scene} | {', '.join(spec.headlines)} | {ref} | {meshes} | {tiny} |")
     L += ["", "What the grid found wrong and unflagged, and what was added (measured when each was found, not "
           "by this run):", "", "| run | what was wrong | added |", "|---|---|---|"]
     L += [f"| {a} | {b} | {c} |" for a, b, c in FINDINGS]
@@ -381,5 +391,6 @@ def extremes_markdown(res):
           "|---|---|---|---|---|"]
     for r in res["rows"]:
         what = ", ".join(r["flags"]) if r["flags"] else r["error"][:120].replace("|", "/")
-        L.append(f"| {r['scene']} | {r['axis']} | {r['outcome']} | {_errors_text(r['errors']) or '-'} | {what or '-'} |")
+        errors = _errors_text(r["errors"]) or "-"
+        L.append(f"| {r['scene']} | {r['axis']} | {r['outcome']} | {errors} | {what or '-'} |")
     return L + [""]
