@@ -65,7 +65,7 @@ def test_the_quick_slice_is_within_flagged_refused_or_stopped():
     bad = [(r["scene"], r["axis"], r["outcome"], r["errors"]) for r in res["rows"]
            if r["outcome"] in ("wrong", "crashed", "late", "no reference")]
     assert not bad
-    assert c["flagged (off)"] >= 5 and c["within"] >= 2 and c["refused"] >= 1
+    assert c["flagged (off)"] >= 5 and c["within"] >= 2 and c["refused"] >= 1 and c["stopped"] >= 1
     assert res["runs"] == sum(c.values())
 
 

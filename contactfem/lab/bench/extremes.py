@@ -337,6 +337,9 @@ QUICK = [
     ("bar_impact", {"courant": 10.0}, "dt x 10"),
     ("rolling_ring", {"mu": 1e-9, "t_end": 1.5}, "mu 1e-9"),
     ("rolling_ring", {"dt": 0.2, "t_end": 1.5}, "dt x 10"),
+    ("bar_impact", {"courant": 10.0, "contact_integration": "energy_consistent"}, "method energy_consistent, dt x 10"),
+    ("hertz", {"enforcement": "lagrange", "contact_discretization": "mortar"}, "method lagrange, mortar"),
+    ("funnel", {"c_N": 1e19, "n_steps": 80}, "c_N x 1e18"),
 ]
 
 
