@@ -14,18 +14,20 @@ run past its time limit are counted apart; they must stay empty too.
 
 The reference of a run is its closed form where the scene has one for the headline (Hertz's a,
 p0; the patch's uniform pressure), else the same physical problem with the numerical settings
-refined: the step REFINE times the scene's, the penalty max(the run's, the scene's) (the scene's is
-argued stiff enough; a stiffer one is nearer the constraint; a run finer still is checked against
-that converged answer), the mesh the finer of the run's and
-the preset's, the scene's default enforcement, discretisation and integrator; the static block
-uses Lagrange multipliers (no penalty error at all). A headline quantity near zero is compared
-with a scale of the scene (its initial speed) instead of itself.
+refined: the step REFINE times the scene's (a run finer still is checked against that converged
+answer; the cork's dt sets its gas ramp, so its pop's dt_fine and travel_max are refined instead),
+the penalty max(the run's, the scene's) (the scene's is argued stiff enough; a stiffer one is
+nearer the constraint), the mesh the finer of the run's and the preset's, the scene's default
+enforcement, discretisation and integrator; the static block uses Lagrange multipliers (no
+penalty error at all) and keeps its nx (its free ends are counted in elements). A headline
+quantity near zero is compared with a scale of the scene (its initial speed) instead of itself.
+A run and its reference share what makes the smallest step affordable (Spec.tiny).
 
 The grid is no Cartesian product: each axis is walked from the fast preset, one at a time, and the
 penalty and the step are crossed where they interact (the dynamic scenes); the run's end time is
 shortened where the headline quantity is decided early (argued at each scene). The finest mesh is
 the finest this bench affords, not the range's end (Hertz n_el = 2000 is four million quads).
-``quick`` is the slice the test suite runs (about a minute).
+``quick`` is the slice the test suite runs (seconds).
 """
 import signal
 import threading
