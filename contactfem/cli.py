@@ -378,7 +378,7 @@ def cmd_reconstruct(args):
 
 
 BENCH_STUDIES = ("tangents", "work_precision", "cost", "targets", "enforcement", "speed", "semismooth",
-                 "scaling")  # = lab.bench.STUDIES
+                 "scaling", "extremes")  # = lab.bench.STUDIES
 
 
 def cmd_bench(args):
@@ -572,7 +572,7 @@ def build_parser():
                     "results of earlier runs of the same code, in $CONTACTFEM_CACHE or ~/.cache/contactfem)")
     rc.set_defaults(func=cmd_reconstruct)
     bp = sub.add_parser("bench", help="speed against accuracy: tangents, work-precision, cost, targets, "
-                                      "enforcement, speed, semi-smooth Newton, scaling against plain scikit-fem "
+                                      "enforcement, speed, semi-smooth Newton, scaling against plain scikit-fem, the extremes grid "
                                       "(writes bench.json and BENCHMARKS.md)")
     bp.add_argument("--quick", action="store_true", help="fast presets and fewer points (seconds)")
     bp.add_argument("--out", default=None,

@@ -13,7 +13,8 @@ answers (by name) as the part it belongs to, and raises AssertionError with a hi
 
 import numpy as np
 
-from contactfem.lab.course.checks import _tresca, call, compare, parts
+from contactfem.lab.course.checks import (_tresca, call, compare, parts, tolerance_budget_at, tolerance_error_at,
+                                           tolerance_indicators_at)
 
 
 # -- lecture 01 ---------------------------------------------------------------------------------
@@ -173,6 +174,18 @@ def convergence_order_other(convergence_order):
     want = np.log(r[-1] / r[-2]) / np.log(r[-2] / r[-3])
     compare("convergence order of r_(k+1) = 0.8 r_k^3 (last three)", call(convergence_order, "convergence_order", r),
             want, {"r": "0.9, 0.6, ..."}, rtol=1e-8)
+
+
+def tolerance_indicators_tight(settings_for):
+    tolerance_indicators_at(settings_for, 0.01)
+
+
+def tolerance_error_tight(settings_for):
+    tolerance_error_at(settings_for, 0.01)
+
+
+def tolerance_budget_tight(settings_for):
+    tolerance_budget_at(settings_for, 0.01)
 
 
 # -- lecture 10 ----------------------------------------------------------------------------------
@@ -387,6 +400,9 @@ HIDDEN = {
     "moduli_c_N": [moduli_other],
     "observed_order_least_squares": [observed_order_other],
     "convergence_order_quadratic": [convergence_order_other],
+    "tolerance_indicators": [tolerance_indicators_tight],
+    "tolerance_error": [tolerance_error_tight],
+    "tolerance_budget": [tolerance_budget_tight],
     "hardening_bound": [hardening_other],
     "hardening_derivatives": [hardening_other],
     "quadratic_traction": [quadratic_other],

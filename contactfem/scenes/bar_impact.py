@@ -117,7 +117,8 @@ def build(params, *, normal=None, friction=None, system_options=None):
     stage = Stage(stepper, Steps(dt, t_end=t_end, max_cuts=0 if explicit else 4), np.zeros(system.ndof), v0_vec,
                   name="bar_impact")
     return dict(body=body, contact=contact, system=system, systems=[system], nodes=nodes, w=w, c_N=c_N,
-                stage=stage, dt=dt, sizes=dict(element=L / n, body=L))     # the accuracy indicators' lengths
+                stage=stage, dt=dt, sizes=dict(element=L / n, body=L),     # the accuracy indicators' lengths
+                rebound=True)                 # the accuracy's `separated`: the rebound is read after the impact
 
 
 def measure(m, params, records):

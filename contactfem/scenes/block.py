@@ -41,6 +41,7 @@ from ..laws.normal import PowerLaw
 from ..laws.protocol import FrictionLaw
 from ..solver import Static, Steps, System
 from . import enforcement
+from .accuracy import MESH_HEIGHT, MESH_HEIGHT_SOURCE, indicator
 from .base import Scene, Stage, simulate
 from .block_params import FITTED, LAWS, PAPER_TABLE1, PARAMS, check, friction_law, law_range, per_length, size
 
@@ -158,6 +159,9 @@ def measure(model, params, records):
                     "state": [str(v) for v in rep["state"]], "g_N": rep["g_N"], "slip_bound": Y,
                     "weights": rep["weights"]},
         "paper_table1": PAPER_TABLE1.get(params["law"], []),
+        "accuracy": {"mesh_height": indicator(params["ny"], MESH_HEIGHT, "elements through the block's height "
+                                              "(bilinear quads: too few bend too stiffly)", MESH_HEIGHT_SOURCE,
+                                              upper=False)},
         # the scan lost these; their values (the defaults) are fitted to Table 1 by `contactfem reconstruct block`
         "fitted": {k: params[k] for k in FITTED},
         "fitted_to": "Table 1 (first residual, number and pattern of the residuals, conical slip); "

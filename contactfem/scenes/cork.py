@@ -146,8 +146,10 @@ def build(params, *, normal=None, friction=None, system_options=None):
     bottom = cork.boundary_nodes("bottom")
     gas = GasPressure(cork, "bottom", bottom, np.pi * P["R_neck"]**2, P["gas_column"], P["p_step"], P["n_ramp"],
                       P["dt"], P["L_neck"])
+    element = min(float(np.min(np.diff(np.sort(Z[:, 1])))), P["R_neck"] / P["n_r"])   # along the side, across
     return dict(cork=cork, neck=neck, contacts=[contact], gas=gas, axis=axis, side=side, bottom=bottom,
-                length=length, systems=[], system_options=system_options or {})   # cork_stages.py adds the Systems
+                length=length, systems=[], system_options=system_options or {},   # cork_stages.py adds the Systems
+                sizes=dict(element=element, body=P["R_neck"]))                  # the accuracy indicators' lengths
 
 
 def law_range(P):

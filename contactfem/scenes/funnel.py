@@ -72,7 +72,8 @@ def build(params, *, normal=None, friction=None, system_options=None):
     stage = Stage(stepper, Steps(params["dt"], n_steps=params["n_steps"], max_cuts=6), np.zeros(ring.body.ndof),
                   ring.initial_velocity((0.0, -params["v0"])), name="funnel")
     return dict(ring=ring, wall=wall, contact=contact, system=system, systems=[system], stage=stage,
-                sizes=dict(element=np.pi * R / params["n_el"], body=2.0 * R))    # the accuracy indicators' lengths (n_el on the half ring):
+                sizes=dict(element=np.pi * R / params["n_el"], body=2.0 * R, radius=R))
+                # the accuracy indicators' lengths (n_el on the half ring):
                 # a beam element's size is its length (the thickness is its section's)
 
 

@@ -41,7 +41,7 @@ from -p over the element centres of both blocks; each pass's t_N at its slaves.
 Which does better (c_N = 1e6 = 1000 E / H): two passes. Fast preset (4 | 7 elements):
 one pass 2.9 % interface pressure and 1.7 % stress deviation, two passes 1.3 % and 0.8 %;
 paper preset (8 | 13): one pass 5.2 % and 2.4 %, two passes 2.0 % and 0.7 %. The
-two-pass error falls with c_N (0.5 % and 0.3 % at c_N = 1e7) while one pass stalls
+two-pass error falls with c_N (0.5 % at c_N = 1e7) while one pass stalls
 (its error comes from the load transfer, not from the penalty). Within the two-pass
 method the load splits unevenly between the passes (each pass's own t_N is far from
 p): only the sum is meaningful.

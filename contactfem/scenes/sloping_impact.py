@@ -109,7 +109,9 @@ def build(params, *, normal=None, friction=None, system_options=None):
                   ring.initial_velocity((params["vx0"], params["vy0"])), name="sloping_impact")
     return dict(ring=ring, contact=contact, system=system, systems=[system], plane=plane, stage=stage,
                 plastic=params["variant"] == "viscoplastic",      # its plastic work is no integrator's loss
-                sizes=dict(element=2.0 * np.pi * params["R"] / params["n_el"], body=2.0 * params["R"]))  # (elements' length)
+                sizes=dict(element=2.0 * np.pi * params["R"] / params["n_el"], body=2.0 * params["R"],  # (elements' length)
+                           radius=params["R"]),
+                rebound=True)                 # the accuracy's `separated`: the rebound is read after the impact
 
 
 def measure(model, params, records):

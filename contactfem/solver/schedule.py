@@ -76,6 +76,14 @@ class Steps(_Cuts):
         target = self._target(t)
         return target if target - (t + dt) < self.SAME * self.dt else t + dt
 
+    def cut(self, dt, cuts):
+        """As _Cuts.cut, and never below dt / 2^max_cuts of the schedule's dt: the rest of a halved
+        step goes on with the smaller size, and its parts, cut again each with a fresh count, would
+        otherwise halve without end (a run that crawls at 1e-11 of its step and never finishes)."""
+        if dt / 2 < self.dt / 2 ** self.max_cuts * (1 - 1e-9):
+            return None
+        return super().cut(dt, cuts)
+
 
 class Adaptive(_Cuts):
     """Steps of the size ``rule(record)`` gives after each record, up to t_end (the last one

@@ -7,6 +7,7 @@ import numpy as np
 
 from .common import TARGETS
 from .enforcement import enforcement_markdown
+from .extremes import extremes_markdown
 from .scaling import scaling_markdown
 from .semismooth import semismooth_markdown
 from .speed import PARTS, RINGS, SPEED_TARGETS, STARTUP_LAYERS
@@ -382,6 +383,8 @@ def write_markdown(res):
         L += semismooth_markdown(res["semismooth"])
     if "scaling" in res:
         L += scaling_markdown(res["scaling"])
+    if "extremes" in res:
+        L += extremes_markdown(res["extremes"])
     return "\n".join(L) + "\n"
 
 

@@ -579,6 +579,93 @@ def convergence_order_last(convergence_order):
             2.0, {"r": "..."}, rtol=1e-8)
 
 
+# settings for a tolerance: the frictionless sloping impact, run to t = 4 (the rebound is over by 2.4)
+TOLERANCE_END = 4.0
+TOLERANCE_BUDGET = {0.05: 100, 0.01: 400}         # steps: a tolerance's settings may cost this much at most
+TOLERANCE_REFERENCE = dict(c_N=5000.0, dt=0.004)  # 100 times the paper's penalty, a 25th of its step
+_TOLERANCE_RUNS = {}
+
+
+def tolerance_run(c_N, dt):
+    """The frictionless sloping impact (fast preset) with c_N and dt to t = 4, warnings kept out (the
+    check reads the accuracy section); run once per setting in this process."""
+    import warnings
+
+    from ...scenes import run_scene
+
+    key = (float(c_N), float(dt))
+    if key not in _TOLERANCE_RUNS:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            _TOLERANCE_RUNS[key] = run_scene("sloping_impact", "fast", dict(
+                c_N=key[0], dt=key[1], n_steps=max(1, round(TOLERANCE_END / key[1]))))
+    return _TOLERANCE_RUNS[key]
+
+
+def _tolerance_settings(settings_for, tol):
+    out = call(settings_for, "settings_for", tol)
+    if not isinstance(out, dict) or not {"dt", "c_N"} <= set(out):
+        raise AssertionError(f"settings_for({tol:g}) should return a dict with the keys 'dt' and 'c_N', got {out!r:.80}")
+    try:
+        dt, c_N = float(out["dt"]), float(out["c_N"])
+    except (TypeError, ValueError):
+        raise AssertionError(f"settings_for({tol:g}) should give numbers for dt and c_N, got {out!r:.80}") from None
+    if not (math.isfinite(dt) and math.isfinite(c_N) and dt > 0 and c_N > 0):
+        raise AssertionError(f"settings_for({tol:g}) gave dt = {dt:g}, c_N = {c_N:g}: both must be positive numbers")
+    return dt, c_N, max(1, round(TOLERANCE_END / dt))
+
+
+def _tolerance_checked(settings_for, tol):
+    """The run of the student's settings at tol, within the budget (a run past it is not made)."""
+    dt, c_N, steps = _tolerance_settings(settings_for, tol)
+    budget = TOLERANCE_BUDGET[tol]
+    if steps > budget:
+        raise AssertionError(f"at tol = {tol:g} your dt = {dt:g} takes {steps} steps to t = {TOLERANCE_END:g}; the "
+                             f"budget is {budget} (dt >= {TOLERANCE_END / budget:g}): a step far smaller than the "
+                             "tolerance needs is work wasted; the run was not made")
+    try:
+        return dt, c_N, tolerance_run(c_N, dt)
+    except (ValueError, RuntimeError) as err:
+        raise AssertionError(f"at tol = {tol:g} the run with dt = {dt:g}, c_N = {c_N:g} stopped: {err}") from None
+
+
+def tolerance_indicators_at(settings_for, tol):
+    dt, c_N, r = _tolerance_checked(settings_for, tol)
+    past = [f"{k} = {v['value']:.3g} ({v['bound']} {v['threshold']:.3g})" for k, v in r["accuracy"].items()
+            if isinstance(v, dict) and not v["ok"]]
+    if past:
+        raise AssertionError(f"at tol = {tol:g} your settings dt = {dt:g}, c_N = {c_N:g} leave indicators past their "
+                             f"thresholds: {'; '.join(past)}. Read r['accuracy'][name]['what'] and ['source']: which "
+                             "setting moves each one?")
+
+
+def tolerance_error_at(settings_for, tol):
+    dt, c_N, r = _tolerance_checked(settings_for, tol)
+    ref = tolerance_run(**TOLERANCE_REFERENCE)["rebound_vy"]
+    err = abs(r["rebound_vy"] - ref) / abs(ref)
+    if not err <= tol:
+        raise AssertionError(f"at tol = {tol:g} your settings dt = {dt:g}, c_N = {c_N:g} give a rebound v_y = "
+                             f"{r['rebound_vy']:.4f}, {100 * err:.2g} % off the reference {ref:.4f} (c_N = "
+                             f"{TOLERANCE_REFERENCE['c_N']:g}, dt = {TOLERANCE_REFERENCE['dt']:g}): more than the "
+                             "tolerance. Which error is it: the step's (Newmark damps the rebound) or the penalty's?")
+
+
+def tolerance_budget_at(settings_for, tol):
+    _tolerance_checked(settings_for, tol)
+
+
+def tolerance_indicators(settings_for):
+    tolerance_indicators_at(settings_for, 0.05)
+
+
+def tolerance_error(settings_for):
+    tolerance_error_at(settings_for, 0.05)
+
+
+def tolerance_budget(settings_for):
+    tolerance_budget_at(settings_for, 0.05)
+
+
 # -- lecture 10: your own law ------------------------------------------------------------------
 
 def _hardening(LinearHardening):
@@ -1466,6 +1553,9 @@ EXERCISES = {e.name: e for e in [
     _ex("ex09_convergence_order", "09_speed_accuracy", "medium", False,
         "Newton's order from a residual history: consistent tangent against staggered",
         (convergence_order_linear, 1), (convergence_order_quadratic, 2), (convergence_order_last, 1)),
+    _ex("ex09_settings_for_tolerance", "09_speed_accuracy", "medium", False,
+        "the step and the penalty of the sloping impact for a tolerance, checked with the run's indicators",
+        (tolerance_indicators, 2), (tolerance_error, 2), (tolerance_budget, 1)),
     _ex("ex10_linear_hardening", "10_write_your_own_law", "easy", True,
         "a slip-hardening friction law with its derivatives, passing check_law",
         (hardening_bound, 2), (hardening_derivatives, 2), (hardening_check_law, 1)),
