@@ -100,7 +100,7 @@ def solve(params, *, friction=None, normal=None, progress=None, system_options=N
     """Build the block and apply the load in ``n_steps`` static steps of the pseudo-time
     (default: the whole load in ONE step, Newton from u = 0). Returns build()'s dict plus the
     records and what ``converged`` reads from them."""
-    model = build(params, friction=friction, normal=normal, **(system_options or {}))
+    model = build(params, friction=friction, normal=normal, system_options=system_options)
     records = simulate(model, params, progress)
     return dict(model, records=records, **converged(model, records))
 
