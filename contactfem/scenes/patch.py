@@ -89,13 +89,7 @@ def build(params, *, normal=None, friction=None, system_options=None):
     from ..bodies.loads import OverhangPressure, Pressure
 
     W, H, E, nu = params["W"], params["H"], params["E"], params["nu"]
-    e = W / params["nx_lower"]
-    xs_lower = -0.5 * e + e * np.arange(params["nx_lower"] + 2)      # [-e/2, W + e/2], shifted
-    xs_upper = np.linspace(0.0, W, params["nx_upper"] + 1)
-    if params["contact_discretization"] == "node_to_segment" and \
-            np.min(np.abs(xs_upper[:, None] - xs_lower[None, :])) < 1e-6 * W:
-        raise ValueError("parameters nx_lower, nx_upper put a slave node exactly above a master node "
-                         "(node-to-segment switching is non-smooth there): choose nx_upper odd")
+    e, xs_lower, xs_upper = columns(params)
     lower = block(xs_lower, 0.0, H, params["ny"], "lower", E, nu)
     upper = block(xs_upper, H, 2 * H, params["ny"], "upper", params["E_upper"], nu)
     law = normal or PowerLaw(params["c_N"], 1.0)
@@ -196,14 +190,27 @@ def measure(m, params, records):
     return result
 
 
-
 def law_range(params):
     """Normal law only: probed down to a penetration of the blocks' height."""
     return dict(g=params["H"])
 
+
+def columns(params):
+    """The element size of the lower block and the x of both blocks' node columns: the lower
+    block's [-e/2, W + e/2] (shifted by half an element), the upper block's [0, W]."""
+    W, e = params["W"], params["W"] / params["nx_lower"]
+    return e, -0.5 * e + e * np.arange(params["nx_lower"] + 2), np.linspace(0.0, W, params["nx_upper"] + 1)
+
+
 def check(params):
-    """enforcement.check, and a penalty (or Lagrange's steering c_N) that round-off can resolve."""
+    """enforcement.check, no slave node exactly above a master node with node-to-segment, and a
+    penalty (or Lagrange's steering c_N) that round-off can resolve."""
     enforcement.check(params)
+    _, xs_lower, xs_upper = columns(params)
+    if params["contact_discretization"] == "node_to_segment" and \
+            np.min(np.abs(xs_upper[:, None] - xs_lower[None, :])) < 1e-6 * params["W"]:
+        raise ValueError("parameters nx_lower, nx_upper put a slave node exactly above a master node "
+                         "(node-to-segment switching is non-smooth there): choose nx_upper odd")
     enforcement.check_roundoff(params["c_N"], params["p"], max(params["W"], 2.0 * params["H"]))
     enforcement.check_steering(params, min(params["E"], params["E_upper"]) / params["H"], "E / H")
 
