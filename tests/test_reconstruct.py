@@ -448,3 +448,23 @@ def test_fig8_figure_carries_its_runs():
         frac, red = rc.fig8_remark(runs["conical"], runs["parabolic"])
         assert (frac, red) == pytest.approx((data["readings"][name]["fig8_fraction"],
                                              data["readings"][name]["fig8_min_reduction"]), rel=1e-12)
+
+
+@pytest.mark.parametrize("enabled", [True, False])
+def test_the_studies_keep_their_cases_on_disk(enabled, monkeypatch):
+    """A study's case is solved once for the same code and kept by joblib.Memory in the cache
+    folder (the next process reads it), unless the cache is off (--no-cache): then every time."""
+    import os
+
+    solved = []
+
+    def case(params):
+        solved.append(params["law"])
+        return dict(converged=True, law=params["law"])
+    monkeypatch.setattr(rc, "_block_case", case)
+    params = get_scene("block").resolve("paper")
+    solve = rc.cases(enabled)
+    first, again = solve("block", params), rc.cases(enabled)("block", dict(reversed(list(params.items()))))
+    assert first == again == dict(converged=True, law="conical")
+    assert solved == (["conical"] if enabled else ["conical", "conical"])
+    assert os.path.isdir(os.path.join(os.environ["CONTACTFEM_CACHE"], "figures")) == enabled
