@@ -45,10 +45,9 @@ def check(params):
     if params.get("enforcement") == "augmented":
         raise ValueError("parameter enforcement = augmented is offered with contact_discretization = node_to_segment "
                          "only: use penalty or lagrange with mortar")
-    for name, value in (("tangent", "consistent"), ("contact_integration", "standard")):
-        if params.get(name, value) != value:
-            raise ValueError(f"parameter {name} = {params[name]} is offered with contact_discretization = "
-                             f"node_to_segment only: mortar takes {name} = {value}")
+    if params.get("tangent", "consistent") != "consistent":        # (contact_integration: the scene's check)
+        raise ValueError(f"parameter tangent = {params['tangent']} is offered with contact_discretization = "
+                         "node_to_segment only: mortar takes tangent = consistent")
 
 
 def outward(body, nodes):

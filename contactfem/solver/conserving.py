@@ -54,7 +54,7 @@ class EnergyConsistent:
 
     def __init__(self, system, **newton_options):
         self.system, self.newton_options = system, newton_options
-        self.rotations = np.concatenate([b.dof_offset + np.asarray(b.rotation_dofs, dtype=int)
+        self.rotations = np.concatenate([system.offset(b) + np.asarray(b.rotation_dofs, dtype=int)
                                          for b in system.bodies] + [np.zeros(0, int)])
         for c in system.contacts:
             if c.integration != "energy_consistent":
@@ -72,10 +72,11 @@ class EnergyConsistent:
         G = np.zeros(s.ndof)
         rows, cols, vals = [], [], []
         for b in s.bodies:
-            sl = slice(b.dof_offset, b.dof_offset + b.ndof)
+            off = s.offset(b)
+            sl = slice(off, off + b.ndof)
             F, r, c, v = b.discrete_gradient(u0[sl], u1[sl])
             G[sl] += F
-            rows.append(np.asarray(r, int) + b.dof_offset), cols.append(np.asarray(c, int) + b.dof_offset)
+            rows.append(np.asarray(r, int) + off), cols.append(np.asarray(c, int) + off)
             vals.append(np.asarray(v, float))
         return G, rows, cols, vals
 
@@ -102,14 +103,14 @@ class EnergyConsistent:
             # conjugate to dq (chord dq = d there); the derivative of chord on the diagonal
             Gc, rows_c, cols_c, vals_c = np.zeros(s.ndof), [], [], []
             for ct, h in zip(s.contacts, state.contacts):
-                cs = ct.evaluate(u1, t1, dt, u, history=h)
+                cs = ct.evaluate(u1, t1, dt, u, history=h, offsets=s.offsets)
                 Rc, r, c, vv = cs.scatter(s.ndof)
                 states.append(cs)
                 Gc += Rc
                 rows_c.append(np.asarray(r, int)), cols_c.append(np.asarray(c, int)), vals_c.append(np.asarray(vv, float))
             Pm = np.zeros(s.ndof)
             for load, ls in zip(s.loads, state.loads):
-                P, r, c, vv = load.assemble(um, tm, ls)
+                P, r, c, vv = load.assemble(um, tm, ls, offsets=s.offsets)
                 Gc -= P
                 Pm += P
                 rows_c.append(np.asarray(r, int)), cols_c.append(np.asarray(c, int))
