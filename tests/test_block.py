@@ -169,6 +169,7 @@ def test_bad_input(over):
         solve(SCENE.resolve("canonical", over))
 
 
+@pytest.mark.slow
 def test_cli_json(tmp_path):
     out = tmp_path / "block.json"
     subprocess.run([sys.executable, "-m", "contactfem", "run", "block", "--preset", "canonical", "--set", "law=coulomb",
