@@ -183,7 +183,7 @@ SCENE = Scene(
         Param("integrator", "newmark", choices=("newmark", "central_difference"),
               doc="implicit Newmark (delta, beta_newmark) or explicit central differences (stable for "
                   "courant < 1; no Newton, no cutback)"),
-        *time_integration.newmark_params(0.5, 0.25, "average acceleration"),
+        *time_integration.newmark_params(0.5, 0.25, "chosen, average acceleration"),
         Param("t_end", 1.5, "2L/c", 0.0, None, low_open=True, doc="simulated time in units of 2 L / c"),
         time_integration.CONTACT_INTEGRATION_PARAM,
         *enforcement.ENFORCEMENT_PARAMS,

@@ -109,7 +109,7 @@ PARAMS = (
           doc="largest axial travel per step (adaptive dt). Chosen: a quarter of an element"),
     Param("t_end", 4.0e-3, "s", 0.0, low_open=True, doc="latest end of the run (paper: Fig 15 up to 3 ms)"),
     Param("t_flight", 4.0e-4, "s", 0.0, doc="the run stops this long after the exit (paper: 3.0 - 2.65 ms)"),
-    *newmark_params(0.7, 0.4, "paper: 0.7, 0.4"),
+    *newmark_params(0.7, 0.4, "paper"),
     Param("max_cuts", 6, "", 0, 20, doc="step halvings allowed when Newton fails"),
     Param("atol", 1e-8, "N", 0.0, doc="Newton absolute tolerance (a floor for a step without forces; the breakaway "
           "step is a knife edge: the paper preset exits at 2.71 ms with 1e-6 or 1e-10 N, at 2.86 ms with 1e-8 N, "

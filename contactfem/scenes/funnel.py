@@ -155,7 +155,7 @@ SCENE = Scene(
         Param("dt", 0.1, "T", 0.0, None, low_open=True, doc="time step (paper)"),
         Param("n_steps", 150, "", 4, 100000,
               doc="number of steps (chosen: the scan gives none; 150 covers the impact and 7 s after it)"),
-        *time_integration.newmark_params(0.7, 0.4, "chosen as in Sec. 5.3: 0.7, 0.4"),
+        *time_integration.newmark_params(0.7, 0.4, "chosen as in Sec. 5.3"),
         time_integration.CONTACT_INTEGRATION_PARAM,
         MASS_MATRIX_PARAM,
         Param("outline_every", 5, "", 1, 100000, doc="store the ring outline every this many steps (paper: 5)"),

@@ -224,7 +224,7 @@ SCENE = Scene(
         Param("dt", 0.01, "s", 0.0, None, low_open=True, doc="time step (paper: 0.01)"),
         Param("t_end", 2.0, "s", 0.0, None, low_open=True,
               doc="duration (chosen: 2 s, where the paper's exact position is 376 cm)"),
-        *time_integration.newmark_params(0.7, 0.4, "paper: 0.7, 0.4"),
+        *time_integration.newmark_params(0.7, 0.4, "paper"),
         time_integration.CONTACT_INTEGRATION_PARAM,
         MASS_MATRIX_PARAM,
         Param("outline_interval", 0.25, "s", 0.0, None, low_open=True,

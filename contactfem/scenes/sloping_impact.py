@@ -218,7 +218,7 @@ SCENE = Scene(
                   "(without the c_N^s C coupling of eq 49); the residual is always eq 28"),
         Param("dt", 0.1, "T", 0.0, None, low_open=True, doc="time step (paper)"),
         Param("n_steps", 200, "", 1, 100000, doc="number of steps (paper: 200)"),
-        *time_integration.newmark_params(0.7, 0.4, "paper: 0.7, 0.4"),
+        *time_integration.newmark_params(0.7, 0.4, "paper"),
         time_integration.CONTACT_INTEGRATION_PARAM,
         MASS_MATRIX_PARAM,
         Param("outline_every", 20, "", 1, 100000, doc="store the ring outline every this many steps (figures)"),

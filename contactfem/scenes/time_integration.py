@@ -24,10 +24,10 @@ def newmark_params(delta, beta, source):
     (solver.newmark: delta in [0.5, 1], beta in (0, 0.5]); ``source`` says where the defaults
     come from (e.g. "paper")."""
     return (Param("delta", delta, "", **DELTA_RANGE,
-                  doc=f"Newmark delta, the usual gamma ({source}; 0.5 with beta 0.25 conserves energy, below 0.5 "
-                      "every step amplifies)"),
+                  doc=f"Newmark delta, the usual gamma ({source}: {delta:g}; 0.5 with beta 0.25 conserves energy, "
+                      "below 0.5 every step amplifies)"),
             Param("beta_newmark", beta, "", **BETA_RANGE,
-                  doc=f"Newmark beta ({source}; stable for every step when beta >= (delta + 1/2)^2 / 4)"))
+                  doc=f"Newmark beta ({source}: {beta:g}; stable for every step when beta >= (delta + 1/2)^2 / 4)"))
 
 
 def contact_integration(params):
