@@ -209,6 +209,7 @@ PARENT = textwrap.dedent("""
 """)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sig,code", [(signal.SIGINT, 130), (signal.SIGTERM, 143), (signal.SIGKILL, -9)])
 def test_a_stopped_batch_process_leaves_no_worker(tmp_path, sig, code):
     """Ctrl-C and SIGTERM to the batch's process end it at once with every worker and the
@@ -229,6 +230,7 @@ def test_a_stopped_batch_process_leaves_no_worker(tmp_path, sig, code):
         p.wait()
 
 
+@pytest.mark.slow
 def test_a_task_whose_worker_died_runs_again_on_a_fresh_worker_not_an_idle_one(tmp_path):
     """Two workers; one task kills its worker on its first attempt while the other worker
     is idle: the second attempt runs in a process that ran nothing before."""

@@ -113,6 +113,7 @@ def inside(p):
     return values
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(SCENES))
 def test_what_the_params_accept_the_build_accepts(name):
     """No later rule disagrees: every value its Params (and the scene's cross-parameter check)
