@@ -80,6 +80,7 @@ def test_rolling_ring_sliding_reference():
     assert abs(r["v_final_rel_err"]) < 1e-6 and not flagged
 
 
+@pytest.mark.slow
 def test_presets_unflagged():
     for name in ("sloping_impact", "rolling_ring", "block", "patch"):
         r, flagged = _run(name, {})
@@ -87,12 +88,14 @@ def test_presets_unflagged():
         assert "equilibrium" in r["accuracy"]
 
 
+@pytest.mark.slow
 def test_energy_consistent_stiff_penalty_keeps_energy_or_is_flagged():
     r, flagged = _run("sloping_impact", {"contact_integration": "energy_consistent", "c_N": 5e7})
     assert abs(r["energy_error"]) < 1e-8                          # the force test resolves it (was 3.3e-6)
     assert "impact_steps" in flagged                              # one step for the whole impact
 
 
+@pytest.mark.slow
 def test_cli_strict_exits_1_with_one_line_per_indicator(tmp_path):
     out = subprocess.run([sys.executable, "-m", "contactfem", "run", "block", "--set", "c_N=10", "--strict"],
                          capture_output=True, text=True)

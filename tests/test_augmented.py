@@ -142,6 +142,7 @@ def hertz_runs():
     return out
 
 
+@pytest.mark.slow
 def test_hertz_augmented_reaches_1e8_in_6_updates(hertz_runs):
     r = hertz_runs["default"]
     assert r["c_N_per_length_min"] == 1e9                 # the scene's default c_N
@@ -150,6 +151,7 @@ def test_hertz_augmented_reaches_1e8_in_6_updates(hertz_runs):
     assert pen["gap_violation"] > 1e-6                    # the penalty: a penetration of ~1e-5 a
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("c_N", [1e7, 1e11])
 def test_hertz_augmented_independent_of_penalty(hertz_runs, c_N):
     ref, r = hertz_runs[1e9], hertz_runs[c_N]

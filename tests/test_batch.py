@@ -75,6 +75,7 @@ def test_values_come_back_by_key_from_several_workers():
     assert all(isinstance(o, Outcome) for o in out)
 
 
+@pytest.mark.slow
 def test_outcomes_come_in_completion_order():
     out = list(run_batch(act, [("slow", ("sleep", 1.0)), ("fast", ("sleep", 0.0))], jobs=2))
     assert [o.key for o in out] == ["fast", "slow"]
@@ -104,6 +105,7 @@ def test_a_task_whose_worker_died_once_succeeds_on_a_fresh_worker(tmp_path):
     assert out == [Outcome("once", True, "second time", None, 2)]
 
 
+@pytest.mark.slow
 def test_a_task_over_its_time_limit_is_stopped_and_not_retried():
     t0 = time.monotonic()
     out = by_key(run_batch(act, [("hang", ("sleep", 60)), ("quick", ("sleep", 0.1))], jobs=2, timeout=1.5))
@@ -143,6 +145,7 @@ def test_a_value_that_cannot_be_sent_back_is_an_error():
     assert by_key(out)["g"].ok
 
 
+@pytest.mark.slow
 def test_workers_ignore_ctrl_c():
     out = run_batch(act, [("a", ("pid",)), ("b", ("sleep", 1.0))], jobs=1)
     pid = next(out).value
@@ -206,6 +209,7 @@ PARENT = textwrap.dedent("""
 """)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sig,code", [(signal.SIGINT, 130), (signal.SIGTERM, 143), (signal.SIGKILL, -9)])
 def test_a_stopped_batch_process_leaves_no_worker(tmp_path, sig, code):
     """Ctrl-C and SIGTERM to the batch's process end it at once with every worker and the
@@ -226,6 +230,7 @@ def test_a_stopped_batch_process_leaves_no_worker(tmp_path, sig, code):
         p.wait()
 
 
+@pytest.mark.slow
 def test_a_task_whose_worker_died_runs_again_on_a_fresh_worker_not_an_idle_one(tmp_path):
     """Two workers; one task kills its worker on its first attempt while the other worker
     is idle: the second attempt runs in a process that ran nothing before."""

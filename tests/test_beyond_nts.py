@@ -110,6 +110,7 @@ def block_ssn():
     return {law: run_scene("block", "paper", dict(over, enforcement="lagrange")) for law, over in LAWS.items()}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("law", list(LAWS))
 def test_semismooth_newton_on_the_block(block_ssn, law):
     r = block_ssn[law]
@@ -129,6 +130,7 @@ def test_semismooth_newton_on_the_block(block_ssn, law):
     assert res[-1] < 1e-12 * res[0] and res[-2] > 1e3 * res[-1]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("law", ["coulomb", "parabolic"])
 def test_semismooth_newton_does_not_depend_on_c_N_or_c_T(block_ssn, law):
     ref = block_ssn[law]
@@ -140,6 +142,7 @@ def test_semismooth_newton_does_not_depend_on_c_N_or_c_T(block_ssn, law):
             assert np.max(np.abs(a - b)) < 1e-10 * np.max(np.abs(b)), (over, key)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("law", list(LAWS))
 def test_semismooth_newton_tractions_are_the_augmented_lagrangians(block_ssn, law):
     """Uzawa to uzawa_tol = 1e-11 (its violation stalls at 7e-12, round-off of the shifted gap): its
@@ -153,6 +156,7 @@ def test_semismooth_newton_tractions_are_the_augmented_lagrangians(block_ssn, la
     assert aug["contact"]["state"] == r["contact"]["state"]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("discretization", ["node_to_segment", "mortar"])
 def test_quadratic_convergence_at_finite_strain(discretization):
     """The finite-strain block (St Venant-Kirchhoff, plane strain, a quarter of the loads): the
@@ -178,6 +182,7 @@ def test_mortar_semismooth_newton_on_the_block():
 
 # -- bar impact and refusals -------------------------------------------------------------------
 
+@pytest.mark.slow
 def test_bar_impact_takes_both_options():
     """Exact constraints under the paper's Newmark 0.7/0.4: the contact lasts 2 L / c to the step,
     with no penetration, and the energy falls by about what the rule removes with the penalty

@@ -169,6 +169,7 @@ def test_bad_input(over):
         solve(SCENE.resolve("canonical", over))
 
 
+@pytest.mark.slow
 def test_cli_json(tmp_path):
     out = tmp_path / "block.json"
     subprocess.run([sys.executable, "-m", "contactfem", "run", "block", "--preset", "canonical", "--set", "law=coulomb",
@@ -198,3 +199,17 @@ def test_c_N_documentation_states_the_penetration():
     assert r["max_penetration"] == pytest.approx(-g_N.min(), rel=1e-12)
     assert np.argmax(t_N) == np.argmin(g_N) in (0, len(t_N) - 1)
     assert r["max_penetration"] < 0.02 * P["p_y"] * P["height"] / P["E"]
+
+
+def test_solve_takes_system_options():
+    """solve(params, system_options=...) hands the options to every System it builds (the
+    linear algebra and the timings asked for), and the solution is the same as without them."""
+    from contactfem.solver.instrument import Timings
+
+    params = SCENE.resolve("fast")
+    timings = Timings()
+    s = solve(params, system_options=dict(linear_algebra="dense", instrument=timings))
+    assert s["system"].linear_algebra == "dense" and s["system"].instrument is timings
+    ref = solve(params)
+    assert ref["system"].linear_algebra != "dense"
+    assert np.allclose(s["u"], ref["u"], rtol=1e-9, atol=1e-12)

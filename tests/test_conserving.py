@@ -134,6 +134,7 @@ def test_bar_impact_energy_any_phase(phase):
     assert abs(r["error_rebound"]) < 0.05                      # it did rebound
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("c_N_factor", [0.1, 1.0, 10.0, 100.0, 1000.0])
 def test_bar_impact_energy_any_penalty(c_N_factor):
     r = bar(phase=0.3, c_N_factor=c_N_factor)
@@ -156,6 +157,7 @@ def test_sloping_impact_frictionless_conserves_energy():
     assert paper["energy_after_rebound_rel"] < -0.05
 
 
+@pytest.mark.slow
 def test_sloping_impact_friction_only_dissipates():
     r = run_scene("sloping_impact", "fast", {"contact_integration": "energy_consistent", "variant": "frictional"})
     E, D = np.array(r["energy_total"]), np.array(r["energy_dissipation"])
@@ -171,6 +173,7 @@ def test_viscoplastic_ring_refuses_energy_consistent():
         run_scene("sloping_impact", "fast", {"contact_integration": "energy_consistent", "variant": "viscoplastic"})
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("scene, over", [("funnel", {"n_steps": 40}), ("rolling_ring", {"t_end": 0.3})])
 def test_other_ring_scenes_balance_energy(scene, over):
     """The funnel (rigid polyline, symmetry supports) and the rolling ring (gravity, Coulomb
@@ -210,6 +213,7 @@ def flying_ring(kind="beam", omega=0.3, wobble=0.3, n_steps=200, atol=1e-11):
     return records, momenta
 
 
+@pytest.mark.slow
 def test_free_flight_keeps_momentum_and_energy():
     """A spinning ring that deforms as it flies: the discrete-gradient correction acts on the
     increment without its translation, so the momentum (the centre of mass's velocity) stays
@@ -223,6 +227,7 @@ def test_free_flight_keeps_momentum_and_energy():
     assert drift <= 1e-10, drift
 
 
+@pytest.mark.slow
 def test_frictionless_rebound_keeps_the_velocity_along_the_plane():
     """A frictionless flat plane pushes along its normal only: the rebound v_x = 2 to 1e-8
     (the correction's resultant along the plane is zero, whatever the ring's deformation)."""

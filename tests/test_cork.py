@@ -36,11 +36,13 @@ def test_fast_run_completes_and_the_cork_leaves(fast):
     assert fast["newton_iterations_total"] > 0
 
 
+@pytest.mark.slow
 def test_penetration_stays_below_two_percent_of_the_radius(fast):
     # stated bound: |g_N| < 2 % of the neck radius, press fit and exit included
     assert fast["max_penetration_ratio"] < 0.02, fast["max_penetration_ratio"]
 
 
+@pytest.mark.slow
 def test_fast_preset_exit_velocity_is_near_the_paper(fast, paper):
     # paper "about 28 m/s" (two digits: +-2 %). The fast preset differs from the paper preset
     # only by its coarser steps around the exit (dt_fine 2e-5 instead of 5e-6 s, 1 mm of travel
@@ -52,6 +54,7 @@ def test_fast_preset_exit_velocity_is_near_the_paper(fast, paper):
     assert abs(v - PAPER_V) / PAPER_V < 0.15, f"paper {PAPER_V} m/s, ours {v:.2f} m/s, tolerance 15 %"
 
 
+@pytest.mark.slow
 def test_press_fit_force_and_breakaway(fast):
     # paper: normal force "about 2500 N" (one to two digits: the scan prints no more). Ours is
     # fitted through R_tip, so this checks the calibration holds (2 %: the rounding of "2500"),
@@ -61,6 +64,7 @@ def test_press_fit_force_and_breakaway(fast):
     assert fast["breakaway_pressure_MPa"] is not None and fast["breakaway_pressure_MPa"] <= 0.8 + 1e-9
 
 
+@pytest.mark.slow
 def test_fast_preset_leaves_by_static_breakaway(fast):
     # the mechanism of the paper preset (test below): the applied pressure exceeds the static
     # friction reserve mu N / (pi R^2), so the cork leaves; a coarser mesh would overestimate
@@ -87,6 +91,7 @@ def test_press_fit_only_gives_the_same_margin(fast):
     assert not press_fit_only(SCENE.resolve("fast", {"R_tip": 10.05}))["press_fit_calibrated"]
 
 
+@pytest.mark.slow
 def test_boyle_pressure_is_explicit_in_the_volume(fast):
     # p_k = p0 V0 / V_(k-1) on every Boyle step (pressure from the last converged state)
     P = fast["parameters"]
@@ -171,6 +176,7 @@ def test_paper_preset_leaves_by_static_breakaway_near_28_m_s(paper):
     assert r["max_penetration_ratio"] < 0.02
 
 
+@pytest.mark.slow
 def test_knife_edge_figure_draws_from_its_data(tmp_path, monkeypatch):
     # the figure is computed by `contactfem figures` (minutes); here it is drawn from data of
     # the same shape, and the grid switches to the full one with CONTACTFEM_SLOW
@@ -223,6 +229,7 @@ def test_exit_study_reads_the_scene(exit_study, paper):
     assert (s["dt_paper_s"], s["n_press"]) == (paper["parameters"]["dt"], paper["parameters"]["n_press"])
 
 
+@pytest.mark.slow
 def test_the_closing_step_is_the_converged_rule(exit_study):
     """Why the closing step is kept: it acts through the press fit only (switched off in the pop,
     the exit stays in its step), and with the preset's press-fit increments it already gives the
@@ -236,6 +243,7 @@ def test_the_closing_step_is_the_converged_rule(exit_study):
     assert abs(s["exit_without_ms"] - fit["without"]) > 10 * ONE_STEP_MS
 
 
+@pytest.mark.slow
 def test_refined_exit_lies_within_the_paper_steps_error_of_the_window(exit_study, paper):
     """The README and lecture 08: refined in the neck (the ramp kept), both rules leave at the same
     time, and the paper's window lies within the discretisation error of the paper's own step
@@ -257,6 +265,7 @@ def test_refined_exit_lies_within_the_paper_steps_error_of_the_window(exit_study
     assert ("both rules leave just past the paper's window" in readme) == (gap > 0)
 
 
+@pytest.mark.slow
 def test_published_exit_numbers_are_the_run(exit_study, paper):
     """summary.md (and the README), figures/cork_exit_time.md and its full study print what the
     runs give: the paper preset's exit time and velocity, the refined exit of either rule."""

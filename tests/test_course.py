@@ -259,6 +259,7 @@ def test_graded_solution_stub_and_wrong_answer(course, name):
     assert re.search(_wrong(name)[1], note), note
 
 
+@pytest.mark.slow
 def test_graded_totals(course):
     from contactfem.lab.course.checks import MANUAL
 
@@ -270,6 +271,7 @@ def test_graded_totals(course):
         assert float(row["possible"]) == sum(ex[n].points for n in mine) + sum(m.points for m in written)
 
 
+@pytest.mark.slow
 def test_student_version_holds_no_solution_text(course):
     """Every line of a solution that appears nowhere else in its lecture is absent from the
     student build (cells and metadata alike), and present in the instructor build."""
@@ -347,6 +349,7 @@ def test_course_command_line_refuses_bad_input(tmp_path, capsys):
     assert not (tmp_path / "x.csv").exists()
 
 
+@pytest.mark.slow
 def test_a_broken_submission_is_a_row_not_a_crash(course, tmp_path):
     from contactfem.lab.course import grade
 

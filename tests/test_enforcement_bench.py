@@ -27,6 +27,7 @@ def test_augmented_meets_the_target_at_every_penalty(study):
         assert g[1] / g[2] == pytest.approx(100.0, rel=0.2) and g[0] > g[1]
 
 
+@pytest.mark.slow
 def test_in_the_bench_and_its_markdown(study):
     assert STUDIES["enforcement"] is enforcement_study
     md = write_markdown({"machine": {}, "enforcement": study})
@@ -60,6 +61,7 @@ def test_semismooth_newton_meets_the_target_in_fewer_solves_than_uzawa(ssn_study
         assert rows["penalty"]["c_N"] > 1e3 * s["c_N_default"]
 
 
+@pytest.mark.slow
 def test_semismooth_study_in_the_bench_and_its_markdown(ssn_study):
     from contactfem.lab.bench.semismooth import semismooth_markdown, semismooth_study
 

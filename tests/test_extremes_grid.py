@@ -33,6 +33,7 @@ def _outcome(c_N, dt):
     return ("flagged" if flagged else "clean"), r
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("factor", [1e-4, 1.0, 1e4])
 def test_no_run_exits_unflagged_and_wrong(factor):
     c_N = C_N * factor

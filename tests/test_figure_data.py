@@ -129,6 +129,7 @@ def test_every_figure_has_committed_data_and_a_test():
         assert d["figure"] == s and d["code_version"].startswith("0.") and isinstance(d["parameters"], dict)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("stem", FAST)
 def test_committed_figure_data_is_a_fresh_run(stem, tmp_path, monkeypatch):
     assert_same_data(stem, tmp_path, monkeypatch)

@@ -105,6 +105,7 @@ def test_large_meshes_announce_themselves(monkeypatch, capsys):
     assert "building the mesh" in err and "160,000 elements" in err
 
 
+@pytest.mark.slow
 def test_a_non_finite_residual_is_one_line_of_cause_and_the_history():
     out = run_cli("run", "block", "--set", "c_N=1e300")
     lines = out.stderr.strip().splitlines()

@@ -32,6 +32,7 @@ def test_fast_preset_matches_hertz():
     assert r["newton_iterations_total"] >= 1
 
 
+@pytest.mark.slow
 def test_half_width_is_measured_on_the_reference_configuration():
     # the fit uses the undeformed positions X (small-strain theory): the profile's x are
     # the reference positions of the contact nodes, not the deformed ones
@@ -42,6 +43,7 @@ def test_half_width_is_measured_on_the_reference_configuration():
     assert np.all(np.diff(x) > 0) and x[0] == pytest.approx(0.0, abs=1e-12)   # B = (0, -R) stays at x = 0
 
 
+@pytest.mark.slow
 def test_half_width_converges_under_refinement():
     # the refinement study behind the 0.5 % tolerance above: |error a| falls from 16^2 to 32^2
     # (measured +0.34 % -> +0.04 %); on deformed coordinates it grew instead (-0.37 -> -0.73 %)
@@ -49,6 +51,7 @@ def test_half_width_converges_under_refinement():
     assert e[1] < e[0] < 5e-3, e
 
 
+@pytest.mark.slow
 def test_per_length_penalty_is_mesh_independent_nodal_is_not():
     # a soft penalty (c_N = 1e7 MPa/mm) so that the penalty compliance shows; the nodal
     # value is the per-length one times the contact element size of the 16 x 16 mesh
@@ -63,6 +66,7 @@ def test_per_length_penalty_is_mesh_independent_nodal_is_not():
     assert nd[1]["c_N_per_length_max"] / nd[0]["c_N_per_length_max"] == pytest.approx(2.0, rel=0.1)
 
 
+@pytest.mark.slow
 def test_finite_strain_option_runs():
     r = run_scene("hertz", "fast", {"n_el": 16, "material": "neohooke"})
     assert abs(r["error_p0"]) < 0.02

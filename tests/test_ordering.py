@@ -60,7 +60,7 @@ def run(rng=None, shuffle_slaves=False, deformable=False):
     out = []
     for b, old in zip(bodies, (old_up, old_lo) if deformable else (old_up,)):
         U = np.empty((b.X.shape[0], 2))
-        U[old] = hist.u[b.dof_offset + b.xdofs]
+        U[old] = hist.u[system.global_dofs(b, b.xdofs)]
         out.append(U)
     return out, hist
 

@@ -150,6 +150,7 @@ def test_cork_sensitivity_md_as_chosen_row_is_the_run():
     assert [_cells(ln)[0] for ln in table[2:]] == [label for label, _ in F.SENSITIVITY]
 
 
+@pytest.mark.slow
 def test_cork_exit_time_md_is_its_json_and_the_quick_cases_are_the_runs():
     """figures/cork_exit_time.md is written from figures/cork_exit_time.json (the full study,
     CONTACTFEM_SLOW=1, 38 runs): the file equals the markdown made from the JSON. The quick

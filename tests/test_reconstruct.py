@@ -50,6 +50,7 @@ def test_no_uniform_block_reaches_the_printed_first_residual():
         assert x["p_x"] * x["height"] < 0.5 * x["p_y"] * x["width"]
 
 
+@pytest.mark.slow
 def test_readme_closest_first_residual_states_its_filters():
     """The README's closest geometry holds with the study's shape filters (blocks, usable elements),
     which it states, and it names the closest without them; on a grid of step 0.1 none, filtered or
@@ -179,6 +180,7 @@ def test_block_study_records_every_outcome(study):
             assert (r[f"outcome_{law}"] == "no_equilibrium") == (T > cap * (1 + 1e-9))
 
 
+@pytest.mark.slow
 def test_block_study_physical_screen(study):
     """Only readings that keep the block on its foundation are ranked: the largest penetration
     at most PENETRATION_FRACTION of the height (argued beside the constant), no inverted element."""
@@ -196,6 +198,7 @@ def test_block_study_physical_screen(study):
     assert soft["outcome"] == "rejected_penetration" and soft["max_penetration_ratio"] > 1.0
 
 
+@pytest.mark.slow
 def test_the_preset_is_the_fit(study):
     """FITTED: the preset's reading is the study's choice, and this is the one place that checks
     the fit's own criterion (admissible, and as many of the paper's facts as any admissible
@@ -207,6 +210,7 @@ def test_the_preset_is_the_fit(study):
     assert mine["n_facts"] == max(r["n_facts"] for r in rows)
 
 
+@pytest.mark.slow
 def test_readme_states_the_block_study(study):
     """The README's block section, every number of it, against the study's run: how many readings
     end how, how many meet how many facts, the preset's rank and distance, the best pulling
@@ -255,6 +259,7 @@ def _fig8_docs():
 FIG8_NONE = "no reading that meets table 1's conical facts"
 
 
+@pytest.mark.slow
 def test_fig8_claim_is_the_studys(study):
     """Fig 8's remark as the docs state it, against the full study, whichever way the study
     moves: the readings that show it (how many, the best one's rank, facts and parameters: the
@@ -326,6 +331,7 @@ def test_sloping_study_records_every_outcome(study):
             assert max(gains) > rc.ENERGY_GAIN_TOL
 
 
+@pytest.mark.slow
 def test_sloping_study_against_the_readme(study):
     """The README says 'out of reach' (no ranked reading, admissible and with the paper's mass and
     integrator, brings any of Table 2's three informative numbers within 10 %) exactly when the
@@ -370,6 +376,7 @@ def test_sloping_study_against_the_readme(study):
         assert t in text, f"README's Table 2 section lacks {t!r}"
 
 
+@pytest.mark.slow
 def test_sloping_study_mass_and_integration_against_the_text(study):
     """The paper states a lumped mass and Newmark 0.7/0.4; the study runs the preset, the
     midpoint reading and the best ranked one also with the consistent mass and the
@@ -448,3 +455,23 @@ def test_fig8_figure_carries_its_runs():
         frac, red = rc.fig8_remark(runs["conical"], runs["parabolic"])
         assert (frac, red) == pytest.approx((data["readings"][name]["fig8_fraction"],
                                              data["readings"][name]["fig8_min_reduction"]), rel=1e-12)
+
+
+@pytest.mark.parametrize("enabled", [True, False])
+def test_the_studies_keep_their_cases_on_disk(enabled, monkeypatch):
+    """A study's case is solved once for the same code and kept by joblib.Memory in the cache
+    folder (the next process reads it), unless the cache is off (--no-cache): then every time."""
+    import os
+
+    solved = []
+
+    def case(params):
+        solved.append(params["law"])
+        return dict(converged=True, law=params["law"])
+    monkeypatch.setattr(rc, "_block_case", case)
+    params = get_scene("block").resolve("paper")
+    solve = rc.cases(enabled)
+    first, again = solve("block", params), rc.cases(enabled)("block", dict(reversed(list(params.items()))))
+    assert first == again == dict(converged=True, law="conical")
+    assert solved == (["conical"] if enabled else ["conical", "conical"])
+    assert os.path.isdir(os.path.join(os.environ["CONTACTFEM_CACHE"], "figures")) == enabled

@@ -71,6 +71,7 @@ def test_fast_preset_against_the_thin_ring(fast):
     assert np.all(np.abs(np.asarray(r["y_c"]) - 50.5) < 0.5)
 
 
+@pytest.mark.slow
 def test_paper_preset_rolling_speed():
     """Paper (Fig 9): 300 -> 150 cm/s exact, computed "149", 0.7 % off. At the paper's 120
     elements and dt = 0.01 ours must be as close to the exact value as the paper's own run, up
@@ -84,6 +85,7 @@ def test_paper_preset_rolling_speed():
     assert r["omega_final"] == pytest.approx(-r["v_final"] / r["rolling_radius"], rel=0.01)
 
 
+@pytest.mark.slow
 def test_refinement_reduces_the_error(fast):
     # mesh and step refined together (n_el 40 -> 80, dt 0.02 -> 0.01): both errors shrink
     fine = run_scene("rolling_ring", "fast", {"n_el": 80, "dt": 0.01})

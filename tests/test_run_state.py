@@ -158,6 +158,7 @@ def test_a_lectures_march_cell_run_twice_gives_the_same_records(name, monkeypatc
             same(r, q)
 
 
+@pytest.mark.slow
 def test_the_readme_example_resumes_a_run(tmp_path, monkeypatch):
     """The README's example, run as written (in a scratch folder): the rest of the run from its
     saved record 10 is the run's records 11 on."""

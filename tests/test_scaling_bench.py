@@ -29,6 +29,7 @@ def test_the_plain_script_solves_the_same_problem(study):
         assert r["ratio"] == r["contactfem_s"] / r["plain_s"]
 
 
+@pytest.mark.slow
 def test_the_table_prints_the_json(study):
     assert STUDIES["scaling"] is scaling_study and "scaling" in BENCH_STUDIES
     md = write_markdown({"machine": {}, "scaling": study})
@@ -51,6 +52,7 @@ def test_the_table_prints_the_json(study):
     assert f"{study['import_floor_s']:.3g} s" in md
 
 
+@pytest.mark.slow
 def test_whole_processes_are_timed(study):
     """The whole-process columns are times of processes that ran (a failing process raises),
     each above half the import floor both stand on (half: the floor and the processes are single

@@ -5,6 +5,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 TESTS = Path(__file__).resolve().parent
 
 SKIPPING = '''
@@ -23,6 +25,7 @@ def test_other():
 '''
 
 
+@pytest.mark.slow
 def test_the_summary_line_names_why_browser_tests_skip(tmp_path):
     shutil.copy(TESTS / "conftest.py", tmp_path / "conftest.py")
     (tmp_path / "test_pages.py").write_text(SKIPPING)

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
+from contactfem.contact.placement import start_of
 from contactfem.solver.system import as_array
 from contactfem.solver import (CentralDifference, Dirichlet, Newmark, NewtonError, Static, System,
                                initial_acceleration, integrate, newton)
@@ -23,7 +24,6 @@ class SpringChain:
         self.ndof = 2 * n
         self.xdofs = np.arange(2 * n).reshape(n, 2)
         self.dt = None
-        self.dof_offset = 0
         self.hyperelastic = True
         self.quadratic_energy = k3 == 0.0
         self.mass_matrix = "lumped"
@@ -104,12 +104,12 @@ class Wall:
         self.per_commit = dissipation_per_commit
         self.name, self.evaluations = "wall", 0
 
-    def start(self, u, t=0.0):
+    def start(self, u, t=0.0, *, offsets=None):
         return 0
 
-    def evaluate(self, u, t=0.0, dt=None, u0=None, phase=None, *, history):
+    def evaluate(self, u, t=0.0, dt=None, u0=None, phase=None, *, history, offsets=None):
         self.evaluations += 1
-        dof = self.body.dof_offset + self.body.xdofs[self.node, 1]
+        dof = start_of(self.body, offsets) + self.body.xdofs[self.node, 1]
         return WallState(dof, self.body.X[self.node, 1] + u[dof] - self.y_wall, self.c,
                          self.per_commit, history + 1)
 
@@ -124,15 +124,15 @@ class DeadLoad:
         self.body, self.local_dofs, self.f = body, np.asarray(local_dofs), f
         self.value = np.asarray(value, dtype=float)
 
-    def start(self, u, t=0.0):
+    def start(self, u, t=0.0, offsets=None):
         return None
 
-    def assemble(self, u, t, state=None):
+    def assemble(self, u, t, state=None, offsets=None):
         P = np.zeros(u.size)
-        P[self.body.dof_offset + self.local_dofs] = self.value * self.f(t)
+        P[start_of(self.body, offsets) + self.local_dofs] = self.value * self.f(t)
         return P, [], [], []
 
-    def commit(self, u, t, state=None):
+    def commit(self, u, t, state=None, offsets=None):
         return state
 
 
@@ -142,16 +142,16 @@ class SpringLoad:
     def __init__(self, body, local_dof, f0, kl):
         self.body, self.local_dof, self.f0, self.kl = body, local_dof, f0, kl
 
-    def start(self, u, t=0.0):
+    def start(self, u, t=0.0, offsets=None):
         return None
 
-    def assemble(self, u, t, state=None):
-        g = self.body.dof_offset + self.local_dof
+    def assemble(self, u, t, state=None, offsets=None):
+        g = start_of(self.body, offsets) + self.local_dof
         P = np.zeros(u.size)
         P[g] = self.f0 - self.kl * u[g]
         return P, [g], [g], [-self.kl]
 
-    def commit(self, u, t, state=None):
+    def commit(self, u, t, state=None, offsets=None):
         return state
 
 
@@ -180,7 +180,8 @@ def total_energy(hist):
 def test_offsets_global_dofs_and_fixed():
     a, b = SpringChain(3, name="a"), SpringChain(2, name="b")
     s = System([a, b], fixed=[Dirichlet(b, [1, 2], 0.5), Dirichlet(a, [0])])
-    assert (a.dof_offset, b.dof_offset, s.ndof) == (0, 6, 10)
+    assert (s.offset(a), s.offset(b), s.ndof) == (0, 6, 10)
+    assert not hasattr(a, "dof_offset") and not hasattr(b, "dof_offset")     # the System's, not theirs
     assert list(s.global_dofs(b, [0, 3])) == [6, 9]
     assert list(s.fixed_dofs) == [0, 7, 8]
     assert list(s.free_dofs) == [1, 2, 3, 4, 5, 6, 9]
@@ -411,12 +412,12 @@ def test_bad_input_raises():
     for dt in (0.0, -1.0, np.nan):
         with pytest.raises(ValueError, match="dt"):
             integrate(Newmark(s), 0.0, np.zeros(4), n_steps=2, dt=dt)
-        with pytest.raises(ValueError, match="dt"):
+        with pytest.raises(AssertionError, match="Schedule"):    # a step's size is the schedule's, checked there
             Newmark(s).step(0.0, np.zeros(4), np.zeros(4), np.zeros(4), dt, state=s.start(np.zeros(4)))
     for beta in (0.0, -0.1, 0.6):
         with pytest.raises(ValueError, match="beta"):
             Newmark(s, beta=beta)
-    for delta in (-0.1, 1.1):
+    for delta in (-0.1, 0.4, 1.1):                    # below 1/2 every step amplifies
         with pytest.raises(ValueError, match="delta"):
             Newmark(s, delta=delta)
     with pytest.warns(UserWarning, match="unconditionally stable"):
@@ -467,3 +468,40 @@ def test_gonzalez_discrete_gradient_of_a_nonlinear_chain(rng):
     K = np.zeros((body.ndof, body.ndof))
     np.add.at(K, (rows, cols), vals)
     assert rel_error(K, fd_jacobian(lambda x: body.discrete_gradient(u0, x)[0], u1, h=1e-6)) < 1e-7
+
+
+def test_the_system_keeps_its_offsets_and_writes_nothing_on_its_objects():
+    """Bodies, contacts and loads hold configuration only: a System places them in its own
+    offsets (by identity), writes no attribute on them, and a second System of the same objects
+    in another order leaves the first one's evaluation as it was, bit for bit."""
+    from contactfem.bodies.continuum import Continuum
+    from contactfem.bodies.loads import Pressure
+    from contactfem.bodies.meshes import block_mesh
+    from contactfem.contact import BodySurface
+    from contactfem.contact.lagrange import LagrangeNodeToSegment
+    from contactfem.laws import PowerLaw
+
+    lower = Continuum(block_mesh(1.0, 0.5, 4, 2), E=100.0, nu=0.3, rho=1.0, name="lower")
+    upper = Continuum(block_mesh(1.0, 0.5, 3, 2), E=100.0, nu=0.3, rho=1.0, name="upper")
+    upper_bottom = upper.boundary_nodes("bottom")
+    lower_top = lower.boundary_nodes("top")
+    contact = LagrangeNodeToSegment(upper, upper_bottom, BodySurface(lower, lower_top[::-1]), normal=PowerLaw(c_N=1e3))
+    load = Pressure(upper, "top", 1.0)
+    objects = (lower, upper, contact, load)
+    before = [dict(vars(o)) for o in objects]
+    s = System([lower, upper], [contact], [load])
+    assert [vars(o) for o in objects] == before and all(
+        vars(o)[k] is v for o, b in zip(objects, before) for k, v in b.items())
+    assert (s.offset(lower), s.offset(upper), s.offset(contact)) == (0, lower.ndof, lower.ndof + upper.ndof)
+    rng = np.random.default_rng(5)
+    u = np.zeros(s.ndof)
+    u[s.global_dofs(upper, upper.xdofs[:, 1])] = -0.01 * (1 + rng.random(len(upper.X)))
+    u[s.contact_dofs] = -rng.random(len(s.contact_dofs))
+    G = s.evaluate(u, 1.0, state=s.start(u)).G
+    other = System([upper, lower], [contact], [load])              # the same objects, placed otherwise
+    assert (other.offset(upper), other.offset(lower)) == (0, upper.ndof)
+    assert np.array_equal(s.evaluate(u, 1.0, state=s.start(u)).G, G)
+    v = np.concatenate([s.local(upper, u), s.local(lower, u), u[s.contact_dofs]])   # u in the other's order
+    H = other.evaluate(v, 1.0, state=other.start(v)).G
+    assert np.allclose(np.concatenate([H[upper.ndof:other.body_ndof], H[:upper.ndof], H[other.body_ndof:]]), G,
+                       rtol=1e-12, atol=1e-12)

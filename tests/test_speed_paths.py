@@ -510,6 +510,7 @@ def test_a_wrong_linear_algebra_names_the_allowed_ones():
         run_scene("block", "fast", linear_algebra="Sparse")
 
 
+@pytest.mark.slow
 def test_a_run_reports_the_band_it_solved():
     from contactfem.scenes import run_scene
 

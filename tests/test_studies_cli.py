@@ -44,6 +44,7 @@ def test_sweep_on_a_cluster_without_dask_is_one_clear_error(tmp_path, capsys, mo
     assert not (tmp_path / "s.csv").exists()
 
 
+@pytest.mark.slow
 def test_sweep_on_a_dask_cluster_is_the_local_sweep(tmp_path):
     """With dask installed (the cluster extra, in [all]): the sweep runs on a scheduler (a local
     cluster started here, in-process workers) and its table equals the local sweep's."""
@@ -101,6 +102,7 @@ def test_a_quick_figure_run_never_writes_over_the_paper_figures(monkeypatch):
 LAWS = Path(__file__).parent / "data" / "lying_laws.py"
 
 
+@pytest.mark.slow
 def test_sweep_of_a_law_files_fields_writes_a_row_per_value(tmp_path, capsys):
     out = tmp_path / "s.csv"
     assert main(["sweep", "rolling_ring", "--friction", f"{LAWS}:OwnFields", "--set", "law.mu=0.1,0.2,0.3",
@@ -112,6 +114,7 @@ def test_sweep_of_a_law_files_fields_writes_a_row_per_value(tmp_path, capsys):
     assert "t_end" not in rows[0] and rows[0]["param.t_end"] == "0.2"       # a swept parameter once, as param.
 
 
+@pytest.mark.slow
 def test_sweep_points_equal_runs_of_the_same_law(tmp_path, capsys):
     out = tmp_path / "s.json"
     assert main(["sweep", "block", "--friction", f"{LAWS}:OwnFields", "--set", "law.mu=0.3,0.4", "--out", str(out)]) == 0

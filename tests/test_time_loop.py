@@ -157,6 +157,7 @@ def test_fixed_steps_to_t_end_take_exactly_the_steps_that_fit(dt, t_end):
     assert min(sizes[:-1]) >= dt * (1 - 1e-9) and sizes[-1] > 0.5 * dt * 1e-9
 
 
+@pytest.mark.slow
 def test_run_cork_progress_shows_a_bar(capsys):
     from contactfem.cli import main
     assert main(["run", "cork", "--progress", "--set", "t_end=0.0004", "--set", "n_press=2"]) == 0

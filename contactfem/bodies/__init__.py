@@ -25,5 +25,6 @@ for a continuum ring and the solver never knows the difference:
 (interfaces.py writes the interface down as a Protocol).
 
 `u` is always the body's own (local) displacement vector; the solver's System
-places bodies one after another in the global vector (``body.dof_offset``).
+places bodies one after another in the global vector and keeps where each starts
+(``System.offset(body)``); a body holds no place of its own.
 """

@@ -41,6 +41,7 @@ Backward Euler gives the closed-form return map (see ``return_map``).
 
 import numpy as np
 
+from ..contact.placement import start_of
 from .interfaces import MASS_MATRICES
 
 def _check(name, value, low, low_open=True):
@@ -152,7 +153,6 @@ class Beam:
         self._edofs_T = self.edofs.T.ravel()                      # the element dofs, dof by dof
         self.ne = ne
         self._dX = chord                                          # X_b - X_a per element
-        self.dof_offset = 0
 
         self.S0, self.eta = None, None
         if plastic is not None:
@@ -553,23 +553,23 @@ class BeamGravity:
         self.beam, self.g = beam, g
         self._P = (None, None)              # (where, triplets): P made for one place of the beam
 
-    def start(self, u, t=0.0):
+    def start(self, u, t=0.0, offsets=None):
         """A dead load has no state."""
         return None
 
-    def commit(self, u, t, state=None):
+    def commit(self, u, t, state=None, offsets=None):
         """A dead load keeps no history."""
         return state
 
-    def assemble(self, u_global, t, state=None):
+    def assemble(self, u_global, t, state=None, offsets=None):
         """(P, rows, cols, vals): the dead load and an empty tangent. P is made once for the
         beam's place in the global vector (read-only: a dead load does not change; a pure
         function of the beam and the vector's size)."""
         b = self.beam
-        where = (b.dof_offset, np.size(u_global))
+        where = (start_of(b, offsets), np.size(u_global))
         if self._P[0] != where:
             P = np.zeros(where[1])
-            P[b.dof_offset + b.xdofs] = b.mass()[b.xdofs] * self.g
+            P[where[0] + b.xdofs] = b.mass()[b.xdofs] * self.g
             empty_i, empty_v = np.zeros(0, dtype=int), np.zeros(0)
             for a in (P, empty_i, empty_v):
                 a.flags.writeable = False

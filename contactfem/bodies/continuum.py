@@ -204,7 +204,6 @@ class Continuum:
         self.ndof = self.basis.N
         self.X = mesh.p.T.copy()
         self.xdofs = self.basis.nodal_dofs.T.copy()
-        self.dof_offset = 0
         self._K_linear = None
         self.mass_matrix = mass_matrix  # the mass the System uses: lumped (diagonal) or consistent
         self._mass = None
@@ -320,7 +319,7 @@ class Continuum:
         """Elastic: no internal variables (None)."""
         return None
 
-    def corner_jacobian_ratios(self, u):
+    def corner_jacobian_ratios(self, u, offset=0):
         """det J of the element map in the deformed configuration X + u at every corner of
         every element, over its value in the reference configuration, shape (nel, corners).
         A corner's det J is the cross product of its two edges (up to a constant factor that
@@ -338,12 +337,12 @@ class Continuum:
             e_prev = np.roll(q, 1, axis=1) - q
             return e_next[..., 0] * e_prev[..., 1] - e_next[..., 1] * e_prev[..., 0]
 
-        x = self.X + u[self.dof_offset + self.xdofs]           # u: the System's vector (or the body's)
+        x = self.X + u[offset + self.xdofs]          # u: the body's vector, or a System's with its offset
         return corners(x) / corners(self.X)
 
-    def inverted_elements(self, u):
+    def inverted_elements(self, u, offset=0):
         """Indices of the elements with a non-positive det J somewhere (corner_jacobian_ratios)."""
-        return np.flatnonzero(np.min(self.corner_jacobian_ratios(u), axis=1) <= 0.0)
+        return np.flatnonzero(np.min(self.corner_jacobian_ratios(u, offset), axis=1) <= 0.0)
 
     rotation_dofs = np.zeros(0, dtype=int)      # no angles among the unknowns
 

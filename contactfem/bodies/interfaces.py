@@ -27,7 +27,6 @@ class Body(Protocol):
     X: np.ndarray               # (nn, 2) reference positions of the nodes that can touch
     ndof: int
     xdofs: np.ndarray           # (nn, 2) local dof numbers of each node's (u_x, u_y)
-    dof_offset: int             # where the body's dofs start in the global vector (set by the System)
     hyperelastic: bool          # a stored energy and no history (energy-consistent stepping needs it)
     quadratic_energy: bool      # W(u) quadratic (a linear body): the midpoint rule is energy-exact for it
     mass_matrix: str            # the mass the System uses: "lumped" or "consistent" (MASS_MATRICES)
@@ -66,12 +65,13 @@ class Body(Protocol):
 class Load(Protocol):
     """An external load (see bodies/loads.py)."""
 
-    def start(self, u: np.ndarray, t: float = 0.0) -> object:
-        """The load's state at the initial state (u, t) (None for a load without one)."""
+    def start(self, u: np.ndarray, t: float = 0.0, offsets: dict | None = None) -> object:
+        """The load's state at the initial state (u, t) (None for a load without one);
+        ``offsets``: where the bodies' dofs start in u (a System's: contact/placement.py)."""
 
-    def assemble(self, u: np.ndarray, t: float, state: object = None) -> tuple:
+    def assemble(self, u: np.ndarray, t: float, state: object = None, offsets: dict | None = None) -> tuple:
         """(P, rows, cols, vals): the external forces (global) and dP/du as COO triplets, with
         the load's ``state``."""
 
-    def commit(self, u: np.ndarray, t: float, state: object = None) -> object:
+    def commit(self, u: np.ndarray, t: float, state: object = None, offsets: dict | None = None) -> object:
         """The load's state after the converged state u at time t (a gas pressure's next value)."""

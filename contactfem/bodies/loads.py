@@ -1,11 +1,12 @@
 """External loads on a ``Continuum`` body.
 
-Each load has ``assemble(u_global, t, state) -> (P, rows, cols, vals)``: the external
-force vector P (ndof_global,) and dP/du as COO triplets in global numbering
-(empty for dead loads). The body's dofs start at ``body.dof_offset``. A load holds its
-configuration only; what it remembers from step to step (the gas pressure's value) is its
-state, a value the System carries (``start(u, t)``, ``commit(u, t, state)``; None for the
-loads without one).
+Each load has ``assemble(u_global, t, state, offsets) -> (P, rows, cols, vals)``: the
+external force vector P (ndof_global,) and dP/du as COO triplets in global numbering
+(empty for dead loads). The body's dofs start where the System's ``offsets`` place it
+(contact/placement.py; at 0 without a System). A load holds its configuration only; what it
+remembers from step to step (the gas pressure's value) is its state, a value the System
+carries (``start(u, t, offsets)``, ``commit(u, t, state, offsets)``; None for the loads
+without one).
 ``total_force(u_global, t)`` sums the nodal forces: the resultant (Fx, Fy).
 
 Axisymmetric bodies integrate over the full ring (2 pi r), plane bodies over
@@ -16,6 +17,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from skfem import FacetBasis, LinearForm, asm
 
+from ..contact.placement import start_of
 from .continuum import _weight, oriented_facets
 
 _EMPTY = (np.zeros(0, dtype=int), np.zeros(0, dtype=int), np.zeros(0))
@@ -47,25 +49,25 @@ class _Load:
     def _local(self, u, t, state=None):
         raise NotImplementedError
 
-    def start(self, u_global, t=0.0):
+    def start(self, u_global, t=0.0, offsets=None):
         """The load's state at the initial state: None (no history)."""
         return None
 
-    def commit(self, u_global, t, state=None):
+    def commit(self, u_global, t, state=None, offsets=None):
         """The load's state after the converged state u at time t: unchanged (no history)."""
         return state
 
-    def assemble(self, u_global, t, state=None):
-        off, n = self.body.dof_offset, self.body.ndof
+    def assemble(self, u_global, t, state=None, offsets=None):
+        off, n = start_of(self.body, offsets), self.body.ndof
         P_local, rows, cols, vals = self._local(np.asarray(u_global)[off:off + n], t, state)
         P = np.zeros(len(u_global))
         P[off:off + n] = P_local
         return P, rows + off, cols + off, vals
 
-    def total_force(self, u_global, t, state=None):
+    def total_force(self, u_global, t, state=None, offsets=None):
         """Resultant (sum of the nodal forces) in x and y."""
-        P = self.assemble(u_global, t, state)[0]
-        dofs = self.body.xdofs + self.body.dof_offset
+        P = self.assemble(u_global, t, state, offsets)[0]
+        dofs = self.body.xdofs + start_of(self.body, offsets)
         return np.array([P[dofs[:, 0]].sum(), P[dofs[:, 1]].sum()])
 
 
@@ -201,39 +203,39 @@ class GasPressure(Pressure):
         self.p_step, self.n_ramp, self.dt_ramp, self.z_release = p_step, n_ramp, dt_ramp, z_release
         self.p0 = p_step * n_ramp
 
-    def face_positions(self, u):
+    def face_positions(self, u, offsets=None):
         b = self.body
-        x = b.X[self.face] + u[b.dof_offset + b.xdofs[self.face]]
+        x = b.X[self.face] + u[start_of(b, offsets) + b.xdofs[self.face]]
         return x[np.argsort(b.X[self.face, 0])]
 
-    def start(self, u, t=0.0):
+    def start(self, u, t=0.0, offsets=None):
         """The GasState at the initial state u (where the gas column has its volume V0), with
         the pressure of the first step set from it (``update``)."""
-        return self.update(u, t, GasState(S0=swept_volume(self.face_positions(u))))
+        return self.update(u, t, GasState(S0=swept_volume(self.face_positions(u, offsets))), offsets)
 
-    def commit(self, u, t, state):
+    def commit(self, u, t, state, offsets=None):
         """The GasState after the converged state u at time t: the next step's pressure."""
-        return self.update(u, t, state)
+        return self.update(u, t, state, offsets)
 
-    def volume(self, u, state):
-        return self.V0 + swept_volume(self.face_positions(u)) - state.S0
+    def volume(self, u, state, offsets=None):
+        return self.V0 + swept_volume(self.face_positions(u, offsets)) - state.S0
 
-    def edge_z(self, u):
+    def edge_z(self, u, offsets=None):
         """Height of the face's outer edge (the gas escapes when it reaches z_release)."""
-        return self.face_positions(u)[-1, 1]
+        return self.face_positions(u, offsets)[-1, 1]
 
-    def update(self, u, t, state):
+    def update(self, u, t, state, offsets=None):
         """The GasState with the pressure for the next step from the converged u (explicit
         coupling); t is recorded as ``released_at`` at the release."""
         k, released, released_at = state.k + 1, state.released, state.released_at
-        if not released and self.edge_z(u) >= self.z_release:
+        if not released and self.edge_z(u, offsets) >= self.z_release:
             released, released_at = True, t
         if released:
             value = 0.0
         elif k <= self.n_ramp:
             value = self.p_step * k
         else:
-            value = self.p0 * self.V0 / self.volume(u, state)
+            value = self.p0 * self.V0 / self.volume(u, state, offsets)
         return replace(state, k=k, value=value, released=released, released_at=released_at)
 
     def pressure(self, t, state):
@@ -270,16 +272,17 @@ class OverhangPressure:
         self.local = np.zeros(body.ndof)
         self.local[body.xdofs[nodes, 1]] = -p * f * body.thickness
 
-    def start(self, u_global, t=0.0):
+    def start(self, u_global, t=0.0, offsets=None):
         """A dead load has no state."""
         return None
 
-    def commit(self, u_global, t, state=None):
+    def commit(self, u_global, t, state=None, offsets=None):
         """A dead load keeps no history."""
         return state
 
-    def assemble(self, u_global, t, state=None):
+    def assemble(self, u_global, t, state=None, offsets=None):
         P = np.zeros(len(u_global))
-        P[self.body.dof_offset:self.body.dof_offset + self.body.ndof] = self.local
+        off = start_of(self.body, offsets)
+        P[off:off + self.body.ndof] = self.local
         e = np.zeros(0, dtype=int)
         return P, e, e, np.zeros(0)

@@ -131,11 +131,10 @@ class RingModel:
         return self.R if self.kind == "beam" else self.R_outer
 
     def _u(self, u):
-        """The body's local part of u (a global vector is accepted too; or a stack of them,
-        one a row)."""
+        """The body's local part of u (a global vector whose dofs start with the ring's, as in
+        the ring scenes, is accepted too; or a stack of them, one a row)."""
         u = np.asarray(u, float)
-        b = self.body
-        return u[..., b.dof_offset:b.dof_offset + b.ndof] if u.shape[-1] != b.ndof else u
+        return u[..., :self.body.ndof]
 
     def positions(self, u):
         """Current positions of all nodes (beam: centreline nodes), (nn, 2) (a stack of u:
@@ -265,7 +264,7 @@ class RingModel:
         """Local velocity vector (ndof,) of the rigid motion v = v0 + omega e3 x (X - c)
         about the reference centre c; beam rotations get theta_dot = omega.
         (For a one-body System the local vector is the global one; otherwise place
-        it at body.dof_offset.)"""
+        it at the System's offset of the body, ``System.offset(body)``.)"""
         v0_vec = np.asarray(v0_vec, float)
         if v0_vec.shape != (2,) or not np.all(np.isfinite(v0_vec)):
             raise ValueError(f"parameter v0_vec must be a finite 2-vector, got {v0_vec!r}")

@@ -71,16 +71,16 @@ class AugmentedNodeToSegment(NodeToSegment):
         super().__init__(*args, **kwargs)
         self.augment_normal = augments_normal(self.normal)
 
-    def start(self, u, t=0.0):
+    def start(self, u, t=0.0, *, offsets=None):
         """The penalty interface's initial history with zero multipliers."""
-        h = super().start(u, t)
+        h = super().start(u, t, offsets=offsets)
         nc = len(self.nodes)
         return AugmentedHistory(**vars(h), lam_N=np.zeros(nc), lam_T=np.zeros(nc))
 
-    def kinematics(self, u, t, h):
+    def kinematics(self, u, t, h, offsets=None):
         """As NodeToSegment.kinematics, with the penalty law evaluated at the shifted gap
         g_N + lam_N / c_N (eq 4, m = 1; module docstring)."""
-        e = super().kinematics(u, t, h)
+        e = super().kinematics(u, t, h, offsets)
         if not self.augment_normal:
             return e
         g_eff = e["g_N"] + h.lam_N / self.normal.c_N

@@ -109,14 +109,14 @@ def secant(law, g0, g1):
     return np.where(small, tm, phi), np.where(small, 0.5 * dtm, dphi)
 
 
-def conserving_force(contact, u0, u1, t, h, e1, fr):
+def conserving_force(contact, u0, u1, t, h, e1, fr, offsets=None):
     """Residual and tangent of the energy-consistent contact force of a NodeToSegment over the
     step u0 -> u1 (module docstring), per pair: (R, K, on, work_T), with e1 and fr the
     kinematics and the return map's result at u1 and h the committed history; ``on`` marks the
     pairs that carry a force (in range at the end and penetrating at either end), ``work_T``
     the friction force's work over the step (per node)."""
     um = 0.5 * (u0 + u1)
-    e0, em = contact.kinematics(u0, t, h), contact.kinematics(um, t, h)
+    e0, em = contact.kinematics(u0, t, h, offsets), contact.kinematics(um, t, h, offsets)
     nc = len(contact.nodes)
     dofs = e1["dofs"]
     d = (u1 - u0)[dofs]

@@ -35,6 +35,7 @@ import numpy as np
 from ..laws.protocol import as_friction_law
 from ..laws.return_map import OPEN, STICK, return_map
 from .element import contact_element, normal_element, pattern, to_coo
+from .placement import start_of
 from .state import ContactHistory, ContactState
 from .tangents import TANGENTS
 
@@ -136,13 +137,14 @@ class NodeToSegment:
         return other
 
     # -- the history ------------------------------------------------------------------
-    def start(self, u, t=0.0):
+    def start(self, u, t=0.0, *, offsets=None):
         """The history at the initial state u (a ContactHistory, kept by the caller): the
         projections there are the reference of the first slip increment, no traction, no slip,
-        the law's initial variables."""
+        the law's initial variables. ``offsets``: where the bodies' dofs start in u (a System's:
+        contact/placement.py)."""
         nc = len(self.nodes)
-        ref = self.master.reference(u)
-        k = self.master.locate(self.slave_positions(u), np.zeros(nc), u, t=t, ref=ref)
+        ref = self.master.reference(u, offsets)
+        k = self.master.locate(self.slave_positions(u, offsets), np.zeros(nc), u, t=t, ref=ref, offsets=offsets)
         z = self._law.initial_state(nc) if self._law is not None else np.zeros((nc, 0))
         g = k["g_N"] - self.offset + self.gap_offset(z)
         return ContactHistory(s_bar=k["s"], g_bar=g, t_T_bar=np.zeros(nc), q_bar=np.zeros(nc), z_bar=z, master=ref)
@@ -153,13 +155,12 @@ class NodeToSegment:
         return state.next_history
 
     # -- kinematics -------------------------------------------------------------------
-    def slave_dofs(self):
-        """Global (u_x, u_y) dofs of the slave nodes, (nc, 2)."""
-        return self.slave.dof_offset + self.slave.xdofs[self.nodes]
+    def slave_dofs(self, offsets=None):
+        """Global (u_x, u_y) dofs of the slave nodes, (nc, 2), the body placed by ``offsets``."""
+        return start_of(self.slave, offsets) + self.slave.xdofs[self.nodes]
 
-    def slave_positions(self, u):
-        dofs = self.slave_dofs()
-        return self._X_s + u[dofs]
+    def slave_positions(self, u, offsets=None):
+        return self._X_s + u[self.slave_dofs(offsets)]
 
     def gap_offset(self, z):
         """How far a friction law with internal variables has moved the surface (wear), (nc,)."""
@@ -171,11 +172,11 @@ class NodeToSegment:
         """The normal law's potential at g_N (0 for a law without one)."""
         return self.normal.energy(g_N) if self._has_energy else np.zeros_like(g_N)
 
-    def kinematics(self, u, t, h):
+    def kinematics(self, u, t, h, offsets=None):
         """Gap, normal traction and variations at u with the history h (step 4a-b of Sec. 4.3),
         before friction: a dict of per-node arrays."""
-        x_s = self.slave_positions(u)
-        k = self.master.locate(x_s, h.s_bar, u, t=t, ref=h.master)
+        x_s = self.slave_positions(u, offsets)
+        k = self.master.locate(x_s, h.s_bar, u, t=t, ref=h.master, offsets=offsets)
         g_raw = k["g_N"] - self.offset
         g_N = g_raw + self.gap_offset(h.z_bar) if self._wear else g_raw
         active = k["inside"] & (g_N < 0.0)
@@ -185,7 +186,7 @@ class NodeToSegment:
             t_N, dt_N = self.normal.traction(np.where(active, g_N, 1.0))
         else:                                               # every node open (a body in flight): a normal
             t_N = dt_N = zeros(nc)                          # law's t_N is 0 when open (read-only)
-        slave_dofs = self.slave_dofs()
+        slave_dofs = self.slave_dofs(offsets)
         dofs = np.concatenate([slave_dofs, k["master_dofs"]], axis=1) if k["master_dofs"].size else slave_dofs
         travel = k["s"] - h.s_bar
         r, dr, dg_T, ddg_T = ones(nc), zeros(nc), travel, k["ds"]   # r = 1: Delta g_T = travel (read-only)
@@ -229,24 +230,24 @@ class NodeToSegment:
         return dict(t_T=fr.t_T, c_T_s=fr.c_T_s, c_N_s=fr.c_N_s, slip=fr.state, lam=fr.lam, q=fr.q, z=fr.z)
 
     # -- one evaluation ------------------------------------------------------------------
-    def evaluate(self, u, t=0.0, dt=None, u0=None, phase=None, *, history):
+    def evaluate(self, u, t=0.0, dt=None, u0=None, phase=None, *, history, offsets=None):
         """The ContactState at the trial displacement u of the step (t - dt, t] that starts
         from u0 (needed by energy-consistent integration), with the committed ``history`` (from
         ``start`` or ``commit``): kinematics, tractions, return mapping, element residuals and
         tangents. ``phase``: a phase of the staggered algorithm (contact/tangents.py), None for
-        the contact as it is."""
+        the contact as it is. ``offsets``: where the bodies' dofs start in u (placement.py)."""
         h = history
         if not isinstance(h, ContactHistory):
             raise ValueError(f"contact {self.name!r}: history must be a ContactHistory (from start(u) or "
                              f"commit(state)), got {type(h).__name__}")
         self.evaluations += 1
-        k = self.kinematics(u, t, h)
+        k = self.kinematics(u, t, h, offsets)
         fr = self.friction_state(k, h, dt, phase)
         work_T = None
         if self.integration == "energy_consistent" and u0 is not None:
             from .conserving import conserving_force
 
-            R, K, on, work_T = conserving_force(self, u0, u, t, h, k, fr)
+            R, K, on, work_T = conserving_force(self, u0, u, t, h, k, fr, offsets)
             element_dofs = k["dofs"][on]
         else:
             on = k["active"].nonzero()[0]                  # the pairs in contact, by index
@@ -256,7 +257,7 @@ class NodeToSegment:
             else:                                          # none in contact (a body in flight): no element
                 m = element_dofs.shape[1]
                 R, K = np.zeros((0, m)), np.zeros((0, m, m))
-        return ContactState(contact=self, history=h, u=u, t=t, x_s=k["x_s"], g_N=k["g_N"], g_raw=k["g_raw"], s=k["s"],
+        return ContactState(contact=self, history=h, u=u, t=t, offsets=offsets, x_s=k["x_s"], g_N=k["g_N"], g_raw=k["g_raw"], s=k["s"],
                             s_next=k.get("s_next", k["s"]), n=k["n"], tangent=k["t"], seg=k["seg"],
                             inside=k["inside"], active=k["active"], r=k["r"], t_N=k["t_N"], dt_N=k["dt_N"],
                             t_T=fr["t_T"], c_T_s=fr["c_T_s"], c_N_s=fr["c_N_s"], slip=fr["slip"], lam=fr["lam"],
@@ -289,9 +290,9 @@ class NodeToSegment:
         return pattern(dofs)
 
     # -- conveniences (tests, lectures) -------------------------------------------------
-    def assemble(self, u, t=0.0, dt=None, u0=None, *, history):
+    def assemble(self, u, t=0.0, dt=None, u0=None, *, history, offsets=None):
         """Global contact residual R_c (eq 28) and tangent triplets (eqs 33, 39, 49) at u."""
-        return self.evaluate(u, t, dt, u0, history=history).scatter(len(u))
+        return self.evaluate(u, t, dt, u0, history=history, offsets=offsets).scatter(len(u))
 
 
 def element_triplets(state):

@@ -17,11 +17,12 @@ class Master(Protocol):
     rigid: bool
     straight: bool          # second variations of g_N and s zero everywhere (a rigid line or polyline)
 
-    def locate(self, x_s: np.ndarray, s_bar: np.ndarray, u: np.ndarray, t=None, ref=None) -> dict:
+    def locate(self, x_s: np.ndarray, s_bar: np.ndarray, u: np.ndarray, t=None, ref=None,
+               offsets: dict | None = None) -> dict:
         """The kinematics of each slave with its closest master segment (masters.py): g_N, s,
         dg_N, ds, d2g_N, d2s, master_dofs, inside, seg (and s_next)."""
 
-    def reference(self, u: np.ndarray) -> object:
+    def reference(self, u: np.ndarray, offsets: dict | None = None) -> object:
         """What the master remembers of a converged state (a metric), None if nothing."""
 
 
@@ -37,18 +38,19 @@ class Contact(Protocol):
 
     ``unknowns``: how many unknowns of its own the contact carries (the Lagrange multipliers
     of contact/lagrange.py; 0 for penalty contacts). The System places them after the
-    bodies' dofs and tells the contact where (``dof_offset``); the contact's states then
+    bodies' dofs and keeps where, with where each body's dofs start (``offsets``, by identity:
+    contact/placement.py), handed to ``start`` and ``evaluate``; the contact's states then
     give their rows of the residual and the tangent like any other."""
 
     name: str
     integration: str            # "standard" | "energy_consistent"
     unknowns: int               # unknowns of its own (0: only the bodies' dofs)
 
-    def start(self, u: np.ndarray, t: float = 0.0) -> object:
+    def start(self, u: np.ndarray, t: float = 0.0, *, offsets: dict | None = None) -> object:
         """The history at the initial state u (a value)."""
 
     def evaluate(self, u: np.ndarray, t: float = 0.0, dt: float | None = None, u0: np.ndarray | None = None,
-                 phase: object = None, *, history: object) -> object:
+                 phase: object = None, *, history: object, offsets: dict | None = None) -> object:
         """The contact's state at the trial u of the step (t - dt, t] that starts from u0, with
         the committed ``history``."""
 

@@ -4,10 +4,10 @@
 Each slave node j carries its normal and tangential traction t_N,j, t_T,j as unknowns
 (tractions per unit length, or nodal forces with weights 1, like the penalty laws';
 frictionless: t_N,j only). The contact owns them (``unknowns``; the System places them
-after the bodies' dofs, at ``dof_offset``):
+after the bodies' dofs, at an offset o it keeps: contact/placement.py):
 
-    dof_offset + j          t_N,j     (j = 0 .. nc - 1)
-    dof_offset + nc + j     t_T,j     (with friction)
+    o + j                   t_N,j     (j = 0 .. nc - 1)
+    o + nc + j              t_T,j     (with friction)
 
 and its state writes two kinds of rows of the global G and K:
 
@@ -50,6 +50,7 @@ from .element import contact_element, to_coo
 from .interface import NodeToSegment
 from .mortar import _pair_rows, contact_forces
 from .mortar_contact import MortarContact, MortarHistory, MortarState
+from .placement import placed, start_of
 from .state import ContactState
 
 
@@ -59,16 +60,16 @@ def _lagrange_checks(contact):
     contact.c_N = float(contact.normal.c_N)
     contact.c_T_ncp = float(contact.friction.c_T) if contact.friction is not None else 0.0
     contact.unknowns = (2 if contact.friction is not None else 1) * nc
-    contact.dof_offset = None
 
 
-def multipliers(contact, u):
-    """t_N, t_T (nc,) of the contact from the global u, and their global dofs."""
-    if contact.dof_offset is None:
+def multipliers(contact, u, offsets=None):
+    """t_N, t_T (nc,) of the contact from the global u, and their global dofs (where the
+    System's ``offsets`` place them: placement.py)."""
+    if not placed(contact, offsets):
         raise ValueError(f"contact {contact.name!r} owns unknowns (Lagrange multipliers): put it in a System, "
-                         "which places them (dof_offset)")
+                         "which places them")
     nc = len(contact.nodes)
-    dN = contact.dof_offset + np.arange(nc)
+    dN = start_of(contact, offsets) + np.arange(nc)
     dT = dN + nc if contact.friction is not None else np.zeros(0, int)
     t_T = u[dT] if contact.friction is not None else np.zeros(nc)
     return u[dN].copy(), np.array(t_T, dtype=float), dN, dT
@@ -128,14 +129,14 @@ class LagrangeNodeToSegment(NodeToSegment):
                              f"integration = standard (got {self.tangent}, {self.integration})")
         _lagrange_checks(self)
 
-    def evaluate(self, u, t=0.0, dt=None, u0=None, phase=None, *, history):
+    def evaluate(self, u, t=0.0, dt=None, u0=None, phase=None, *, history, offsets=None):
         """The LagrangeState at u (displacements and multipliers) with the committed ``history``."""
         h = history
         if phase is not None:
             raise ValueError(f"contact {self.name!r}: enforcement = lagrange has no staggered phases")
         self.evaluations += 1
-        k = self.kinematics(u, t, h)
-        t_N, t_T, dN, dT = multipliers(self, u)
+        k = self.kinematics(u, t, h, offsets)
+        t_N, t_T, dN, dT = multipliers(self, u, offsets)
         on = k["inside"]
         dg_T = k["s"] - h.s_bar                              # eq 20, no closing-step factor (module docstring)
         cond = conditions(self, t_N, t_T, k["g_N"], dg_T, on)
@@ -159,7 +160,7 @@ class LagrangeNodeToSegment(NodeToSegment):
             C.append(w * cond["C_T"])
         lam = np.where(cond["slip"] == SLIP, np.abs(dg_T), 0.0)
         return LagrangeState(
-            contact=self, history=h, u=u, t=t, x_s=k["x_s"], g_N=k["g_N"], g_raw=k["g_raw"], s=k["s"],
+            contact=self, history=h, u=u, t=t, offsets=offsets, x_s=k["x_s"], g_N=k["g_N"], g_raw=k["g_raw"], s=k["s"],
             s_next=k.get("s_next", k["s"]), n=k["n"], tangent=k["t"], seg=k["seg"], inside=on,
             active=cond["closed"], r=np.ones(nc), t_N=t_N, dt_N=np.zeros(nc), t_T=t_T, c_T_s=np.zeros(nc),
             c_N_s=np.zeros(nc), slip=cond["slip"], lam=lam, q=h.q_bar + lam, z=h.z_bar, R=R, K=K,
@@ -185,16 +186,16 @@ class LagrangeMortar(MortarContact):
         L = np.linalg.norm(np.diff(X, axis=0), axis=1)
         self.row_weights = np.concatenate([[0.0], L / 2]) + np.concatenate([L / 2, [0.0]])
 
-    def evaluate(self, u, t=0.0, dt=None, u0=None, phase=None, *, history):
+    def evaluate(self, u, t=0.0, dt=None, u0=None, phase=None, *, history, offsets=None):
         """The MortarState at u (displacements and multipliers) with the committed ``history``:
         the virtual work of the multipliers and the complementarity rows (module docstring)."""
         h = self._check(phase, history)
-        k = self.kinematics_at(u, h)
+        k = self.kinematics_at(u, h, offsets)
         mi, slip = k["mi"], k["slip"]
-        t_N, t_T, dN, dT = multipliers(self, u)
+        t_N, t_T, dN, dT = multipliers(self, u, offsets)
         cond = conditions(self, t_N, t_T, k["g_N"], k["dg_T"], k["covered"])
         s, ns = self.row_weights, len(t_N)
-        g = np.concatenate([self.slave_dofs().ravel(), self.master_dofs().ravel()])   # interface -> global (-1: rigid)
+        g = np.concatenate([self.slave_dofs(offsets).ravel(), self.master_dofs(offsets).ravel()])   # interface -> global (-1: rigid)
         zero = np.zeros(ns)
         # the bodies' rows: R = sum_j t_N,j f_N,j + t_T,j f_T,j and its geometric tangent (no moduli)
         R_i, (r, c, v) = contact_forces(mi, t_N, zero, k["offset"], slip,

@@ -2,10 +2,11 @@
 coordinate vary with the unknowns.
 
 Every master answers one question for an array of slave positions x_s (nc, 2):
-``locate(x_s, s_bar, u, t=None, ref=None)`` returns the contact kinematics of each slave
+``locate(x_s, s_bar, u, t=None, ref=None, offsets=None)`` returns the contact kinematics of each slave
 with its closest master segment (or point of a smooth obstacle) at time t (a moving rigid
 obstacle), in the metric of ``ref`` (what ``reference(u)`` gave at the last converged
-state: a deformable master's node positions; None for a rigid master):
+state: a deformable master's node positions; None for a rigid master); ``offsets``: where
+the bodies' dofs start in u (a System's, contact/placement.py; a deformable master's only):
 
     g_N (nc,), s (nc,)        gap (eq 17) and arc coordinate of the projection
     dg_N, ds (nc, k)          first variations w.r.t. the pair's dofs (eq 27)
@@ -32,6 +33,7 @@ from functools import lru_cache
 import numpy as np
 
 from .kinematics import arc_variations, e3_cross, line_variations, segment_variations
+from .placement import start_of
 
 
 @lru_cache(maxsize=16)
@@ -88,12 +90,12 @@ class RigidLine:
         self.point = np.asarray(point, dtype=float)
         self.normal = nrm / np.linalg.norm(nrm)
 
-    def locate(self, x_s, s_bar, u, t=None, ref=None):
+    def locate(self, x_s, s_bar, u, t=None, ref=None, offsets=None):
         k = line_variations(x_s, self.point, self.normal)
         k.update(rigid_fields(len(x_s)))
         return k
 
-    def reference(self, u):
+    def reference(self, u, offsets=None):
         return None
 
     def outline(self, extent=(-1.0, 1.0)):
@@ -113,10 +115,10 @@ class RigidPolyline:
         self.points = _check_points(points, "points")
         self.S = _arc_lengths(self.points)
 
-    def reference(self, u):
+    def reference(self, u, offsets=None):
         return None
 
-    def locate(self, x_s, s_bar, u, t=None, ref=None):
+    def locate(self, x_s, s_bar, u, t=None, ref=None, offsets=None):
         """Each slave against the fixed line of its closest segment j (eqs 17-19 with x_1, x_2
         fixed: line_variations), s = S[j] + (x_s - P_j).t_j."""
         P = self.points
@@ -147,10 +149,10 @@ class RigidArc:
         self.center = np.asarray(center, dtype=float)
         self.R, self.theta0, self.theta1, self.inside = float(R), float(theta0), float(theta1), bool(inside)
 
-    def reference(self, u):
+    def reference(self, u, offsets=None):
         return None
 
-    def locate(self, x_s, s_bar, u, t=None, ref=None):
+    def locate(self, x_s, s_bar, u, t=None, ref=None, offsets=None):
         theta_ref = np.asarray(s_bar, dtype=float) / self.R
         k = arc_variations(x_s, self.center, self.R, self.inside, theta_ref)
         th = k["theta"]
@@ -180,34 +182,35 @@ class BodySurface:
             raise ValueError("parameter nodes of a master surface must list at least 2 nodes")
         _check_points(body.X[self.nodes], "master nodes (reference positions)")
 
-    def dofs(self):
-        return self.body.dof_offset + self.body.xdofs[self.nodes]       # (nm, 2)
+    def dofs(self, offsets=None):
+        """Global dofs of the master nodes (nm, 2), the body placed by ``offsets`` (placement.py)."""
+        return start_of(self.body, offsets) + self.body.xdofs[self.nodes]
 
-    def positions(self, u):
-        return self.body.X[self.nodes] + u[self.dofs()]
+    def positions(self, u, offsets=None):
+        return self.body.X[self.nodes] + u[self.dofs(offsets)]
 
-    def reference(self, u):
+    def reference(self, u, offsets=None):
         """The converged node positions x_bar: the metric (l_bar, S_bar) of the next step's s."""
-        return self.positions(u)
+        return self.positions(u, offsets)
 
-    def locate(self, x_s, s_bar, u, t=None, ref=None):
+    def locate(self, x_s, s_bar, u, t=None, ref=None, offsets=None):
         """Eqs (17)-(19), (27), (31)-(38) with the master nodes moving; s = S_bar[j] + alpha l_bar
         in the metric of ref (the converged positions x_bar; the reference positions if None)."""
         x_bar = self.body.X[self.nodes] if ref is None else ref
-        P = self.positions(u)
+        P = self.positions(u, offsets)
         j, inside = closest_segment(x_s, P)
         k = segment_variations(x_s, P[j], P[j + 1])
         l_bar = np.linalg.norm(x_bar[j + 1] - x_bar[j], axis=1)
         S_bar = _arc_lengths(x_bar)
-        dofs = self.dofs()
+        dofs = self.dofs(offsets)
         return dict(g_N=k["g_N"], s=S_bar[j] + k["alpha"] * l_bar, t=k["t"], n=k["n"],
                     dg_N=k["dg_N"], d2g_N=k["d2g_N"],
                     ds=l_bar[:, None] * k["dalpha"], d2s=l_bar[:, None, None] * k["d2alpha"],
                     master_dofs=np.concatenate([dofs[j], dofs[j + 1]], axis=1), inside=inside, seg=j,
                     s_next=_arc_lengths(P)[j] + k["alpha"] * k["l"])
 
-    def outline(self, u=None):
-        return self.body.X[self.nodes] if u is None else self.positions(u)
+    def outline(self, u=None, offsets=None):
+        return self.body.X[self.nodes] if u is None else self.positions(u, offsets)
 
 
 def _expand(mask, like):
@@ -273,7 +276,7 @@ class RigidComposite:
             return self.offset
         return self.offset + np.asarray(self.motion(t), dtype=float)
 
-    def reference(self, u):
+    def reference(self, u, offsets=None):
         return None
 
     def _piece(self, i, x_s, offset):
@@ -290,7 +293,7 @@ class RigidComposite:
             return k, p["R"] * p["th0"] - k["s"]
         return k, k["s"] - p["R"] * p["th0"]
 
-    def locate(self, x_s, s_bar, u, t=None, ref=None):
+    def locate(self, x_s, s_bar, u, t=None, ref=None, offsets=None):
         nc, m = len(x_s), len(self.pieces)
         own = np.full(nc, m - 1)
         offset = self.position(t)

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .masters import BodySurface, RigidLine, RigidPolyline
+from .placement import start_of
 from .mortar import (Pairs, contact_forces, linear_slip, linearised, mortar_integrals, nodal_gap, penalty_tractions,
                      slip_increment, weighted_slip)
 from .segmentation import candidate_pairs
@@ -184,14 +185,15 @@ class MortarContact:
         self.evaluations = 0                # a counter for the benchmarks (not part of any result)
 
     # -- where the interface's unknowns are ----------------------------------------
-    def slave_dofs(self):
-        """Global (u_x, u_y) dofs of the slave nodes (ns, 2)."""
-        return self.slave.dof_offset + self.slave.xdofs[self.nodes]
+    def slave_dofs(self, offsets=None):
+        """Global (u_x, u_y) dofs of the slave nodes (ns, 2), the body placed by ``offsets``
+        (a System's: placement.py)."""
+        return start_of(self.slave, offsets) + self.slave.xdofs[self.nodes]
 
-    def master_dofs(self):
+    def master_dofs(self, offsets=None):
         """Global dofs of the master nodes (nm, 2); -1 for a rigid master's fixed points."""
         if isinstance(self.master, BodySurface):
-            return self.master.dofs()
+            return self.master.dofs(offsets)
         return np.full((len(self._master_points()), 2), -1)
 
     def _master_points(self):
@@ -200,33 +202,33 @@ class MortarContact:
             return np.array([self.master.point, self.master.point + np.array([n[1], -n[0]])])
         return self.master.points
 
-    def positions(self, u):
+    def positions(self, u, offsets=None):
         """Current slave chain xs (ns, 2) and master chain xm (nm, 2)."""
-        xs = self.slave.X[self.nodes] + u[self.slave_dofs()]
-        xm = self.master.positions(u) if isinstance(self.master, BodySurface) else self._master_points()
+        xs = self.slave.X[self.nodes] + u[self.slave_dofs(offsets)]
+        xm = self.master.positions(u, offsets) if isinstance(self.master, BodySurface) else self._master_points()
         return xs, xm
 
     # -- the protocol --------------------------------------------------------------
-    def start(self, u, t=0.0):
+    def start(self, u, t=0.0, *, offsets=None):
         """The history of the state u: no traction, no slip, the pairs of u as the
         reference of the first step's slip (small kinematics: the pairs of the reference
-        configuration, computed here once)."""
-        xs, xm = self.positions(u)
+        configuration, computed here once). ``offsets``: where the bodies' dofs start in u."""
+        xs, xm = self.positions(u, offsets)
         if self.kinematics == "small":
             zero = np.zeros(len(u))
-            self._reference = self._integrals(*self.positions(zero))
+            self._reference = self._integrals(*self.positions(zero, offsets))
         mi = self._integrals(xs, xm) if self.kinematics == "finite" else self._reference
         ns = len(self.nodes)
         z = self._law.initial_state(ns) if self._law is not None else np.zeros((ns, 0))
         return MortarHistory(t_T=np.zeros(ns), q=np.zeros(ns), z=z, pairs=mi.pairs, D=mi.D, M=mi.M,
                              w=mi.w, x=np.concatenate([xs.ravel(), xm.ravel()]))
 
-    def kinematics_at(self, u, h):
+    def kinematics_at(self, u, h, offsets=None):
         """Segmentation, mortar integrals, nodal gaps and slip increments at u with the
         history h: a dict with xs, xm, x (the interface positions), mi (MortarIntegrals),
         offset, g_N, covered, dg_N (sparse, over the interface dofs), slip (WeightedSlip, None
         when frictionless) and dg_T (the nodal slip increments)."""
-        xs, xm = self.positions(u)
+        xs, xm = self.positions(u, offsets)
         x = np.concatenate([xs.ravel(), xm.ravel()])
         mi = self._integrals(xs, xm) if self.kinematics == "finite" else linearised(self._reference, x)
         offset = self.offset
@@ -241,18 +243,18 @@ class MortarContact:
         return dict(xs=xs, xm=xm, x=x, mi=mi, offset=offset, g_N=g_N, covered=covered, dg_N=dg_N, slip=slip,
                     dg_T=dg_T)
 
-    def evaluate(self, u, t=0.0, dt=None, u0=None, phase=None, *, history):
+    def evaluate(self, u, t=0.0, dt=None, u0=None, phase=None, *, history, offsets=None):
         """Everything at u with the committed ``history``: segmentation, mortar integrals,
         tractions (penalty and return map), residual and tangent. Pure (u0 is not needed:
         the history holds the reference of the slip). ``phase``: the staggered algorithm's
-        phases are not offered for mortar contact (None only)."""
+        phases are not offered for mortar contact (None only). ``offsets``: placement.py."""
         h = self._check(phase, history)
-        k = self.kinematics_at(u, h)
+        k = self.kinematics_at(u, h, offsets)
         mi, slip, g_N, dg_T = k["mi"], k["slip"], k["g_N"], k["dg_T"]
         t_N, dt_N, fr = penalty_tractions(self.normal, self.friction, g_N, dg_T, h.t_T, h.q,
                                           z_bar=h.z if self._law is not None else None, dt=dt)
         R_i, (r, c, v) = contact_forces(mi, t_N, dt_N, k["offset"], slip, fr if slip is not None else None, h.w)
-        R, rows, cols, vals = self._to_global(R_i, r, c, v, len(u))
+        R, rows, cols, vals = self._to_global(R_i, r, c, v, len(u), offsets)
         z = fr.z if (self._law is not None and fr.z is not None) else h.z
         history = MortarHistory(t_T=fr.t_T, q=fr.q, z=z, pairs=mi.pairs, D=mi.D, M=mi.M, w=mi.w, x=k["x"])
         return MortarState(t=t, dt=dt, nodes=self.nodes, X=self.slave.X[self.nodes], x=k["xs"], g_N=g_N, t_N=t_N,
@@ -289,10 +291,10 @@ class MortarContact:
         s, m = candidate_pairs(xs, xm, self.unbounded, self.search)
         return mortar_integrals(xs, xm, Pairs.of(s, m, len(xs)), self.unbounded)
 
-    def _to_global(self, R_i, r, c, v, ndof):
+    def _to_global(self, R_i, r, c, v, ndof, offsets=None):
         """Interface dofs (slave nodes, then master nodes) to global dofs; a rigid
         master's rows and columns are dropped."""
-        g = np.concatenate([self.slave_dofs().ravel(), self.master_dofs().ravel()])
+        g = np.concatenate([self.slave_dofs(offsets).ravel(), self.master_dofs(offsets).ravel()])
         R = np.zeros(ndof)
         on = g >= 0
         np.add.at(R, g[on], R_i[on])

@@ -78,6 +78,7 @@ class ContactState:
     K: np.ndarray
     element_dofs: np.ndarray
     work_T: np.ndarray | None = None       # energy-consistent: the friction force's work over the step
+    offsets: object = None                 # where the bodies' dofs start in u (a System's: placement.py)
 
     # -- assembly ---------------------------------------------------------------------
     def scatter(self, ndof):
@@ -99,7 +100,7 @@ class ContactState:
         z = self.z
         g = self.g_raw + c.gap_offset(z)
         return ContactHistory(s_bar=self.s_next, g_bar=g, t_T_bar=np.where(self.active, self.t_T, 0.0),
-                              q_bar=self.q, z_bar=z, master=c.master.reference(self.u))
+                              q_bar=self.q, z_bar=z, master=c.master.reference(self.u, self.offsets))
 
     @cached_property
     def energy(self):

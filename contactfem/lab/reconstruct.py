@@ -59,10 +59,8 @@ at 1e-3 (the tails below it are round-off and stopping rule, not the problem).
 Sloping impact (Sec. 5.3): see ``sloping_impact_readings``.
 """
 
-import hashlib
 import itertools
 import json
-import os
 from pathlib import Path
 
 import numpy as np
@@ -81,45 +79,20 @@ OUTCOMES = ("converged", "no_equilibrium", "no_convergence", "rejected_inverted"
 
 
 # ---------------------------------------------------------------------------------------
-# caching: one JSON file per study, keyed by the reading; invalidated when the code changes
-def _code_hash(modules):
-    import contactfem
+# the cases: kept on disk by joblib.Memory (plots.stored), keyed by the scene and its parameters and
+# invalidated when the code changes
+def cases(enabled=True):
+    """How the studies get a case, ``case(scene, params)``: kept on disk for the same code
+    (plots.stored: joblib.Memory in ``$CONTACTFEM_CACHE/figures`` or ~/.cache/contactfem) when
+    ``enabled``, else solved every time."""
+    from ..plots import stored
 
-    root = Path(contactfem.__file__).parent
-    h = hashlib.sha1()
-    for rel in modules:
-        for f in sorted((root / rel).rglob("*.py")) if (root / rel).is_dir() else [root / rel]:
-            h.update(f.read_bytes())
-    return h.hexdigest()[:12]
+    return stored(_case) if enabled else _case
 
 
-class Cache:
-    """Results of earlier runs of the same code (``$CONTACTFEM_CACHE`` or ~/.cache/contactfem)."""
-
-    def __init__(self, name, modules, enabled=True):
-        base = Path(os.environ.get("CONTACTFEM_CACHE", Path.home() / ".cache" / "contactfem"))
-        self.path = base / f"reconstruct-{name}-{_code_hash(modules)}.json"
-        self.enabled, self.data, self.dirty = enabled, {}, False
-        if enabled and self.path.exists():
-            try:
-                self.data = json.loads(self.path.read_text())
-            except (OSError, ValueError):
-                self.data = {}
-
-    def get(self, key, compute):
-        k = json.dumps(key, sort_keys=True)
-        if k not in self.data:
-            self.data[k] = compute()
-            self.dirty = True
-        return self.data[k]
-
-    def save(self):
-        if self.enabled and self.dirty:
-            try:
-                self.path.parent.mkdir(parents=True, exist_ok=True)
-                self.path.write_text(json.dumps(self.data))
-            except OSError:
-                pass
+def _case(scene, params):
+    """One solve of a reading of ``scene`` (block or sloping_impact), reduced to what the score needs."""
+    return (_block_case if scene == "block" else _sloping_case)(params)
 
 
 # ---------------------------------------------------------------------------------------
@@ -279,7 +252,7 @@ def reading_outcome(outcomes, kinds=OUTCOMES):
     return "converged"
 
 
-def evaluate_block(reading, cache):
+def evaluate_block(reading, solve):
     cases, outcomes = {}, {}
     for law in ("conical", "parabolic"):
         T, cap = block_equilibrium(reading, law)
@@ -288,8 +261,7 @@ def evaluate_block(reading, cache):
             outcomes[law] = "no_equilibrium"
             continue
         params = block_reading_params(reading, law)
-        cases[law] = cache.get(["block", law, {k: params[k] for k in sorted(params)}],
-                               lambda: _block_case(params))
+        cases[law] = solve("block", params)
         outcomes[law] = block_case_outcome(cases[law], reading["height"])
     row = score_block(reading, cases["conical"], cases["parabolic"])
     pen = [c["max_penetration"] for c in cases.values() if c.get("converged")]
@@ -341,8 +313,7 @@ def reconstruct_block(quick=False, cache=True, progress=None):
     """Stages A-C (module docstring); returns (ranked rows, stage A geometries).
     quick: stage B on the paper preset's geometry and the paper preset's reading itself,
     without stage C (for CI)."""
-    cache = Cache("block", ["scenes/block.py", "contact", "laws", "bodies/continuum.py", "bodies/loads.py",
-                            "solver", "lab/reconstruct.py"], enabled=cache)
+    solve = cases(cache)
     geos = block_geometries()
     paper = block_paper_reading()
     if quick:
@@ -352,32 +323,30 @@ def reconstruct_block(quick=False, cache=True, progress=None):
                 for c_N in (1e2, 1e4, 1e6) for unit in ("per_node", "per_length") for plane in ("strain", "stress")]
     if quick:
         readings.append(paper)
-    try:
-        rows = evaluate_all(readings, evaluate_block, cache, progress)
-        if not quick:                      # stage C around the best of stage B
-            seen = {json.dumps({k: r[k] for k in BLOCK_KEYS}, sort_keys=True) for r in rows}
-            extra = []
-            for best in [r for r in rank(rows) if r["rank"]][:12]:    # the 12 best admissible readings
-                for c_N, plane in itertools.product((1e3, 1e5), ("strain", "stress")):
-                    rd = {k: best[k] for k in BLOCK_KEYS} | dict(c_N=c_N, plane=plane,
-                                                                  first_residual=best["first_residual"])
-                    key = json.dumps({k: rd[k] for k in BLOCK_KEYS}, sort_keys=True)
-                    if key not in seen:
-                        seen.add(key)
-                        extra.append(rd)
-            if json.dumps({k: paper[k] for k in BLOCK_KEYS}, sort_keys=True) not in seen:
-                extra.append(paper)        # the scene's defaults are always among the readings
-            rows += evaluate_all(extra, evaluate_block, cache)
-    finally:
-        cache.save()
+    rows = evaluate_all(readings, evaluate_block, solve, progress)
+    if not quick:                      # stage C around the best of stage B
+        seen = {json.dumps({k: r[k] for k in BLOCK_KEYS}, sort_keys=True) for r in rows}
+        extra = []
+        for best in [r for r in rank(rows) if r["rank"]][:12]:    # the 12 best admissible readings
+            for c_N, plane in itertools.product((1e3, 1e5), ("strain", "stress")):
+                rd = {k: best[k] for k in BLOCK_KEYS} | dict(c_N=c_N, plane=plane,
+                                                              first_residual=best["first_residual"])
+                key = json.dumps({k: rd[k] for k in BLOCK_KEYS}, sort_keys=True)
+                if key not in seen:
+                    seen.add(key)
+                    extra.append(rd)
+        if json.dumps({k: paper[k] for k in BLOCK_KEYS}, sort_keys=True) not in seen:
+            extra.append(paper)        # the scene's defaults are always among the readings
+        rows += evaluate_all(extra, evaluate_block, solve)
     return rank(rows), geos
 
 
-def evaluate_all(readings, evaluate, cache, progress=None):
-    """Score every reading with ``evaluate(reading, cache)``; ``progress(done, total)``."""
+def evaluate_all(readings, evaluate, solve, progress=None):
+    """Score every reading with ``evaluate(reading, solve)`` (``solve(scene, params)``: ``cases``);
+    ``progress(done, total)``."""
     rows = []
     for i, rd in enumerate(readings):
-        rows.append(evaluate(rd, cache))
+        rows.append(evaluate(rd, solve))
         if progress:
             progress(i + 1, len(readings))
     return rows
@@ -484,7 +453,7 @@ def sloping_case_outcome(case):
     return "converged"
 
 
-def evaluate_sloping(reading, cache):
+def evaluate_sloping(reading, solve):
     from ..scenes.sloping_impact import PAPER_TABLE2, SCENE
 
     row = dict(reading)
@@ -492,12 +461,10 @@ def evaluate_sloping(reading, cache):
     for variant in ("frictionless", "frictional"):
         over = dict(reading, variant=variant, n_steps=SLOPING_STEPS, outline_every=1000)
         params = SCENE.resolve("paper", over)
-        key = ["sloping_impact", {k: params[k] for k in sorted(params)}]
-        case = cache.get(key, lambda: _sloping_case(params))
+        case = solve("sloping_impact", params)
         if case.get("converged") and not (case["rebounded"] and case["t_separation"] < SLOPING_STEPS * params["dt"]):
             params = SCENE.resolve("paper", dict(over, n_steps=200))
-            case = cache.get(["sloping_impact", {k: params[k] for k in sorted(params)}],
-                             lambda: _sloping_case(params))
+            case = solve("sloping_impact", params)
         outcomes[variant] = sloping_case_outcome(case)
         paper = PAPER_TABLE2[variant]
         for q in ("vx", "vy", "angle"):
@@ -575,24 +542,18 @@ def reconstruct_sloping_impact(quick=False, cache=True, progress=None):
     stage 3 (``against_text_readings``): the presets paper and midpoint and the best reading
     with the consistent mass and / or the energy-consistent time integration (against the text:
     shown, not ranked)."""
-    cache = Cache("sloping_impact", ["scenes/sloping_impact.py", "scenes/time_integration.py", "scenes/rings.py",
-                                     "contact", "laws", "bodies/beam.py", "bodies/ring.py", "bodies/interfaces.py",
-                                     "solver", "lab/reconstruct.py"],
-                  enabled=cache)
+    solve = cases(cache)
     readings = sloping_impact_readings(quick)
-    try:
-        rows = evaluate_all(readings, evaluate_sloping, cache, progress)
-        if not quick:
-            best = [r for r in rank(rows, SLOPING_OUTCOMES, follows_text) if r["rank"]][:6]
-            extra = [dict({k: b[k] for k in SLOPING_KEYS}, c_N=c) for b in best for c in (25.0, 100.0, 500.0)]
-            rows += evaluate_all(extra, evaluate_sloping, cache)
-            top = [r for r in rank(rows, SLOPING_OUTCOMES, follows_text) if r["rank"]][0]
-            bases = [SLOPING_PAPER_READING, dict(SLOPING_PAPER_READING, integration="1")]
-            if {k: top[k] for k in SLOPING_KEYS} not in bases:
-                bases.append({k: top[k] for k in SLOPING_KEYS})
-            rows += evaluate_all(against_text_readings(bases), evaluate_sloping, cache)
-    finally:
-        cache.save()
+    rows = evaluate_all(readings, evaluate_sloping, solve, progress)
+    if not quick:
+        best = [r for r in rank(rows, SLOPING_OUTCOMES, follows_text) if r["rank"]][:6]
+        extra = [dict({k: b[k] for k in SLOPING_KEYS}, c_N=c) for b in best for c in (25.0, 100.0, 500.0)]
+        rows += evaluate_all(extra, evaluate_sloping, solve)
+        top = [r for r in rank(rows, SLOPING_OUTCOMES, follows_text) if r["rank"]][0]
+        bases = [SLOPING_PAPER_READING, dict(SLOPING_PAPER_READING, integration="1")]
+        if {k: top[k] for k in SLOPING_KEYS} not in bases:
+            bases.append({k: top[k] for k in SLOPING_KEYS})
+        rows += evaluate_all(against_text_readings(bases), evaluate_sloping, solve)
     return rank(rows, SLOPING_OUTCOMES, follows_text)
 
 

@@ -88,6 +88,7 @@ def stored(fn):
     def call(*args, **kwargs):
         return kept(fn, source_hash(), args, kwargs)
     call.__wrapped__ = fn
+    call.kept = lambda *args, **kwargs: kept.check_call_in_cache(fn, source_hash(), args, kwargs)   # on disk?
     return call
 
 

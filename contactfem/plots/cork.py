@@ -18,6 +18,7 @@ axis to show the whole cork and both sides of the neck.
 """
 
 
+import json
 import os
 from pathlib import Path
 
@@ -442,42 +443,27 @@ def exit_case(case, preset=EXIT_PRESET):
                 steps=int(len(h["t"]) - 1), newton_failures=sum(len(rec.failures) for rec in records))
 
 
-# The cases run in this process, by (preset, case): the summary's cork row and the study share
-# them (as the figures share scene runs through plots.cached_run).
-_EXIT_RUNS = {}
-
-
-def _exit_key(case, preset):
-    import json
-
-    return json.dumps([preset, case], sort_keys=True)
-
-
 def stored_exit_case(case, preset=EXIT_PRESET):
-    """``exit_case``, kept on disk for the same code (plots.stored)."""
+    """``exit_case``, kept on disk for the same code (plots.stored): the summary's cork row and
+    the study share the cases (as the figures share scene runs through plots.cached_run)."""
     return stored(exit_case)(case, preset)
 
 
 def cached_exit_case(case, preset=EXIT_PRESET):
-    """``exit_case``, run once per process for each case and preset (a copy of the row)."""
-    key = _exit_key(case, preset)
-    if key not in _EXIT_RUNS:
-        _EXIT_RUNS[key] = stored_exit_case(case, preset)
-    return dict(_EXIT_RUNS[key])
+    """``exit_case`` (plots.stored: run once for the same code), a copy of the row."""
+    return dict(stored_exit_case(case, preset))
 
 
 def exit_time_data(cases=None, jobs=2):
-    """Every case of ``exit_cases()`` (those not run yet in this process in parallel on ``jobs``
-    cores with joblib, if installed)."""
+    """Every case of ``exit_cases()`` (those not kept yet run in parallel on ``jobs`` cores with
+    joblib)."""
+    from joblib import Parallel, delayed
+
     cases = cases or exit_cases()
-    todo = list({_exit_key(c, EXIT_PRESET): c for c in cases if _exit_key(c, EXIT_PRESET) not in _EXIT_RUNS}.values())
-    try:
-        from joblib import Parallel, delayed
-    except ImportError:
-        rows = [stored_exit_case(c) for c in todo]
-    else:
-        rows = Parallel(n_jobs=jobs)(delayed(stored_exit_case)(c) for c in todo)
-    _EXIT_RUNS.update({_exit_key(c, EXIT_PRESET): r for c, r in zip(todo, rows)})
+    kept = stored(exit_case).kept
+    todo = [c for c in {json.dumps(c, sort_keys=True): c for c in cases}.values() if not kept(c, EXIT_PRESET)]
+    if todo:
+        Parallel(n_jobs=jobs)(delayed(stored_exit_case)(c) for c in todo)
     return dict(preset=EXIT_PRESET, slow=cases is EXIT_CASES_SLOW, cases=[cached_exit_case(c) for c in cases])
 
 

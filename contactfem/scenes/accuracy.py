@@ -192,7 +192,7 @@ def _penalty_frequency(model, records):
             j = int(np.argmax(k))
             if k[j] <= 0 or len(c.nodes) != len(k):
                 continue
-            dof = body.dof_offset + body.xdofs[c.nodes[j], 1] if hasattr(body, "xdofs") else None
+            dof = system.offset(body) + body.xdofs[c.nodes[j], 1] if hasattr(body, "xdofs") else None
             if dof is None or m[dof] <= 0:
                 continue
             f = float(np.sqrt(k[j] / m[dof]))

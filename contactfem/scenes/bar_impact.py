@@ -184,8 +184,7 @@ SCENE = Scene(
         Param("integrator", "newmark", choices=("newmark", "central_difference"),
               doc="implicit Newmark (delta, beta_newmark) or explicit central differences (stable for "
                   "courant < 1; no Newton, no cutback)"),
-        Param("delta", 0.5, "", 0.0, 1.0, doc="Newmark delta (paper's; the usual gamma)"),
-        Param("beta_newmark", 0.25, "", 0.0, 0.5, low_open=True, doc="Newmark beta"),
+        *time_integration.newmark_params(0.5, 0.25, "chosen, average acceleration"),
         Param("t_end", 1.5, "2L/c", 0.0, None, low_open=True, doc="simulated time in units of 2 L / c"),
         time_integration.CONTACT_INTEGRATION_PARAM,
         *enforcement.ENFORCEMENT_PARAMS,

@@ -18,7 +18,7 @@ from typing import Callable
 
 import numpy as np
 
-from .params import Param, check_overrides  # noqa: F401  (scene modules take Param from here)
+from .params import Limit, Param, check_overrides, parse_all  # noqa: F401  (scene modules take Param, Limit here)
 from .resources import check_resources, describe  # noqa: F401  (the command line takes them from here)
 
 PENALTIES = ("per_length", "per_node")
@@ -140,7 +140,7 @@ class Scene:
                                      f"or dataclasses.replace(law, {field}=...)")
                 raise ValueError(f"unknown parameter {k!r} for scene {self.name}: known are {', '.join(known)}")
             values[k] = v
-        values = {k: known[k].parse(v) for k, v in values.items()}
+        values = parse_all(self.params, values)  # each value, then the ranges from other parameters
         for k in overrides:                       # a value the resolved variant would silently ignore
             if not known[k].applies(values):
                 now = ", ".join(f"{o}={values[o]}" for o, _ in known[k].when)

@@ -61,8 +61,7 @@ def build(params, *, normal=None, friction=None, system_options=None):
     bottom = body.boundary_nodes("bottom")
     bottom = bottom[np.argsort(body.X[bottom, 0])]          # left to right
     k = params["free_end_nodes"]
-    if not 2 * k < len(bottom) - 1:
-        raise ValueError(f"parameter free_end_nodes = {k} is out of range: allowed [1, {(len(bottom) - 2) // 2}] for nx = {params['nx']}")
+    assert 0 < 2 * k < len(bottom) - 1, "free_end_nodes leaves no contact node (its Param's limit)"
     weights = tributary_lengths(body.X[bottom])[k:-k]        # tractions per unit length of the bottom
     slaves = bottom[k:-k]                                   # the first and last element never touch
     contact = enforcement.interface(params, body, slaves, RigidLine((0.0, 0.0), (0.0, 1.0)),
@@ -101,7 +100,7 @@ def solve(params, *, friction=None, normal=None, progress=None, system_options=N
     """Build the block and apply the load in ``n_steps`` static steps of the pseudo-time
     (default: the whole load in ONE step, Newton from u = 0). Returns build()'s dict plus the
     records and what ``converged`` reads from them."""
-    model = build(params, friction=friction, normal=normal, **(system_options or {}))
+    model = build(params, friction=friction, normal=normal, system_options=system_options)
     records = simulate(model, params, progress)
     return dict(model, records=records, **converged(model, records))
 

@@ -33,7 +33,7 @@ from ..bodies.materials import MATERIALS
 from ..contact.tangents import TANGENTS
 from ..laws.friction import Coulomb, ParabolicSlip
 from . import enforcement
-from .base import PENALTIES, PENALTY_DOC, Param
+from .base import PENALTIES, PENALTY_DOC, Limit, Param
 
 # Table 1 of the paper: norm of the residual ||G|| per Newton iteration (the first
 # entry is the residual of the initial state). The scan garbled the exponents of
@@ -67,9 +67,11 @@ PARAMS = (
           doc="block width. FITTED to Table 1 (the scan lost it; contactfem reconstruct block)"),
     Param("height", 3.25, "L", 0.0, low_open=True,
           doc="block height. FITTED to Table 1 (the scan lost it; contactfem reconstruct block)"),
-    Param("free_end_nodes", 2, "", 1, 100,
+    Param("free_end_nodes", 2, "", 1,
           doc="bottom nodes at each end kept out of contact (paper: 'the first and the last element'; 2 = both "
-              "nodes of each end element, FITTED against 1 = the end node only)"),
+              "nodes of each end element, FITTED against 1 = the end node only); at least one bottom node "
+              "stays in contact",
+          limit=Limit(("nx",), lambda v: (None, (v["nx"] - 1) // 2), "[1, (nx - 1) // 2]")),
     Param("nx", 25, "", 3, 400, doc="elements along the width (paper: 200 elements in all; 25 x 8 FITTED)"),
     Param("ny", 8, "", 1, 400, doc="elements along the height (paper: 200 elements in all; 25 x 8 FITTED)"),
     Param("p_y", 200.0, "F/L", 0.0, doc="downward pressure on the top (paper: p_y = 200 per unit length)"),
@@ -132,12 +134,12 @@ def friction_capacity(params):
 
 
 def check(params):
-    """Before any solve: the ends kept free must leave contact nodes, and the static problem
-    must have a solution (the block is held by friction alone)."""
+    """Before any solve: the combinations that do not exist (a finite-strain material in plane
+    stress), and the static problem must have a solution (the block is held by friction alone)."""
     enforcement.check(params)
-    k, nx = params["free_end_nodes"], params["nx"]
-    if not 2 * k < nx:
-        raise ValueError(f"parameter free_end_nodes = {k} is out of range: allowed [1, {(nx - 1) // 2}] for nx = {nx}")
+    if params["plane"] == "stress" and params["material"] != "linear":
+        raise ValueError(f"parameter material = {params['material']} needs plane = strain (plane stress is "
+                         "small-strain only: material = linear)")
     if params["material"] == "linear":           # dead loads: the applied forces are known beforehand
         T = abs(params["p_x"]) * params["height"]
         cap, how = friction_capacity(params)

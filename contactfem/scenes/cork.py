@@ -55,7 +55,8 @@ from ..contact import NodeToSegment, tributary_lengths
 from ..contact.masters import bottle_neck
 from ..laws.friction import SlipHardening
 from ..laws.normal import PowerLaw
-from .base import PENALTIES, PENALTY_DOC, Param, Scene
+from .base import PENALTIES, PENALTY_DOC, Limit, Param, Scene
+from .time_integration import newmark_params
 from .cork_measure import PAPER, R_TIP_FITTED, measure  # noqa: F401 (public here)
 from .cork_stages import press_fit_only, simulate  # noqa: F401 (public here)
 
@@ -74,8 +75,10 @@ PARAMS = (
           doc=PENALTY_DOC + ". Chosen: per_length, c_N per unit area of the neck (w = 2 pi R_neck * tributary "
               "length): per node, c_N = 100 N/mm would need the whole interference as penetration"),
     Param("R_neck", 10.0, "mm", 0.0, low_open=True, doc="inner radius of the neck (paper)"),
-    Param("R_cork", 12.0, "mm", 0.0, low_open=True, doc="radius of the free cork (paper: maximum radius 12)"),
-    Param("R_tip", R_TIP_FITTED, "mm", 0.0, low_open=True,
+    Param("R_cork", 12.0, "mm", 0.0, low_open=True, doc="radius of the free cork (paper: maximum radius 12): "
+          "above R_neck (a press fit)", limit=Limit(("R_neck",), lambda v: (v["R_neck"], None), "(R_neck, inf)")),
+    Param("R_tip", R_TIP_FITTED, "mm", limit=Limit(("R_neck", "R_cork"), lambda v: (v["R_neck"], v["R_cork"]),
+                                                   "[R_neck, R_cork]"),
           doc="radius of the cork's bottom: the shaft is conical from R_tip to R_cork at the mouth. Fitted: "
               "scan lost the shape; 10 (the shaft's tip fits the neck) gives the paper's ~2500 N press-fit "
               "force (press_fit_calibrated), a cylinder (R_tip = 12) twice that, which 0.8 MPa could not push "
@@ -106,8 +109,7 @@ PARAMS = (
           doc="largest axial travel per step (adaptive dt). Chosen: a quarter of an element"),
     Param("t_end", 4.0e-3, "s", 0.0, low_open=True, doc="latest end of the run (paper: Fig 15 up to 3 ms)"),
     Param("t_flight", 4.0e-4, "s", 0.0, doc="the run stops this long after the exit (paper: 3.0 - 2.65 ms)"),
-    Param("delta", 0.7, "", 0.0, 1.0, doc="Newmark delta (paper)"),
-    Param("beta_newmark", 0.4, "", 0.0, 0.5, low_open=True, doc="Newmark beta (paper)"),
+    *newmark_params(0.7, 0.4, "paper"),
     Param("max_cuts", 6, "", 0, 20, doc="step halvings allowed when Newton fails"),
     Param("atol", 1e-8, "N", 0.0, doc="Newton absolute tolerance (a floor for a step without forces; the breakaway "
           "step is a knife edge: the paper preset exits at 2.71 ms with 1e-6 or 1e-10 N, at 2.86 ms with 1e-8 N, "
@@ -127,11 +129,8 @@ def build(params, *, normal=None, friction=None, system_options=None):
     from ..bodies.meshes import cork_mesh
 
     P = params
-    if not P["R_cork"] > P["R_neck"]:
-        raise ValueError(f"parameter R_cork = {P['R_cork']} must exceed R_neck = {P['R_neck']} (a press fit)")
+    assert 0 < P["R_neck"] <= P["R_tip"] <= P["R_cork"], "R_tip, R_cork outside their Params' limits"
     length = P["L_neck"] + P["r_mouth"] + P["L_head"]
-    if not P["R_neck"] <= P["R_tip"] <= P["R_cork"]:
-        raise ValueError(f"parameter R_tip = {P['R_tip']} is out of range: allowed [R_neck, R_cork]")
     mesh = cork_mesh(P["R_tip"], P["R_cork"], P["L_neck"], length, P["n_r"], P["n_z"])
     cork = Continuum(mesh, P["E"], P["nu"], P["rho"], kind="axisymmetric", material="neohooke", name="cork")
     shift0 = P["R_cork"] - P["R_neck"]                  # the press fit moves the neck in from r = R_cork

@@ -42,10 +42,11 @@ def contact_forces(states):
                 n_slip=len(slipping))
 
 
-def centre_of_mass_velocity(body, v):
-    """Axial velocity of the centre of mass, sum M_i v_i / sum M_i (lumped mass)."""
+def centre_of_mass_velocity(body, v, offset=0):
+    """Axial velocity of the centre of mass, sum M_i v_i / sum M_i (lumped mass); the body's
+    dofs start at ``offset`` in v (0: the cork, its Systems' only body)."""
     M = body.mass()[body.xdofs[:, 1]]
-    return float(np.sum(M * v[body.dof_offset + body.xdofs[:, 1]]) / np.sum(M))
+    return float(np.sum(M * v[offset + body.xdofs[:, 1]]) / np.sum(M))
 
 
 def history(model, out):
@@ -54,7 +55,7 @@ def history(model, out):
     the smallest gap, the smallest element area ratio, iterations, cuts, energies."""
     cork, gas, records = model["cork"], model["gas"], out["records"]
     u0 = records[0].u
-    uz = cork.xdofs[:, 1] + cork.dof_offset
+    uz = cork.xdofs[:, 1]                             # the cork is its Systems' only body: offset 0
     centre = model["bottom"][np.argmin(cork.X[model["bottom"], 0])]
     top = model["axis"][np.argmax(cork.X[model["axis"], 1])]
     M, A0 = cork.mass()[cork.xdofs[:, 1]], cork.element_areas(np.zeros(cork.ndof))

@@ -40,9 +40,14 @@ ENFORCEMENT_PARAMS = (
 
 def check(params):
     """Combinations that do not exist, before any run: one ValueError naming the parameters."""
-    if params.get("contact_discretization") == "mortar" and params.get("enforcement") == "augmented":
+    if params.get("contact_discretization") != "mortar":
+        return
+    if params.get("enforcement") == "augmented":
         raise ValueError("parameter enforcement = augmented is offered with contact_discretization = node_to_segment "
                          "only: use penalty or lagrange with mortar")
+    if params.get("tangent", "consistent") != "consistent":        # (contact_integration: the scene's check)
+        raise ValueError(f"parameter tangent = {params['tangent']} is offered with contact_discretization = "
+                         "node_to_segment only: mortar takes tangent = consistent")
 
 
 def outward(body, nodes):
@@ -71,10 +76,8 @@ def interface(params, slave, nodes, master, *, normal, friction=None, weights=1.
     from ..contact.lagrange import LagrangeMortar            # (scipy: loaded when a scene builds, not by show)
     from ..contact.mortar_contact import MortarContact
 
-    check(dict(params, enforcement=enforcement, contact_discretization="mortar"))
-    if tangent != "consistent" or integration != "standard":
-        raise ValueError(f"contact_discretization = mortar takes tangent = consistent and contact_integration = "
-                         f"standard (got {tangent}, {integration})")
+    assert enforcement != "augmented" and tangent == "consistent" and integration == "standard", \
+        "a mortar contact with node-to-segment options (enforcement.check refuses them)"
     cls = LagrangeMortar if enforcement == "lagrange" else MortarContact
     return cls(slave, outward(slave, nodes), master, normal=normal, friction=friction, offset=offset, name=name,
                kinematics="small" if material == "linear" else "finite")

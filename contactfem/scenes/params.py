@@ -5,16 +5,31 @@ parameter and its range).
 One rule for a value, whichever way it comes (the command line's text, a sweep's grid, a scene
 file, Python's run_scene): it is accepted when it denotes exactly one value of the parameter's
 type, as a number or as the text of one. An integer parameter takes 12, 12.0, "12" and "1.2e1"
-(the same integer) and refuses 12.5; a boolean is not a number (True is not 1)."""
+(the same integer) and refuses 12.5; a boolean is not a number (True is not 1).
+
+A range that depends on other parameters (the block's free end nodes and its number of
+elements, a cork's tip between the neck's radius and its own) is part of the parameter too
+(``limit``): ``Scene.resolve`` checks it once every value is known. The Param is the one place
+a scene's parameter is checked; the constructors the scene calls only assert what they need."""
 
 import numbers
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
 from ..laws.validation import require
+
+
+@dataclass(frozen=True)
+class Limit:
+    """A range from other parameters: ``bounds(values) -> (low, high)`` (None: no bound beyond
+    the parameter's own), the parameters it reads (``of``) and how ``show`` states it (``text``,
+    e.g. "[1, (nx - 1) // 2]")."""
+    of: tuple
+    bounds: Callable[[dict], tuple]
+    text: str
 
 
 @dataclass(frozen=True)
@@ -29,6 +44,7 @@ class Param:
     choices: tuple | None = None
     doc: str = ""
     when: tuple = ()      # ((other_param, (values...)), ...): the parameter is used only then
+    limit: Limit | None = None   # a range from other parameters (checked by Scene.resolve)
 
     def applies(self, values):
         """Whether the resolved `values` use this parameter (see `when`)."""
@@ -37,14 +53,42 @@ class Param:
     def when_text(self):
         return " and ".join(f"{k}={'|'.join(map(str, vals))}" for k, vals in self.when)
 
-    def range_text(self):
+    def range_text(self, values=None):
+        """The allowed range, e.g. "(0, inf)"; with a ``limit``: its text, or, given the other
+        parameters' ``values``, the range they leave, e.g. "[1, 12] for nx = 25"."""
         if self.choices is not None:
             return "one of " + "|".join(map(str, self.choices))
         if isinstance(self.default, bool):
             return "true|false"
-        lo = "-inf" if self.low is None else f"{self.low:g}"
-        hi = "inf" if self.high is None else f"{self.high:g}"
-        return ("(" if self.low_open or self.low is None else "[") + f"{lo}, {hi}" + (")" if self.high_open or self.high is None else "]")
+        if self.limit is not None and values is None:
+            return self.limit.text
+        low, high = self.bounds(values)
+        lo = "-inf" if low is None else f"{low:g}"
+        hi = "inf" if high is None else f"{high:g}"
+        text = ("(" if self.low_open or low is None else "[") + f"{lo}, {hi}" + (")" if self.high_open or high is None else "]")
+        if self.limit is not None:
+            text += " for " + ", ".join(f"{k} = {values[k]:g}" for k in self.limit.of)
+        return text
+
+    def bounds(self, values=None):
+        """(low, high): the parameter's own, narrowed by its ``limit`` at the other ``values``."""
+        low, high = self.low, self.high
+        if self.limit is not None and values is not None:
+            lo, hi = self.limit.bounds(values)
+            low = lo if low is None else (low if lo is None else max(low, lo))
+            high = hi if high is None else (high if hi is None else min(high, hi))
+        return low, high
+
+    def check_limit(self, values):
+        """ValueError (one line, naming the parameter and the range the others leave) unless
+        ``values[name]`` is within its limit; nothing without one."""
+        if self.limit is None:
+            return
+        v = values[self.name]
+        low, high = self.bounds(values)
+        if (low is not None and (v <= low if self.low_open else v < low)) or \
+                (high is not None and (v >= high if self.high_open else v > high)):
+            raise ValueError(f"parameter {self.name} = {v:g} is out of range: allowed {self.range_text(values)}")
 
     def parse(self, value):
         """Convert (from text if need be) and validate; ValueError names the parameter and range."""
@@ -64,11 +108,14 @@ class Param:
             raise ValueError(f"parameter {self.name} = {value!r} is not allowed: true|false")
         if isinstance(value, (bool, np.bool_)):
             raise ValueError(f"parameter {self.name} must be a number in {self.range_text()}, got {value!r}")
-        if isinstance(self.default, int):
-            iv = self._integer(value)
-            require(self.name, iv, self.low, self.high, self.low_open, self.high_open)
-            return iv
-        return require(self.name, value, self.low, self.high, self.low_open, self.high_open)
+        number = self._integer(value) if isinstance(self.default, int) else value
+        try:
+            v = require(self.name, number, self.low, self.high, self.low_open, self.high_open)
+        except ValueError:
+            if self.limit is None:
+                raise
+            raise ValueError(f"parameter {self.name} = {value!r} is out of range: allowed {self.range_text()}") from None
+        return number if isinstance(self.default, int) else v
 
     def _integer(self, value):
         """The integer ``value`` denotes (an int, an integral float, or the text of either)."""
@@ -88,6 +135,17 @@ class Param:
         if not f.is_integer():
             raise bad
         return int(f)
+
+
+def parse_all(params, values):
+    """{name: value} with every value parsed by its Param, then checked against the range the
+    other values leave it (its Limit, where it applies)."""
+    known = {p.name: p for p in params}
+    values = {k: known[k].parse(v) for k, v in values.items()}
+    for p in params:
+        if p.applies(values):
+            p.check_limit(values)
+    return values
 
 
 def check_overrides(overrides):

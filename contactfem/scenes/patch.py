@@ -89,13 +89,7 @@ def build(params, *, normal=None, friction=None, system_options=None):
     from ..bodies.loads import OverhangPressure, Pressure
 
     W, H, E, nu = params["W"], params["H"], params["E"], params["nu"]
-    e = W / params["nx_lower"]
-    xs_lower = -0.5 * e + e * np.arange(params["nx_lower"] + 2)      # [-e/2, W + e/2], shifted
-    xs_upper = np.linspace(0.0, W, params["nx_upper"] + 1)
-    if params["contact_discretization"] == "node_to_segment" and \
-            np.min(np.abs(xs_upper[:, None] - xs_lower[None, :])) < 1e-6 * W:
-        raise ValueError("parameters nx_lower, nx_upper put a slave node exactly above a master node "
-                         "(node-to-segment switching is non-smooth there): choose nx_upper odd")
+    e, xs_lower, xs_upper = columns(params)
     lower = block(xs_lower, 0.0, H, params["ny"], "lower", E, nu)
     upper = block(xs_upper, H, 2 * H, params["ny"], "upper", params["E_upper"], nu)
     law = normal or PowerLaw(params["c_N"], 1.0)
@@ -138,7 +132,7 @@ def build(params, *, normal=None, friction=None, system_options=None):
     # initial guess: the upper block pushed into the lower by twice the penalty
     # penetration p / c_N, so the interface is active and the first tangent regular
     u0 = np.zeros(system.ndof)
-    u0[upper.dof_offset + upper.xdofs[:, 1]] = -2.0 * p / params["c_N"]
+    u0[system.global_dofs(upper, upper.xdofs[:, 1])] = -2.0 * p / params["c_N"]
     stepper = Static(system, atol=1e-12 * p * params["W"], maxit=30)      # Newton's force test; atol: a floor
     stepper = enforcement.wrap(params, stepper, contacts, length=H)     # gap_violation: penetration / H
     return dict(lower=lower, upper=upper, contacts=contacts, system=system, systems=[system], bottom_upper=bottom_upper,
@@ -147,7 +141,7 @@ def build(params, *, normal=None, friction=None, system_options=None):
 
 
 def measure(m, params, records):
-    lower, upper = m["lower"], m["upper"]
+    lower, upper, system = m["lower"], m["upper"], m["system"]
     p = params["p"]
     hist = History.of(records)
     u, states = records[-1].u, records[-1].contacts
@@ -163,7 +157,7 @@ def measure(m, params, records):
     # passes (slave forces of pass 1, master reactions of pass 2) over the tributary
     # lengths; the exact solution gives p at every node
     nodes = m["bottom_upper"]
-    dofs = upper.dof_offset + upper.xdofs[nodes, 1]
+    dofs = system.global_dofs(upper, upper.xdofs[nodes, 1])
     f = -sum(st.scatter(len(u))[0][dofs] for st in states)
     pressure = f / tributary_lengths(upper.X[nodes])
     order = np.argsort(upper.X[nodes, 0])
@@ -172,8 +166,8 @@ def measure(m, params, records):
     # what the lower block feels: the contact forces on its top nodes (master reactions of pass
     # 1, slave forces of pass 2) and the overhang's load, over the tributary lengths of its top
     top = m["top_lower"]
-    dofs = lower.dof_offset + lower.xdofs[top, 1]
-    f_lower = sum(st.scatter(len(u))[0][dofs] for st in states) - m["system"].external_force(u, 1.0, records[-1].state)[dofs]
+    dofs = system.global_dofs(lower, lower.xdofs[top, 1])
+    f_lower = sum(st.scatter(len(u))[0][dofs] for st in states) - system.external_force(u, 1.0, records[-1].state)[dofs]
     pressure_lower = f_lower / tributary_lengths(lower.X[top])
     result["lower_interface_x"] = lower.X[top, 0]
     result["lower_interface_pressure"] = pressure_lower
@@ -184,7 +178,7 @@ def measure(m, params, records):
     result["load_applied"] = p * params["W"]          # through the interface
     s_dev = 0.0
     for body in (lower, upper):
-        s = body.cauchy_stress(u[body.dof_offset:body.dof_offset + body.ndof])
+        s = body.cauchy_stress(system.local(body, u))
         s_dev = max(s_dev, float(np.max(np.abs(s[:, 1, 1] + p)) / p))
     result["stress_deviation_max"] = s_dev
     from .accuracy import PRESSURE_TOL, indicator
@@ -196,14 +190,27 @@ def measure(m, params, records):
     return result
 
 
-
 def law_range(params):
     """Normal law only: probed down to a penetration of the blocks' height."""
     return dict(g=params["H"])
 
+
+def columns(params):
+    """The element size of the lower block and the x of both blocks' node columns: the lower
+    block's [-e/2, W + e/2] (shifted by half an element), the upper block's [0, W]."""
+    W, e = params["W"], params["W"] / params["nx_lower"]
+    return e, -0.5 * e + e * np.arange(params["nx_lower"] + 2), np.linspace(0.0, W, params["nx_upper"] + 1)
+
+
 def check(params):
-    """enforcement.check, and a penalty (or Lagrange's steering c_N) that round-off can resolve."""
+    """enforcement.check, no slave node exactly above a master node with node-to-segment, and a
+    penalty (or Lagrange's steering c_N) that round-off can resolve."""
     enforcement.check(params)
+    _, xs_lower, xs_upper = columns(params)
+    if params["contact_discretization"] == "node_to_segment" and \
+            np.min(np.abs(xs_upper[:, None] - xs_lower[None, :])) < 1e-6 * params["W"]:
+        raise ValueError("parameters nx_lower, nx_upper put a slave node exactly above a master node "
+                         "(node-to-segment switching is non-smooth there): choose nx_upper odd")
     enforcement.check_roundoff(params["c_N"], params["p"], max(params["W"], 2.0 * params["H"]))
     enforcement.check_steering(params, min(params["E"], params["E_upper"]) / params["H"], "E / H")
 

@@ -14,7 +14,7 @@ history moved on).
 import numpy as np
 
 from ..laws.return_map import OPEN, SLIP
-from .base import Param
+from .base import Limit, Param
 
 # The mass matrix of every ring scene (the scan does not say which the paper used).
 MASS_MATRIX_PARAM = Param(
@@ -22,13 +22,17 @@ MASS_MATRIX_PARAM = Param(
     doc="the ring's mass: lumped (diagonal, row sums; our default) or consistent (the P1 mass matrix of the "
         "beam's translations and rotations, scikit-fem's mass form for the continuum); the scan does not say")
 
+# A ring's wall is thinner than its diameter: thickness in (0, 2 R) (the ring builders assert it).
+THICKNESS_LIMIT = Limit(("R",), lambda v: (None, 2.0 * v["R"]), "(0, 2 R)")
+
 # The ring of Sec. 5.3; Sec. 5.4 (the funnel) uses "the same ring".
 RING_PARAMS = (
     Param("kind", "beam", choices=("beam", "continuum"),
           doc="beam: the paper's finite-deformation beam; continuum: annulus of quads (plane strain, SVK)"),
     Param("R", 10.0, "L", 0.0, None, low_open=True, doc="mean radius of the ring (paper, Sec. 5.3). The paper gives no "
           "units: any consistent set of length L, time T, force F (mass M = F T^2 / L)"),
-    Param("thickness", 1.0, "L", 0.0, None, low_open=True, doc="radial wall thickness h (paper: square section A = 1)"),
+    Param("thickness", 1.0, "L", 0.0, None, low_open=True, high_open=True, limit=THICKNESS_LIMIT,
+          doc="radial wall thickness h (paper: square section A = 1)"),
     Param("width", 1.0, "L", 0.0, None, low_open=True, doc="out-of-plane depth b (paper: square section A = 1)"),
     Param("E", 100.0, "F/L^2", 0.0, None, low_open=True, doc="Young's modulus (paper)"),
     Param("nu", 0.0, "", -1.0, 0.5, low_open=True, high_open=True, doc="Poisson's ratio (paper)"),

@@ -58,7 +58,7 @@ from ..solver import History, Steps, System
 from . import time_integration
 from .accuracy import V_FINAL_TOL, X_END_TOL, references
 from .base import Param, Scene, Stage
-from .rings import MASS_MATRIX_PARAM, detect_rolling, penalty_pressure, rigid_ring_exact, ring_gyration_radius2, ring_history, ring_size, snapshot_indices  # noqa: F401
+from .rings import MASS_MATRIX_PARAM, THICKNESS_LIMIT, detect_rolling, penalty_pressure, rigid_ring_exact, ring_gyration_radius2, ring_history, ring_size, snapshot_indices  # noqa: F401
 
 # Paper, Fig 9 (bracketed values are the rigid thin-ring solution)
 PAPER = dict(x_roll_exact=229.0, x_roll_computed="23x (scan)", x_end_exact=376.0, x_end_computed=382.0,
@@ -201,7 +201,7 @@ SCENE = Scene(
               doc="beam: the paper's finite-deformation beam ring; continuum: annulus of quads "
                   "(plane strain, St Venant-Kirchhoff, n_radial through the wall)"),
         Param("R", 50.0, "cm", 0.0, None, low_open=True, doc="mean radius (paper)"),
-        Param("thickness", 1.0, "cm", 0.0, None, low_open=True,
+        Param("thickness", 1.0, "cm", 0.0, None, low_open=True, high_open=True, limit=THICKNESS_LIMIT,
               doc="radial wall thickness h (chosen: the paper gives A = 10 cm^2 only; a thin ring, "
                   "h = 1 cm x width 10 cm, as the closed form assumes)"),
         Param("width", 10.0, "cm", 0.0, None, low_open=True,
@@ -227,8 +227,7 @@ SCENE = Scene(
         Param("dt", 0.01, "s", 0.0, None, low_open=True, doc="time step (paper: 0.01)"),
         Param("t_end", 2.0, "s", 0.0, None, low_open=True,
               doc="duration (chosen: 2 s, where the paper's exact position is 376 cm)"),
-        Param("delta", 0.7, "", 0.5, 1.0, doc="Newmark delta (paper: 0.7)"),
-        Param("beta_newmark", 0.4, "", 0.0, 0.5, low_open=True, doc="Newmark beta (paper: 0.4)"),
+        *time_integration.newmark_params(0.7, 0.4, "paper"),
         time_integration.CONTACT_INTEGRATION_PARAM,
         MASS_MATRIX_PARAM,
         Param("outline_interval", 0.25, "s", 0.0, None, low_open=True,

@@ -80,8 +80,7 @@ def build(params, *, normal=None, friction=None, system_options=None):
     h = params["thickness"]
     plastic = None
     if params["variant"] == "viscoplastic":
-        if params["kind"] != "beam":
-            raise ValueError("parameter variant = 'viscoplastic' needs kind = 'beam' (the continuum ring is elastic)")
+        assert params["kind"] == "beam", "variant = viscoplastic with a continuum ring (the scene's check)"
         plastic = dict(N0=params["N0"], Q0=params["Q0"], M0=params["M0"], eta=params["eta"])
     R = params["R"]
     center = (0.0, R + h / 2 + params["gap0"])
@@ -219,8 +218,7 @@ SCENE = Scene(
                   "(without the c_N^s C coupling of eq 49); the residual is always eq 28"),
         Param("dt", 0.1, "T", 0.0, None, low_open=True, doc="time step (paper)"),
         Param("n_steps", 200, "", 1, 100000, doc="number of steps (paper: 200)"),
-        Param("delta", 0.7, "", 0.5, 1.0, doc="Newmark delta (paper: 0.7; 0.5 with beta 0.25 conserves energy)"),
-        Param("beta_newmark", 0.4, "", 0.0, 0.5, low_open=True, doc="Newmark beta (paper: 0.4)"),
+        *time_integration.newmark_params(0.7, 0.4, "paper"),
         time_integration.CONTACT_INTEGRATION_PARAM,
         MASS_MATRIX_PARAM,
         Param("outline_every", 20, "", 1, 100000, doc="store the ring outline every this many steps (figures)"),

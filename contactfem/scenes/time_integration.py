@@ -6,6 +6,7 @@ import numpy as np
 
 from ..solver import Newmark
 from ..solver.conserving import EnergyConsistent
+from ..solver.newmark import BETA_RANGE, DELTA_RANGE
 from .base import Param
 
 CONTACT_INTEGRATIONS = ("standard", "energy_consistent")
@@ -16,6 +17,17 @@ CONTACT_INTEGRATION_PARAM = Param(
         "rule gains energy at impact); energy_consistent: midpoint rule with discrete gradients of the "
         "bodies' and the interface's energy (Armero-Petocz): a frictionless impact conserves energy whatever "
         "c_N, dt and the phase at which contact begins; friction only dissipates (delta, beta_newmark unused)")
+
+
+def newmark_params(delta, beta, source):
+    """The Params delta and beta_newmark with the scene's defaults and Newmark's own ranges
+    (solver.newmark: delta in [0.5, 1], beta in (0, 0.5]); ``source`` says where the defaults
+    come from (e.g. "paper")."""
+    return (Param("delta", delta, "", **DELTA_RANGE,
+                  doc=f"Newmark delta, the usual gamma ({source}: {delta:g}; 0.5 with beta 0.25 conserves energy, "
+                      "below 0.5 every step amplifies)"),
+            Param("beta_newmark", beta, "", **BETA_RANGE,
+                  doc=f"Newmark beta ({source}: {beta:g}; stable for every step when beta >= (delta + 1/2)^2 / 4)"))
 
 
 def contact_integration(params):

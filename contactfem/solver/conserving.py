@@ -42,7 +42,6 @@ with the derivative of X on the diagonal.
 import numpy as np
 
 from ..bodies.discrete_gradient import cayley
-from .newmark import _check_dt
 from .newton import newton
 from .system import Evaluation
 
@@ -55,7 +54,7 @@ class EnergyConsistent:
 
     def __init__(self, system, **newton_options):
         self.system, self.newton_options = system, newton_options
-        self.rotations = np.concatenate([b.dof_offset + np.asarray(b.rotation_dofs, dtype=int)
+        self.rotations = np.concatenate([system.offset(b) + np.asarray(b.rotation_dofs, dtype=int)
                                          for b in system.bodies] + [np.zeros(0, int)])
         for c in system.contacts:
             if c.integration != "energy_consistent":
@@ -73,17 +72,18 @@ class EnergyConsistent:
         G = np.zeros(s.ndof)
         rows, cols, vals = [], [], []
         for b in s.bodies:
-            sl = slice(b.dof_offset, b.dof_offset + b.ndof)
+            off = s.offset(b)
+            sl = slice(off, off + b.ndof)
             F, r, c, v = b.discrete_gradient(u0[sl], u1[sl])
             G[sl] += F
-            rows.append(np.asarray(r, int) + b.dof_offset), cols.append(np.asarray(c, int) + b.dof_offset)
+            rows.append(np.asarray(r, int) + off), cols.append(np.asarray(c, int) + off)
             vals.append(np.asarray(v, float))
         return G, rows, cols, vals
 
     def step(self, t, u, v, a, dt, label="", *, state):
         import scipy.sparse as sp
 
-        _check_dt(dt)
+        assert dt > 0, "a step's size comes from its Schedule, which checks it"
         s = self.system
         t1, tm = t + dt, t + 0.5 * dt
         M = s.mass()                        # lumped (a vector) or consistent (a sparse matrix)
@@ -103,14 +103,14 @@ class EnergyConsistent:
             # conjugate to dq (chord dq = d there); the derivative of chord on the diagonal
             Gc, rows_c, cols_c, vals_c = np.zeros(s.ndof), [], [], []
             for ct, h in zip(s.contacts, state.contacts):
-                cs = ct.evaluate(u1, t1, dt, u, history=h)
+                cs = ct.evaluate(u1, t1, dt, u, history=h, offsets=s.offsets)
                 Rc, r, c, vv = cs.scatter(s.ndof)
                 states.append(cs)
                 Gc += Rc
                 rows_c.append(np.asarray(r, int)), cols_c.append(np.asarray(c, int)), vals_c.append(np.asarray(vv, float))
             Pm = np.zeros(s.ndof)
             for load, ls in zip(s.loads, state.loads):
-                P, r, c, vv = load.assemble(um, tm, ls)
+                P, r, c, vv = load.assemble(um, tm, ls, offsets=s.offsets)
                 Gc -= P
                 Pm += P
                 rows_c.append(np.asarray(r, int)), cols_c.append(np.asarray(c, int))

@@ -25,18 +25,19 @@ The unknowns a contact owns (Lagrange multipliers, system.py) are not motions: N
 starts them from their last converged values and they get no velocity or acceleration
 (``system.contact_dofs``; none in a penalty model, where nothing of this changes).
 """
-import math
 import warnings
 
 import numpy as np
 
+from ..laws.validation import require
 from .march import acceleration
 from .newton import NewtonError, NewtonResult, newton
 
-
-def _check_dt(dt):
-    if not (math.isfinite(dt) and dt > 0):
-        raise ValueError(f"dt must be a finite number > 0, got {dt}")
+# Newmark's parameters (a scene's delta and beta_newmark take these ranges): delta >= 1/2, or every
+# step amplifies (no stable step size); beta = 0 is explicit (CentralDifference); beta <= 1/2.
+DELTA_RANGE = dict(low=0.5, high=1.0)
+BETA_RANGE = dict(low=0.0, high=0.5, low_open=True)
+SIZE_CHECKED = "a step's size comes from its Schedule, which checks it (schedule.check_dt)"
 
 
 def initial_acceleration(system, t, u, dt=None, state=None):
@@ -55,14 +56,11 @@ class Newmark:
     dynamic = True
 
     def __init__(self, system, delta=0.7, beta=0.4, **newton_options):
-        if not 0 <= delta <= 1:
-            raise ValueError(f"delta must be in [0, 1], got {delta}")
-        if not 0 < beta <= 0.5:
-            raise ValueError(f"beta must be in (0, 0.5], got {beta} "
-                             "(beta = 0 is explicit: use CentralDifference)")
-        if delta < 0.5 or beta < (delta + 0.5) ** 2 / 4:
+        require("delta", delta, **DELTA_RANGE)
+        require("beta", beta, **BETA_RANGE)
+        if beta < (delta + 0.5) ** 2 / 4:
             warnings.warn(f"Newmark delta={delta}, beta={beta} is not unconditionally stable "
-                          "(needs delta >= 1/2 and beta >= (delta + 1/2)^2 / 4)", stacklevel=2)
+                          "(needs beta >= (delta + 1/2)^2 / 4)", stacklevel=2)
         for contact in system.contacts:
             if contact.integration != "standard":
                 raise ValueError(f"contact {contact.name!r} is built for {contact.integration} integration: "
@@ -71,7 +69,7 @@ class Newmark:
         self.newton_options = newton_options
 
     def step(self, t, u, v, a, dt, label="", *, state):
-        _check_dt(dt)
+        assert dt > 0, SIZE_CHECKED
         s, beta, delta = self.system, self.beta, self.delta
         t1 = t + dt
         c = 1.0 / (beta * dt ** 2)
@@ -109,7 +107,7 @@ class Static:
         self.system, self.newton_options = system, newton_options
 
     def step(self, t, u, v, a, dt, label="", *, state):
-        _check_dt(dt)
+        assert dt > 0, SIZE_CHECKED
         s, t1 = self.system, t + dt
         result = newton(lambda w: s.evaluate(w, t1, dt, u, state=state), s.apply_dirichlet(u, t1),
                         s.free_dofs, instrument=s.instrument, label=label or f"t = {t1:.6g}", start=u,
@@ -136,7 +134,7 @@ class CentralDifference:
         self.system = system
 
     def step(self, t, u, v, a, dt, label="", *, state):
-        _check_dt(dt)
+        assert dt > 0, SIZE_CHECKED
         s, t1 = self.system, t + dt
         u1 = s.apply_dirichlet(u + dt * v + 0.5 * dt ** 2 * a, t1)
         ev = s.evaluate(u1, t1, dt, u, state=state)

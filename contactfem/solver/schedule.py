@@ -13,7 +13,8 @@ import math
 import numpy as np
 
 
-def _check_dt(dt, name="dt"):
+def check_dt(dt, name="dt"):
+    """The one check of a step size: a finite number > 0 (ValueError naming it)."""
     if not (np.isfinite(dt) and dt > 0):
         raise ValueError(f"parameter {name} = {dt!r} is out of range: allowed (0, inf)")
     return float(dt)
@@ -39,7 +40,7 @@ class Steps(_Cuts):
 
     def __init__(self, dt, n_steps=None, t_end=None, t0=0.0, max_cuts=0, min_dt=None):
         super().__init__(max_cuts, min_dt)
-        self.dt, self.t0 = _check_dt(dt), float(t0)
+        self.dt, self.t0 = check_dt(dt), float(t0)
         if (n_steps is None) == (t_end is None):
             raise ValueError("give exactly one of n_steps and t_end")
         if t_end is not None:
@@ -95,7 +96,7 @@ class Adaptive(_Cuts):
 
     def __init__(self, rule, t_end, dt, t0=0.0, max_cuts=0, min_dt=None, growth=None):
         super().__init__(max_cuts, min_dt)
-        self.rule, self.t0, self.t_end, self.dt = rule, float(t0), float(t_end), _check_dt(dt)
+        self.rule, self.t0, self.t_end, self.dt = rule, float(t0), float(t_end), check_dt(dt)
         if not self.t_end > self.t0:
             raise ValueError(f"parameter t_end = {t_end!r} is out of range: allowed (t0, inf) = ({t0}, inf)")
         if growth is not None and not growth >= 1:
@@ -105,7 +106,7 @@ class Adaptive(_Cuts):
     def next_dt(self, rec):
         if rec.t >= self.t_end - 1e-9 * (self.t_end - self.t0):
             return None
-        h = _check_dt(float(self.rule(rec)), "dt (the schedule's rule)")
+        h = check_dt(float(self.rule(rec)), "dt (the schedule's rule)")
         if self.growth is not None and rec.k > 0:
             h = min(h, self.growth * rec.dt)
         return min(h, self.t_end - rec.t)

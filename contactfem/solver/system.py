@@ -12,9 +12,11 @@ bodies' lumped (diagonal) mass, a vector, unless a body asks for its consistent 
 blocks of those bodies and the diagonal of the others (``mass``, ``mass_times``).
 
 Bodies are placed one after another in the global vector: body b owns the global
-dofs ``b.dof_offset + local``. A contact may own unknowns too (``contact.unknowns`` of
+dofs ``offset(b) + local``. A contact may own unknowns too (``contact.unknowns`` of
 them: the Lagrange multipliers of contact/lagrange.py; 0 for a penalty contact): they
-follow the bodies' dofs, contact c owning ``c.dof_offset + range(c.unknowns)``. They have
+follow the bodies' dofs, contact c owning ``offset(c) + range(c.unknowns)``. The System
+keeps these offsets (``offsets``, by identity) and hands them to the contacts and loads it
+evaluates (contact/placement.py); nothing is written on a body or a contact. They have
 no mass (no velocity, no acceleration: the steppers carry them over as values, newmark.py),
 no Dirichlet condition, and the contact that owns them writes their rows of G and K; so
 the System, Newton and the time loop treat them like any other unknown, and one
@@ -36,6 +38,7 @@ with, so the converged one is what the time loop commits, records and reports
 (solver/march.py); nothing evaluates it again.
 """
 from dataclasses import dataclass
+from types import MappingProxyType
 from typing import NamedTuple
 
 import numpy as np
@@ -116,10 +119,11 @@ class System:
     bodies   : list of bodies (the interface of contactfem.bodies)
     bodies   : list of bodies (contactfem.bodies.interfaces.Body)
     contacts : list of contacts (contactfem.contact.interfaces.Contact): ``evaluate(u, t, dt, u0,
-               history=h)`` gives a state, ``state.scatter(ndof) -> (R_c, rows, cols, vals)``; each
-               contact gets ``dof_offset``, where its own ``unknowns`` (if any) start
-    loads    : list of loads (contactfem.bodies.interfaces.Load), ``assemble(u, t, state) -> (P,
-               rows, cols, vals)``
+               history=h, offsets=...)`` gives a state, ``state.scatter(ndof) -> (R_c, rows, cols,
+               vals)``; ``offsets`` (the System's, by identity) say where each body's dofs and
+               each contact's own ``unknowns`` (if any) start (contact/placement.py)
+    loads    : list of loads (contactfem.bodies.interfaces.Load), ``assemble(u, t, state,
+               offsets=...) -> (P, rows, cols, vals)``
     fixed    : list of Dirichlet conditions
     linear_algebra : "auto" (default: dense up to assembly.DENSE_MAX unknowns; above, banded where
                the band LU is cheap, else sparse), "dense", "sparse" or "banded"
@@ -141,14 +145,15 @@ class System:
         if not self.bodies:
             raise ValueError("bodies must contain at least one body")
 
-        offset = 0
+        offsets, offset = {}, 0                    # the System's own: nothing is written on the objects
         for body in self.bodies:
-            body.dof_offset = offset
+            offsets[id(body)] = offset
             offset += body.ndof
         self.body_ndof = offset
         for contact in self.contacts:              # a contact's own unknowns follow the bodies'
-            contact.dof_offset = offset
+            offsets[id(contact)] = offset
             offset += int(contact.unknowns)
+        self.offsets = MappingProxyType(offsets)   # id(body or contact) -> where its unknowns start
         self.ndof = offset
         self.contact_dofs = np.arange(self.body_ndof, self.ndof)   # massless, never prescribed
 
@@ -185,13 +190,19 @@ class System:
         plan = self._tangent.banded_plan                # of the last K solved banded
         return (plan.kl, plan.ku) if plan is not None else None
 
+    def offset(self, obj):
+        """Where the unknowns of ``obj`` (one of the System's bodies or contacts) start in the
+        global vector."""
+        return self.offsets[id(obj)]
+
     def global_dofs(self, body, local):
         """Global numbers of a body's local dofs."""
-        return body.dof_offset + np.asarray(local, dtype=int)
+        return self.offset(body) + np.asarray(local, dtype=int)
 
     def local(self, body, u):
         """The body's own part (a view) of a global vector."""
-        return u[body.dof_offset:body.dof_offset + body.ndof]
+        off = self.offset(body)
+        return u[off:off + body.ndof]
 
     # -- Dirichlet conditions -------------------------------------------------
 
@@ -252,7 +263,7 @@ class System:
         """P(u, t), the sum of all loads (ndof,), with the loads' states of the SystemState."""
         P = np.zeros(self.ndof)
         for load, ls in zip(self.loads, state.loads):
-            P += load.assemble(u, t, ls)[0]
+            P += load.assemble(u, t, ls, offsets=self.offsets)[0]
         return P
 
     def _check_state(self, state):
@@ -287,7 +298,7 @@ class System:
 
         with timed(self.instrument, "bulk"):
             for body, bs in zip(self.bodies, state.bodies):   # block diagonal: internal forces
-                off = body.dof_offset
+                off = self.offsets[id(body)]
                 R, rows, cols, vals = body.internal_coo(u[off:off + body.ndof], dt, bs)
                 G[off:off + body.ndof] += R
                 blocks.append((rows, cols, vals, off, body))
@@ -295,7 +306,8 @@ class System:
         states = []
         with timed(self.instrument, "contact"):
             for i, (contact, h) in enumerate(zip(self.contacts, state.contacts)):   # eq 28 and its tangent
-                cs = contact.evaluate(u, t, dt, u0, None if phases is None else phases[i], history=h)
+                cs = contact.evaluate(u, t, dt, u0, None if phases is None else phases[i], history=h,
+                                      offsets=self.offsets)
                 Rc, r, c, v = cs.scatter(self.ndof)
                 G += Rc
                 if len(v):                             # (a contact in flight adds no tangent entries)
@@ -305,7 +317,7 @@ class System:
         with timed(self.instrument, "assembly"):
             P = np.zeros(self.ndof)
             for load, ls in zip(self.loads, state.loads):   # loads enter with a minus sign
-                Pl, r, c, v = load.assemble(u, t, ls)
+                Pl, r, c, v = load.assemble(u, t, ls, offsets=self.offsets)
                 P += Pl
                 if len(v):                             # (a dead load has no tangent)
                     r, c, v = _triplets(r, c, v)
@@ -337,9 +349,9 @@ class System:
         state, whatever ran before), so every run from the start is solved the same way."""
         u = np.asarray(u, dtype=float)
         self._tangent = TangentAssembler(self.ndof, self._requested, self.free_dofs)
-        return SystemState(contacts=tuple(c.start(u, t) for c in self.contacts),
+        return SystemState(contacts=tuple(c.start(u, t, offsets=self.offsets) for c in self.contacts),
                            bodies=tuple(b.start(self.local(b, u).copy()) for b in self.bodies),
-                           loads=tuple(ld.start(u, t) for ld in self.loads))
+                           loads=tuple(ld.start(u, t, offsets=self.offsets) for ld in self.loads))
 
     def commit(self, evaluation, u, t, dt=None):
         """The SystemState after a converged step ending at (u, t) (``evaluation`` the converged
@@ -349,7 +361,7 @@ class System:
         return SystemState(
             contacts=tuple(c.commit(cs) for c, cs in zip(self.contacts, evaluation.contacts)),
             bodies=tuple(b.commit(self.local(b, u).copy(), dt, bs) for b, bs in zip(self.bodies, state.bodies)),
-            loads=tuple(ld.commit(u, t, ls) for ld, ls in zip(self.loads, state.loads)))
+            loads=tuple(ld.commit(u, t, ls, offsets=self.offsets) for ld, ls in zip(self.loads, state.loads)))
 
     # -- energies ------------------------------------------------------------------
     def energies(self, u, v, evaluation, dt=None, state=None):

@@ -27,7 +27,7 @@ def iteration_cost(system, u, t=1.0, repeat=3, solvers=True, dt=None, state=None
     # each body as the System evaluates it (a beam's COO triplets, a continuum's sparse K)
     _, out["bulk_s"] = best_of(lambda: [b.internal_coo(system.local(b, u), dt, bs)
                                         for b, bs in zip(system.bodies, state.bodies)], repeat)
-    _, out["contact_s"] = best_of(lambda: [c.evaluate(u, t, dt, history=h).scatter(system.ndof)
+    _, out["contact_s"] = best_of(lambda: [c.evaluate(u, t, dt, history=h, offsets=system.offsets).scatter(system.ndof)
                                            for c, h in zip(system.contacts, state.contacts)], repeat)
     (G, K), total = best_of(lambda: system.residual_tangent(u, t, dt=dt, state=state), repeat)
     out["assembly_s"] = max(total - out["bulk_s"] - out["contact_s"], 0.0)
@@ -106,7 +106,7 @@ def cost_study(quick=False):
     for nx in ((50, 200, 800) if quick else (50, 200, 800, 1600, 3200)):
         system, u, state = _block_system(nx, 1, width=4.0)
         c = system.contacts[0]
-        _, t_c = best_of(lambda: c.evaluate(u, 1.0, history=state.contacts[0]).scatter(system.ndof), 5)
+        _, t_c = best_of(lambda: c.evaluate(u, 1.0, history=state.contacts[0], offsets=system.offsets).scatter(system.ndof), 5)
         scaling.append(dict(n_contact_nodes=int(len(c.nodes)), contact_s=t_c))
     slope = float(np.polyfit(np.log([r["n_contact_nodes"] for r in scaling[1:]]),
                              np.log([r["contact_s"] for r in scaling[1:]]), 1)[0])

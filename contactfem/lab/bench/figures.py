@@ -7,15 +7,13 @@ committed full run), else a quick bench run here (seconds)."""
 
 import json
 import os
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
 from ...plots import default_outdir, figure, pyplot
 from ...plots.data import save_figure
-
-_CACHE = {}
-
 
 def bench_json_path():
     """$CONTACTFEM_BENCH if set, else bench.json at the repository root (may not exist)."""
@@ -31,11 +29,16 @@ def load_bench(preset="fast"):
     path = bench_json_path()
     if path.exists():
         return json.loads(path.read_text())
-    if "quick" not in _CACHE:
-        from . import run_bench
+    return quick_bench()
 
-        _CACHE["quick"] = run_bench(quick=True, only=("tangents", "work_precision", "cost", "speed"), progress=None)
-    return _CACHE["quick"]
+
+@lru_cache(maxsize=1)
+def quick_bench():
+    """The quick bench of the four studies the figures need (measured in this process: timings
+    are not kept on disk)."""
+    from . import run_bench
+
+    return run_bench(quick=True, only=("tangents", "work_precision", "cost", "speed"), progress=None)
 
 
 @figure("bench_tangents", "bench")

@@ -4,22 +4,21 @@ Newmark 0.7/0.4 against 0.5/0.25, implicit Newmark against explicit central diff
 on bar_impact (exact contact duration), beam ring against continuum ring. Observed
 orders: slope of log(error) against log(h) by least squares."""
 
+from functools import lru_cache
+
 from ...scenes import get_scene, run_scene
 from .common import observed_order, timed
-
-_POINTS = {}
 
 
 def _scene_point(scene, preset, over, keys):
     """Run a scene, keep the wall time of the solve, the linear solves and `keys` (a point
-    already run in this process is reused)."""
-    key = (scene, preset, tuple(sorted(over.items())), keys)
-    if key not in _POINTS:
-        _POINTS[key] = _scene_point_run(scene, preset, over, keys)
-    return dict(_POINTS[key])
+    already run in this process is reused: timings are not kept on disk)."""
+    return dict(_scene_point_run(scene, preset, tuple(sorted(over.items())), keys))
 
 
+@lru_cache(maxsize=None)
 def _scene_point_run(scene, preset, over, keys):
+    over = dict(over)
     try:
         r = run_scene(scene, preset, over)
     except Exception as err:       # recorded, not hidden: a failed point is a result
