@@ -58,7 +58,7 @@ import numpy as np
 
 from ..contact import RigidLine, tributary_lengths
 from ..laws import PowerLaw
-from ..solver import CentralDifference, History, Steps, System
+from ..solver import CentralDifference, History, System
 from . import enforcement, time_integration
 from .base import Param, Scene, Stage
 
@@ -114,8 +114,10 @@ def build(params, *, normal=None, friction=None, system_options=None):
     stepper = enforcement.wrap(params, stepper, [contact], length=L / n)     # gap_violation: penetration / h_x
     v0_vec = np.zeros(system.ndof)
     v0_vec[body.xdofs[:, 0]] = -v0
-    stage = Stage(stepper, Steps(dt, t_end=t_end, max_cuts=0 if explicit else 4), np.zeros(system.ndof), v0_vec,
-                  name="bar_impact")
+    # accuracy: the errors of the rebound velocity (speed v0) add up over the run
+    stepper, schedule = time_integration.plan(params, stepper, dt=dt, t_end=t_end, speed=v0, duration=t_end,
+                                              max_cuts=0 if explicit else 4)
+    stage = Stage(stepper, schedule, np.zeros(system.ndof), v0_vec, name="bar_impact")
     return dict(body=body, contact=contact, system=system, systems=[system], nodes=nodes, w=w, c_N=c_N,
                 stage=stage, dt=dt, sizes=dict(element=L / n, body=L))     # the accuracy indicators' lengths
 
@@ -187,6 +189,7 @@ SCENE = Scene(
         Param("beta_newmark", 0.25, "", 0.0, 0.5, low_open=True, doc="Newmark beta"),
         Param("t_end", 1.5, "2L/c", 0.0, None, low_open=True, doc="simulated time in units of 2 L / c"),
         time_integration.CONTACT_INTEGRATION_PARAM,
+        time_integration.ACCURACY_PARAM,
         *enforcement.ENFORCEMENT_PARAMS,
     ),
     build=build,

@@ -72,6 +72,10 @@ def run(scene, params, normal=None, friction=None, progress=None, linear_algebra
         results = dict(scene.measure(model, params, records))
         wall = time.perf_counter() - t0
     systems = model["systems"]
+    if any(p.name == "accuracy" for p in scene.params):     # how the run stepped: fixed, or at a tolerance
+        from .time_integration import stepping
+
+        results["stepping"] = stepping(params, records["records"] if isinstance(records, dict) else records)
     accuracy = collect(model, params, records, results)
     accuracy.update(results.pop("accuracy", None) or {})     # the scene's own (its references)
     results["accuracy"] = accuracy

@@ -34,7 +34,7 @@ from ..bodies.ring import make_ring
 from ..contact import NodeToSegment, RigidLine, tributary_lengths
 from ..contact.tangents import TANGENTS
 from ..laws import ParabolicSlip, PowerLaw
-from ..solver import History, Steps, System
+from ..solver import History, System
 from . import time_integration
 from .base import PENALTIES, PENALTY_DOC, Param, Scene, Stage
 from .rings import MASS_MATRIX_PARAM, RING_PARAMS, penalty_pressure, ring_history, ring_size, snapshot_indices
@@ -107,7 +107,11 @@ def build(params, *, normal=None, friction=None, system_options=None):
     system = System([ring.body], [contact], **(system_options or {}))
     stepper = time_integration.make_stepper(params, system, atol=newton_atol(params, ring.body.ndof),
                                             maxit=30)
-    stage = Stage(stepper, Steps(params["dt"], n_steps=params["n_steps"], max_cuts=6), np.zeros(ring.body.ndof),
+    # accuracy: the errors of the rebound velocities (speed |v0|) add up over the run
+    stepper, schedule = time_integration.plan(params, stepper, dt=params["dt"], n_steps=params["n_steps"],
+                                              t_end=None, speed=float(np.hypot(params["vx0"], params["vy0"])),
+                                              duration=params["n_steps"] * params["dt"], max_cuts=6)
+    stage = Stage(stepper, schedule, np.zeros(ring.body.ndof),
                   ring.initial_velocity((params["vx0"], params["vy0"])), name="sloping_impact")
     return dict(ring=ring, contact=contact, system=system, systems=[system], plane=plane, stage=stage,
                 plastic=params["variant"] == "viscoplastic",      # its plastic work is no integrator's loss
@@ -222,6 +226,7 @@ SCENE = Scene(
         Param("delta", 0.7, "", 0.5, 1.0, doc="Newmark delta (paper: 0.7; 0.5 with beta 0.25 conserves energy)"),
         Param("beta_newmark", 0.4, "", 0.0, 0.5, low_open=True, doc="Newmark beta (paper: 0.4)"),
         time_integration.CONTACT_INTEGRATION_PARAM,
+        time_integration.ACCURACY_PARAM,
         MASS_MATRIX_PARAM,
         Param("outline_every", 20, "", 1, 100000, doc="store the ring outline every this many steps (figures)"),
     ),

@@ -2,9 +2,12 @@
 (``standard``) or the energy-consistent stepper (solver/conserving.py), and the energy
 error every such scene reports."""
 
+from functools import partial
+
 import numpy as np
 
-from ..solver import Newmark
+from ..solver import Adaptive, Newmark, Steps
+from ..solver.schedule import Estimated, centre_of_mass_rows, error_step
 from ..solver.conserving import EnergyConsistent
 from .base import Param
 
@@ -40,3 +43,37 @@ def energy_error(hist):
     balance = E + hist.dissipation - hist.external_work
     E0 = E[0]
     return float((balance[-1] - E0) / E0), float(np.max(np.abs(balance - E0)) / E0)
+
+
+ACCURACY_PARAM = Param(
+    "accuracy", 0.0, "", 0.0, 0.1,
+    doc="0: fixed steps of dt (the default); TOL > 0: the steps are chosen from a local error estimate "
+        "(solver/schedule.py: each step's error in the centre-of-mass velocity held at TOL speed dt / duration) so "
+        "that the headline quantities land within about TOL (relative) of the run refined in time; dt is then the "
+        "largest step. The penalty is not changed: it is part of the model (the penetration indicator says how "
+        "deep it lets the bodies go)")
+
+
+def plan(params, stepper, *, dt, t_end, speed, duration, max_cuts, n_steps=None, t0=0.0):
+    """The stepper and the schedule of a dynamic scene's march: fixed steps of dt (``n_steps`` of
+    them, or up to t_end) when params['accuracy'] is 0; else steps chosen from the local error
+    estimate (schedule.error_step) at the tolerance params['accuracy'], relative to ``speed``
+    (the scene's velocity scale) over ``duration`` (the time its errors add up over), no step
+    longer than dt, the first dt * accuracy."""
+    tol = params.get("accuracy") or 0.0
+    if not tol:
+        return stepper, Steps(dt, n_steps=n_steps, t_end=None if n_steps else t_end, t0=t0, max_cuts=max_cuts)
+    estimated = Estimated(stepper, centre_of_mass_rows(stepper.system))
+    rule = partial(error_step, tol=tol, speed=speed, duration=duration, dt_first=dt * tol, dt_max=dt,
+                   power=estimated.power)
+    return estimated, Adaptive(rule, t_end=t0 + n_steps * dt if n_steps else t_end, dt=dt * tol, t0=t0,
+                               max_cuts=max_cuts, growth=2.0)
+
+
+def stepping(params, records):
+    """How a run stepped (its ``stepping`` result): the mode (fixed or adaptive), the tolerance,
+    the steps taken, the smallest and largest step."""
+    dts = [r.dt for r in records[1:]]
+    tol = params.get("accuracy") or 0.0
+    return dict(mode="adaptive" if tol else "fixed", accuracy=tol or None, steps=len(dts),
+                dt_min=min(dts, default=None), dt_max=max(dts, default=None))
