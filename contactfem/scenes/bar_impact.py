@@ -74,6 +74,9 @@ def check(params):
         raise ValueError("parameter contact_integration = 'energy_consistent' is implicit: "
                          "use it with integrator = newmark")
     enforcement.check(params)
+    if params["integrator"] == "central_difference" and params["accuracy"]:
+        raise ValueError(f"parameter accuracy = {params['accuracy']} needs an implicit stepper (its local error "
+                         "estimate): use it with integrator = newmark")
     if params["integrator"] == "central_difference" and params["enforcement"] != "penalty":
         raise ValueError(f"parameter enforcement = {params['enforcement']} needs an implicit solve: use it with "
                          "integrator = newmark")

@@ -7,7 +7,7 @@ from functools import partial
 import numpy as np
 
 from ..solver import Adaptive, Newmark, Steps
-from ..solver.schedule import Estimated, centre_of_mass_rows, error_step
+from ..solver.schedule import Estimated, error_step
 from ..solver.conserving import EnergyConsistent
 from .base import Param
 
@@ -48,7 +48,7 @@ def energy_error(hist):
 ACCURACY_PARAM = Param(
     "accuracy", 0.0, "", 0.0, 0.1,
     doc="0: fixed steps of dt (the default); TOL > 0: the steps are chosen from a local error estimate "
-        "(solver/schedule.py: each step's error in the centre-of-mass velocity held at TOL speed dt / duration) so "
+        "(solver/schedule.py: each step's error in the velocities held at TOL speed dt / duration) so "
         "that the headline quantities land within about TOL (relative) of the run refined in time; dt is then the "
         "largest step. The penalty is not changed: it is part of the model (the penetration indicator says how "
         "deep it lets the bodies go)")
@@ -63,7 +63,7 @@ def plan(params, stepper, *, dt, t_end, speed, duration, max_cuts, n_steps=None,
     tol = params.get("accuracy") or 0.0
     if not tol:
         return stepper, Steps(dt, n_steps=n_steps, t_end=None if n_steps else t_end, t0=t0, max_cuts=max_cuts)
-    estimated = Estimated(stepper, centre_of_mass_rows(stepper.system))
+    estimated = Estimated(stepper)
     rule = partial(error_step, tol=tol, speed=speed, duration=duration, dt_first=dt * tol, dt_max=dt,
                    power=estimated.power)
     return estimated, Adaptive(rule, t_end=t0 + n_steps * dt if n_steps else t_end, dt=dt * tol, t0=t0,

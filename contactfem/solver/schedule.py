@@ -109,25 +109,29 @@ class Adaptive(_Cuts):
 
 # -- steps chosen from a local error estimate (a scene's ``accuracy``) ----------------------------
 #
-# What a run's headline quantities are made of is its bodies' centre-of-mass motion (rebound
-# velocities, a rolling speed, an exit velocity; the times at which a contact opens). A step of
-# Newmark (delta, beta) updates a velocity by dt ((1 - delta) a + delta a+); against the Taylor
-# series of the exact motion its local error is
+# A step of Newmark (delta, beta) updates the velocities by dt ((1 - delta) a + delta a+); against
+# the Taylor series of the exact motion its local error is
 #
 #     (delta - 1/2) dt^2 a' + (delta / 2 - 1/6) dt^3 a'' + ...,     a' ~ (a+ - a) / dt,
 #
-# first order in dt where delta > 1/2 (the paper's 0.7): c dt |A+ - A| with c = delta - 1/2, A the
-# centre-of-mass accelerations (M-weighted means of a: a body's elastic ringing, which has no
-# resultant, does not count). Where delta = 1/2 the first term vanishes and the second needs a
-# second difference, which one step does not have; the estimate is then Zienkiewicz and Xie's
-# for the displacement, dt^2 |beta - 1/6| |A+ - A|, per unit step: c = |beta - 1/6| (1/12 for the
-# trapezoidal rule). The energy-consistent stepper (solver/conserving.py) is the trapezoidal rule
-# on a linear problem (its a+ the step's mean acceleration): c = 1/12 too. The local errors of the
-# steps add up; holding each at ``tol speed dt / duration`` keeps their sum over the run within
+# first order in dt where delta > 1/2 (the paper's 0.7): c dt |a+ - a| with c = delta - 1/2. This
+# term is the method's numerical damping: it takes the energy of the vibrations an impact excites,
+# and a rebound's or a rolling ring's speed with it. Where delta = 1/2 the first term vanishes and
+# the second needs a second difference, which one step does not have; the estimate is then
+# Zienkiewicz and Xie's for the displacement, dt^2 |beta - 1/6| |a+ - a|, per unit step:
+# c = |beta - 1/6| (1/12 for the trapezoidal rule). The energy-consistent stepper
+# (solver/conserving.py) is the trapezoidal rule on a linear problem (its a+ the step's mean
+# acceleration): c = 1/12 too. Which velocities: with numerical damping (delta > 1/2) the error
+# of every vibration takes energy from the motion the headline quantities are made of, so |.| is
+# the kinetic energy's norm, a mass-weighted root mean square (sum m_i d_i^2 / sum m_i)^(1/2);
+# without it (delta = 1/2, the energy-consistent stepper) a vibration's error is a phase error
+# that keeps its energy, and |.| is the largest of the bodies' centre-of-mass components
+# (mass-weighted means: a body's elastic ringing has no resultant). The local errors of the steps
+# add up; holding each at ``tol speed dt / duration`` keeps their sum over the run within
 # tol speed (error per unit step).
 
 def error_constant(stepper):
-    """c of the local error estimate c dt |A+ - A| (the comment above), and the power of the
+    """c of the local error estimate c dt |a+ - a| (the comment above), and the power of the
     error's ratio that gives the next step (1 for a first-order velocity update, 1/2 for a
     second-order one)."""
     if type(stepper).__name__ == "EnergyConsistent":
@@ -156,23 +160,29 @@ def centre_of_mass_rows(system, directions=(0, 1)):
 
 
 class Estimated:
-    """A dynamic stepper whose step results carry ``local_error``: c dt max |rows (a+ - a)|, the
-    estimate of the comment above (``rows``: centre_of_mass_rows). Anything else is the wrapped
-    stepper's (``stepper``)."""
+    """A dynamic stepper whose step results carry ``local_error``: c dt |a+ - a|, the estimate of
+    the comment above. Anything else is the wrapped stepper's (``stepper``)."""
 
-    def __init__(self, stepper, rows):
-        self.stepper, self.rows = stepper, np.asarray(rows, float)
+    def __init__(self, stepper):
+        self.stepper = stepper
         self.c, self.power = error_constant(stepper)
+        self.mass = stepper.system.lumped_mass()
+        self.rows = None if self.power == 1.0 else centre_of_mass_rows(stepper.system)
 
     def __getattr__(self, name):
         if name == "stepper":
             raise AttributeError(name)
         return getattr(self.stepper, name)
 
+    def norm(self, d):
+        """|d|: the kinetic energy's norm (damped steppers) or the largest centre-of-mass component."""
+        if self.rows is None:
+            return float(np.sqrt(np.sum(self.mass * d * d) / np.sum(self.mass)))
+        return float(np.max(np.abs(self.rows @ d)))
+
     def step(self, t, u, v, a, dt, label="", *, state):
         u1, v1, a1, result = self.stepper.step(t, u, v, a, dt, label, state=state)
-        e = self.c * dt * float(np.max(np.abs(self.rows @ (a1 - a))))
-        return u1, v1, a1, replace(result, local_error=e)
+        return u1, v1, a1, replace(result, local_error=self.c * dt * self.norm(a1 - a))
 
 
 def error_step(rec, tol, speed, duration, dt_first, dt_max, power=1.0):

@@ -1,0 +1,97 @@
+"""A tolerance the user can ask for (a dynamic scene's ``accuracy``): the local error estimate
+of a step (solver/schedule.py: Estimated, error_step) against the exact motion of an
+oscillator, the rule's fixed point, and the scenes' adaptive runs."""
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+from contactfem.scenes import get_scene, run_scene
+from contactfem.solver.newton import NewtonResult
+from contactfem.solver.schedule import Estimated, error_step
+
+
+class _Oscillator:
+    """Newmark (delta, beta) on m u'' + k u = 0 (m = 2, one dof), solved in closed form."""
+    dynamic = True
+
+    def __init__(self, delta, beta, k=3.0, m=2.0):
+        self.delta, self.beta, self.k, self.m = delta, beta, k, m
+        body = type("B", (), {"dof_offset": 0, "xdofs": np.array([[0, 0]])})()
+        self.system = type("S", (), {"lumped_mass": lambda s: np.array([m]), "bodies": [body], "ndof": 1})()
+
+    def step(self, t, u, v, a, dt, label="", *, state=None):
+        u_pred = u + dt * v + dt ** 2 * (0.5 - self.beta) * a
+        u1 = u_pred / (1.0 + self.beta * dt ** 2 * self.k / self.m)
+        a1 = -self.k / self.m * u1
+        v1 = v + dt * ((1.0 - self.delta) * a + self.delta * a1)
+        return u1, v1, a1, NewtonResult(u=u1)
+
+
+def _velocity_error(osc, dt, u=np.array([1.0]), v=np.array([0.5])):
+    """The estimate of one step from (u, v) and the step's true velocity error."""
+    w = math.sqrt(osc.k / osc.m)
+    a = -osc.k / osc.m * u
+    _, v1, _, result = Estimated(osc).step(0.0, u, v, a, dt, state=None)
+    exact = -u * w * math.sin(w * dt) + v * math.cos(w * dt)
+    return result.local_error, float(abs(v1 - exact)[0])
+
+
+@pytest.mark.parametrize("dt", [1e-2, 1e-3])
+def test_estimate_is_the_first_order_error_of_newmark_delta_07(dt):
+    est, err = _velocity_error(_Oscillator(0.7, 0.4), dt)
+    assert est == pytest.approx(err, rel=20 * dt)         # the leading term, to O(dt)
+
+
+@pytest.mark.parametrize("dt", [1e-1, 1e-2, 1e-3])
+def test_estimate_bounds_the_trapezoidal_rule_error(dt):
+    est, err = _velocity_error(_Oscillator(0.5, 0.25), dt)
+    assert err <= est and est < 10 * err / dt              # a bound, one order of dt above the error
+
+
+def test_error_step_fixed_point_first_step_and_cap():
+    rec = type("R", (), {})()
+    rec.k, rec.dt = 5, 0.01
+    tol, speed, duration = 1e-3, 2.0, 4.0
+    rec.result = NewtonResult(u=None, local_error=tol * speed * rec.dt / duration)
+    assert error_step(rec, tol, speed, duration, 1e-5, 1.0) == pytest.approx(rec.dt)   # on target: kept
+    rec.result.local_error *= 4.0
+    assert error_step(rec, tol, speed, duration, 1e-5, 1.0) == pytest.approx(rec.dt / 4)
+    assert error_step(rec, tol, speed, duration, 1e-5, 1.0, power=0.5) == pytest.approx(rec.dt / 2)
+    rec.result.local_error = 0.0
+    assert error_step(rec, tol, speed, duration, 1e-5, 0.02) == 0.02      # nothing to resolve: dt_max
+    rec.k = 0
+    assert error_step(rec, tol, speed, duration, 1e-5, 0.02) == 1e-5      # no estimate yet
+
+
+@pytest.mark.parametrize("scene", ["sloping_impact", "rolling_ring", "bar_impact", "cork"])
+def test_accuracy_is_a_parameter_off_by_default(scene):
+    s = get_scene(scene)
+    assert s.resolve("fast")["accuracy"] == 0.0
+    assert s.resolve("fast", {"accuracy": "1e-3"})["accuracy"] == 1e-3
+    for bad in (-1e-3, 0.5, "tight"):
+        with pytest.raises(ValueError, match="accuracy"):
+            s.resolve("fast", {"accuracy": bad})
+
+
+def test_accuracy_refused_with_the_explicit_stepper():
+    with pytest.raises(ValueError, match="parameter accuracy .* integrator = newmark"):
+        get_scene("bar_impact").resolve("fast", {"accuracy": 1e-2, "integrator": "central_difference"})
+
+
+def _bar(over):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return run_scene("bar_impact", "fast", over)
+
+
+def test_adaptive_run_reports_its_steps_and_repeats_bit_for_bit():
+    a, b = _bar({"accuracy": 1e-2}), _bar({"accuracy": 1e-2})
+    assert a["stepping"]["mode"] == "adaptive" and a["stepping"]["accuracy"] == 1e-2
+    assert a["stepping"]["steps"] == a["n_steps"] and a["stepping"]["dt_max"] <= a["dt"] * (1 + 1e-12)
+    assert a["stepping"]["dt_min"] < a["stepping"]["dt_max"]
+    assert np.array_equal(a["time"], b["time"]) and np.array_equal(a["contact_stress"], b["contact_stress"])
+    fixed = _bar({})
+    assert fixed["stepping"] == dict(mode="fixed", accuracy=None, steps=fixed["n_steps"], dt_min=pytest.approx(fixed["dt"]),
+                                     dt_max=pytest.approx(fixed["dt"]))
