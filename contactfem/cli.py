@@ -378,7 +378,7 @@ def cmd_reconstruct(args):
 
 
 BENCH_STUDIES = ("tangents", "work_precision", "cost", "targets", "enforcement", "speed", "semismooth",
-                 "scaling")  # = lab.bench.STUDIES
+                 "scaling", "adaptive")  # = lab.bench.STUDIES
 
 
 def cmd_bench(args):

@@ -95,3 +95,38 @@ def test_adaptive_run_reports_its_steps_and_repeats_bit_for_bit():
     fixed = _bar({})
     assert fixed["stepping"] == dict(mode="fixed", accuracy=None, steps=fixed["n_steps"], dt_min=pytest.approx(fixed["dt"]),
                                      dt_max=pytest.approx(fixed["dt"]))
+
+
+# -- the adaptive mode against a reference refined in time (the bench's study 9, in small) ---------
+
+def _largest_fixed_reaching(scene, ladder, error, ref):
+    """The first step of the ladder (coarse to fine) whose run is within ``error`` of ``ref``, with its cost."""
+    for h in ladder:
+        r = study.scene_run(scene, h)
+        if r["ok"] and study.max_error(r, ref) <= error:
+            return h, r
+    return None, None
+
+
+from contactfem.lab.bench import adaptive as study  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def bar_reference():
+    return study.reference("bar_impact")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("tol", [1e-2, 1e-3])
+def test_bar_impact_at_a_tolerance(tol, bar_reference):
+    """Duration and rebound velocity within tol of the run refined in time (courant 1/64: its
+    change from 1/32 is below tol / 10), at no more residual evaluations than the largest fixed
+    step that reaches the same error."""
+    assert bar_reference["change"] < 0.1 * tol
+    ref = bar_reference["values"]
+    run = study.adaptive_run("bar_impact", tol)
+    error = study.max_error(run, ref)
+    assert error <= tol
+    h, fixed = _largest_fixed_reaching("bar_impact", study.STUDY["bar_impact"]["ladder"], error, ref)
+    assert h is not None, f"no fixed step of the ladder reaches {error:.2e}"
+    assert run["residual_evaluations"] <= fixed["residual_evaluations"]

@@ -117,8 +117,8 @@ def build(params, *, normal=None, friction=None, system_options=None):
     stepper = enforcement.wrap(params, stepper, [contact], length=L / n)     # gap_violation: penetration / h_x
     v0_vec = np.zeros(system.ndof)
     v0_vec[body.xdofs[:, 0]] = -v0
-    # accuracy: the errors of the rebound velocity (speed v0) add up over the run
-    stepper, schedule = time_integration.plan(params, stepper, dt=dt, t_end=t_end, speed=v0, duration=t_end,
+    # accuracy: the errors of the rebound velocity (speed v0) are made while the bar touches, 2 L / c
+    stepper, schedule = time_integration.plan(params, stepper, dt=dt, t_end=t_end, speed=v0, duration=ex["duration"],
                                               max_cuts=0 if explicit else 4)
     stage = Stage(stepper, schedule, np.zeros(system.ndof), v0_vec, name="bar_impact")
     return dict(body=body, contact=contact, system=system, systems=[system], nodes=nodes, w=w, c_N=c_N,

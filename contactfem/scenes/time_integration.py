@@ -2,12 +2,10 @@
 (``standard``) or the energy-consistent stepper (solver/conserving.py), and the energy
 error every such scene reports."""
 
-from functools import partial
-
 import numpy as np
 
 from ..solver import Adaptive, Newmark, Steps
-from ..solver.schedule import Estimated, error_step
+from ..solver.schedule import at_tolerance
 from ..solver.conserving import EnergyConsistent
 from .base import Param
 
@@ -59,15 +57,14 @@ def plan(params, stepper, *, dt, t_end, speed, duration, max_cuts, n_steps=None,
     them, or up to t_end) when params['accuracy'] is 0; else steps chosen from the local error
     estimate (schedule.error_step) at the tolerance params['accuracy'], relative to ``speed``
     (the scene's velocity scale) over ``duration`` (the time its errors add up over), no step
-    longer than dt, the first dt * accuracy."""
+    longer than dt, the first dt * accuracy; a step past twice its share of the error is retried
+    halved (schedule.at_tolerance)."""
     tol = params.get("accuracy") or 0.0
     if not tol:
         return stepper, Steps(dt, n_steps=n_steps, t_end=None if n_steps else t_end, t0=t0, max_cuts=max_cuts)
-    estimated = Estimated(stepper)
-    rule = partial(error_step, tol=tol, speed=speed, duration=duration, dt_first=dt * tol, dt_max=dt,
-                   power=estimated.power)
+    estimated, rule, rejections = at_tolerance(stepper, tol, speed, duration, dt)
     return estimated, Adaptive(rule, t_end=t0 + n_steps * dt if n_steps else t_end, dt=dt * tol, t0=t0,
-                               max_cuts=max_cuts, growth=2.0)
+                               max_cuts=max_cuts + rejections, growth=2.0)
 
 
 def stepping(params, records):

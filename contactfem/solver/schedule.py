@@ -10,8 +10,11 @@ over), the size after a failure, and the time a step ends at.
 """
 import math
 from dataclasses import replace
+from functools import partial
 
 import numpy as np
+
+from .newton import NewtonError
 
 
 def _check_dt(dt, name="dt"):
@@ -127,8 +130,11 @@ class Adaptive(_Cuts):
 # without it (delta = 1/2, the energy-consistent stepper) a vibration's error is a phase error
 # that keeps its energy, and |.| is the largest of the bodies' centre-of-mass components
 # (mass-weighted means: a body's elastic ringing has no resultant). The local errors of the steps
-# add up; holding each at ``tol speed dt / duration`` keeps their sum over the run within
-# tol speed (error per unit step).
+# add up; holding each at ``tol speed dt / duration`` (its share) keeps their sum over the run
+# within tol speed (error per unit step). A step is chosen from the last one's error (error_step)
+# and taken; one whose error is past twice its share (the step into an impact or out of it: the
+# rule cannot see an event coming) is retried halved, as a step whose Newton fails (StepRejected),
+# down to the first step's size.
 
 def error_constant(stepper):
     """c of the local error estimate c dt |a+ - a| (the comment above), and the power of the
@@ -159,12 +165,18 @@ def centre_of_mass_rows(system, directions=(0, 1)):
     return np.array(rows)
 
 
+class StepRejected(NewtonError):
+    """A converged step whose local error is past twice its share: the march retries it halved."""
+
+
 class Estimated:
     """A dynamic stepper whose step results carry ``local_error``: c dt |a+ - a|, the estimate of
-    the comment above. Anything else is the wrapped stepper's (``stepper``)."""
+    the comment above. ``share(dt)``: the error a step of dt may have; a step longer than ``floor``
+    with more than twice that raises StepRejected (None: every step kept). Anything else is the
+    wrapped stepper's (``stepper``)."""
 
-    def __init__(self, stepper):
-        self.stepper = stepper
+    def __init__(self, stepper, share=None, floor=0.0):
+        self.stepper, self.share, self.floor = stepper, share, floor
         self.c, self.power = error_constant(stepper)
         self.mass = stepper.system.lumped_mass()
         self.rows = None if self.power == 1.0 else centre_of_mass_rows(stepper.system)
@@ -182,17 +194,38 @@ class Estimated:
 
     def step(self, t, u, v, a, dt, label="", *, state):
         u1, v1, a1, result = self.stepper.step(t, u, v, a, dt, label, state=state)
-        return u1, v1, a1, replace(result, local_error=self.c * dt * self.norm(a1 - a))
+        e = self.c * dt * self.norm(a1 - a)
+        if self.share is not None and dt > self.floor * (1 + 1e-9) and e > 2.0 * self.share(dt):
+            raise StepRejected(f"local error {e:.3g} is past twice its share {self.share(dt):.3g}", [], label)
+        return u1, v1, a1, replace(result, local_error=e)
 
 
 def error_step(rec, tol, speed, duration, dt_first, dt_max, power=1.0):
     """Adaptive's rule for a run at a tolerance: the size of the step after ``rec`` from its
     step's local error e (``rec.result.local_error``, Estimated): the step whose error would be
-    tol speed dt / duration, dt (tol speed dt / (duration e))^power, at most dt_max; dt_first
-    for the first step (no estimate yet)."""
+    tol speed dt / duration, dt (tol speed dt / (duration e))^power, between dt_first and dt_max;
+    dt_first for the first step (no estimate yet). (The floor: an acceleration that jumps, as a
+    friction force from stick to slip, gives an error that no step makes smaller.)"""
     e = getattr(rec.result, "local_error", None)
     if rec.k == 0 or e is None:
         return dt_first
     if not e > 0:
         return dt_max
-    return min(dt_max, rec.dt * (tol * speed * rec.dt / (duration * e)) ** power)
+    return min(dt_max, max(dt_first, rec.dt * (tol * speed * rec.dt / (duration * e)) ** power))
+
+
+def at_tolerance(stepper, tol, speed, duration, dt_max):
+    """A run at the tolerance tol (relative to ``speed``, its errors adding up over ``duration``,
+    no step longer than dt_max): the stepper (Estimated, rejecting a step past twice its share),
+    Adaptive's rule (error_step, the first step dt_max tol) and the halvings a step may need
+    on top of its Newton's (a rejected step down to the first step's size)."""
+    dt_first = dt_max * tol
+    share = partial(_share, tol * speed / duration)
+    estimated = Estimated(stepper, share=share, floor=dt_first)
+    rule = partial(error_step, tol=tol, speed=speed, duration=duration, dt_first=dt_first, dt_max=dt_max,
+                   power=estimated.power)
+    return estimated, rule, int(math.ceil(math.log2(1.0 / tol)))
+
+
+def _share(rate, dt):
+    return rate * dt
