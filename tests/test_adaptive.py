@@ -9,7 +9,7 @@ import pytest
 
 from contactfem.scenes import get_scene, run_scene
 from contactfem.solver.newton import NewtonResult
-from contactfem.solver.schedule import Estimated, error_step
+from contactfem.solver.schedule import Estimated, StepRejected, error_step
 
 
 class _Oscillator:
@@ -50,6 +50,18 @@ def test_estimate_bounds_the_trapezoidal_rule_error(dt):
     assert err <= est and est < 10 * err / dt              # a bound, one order of dt above the error
 
 
+def test_a_step_past_twice_its_share_is_rejected_down_to_the_floor():
+    osc = _Oscillator(0.7, 0.4)
+    u, v = np.array([1.0]), np.array([0.5])
+    a = -osc.k / osc.m * u
+    e = Estimated(osc).step(0.0, u, v, a, 0.1, state=None)[3].local_error
+    strict = Estimated(osc, share=lambda dt: 0.4 * e, floor=0.01)
+    with pytest.raises(StepRejected, match="local error"):
+        strict.step(0.0, u, v, a, 0.1, state=None)
+    assert Estimated(osc, share=lambda dt: 0.6 * e, floor=0.01).step(0.0, u, v, a, 0.1, state=None)[3].local_error == e
+    assert strict.step(0.0, u, v, a, 0.01, state=None)[3].local_error > 0     # at the floor: kept
+
+
 def test_error_step_fixed_point_first_step_and_cap():
     rec = type("R", (), {})()
     rec.k, rec.dt = 5, 0.01
@@ -59,6 +71,8 @@ def test_error_step_fixed_point_first_step_and_cap():
     rec.result.local_error *= 4.0
     assert error_step(rec, tol, speed, duration, 1e-5, 1.0) == pytest.approx(rec.dt / 4)
     assert error_step(rec, tol, speed, duration, 1e-5, 1.0, power=0.5) == pytest.approx(rec.dt / 2)
+    rec.result.local_error *= 1e6
+    assert error_step(rec, tol, speed, duration, 1e-5, 1.0) == 1e-5      # never below the first step
     rec.result.local_error = 0.0
     assert error_step(rec, tol, speed, duration, 1e-5, 0.02) == 0.02      # nothing to resolve: dt_max
     rec.k = 0

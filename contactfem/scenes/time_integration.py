@@ -48,8 +48,9 @@ ACCURACY_PARAM = Param(
     doc="0: fixed steps of dt (the default); TOL > 0: the steps are chosen from a local error estimate "
         "(solver/schedule.py: each step's error in the velocities held at TOL speed dt / duration) so "
         "that the headline quantities land within about TOL (relative) of the run refined in time; dt is then the "
-        "largest step. The penalty is not changed: it is part of the model (the penetration indicator says how "
-        "deep it lets the bodies go)")
+        "largest step. The penalty is not changed: in these scenes it is the interface law of the model (the "
+        "paper's eq 4, the bar's one-element stiffness), the reference is the same model refined in time, and the "
+        "penetration indicator says how deep it lets the bodies go")
 
 
 def plan(params, stepper, *, dt, t_end, speed, duration, max_cuts, n_steps=None, t0=0.0):

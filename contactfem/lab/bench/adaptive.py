@@ -59,7 +59,7 @@ def _point(scene, preset, over, keys):
         try:
             r, wall = timed(run_scene, scene, preset, over)
         except Exception as err:                   # recorded, not hidden: a failed point is a result
-            return dict(over, ok=False, error=f"{type(err).__name__}: {str(err).splitlines()[0][:160]}")
+            return dict(over, ok=False, failure=f"{type(err).__name__}: {str(err).splitlines()[0][:160]}")
     st = r["stepping"]
     return dict(over, ok=True, values={k: r.get(k) for k in keys}, newton_iterations=int(r["newton_iterations_total"]),
                 residual_evaluations=int(r["residual_evaluations"]), wall_time_s=wall, steps=st["steps"],
