@@ -144,3 +144,19 @@ def test_bar_impact_at_a_tolerance(tol, bar_reference):
     h, fixed = _largest_fixed_reaching("bar_impact", study.STUDY["bar_impact"]["ladder"], error, ref)
     assert h is not None, f"no fixed step of the ladder reaches {error:.2e}"
     assert run["residual_evaluations"] <= fixed["residual_evaluations"]
+
+
+def test_readme_states_the_committed_study():
+    """The README's lines on the tolerance are the committed bench.json's study 9, number for number."""
+    import json
+    from pathlib import Path
+
+    from contactfem.lab.bench.report import adaptive_sentences
+
+    root = Path(__file__).resolve().parents[1]
+    bench = json.loads((root / "bench.json").read_text())
+    readme = " ".join((root / "README.md").read_text().split())
+    lines = adaptive_sentences(bench["adaptive"])
+    assert set(bench["adaptive"]["scenes"]) == {"sloping_impact", "rolling_ring", "bar_impact", "cork"}
+    for line in lines:
+        assert " ".join(line.split()) in readme

@@ -2,6 +2,8 @@
 
     Steps(dt, n_steps=200)                   fixed steps of dt (or up to t_end)
     Adaptive(rule, t_end, dt=...)            rule(record) -> the size of the next step
+    at_tolerance(stepper, tol, speed, ...)   a stepper that estimates its local error and the
+                                             rule that keeps it at a tolerance (error_step)
 
 Both halve a step whose Newton fails, up to ``max_cuts`` times and never below
 ``min_dt`` (``cut``); the march then retries the step with the smaller size. A schedule
