@@ -77,6 +77,9 @@ def check(params):
     if params["integrator"] == "central_difference" and params["accuracy"]:
         raise ValueError(f"parameter accuracy = {params['accuracy']} needs an implicit stepper (its local error "
                          "estimate): use it with integrator = newmark")
+    if params["enforcement"] != "penalty" and params["accuracy"]:
+        raise ValueError(f"parameter accuracy = {params['accuracy']} is offered with enforcement = penalty only "
+                         "(the multipliers' iterations are not tried at the adaptive mode's small first steps)")
     if params["integrator"] == "central_difference" and params["enforcement"] != "penalty":
         raise ValueError(f"parameter enforcement = {params['enforcement']} needs an implicit solve: use it with "
                          "integrator = newmark")

@@ -141,7 +141,8 @@ class Adaptive(_Cuts):
 def error_constant(stepper):
     """c of the local error estimate c dt |a+ - a| (the comment above), and the power of the
     error's ratio that gives the next step (1 for a first-order velocity update, 1/2 for a
-    second-order one)."""
+    second-order one). A wrapping stepper (Uzawa's outer loop) is looked through."""
+    stepper = getattr(stepper, "stepper", stepper)
     if type(stepper).__name__ == "EnergyConsistent":
         return 1.0 / 12.0, 0.5
     delta, beta = getattr(stepper, "delta", None), getattr(stepper, "beta", None)
