@@ -84,9 +84,9 @@ def build(params, *, normal=None, friction=None, system_options=None):
                             name="plane", integration=time_integration.contact_integration(params))
     system = System([ring.body], [contact], [ring.gravity(params["g"])], **(system_options or {}))
     stepper = time_integration.make_stepper(params, system, atol=1e-7 if params["kind"] == "beam" else 1e-6, maxit=30)
-    # accuracy: the errors of v_final (speed v0) add up over the run
+    # accuracy: the errors of v_final (relative to v0) add up over the run
     stepper, schedule = time_integration.plan(params, stepper, dt=params["dt"], t_end=params["t_end"],
-                                              speed=params["v0"], duration=params["t_end"], max_cuts=8)
+                                              speed=params["v0"], max_cuts=8)
     stage = Stage(stepper, schedule, np.zeros(ring.body.ndof), ring.initial_velocity((params["v0"], 0.0)),
                   name="rolling_ring")
     # the closed forms hold for Coulomb friction: the scene's, or a Coulomb law given with its own mu

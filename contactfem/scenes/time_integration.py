@@ -53,25 +53,18 @@ ACCURACY_PARAM = Param(
         "penetration indicator says how deep it lets the bodies go")
 
 
-def plan(params, stepper, *, dt, t_end, speed, duration, max_cuts, n_steps=None, t0=0.0):
+def plan(params, stepper, *, dt, speed, max_cuts, t_end=None, n_steps=None, duration=None, t0=0.0):
     """The stepper and the schedule of a dynamic scene's march: fixed steps of dt (``n_steps`` of
     them, or up to t_end) when params['accuracy'] is 0; else steps chosen from the local error
     estimate (schedule.error_step) at the tolerance params['accuracy'], relative to ``speed``
-    (the scene's velocity scale) over ``duration`` (the time its errors add up over), no step
+    (the scene's velocity scale) over ``duration`` (the time its errors add up over; default: the
+    run's, n_steps dt or t_end - t0), no step
     longer than dt, the first dt * accuracy; a step past twice its share of the error is retried
     halved (schedule.at_tolerance)."""
     tol = params.get("accuracy") or 0.0
     if not tol:
         return stepper, Steps(dt, n_steps=n_steps, t_end=None if n_steps else t_end, t0=t0, max_cuts=max_cuts)
+    duration = duration or (n_steps * dt if n_steps else t_end - t0)
     estimated, rule, rejections = at_tolerance(stepper, tol, speed, duration, dt)
     return estimated, Adaptive(rule, t_end=t0 + n_steps * dt if n_steps else t_end, dt=dt * tol, t0=t0,
                                max_cuts=max_cuts + rejections, growth=2.0)
-
-
-def stepping(params, records):
-    """How a run stepped (its ``stepping`` result): the mode (fixed or adaptive), the tolerance,
-    the steps taken, the smallest and largest step."""
-    dts = [r.dt for r in records[1:]]
-    tol = params.get("accuracy") or 0.0
-    return dict(mode="adaptive" if tol else "fixed", accuracy=tol or None, steps=len(dts),
-                dt_min=min(dts, default=None), dt_max=max(dts, default=None))
