@@ -178,3 +178,19 @@ def test_sloping_impact_at_one_percent():
     run = study.adaptive_run("sloping_impact", 1e-2)
     assert run["steps"] < 0.5 * 3.0 / 1.5625e-4
     assert study.max_error(run, ref["values"]) <= 1e-2
+
+
+def test_command_line_equals_python(tmp_path):
+    """`--set accuracy=TOL` on the command line is run_scene(..., {"accuracy": TOL}): the same steps."""
+    import json
+
+    from contactfem.cli import main
+
+    out = tmp_path / "run.json"
+    assert main(["run", "sloping_impact", "--set", "accuracy=0.01", "--set", "n_steps=10", "--json", str(out)]) == 0
+    cli = json.loads(out.read_text())
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        py = run_scene("sloping_impact", "fast", {"accuracy": 0.01, "n_steps": 10})
+    assert cli["stepping"] == py["stepping"] and cli["stepping"]["mode"] == "adaptive"
+    assert cli["t"] == list(py["t"]) and cli["rebound_vy"] == py["rebound_vy"]
