@@ -438,10 +438,11 @@ def adaptive_sentences(ad):
                 parts.append(f"accuracy = {a['accuracy']:g} failed ({a.get('failure', 'no headline value')})")
                 continue
             m = a.get("fixed_match")
-            against = (f"the largest fixed step reaching that error ({s['step']} = {m['h']:g}) "
+            against = (f"the largest fixed step reaching that error, {s['step']} = {m['h']:g}, needs "
                        f"{m['residual_evaluations']}" if m else "no fixed step of the ladder reaches that error")
             parts.append(f"accuracy = {a['accuracy']:g}: error {a['error']:.1e} with {a['residual_evaluations']} "
-                         f"residual evaluations ({against})")
+                         f"residual evaluations in {a['steps']} steps of {a['dt_min']:.2g} to {a['dt_max']:.2g} "
+                         f"({against})")
         lines.append(f"- {name} ({', '.join(s['keys'])}; the reference's own change "
                      f"{s['reference_change']:.1e}): " + "; ".join(parts) + ".")
     return lines
