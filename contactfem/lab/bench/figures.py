@@ -293,6 +293,9 @@ def bench_adaptive(preset="fast", outdir=None):
                        label="below the reference's own change")
         ax.set_title(f"{name} ({s['preset']}): {', '.join(s['keys'])}\nreference: {s['step']} = {s['h_reference']:g}",
                      fontsize=9)
+        from matplotlib.ticker import NullFormatter
+
+        ax.xaxis.set_minor_formatter(NullFormatter())
         ax.set_xlabel("largest relative error of the headline quantities")
         ax.set_ylabel("residual evaluations (Newton iterations, rejected steps too)")
         ax.legend(fontsize=7, loc="best")
