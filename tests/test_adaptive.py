@@ -194,3 +194,13 @@ def test_command_line_equals_python(tmp_path):
         py = run_scene("sloping_impact", "fast", {"accuracy": 0.01, "n_steps": 10})
     assert cli["stepping"] == py["stepping"] and cli["stepping"]["mode"] == "adaptive"
     assert cli["t"] == list(py["t"]) and cli["rebound_vy"] == py["rebound_vy"]
+
+
+def test_matching_fixed_is_the_largest_step_within_the_error():
+    fixed = [dict(h=1.0, error=0.02, residual_evaluations=10, newton_iterations=5, wall_time_s=0.1),
+             dict(h=0.5, error=0.004, residual_evaluations=20, newton_iterations=10, wall_time_s=0.2),
+             dict(h=0.25, error=0.006, residual_evaluations=40, newton_iterations=20, wall_time_s=0.4),
+             dict(h=0.125, error=0.001, residual_evaluations=80, newton_iterations=40, wall_time_s=0.8)]
+    assert study.matching_fixed(fixed, 0.005)["h"] == 0.5          # not the first in order of cost
+    assert study.matching_fixed(fixed, 0.002)["residual_evaluations"] == 80
+    assert study.matching_fixed(fixed, 1e-4) is None

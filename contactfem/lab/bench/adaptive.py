@@ -121,7 +121,8 @@ def scene_study(scene, tolerances=TOLERANCES, ladder=None, h_ref=None):
     if not r["ok"]:
         return dict(reference=r, fixed=[], adaptive=[])
     ref = r["values"]
-    steps = sorted(set(ladder) | {h * r["h_ref"] for h in (1, 2, 4)[:3 if s["order"] == 1 else 2]}, reverse=True)
+    own = (1, 2, 4) if s["order"] == 1 else (2,)       # (a second-order reference is its own run: error 0)
+    steps = sorted(set(ladder) | {m * r["h_ref"] for m in own}, reverse=True)
     fixed = [dict(_errors(_run(scene, s["preset"], s["fixed"](h), keys), ref, keys), h=h) for h in steps]  # ladder + reference runs
     adaptive = [dict(_errors(_run(scene, s["preset"], dict(s["adaptive"], accuracy=tol), keys), ref, keys),
                      accuracy=tol) for tol in tolerances]
