@@ -378,7 +378,8 @@ def cmd_reconstruct(args):
 
 
 BENCH_STUDIES = ("tangents", "work_precision", "cost", "targets", "enforcement", "speed", "semismooth",
-                 "scaling", "extremes")  # = lab.bench.STUDIES
+                 "scaling", "extremes",
+                 "adaptive")  # = lab.bench.STUDIES
 
 
 def cmd_bench(args):

@@ -74,7 +74,7 @@ from pathlib import Path  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 FIGURES = REPO / "figures"
-FAST = ("bench_cost", "bench_speed", "bench_tangents", "bench_work_precision",
+FAST = ("bench_adaptive", "bench_cost", "bench_speed", "bench_tangents", "bench_work_precision",
         "fig01_true_contact_area", "fig02_force_vs_microdisplacement", "fig03_shear_vs_normal",
         "fig04_parabolic_slip_surface", "fig06_block_mesh_deformed", "fig07_block_conical_stresses",
         "fig08_block_parabolic_stresses", "fig08b_block_fig8_readings", "table1_block_newton_residuals",

@@ -200,6 +200,17 @@ def _penalty_frequency(model, records):
     return best
 
 
+def stepping(params, records):
+    """How a run stepped (its ``stepping`` result): the mode (fixed, or adaptive at the tolerance
+    params['accuracy']), the steps taken, the smallest and the largest step."""
+    if isinstance(records, dict):                 # a scene of several stages (the cork): its dynamic one
+        records = records["records"]
+    dts = [r.dt for r in records[1:]]
+    tol = params.get("accuracy") or 0.0
+    return dict(mode="adaptive" if tol else "fixed", accuracy=tol or None, steps=len(dts),
+                dt_min=min(dts, default=None), dt_max=max(dts, default=None))
+
+
 def warn(accuracy, stacklevel=2):
     """One AccuracyWarning per indicator past its threshold; returns their messages."""
     lines = []

@@ -58,7 +58,7 @@ import numpy as np
 
 from ..contact import RigidLine, tributary_lengths
 from ..laws import PowerLaw
-from ..solver import CentralDifference, History, Steps, System
+from ..solver import CentralDifference, History, System
 from . import enforcement, time_integration
 from .base import Param, Scene, Stage
 
@@ -74,6 +74,12 @@ def check(params):
         raise ValueError("parameter contact_integration = 'energy_consistent' is implicit: "
                          "use it with integrator = newmark")
     enforcement.check(params)
+    if params["integrator"] == "central_difference" and params["accuracy"]:
+        raise ValueError(f"parameter accuracy = {params['accuracy']} needs an implicit stepper (its local error "
+                         "estimate): use it with integrator = newmark")
+    if params["enforcement"] != "penalty" and params["accuracy"]:
+        raise ValueError(f"parameter accuracy = {params['accuracy']} is offered with enforcement = penalty only "
+                         "(the multipliers' iterations are not tried at the adaptive mode's small first steps)")
     if params["integrator"] == "central_difference" and params["enforcement"] != "penalty":
         raise ValueError(f"parameter enforcement = {params['enforcement']} needs an implicit solve: use it with "
                          "integrator = newmark")
@@ -114,8 +120,10 @@ def build(params, *, normal=None, friction=None, system_options=None):
     stepper = enforcement.wrap(params, stepper, [contact], length=L / n)     # gap_violation: penetration / h_x
     v0_vec = np.zeros(system.ndof)
     v0_vec[body.xdofs[:, 0]] = -v0
-    stage = Stage(stepper, Steps(dt, t_end=t_end, max_cuts=0 if explicit else 4), np.zeros(system.ndof), v0_vec,
-                  name="bar_impact")
+    # accuracy: the errors of the rebound velocity (speed v0) are made while the bar touches, 2 L / c
+    stepper, schedule = time_integration.plan(params, stepper, dt=dt, t_end=t_end, speed=v0, duration=ex["duration"],
+                                              max_cuts=0 if explicit else 4)
+    stage = Stage(stepper, schedule, np.zeros(system.ndof), v0_vec, name="bar_impact")
     return dict(body=body, contact=contact, system=system, systems=[system], nodes=nodes, w=w, c_N=c_N,
                 stage=stage, dt=dt, sizes=dict(element=L / n, body=L),     # the accuracy indicators' lengths
                 rebound=True)                 # the accuracy's `separated`: the rebound is read after the impact
@@ -187,6 +195,7 @@ SCENE = Scene(
         *time_integration.newmark_params(0.5, 0.25, "chosen, average acceleration"),
         Param("t_end", 1.5, "2L/c", 0.0, None, low_open=True, doc="simulated time in units of 2 L / c"),
         time_integration.CONTACT_INTEGRATION_PARAM,
+        time_integration.ACCURACY_PARAM,
         *enforcement.ENFORCEMENT_PARAMS,
     ),
     build=build,

@@ -58,11 +58,10 @@ def run(scene, params, normal=None, friction=None, progress=None, linear_algebra
     contactfem.clock), the linear algebra of the Systems it built (``linear_algebra``,
     ``ordering``, ``unknowns``, ``band_kl``, ``band_ku``) and how often they were evaluated
     (``residual_evaluations``: System evaluations, one per residual Newton needs;
-    ``contact_evaluations``: contact evaluations, one per contact in each). A run whose
-    The results carry an ``accuracy`` section (scenes/accuracy.py: the generic indicators and the
-    scene's own); every indicator past its threshold warns (AccuracyWarning)."""
+    ``contact_evaluations``: contact evaluations, one per contact in each), an ``accuracy`` section
+    (scenes/accuracy.py; AccuracyWarning past a threshold) and ``stepping`` where a scene takes ``accuracy``."""
     from ..clock import imports_timed
-    from .accuracy import collect, warn
+    from .accuracy import collect, stepping, warn
 
     with imports_timed() as imported:              # modules loaded on first use: not the run's time
         t0 = time.perf_counter()
@@ -72,6 +71,8 @@ def run(scene, params, normal=None, friction=None, progress=None, linear_algebra
         results = dict(scene.measure(model, params, records))
         wall = time.perf_counter() - t0
     systems = model["systems"]
+    if "accuracy" in params:                    # how the run stepped: fixed, or at a tolerance
+        results["stepping"] = stepping(params, records)
     accuracy = collect(model, params, records, results)
     accuracy.update(results.pop("accuracy", None) or {})     # the scene's own (its references)
     results["accuracy"] = accuracy
@@ -86,8 +87,7 @@ def run(scene, params, normal=None, friction=None, progress=None, linear_algebra
     results["residual_evaluations"] = int(sum(s.evaluations for s in systems))
     contacts = {id(c): c for s in systems for c in s.contacts}
     results["contact_evaluations"] = int(sum(c.evaluations for c in contacts.values()))
-    results.setdefault("newton_iterations_total",          # a scene that does not count them itself
-                       int(sum(getattr(r, "iterations", 0) for r in records)))
+    results.setdefault("newton_iterations_total", int(sum(getattr(r, "iterations", 0) for r in records)))  # if not counted
     return results
 
 

@@ -55,6 +55,7 @@ from ..contact import NodeToSegment, tributary_lengths
 from ..contact.masters import bottle_neck
 from ..laws.friction import SlipHardening
 from ..laws.normal import PowerLaw
+from . import time_integration
 from .base import PENALTIES, PENALTY_DOC, Limit, Param, Scene
 from .time_integration import newmark_params
 from .cork_measure import PAPER, R_TIP_FITTED, measure  # noqa: F401 (public here)
@@ -101,6 +102,7 @@ PARAMS = (
     Param("p_step", 0.1, "MPa", 0.0, low_open=True, doc="pressure increment per ramp step (paper: 0.1)"),
     Param("n_ramp", 8, "", 1, 100, doc="ramp steps (paper: 8, to 0.8 MPa), then Boyle's law"),
     Param("dt", 1.0e-4, "s", 0.0, low_open=True, doc="time step in the neck (paper: 1e-4)"),
+    time_integration.ACCURACY_PARAM,
     Param("dt_fine", 5.0e-6, "s", 0.0, low_open=True, doc="time step around the exit (paper: 5e-6)"),
     Param("exit_zone", 2.0, "mm", 0.0,
           doc="dt_fine once the cork bottom is closer than this to the mouth. Chosen: one mouth radius"),

@@ -18,7 +18,8 @@ the paper; the gas pressure load's state, GasPressure.update at each commit): p 
 by the bottom face since the start of stage 2), i.e. V0 + pi R^2 * (its axial
 displacement). When the bottom corner of the cork reaches the mouth (z = 24 mm)
 the gas escapes: p = 0 from then on (ambient; no gas jet is modelled).
-Adaptive step (what drives it): dt_fine while the cork bottom is within
+Adaptive step (what drives it; with ``accuracy`` > 0 the local error estimate instead,
+solver/schedule.py, under the same travel limit): dt_fine while the cork bottom is within
 ``exit_zone`` of the mouth and for ``t_after`` after the gas release (the paper's
 5e-6 s), otherwise dt, but never more than ``travel_max`` of axial travel per step
 (so a contact node does not jump over the 2 mm mouth in one step); a step whose Newton
@@ -34,6 +35,7 @@ import numpy as np
 
 from ..solver import Adaptive, Dirichlet, Newmark, Static, System
 from ..solver.march import march, watch
+from ..solver.schedule import at_tolerance
 from .cork_measure import R_TIP_FITTED, centre_of_mass_velocity, contact_forces, static_breakaway
 
 def _newton_options(P):
@@ -75,6 +77,14 @@ def choose_dt(P, t, gap_to_mouth, released_at, v_cm):
     return max(dt, P["dt_fine"])
 
 
+def speed_scale(P):
+    """The speed the gas could give the cork over the neck (all its largest pressure's work
+    p_0 pi R_neck^2 (L_neck + r_mouth) as kinetic energy), in mm/s: the exit velocity's scale."""
+    W = P["p_step"] * P["n_ramp"] * np.pi * P["R_neck"] ** 2 * (P["L_neck"] + P["r_mouth"])
+    M = P["rho"] * np.pi * P["R_cork"] ** 2 * (P["L_neck"] + P["r_mouth"] + P["L_head"])
+    return float(np.sqrt(2.0 * W / M))
+
+
 def pop(model, P, u0, progress=None, histories=None):
     """Stage 2: the gas drives the cork out (Newmark; explicit Boyle coupling: the gas pressure
     of the next step from each converged step, the load's state; adaptive dt with cutback).
@@ -93,16 +103,26 @@ def pop(model, P, u0, progress=None, histories=None):
     if histories is not None:                                # the contacts go on from the press fit
         state = replace(state, contacts=tuple(histories))
 
+    stepper = Newmark(system, delta=P["delta"], beta=P["beta_newmark"], **_newton_options(P))
+    tol = P.get("accuracy") or 0.0
+    rule, rejections = None, 0
+    if tol:        # steps from the local error estimate: the exit velocity's errors (its scale: speed_scale) add up
+        stepper, rule, rejections = at_tolerance(stepper, tol, speed_scale(P), P["t_end"], P["dt"])   # over t_end
+
     def dt_rule(rec):                                        # rec.state: the gas after the step
         v_cm = centre_of_mass_velocity(cork, rec.v) / 1e3 if rec.k else 0.0
-        h = choose_dt(P, rec.t, P["L_neck"] - gas.edge_z(rec.u), rec.state.loads[0].released_at, v_cm)
+        if rule is not None:                                 # travel_max still holds
+            h = rule(rec)
+            h = min(h, P["travel_max"] / (1e3 * abs(v_cm))) if v_cm else h
+        else:
+            h = choose_dt(P, rec.t, P["L_neck"] - gas.edge_z(rec.u), rec.state.loads[0].released_at, v_cm)
         return min(h, t_ramp - rec.t) if rec.t < t_ramp * (1 - 1e-9) else h
 
     # the press fit is a static state: start at rest with a0 = 0 (M^-1 G would put the hold's
     # reaction on one light axis node as a spurious acceleration spike)
     zero = np.zeros(system.ndof)
-    stepper = Newmark(system, delta=P["delta"], beta=P["beta_newmark"], **_newton_options(P))
-    schedule = Adaptive(dt_rule, t_end=P["t_end"], dt=P["dt"], max_cuts=P["max_cuts"])
+    schedule = Adaptive(dt_rule, t_end=P["t_end"], dt=P["dt"], max_cuts=P["max_cuts"] + rejections,
+                        growth=2.0 if tol else None)
     records, pressures, exit_time, touching, acting = [], [], None, None, None
     bar = progress(0.0, P["t_end"], "cork: pop") if progress is not None else None
     try:

@@ -54,7 +54,7 @@ import numpy as np
 from ..bodies.ring import make_ring
 from ..contact import NodeToSegment, RigidLine
 from ..laws import Coulomb, PowerLaw
-from ..solver import History, Steps, System
+from ..solver import History, System
 from . import time_integration
 from .accuracy import V_FINAL_TOL, X_END_TOL, references
 from .base import Param, Scene, Stage
@@ -84,8 +84,11 @@ def build(params, *, normal=None, friction=None, system_options=None):
                             name="plane", integration=time_integration.contact_integration(params))
     system = System([ring.body], [contact], [ring.gravity(params["g"])], **(system_options or {}))
     stepper = time_integration.make_stepper(params, system, atol=1e-7 if params["kind"] == "beam" else 1e-6, maxit=30)
-    stage = Stage(stepper, Steps(params["dt"], t_end=params["t_end"], max_cuts=8), np.zeros(ring.body.ndof),
-                  ring.initial_velocity((params["v0"], 0.0)), name="rolling_ring")
+    # accuracy: the errors of v_final (relative to v0) add up over the run
+    stepper, schedule = time_integration.plan(params, stepper, dt=params["dt"], t_end=params["t_end"],
+                                              speed=params["v0"], max_cuts=8)
+    stage = Stage(stepper, schedule, np.zeros(ring.body.ndof), ring.initial_velocity((params["v0"], 0.0)),
+                  name="rolling_ring")
     # the closed forms hold for Coulomb friction: the scene's, or a Coulomb law given with its own mu
     exact_mu = params["mu"] if friction is None else (friction.mu if isinstance(friction, Coulomb) else None)
     return dict(ring=ring, contact=contact, system=system, systems=[system], plane=plane, stage=stage,
@@ -229,6 +232,7 @@ SCENE = Scene(
               doc="duration (chosen: 2 s, where the paper's exact position is 376 cm)"),
         *time_integration.newmark_params(0.7, 0.4, "paper"),
         time_integration.CONTACT_INTEGRATION_PARAM,
+        time_integration.ACCURACY_PARAM,
         MASS_MATRIX_PARAM,
         Param("outline_interval", 0.25, "s", 0.0, None, low_open=True,
               doc="store the ring outline this often (figures)"),

@@ -34,7 +34,7 @@ from ..bodies.ring import make_ring
 from ..contact import NodeToSegment, RigidLine, tributary_lengths
 from ..contact.tangents import TANGENTS
 from ..laws import ParabolicSlip, PowerLaw
-from ..solver import History, Steps, System
+from ..solver import History, System
 from . import time_integration
 from .base import PENALTIES, PENALTY_DOC, Param, Scene, Stage
 from .rings import MASS_MATRIX_PARAM, RING_PARAMS, penalty_pressure, ring_history, ring_size, snapshot_indices
@@ -57,26 +57,23 @@ def check(params):
 
 
 def integration_points(params):
-    """Points per beam element: the parameter, or for 'auto' 2 for the elastic ring (fitted to
-    Table 2) and 1 for the viscoplastic ring."""
+    """Points per beam element: the parameter, or for 'auto' 2 (elastic ring, fitted to Table 2), 1 (viscoplastic)."""
     if params["integration"] != "auto":
         return int(params["integration"])
     return 1 if params["variant"] == "viscoplastic" else 2
 
 
 def newton_atol(params, ndof):
-    """Newton's absolute tolerance: 1e-10, or ten times the round-off of the ring's residual
-    where that is larger, eps (E A / L0) R sqrt(ndof) (a fine ring: n_el = 700 stalls at 1.1e-10,
-    where this estimate gives 1.1e-10; up to n_el ~ 140 the tolerance stays 1e-10)."""
+    """Newton's absolute tolerance: 1e-10, or ten times the round-off of the ring's residual where that is
+    larger, eps (E A / L0) R sqrt(ndof) (n_el = 700 stalls at 1.1e-10, as estimated; to n_el ~ 140: 1e-10)."""
     L0 = 2.0 * np.pi * params["R"] / params["n_el"]
     EA = params["E"] * params["thickness"] * params["width"]
     return max(1e-10, 10.0 * np.finfo(float).eps * EA / L0 * params["R"] * np.sqrt(ndof))
 
 
 def build(params, *, normal=None, friction=None, system_options=None):
-    """The ring (make_ring), the plane y = 0, the contact and the march; returns a dict.
-    ``normal`` / ``friction``: law objects instead of the ones the parameters build
-    (a friction law given makes any variant frictional)."""
+    """The ring (make_ring), the plane y = 0, the contact and the march; returns a dict. ``normal`` /
+    ``friction``: law objects instead of the parameters' (a friction law given makes any variant frictional)."""
     h = params["thickness"]
     plastic = None
     if params["variant"] == "viscoplastic":
@@ -104,8 +101,10 @@ def build(params, *, normal=None, friction=None, system_options=None):
     system = System([ring.body], [contact], **(system_options or {}))
     stepper = time_integration.make_stepper(params, system, atol=newton_atol(params, ring.body.ndof),
                                             maxit=30)
-    stage = Stage(stepper, Steps(params["dt"], n_steps=params["n_steps"], max_cuts=6), np.zeros(ring.body.ndof),
-                  ring.initial_velocity((params["vx0"], params["vy0"])), name="sloping_impact")
+    v0 = (params["vx0"], params["vy0"])            # accuracy: the rebound velocities' errors, relative to |v0|
+    stepper, schedule = time_integration.plan(params, stepper, dt=params["dt"], n_steps=params["n_steps"],
+                                              speed=float(np.hypot(*v0)), max_cuts=6)
+    stage = Stage(stepper, schedule, np.zeros(ring.body.ndof), ring.initial_velocity(v0), name="sloping_impact")
     return dict(ring=ring, contact=contact, system=system, systems=[system], plane=plane, stage=stage,
                 plastic=params["variant"] == "viscoplastic",      # its plastic work is no integrator's loss
                 sizes=dict(element=2.0 * np.pi * params["R"] / params["n_el"], body=2.0 * params["R"],  # (elements' length)
@@ -220,6 +219,7 @@ SCENE = Scene(
         Param("n_steps", 200, "", 1, 100000, doc="number of steps (paper: 200)"),
         *time_integration.newmark_params(0.7, 0.4, "paper"),
         time_integration.CONTACT_INTEGRATION_PARAM,
+        time_integration.ACCURACY_PARAM,
         MASS_MATRIX_PARAM,
         Param("outline_every", 20, "", 1, 100000, doc="store the ring outline every this many steps (figures)"),
     ),

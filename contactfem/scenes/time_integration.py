@@ -4,7 +4,8 @@ error every such scene reports."""
 
 import numpy as np
 
-from ..solver import Newmark
+from ..solver import Adaptive, Newmark, Steps
+from ..solver.schedule import at_tolerance
 from ..solver.conserving import EnergyConsistent
 from ..solver.newmark import BETA_RANGE, DELTA_RANGE
 from .base import Param
@@ -52,3 +53,30 @@ def energy_error(hist):
     balance = E + hist.dissipation - hist.external_work
     E0 = E[0]
     return float((balance[-1] - E0) / E0), float(np.max(np.abs(balance - E0)) / E0)
+
+
+ACCURACY_PARAM = Param(
+    "accuracy", 0.0, "", 0.0, 0.1,
+    doc="0: fixed steps of dt (the default); TOL > 0: the steps are chosen from a local error estimate "
+        "(solver/schedule.py: each step's error in the velocities held at TOL speed dt / duration) so "
+        "that the headline quantities land within about TOL (relative) of the run refined in time; dt is then the "
+        "largest step. The penalty is not changed: in these scenes it is the interface law of the model (the "
+        "paper's eq 4, the bar's one-element stiffness), the reference is the same model refined in time, and the "
+        "penetration indicator says how deep it lets the bodies go")
+
+
+def plan(params, stepper, *, dt, speed, max_cuts, t_end=None, n_steps=None, duration=None, t0=0.0):
+    """The stepper and the schedule of a dynamic scene's march: fixed steps of dt (``n_steps`` of
+    them, or up to t_end) when params['accuracy'] is 0; else steps chosen from the local error
+    estimate (schedule.error_step) at the tolerance params['accuracy'], relative to ``speed``
+    (the scene's velocity scale) over ``duration`` (the time its errors add up over; default: the
+    run's, n_steps dt or t_end - t0), no step
+    longer than dt, the first dt * accuracy; a step past twice its share of the error is retried
+    halved (schedule.at_tolerance)."""
+    tol = params.get("accuracy") or 0.0
+    if not tol:
+        return stepper, Steps(dt, n_steps=n_steps, t_end=None if n_steps else t_end, t0=t0, max_cuts=max_cuts)
+    duration = duration or (n_steps * dt if n_steps else t_end - t0)
+    estimated, rule, rejections = at_tolerance(stepper, tol, speed, duration, dt)
+    return estimated, Adaptive(rule, t_end=t0 + n_steps * dt if n_steps else t_end, dt=dt * tol, t0=t0,
+                               max_cuts=max_cuts + rejections, growth=2.0)

@@ -2,6 +2,8 @@
 
     Steps(dt, n_steps=200)                   fixed steps of dt (or up to t_end)
     Adaptive(rule, t_end, dt=...)            rule(record) -> the size of the next step
+    at_tolerance(stepper, tol, speed, ...)   a stepper that estimates its local error and the
+                                             rule that keeps it at a tolerance (error_step)
 
 Both halve a step whose Newton fails, up to ``max_cuts`` times and never below
 ``min_dt`` (``cut``); the march then retries the step with the smaller size. A schedule
@@ -9,8 +11,12 @@ answers three questions: the size of the next step after a record (None: the run
 over), the size after a failure, and the time a step ends at.
 """
 import math
+from dataclasses import replace
+from functools import partial
 
 import numpy as np
+
+from .newton import NewtonError
 
 
 def check_dt(dt, name="dt"):
@@ -113,3 +119,125 @@ class Adaptive(_Cuts):
 
     def end_time(self, t, dt):
         return t + dt
+
+
+# -- steps chosen from a local error estimate (a scene's ``accuracy``) ----------------------------
+#
+# A step of Newmark (delta, beta) updates the velocities by dt ((1 - delta) a + delta a+); against
+# the Taylor series of the exact motion its local error is
+#
+#     (delta - 1/2) dt^2 a' + (delta / 2 - 1/6) dt^3 a'' + ...,     a' ~ (a+ - a) / dt,
+#
+# first order in dt where delta > 1/2 (the paper's 0.7): c dt |a+ - a| with c = delta - 1/2. This
+# term is the method's numerical damping: it takes the energy of the vibrations an impact excites,
+# and a rebound's or a rolling ring's speed with it. Where delta = 1/2 the first term vanishes and
+# the second needs a second difference, which one step does not have; the estimate is then
+# Zienkiewicz and Xie's for the displacement, dt^2 |beta - 1/6| |a+ - a|, per unit step:
+# c = |beta - 1/6| (1/12 for the trapezoidal rule). The energy-consistent stepper
+# (solver/conserving.py) is the trapezoidal rule on a linear problem (its a+ the step's mean
+# acceleration): c = 1/12 too. Which velocities: with numerical damping (delta > 1/2) the error
+# of every vibration takes energy from the motion the headline quantities are made of, so |.| is
+# the kinetic energy's norm, a mass-weighted root mean square (sum m_i d_i^2 / sum m_i)^(1/2);
+# without it (delta = 1/2, the energy-consistent stepper) a vibration's error is a phase error
+# that keeps its energy, and |.| is the largest of the bodies' centre-of-mass components
+# (mass-weighted means: a body's elastic ringing has no resultant). The local errors of the steps
+# add up; holding each at ``tol speed dt / duration`` (its share) keeps their sum over the run
+# within tol speed (error per unit step). A step is chosen from the last one's error (error_step)
+# and taken; one whose error is past twice its share (the step into an impact or out of it: the
+# rule cannot see an event coming) is retried halved, as a step whose Newton fails (StepRejected),
+# down to the first step's size.
+
+def error_constant(stepper):
+    """c of the local error estimate c dt |a+ - a| (the comment above), and the power of the
+    error's ratio that gives the next step (1 for a first-order velocity update, 1/2 for a
+    second-order one). A wrapping stepper (Uzawa's outer loop) is looked through."""
+    stepper = getattr(stepper, "stepper", stepper)
+    if type(stepper).__name__ == "EnergyConsistent":
+        return 1.0 / 12.0, 0.5
+    delta, beta = getattr(stepper, "delta", None), getattr(stepper, "beta", None)
+    if delta is None or beta is None:
+        raise ValueError(f"accuracy needs an implicit Newmark or the energy-consistent stepper, not "
+                         f"{type(stepper).__name__}")
+    if abs(delta - 0.5) > 1e-12:
+        return abs(delta - 0.5), 1.0
+    return abs(beta - 1.0 / 6.0), 0.5
+
+
+def centre_of_mass_rows(system, directions=(0, 1)):
+    """The rows (bodies x directions, ndof) that map a dof vector to the bodies' centre-of-mass
+    components along ``directions`` (lumped mass weights over each body's translations)."""
+    m = system.lumped_mass()
+    rows = []
+    for body in system.bodies:
+        for d in directions:
+            dofs = body.dof_offset + np.asarray(body.xdofs)[:, d]
+            row = np.zeros(system.ndof)
+            row[dofs] = m[dofs] / np.sum(m[dofs])
+            rows.append(row)
+    return np.array(rows)
+
+
+class StepRejected(NewtonError):
+    """A converged step whose local error is past twice its share: the march retries it halved."""
+
+
+class Estimated:
+    """A dynamic stepper whose step results carry ``local_error``: c dt |a+ - a|, the estimate of
+    the comment above. ``share(dt)``: the error a step of dt may have; a step longer than ``floor``
+    with more than twice that raises StepRejected (None: every step kept). Anything else is the
+    wrapped stepper's (``stepper``)."""
+
+    def __init__(self, stepper, share=None, floor=0.0):
+        self.stepper, self.share, self.floor = stepper, share, floor
+        self.c, self.power = error_constant(stepper)
+        self.mass = stepper.system.lumped_mass()
+        self.rows = None if self.power == 1.0 else centre_of_mass_rows(stepper.system)
+
+    def __getattr__(self, name):
+        if name == "stepper":
+            raise AttributeError(name)
+        return getattr(self.stepper, name)
+
+    def norm(self, d):
+        """|d|: the kinetic energy's norm (damped steppers) or the largest centre-of-mass component."""
+        if self.rows is None:
+            return float(np.sqrt(np.sum(self.mass * d * d) / np.sum(self.mass)))
+        return float(np.max(np.abs(self.rows @ d)))
+
+    def step(self, t, u, v, a, dt, label="", *, state):
+        u1, v1, a1, result = self.stepper.step(t, u, v, a, dt, label, state=state)
+        e = self.c * dt * self.norm(a1 - a)
+        if self.share is not None and dt > self.floor * (1 + 1e-9) and e > 2.0 * self.share(dt):
+            raise StepRejected(f"local error {e:.3g} is past twice its share {self.share(dt):.3g}", [], label)
+        return u1, v1, a1, replace(result, local_error=e)
+
+
+def error_step(rec, tol, speed, duration, dt_first, dt_max, power=1.0):
+    """Adaptive's rule for a run at a tolerance: the size of the step after ``rec`` from its
+    step's local error e (``rec.result.local_error``, Estimated): the step whose error would be
+    tol speed dt / duration, dt (tol speed dt / (duration e))^power, between dt_first and dt_max;
+    dt_first for the first step (no estimate yet). (The floor: an acceleration that jumps, as a
+    friction force from stick to slip, gives an error that no step makes smaller.)"""
+    e = getattr(rec.result, "local_error", None)
+    if rec.k == 0 or e is None:
+        return dt_first
+    if not e > 0:
+        return dt_max
+    return min(dt_max, max(dt_first, rec.dt * (tol * speed * rec.dt / (duration * e)) ** power))
+
+
+def at_tolerance(stepper, tol, speed, duration, dt_max):
+    """A run at the tolerance tol (relative to ``speed``, its errors adding up over ``duration``,
+    no step longer than dt_max): the stepper (Estimated, rejecting a step past twice its share),
+    Adaptive's rule (error_step, the first step dt_max tol) and the halvings a step may need
+    on top of its Newton's (a rejected step down to the first step's size)."""
+    dt_first = dt_max * tol
+    share = partial(_share, tol * speed / duration)
+    estimated = Estimated(stepper, share=share, floor=dt_first)
+    rule = partial(error_step, tol=tol, speed=speed, duration=duration, dt_first=dt_first, dt_max=dt_max,
+                   power=estimated.power)
+    return estimated, rule, int(math.ceil(math.log2(1.0 / tol)))
+
+
+def _share(rate, dt):
+    return rate * dt

@@ -53,6 +53,7 @@ class UzawaResult:
     violations: list = field(default_factory=list)
     gap_violation: float = 0.0
     gap_violations: list = field(default_factory=list)
+    local_error: float | None = None          # a time stepper's estimate of the step's error (schedule.Estimated)
 
 
 class Uzawa:

@@ -1,10 +1,10 @@
 """`contactfem bench`: speed against accuracy, measured.
 
-Nine studies, each a module with a function returning a JSON-able dict; ``run_bench``
+Ten studies, each a module with a function returning a JSON-able dict; ``run_bench``
 runs them all and ``write_markdown`` (report.py, the one report writer) turns the result
 into the tables of BENCHMARKS.md. Files: common.py (targets, timing, observed order),
 tangents.py, work_precision.py, cost.py, targets.py, enforcement.py, speed.py, semismooth.py,
-scaling.py, extremes.py, report.py.
+scaling.py, extremes.py, adaptive.py, report.py.
 
 1. tangents        the paper's central claim (Sec. 4.2): Newton with the consistent
                    non-symmetric tangent (eqs 49-50) against a symmetrised tangent, the
@@ -45,6 +45,11 @@ scaling.py, extremes.py, report.py.
                    enforcement, discretisation, integration): each run within 5 % of its refined
                    reference, flagged by an accuracy indicator, refused or stopped in one line;
                    none wrong and unflagged (extremes.py).
+10. adaptive        a tolerance against fixed steps: for each dynamic scene (sloping impact,
+                    rolling ring, bar impact, cork) Newton iterations, residual evaluations and
+                    wall time against the error of its headline quantities, a ladder of fixed
+                    steps and the ``accuracy`` mode at several tolerances, against a reference
+                    refined in time (adaptive.py); quick: the bar impact alone.
 
 ``quick`` shrinks every study (fast presets, fewer points) to seconds in all.
 No timing enters a test: times depend on the machine and its load.
@@ -67,10 +72,12 @@ from .speed import speed_study
 from .tangents import VARIANTS, tangent_study
 from .targets import targets_study
 from .work_precision import work_precision
+from .adaptive import adaptive_study
 
 STUDIES = {"tangents": tangent_study, "work_precision": work_precision, "cost": cost_study,
            "targets": targets_study, "enforcement": enforcement_study, "speed": speed_study,
-           "semismooth": semismooth_study, "scaling": scaling_study, "extremes": extremes_study}
+           "semismooth": semismooth_study, "scaling": scaling_study, "extremes": extremes_study,
+           "adaptive": adaptive_study}
 
 
 def machine():
@@ -98,4 +105,4 @@ def run_bench(quick=False, only=None, progress=print):
 __all__ = ["run_bench", "STUDIES", "TARGETS", "PAPER_SCENES", "VARIANTS", "observed_order", "machine",
            "write_markdown", "write_outputs", "tangent_study", "work_precision", "cost_study",
            "iteration_cost", "targets_study", "enforcement_study", "speed_study", "semismooth_study",
-           "scaling_study", "plain_hertz", "extremes_study"]
+           "scaling_study", "plain_hertz", "extremes_study", "adaptive_study"]

@@ -255,3 +255,53 @@ def bench_speed(preset="fast", outdir=None):
                   f"{st['run_block_over_scipy_skfem']:.2f} x scipy + skfem", fontsize=9)
     fig.tight_layout()
     return _save(fig, outdir, preset, "bench_speed", "speed")
+
+
+def _adaptive_section(preset):
+    """The adaptive study of the bench JSON, or a quick one run here (the bar impact, seconds)."""
+    b = load_bench(preset)
+    if "adaptive" in b:
+        return b["adaptive"], dict(source=bench_json_path().name, quick=b.get("quick"), machine=b.get("machine"))
+    if "adaptive_quick" not in _CACHE:
+        from ...scenes import jsonable
+        from .adaptive import adaptive_study
+
+        _CACHE["adaptive_quick"] = jsonable(adaptive_study(quick=True))
+    return _CACHE["adaptive_quick"], dict(source="a quick bench run", quick=True)
+
+
+@figure("bench_adaptive", "bench")
+def bench_adaptive(preset="fast", outdir=None):
+    """Work against precision of the dynamic scenes: residual evaluations against the error of
+    the headline quantities, fixed steps against the adaptive mode at several tolerances."""
+    plt = pyplot()
+    study, parameters = _adaptive_section(preset)
+    scenes = study["scenes"]
+    fig, axes = plt.subplots(1, len(scenes), figsize=(4.6 * len(scenes), 4.0), squeeze=False)
+    for ax, (name, s) in zip(axes[0], scenes.items()):
+        fixed = [f for f in s["fixed"] if f.get("error")]
+        adaptive = [a for a in s["adaptive"] if a.get("error")]
+        ax.loglog([f["error"] for f in fixed], [f["residual_evaluations"] for f in fixed], "o-", color="C0",
+                  label=f"fixed {s['step']}")
+        for f in fixed:
+            ax.annotate(f"{f['h']:g}", (f["error"], f["residual_evaluations"]), fontsize=6, color="C0",
+                        textcoords="offset points", xytext=(3, 3))
+        ax.loglog([a["error"] for a in adaptive], [a["residual_evaluations"] for a in adaptive], "s--", color="C3",
+                  label="accuracy = TOL")
+        for a in adaptive:
+            ax.annotate(f"TOL {a['accuracy']:g}", (a["error"], a["residual_evaluations"]), fontsize=6, color="C3",
+                        textcoords="offset points", xytext=(3, -9))
+        if s.get("reference_change"):
+            ax.axvspan(ax.get_xlim()[0], s["reference_change"], color="0.85", zorder=0,
+                       label="below the reference's own change")
+        ax.set_title(f"{name} ({s['preset']}): {', '.join(s['keys'])}\nreference: {s['step']} = {s['h_reference']:g}",
+                     fontsize=9)
+        from matplotlib.ticker import NullFormatter
+
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.set_xlabel("largest relative error of the headline quantities")
+        ax.set_ylabel("residual evaluations (Newton iterations, rejected steps too)")
+        ax.legend(fontsize=7, loc="best")
+    fig.tight_layout()
+    return save_figure(fig, Path(outdir or default_outdir(preset)) / "bench_adaptive.png", {"adaptive": study},
+                       parameters)

@@ -385,7 +385,45 @@ def write_markdown(res):
         L += scaling_markdown(res["scaling"])
     if "extremes" in res:
         L += extremes_markdown(res["extremes"])
+    if "adaptive" in res:
+        L += adaptive_markdown(res["adaptive"])
     return "\n".join(L) + "\n"
+
+
+ADAPTIVE_NOTES = {"sloping_impact": "The first 3 time units (the ring leaves the plane at ~2.5), for the fixed and the "
+                                    "adaptive runs alike.",
+                  "cork": "Fixed steps: the scene's schedule with dt_fine = h everywhere (travel_max 1e-9 mm); dt "
+                          "(1e-4 s) stays, as it sets the gas's ramp."}
+
+
+def adaptive_markdown(ad):
+    """Study 10: fixed steps against the adaptive mode, per scene (lab/bench/adaptive.py)."""
+    L = ["## A tolerance against fixed steps (accuracy = TOL)", "",
+         "Each scene's headline quantities against a reference refined in time (fixed steps h_ref; "
+         "Richardson's extrapolation from h_ref and 2 h_ref where the stepper is first order, Newmark "
+         "delta = 0.7); error: the largest relative error of the headline quantities; cost: residual "
+         "evaluations (every Newton iteration, those of rejected and halved steps too). `fixed match`: "
+         "the largest fixed step of the ladder whose error is at most the adaptive run's, and its cost.", ""]
+    for name, s in ad["scenes"].items():
+        if not s.get("fixed"):
+            L += [f"### {name}: the reference failed", ""]
+            continue
+        ref = ", ".join(f"{k} = {v:.6g}" for k, v in s["reference"].items())
+        L += [f"### {name} ({s['preset']} preset): {ref}", "",
+              f"Reference: {s['step']} = {s['h_reference']:g}, its own change {_f(s['reference_change'])}. "
+              + ADAPTIVE_NOTES.get(name, ""), "",
+              "| run | error | residual evaluations | Newton iterations | steps | time [s] | fixed match (evaluations) |",
+              "|---|---|---|---|---|---|---|"]
+        for f in s["fixed"]:
+            L.append(f"| {s['step']} = {f['h']:g} | {_f(f.get('error'))} | {f.get('residual_evaluations', '-')} | "
+                     f"{f.get('newton_iterations', '-')} | {f.get('steps', '-')} | {_f(f.get('wall_time_s'))} | |")
+        for a in s["adaptive"]:
+            m = a.get("fixed_match")
+            match = f"{s['step']} = {m['h']:g} ({m['residual_evaluations']})" if m else "none of the ladder"
+            L.append(f"| accuracy = {a['accuracy']:g} | {_f(a.get('error'))} | {a.get('residual_evaluations', '-')} | "
+                     f"{a.get('newton_iterations', '-')} | {a.get('steps', '-')} | {_f(a.get('wall_time_s'))} | {match} |")
+        L.append("")
+    return L
 
 
 def write_outputs(res, outdir):
@@ -396,3 +434,25 @@ def write_outputs(res, outdir):
     pj.write_text(json.dumps(res, indent=1))
     pm.write_text(write_markdown(res))
     return str(pj), str(pm)
+
+
+def adaptive_sentences(ad):
+    """The README's account of study 10, one line per scene, from the study's numbers."""
+    lines = []
+    for name, s in ad["scenes"].items():
+        if not s.get("fixed"):
+            continue
+        parts = []
+        for a in s["adaptive"]:
+            if a.get("error") is None:
+                parts.append(f"accuracy = {a['accuracy']:g} failed ({a.get('failure', 'no headline value')})")
+                continue
+            m = a.get("fixed_match")
+            against = (f"the largest fixed step reaching that error, {s['step']} = {m['h']:g}, needs "
+                       f"{m['residual_evaluations']}" if m else "no fixed step of the ladder reaches that error")
+            parts.append(f"accuracy = {a['accuracy']:g}: error {a['error']:.1e} with {a['residual_evaluations']} "
+                         f"residual evaluations in {a['steps']} steps of {a['dt_min']:.2g} to {a['dt_max']:.2g} "
+                         f"({against})")
+        lines.append(f"- {name} ({', '.join(s['keys'])}; the reference's own change "
+                     f"{s['reference_change']:.1e}): " + "; ".join(parts) + ".")
+    return lines
