@@ -355,7 +355,7 @@ def _census_short(census):
 
     def stage():
         model, _ = _scene_model("funnel", {"variant": "frictional"})
-        st = model["stage"]
+        st = model.stage
         return st, Steps(st.schedule.dt, n_steps=12, t0=st.schedule.t0)
 
     def student():

@@ -27,7 +27,7 @@ from conftest import PointCloud
 
 def _block_staggered(params, max_cycles=200):
     b = block.build(params)
-    system = b["system"]
+    system = b.system
     stepper = Staggered(Static(system, atol=params["atol"], rtol=params["rtol"], maxit=params["maxit"]),
                         max_cycles=max_cycles)
     u = np.zeros(system.ndof)
@@ -108,9 +108,9 @@ def test_phase_tangents_match_finite_differences(phase, friction):
 def test_a_bad_phase_is_refused():
     params = get_scene("block").resolve("paper")
     b = block.build(params)
-    state = b["system"].start(np.zeros(b["system"].ndof))
+    state = b.system.start(np.zeros(b.system.ndof))
     with pytest.raises(ValueError, match="phase"):
-        freeze(b["contact"].evaluate(np.zeros(b["system"].ndof), history=state.contacts[0]), "tangential")
+        freeze(b.parts["contact"].evaluate(np.zeros(b.system.ndof), history=state.contacts[0]), "tangential")
 
 
 def test_observed_order_of_a_power_law():

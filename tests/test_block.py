@@ -128,7 +128,7 @@ def test_the_friction_law_barely_changes_the_normal_stress(results):
 def newton_states(params, n_iter):
     """Newton iterates of the block (no commit): u_0 = 0, u_1, ... u_{n_iter}."""
     sc = build(params)
-    system = sc["system"]
+    system = sc.system
     u = np.zeros(system.ndof)
     start = system.start(u)
     states = [u.copy()]
@@ -151,7 +151,7 @@ def test_full_tangent_finite_differences(law, material, which):
     if material != "linear":
         over.update(p_y=20.0, p_x=6.0)        # finite strain: lighter loads (see the scene's doc)
     sc, states = newton_states(SCENE.resolve("canonical", over), which)
-    system, contact = sc["system"], sc["contact"]
+    system, contact = sc.system, sc.parts["contact"]
     u = states[-1]
     start = sc["start"]
     state = contact.evaluate(u, 1.0, 1.0, history=start.contacts[0]).slip

@@ -76,7 +76,7 @@ def test_wall_time_of_a_run_leaves_out_its_imports(fake_time, monkeypatch):
 
     def build(params, *, normal=None, friction=None, system_options=None):
         import slow_other  # noqa: F401
-        return {"systems": []}
+        return base.Model(systems=())
 
     def simulate(model, params, progress):
         fake_time.t += 1.0

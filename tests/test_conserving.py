@@ -325,7 +325,7 @@ def test_energy_consistent_step_tangent_with_a_contact_on_the_ring(rng, variant)
     from contactfem.scenes import get_scene, sloping_impact
     p = get_scene("sloping_impact").resolve("fast", {"variant": variant, "contact_integration": "energy_consistent"})
     m = sloping_impact.build(p)
-    ring, system = m["ring"], m["system"]
+    ring, system = m.parts["ring"], m.system
     stepper = conserving.EnergyConsistent(system)
     u = np.zeros(system.ndof)
     u[ring.body.xdofs[:, 1]] = -(p["gap0"] + 0.02)                      # the lowest nodes pressed in

@@ -98,7 +98,7 @@ def test_energy_never_increases(res):
 
 def test_symmetry_conditions():
     m = build(SCENE.resolve("fast", {}))
-    ring, system = m["ring"], m["system"]
+    ring, system = m.parts["ring"], m.system
     ends = [0, ring.body.X.shape[0] - 1]
     assert np.allclose(ring.body.X[ends, 0], 0.0)
     assert set(system.fixed_dofs) == {0, 2, 3 * ends[1], 3 * ends[1] + 2}   # u_x and theta

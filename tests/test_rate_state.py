@@ -137,7 +137,7 @@ def test_block_tangent_against_finite_differences(name):
     s = block.solve(params, friction=RATE_LAWS[name])
     # the same two steps, stopped before committing the second
     sc = block.build(params, friction=RATE_LAWS[name])
-    c1, system = sc["contact"], sc["system"]
+    c1, system = sc.parts["contact"], sc.system
     st = Static(system, atol=params["atol"], rtol=params["rtol"], maxit=40)
     u = np.zeros(system.ndof)
     state = system.start(u)

@@ -33,7 +33,7 @@ def test_first_residual_formula_is_the_nodal_load_norm(over):
     # the scene refuses before any solve
     p = dict(get_scene("block").resolve("paper", {}), **over)
     b = build(p)
-    top, side = load_norms(b["body"], b["loads"])
+    top, side = load_norms(b.parts["body"], b.parts["loads"])
     assert rc.block_first_residual(p["width"], p["height"], p["nx"], p["ny"], p["p_y"], p["p_x"]) == \
         pytest.approx(np.hypot(top, side), rel=1e-12)
 

@@ -54,7 +54,7 @@ def test_marching_the_same_model_twice_gives_the_same_records(name, over):
 def test_a_run_resumed_from_its_kth_record_goes_on_as_it_went(name, over):
     scene, params, model = model_of(name, over)
     records = simulate(model, params)
-    st = model["stage"]
+    st = model.stage
     k = len(records) // 2
     rest = list(resume(st.stepper, st.schedule, records[k], label=st.label))
     assert len(rest) == len(records) - k - 1
@@ -71,7 +71,7 @@ def test_a_run_restarted_from_its_saved_kth_record_goes_on_as_it_went(name, over
     contact histories) resumes the run exactly: the same records from k on, bit for bit."""
     scene, params, model = model_of(name, over)
     records = simulate(model, params)
-    st = model["stage"]
+    st = model.stage
     k = len(records) // 2
     loaded = load_record(save_record(records[k], tmp_path / f"record{suffix}"))
     same(loaded, records[k])
@@ -98,9 +98,9 @@ def test_the_block_of_lecture_04_twice():
 
 def test_a_contact_keeps_nothing_of_a_run():
     scene, params, model = model_of("sloping_impact", {"variant": "frictional"})
-    before = {c.name: dict(vars(c)) for c in model["system"].contacts}
+    before = {c.name: dict(vars(c)) for c in model.system.contacts}
     simulate(model, params)
-    for c in model["system"].contacts:
+    for c in model.system.contacts:
         after = vars(c)
         changed = [k for k in after if k != "evaluations" and after[k] is not before[c.name].get(k)]
         assert not changed, f"contact {c.name!r} changed {changed} during a run"
@@ -181,9 +181,9 @@ def test_the_cork_twice_gives_the_same_records():
     """Both stages of the cork (press fit, pop) run twice on the same model: the same records;
     the model is not changed by a run (the pop's neck at rest is a new master)."""
     scene, params, model = model_of("cork", {"t_end": 0.0004, "n_press": 2})
-    motion = model["neck"].motion
+    motion = model.parts["neck"].motion
     first, second = scene.simulate(model, params), scene.simulate(model, params)
-    assert model["neck"].motion is motion is not None
+    assert model.parts["neck"].motion is motion is not None
     same(first["fit_last"], second["fit_last"])
     assert len(first["records"]) == len(second["records"]) > 1
     for r, q in zip(first["records"], second["records"]):

@@ -127,7 +127,10 @@ def _edited(tmp_path, old, new):
 
 @pytest.mark.parametrize("role, old, new", [
     ("build", "    system = System(", "    1 / 0\n    system = System("),
-    ("build", "return dict(disc=disc, systems=[system], stage=stage)", "return [system]"),
+    ("build", "return Model(systems=(system,), stage=stage, parts=dict(disc=disc))", "return [system]"),
+    ("build", "return Model(systems=(system,), stage=stage, parts=dict(disc=disc))",
+     "return dict(disc=disc, systems=[system], stage=stage)"),              # a dict is not a Model
+    ("build", "stage=stage, parts=dict(disc=disc))", "stage=None, parts=dict(disc=disc))"),   # nothing to march
     ("measure", "return dict(rebound_vx=", "return None and dict(rebound_vx="),
 ])
 def test_an_error_in_the_file_code_names_the_function(tmp_path, role, old, new):

@@ -109,7 +109,7 @@ def impact(linear_algebra, n_steps=40):
     """The frictional sloping impact (paper data) through the impact, with a chosen tangent kind."""
     p = get_scene("sloping_impact").resolve("paper", {"variant": "frictional"})
     m = sloping_impact.build(p, system_options=dict(linear_algebra=linear_algebra))
-    ring, system = m["ring"], m["system"]
+    ring, system = m.parts["ring"], m.system
     stepper = Newmark(system, p["delta"], p["beta_newmark"], atol=1e-10, rtol=1e-10, maxit=30)
     hist = integrate(stepper, 0.0, np.zeros(system.ndof), ring.initial_velocity((p["vx0"], p["vy0"])),
                      n_steps=n_steps, dt=p["dt"], cutback=True, max_cuts=6)
@@ -292,7 +292,7 @@ def cork_press_fit(preset):
     params = get_scene("cork").resolve(preset)
     model = cork.build(params)
     last, fit = cork_stages.press_fit(model, params)
-    (system,) = model["systems"]
+    system = model.systems[0]                    # the press fit's (the pop's is the second)
     return dict(fit, **cork_measure.contact_forces(last.contacts), u=last.u, linear_algebra=system.linear_algebra,
                 ordering=system.ordering)
 
@@ -531,7 +531,7 @@ def test_a_contact_set_kept_reuses_its_pattern_and_gives_the_same_tangent(kind):
 
     def system():
         model = scene.build(params, system_options=dict(linear_algebra=kind))
-        s = model["system"]
+        s = model.system
         return s, s.start(np.zeros(s.ndof))
 
     s, state = system()

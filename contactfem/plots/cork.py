@@ -21,6 +21,7 @@ axis to show the whole cork and both sides of the neck.
 import json
 import os
 from pathlib import Path
+from dataclasses import replace
 
 import numpy as np
 
@@ -414,7 +415,7 @@ def exit_case(case, preset=EXIT_PRESET):
     from ..scenes import get_scene
     from ..scenes.cork import build
     from ..scenes.cork_measure import contact_forces, history
-    from ..scenes.cork_stages import pop, press_fit
+    from ..scenes.cork_stages import pop, press_fit, stage_systems
 
     group, label, over, (fit_rule, pop_rule), ramp = case
     row = dict(group=group, label=label, overrides=dict(over), closing_step_press_fit=fit_rule,
@@ -423,10 +424,11 @@ def exit_case(case, preset=EXIT_PRESET):
         P = get_scene("cork").resolve(preset, over)
         model = build(P)
         if ramp is not None:
-            model["gas"].dt_ramp = ramp
-        model["contacts"] = [c.with_closing_step(fit_rule) for c in model["contacts"]]
+            model.parts["gas"].dt_ramp = ramp
+        contacts = model.parts["contacts"]
+        model = replace(model, systems=stage_systems(model.parts, P, contacts=(
+            [c.with_closing_step(fit_rule) for c in contacts], [c.with_closing_step(pop_rule) for c in contacts])))
         fit_last, _ = press_fit(model, P)
-        model["contacts"] = [c.with_closing_step(pop_rule) for c in model["contacts"]]
         records, pressures, exit_time, gas = pop(model, P, fit_last.u, histories=fit_last.state.contacts)
     except Exception as err:                        # a failed run is a row of the study, not hidden
         return dict(row, exited=None, error=f"{type(err).__name__}: {str(err).splitlines()[0][:100]}")

@@ -9,7 +9,7 @@ Listing the scenes imports every scene module, so a scene module imports scikit-
 import importlib
 import pkgutil
 
-from .base import Limit, Param, Scene, Stage, jsonable, simulate
+from .base import Limit, Model, Param, Scene, Stage, jsonable, simulate
 from .files import SceneError, is_scene_file, load_scene_file
 
 
@@ -127,4 +127,4 @@ def run_scene(name, preset="fast", overrides=None, progress=None, friction=None,
     return jsonable(results)
 
 
-__all__ = ["Limit", "Param", "Scene", "SceneError", "Stage", "all_scenes", "is_scene_file", "get_scene", "run_scene", "check_laws", "jsonable", "simulate"]
+__all__ = ["Limit", "Model", "Param", "Scene", "SceneError", "Stage", "all_scenes", "is_scene_file", "get_scene", "run_scene", "check_laws", "jsonable", "simulate"]

@@ -92,7 +92,7 @@ def collect(model, params, records, results):
     if ratios:
         out["equilibrium"] = indicator(max(ratios), EQUILIBRIUM, "largest converged residual / the step's force scale",
                                        "Newton's round-off tolerance (solver.newton.ROUNDOFF_RTOL); its own is 1e-8")
-    sizes = model.get("sizes") or {}
+    sizes = model.sizes
     deepest = _deepest(records[1:] or records)      # (a scene's initial guess may overlap on purpose: hertz)
     if deepest is not None and sizes.get("element"):
         out["penetration"] = indicator(deepest / sizes["element"], PENETRATION_ELEMENT,
@@ -110,15 +110,15 @@ def collect(model, params, records, results):
         out["energy_gain"] = indicator(max(err, 0.0), ENERGY_GAIN, "energy gained over the run / initial energy "
                                        "(dissipation and the loads' work counted)",
                                        "a gain above 1 % is the integrator's, not Newton's (1e-6 at most)")
-    if isinstance(err, float) and not model.get("plastic", False):    # plastic work is no integrator's loss
+    if isinstance(err, float) and not model.plastic:    # plastic work is no integrator's loss
         out["energy_loss"] = indicator(max(-err, 0.0), ENERGY_LOSS, "energy lost to the integrator / initial energy "
                                        "(friction's dissipation counted apart)",
                                        "measured: the paper's sloping impact loses 22 % to Newmark's damping")
-    if model.get("rebound") and steps:
+    if model.rebound and steps:
         out["separated"] = indicator(float(_touching(records[-1])), 0.0, "in contact at the run's end (1: the impact "
                                      "is not over, the rebound it reports is read mid-impact)",
                                      "the scene's rebound quantities are read after the body has left the obstacle")
-    stepper = getattr(model.get("stage"), "stepper", None)
+    stepper = getattr(model.stage, "stepper", None)
     stepper = getattr(stepper, "stepper", stepper)            # Uzawa's inner stepper
     if bool(steps) and getattr(stepper, "dynamic", False):
         beta = getattr(stepper, "beta", 0.25 if type(stepper).__name__ == "EnergyConsistent" else None)
@@ -176,7 +176,7 @@ def _time_resolution(model, records, beta):
 
 def _penalty_frequency(model, records):
     """sqrt(k / m) at the stiffest touching node (k = dt_N w, m its lumped mass), or None."""
-    system = model.get("system") or (model.get("systems") or [None])[0]
+    system = model.system
     if system is None:
         return None
     m = system.lumped_mass()

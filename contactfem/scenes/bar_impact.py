@@ -60,7 +60,7 @@ from ..contact import RigidLine, tributary_lengths
 from ..laws import PowerLaw
 from ..solver import CentralDifference, History, System
 from . import enforcement, time_integration
-from .base import Param, Scene, Stage
+from .base import Model, Param, Scene, Stage
 
 
 def bar_exact(L, E, rho, v0):
@@ -124,16 +124,16 @@ def build(params, *, normal=None, friction=None, system_options=None):
     stepper, schedule = time_integration.plan(params, stepper, dt=dt, t_end=t_end, speed=v0, duration=ex["duration"],
                                               max_cuts=0 if explicit else 4)
     stage = Stage(stepper, schedule, np.zeros(system.ndof), v0_vec, name="bar_impact")
-    return dict(body=body, contact=contact, system=system, systems=[system], nodes=nodes, w=w, c_N=c_N,
-                stage=stage, dt=dt, sizes=dict(element=L / n, body=L),     # the accuracy indicators' lengths
-                rebound=True)                 # the accuracy's `separated`: the rebound is read after the impact
+    return Model(systems=(system,), stage=stage, sizes=dict(element=L / n, body=L),     # the accuracy indicators' lengths
+                 rebound=True,                # the accuracy's `separated`: the rebound is read after the impact
+                 parts=dict(body=body, contact=contact, nodes=nodes, w=w, c_N=c_N, dt=dt))
 
 
 def measure(m, params, records):
-    body = m["body"]
+    body = m.parts["body"]
     L, H, v0 = params["L"], params["h"], params["v0"]
     ex = bar_exact(L, params["E"], params["rho"], v0)
-    dt = m["dt"]
+    dt = m.parts["dt"]
     hist = History.of(records)
     force = [0.0] + [float(-rec.contacts[0].report()["f_N"].sum()) for rec in records[1:]]
     t, F = hist.t, np.asarray(force)
@@ -162,7 +162,7 @@ def measure(m, params, records):
         error_rebound=(v_after - v0) / v0,
         energy_initial=E0, energy_final=float(E_tot[-1]),
         energy_error=float((E_tot[-1] - E0) / E0), energy_error_max=float(np.max(np.abs(E_tot - E0)) / E0),
-        wave_speed=ex["c"], dt=dt, c_N=m["c_N"], n_steps=int(len(t) - 1),
+        wave_speed=ex["c"], dt=dt, c_N=m.parts["c_N"], n_steps=int(len(t) - 1),
         time=t, contact_stress=stress, energy_total=E_tot,
         newton_iterations_total=int(np.sum(hist.iterations)),
         **enforcement.report(params, records, max(enforcement.penetration(rec.contacts[0]) for rec in records),

@@ -1,6 +1,6 @@
 """What a scene is: named parameters with units and ranges, presets, and three steps,
 
-    model = scene.build(params, normal=..., friction=..., system_options=...)   # bodies, contacts, System
+    model = scene.build(params, normal=..., friction=..., system_options=...)   # a Model: Systems, Stage
     records = simulate(model, params, progress)   # the time loop (solver.march) over the model's Stage
     results = scene.measure(model, params, records)   # a JSON-able dict from the records
 
@@ -41,13 +41,39 @@ class Stage:
     label: Callable | None = None
 
 
+@dataclass(frozen=True)
+class Model:
+    """What a scene's ``build`` returns: every System it built (``systems``), the march that
+    runs it (``stage``; None for a scene with its own ``simulate``), the lengths the accuracy
+    indicators compare the penetration with (``sizes``: ``element``, ``body``, and ``radius``
+    for a ring), whether the scene reads a rebound after the impact (``rebound``) or dissipates
+    energy by plasticity (``plastic``: no integrator's loss), the name progress shows, and the
+    scene's own objects (``parts``: bodies, contacts, node sets, closed forms) for its
+    ``measure`` and plots."""
+    systems: tuple
+    stage: Stage | None = None
+    sizes: dict = field(default_factory=dict)
+    rebound: bool = False
+    plastic: bool = False
+    name: str = ""
+    parts: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        object.__setattr__(self, "systems", tuple(self.systems))
+
+    @property
+    def system(self):
+        """The first System the scene built (None if it built none)."""
+        return self.systems[0] if self.systems else None
+
+
 def simulate(model, params=None, progress=None):
-    """The records of the model's stage (``model["stage"]``): the initial state and every step."""
+    """The records of the model's stage (``model.stage``): the initial state and every step."""
     from ..solver.march import march, watch
 
-    st = model["stage"]
+    st = model.stage
     records = march(st.stepper, st.schedule, st.t0, st.u0, st.v0, a0=st.a0, label=st.label)
-    return list(watch(records, progress, st.t0, st.schedule.t_end, st.name or model.get("name", "")))
+    return list(watch(records, progress, st.t0, st.schedule.t_end, st.name or model.name))
 
 
 def run(scene, params, normal=None, friction=None, progress=None, linear_algebra="auto", instrument=None):
@@ -67,10 +93,13 @@ def run(scene, params, normal=None, friction=None, progress=None, linear_algebra
         t0 = time.perf_counter()
         options = dict(linear_algebra=linear_algebra, instrument=instrument)
         model = scene.build(params, normal=normal, friction=friction, system_options=options)
+        if not isinstance(model, Model):
+            raise TypeError(f"scene {scene.name}, build: returned {type(model).__name__}, not a Model "
+                            "(contactfem.scenes.Model)")
         records = (scene.simulate or simulate)(model, params, progress)
         results = dict(scene.measure(model, params, records))
         wall = time.perf_counter() - t0
-    systems = model["systems"]
+    systems = model.systems
     if "accuracy" in params:                    # how the run stepped: fixed, or at a tolerance
         results["stepping"] = stepping(params, records)
     accuracy = collect(model, params, records, results)
@@ -96,7 +125,7 @@ class Scene:
     name: str
     title: str
     params: tuple
-    build: Callable                               # (params, *, normal, friction, system_options) -> model dict
+    build: Callable                               # (params, *, normal, friction, system_options) -> Model
     measure: Callable                             # (model, params, records) -> results dict
     simulate: Callable | None = None              # (model, params, progress) -> records; default: the model's stage
     presets: dict = field(default_factory=dict)   # preset name -> {param: value}

@@ -42,7 +42,7 @@ from ..laws.protocol import FrictionLaw
 from ..solver import Static, Steps, System
 from . import enforcement
 from .accuracy import MESH_HEIGHT, MESH_HEIGHT_SOURCE, indicator
-from .base import Scene, Stage, simulate
+from .base import Model, Scene, Stage, simulate
 from .block_params import FITTED, LAWS, PAPER_TABLE1, PARAMS, check, friction_law, law_range, per_length, size
 
 
@@ -80,9 +80,9 @@ def build(params, *, normal=None, friction=None, system_options=None):
                                [contact], length=h)
     stage = Stage(stepper, Steps(1.0 / n, n_steps=n), np.zeros(system.ndof), name="block",
                   label=lambda k, t1, dt: f"block, load step {k} of {n}")
-    return dict(body=body, contact=contact, loads=loads, system=system, systems=[system], slaves=slaves,
-                stepper=stepper, stage=stage, element_size=h,
-                sizes=dict(element=min(h, params["height"] / params["ny"]), body=min(params["width"], params["height"])))
+    return Model(systems=(system,), stage=stage,
+                 sizes=dict(element=min(h, params["height"] / params["ny"]), body=min(params["width"], params["height"])),
+                 parts=dict(body=body, contact=contact, loads=loads, slaves=slaves, stepper=stepper, element_size=h))
 
 
 def converged(model, records):
@@ -91,7 +91,7 @@ def converged(model, records):
     of the law in use after the step (before the friction history is committed)."""
     last = records[-1]
     state = last.contacts[0]
-    Y = FrictionLaw(model["contact"].friction).slip_bound(-state.t_N, state.q, state.lam / last.dt, state.z)[0]
+    Y = FrictionLaw(model.parts["contact"].friction).slip_bound(-state.t_N, state.q, state.lam / last.dt, state.z)[0]
     return dict(u=last.u, result=last.result, results=[r.result for r in records[1:]], report=state.report(),
                 R_c=state.scatter(len(last.u))[0], slip_bound=Y, state=state)
 
@@ -99,10 +99,11 @@ def converged(model, records):
 def solve(params, *, friction=None, normal=None, progress=None, system_options=None):
     """Build the block and apply the load in ``n_steps`` static steps of the pseudo-time
     (default: the whole load in ONE step, Newton from u = 0). Returns build()'s dict plus the
-    records and what ``converged`` reads from them."""
+    records and what ``converged`` reads from them: a dict of the model's parts, its ``model``
+    and ``system``, the ``records`` and ``converged``'s entries."""
     model = build(params, friction=friction, normal=normal, system_options=system_options)
     records = simulate(model, params, progress)
-    return dict(model, records=records, **converged(model, records))
+    return dict(model.parts, model=model, system=model.system, records=records, **converged(model, records))
 
 
 def slip_bound(params, t_N):
@@ -119,7 +120,7 @@ def load_norms(body, loads):
 
 
 def measure(model, params, records):
-    s = dict(model, **converged(model, records))
+    s = dict(model.parts, **converged(model, records))
     body, rep, res = s["body"], s["report"], s["result"]
     dofs = body.xdofs
     total_normal = float(s["R_c"][dofs[:, 1]].sum())          # = sum w t_N (signed, < 0 compressive)

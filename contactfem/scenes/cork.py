@@ -56,10 +56,10 @@ from ..contact.masters import bottle_neck
 from ..laws.friction import SlipHardening
 from ..laws.normal import PowerLaw
 from . import time_integration
-from .base import PENALTIES, PENALTY_DOC, Limit, Param, Scene
+from .base import PENALTIES, PENALTY_DOC, Limit, Model, Param, Scene
 from .time_integration import newmark_params
 from .cork_measure import PAPER, R_TIP_FITTED, measure  # noqa: F401 (public here)
-from .cork_stages import press_fit_only, simulate  # noqa: F401 (public here)
+from .cork_stages import press_fit_only, simulate, stage_systems  # noqa: F401 (public here)
 
 PARAMS = (
     Param("E", 10.0, "MPa", 0.0, low_open=True, doc="Young's modulus (paper)"),
@@ -148,9 +148,10 @@ def build(params, *, normal=None, friction=None, system_options=None):
     gas = GasPressure(cork, "bottom", bottom, np.pi * P["R_neck"]**2, P["gas_column"], P["p_step"], P["n_ramp"],
                       P["dt"], P["L_neck"])
     element = min(float(np.min(np.diff(np.sort(Z[:, 1])))), P["R_neck"] / P["n_r"])   # along the side, across
-    return dict(cork=cork, neck=neck, contacts=[contact], gas=gas, axis=axis, side=side, bottom=bottom,
-                length=length, systems=[], system_options=system_options or {},   # cork_stages.py adds the Systems
-                sizes=dict(element=element, body=P["R_neck"]))                  # the accuracy indicators' lengths
+    parts = dict(cork=cork, neck=neck, contacts=[contact], gas=gas, axis=axis, side=side, bottom=bottom, length=length)
+    return Model(systems=stage_systems(parts, P, system_options),      # the press fit's, the pop's (cork_stages.py)
+                 sizes=dict(element=element, body=P["R_neck"]),        # the accuracy indicators' lengths
+                 parts=parts)
 
 
 def law_range(P):

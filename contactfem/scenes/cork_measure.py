@@ -53,11 +53,11 @@ def history(model, out):
     """Per pop record (arrays): time, step, pressure, gas volume, displacements of the bottom
     centre, the top and the centre of mass, its velocity (m/s), contact forces and counts,
     the smallest gap, the smallest element area ratio, iterations, cuts, energies."""
-    cork, gas, records = model["cork"], model["gas"], out["records"]
+    cork, gas, records = model.parts["cork"], model.parts["gas"], out["records"]
     u0 = records[0].u
     uz = cork.xdofs[:, 1]                             # the cork is its Systems' only body: offset 0
-    centre = model["bottom"][np.argmin(cork.X[model["bottom"], 0])]
-    top = model["axis"][np.argmax(cork.X[model["axis"], 1])]
+    centre = model.parts["bottom"][np.argmin(cork.X[model.parts["bottom"], 0])]
+    top = model.parts["axis"][np.argmax(cork.X[model.parts["axis"], 1])]
     M, A0 = cork.mass()[cork.xdofs[:, 1]], cork.element_areas(np.zeros(cork.ndof))
     rows = []
     for rec in records:
@@ -115,7 +115,7 @@ def measure(model, P, out):
     max_pen = max(0.0, -min(fit["min_gap"], float(np.min(h["min_gap"]))))
     snaps = snapshot_times(t_ramp, out["exit_time"], h["t"][-1])
     idx = [int(np.argmin(np.abs(h["t"] - ts))) for ts in snaps]
-    cork, states = model["cork"], [rec.u for rec in out["records"]]
+    cork, states = model.parts["cork"], [rec.u for rec in out["records"]]
     loop = boundary_loop(cork.mesh)                                  # outlines for animations
     frames = np.unique(np.linspace(0, len(h["t"]) - 1, 80).astype(int))
     failures = [f for rec in out["records"] for f in rec.failures]
@@ -154,6 +154,6 @@ def measure(model, P, out):
         snapshots_x=[(cork.X + states[k][cork.xdofs]).tolist() for k in idx],
         outlines=[cork.X[loop] + states[k][cork.xdofs[loop]] for k in frames],
         outline_t=h["t"][frames],
-        obstacles=[model["neck"].outline()],
+        obstacles=[model.parts["neck"].outline()],
         paper=PAPER,
     )

@@ -42,16 +42,35 @@ def _newton_options(P):
     return dict(atol=P["atol"], rtol=P["rtol"], maxit=P["maxit"])
 
 
+def _hold(cork, axis, P):
+    """The axis node the press fit holds axially (nearest to z = z_hold L_neck)."""
+    return axis[np.argmin(np.abs(cork.X[axis, 1] - P["z_hold"] * P["L_neck"]))]
+
+
+def stage_systems(parts, P, system_options=None, contacts=None):
+    """The Systems of both stages, from the cork's parts (cork.build): the press fit's
+    (the axis held radially, the hold node axially) and the pop's (the gas on the bottom
+    face, the neck at rest at r = R_neck). ``contacts``: (the press fit's, the pop's) contacts
+    instead of ``parts["contacts"]`` in both (the pop's own moved to the neck at rest)."""
+    cork, axis, neck, options = parts["cork"], parts["axis"], parts["neck"], system_options or {}
+    fit_contacts, pop_contacts = contacts if contacts is not None else (parts["contacts"], parts["contacts"])
+    hold = _hold(cork, axis, P)
+    fixed = [Dirichlet(cork, cork.xdofs[axis, 0], 0.0), Dirichlet(cork, [cork.xdofs[hold, 1]], 0.0)]
+    fit = System([cork], fit_contacts, [], fixed, **options)
+    rest = neck.without_motion()                             # the press fit is done: the neck stays at r = R_neck
+    moved = [c.with_master(rest) if c.master is neck else c for c in pop_contacts]
+    pop = System([cork], moved, [parts["gas"]], [Dirichlet(cork, cork.xdofs[axis, 0], 0.0)], **options)
+    return fit, pop
+
+
 def press_fit(model, P, progress=None):
     """Stage 1: the neck moves in from r = R_cork to r = R_neck over the pseudo-time t in
     [0, 1] (its ``motion``) in n_press static increments (a failed increment is halved and the
     smaller increment kept), the axial position held at one axis node (released at the start
-    of stage 2). Returns the last record and the stage's iterations, failures, hold reaction."""
-    cork, contacts, axis = model["cork"], model["contacts"], model["axis"]
-    hold = axis[np.argmin(np.abs(cork.X[axis, 1] - P["z_hold"] * P["L_neck"]))]
-    fixed = [Dirichlet(cork, cork.xdofs[axis, 0], 0.0), Dirichlet(cork, [cork.xdofs[hold, 1]], 0.0)]
-    system = System([cork], contacts, [], fixed, **model["system_options"])
-    model["systems"].append(system)
+    of stage 2); the model's first System. Returns the last record and the stage's
+    iterations, failures, hold reaction."""
+    cork, system = model.parts["cork"], model.systems[0]
+    hold = _hold(cork, model.parts["axis"], P)
     ds = 1.0 / P["n_press"]
     schedule = Adaptive(lambda rec: ds, t_end=1.0, dt=ds, growth=1.0, max_cuts=P["max_cuts"],
                         min_dt=ds / 2 ** P["max_cuts"])
@@ -90,15 +109,10 @@ def pop(model, P, u0, progress=None, histories=None):
     of the next step from each converged step, the load's state; adaptive dt with cutback).
     Runs to t_end, or t_flight after the exit. ``histories``: the contacts' histories to start
     from (the press fit's last record's, ``record.state.contacts``; None: started at u0).
-    Returns the records, the gas pressure that acted in each step, the exit time and the gas
-    state at the end (GasState: ``released``, ``released_at``)."""
-    cork, gas, neck = model["cork"], model["gas"], model["neck"]
-    rest = neck.without_motion()                             # the press fit is done: the neck stays at r = R_neck
-    contacts = [c.with_master(rest) if c.master is neck else c for c in model["contacts"]]
+    The model's second System. Returns the records, the gas pressure that acted in each step,
+    the exit time and the gas state at the end (GasState: ``released``, ``released_at``)."""
+    cork, gas, system = model.parts["cork"], model.parts["gas"], model.systems[1]
     t_ramp = P["n_ramp"] * P["dt"]
-    system = System([cork], contacts, [gas], [Dirichlet(cork, cork.xdofs[model["axis"], 0], 0.0)],
-                    **model["system_options"])
-    model["systems"].append(system)
     state = system.start(u0, 0.0)
     if histories is not None:                                # the contacts go on from the press fit
         state = replace(state, contacts=tuple(histories))
@@ -153,7 +167,7 @@ def simulate(model, P, progress=None):
     the contact forces it ends with) and the pop (records, pressures, exit and release)."""
     fit_last, fit = press_fit(model, P, progress)
     fit.update(contact_forces(fit_last.contacts))
-    areas = model["cork"].element_areas
+    areas = model.parts["cork"].element_areas
     fit["min_area_ratio"] = float(np.min(areas(fit_last.u) / areas(0 * fit_last.u)))
     records, pressures, exit_time, gas = pop(model, P, fit_last.u, progress, fit_last.state.contacts)
     exited = bool(gas.released and records[-1].contacts[0].n_active == 0)

@@ -2,8 +2,8 @@
 
 A scene file is a Python module that defines ``SCENE = Scene(...)`` exactly as the shipped
 scenes do (the modules of this package): its parameters (``Param``: unit, range, meaning),
-``build(params, *, normal, friction, system_options)`` returning the model (a dict with the
-time loop's ``stage`` and the ``systems`` it built), and ``measure(model, params, records)``
+``build(params, *, normal, friction, system_options)`` returning the model (a ``Model`` with
+the ``systems`` it built, the time loop's ``stage`` and its own objects in ``parts``), and ``measure(model, params, records)``
 returning the results (a dict). Everything a shipped scene gets, it gets: ``run``, ``sweep``
 (with ``law.FIELD``), ``show``, ``--friction`` / ``--normal``, ``--json``, ``--save``,
 progress, the pre-flight of a law over ``law_range`` where the file declares one. From
@@ -15,8 +15,8 @@ The file is the user's code, so every call into it is guarded:
   ValueError naming the file, the line and the cause (the command line: exit code 2);
 * its ``build``, ``measure``, ``check``, ``size`` and ``law_range`` during a run: an error
   is one SceneError naming the file, the function, the line and the cause (exit code 1),
-  and a result of the wrong kind (a model without ``stage``, results that are not a dict)
-  is named as such.
+  and a result of the wrong kind (a build that returns no Model, a Model without a
+  ``stage`` and no ``simulate`` of its own, results that are not a dict) is named as such.
 
 A solver failure (NewtonError) or a law's bad value (LawValueError) inside the run is the
 run's outcome, as in a shipped scene, and passes through unchanged.
@@ -29,7 +29,7 @@ import traceback
 from dataclasses import replace
 from pathlib import Path
 
-from .base import Scene
+from .base import Model, Scene
 
 
 class SceneError(RuntimeError):
@@ -110,12 +110,15 @@ def _error(err, path, role):
     return SceneError(f"scene file {path.name}, {role}" + (f", line {line}" if line else "") + f": {_cause(err)}")
 
 
-def _checked_build(build, path):
+def _checked_build(build, path, own_simulate):
     def call(params, **kwargs):
         model = build(params, **kwargs)
-        if not isinstance(model, dict) or "stage" not in model or "systems" not in model:
-            raise SceneError(f"scene file {path.name}, build: returned {type(model).__name__}, not the model: a dict "
-                             "with 'stage' (the time loop's Stage) and 'systems' (the Systems it built)")
+        if not isinstance(model, Model):
+            raise SceneError(f"scene file {path.name}, build: returned {type(model).__name__}, not a Model: "
+                             "return Model(systems=(system,), stage=Stage(...), parts=dict(...))")
+        if model.stage is None and not own_simulate:
+            raise SceneError(f"scene file {path.name}, build: the Model has no stage (the time loop's Stage) "
+                             "and the Scene no simulate of its own")
         return model
     return call
 
@@ -140,6 +143,6 @@ def load_scene_file(path):
         raise ValueError(f"scene file {path.name} defines no SCENE = Scene(...){found}: see contactfem.scenes.Scene")
     guarded = {role: _guarded(getattr(scene, role), path, role)
                for role in ("check", "size", "law_range", "simulate") if getattr(scene, role) is not None}
-    build = _guarded(_checked_build(scene.build, path), path, "build")
+    build = _guarded(_checked_build(scene.build, path, scene.simulate is not None), path, "build")
     measure = _guarded(_checked_measure(scene.measure, path), path, "measure")
     return replace(scene, build=build, measure=measure, **guarded)

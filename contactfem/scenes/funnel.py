@@ -36,7 +36,7 @@ from ..contact import NodeToSegment, RigidPolyline
 from ..laws import ParabolicSlip, PowerLaw
 from ..solver import Dirichlet, History, Steps, System
 from . import time_integration
-from .base import Param, Scene, Stage
+from .base import Model, Param, Scene, Stage
 from .rings import MASS_MATRIX_PARAM, RING_PARAMS, penalty_pressure, ring_history, ring_size, snapshot_indices
 
 VARIANTS = ("frictionless", "frictional")
@@ -71,8 +71,8 @@ def build(params, *, normal=None, friction=None, system_options=None):
     stepper = time_integration.make_stepper(params, system, atol=1e-10, maxit=30)
     stage = Stage(stepper, Steps(params["dt"], n_steps=params["n_steps"], max_cuts=6), np.zeros(ring.body.ndof),
                   ring.initial_velocity((0.0, -params["v0"])), name="funnel")
-    return dict(ring=ring, wall=wall, contact=contact, system=system, systems=[system], stage=stage,
-                sizes=dict(element=np.pi * R / params["n_el"], body=2.0 * R, radius=R))
+    return Model(systems=(system,), stage=stage, sizes=dict(element=np.pi * R / params["n_el"], body=2.0 * R, radius=R),
+                 parts=dict(ring=ring, wall=wall, contact=contact))
                 # the accuracy indicators' lengths (n_el on the half ring):
                 # a beam element's size is its length (the thickness is its section's)
 
@@ -85,7 +85,7 @@ def radial_deviation(ring, u, center):
 
 
 def measure(m, params, records):
-    ring = m["ring"]
+    ring = m.parts["ring"]
     hist = History.of(records)
     rec = ring_history(ring, records, measures=dict(
         deformation=lambda u, v: radial_deviation(ring, u, ring.center_of_mass(u))))
@@ -116,8 +116,8 @@ def measure(m, params, records):
         energy_kinetic=hist.kinetic, energy_strain=hist.strain, energy_contact=hist.contact,
         energy_dissipation=hist.dissipation, energy_total=mech,
         outlines=np.array([ring.outline(records[k].u, mirror=True) for k in shots]), outline_t=t[shots],
-        wall=m["wall"].points,
-        obstacles=[m["wall"].points, m["wall"].points * [-1.0, 1.0]],     # the wall and its mirror image
+        wall=m.parts["wall"].points,
+        obstacles=[m.parts["wall"].points, m.parts["wall"].points * [-1.0, 1.0]],     # the wall and its mirror image
         newton_iterations_total=int(np.sum(hist.iterations)),
         step_cuts_total=int(np.sum(hist.cuts)),
     )

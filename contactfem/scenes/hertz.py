@@ -49,7 +49,7 @@ from ..laws import PowerLaw
 from ..solver import Dirichlet, History, Static, Steps, System
 from . import enforcement
 from .accuracy import HERTZ_SOURCE, HERTZ_TOL, hertz_half_width, references
-from .base import PENALTIES, PENALTY_DOC, Param, Scene, Stage
+from .base import PENALTIES, PENALTY_DOC, Model, Param, Scene, Stage
 
 
 def hertz_exact(P, R, E, nu, E2=np.inf, nu2=0.0):
@@ -137,8 +137,8 @@ def build(params, *, normal=None, friction=None, system_options=None):
                                length=a_ex)                  # gap_violation: penetration / a
     n = params["n_steps"]
     stage = Stage(stepper, Steps(1.0 / n, n_steps=n, max_cuts=6), u0, name="hertz")
-    return dict(body=body, contact=contact, system=system, systems=[system], nodes=nodes, w=w, a_exact=a_ex,
-                p0_exact=p0_ex, grading_k=k, stage=stage, sizes=dict(element=float(np.min(w[w > 0])), body=R))
+    return Model(systems=(system,), stage=stage, sizes=dict(element=float(np.min(w[w > 0])), body=R),
+                 parts=dict(body=body, contact=contact, nodes=nodes, w=w, a_exact=a_ex, p0_exact=p0_ex, grading_k=k))
 
 
 def oscillations(x, p, p_exact, a, p0):
@@ -170,9 +170,9 @@ def check(params):
 
 
 def measure(m, params, records):
-    body, w = m["body"], m["w"]
+    body, w = m.parts["body"], m.parts["w"]
     P = params["P"]
-    a_ex = m["a_exact"]
+    a_ex = m.parts["a_exact"]
     hist = History.of(records)
     state = records[-1].contacts[0]
     rep = state.report()
@@ -183,7 +183,7 @@ def measure(m, params, records):
     p = -rep["t_N"] if params["penalty"] == "per_length" else -rep["f_N"] / w
     a_fit, p0_fit = fit_hertz(x, p)
     p0_max = float(p.max())
-    a_ex, p0_ex = m["a_exact"], m["p0_exact"]
+    a_ex, p0_ex = m.parts["a_exact"], m.parts["p0_exact"]
     in_contact = p > 0
     h_c = float(np.median(np.diff(np.sort(x))[: max(2, np.count_nonzero(in_contact))]))
     c_eff = params["c_N"] if params["penalty"] == "per_length" else params["c_N"] / w[in_contact]
@@ -192,7 +192,7 @@ def measure(m, params, records):
     a = a_mom if params["contact_discretization"] == "mortar" else a_fit
     return dict(
         **oscillations(x, p, profile_exact, a_ex, p0_ex),
-        a=a, p0=p0_max, p0_fit=p0_fit, a_exact=a_ex, p0_exact=m["p0_exact"], a_fit=a_fit, a_moments=a_mom,
+        a=a, p0=p0_max, p0_fit=p0_fit, a_exact=a_ex, p0_exact=m.parts["p0_exact"], a_fit=a_fit, a_moments=a_mom,
         error_a=(a - a_ex) / a_ex, error_a_fit=(a_fit - a_ex) / a_ex, error_a_moments=(a_mom - a_ex) / a_ex,
         error_p0=(p0_max - p0_ex) / p0_ex, error_p0_fit=(p0_fit - p0_ex) / p0_ex, accuracy=references(
             dict(a=(a - a_ex) / a_ex, p0=(p0_max - p0_ex) / p0_ex), HERTZ_TOL, HERTZ_SOURCE),

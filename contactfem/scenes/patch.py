@@ -67,7 +67,7 @@ from ..contact import BodySurface, tributary_lengths
 from ..laws import Coulomb, PowerLaw
 from ..solver import Dirichlet, History, Static, Steps, System
 from . import enforcement
-from .base import Param, Scene, Stage
+from .base import Model, Param, Scene, Stage
 
 
 def block(xs, y0, y1, ny, name, E, nu):
@@ -135,13 +135,13 @@ def build(params, *, normal=None, friction=None, system_options=None):
     u0[system.global_dofs(upper, upper.xdofs[:, 1])] = -2.0 * p / params["c_N"]
     stepper = Static(system, atol=1e-12 * p * params["W"], maxit=30)      # Newton's force test; atol: a floor
     stepper = enforcement.wrap(params, stepper, contacts, length=H)     # gap_violation: penetration / H
-    return dict(lower=lower, upper=upper, contacts=contacts, system=system, systems=[system], bottom_upper=bottom_upper,
-                top_lower=top_sorted, stage=Stage(stepper, Steps(1.0, n_steps=1), u0, name="patch"),
-                sizes=dict(element=min(e, W / params["nx_upper"], H / params["ny"]), body=H))
+    return Model(systems=(system,), stage=Stage(stepper, Steps(1.0, n_steps=1), u0, name="patch"),
+                 sizes=dict(element=min(e, W / params["nx_upper"], H / params["ny"]), body=H),
+                 parts=dict(lower=lower, upper=upper, contacts=contacts, bottom_upper=bottom_upper, top_lower=top_sorted))
 
 
 def measure(m, params, records):
-    lower, upper, system = m["lower"], m["upper"], m["system"]
+    lower, upper, system = m.parts["lower"], m.parts["upper"], m.system
     p = params["p"]
     hist = History.of(records)
     u, states = records[-1].u, records[-1].contacts
@@ -149,14 +149,14 @@ def measure(m, params, records):
     result = dict(newton_iterations_total=int(np.sum(hist.iterations)), passes=params["passes"])
     result.update(enforcement.report(params, records, max(enforcement.penetration(st) for st in states), params["H"],
                                      "the block height H"))
-    for c, st in zip(m["contacts"], states):      # each pass's own traction law values
+    for c, st in zip(m.parts["contacts"], states):      # each pass's own traction law values
         rep = st.report()
         result[f"{c.name}_x"] = rep["X"][:, 0]
         result[f"{c.name}_t_N"] = -rep["t_N"]
     # what the upper block feels: the nodal contact forces on its bottom nodes from all
     # passes (slave forces of pass 1, master reactions of pass 2) over the tributary
     # lengths; the exact solution gives p at every node
-    nodes = m["bottom_upper"]
+    nodes = m.parts["bottom_upper"]
     dofs = system.global_dofs(upper, upper.xdofs[nodes, 1])
     f = -sum(st.scatter(len(u))[0][dofs] for st in states)
     pressure = f / tributary_lengths(upper.X[nodes])
@@ -165,7 +165,7 @@ def measure(m, params, records):
     result["interface_pressure"] = pressure[order]
     # what the lower block feels: the contact forces on its top nodes (master reactions of pass
     # 1, slave forces of pass 2) and the overhang's load, over the tributary lengths of its top
-    top = m["top_lower"]
+    top = m.parts["top_lower"]
     dofs = system.global_dofs(lower, lower.xdofs[top, 1])
     f_lower = sum(st.scatter(len(u))[0][dofs] for st in states) - system.external_force(u, 1.0, records[-1].state)[dofs]
     pressure_lower = f_lower / tributary_lengths(lower.X[top])

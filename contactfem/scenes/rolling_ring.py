@@ -57,7 +57,7 @@ from ..laws import Coulomb, PowerLaw
 from ..solver import History, System
 from . import time_integration
 from .accuracy import V_FINAL_TOL, X_END_TOL, references
-from .base import Param, Scene, Stage
+from .base import Model, Param, Scene, Stage
 from .rings import MASS_MATRIX_PARAM, THICKNESS_LIMIT, detect_rolling, penalty_pressure, rigid_ring_exact, ring_gyration_radius2, ring_history, ring_size, snapshot_indices  # noqa: F401
 
 # Paper, Fig 9 (bracketed values are the rigid thin-ring solution)
@@ -91,10 +91,10 @@ def build(params, *, normal=None, friction=None, system_options=None):
                   name="rolling_ring")
     # the closed forms hold for Coulomb friction: the scene's, or a Coulomb law given with its own mu
     exact_mu = params["mu"] if friction is None else (friction.mu if isinstance(friction, Coulomb) else None)
-    return dict(ring=ring, contact=contact, system=system, systems=[system], plane=plane, stage=stage,
-                sizes=dict(element=2.0 * np.pi * params["R"] / params["n_el"], body=2.0 * params["R"],  # (their length)
-                           radius=params["R"]),
-                exact_mu=exact_mu)
+    return Model(systems=(system,), stage=stage,
+                 sizes=dict(element=2.0 * np.pi * params["R"] / params["n_el"], body=2.0 * params["R"],  # (their length)
+                            radius=params["R"]),
+                 parts=dict(ring=ring, contact=contact, plane=plane, exact_mu=exact_mu))
 
 
 def animation(ring, records, floor):
@@ -118,7 +118,7 @@ CLOSED_FORM_KEYS = ("exact_mu", "t_star_exact", "x_roll_exact", "v_final_exact",
 
 
 def measure(model, params, records):
-    ring = model["ring"]
+    ring = model.parts["ring"]
     v0 = params["v0"]
     nodes = ring.body.xdofs[ring.contact_nodes]          # (u_x, u_y) dofs of the contact nodes
     hist = History.of(records)
@@ -141,7 +141,7 @@ def measure(model, params, records):
     floor = np.array([[xc[:, 0].min() - 1.2 * params["R"], 0.0], [xc[:, 0].max() + 1.2 * params["R"], 0.0]])
     # Coulomb's mu of the closed forms: build's choice; a model composed by hand (a lecture's)
     # with the scene's laws: the parameters' mu
-    mu, g = model.get("exact_mu", params.get("mu")), params["g"]
+    mu, g = model.parts.get("exact_mu", params.get("mu")), params["g"]
     k2 = ring_gyration_radius2(ring)
     if mu is not None:
         hoop = rigid_ring_exact(v0, mu, g, params["R"], t=t)   # the paper's thin hoop

@@ -36,7 +36,7 @@ from ..contact.tangents import TANGENTS
 from ..laws import ParabolicSlip, PowerLaw
 from ..solver import History, System
 from . import time_integration
-from .base import PENALTIES, PENALTY_DOC, Param, Scene, Stage
+from .base import PENALTIES, PENALTY_DOC, Model, Param, Scene, Stage
 from .rings import MASS_MATRIX_PARAM, RING_PARAMS, penalty_pressure, ring_history, ring_size, snapshot_indices
 
 VARIANTS = ("frictionless", "frictional", "viscoplastic")
@@ -105,15 +105,16 @@ def build(params, *, normal=None, friction=None, system_options=None):
     stepper, schedule = time_integration.plan(params, stepper, dt=params["dt"], n_steps=params["n_steps"],
                                               speed=float(np.hypot(*v0)), max_cuts=6)
     stage = Stage(stepper, schedule, np.zeros(ring.body.ndof), ring.initial_velocity(v0), name="sloping_impact")
-    return dict(ring=ring, contact=contact, system=system, systems=[system], plane=plane, stage=stage,
-                plastic=params["variant"] == "viscoplastic",      # its plastic work is no integrator's loss
-                sizes=dict(element=2.0 * np.pi * params["R"] / params["n_el"], body=2.0 * params["R"],  # (elements' length)
-                           radius=params["R"]),
-                rebound=True)                 # the accuracy's `separated`: the rebound is read after the impact
+    return Model(systems=(system,), stage=stage,
+                 plastic=params["variant"] == "viscoplastic",      # its plastic work is no integrator's loss
+                 sizes=dict(element=2.0 * np.pi * params["R"] / params["n_el"], body=2.0 * params["R"],  # (elements' length)
+                            radius=params["R"]),
+                 rebound=True,                 # the accuracy's `separated`: the rebound is read after the impact
+                 parts=dict(ring=ring, contact=contact, plane=plane))
 
 
 def measure(model, params, records):
-    ring = model["ring"]
+    ring = model.parts["ring"]
     hist = History.of(records)
     ep = records[-1].state.bodies[0]               # the ring's plastic strains (the System's one body)
     rec = ring_history(ring, records)

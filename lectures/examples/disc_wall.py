@@ -5,7 +5,7 @@ from skfem import MeshTri
 from contactfem.bodies.continuum import Continuum
 from contactfem.contact import NodeToSegment, RigidPolyline
 from contactfem.laws import Coulomb, PowerLaw
-from contactfem.scenes import Param, Scene, Stage
+from contactfem.scenes import Model, Param, Scene, Stage
 from contactfem.solver import History, Newmark, Steps, System
 WALL = [(-3.0, 0.0), (1.0, 0.0), (4.0, 2.0)]     # left to right: the disc is on the wall's left side
 PARAMS = (Param("v0", 2.0, "length/time", 0.0, 20.0, doc="speed of the throw, 45 degrees down"),
@@ -25,11 +25,11 @@ def build(p, *, normal=None, friction=None, system_options=None):
     v0 = np.zeros(disc.ndof)
     v0[disc.xdofs] = p["v0"] * np.array([0.5 ** 0.5, -0.5 ** 0.5])
     stage = Stage(Newmark(system, 0.5, 0.25), Steps(p["dt"], n_steps=p["n_steps"]), np.zeros(disc.ndof), v0)
-    return dict(disc=disc, systems=[system], stage=stage)
+    return Model(systems=(system,), stage=stage, parts=dict(disc=disc))
 
 
 def measure(model, p, records):
-    disc, hist = model["disc"], History.of(records)
+    disc, hist = model.parts["disc"], History.of(records)
     m = disc.mass()[disc.xdofs[:, 0]]                 # lumped nodal masses
     vx, vy = m @ hist.v[disc.xdofs] / m.sum()         # the centre of mass's velocity at the end
     return dict(rebound_vx=float(vx), rebound_vy=float(vy), energy_kinetic=hist.kinetic)

@@ -71,11 +71,11 @@ def _block_system(nx, ny, material="linear", width=None):
     if width is not None:
         p.update(width=width, height=width * ny / nx)  # square elements
     b = block.build(p)
-    u = np.zeros(b["system"].ndof)
-    state = b["system"].start(u)
+    u = np.zeros(b.system.ndof)
+    state = b.system.start(u)
     # a state with every slave in contact: the block pushed down by 1e-3 (stick)
-    u[b["body"].xdofs[:, 1]] = -1e-3
-    return b["system"], u, state
+    u[b.parts["body"].xdofs[:, 1]] = -1e-3
+    return b.system, u, state
 
 
 def cost_study(quick=False):
@@ -88,12 +88,12 @@ def cost_study(quick=False):
         cases[f"block 20x10 ({material})"] = iteration_cost(system, u, state=state)
     hz = get_scene("hertz")
     m = hertz.build(hz.resolve("paper", {"n_el": 32 if quick else 64}))
-    u = np.zeros(m["system"].ndof)
-    u[m["body"].xdofs[:, 1]] = -m["a_exact"] ** 2 / (2 * 10.0)
-    cases[f"hertz {m['body'].mesh.t.shape[1]} quads"] = iteration_cost(m["system"], u)
+    u = np.zeros(m.system.ndof)
+    u[m.parts["body"].xdofs[:, 1]] = -m.parts["a_exact"] ** 2 / (2 * 10.0)
+    cases[f"hertz {m.parts['body'].mesh.t.shape[1]} quads"] = iteration_cost(m.system, u)
     ring = rolling_ring.build(get_scene("rolling_ring").resolve("paper"))
-    u = np.zeros(ring["system"].ndof)
-    cases["rolling ring 120 beams"] = iteration_cost(ring["system"], u, t=0.0)
+    u = np.zeros(ring.system.ndof)
+    cases["rolling ring 120 beams"] = iteration_cost(ring.system, u, t=0.0)
     n_big = 64 if quick else 223                        # 2 (n + 1)^2 = 100352 unknowns
     for material in ("linear",) if quick else ("linear", "svk"):
         system, u, state = _block_system(n_big, n_big, material)

@@ -160,7 +160,7 @@ def iteration_limit(repeat=7, number=200):
 
     scene = get_scene("sloping_impact")
     params = scene.resolve("paper", {"variant": "frictional"})
-    body = scene.build(params)["system"].bodies[0]
+    body = scene.build(params).system.bodies[0]
     n = body.ndof
     rng = np.random.default_rng(0)
     u = 1e-3 * rng.standard_normal(n)                   # a deformed ring: a regular K, a non-zero G

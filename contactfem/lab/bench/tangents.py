@@ -22,7 +22,7 @@ def _block_variant(params, variant):
     try:
         if variant == "staggered":
             b = block.build(dict(params, tangent="consistent"))
-            system = b["system"]
+            system = b.system
             stepper = Staggered(Static(system, atol=params["atol"], rtol=params["rtol"], maxit=params["maxit"]),
                                 max_cycles=200)
             u = np.zeros(system.ndof)
@@ -45,7 +45,7 @@ def _impact_variant(params, variant):
 
     tangent = "consistent" if variant == "staggered" else variant
     m = sloping_impact.build(dict(params, tangent=tangent))
-    ring, system = m["ring"], m["system"]
+    ring, system = m.parts["ring"], m.system
     newmark = Newmark(system, params["delta"], params["beta_newmark"], atol=1e-10, rtol=1e-10, maxit=30)
     stepper = Staggered(newmark, max_cycles=100) if variant == "staggered" else newmark
     u0 = np.zeros(ring.body.ndof)

@@ -912,7 +912,7 @@ def margin_block(slip_margin):
         from ...scenes.block_params import friction_law
 
         model, P = _scene_model("block", {"law": "conical"})
-        st = model["stage"]
+        st = model.stage
         last = list(march(st.stepper, st.schedule, st.t0, st.u0))[-1].contacts[0]
         return last, friction_law(P)
 
@@ -934,7 +934,7 @@ def margin_block(slip_margin):
 def _load_steps(load_steps, n):
     def run():
         model, _ = _scene_model("block", {"law": "conical"})
-        return call(load_steps, "load_steps", model["stepper"], n, timeout=60.0)
+        return call(load_steps, "load_steps", model.parts["stepper"], n, timeout=60.0)
     out = memo(("load_steps", load_steps, n), run)
     return _as_list(out, 3, "load_steps", "the pseudo-times, the linear solves and the slipping nodes of each step")
 
@@ -945,7 +945,7 @@ def _load_steps_ref(n):
         from ...solver.march import march
 
         model, _ = _scene_model("block", {"law": "conical"})
-        recs = list(march(model["stepper"], Steps(1.0 / n, n_steps=n), 0.0, np.zeros(model["system"].ndof)))[1:]
+        recs = list(march(model.parts["stepper"], Steps(1.0 / n, n_steps=n), 0.0, np.zeros(model.system.ndof)))[1:]
         return (np.array([r.t for r in recs]), np.array([r.iterations for r in recs], float),
                 np.array([_counts(r)[1] for r in recs], float), np.array([_counts(r)[0] for r in recs], float))
     return memo(("load_steps_ref", n), run)
@@ -1248,7 +1248,7 @@ def escape_steeper(escape_angle):
 def _census(census):
     def run():
         model, _ = _scene_model("funnel", {"variant": "frictional"})
-        st = model["stage"]
+        st = model.stage
         return call(census, "census", st.stepper, st.schedule, st.u0, st.v0, timeout=120.0)
     out = memo(("census", census), run)
     return _as_list(out, 3, "census", "the times, the nodes in contact and the slipping nodes of each record")
@@ -1259,7 +1259,7 @@ def _census_ref():
         from ...solver.march import march
 
         model, _ = _scene_model("funnel", {"variant": "frictional"})
-        st = model["stage"]
+        st = model.stage
         recs = list(march(st.stepper, st.schedule, st.t0, st.u0, st.v0))
         c = np.array([_counts(r) for r in recs], float)
         return np.array([r.t for r in recs]), c[:, 0], c[:, 1]
