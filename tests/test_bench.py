@@ -33,19 +33,19 @@ def _block_staggered(params, max_cycles=200):
     u = np.zeros(system.ndof)
     state = system.start(u)
     u1, _, _, res = stepper.step(0.0, u, u, u, 1.0, state=state)
-    return dict(b, start=state), system, u1, res
+    return state, system, u1, res
 
 
 @pytest.mark.parametrize("law", ["coulomb", "parabolic"])
 def test_staggered_converges_to_the_newton_solution_with_more_solves(law):
     params = get_scene("block").resolve("paper", {"law": law})
     ref = block.solve(params)
-    b, system, u, res = _block_staggered(params)
+    start, system, u, res = _block_staggered(params)
     # same solution: both satisfy the same full residual to 1e-10 relative
     scale = np.max(np.abs(ref["u"]))
     assert np.max(np.abs(u - ref["u"])) < 1e-8 * scale, "staggered and Newton solutions differ"
     # converged by newton's own test in force units: the largest free residual against the force scale
-    ev = system.evaluate(u, 1.0, 1.0, state=b["start"])
+    ev = system.evaluate(u, 1.0, 1.0, state=start)
     free = system.free_dofs
     assert np.max(np.abs(ev.G[free])) <= params["atol"] + params["rtol"] * force_scale(ev, free)
     # more work: consistent Newton 5-6 solves, staggered ~ 3x (linear convergence of the cycles)

@@ -136,7 +136,7 @@ def newton_states(params, n_iter):
         G, K = system.residual_tangent(u, 1.0, state=start)
         u = u - sla.spsolve(K.tocsc(), G)
         states.append(u.copy())
-    return dict(sc, start=start), states
+    return sc, start, states
 
 
 @pytest.mark.parametrize("law,material,which", [("coulomb", "linear", 1), ("coulomb", "linear", 5),
@@ -150,10 +150,9 @@ def test_full_tangent_finite_differences(law, material, which):
     over = {"law": law, "material": material}
     if material != "linear":
         over.update(p_y=20.0, p_x=6.0)        # finite strain: lighter loads (see the scene's doc)
-    sc, states = newton_states(SCENE.resolve("canonical", over), which)
+    sc, start, states = newton_states(SCENE.resolve("canonical", over), which)
     system, contact = sc.system, sc.parts["contact"]
     u = states[-1]
-    start = sc["start"]
     state = contact.evaluate(u, 1.0, 1.0, history=start.contacts[0]).slip
     assert np.any(state == 1) and np.any(state == 2), "stick and slip nodes present"
     rng = np.random.default_rng(which)
