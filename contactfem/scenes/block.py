@@ -98,9 +98,9 @@ def converged(model, records):
 
 def solve(params, *, friction=None, normal=None, progress=None, system_options=None):
     """Build the block and apply the load in ``n_steps`` static steps of the pseudo-time
-    (default: the whole load in ONE step, Newton from u = 0). Returns build()'s dict plus the
-    records and what ``converged`` reads from them: a dict of the model's parts, its ``model``
-    and ``system``, the ``records`` and ``converged``'s entries."""
+    (default: the whole load in ONE step, Newton from u = 0). Returns a dict: the model's
+    parts, the ``model`` itself and its ``system``, the ``records`` and what ``converged``
+    reads from them."""
     model = build(params, friction=friction, normal=normal, system_options=system_options)
     records = simulate(model, params, progress)
     return dict(model.parts, model=model, system=model.system, records=records, **converged(model, records))
