@@ -172,3 +172,15 @@ def test_a_law_object_replaces_the_parameters_that_build_the_scene_law(tmp_path)
     r = json.loads(out.read_text())
     assert not {"mu", "c_T"} & set(r["parameters"]), r["parameters"]
     assert r["friction_law"]["fields"]["c_T"] == 1e3
+
+
+def test_a_scene_whose_build_returns_no_model_is_refused_naming_it():
+    """A Scene built in Python (no file to guard) whose build returns a dict: one line naming
+    the scene and what it returned, before anything is marched."""
+    from contactfem.scenes import Param, Scene, run_scene
+
+    scene = Scene("dicty", "t", (Param("x", 1.0),), build=lambda params, **kw: {"systems": [], "stage": None},
+                  measure=lambda model, params, records: {})
+    with pytest.raises(TypeError, match=r"^scene dicty, build: returned dict, not a Model") as err:
+        run_scene(scene, "fast")
+    assert "\n" not in str(err.value)
