@@ -18,8 +18,9 @@ class _Oscillator:
 
     def __init__(self, delta, beta, k=3.0, m=2.0):
         self.delta, self.beta, self.k, self.m = delta, beta, k, m
-        body = type("B", (), {"dof_offset": 0, "xdofs": np.array([[0, 0]])})()
-        self.system = type("S", (), {"lumped_mass": lambda s: np.array([m]), "bodies": [body], "ndof": 1})()
+        body = type("B", (), {"xdofs": np.array([[0, 0]])})()
+        self.system = type("S", (), {"lumped_mass": lambda s: np.array([m]), "bodies": [body], "ndof": 1,
+                                     "offset": lambda s, obj: 0})()
 
     def step(self, t, u, v, a, dt, label="", *, state=None):
         u_pred = u + dt * v + dt ** 2 * (0.5 - self.beta) * a

@@ -170,7 +170,7 @@ def centre_of_mass_rows(system, directions=(0, 1)):
     rows = []
     for body in system.bodies:
         for d in directions:
-            dofs = body.dof_offset + np.asarray(body.xdofs)[:, d]
+            dofs = system.offset(body) + np.asarray(body.xdofs)[:, d]
             row = np.zeros(system.ndof)
             row[dofs] = m[dofs] / np.sum(m[dofs])
             rows.append(row)
@@ -185,7 +185,7 @@ class Estimated:
     """A dynamic stepper whose step results carry ``local_error``: c dt |a+ - a|, the estimate of
     the comment above. ``share(dt)``: the error a step of dt may have; a step longer than ``floor``
     with more than twice that raises StepRejected (None: every step kept). Anything else is the
-    wrapped stepper's (``stepper``)."""
+    wrapped stepper's (``stepper``: its system, whether it is dynamic, its Newmark parameters)."""
 
     def __init__(self, stepper, share=None, floor=0.0):
         self.stepper, self.share, self.floor = stepper, share, floor
@@ -193,10 +193,13 @@ class Estimated:
         self.mass = stepper.system.lumped_mass()
         self.rows = None if self.power == 1.0 else centre_of_mass_rows(stepper.system)
 
-    def __getattr__(self, name):
-        if name == "stepper":
-            raise AttributeError(name)
-        return getattr(self.stepper, name)
+    @property
+    def system(self):
+        return self.stepper.system
+
+    @property
+    def dynamic(self):
+        return self.stepper.dynamic
 
     def norm(self, d):
         """|d|: the kinetic energy's norm (damped steppers) or the largest centre-of-mass component."""
