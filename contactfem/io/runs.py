@@ -239,7 +239,7 @@ class Recorder:
 
 # what describes how a run went rather than what it computed: not compared
 RUN_KEYS = ("wall_time_s", "import_time_s", "linear_algebra", "ordering", "unknowns", "band_kl", "band_ku",
-            "residual_evaluations", "contact_evaluations", "scene", "preset", "parameters", "accuracy")
+            "residual_evaluations", "contact_evaluations", "scene", "preset", "parameters", "accuracy", "stepping")
 
 
 def compare_runs(mine, ref, skip=RUN_KEYS):
