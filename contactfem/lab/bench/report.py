@@ -436,6 +436,20 @@ def write_outputs(res, outdir):
     return str(pj), str(pm)
 
 
+def _verdict(a, match, reference_change):
+    """Whether a run at a tolerance met it (judged only where the reference is finer than it) and
+    cost no more than the matching fixed step."""
+    tol = a["accuracy"]
+    if reference_change > tol / 2:
+        met = f"not judged (the reference itself moves by {reference_change:.1e})"
+    else:
+        met = "within the tolerance" if a["error"] <= tol else "**above the tolerance**"
+    if match is None:
+        return met
+    cheaper = a["residual_evaluations"] <= match["residual_evaluations"]
+    return met + (", at no more cost than fixed steps" if cheaper else ", **costlier than fixed steps**")
+
+
 def adaptive_sentences(ad):
     """The README's account of study 10, one line per scene, from the study's numbers."""
     lines = []
@@ -452,7 +466,7 @@ def adaptive_sentences(ad):
                        f"{m['residual_evaluations']}" if m else "no fixed step of the ladder reaches that error")
             parts.append(f"accuracy = {a['accuracy']:g}: error {a['error']:.1e} with {a['residual_evaluations']} "
                          f"residual evaluations in {a['steps']} steps of {a['dt_min']:.2g} to {a['dt_max']:.2g} "
-                         f"({against})")
+                         f"({against}): {_verdict(a, m, s['reference_change'])}")
         lines.append(f"- {name} ({', '.join(s['keys'])}; the reference's own change "
                      f"{s['reference_change']:.1e}): " + "; ".join(parts) + ".")
     return lines
