@@ -21,6 +21,9 @@ The indicators that apply to a run (``collect``), from its records and the model
                     end, so the rebound it reports is a rebound (0), not a velocity read mid-impact (1)
     local_error     a dynamic step's local error: Zienkiewicz-Xie's estimate dt^2 |beta - 1/6| |a+ - a|
                     over the largest increment of the run
+    error_budget    a run at a tolerance (``accuracy``): its own estimate of its time-stepping error over
+                    the error the tolerance allows (the sum of its steps' local error estimates over the sum
+                    of their shares, solver/schedule.py); past 2 the tolerance is not assured
 
 and a scene adds its own (``reference``): its closed-form references in every regime its
 ranges allow, each error measure covering every contact surface.
@@ -65,6 +68,7 @@ FACETS = 0.8                # rad, one element of a ring: 8 elements around it (
 FACETS_SOURCE = ("measured: the sloping impact's rebound v_y with 3 to 6 elements around the ring is 20-57 % off "
                  "the 16-element ring's, with 8 within 6 %")
 X_END_TOL = 0.05            # rolling ring x_end: 2.1 % at the fast preset, within 1 % refined; c_N = 1e5 at dt 0.02: 6.9 %
+ERROR_BUDGET = 2.0          # a step is kept with up to twice its share of the error (solver/schedule.py)
 LOCAL_ERROR = 0.30          # measured: the presets stay below 0.25 (the paper's sloping impact); dt = 1: 0.82
 
 
@@ -118,6 +122,14 @@ def collect(model, params, records, results):
         out["separated"] = indicator(float(_touching(records[-1])), 0.0, "in contact at the run's end (1: the impact "
                                      "is not over, the rebound it reports is read mid-impact)",
                                      "the scene's rebound quantities are read after the body has left the obstacle")
+    shares = [(r.result.local_error, r.result.error_share) for r in steps
+              if getattr(r.result, "error_share", None) is not None]
+    if shares:                                                 # a run at a tolerance
+        out["error_budget"] = indicator(
+            sum(e for e, _ in shares) / sum(s for _, s in shares), ERROR_BUDGET,
+            "the run's own estimate of its time-stepping error / the error its tolerance allows (its steps' local "
+            "error estimates over their shares, summed)", "a step is kept with up to twice its share; beyond: steps "
+            "at the floor dt TOL where the estimate asked for smaller ones, and the tolerance is not assured")
     stepper = getattr(model.stage, "stepper", None)
     stepper = getattr(stepper, "stepper", stepper)            # Uzawa's inner stepper
     if bool(steps) and getattr(stepper, "dynamic", False):

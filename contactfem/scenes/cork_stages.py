@@ -11,7 +11,7 @@ the first dynamic step absorbs. (A static release step
 without the hold, where friction alone carries the cork, is singular whenever all
 nodes slip and its Newton iteration chatters between stick and slip.)
 
-Stage 2 (pop, ``Newmark`` delta = 0.7, beta = 0.4): a follower pressure p on the
+Stage 2 (pop, ``Newmark`` delta = 0.7, beta = 0.4; the trapezoidal rule at a tolerance): a follower pressure p on the
 cork's bottom face, raised by p_step per step of dt for n_ramp steps, then Boyle's
 law evaluated ONCE PER STEP from the last converged state (explicit coupling, as
 the paper; the gas pressure load's state, GasPressure.update at each commit): p = p0 V0 / V, V0 = pi R_neck^2 * gas_column, V = V0 + (volume swept
@@ -37,6 +37,7 @@ from ..solver import Adaptive, Dirichlet, Newmark, Static, System
 from ..solver.march import march, watch
 from ..solver.schedule import at_tolerance
 from .cork_measure import R_TIP_FITTED, centre_of_mass_velocity, contact_forces, static_breakaway
+from .time_integration import newmark_of
 
 def _newton_options(P):
     return dict(atol=P["atol"], rtol=P["rtol"], maxit=P["maxit"])
@@ -96,12 +97,30 @@ def choose_dt(P, t, gap_to_mouth, released_at, v_cm):
     return max(dt, P["dt_fine"])
 
 
+def gas_lag_step(P, gas, rec, tol):
+    """The step at which the gas's explicit coupling keeps its share of the error at the tolerance
+    tol (a run at a tolerance; the integrator's own estimate does not see it): a step acts with the
+    pressure of the state before it, p_n for the p_n+1 the step ends with, and so changes the cork's
+    velocity by about dt / 2 |p_n+1 - p_n| A / M less than it should (first order in dt). Held at
+    tol speed dt / t_end like the integrator's error (schedule.error_step): h = dt (share / error)."""
+    if rec.k == 0:
+        return np.inf
+    dp = abs(gas.pressure(rec.t, rec.state.loads[0]) - gas.pressure(rec.t, rec.evaluation.state.loads[0]))
+    lag = 0.5 * rec.dt * dp * np.pi * P["R_neck"] ** 2 / cork_mass(P)
+    share = tol * speed_scale(P) * rec.dt / P["t_end"]
+    return np.inf if lag == 0 else max(rec.dt * share / lag, P["dt"] * tol)
+
+
+def cork_mass(P):
+    """The cork's mass from its outline (shaft over the neck and the mouth, and the head)."""
+    return P["rho"] * np.pi * P["R_cork"] ** 2 * (P["L_neck"] + P["r_mouth"] + P["L_head"])
+
+
 def speed_scale(P):
     """The speed the gas could give the cork over the neck (all its largest pressure's work
     p_0 pi R_neck^2 (L_neck + r_mouth) as kinetic energy), in mm/s: the exit velocity's scale."""
     W = P["p_step"] * P["n_ramp"] * np.pi * P["R_neck"] ** 2 * (P["L_neck"] + P["r_mouth"])
-    M = P["rho"] * np.pi * P["R_cork"] ** 2 * (P["L_neck"] + P["r_mouth"] + P["L_head"])
-    return float(np.sqrt(2.0 * W / M))
+    return float(np.sqrt(2.0 * W / cork_mass(P)))
 
 
 def pop(model, P, u0, progress=None, histories=None):
@@ -117,7 +136,8 @@ def pop(model, P, u0, progress=None, histories=None):
     if histories is not None:                                # the contacts go on from the press fit
         state = replace(state, contacts=tuple(histories))
 
-    stepper = Newmark(system, delta=P["delta"], beta=P["beta_newmark"], **_newton_options(P))
+    delta, beta = newmark_of(P)                              # (the trapezoidal rule at a tolerance)
+    stepper = Newmark(system, delta=delta, beta=beta, **_newton_options(P))
     tol = P.get("accuracy") or 0.0
     rule, rejections = None, 0
     if tol:        # steps from the local error estimate: the exit velocity's errors (its scale: speed_scale) add up
@@ -125,8 +145,8 @@ def pop(model, P, u0, progress=None, histories=None):
 
     def dt_rule(rec):                                        # rec.state: the gas after the step
         v_cm = centre_of_mass_velocity(cork, rec.v) / 1e3 if rec.k else 0.0
-        if rule is not None:                                 # travel_max still holds
-            h = rule(rec)
+        if rule is not None:                                 # travel_max still holds, and the gas's lag
+            h = min(rule(rec), gas_lag_step(P, gas, rec, tol))
             h = min(h, P["travel_max"] / (1e3 * abs(v_cm))) if v_cm else h
         else:
             h = choose_dt(P, rec.t, P["L_neck"] - gas.edge_z(rec.u), rec.state.loads[0].released_at, v_cm)

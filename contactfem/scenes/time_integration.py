@@ -26,9 +26,10 @@ def newmark_params(delta, beta, source):
     come from (e.g. "paper")."""
     return (Param("delta", delta, "", **DELTA_RANGE,
                   doc=f"Newmark delta, the usual gamma ({source}: {delta:g}; 0.5 with beta 0.25 conserves energy, "
-                      "below 0.5 every step amplifies)"),
+                      "below 0.5 every step amplifies; a run with accuracy > 0 uses 0.5)"),
             Param("beta_newmark", beta, "", **BETA_RANGE,
-                  doc=f"Newmark beta ({source}: {beta:g}; stable for every step when beta >= (delta + 1/2)^2 / 4)"))
+                  doc=f"Newmark beta ({source}: {beta:g}; stable for every step when beta >= (delta + 1/2)^2 / 4; "
+                      "a run with accuracy > 0 uses 0.25)"))
 
 
 def contact_integration(params):
@@ -37,12 +38,28 @@ def contact_integration(params):
     return params.get("contact_integration", "standard")
 
 
+# a run at a tolerance integrates with the trapezoidal rule: second order, without the numerical
+# damping of delta > 1/2, whose error is first order in dt (solver/schedule.py; bench study 10 runs
+# both)
+TRAPEZOIDAL = dict(delta=0.5, beta=0.25)
+
+
+def newmark_of(params):
+    """(delta, beta) of the scene's Newmark: params' delta and beta_newmark, or the trapezoidal
+    rule's (1/2, 1/4) in a run at a tolerance (params['accuracy'] > 0)."""
+    if params.get("accuracy"):
+        return TRAPEZOIDAL["delta"], TRAPEZOIDAL["beta"]
+    return params["delta"], params["beta_newmark"]
+
+
 def make_stepper(params, system, **newton_options):
-    """Newmark(delta, beta_newmark) or EnergyConsistent, as params['contact_integration'] says
-    (the System's contacts built with ``integration=contact_integration(params)``)."""
+    """Newmark (newmark_of: delta, beta_newmark, or the trapezoidal rule at a tolerance) or
+    EnergyConsistent, as params['contact_integration'] says (the System's contacts built with
+    ``integration=contact_integration(params)``)."""
     if contact_integration(params) == "energy_consistent":
         return EnergyConsistent(system, **newton_options)
-    return Newmark(system, params["delta"], params["beta_newmark"], **newton_options)
+    delta, beta = newmark_of(params)
+    return Newmark(system, delta, beta, **newton_options)
 
 
 def energy_error(hist):
@@ -60,7 +77,8 @@ ACCURACY_PARAM = Param(
     doc="0: fixed steps of dt (the default); TOL > 0: the steps are chosen from a local error estimate "
         "(solver/schedule.py: each step's error in the velocities held at TOL speed dt / duration) so "
         "that the headline quantities land within about TOL (relative) of the run refined in time; dt is then the "
-        "largest step. The penalty is not changed: in these scenes it is the interface law of the model (the "
+        "largest step, and Newmark is the trapezoidal rule (delta = 0.5, beta_newmark = 0.25: second order; "
+        "the damping of delta > 0.5 is an error of first order in dt). The penalty is not changed: in these scenes it is the interface law of the model (the "
         "paper's eq 4, the bar's one-element stiffness), the reference is the same model refined in time, and the "
         "penetration indicator says how deep it lets the bodies go")
 

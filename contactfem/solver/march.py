@@ -20,7 +20,7 @@ The schedule (schedule.py) decides the step sizes: fixed steps, or an adaptive r
 the last record, with the halving of a failed step; the scene decides when to stop, by
 leaving the loop. ``integrate`` collects a march into a ``History`` of arrays.
 """
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -143,6 +143,8 @@ def accept(system, rec, t1, dt, trial, cuts=0, failures=()):
     work = rec.energy["external_work"] + 0.5 * (P0 + P1) @ du + 0.5 * (F0 + F1) @ du[fixed]
     dissipation = rec.energy["dissipation"] + sum(st.dissipation for st in ev.contacts)
     state = system.commit(ev, u1, t1, dt)
+    if getattr(result, "carry", None) is not None:  # what the stepper hands to its next step
+        state = replace(state, stepper=result.carry)
     energy = dict(system.energies(u1, v1, ev, dt, state), dissipation=dissipation, external_work=float(work))
     return Record(k=rec.k + 1, t=t1, dt=dt, u=u1, v=v1, a=a1, evaluation=ev, energy=energy, result=result,
                   cuts=cuts, failures=tuple(failures), state=state)

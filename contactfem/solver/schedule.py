@@ -130,27 +130,31 @@ class Adaptive(_Cuts):
 #
 # first order in dt where delta > 1/2 (the paper's 0.7): c dt |a+ - a| with c = delta - 1/2. This
 # term is the method's numerical damping: it takes the energy of the vibrations an impact excites,
-# and a rebound's or a rolling ring's speed with it. Where delta = 1/2 the first term vanishes and
-# the second needs a second difference, which one step does not have; the estimate is then
-# Zienkiewicz and Xie's for the displacement, dt^2 |beta - 1/6| |a+ - a|, per unit step:
-# c = |beta - 1/6| (1/12 for the trapezoidal rule). The energy-consistent stepper
-# (solver/conserving.py) is the trapezoidal rule on a linear problem (its a+ the step's mean
-# acceleration): c = 1/12 too. Which velocities: with numerical damping (delta > 1/2) the error
-# of every vibration takes energy from the motion the headline quantities are made of, so |.| is
-# the kinetic energy's norm, a mass-weighted root mean square (sum m_i d_i^2 / sum m_i)^(1/2);
-# without it (delta = 1/2, the energy-consistent stepper) a vibration's error is a phase error
-# that keeps its energy, and |.| is the largest of the bodies' centre-of-mass components
-# (mass-weighted means: a body's elastic ringing has no resultant). The local errors of the steps
-# add up; holding each at ``tol speed dt / duration`` (its share) keeps their sum over the run
-# within tol speed (error per unit step). A step is chosen from the last one's error (error_step)
-# and taken; one whose error is past twice its share (the step into an impact or out of it: the
-# rule cannot see an event coming) is retried halved, as a step whose Newton fails (StepRejected),
-# down to the first step's size.
+# and a rebound's or a rolling ring's speed with it (bench study 10 measures what it costs against
+# the trapezoidal rule). A scene at a tolerance therefore integrates with the trapezoidal rule (delta = 1/2, beta = 1/4,
+# scenes/time_integration.py) or the energy-consistent stepper, both second order. There the first
+# term vanishes and the error is the second, dt^3 a'' / 12, from the second difference of the
+# accelerations over the last two steps (hs their sizes, s = (a+ - a) / h their slopes):
+#
+#     a'' ~ (s - s_prev) / ((h + h_prev) / 2)
+#
+# (the midpoint rule's is dt^3 a'' / 24: 1/12 bounds both). Its norm is the kinetic energy's, a
+# mass-weighted root mean square (sum m_i d_i^2 / sum m_i)^(1/2): the vibrations an impact excites
+# change the contact forces while the bodies touch, and the headline quantities with them. The
+# first step has no slope before it: its estimate is the bound c dt |a+ - a|, c = |beta - 1/6|
+# (Zienkiewicz and Xie's, 1/12 for both steppers). The step hands its slope to the next one in its
+# SystemState (``stepper``): the run carries it as a value. The local errors of the steps add up;
+# holding each at ``tol speed dt / duration`` (its share) keeps their sum over the run within
+# tol speed (error per unit step). A step is chosen from the last one's error (error_step) and
+# taken; one whose error is past twice its share (the step into an impact or out of it: the rule
+# cannot see an event coming) is retried halved, as a step whose Newton fails (StepRejected), down
+# to the first step's size.
 
 def error_constant(stepper):
-    """c of the local error estimate c dt |a+ - a| (the comment above), and the power of the
+    """c of the first-difference estimate c dt |a+ - a| (the comment above), and the power of the
     error's ratio that gives the next step (1 for a first-order velocity update, 1/2 for a
-    second-order one). A wrapping stepper (Uzawa's outer loop) is looked through."""
+    second-order one, whose later steps use the second difference). A wrapping stepper (Uzawa's
+    outer loop) is looked through."""
     stepper = getattr(stepper, "stepper", stepper)
     if type(stepper).__name__ == "EnergyConsistent":
         return 1.0 / 12.0, 0.5
@@ -163,35 +167,22 @@ def error_constant(stepper):
     return abs(beta - 1.0 / 6.0), 0.5
 
 
-def centre_of_mass_rows(system, directions=(0, 1)):
-    """The rows (bodies x directions, ndof) that map a dof vector to the bodies' centre-of-mass
-    components along ``directions`` (lumped mass weights over each body's translations)."""
-    m = system.lumped_mass()
-    rows = []
-    for body in system.bodies:
-        for d in directions:
-            dofs = system.offset(body) + np.asarray(body.xdofs)[:, d]
-            row = np.zeros(system.ndof)
-            row[dofs] = m[dofs] / np.sum(m[dofs])
-            rows.append(row)
-    return np.array(rows)
-
-
 class StepRejected(NewtonError):
     """A converged step whose local error is past twice its share: the march retries it halved."""
 
 
 class Estimated:
-    """A dynamic stepper whose step results carry ``local_error``: c dt |a+ - a|, the estimate of
-    the comment above. ``share(dt)``: the error a step of dt may have; a step longer than ``floor``
-    with more than twice that raises StepRejected (None: every step kept). Anything else is the
-    wrapped stepper's (``stepper``: its system, whether it is dynamic, its Newmark parameters)."""
+    """A dynamic stepper whose step results carry ``local_error``, the estimate of the comment
+    above, ``error_share``, the error a step of its size may have (None without a share), and
+    ``carry``, the step's slope of the accelerations for the next step's estimate (the march puts
+    it in the SystemState, ``state.stepper``). ``share(dt)``: the error a step of dt may have; a step longer than ``floor`` with more than twice that raises StepRejected (None: every
+    step kept). Anything else is the wrapped stepper's (``stepper``: its system, whether it is
+    dynamic, its Newmark parameters)."""
 
     def __init__(self, stepper, share=None, floor=0.0):
         self.stepper, self.share, self.floor = stepper, share, floor
         self.c, self.power = error_constant(stepper)
         self.mass = stepper.system.lumped_mass()
-        self.rows = None if self.power == 1.0 else centre_of_mass_rows(stepper.system)
 
     @property
     def system(self):
@@ -202,17 +193,25 @@ class Estimated:
         return self.stepper.dynamic
 
     def norm(self, d):
-        """|d|: the kinetic energy's norm (damped steppers) or the largest centre-of-mass component."""
-        if self.rows is None:
-            return float(np.sqrt(np.sum(self.mass * d * d) / np.sum(self.mass)))
-        return float(np.max(np.abs(self.rows @ d)))
+        """|d|: the kinetic energy's norm, (sum m_i d_i^2 / sum m_i)^(1/2)."""
+        return float(np.sqrt(np.sum(self.mass * d * d) / np.sum(self.mass)))
+
+    def estimate(self, a, a1, dt, before):
+        """The step's local error in the velocities and its slope (a1 - a) / dt; ``before``: the
+        slope and size of the step before (SystemState.stepper), or None."""
+        slope = (a1 - a) / dt
+        if self.power == 1.0 or before is None:
+            return self.c * dt * self.norm(a1 - a), slope
+        s0, h0 = before
+        return dt ** 3 / 12.0 * self.norm((slope - s0) / (0.5 * (dt + h0))), slope
 
     def step(self, t, u, v, a, dt, label="", *, state):
         u1, v1, a1, result = self.stepper.step(t, u, v, a, dt, label, state=state)
-        e = self.c * dt * self.norm(a1 - a)
+        e, slope = self.estimate(a, a1, dt, getattr(state, "stepper", None))
         if self.share is not None and dt > self.floor * (1 + 1e-9) and e > 2.0 * self.share(dt):
             raise StepRejected(f"local error {e:.3g} is past twice its share {self.share(dt):.3g}", [], label)
-        return u1, v1, a1, replace(result, local_error=e)
+        return u1, v1, a1, replace(result, local_error=e, carry=(slope, dt),
+                                   error_share=None if self.share is None else self.share(dt))
 
 
 def error_step(rec, tol, speed, duration, dt_first, dt_max, power=1.0):

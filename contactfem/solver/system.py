@@ -55,10 +55,13 @@ class SystemState:
     bodies    one per body: its internal variables (a viscoplastic beam's plastic strains;
               None for an elastic body)
     loads     one per load: its state (the gas pressure's value; None for most loads)
+    stepper   what the time stepper carries to its next step (None for most; a run at a
+              tolerance: the last step's change of the accelerations, schedule.Estimated)
     """
     contacts: tuple = ()
     bodies: tuple = ()
     loads: tuple = ()
+    stepper: object = None
 
 
 class Evaluation(NamedTuple):

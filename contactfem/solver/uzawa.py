@@ -54,6 +54,8 @@ class UzawaResult:
     gap_violation: float = 0.0
     gap_violations: list = field(default_factory=list)
     local_error: float | None = None          # a time stepper's estimate of the step's error (schedule.Estimated)
+    carry: object = None                      # what the stepper hands to its next step (SystemState.stepper)
+    error_share: float | None = None          # the error its share allows a step of its size (schedule.Estimated)
 
 
 class Uzawa:

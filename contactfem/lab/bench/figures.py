@@ -282,10 +282,17 @@ def bench_adaptive(preset="fast", outdir=None):
         fixed = [f for f in s["fixed"] if f.get("error")]
         adaptive = [a for a in s["adaptive"] if a.get("error")]
         ax.loglog([f["error"] for f in fixed], [f["residual_evaluations"] for f in fixed], "o-", color="C0",
-                  label=f"fixed {s['step']}")
+                  label=f"fixed {s['step']}, preset")
         for f in fixed:
             ax.annotate(f"{f['h']:g}", (f["error"], f["residual_evaluations"]), fontsize=6, color="C0",
                         textcoords="offset points", xytext=(3, 3))
+        trap = [f for f in s.get("fixed_trapezoidal", []) if f.get("error")]
+        if trap:
+            ax.loglog([f["error"] for f in trap], [f["residual_evaluations"] for f in trap], "^-", color="C2",
+                      label=f"fixed {s['step']}, trapezoidal rule")
+            for f in trap:
+                ax.annotate(f"{f['h']:g}", (f["error"], f["residual_evaluations"]), fontsize=6, color="C2",
+                            textcoords="offset points", xytext=(3, -9))
         ax.loglog([a["error"] for a in adaptive], [a["residual_evaluations"] for a in adaptive], "s--", color="C3",
                   label="accuracy = TOL")
         for a in adaptive:
@@ -294,7 +301,8 @@ def bench_adaptive(preset="fast", outdir=None):
         if s.get("reference_change"):
             ax.axvspan(ax.get_xlim()[0], s["reference_change"], color="0.85", zorder=0,
                        label="below the reference's own change")
-        ax.set_title(f"{name} ({s['preset']}): {', '.join(s['keys'])}\nreference: {s['step']} = {s['h_reference']:g}",
+        ax.set_title(f"{name} ({s['preset']}): {', '.join(s['keys'])}\nreference: {s['step']} = {s['h_reference']:g} "
+                     f"({s.get('reference_with', 'preset')})",
                      fontsize=9)
         from matplotlib.ticker import NullFormatter
 
