@@ -481,7 +481,7 @@ def adaptive_sentences(ad):
             if s.get("fixed_trapezoidal"):
                 against.append(_match_text(s["step"], a.get("trapezoidal_match"), "trapezoidal rule"))
             budget = a.get("error_budget")
-            own = "" if budget is None else (f", its own error estimate {budget:.2g} times the tolerance's"
+            own = "" if budget is None else (f", its own error estimate {budget:.2f} times what the tolerance allows"
                                              + (" (it warns: not assured)" if budget > ERROR_BUDGET else ""))
             parts.append(f"accuracy = {a['accuracy']:g}: error {a['error']:.1e}{own}, with {a['residual_evaluations']} "
                          f"residual evaluations in {a['steps']} steps of {a['dt_min']:.2g} to {a['dt_max']:.2g} "
