@@ -152,6 +152,21 @@ def test_a_run_at_a_tolerance_is_trapezoidal_and_carries_its_slope_as_a_value():
         assert a.t == b.t and np.array_equal(a.u, b.u) and a.result.local_error == b.result.local_error
 
 
+def test_a_tolerance_the_run_cannot_vouch_for_warns():
+    """The rolling ring's polygon touches down node after node, and the trapezoidal rule keeps the
+    vibrations each touch-down excites: the estimate asks for steps below the floor dt TOL, the
+    run's own error estimate passes twice what its tolerance allows, and the run says so; the bar,
+    whose one impact the estimate resolves, stays within its budget."""
+    from contactfem.scenes.accuracy import AccuracyWarning
+
+    with pytest.warns(AccuracyWarning, match="error_budget"):
+        ring = run_scene("rolling_ring", "fast", {"accuracy": 1e-2, "t_end": 0.6})
+    assert ring["accuracy"]["error_budget"]["value"] > 2.0
+    bar = _bar({"accuracy": 1e-2})["accuracy"]["error_budget"]
+    assert bar["ok"] and 0.5 < bar["value"] <= 2.0
+    assert "error_budget" not in _bar({})["accuracy"]                 # fixed steps: no tolerance to keep
+
+
 # -- the adaptive mode against a reference refined in time (the bench's study 10, in small) ---------
 
 def _largest_fixed_reaching(scene, ladder, error, ref, trapezoidal=False):
