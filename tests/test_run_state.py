@@ -65,10 +65,13 @@ def test_a_run_resumed_from_its_kth_record_goes_on_as_it_went(name, over):
 @pytest.mark.slow
 @pytest.mark.parametrize("name,over,suffix", [("sloping_impact", {"variant": "viscoplastic"}, ".json"),
                                               ("bar_impact", {"enforcement": "augmented"}, ".npz"),
-                                              ("sloping_impact", {"variant": "frictional"}, ".npz")])
+                                              ("sloping_impact", {"variant": "frictional"}, ".npz"),
+                                              ("sloping_impact", {"accuracy": 1e-2, "n_steps": 5}, ".json"),
+                                              ("bar_impact", {"accuracy": 1e-2}, ".npz")])
 def test_a_run_restarted_from_its_saved_kth_record_goes_on_as_it_went(name, over, suffix, tmp_path):
     """The record saved to a file and read back (its SystemState: plastic strains, multipliers,
-    contact histories) resumes the run exactly: the same records from k on, bit for bit."""
+    contact histories, the slope a run at a tolerance carries; its step's local error, which
+    sizes the next step) resumes the run exactly: the same records from k on, bit for bit."""
     scene, params, model = model_of(name, over)
     records = simulate(model, params)
     st = model.stage

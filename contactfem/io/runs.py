@@ -351,15 +351,18 @@ def _state_from_plain(obj, types):
 
 def save_record(record, path):
     """Write one record of a march (k, t, dt, u, v, a, energies, Newton's residuals, the
-    reactions and loads the next step's work needs, and its SystemState) to `path` (.json or
-    .npz, as save_run). Returns the path as a string."""
+    reactions and loads the next step's work needs, its SystemState, and in a run at a tolerance
+    its step's local error and share) to `path` (.json or .npz, as save_run). Returns the path as
+    a string."""
     ev, result = record.evaluation, record.result
     G = result.G if result is not None else ev.G          # the prescribed-dof part: the reactions
     doc = dict(k=int(record.k), t=float(record.t), dt=float(record.dt), u=record.u, v=record.v, a=record.a,
                energy={k: float(v) for k, v in record.energy.items()}, cuts=int(record.cuts),
                failures=list(record.failures), G=np.asarray(G), P=np.asarray(ev.P) if ev.P is not None else None,
                iterations=int(record.iterations), residuals=[float(r) for r in record.residuals],
-               state=_state_to_plain(record.state, "state", _state_types()))
+               state=_state_to_plain(record.state, "state", _state_types()),
+               # a run at a tolerance sizes its next step from these (solver/schedule.py)
+               local_error=getattr(result, "local_error", None), error_share=getattr(result, "error_share", None))
     return save_run({"record": doc}, path)
 
 
@@ -378,7 +381,8 @@ def load_record(path):
     state = _state_from_plain(r["state"], _state_types())
     ev = Evaluation(G=r["G"], K=None, contacts=(), P=r["P"], state=state)
     result = (NewtonResult(u=r["u"], residuals=list(r["residuals"]), iterations=int(r["iterations"]), G=r["G"],
-                           evaluation=ev) if r["k"] > 0 else None)
+                           evaluation=ev, local_error=r.get("local_error"), error_share=r.get("error_share"))
+              if r["k"] > 0 else None)
     return Record(k=int(r["k"]), t=float(r["t"]), dt=float(r["dt"]), u=r["u"], v=r["v"], a=r["a"], evaluation=ev,
                   energy=dict(r["energy"]), result=result, cuts=int(r["cuts"]), failures=tuple(r["failures"]),
                   state=state)

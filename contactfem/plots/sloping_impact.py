@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from ..scenes.sloping_impact import PAPER_TABLE2
+from ..scenes.time_integration import newmark_of
 from . import cached_run, default_outdir, figure, fitted_words, pyplot
 from .data import save_figure, write_data
 
@@ -81,7 +82,8 @@ def draw_impact(r, title):
 def fig10(preset="fast", outdir=None, r=None):
     r = r or result("frictionless", preset)
     p = r["parameters"]
-    fig = draw_impact(r, f"Fig 10: sloping impact, frictionless contact (Newmark {p['delta']:g}/{p['beta_newmark']:g}, "
+    newmark = "/".join(map(format, newmark_of(p)))
+    fig = draw_impact(r, f"Fig 10: sloping impact, frictionless contact (Newmark {newmark}, "
                          f"dt = {p['dt']:g})")
     return _save(fig, r, outdir, preset, "fig10_sloping_impact_frictionless")
 
@@ -149,7 +151,7 @@ def table2_markdown(preset="fast", refined_n_el=32, results=None):
     lines = ["# Table 2: rebound of the ring after the sloping impact (Sec. 5.3)", "",
              f"Centre-of-mass velocity after rebound and angle of reflection from the normal, "
              f"atan(|v_x|/|v_y|) in degrees. 'ours': the paper's mesh ({n_el} beam elements), "
-             f"Newmark {P['delta']:g}/{P['beta_newmark']:g}, dt = {P['dt']:g}, {P['n_steps']} steps; "
+             f"Newmark {'/'.join(map(format, newmark_of(P)))}, dt = {P['dt']:g}, {P['n_steps']} steps; "
              f"'{refined_n_el} el.': the same on a refined ring. "
              "The paper gives no viscoplastic row (it reports a lower bounce). Spin: angular velocity "
              "about the centre of mass after rebound (counter-clockwise positive). Beam integration: "

@@ -214,13 +214,16 @@ def _penalty_frequency(model, records):
 
 def stepping(params, records):
     """How a run stepped (its ``stepping`` result): the mode (fixed, or adaptive at the tolerance
-    params['accuracy']), the steps taken, the smallest and the largest step."""
+    params['accuracy']), the integrator (a run at a tolerance: the trapezoidal rule, whatever
+    delta and beta_newmark say), the steps taken, the smallest and the largest step."""
+    from .time_integration import integrator_of
+
     if isinstance(records, dict):                 # a scene of several stages (the cork): its dynamic one
         records = records["records"]
     dts = [r.dt for r in records[1:]]
     tol = params.get("accuracy") or 0.0
-    return dict(mode="adaptive" if tol else "fixed", accuracy=tol or None, steps=len(dts),
-                dt_min=min(dts, default=None), dt_max=max(dts, default=None))
+    return dict(mode="adaptive" if tol else "fixed", accuracy=tol or None, integrator=integrator_of(params),
+                steps=len(dts), dt_min=min(dts, default=None), dt_max=max(dts, default=None))
 
 
 def warn(accuracy, stacklevel=2):

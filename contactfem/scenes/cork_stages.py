@@ -102,7 +102,9 @@ def gas_lag_step(P, gas, rec, tol):
     tol (a run at a tolerance; the integrator's own estimate does not see it): a step acts with the
     pressure of the state before it, p_n for the p_n+1 the step ends with, and so changes the cork's
     velocity by about dt / 2 |p_n+1 - p_n| A / M less than it should (first order in dt). Held at
-    tol speed dt / t_end like the integrator's error (schedule.error_step): h = dt (share / error)."""
+    tol speed dt / t_end like the integrator's error (schedule.error_step): h = dt (share / error).
+    Each of the two errors is held at its share, so together they may reach twice the tolerance;
+    the lag is not in the run's error_budget (the integrator's estimate alone)."""
     if rec.k == 0:
         return np.inf
     dp = abs(gas.pressure(rec.t, rec.state.loads[0]) - gas.pressure(rec.t, rec.evaluation.state.loads[0]))

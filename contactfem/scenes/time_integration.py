@@ -52,6 +52,18 @@ def newmark_of(params):
     return params["delta"], params["beta_newmark"]
 
 
+def integrator_of(params):
+    """What a scene's march integrates with, in words (its results' ``stepping``): the explicit
+    stepper, energy_consistent, or Newmark's delta and beta (newmark_of)."""
+    if params.get("integrator", "newmark") != "newmark":
+        return params["integrator"]
+    if contact_integration(params) == "energy_consistent":
+        return "energy_consistent"
+    delta, beta = newmark_of(params)
+    trapezoidal = (delta, beta) == (TRAPEZOIDAL["delta"], TRAPEZOIDAL["beta"])
+    return f"newmark delta = {delta:g}, beta = {beta:g}" + (" (trapezoidal rule)" if trapezoidal else "")
+
+
 def make_stepper(params, system, **newton_options):
     """Newmark (newmark_of: delta, beta_newmark, or the trapezoidal rule at a tolerance) or
     EnergyConsistent, as params['contact_integration'] says (the System's contacts built with
@@ -76,11 +88,12 @@ ACCURACY_PARAM = Param(
     "accuracy", 0.0, "", 0.0, 0.1,
     doc="0: fixed steps of dt (the default); TOL > 0: the steps are chosen from a local error estimate "
         "(solver/schedule.py: each step's error in the velocities held at TOL speed dt / duration) so "
-        "that the headline quantities land within about TOL (relative) of the run refined in time; dt is then the "
-        "largest step, and Newmark is the trapezoidal rule (delta = 0.5, beta_newmark = 0.25: second order; "
-        "the damping of delta > 0.5 is an error of first order in dt). The penalty is not changed: in these scenes it is the interface law of the model (the "
-        "paper's eq 4, the bar's one-element stiffness), the reference is the same model refined in time, and the "
-        "penetration indicator says how deep it lets the bodies go")
+        "that the headline quantities land within about TOL (relative) of the run refined in time; dt is then "
+        "the largest step, and Newmark is the trapezoidal rule (delta = 0.5, beta_newmark = 0.25: second order; "
+        "the damping of delta > 0.5 is an error of first order in dt); the run's error_budget indicator warns "
+        "where its own estimate passes twice what TOL allows. The penalty is not changed: in these scenes it "
+        "is the interface law of the model (the paper's eq 4, the bar's one-element stiffness), the reference "
+        "is the same model refined in time, and the penetration indicator says how deep it lets the bodies go")
 
 
 def plan(params, stepper, *, dt, speed, max_cuts, t_end=None, n_steps=None, duration=None, t0=0.0):

@@ -142,8 +142,9 @@ class Adaptive(_Cuts):
 # mass-weighted root mean square (sum m_i d_i^2 / sum m_i)^(1/2): the vibrations an impact excites
 # change the contact forces while the bodies touch, and the headline quantities with them. The
 # first step has no slope before it: its estimate is the bound c dt |a+ - a|, c = |beta - 1/6|
-# (Zienkiewicz and Xie's, 1/12 for both steppers). The step hands its slope to the next one in its
-# SystemState (``stepper``): the run carries it as a value. The local errors of the steps add up;
+# (Zienkiewicz and Xie's, 1/12 for both steppers), and so has the second (the first step's slope
+# starts from an initial acceleration a scene may set by hand). A step hands its slope to the
+# next one in its SystemState (``stepper``): the run carries it as a value. The local errors of the steps add up;
 # holding each at ``tol speed dt / duration`` (its share) keeps their sum over the run within
 # tol speed (error per unit step). A step is chosen from the last one's error (error_step) and
 # taken; one whose error is past twice its share (the step into an impact or out of it: the rule
@@ -174,10 +175,11 @@ class StepRejected(NewtonError):
 class Estimated:
     """A dynamic stepper whose step results carry ``local_error``, the estimate of the comment
     above, ``error_share``, the error a step of its size may have (None without a share), and
-    ``carry``, the step's slope of the accelerations for the next step's estimate (the march puts
-    it in the SystemState, ``state.stepper``). ``share(dt)``: the error a step of dt may have; a step longer than ``floor`` with more than twice that raises StepRejected (None: every
-    step kept). Anything else is the wrapped stepper's (``stepper``: its system, whether it is
-    dynamic, its Newmark parameters)."""
+    ``carry``, (the step's slope of the accelerations, its size) for the next step's estimate (the
+    march puts it in the SystemState, ``state.stepper``). ``share(dt)``: the error a step of dt
+    may have; a step longer than ``floor`` with more than twice that raises StepRejected (None:
+    every step kept). Anything else is the wrapped stepper's (``stepper``: its system, whether it
+    is dynamic, its Newmark parameters)."""
 
     def __init__(self, stepper, share=None, floor=0.0):
         self.stepper, self.share, self.floor = stepper, share, floor
@@ -197,20 +199,24 @@ class Estimated:
         return float(np.sqrt(np.sum(self.mass * d * d) / np.sum(self.mass)))
 
     def estimate(self, a, a1, dt, before):
-        """The step's local error in the velocities and its slope (a1 - a) / dt; ``before``: the
-        slope and size of the step before (SystemState.stepper), or None."""
+        """The step's local error in the velocities and what it hands to the next step, (its slope
+        (a1 - a) / dt, dt); ``before``: what the step before handed on (SystemState.stepper), or
+        None at the first step. The first step's slope is not handed on (None): it starts from the
+        initial acceleration, which a scene may set by hand (the cork's pop starts at rest with
+        a0 = 0), so the second step takes the first-difference bound too."""
         slope = (a1 - a) / dt
-        if self.power == 1.0 or before is None:
-            return self.c * dt * self.norm(a1 - a), slope
+        handed = (None if before is None else slope, dt)
+        if self.power == 1.0 or before is None or before[0] is None:
+            return self.c * dt * self.norm(a1 - a), handed
         s0, h0 = before
-        return dt ** 3 / 12.0 * self.norm((slope - s0) / (0.5 * (dt + h0))), slope
+        return dt ** 3 / 12.0 * self.norm((slope - s0) / (0.5 * (dt + h0))), handed
 
     def step(self, t, u, v, a, dt, label="", *, state):
         u1, v1, a1, result = self.stepper.step(t, u, v, a, dt, label, state=state)
-        e, slope = self.estimate(a, a1, dt, getattr(state, "stepper", None))
+        e, handed = self.estimate(a, a1, dt, getattr(state, "stepper", None))
         if self.share is not None and dt > self.floor * (1 + 1e-9) and e > 2.0 * self.share(dt):
             raise StepRejected(f"local error {e:.3g} is past twice its share {self.share(dt):.3g}", [], label)
-        return u1, v1, a1, replace(result, local_error=e, carry=(slope, dt),
+        return u1, v1, a1, replace(result, local_error=e, carry=handed,
                                    error_share=None if self.share is None else self.share(dt))
 
 

@@ -463,7 +463,8 @@ def _verdict(a, matches, reference_change):
 def _match_text(step, m, integrator):
     if m is None:
         return f"no fixed step of the {integrator} reaches that error"
-    return f"the largest fixed step of the {integrator} reaching it, {step} = {m['h']:g}, needs {m['residual_evaluations']}"
+    return (f"the largest fixed step of the {integrator} reaching it, {step} = {m['h']:g}, needs "
+            f"{m['residual_evaluations']}")
 
 
 def adaptive_sentences(ad):
