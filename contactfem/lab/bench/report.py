@@ -393,8 +393,9 @@ def write_markdown(res):
 
 ADAPTIVE_NOTES = {"sloping_impact": "The first 3 time units (the ring leaves the plane at ~2.5), for the fixed and the "
                                     "adaptive runs alike.",
-                  "cork": "Fixed steps: the scene's schedule with dt_fine = h everywhere (travel_max 1e-9 mm); dt "
-                          "(1e-4 s) stays, as it sets the gas's ramp."}
+                  "cork": "Fixed steps: the scene's schedule with dt_fine = h from the start to the end (exit_zone "
+                          "1e3 mm, travel_max 1e-9 mm); dt (1e-4 s) stays, as it sets the gas's ramp, a staircase "
+                          "the steps resolve."}
 
 
 def adaptive_markdown(ad):
