@@ -189,7 +189,8 @@ def test_a_tolerance_the_run_cannot_vouch_for_warns():
 # -- the adaptive mode against a reference refined in time (the bench's study 10, in small) ---------
 
 def _largest_fixed_reaching(scene, ladder, error, ref, trapezoidal=False):
-    """The first step of the ladder (coarse to fine) whose run is within ``error`` of ``ref``, with its cost."""
+    """The first step of the ladder (coarse to fine) whose run is within ``error`` of ``ref``, with its cost
+    (a step that may merely dip below: a stricter match than the study's, matching_fixed)."""
     for h in ladder:
         r = study.scene_run(scene, h, trapezoidal)
         if r["ok"] and study.max_error(r, ref) <= error:
@@ -277,11 +278,13 @@ def test_command_line_equals_python(tmp_path):
     assert cli["t"] == list(py["t"]) and cli["rebound_vy"] == py["rebound_vy"]
 
 
-def test_matching_fixed_is_the_largest_step_within_the_error():
+def test_matching_fixed_is_the_largest_step_that_stays_within_the_error():
+    """A coarse step whose error dips below, with a finer step above it, is not a match."""
     fixed = [dict(h=1.0, error=0.02, residual_evaluations=10, newton_iterations=5, wall_time_s=0.1),
              dict(h=0.5, error=0.004, residual_evaluations=20, newton_iterations=10, wall_time_s=0.2),
              dict(h=0.25, error=0.006, residual_evaluations=40, newton_iterations=20, wall_time_s=0.4),
              dict(h=0.125, error=0.001, residual_evaluations=80, newton_iterations=40, wall_time_s=0.8)]
-    assert study.matching_fixed(fixed, 0.005)["h"] == 0.5          # not the first in order of cost
+    assert study.matching_fixed(fixed, 0.005)["h"] == 0.125        # 0.5 dips below, 0.25 does not
+    assert study.matching_fixed(fixed, 0.007)["h"] == 0.5          # 0.5, 0.25 and 0.125 all within
     assert study.matching_fixed(fixed, 0.002)["residual_evaluations"] == 80
     assert study.matching_fixed(fixed, 1e-4) is None
