@@ -410,7 +410,8 @@ def adaptive_markdown(ad):
          "steps too). Fixed steps with the scene's preset integrator and with the trapezoidal rule (the one a run "
          "at a tolerance integrates with). `fixed match`: the largest fixed step of each ladder whose error, and "
          "that of every finer step of the ladder, is at most the adaptive run's (a step whose error merely dips "
-         "below is not one a user refining until the result settles would pick), and its cost.", ""]
+         "below is not one a user refining until the result settles would pick), and its cost; and the largest "
+         "fixed step that stays within the tolerance itself (what a run at that tolerance could have cost).", ""]
     for name, s in ad["scenes"].items():
         if not s.get("fixed"):
             L += [f"### {name}: the reference failed", ""]
@@ -432,6 +433,10 @@ def adaptive_markdown(ad):
                 m = a.get(key)
                 if m:
                     matches.append(f"{label} {s['step']} = {m['h']:g} ({m['residual_evaluations']})")
+            tm = a.get("tolerance_match")
+            if tm:
+                matches.append(f"within the tolerance itself: {tm['integrator']} {s['step']} = {tm['h']:g} "
+                               f"({tm['residual_evaluations']})")
             L.append(f"| accuracy = {a['accuracy']:g} | {_f(a.get('error'))} | {a.get('residual_evaluations', '-')} | "
                      f"{a.get('newton_iterations', '-')} | {a.get('steps', '-')} | {_f(a.get('wall_time_s'))} | "
                      f"{'; '.join(matches) or 'none of the ladders'} |")
@@ -485,6 +490,10 @@ def adaptive_sentences(ad):
             against = [_match_text(s["step"], a.get("fixed_match"), "preset")]
             if s.get("fixed_trapezoidal"):
                 against.append(_match_text(s["step"], a.get("trapezoidal_match"), "trapezoidal rule"))
+            tm = a.get("tolerance_match")
+            if tm:
+                against.append(f"fixed steps that stay within the tolerance itself: the {tm['integrator']}'s "
+                               f"{s['step']} = {tm['h']:g}, {tm['residual_evaluations']}")
             budget = a.get("error_budget")
             own = "" if budget is None else (f", its own error estimate {budget:.2f} times what the tolerance allows"
                                              + (" (it warns: not assured)" if budget > ERROR_BUDGET else ""))
