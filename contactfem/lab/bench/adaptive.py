@@ -15,7 +15,12 @@ quantities against the reference. Cost: residual evaluations count every Newton 
 of rejected and halved steps too (``newton_iterations`` counts the accepted steps' only).
 
 ``quick``: the bar impact alone (seconds); the full study: the four scenes (tens of minutes:
-the references of the ring scenes take the longest)."""
+the cork's reference and the rolling ring's runs at a tolerance take the longest).
+
+A fixed step matches an error only if it and every finer step of its ladder are within it
+(``matching_fixed``); each run at a tolerance also gets the largest fixed step that stays within
+the tolerance itself (``tolerance_match``): a run that lands far inside its tolerance has paid for
+accuracy it did not ask for, and the study says how much."""
 
 import warnings
 
