@@ -190,7 +190,8 @@ def test_a_tolerance_the_run_cannot_vouch_for_warns():
 
 def _largest_fixed_reaching(scene, ladder, error, ref, trapezoidal=False):
     """The first step of the ladder (coarse to fine) whose run is within ``error`` of ``ref``, with its cost
-    (a step that may merely dip below: a stricter match than the study's, matching_fixed)."""
+    (a step that may merely dip below: a coarser, cheaper match than the study's matching_fixed, so a
+    stricter test of the run's cost)."""
     for h in ladder:
         r = study.scene_run(scene, h, trapezoidal)
         if r["ok"] and study.max_error(r, ref) <= error:
@@ -288,3 +289,25 @@ def test_matching_fixed_is_the_largest_step_that_stays_within_the_error():
     assert study.matching_fixed(fixed, 0.007)["h"] == 0.5          # 0.5, 0.25 and 0.125 all within
     assert study.matching_fixed(fixed, 0.002)["residual_evaluations"] == 80
     assert study.matching_fixed(fixed, 1e-4) is None
+    assert study.matching_fixed(fixed, float("nan")) is None and study.matching_fixed(fixed, None) is None
+    assert study.matching_fixed([], 0.1) is None
+    failed = [dict(fixed[0]), dict(fixed[1]), dict(fixed[2], error=None), dict(fixed[3])]
+    assert study.matching_fixed(failed, 0.05)["h"] == 0.125        # a failed point ends the search
+    nan = [dict(f) for f in fixed[:3]] + [dict(fixed[3], error=float("nan"))]
+    assert study.matching_fixed(nan, 0.05) is None                 # NaN is not within
+
+
+def test_matches_below_the_reference_change_and_at_the_tolerance():
+    """A run's error below the reference's own change is matched at that change (the finest step of
+    a ladder is the reference's neighbour, its error that change); the tolerance's own match is the
+    cheaper ladder's, and none where the reference moves by more than half the tolerance."""
+    ladder = [dict(h=h, error=e, residual_evaluations=n, newton_iterations=n, wall_time_s=0.0)
+              for h, e, n in ((0.4, 2e-2, 10), (0.2, 4e-3, 20), (0.1, 1e-3, 40), (0.05, 2e-4, 80))]
+    trap = [dict(f, residual_evaluations=f["residual_evaluations"] // 2) for f in ladder[1:]]
+    a = dict(accuracy=1e-2, error=1e-5)
+    m = study.matches(a, ladder, trap, reference_change=2e-4)
+    assert m["fixed_match"]["h"] == 0.05 and m["trapezoidal_match"]["h"] == 0.05
+    assert m["tolerance_match"]["integrator"] == "trapezoidal" and m["tolerance_match"]["h"] == 0.2
+    assert study.matches(a, ladder, trap, reference_change=1e-5)["fixed_match"] is None
+    assert study.matches(a, ladder, trap, reference_change=6e-3)["tolerance_match"] is None
+    assert study.matches(dict(a, error=None), ladder, trap, 2e-4)["fixed_match"] is None
