@@ -144,7 +144,34 @@ def test_adaptive_run_reports_its_steps_and_repeats_bit_for_bit():
     fixed = _bar({})
     assert fixed["stepping"] == dict(mode="fixed", accuracy=None, integrator="newmark delta = 0.5, beta = 0.25 "
                                      "(trapezoidal rule)", steps=fixed["n_steps"], dt_min=pytest.approx(fixed["dt"]),
-                                     dt_max=pytest.approx(fixed["dt"]))
+                                     dt_max=pytest.approx(fixed["dt"]), at_floor=None)
+
+
+def test_steps_kept_past_twice_their_share_are_at_the_floor_and_their_time_is_reported():
+    """at_floor: the time of the steps the rule kept only because they are at the floor dt TOL. A
+    step past twice its share is rejected above the floor, so every such step is at the floor (or
+    cut below it by Newton, or the run's shortened last step); and a budget past 2 needs such steps
+    (a run whose every step is within twice its share sums to at most twice the allowed error)."""
+    from contactfem.scenes import simulate
+    from contactfem.scenes.accuracy import at_floor
+
+    scene = get_scene("rolling_ring")
+    params = scene.resolve("fast", {"accuracy": 1e-2, "t_end": 0.5})
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        r = run_scene("rolling_ring", "fast", {"accuracy": 1e-2, "t_end": 0.5})
+    records = simulate(scene.build(params), params)
+    steps = records[1:]
+    floor = params["dt"] * params["accuracy"]
+    over = [s for s in steps if s.result.local_error > 2.0 * s.result.error_share]
+    assert over and all(s.dt <= floor * (1 + 1e-9) or s is steps[-1] for s in over)
+    assert at_floor(steps) == pytest.approx(sum(s.dt for s in over) / sum(s.dt for s in steps), rel=1e-12)
+    assert r["stepping"]["at_floor"] == pytest.approx(at_floor(steps), rel=1e-12) and r["stepping"]["at_floor"] > 0.1
+    budget = r["accuracy"]["error_budget"]
+    assert budget["value"] > 2 and f"{100 * r['stepping']['at_floor']:.0f} % of the run's time" in budget["what"]
+    assert any("error_budget" in str(w.message) for w in caught)
+    bar = _bar({"accuracy": 1e-3})                          # within its budget: no step past twice its share
+    assert bar["stepping"]["at_floor"] == 0.0 and bar["accuracy"]["error_budget"]["value"] <= 2
 
 
 def test_a_run_at_a_tolerance_is_trapezoidal_and_carries_its_slope_as_a_value():

@@ -128,8 +128,10 @@ def collect(model, params, records, results):
         out["error_budget"] = indicator(
             sum(e for e, _ in shares) / sum(s for _, s in shares), ERROR_BUDGET,
             "the run's own estimate of its time-stepping error / the error its tolerance allows (its steps' local "
-            "error estimates over their shares, summed)", "a step is kept with up to twice its share; beyond: steps "
-            "at the floor dt TOL where the estimate asked for smaller ones, and the tolerance is not assured")
+            f"error estimates over their shares, summed; {100 * at_floor(steps):.0f} % of the run's time in steps kept "
+            "at the floor dt TOL with more than twice their share)", "a step is kept with up to twice its share; "
+            "beyond: steps at the floor dt TOL where the estimate asked for smaller ones, and the tolerance is not "
+            "assured")
     stepper = getattr(model.stage, "stepper", None)
     stepper = getattr(stepper, "stepper", stepper)            # Uzawa's inner stepper
     if bool(steps) and getattr(stepper, "dynamic", False):
@@ -223,7 +225,20 @@ def stepping(params, records):
     dts = [r.dt for r in records[1:]]
     tol = params.get("accuracy") or 0.0
     return dict(mode="adaptive" if tol else "fixed", accuracy=tol or None, integrator=integrator_of(params),
-                steps=len(dts), dt_min=min(dts, default=None), dt_max=max(dts, default=None))
+                steps=len(dts), dt_min=min(dts, default=None), dt_max=max(dts, default=None),
+                at_floor=at_floor(records[1:]) if tol else None)
+
+
+def at_floor(steps):
+    """The fraction of a run's time in steps kept with more than twice their share of the error
+    (solver/schedule.py rejects such a step unless it is at the floor dt TOL: there the estimate
+    asked for smaller steps than the rule gives); None without shares (fixed steps)."""
+    shared = [(r.dt, r.result.local_error > 2.0 * r.result.error_share) for r in steps
+              if getattr(r.result, "error_share", None) is not None]
+    if not shared:
+        return None
+    total = sum(dt for dt, _ in shared)
+    return float(sum(dt for dt, over in shared if over) / total) if total > 0 else 0.0
 
 
 def warn(accuracy, stacklevel=2):
