@@ -230,15 +230,12 @@ def stepping(params, records):
 
 
 def at_floor(steps):
-    """The fraction of a run's time in steps kept with more than twice their share of the error
-    (solver/schedule.py rejects such a step unless it is at the floor dt TOL: there the estimate
-    asked for smaller steps than the rule gives); None without shares (fixed steps)."""
+    """The fraction of a run's time in steps kept with more than twice their share of the error (above
+    the floor dt TOL, schedule.py rejects them: the estimate asked for less); None for fixed steps."""
     shared = [(r.dt, r.result.local_error > 2.0 * r.result.error_share) for r in steps
               if getattr(r.result, "error_share", None) is not None]
-    if not shared:
-        return None
     total = sum(dt for dt, _ in shared)
-    return float(sum(dt for dt, over in shared if over) / total) if total > 0 else 0.0
+    return (float(sum(dt for dt, over in shared if over) / total) if total > 0 else 0.0) if shared else None
 
 
 def warn(accuracy, stacklevel=2):
