@@ -62,6 +62,19 @@ def test_block_soft_penalty_is_flagged_by_penetration():
     assert r["accuracy"]["penetration_body"]["value"] > 10
 
 
+def test_the_same_run_twice_warns_twice_under_the_default_filters():
+    """Python's default filter shows a warning once per text and place: a notebook that runs the
+    same flagged scene again must hear it again."""
+    shown = []
+    with warnings.catch_warnings():
+        warnings.resetwarnings()
+        warnings.simplefilter("default")
+        warnings.showwarning = lambda message, category, filename, lineno, *a, **k: shown.append((category, filename))
+        for _ in range(2):
+            run_scene("block", "fast", {"c_N": 10})
+    assert [c for c, _ in shown].count(AccuracyWarning) >= 4           # penetration and penetration_body, twice
+
+
 def test_sloping_impact_coarse_step_is_flagged():
     r, flagged = _run("sloping_impact", {"dt": 1})
     assert {"impact_steps", "energy_loss", "local_error"} <= flagged

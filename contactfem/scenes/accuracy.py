@@ -10,8 +10,7 @@ The indicators that apply to a run (``collect``), from its records and the model
 
     equilibrium     the largest converged residual over the step's force scale (solver/newton.py)
     penetration     the largest penetration over the local element size, and over the body's size
-    facets          a ring's elements against its radius: the angle one element spans (a polygon of a few
-                    sides is no ring)
+    facets          a ring's elements against its radius: the angle one element spans (few: no ring)
     energy_gain     the energy balance's error, both signs: a gain (the integrator adds energy)
     energy_loss     and a loss (the integrator takes it), friction's dissipation and the loads' work
                     counted as the balance counts them (time_integration.energy_error)
@@ -28,6 +27,7 @@ The indicators that apply to a run (``collect``), from its records and the model
 and a scene adds its own (``reference``): its closed-form references in every regime its
 ranges allow, each error measure covering every contact surface.
 """
+import sys
 import warnings
 
 import numpy as np
@@ -45,7 +45,6 @@ def indicator(value, threshold, what, source, upper=True):
                 bound="at most" if upper else "at least")
 
 
-# -- thresholds, each argued where it is set ------------------------------------------------
 EQUILIBRIUM = 1e-6          # solver.newton.ROUNDOFF_RTOL: what Newton accepts when round-off stops it
 PENETRATION_ELEMENT = 0.1   # ANSYS's default penetration tolerance (FTOLN): 0.1 of the underlying element
 PENETRATION_BODY = 0.01     # 1 % of the body's size: the contact changes the body's geometry visibly
@@ -215,11 +214,9 @@ def _penalty_frequency(model, records):
 
 
 def stepping(params, records):
-    """How a run stepped (its ``stepping`` result): the mode (fixed, or adaptive at the tolerance
-    params['accuracy']), the integrator (a run at a tolerance: the trapezoidal rule, whatever
-    delta and beta_newmark say), the steps taken, the smallest and the largest step."""
+    """How a run stepped (``stepping``): the mode (fixed, or at the tolerance params['accuracy']), the
+    integrator, the steps taken, the smallest and the largest step, and at_floor."""
     from .time_integration import integrator_of
-
     if isinstance(records, dict):                 # a scene of several stages (the cork): its dynamic one
         records = records["records"]
     dts = [r.dt for r in records[1:]]
@@ -239,12 +236,15 @@ def at_floor(steps):
 
 
 def warn(accuracy, stacklevel=2):
-    """One AccuracyWarning per indicator past its threshold; returns their messages."""
-    lines = []
-    for name, ind in accuracy.items():
-        if isinstance(ind, dict) and not ind.get("ok", True):
-            lines.append(f"accuracy: {name} = {ind['value']:.3g}, {ind['bound']} {ind['threshold']:.3g} wanted "
-                         f"({ind['what']}; threshold: {ind['source']})")
+    """One AccuracyWarning per indicator past its threshold (the same run twice warns twice: no
+    registry remembers a line), pointing where warnings.warn(stacklevel) would; returns the lines."""
+    lines = [f"accuracy: {name} = {ind['value']:.3g}, {ind['bound']} {ind['threshold']:.3g} wanted ({ind['what']}; "
+             f"threshold: {ind['source']})" for name, ind in accuracy.items()
+             if isinstance(ind, dict) and not ind.get("ok", True)]
+    frame = sys._getframe(1)
+    for _ in range(stacklevel - 2):
+        frame = frame.f_back or frame
     for line in lines:
-        warnings.warn(line, AccuracyWarning, stacklevel=stacklevel)
+        warnings.warn_explicit(line, AccuracyWarning, frame.f_code.co_filename, frame.f_lineno,
+                               module=frame.f_globals.get("__name__"), registry=None)
     return lines
