@@ -75,6 +75,14 @@ def test_the_same_run_twice_warns_twice_under_the_default_filters():
     assert [c for c, _ in shown].count(AccuracyWarning) >= 4           # penetration and penetration_body, twice
 
 
+@pytest.mark.parametrize("over", [{"n_el": 4}, {"n_el": 20}, {"c_N_factor": 0.1}])
+def test_bar_impact_off_its_closed_form_is_flagged(over):
+    """A coarse bar (or a soft penalty) lengthens the contact by 7.5-25 %: the closed form names it."""
+    r, flagged = _run("bar_impact", over)
+    assert "duration" in flagged and r["accuracy"]["duration"]["value"] == pytest.approx(abs(r["error_duration"]))
+    assert abs(r["duration"] / r["duration_exact"] - 1) > 0.05
+
+
 def test_sloping_impact_coarse_step_is_flagged():
     r, flagged = _run("sloping_impact", {"dt": 1})
     assert {"impact_steps", "energy_loss", "local_error"} <= flagged

@@ -60,6 +60,7 @@ from ..contact import RigidLine, tributary_lengths
 from ..laws import PowerLaw
 from ..solver import CentralDifference, History, System
 from . import enforcement, time_integration
+from .accuracy import references
 from .base import Model, Param, Scene, Stage
 
 
@@ -165,9 +166,20 @@ def measure(m, params, records):
         wave_speed=ex["c"], dt=dt, c_N=m.parts["c_N"], n_steps=int(len(t) - 1),
         time=t, contact_stress=stress, energy_total=E_tot,
         newton_iterations_total=int(np.sum(hist.iterations)),
+        accuracy=references(dict(duration=(duration - ex["duration"]) / ex["duration"],
+                                 rebound_velocity=(v_after - ex["rebound_velocity"]) / ex["rebound_velocity"]),
+                            CLOSED_FORM_TOL, CLOSED_FORM_SOURCE),
         **enforcement.report(params, records, max(enforcement.penetration(rec.contacts[0]) for rec in records),
                              L / params["n_el"], "the element length h_x (largest penetration of the run)"),
     )
+
+
+# the continuous bar's closed forms against the run: measured, the fast preset (40 elements) is 3.8 % off in
+# duration and 1.8 % in rebound velocity, the paper's (100) 1.0 % and 1.2 %; the duration's error falls
+# as 1 / n_el (4 elements: 25 %, 10: 10 %, 20: 7.5 %) and grows as the penalty softens (c_N x 0.1: 20 %)
+CLOSED_FORM_TOL = 0.05
+CLOSED_FORM_SOURCE = ("5 %, the extremes grid's criterion; measured: 40 elements 3.8 % (duration) and 1.8 % "
+                      "(rebound), 100 elements 1.0 % and 1.2 %, 20 elements 7.5 %, c_N x 0.1 20 %")
 
 
 def law_range(params):
