@@ -109,6 +109,14 @@ def test_presets_unflagged():
         assert "equilibrium" in r["accuracy"]
 
 
+def test_funnel_paper_penalty_is_flagged_by_its_penetration_alone():
+    """The paper's funnel (c_N = 10, dt = 0.1) sits between two indicators: its ring penetrates just
+    past a tenth of an element, and twice the penalty is no longer resolved by the step."""
+    r, flagged = _run("funnel", {})
+    assert flagged == {"penetration"} and 0.1 < r["accuracy"]["penetration"]["value"] < 0.11
+    assert _run("funnel", {"c_N": 20})[1] == {"penalty_steps"}
+
+
 @pytest.mark.slow
 def test_energy_consistent_stiff_penalty_keeps_energy_or_is_flagged():
     r, flagged = _run("sloping_impact", {"contact_integration": "energy_consistent", "c_N": 5e7})
