@@ -6,6 +6,7 @@ from pathlib import Path
 import numpy as np
 
 from ...scenes.accuracy import ERROR_BUDGET
+from .adaptive import STUDY
 from .common import TARGETS
 from .enforcement import enforcement_markdown
 from .extremes import extremes_markdown
@@ -499,7 +500,9 @@ def adaptive_sentences(ad):
             budget = a.get("error_budget")
             own = "" if budget is None else (f", its own error estimate {budget:.2f} times what the tolerance allows"
                                              + (" (it warns: not assured)" if budget > ERROR_BUDGET else ""))
-            parts.append(f"accuracy = {a['accuracy']:g}: error {a['error']:.1e}{own}, with {a['residual_evaluations']} "
+            ran = "".join(f", {k} = {a[k]:g}" for k in STUDY.get(name, {}).get("adaptive", {}) if k in a)
+            parts.append(f"accuracy = {a['accuracy']:g} ({s.get('preset', 'fast')} preset{ran}): error {a['error']:.1e}{own}, "
+                         f"with {a['residual_evaluations']} "
                          f"residual evaluations in {a['steps']} steps of {a['dt_min']:.2g} to {a['dt_max']:.2g} "
                          f"({'; '.join(against)}): "
                          f"{_verdict(a, (a.get('fixed_match'), a.get('trapezoidal_match')), s['reference_change'])}")
