@@ -11,8 +11,13 @@ and answers Ctrl-C from its first moment; what it offers at the top, loaded on f
 
 __version__ = "0.1.0"
 __all__ = ["run_scene", "check_law", "LawError", "LawValueError", "AccuracyWarning"]
-_HOMES = {"run_scene": "scenes", "check_law": "laws", "LawError": "laws", "LawValueError": "laws",
-          "AccuracyWarning": "scenes.accuracy"}
+_HOMES = {
+    "run_scene": "scenes",
+    "check_law": "laws",
+    "LawError": "laws",
+    "LawValueError": "laws",
+    "AccuracyWarning": "scenes.accuracy",
+}
 
 
 def __dir__():

@@ -25,8 +25,8 @@ import argparse  # noqa: E402  (timed: the command line's own import is import t
 
 from .clock import defer_interrupt, imports_timed  # noqa: E402
 
-_OWN_IMPORT_S = [time.perf_counter() - _LOADING]   # counted once, by the first command of the process
-_CLOCK = {}        # the import clock of the command running (contactfem.clock)
+_OWN_IMPORT_S = [time.perf_counter() - _LOADING]  # counted once, by the first command of the process
+_CLOCK = {}  # the import clock of the command running (contactfem.clock)
 
 
 class UsageError(Exception):
@@ -38,7 +38,7 @@ class Parser(argparse.ArgumentParser):
         raise UsageError(f"{message} (see {self.prog} --help)")
 
 
-_RUN = {}          # what `run` is doing, for the message of an interrupt: phase, progress
+_RUN = {}  # what `run` is doing, for the message of an interrupt: phase, progress
 
 
 def parse_sets(items):
@@ -72,8 +72,15 @@ def cmd_show(args):
     fast, paper = sc.resolve("fast"), sc.resolve("paper")
     rows = [("parameter", "fast (run)", "paper", "unit", "allowed")]
     for p in sc.params:
-        rows.append((p.name, _show_value(fast[p.name]),
-                     "" if paper[p.name] == fast[p.name] else _show_value(paper[p.name]), p.unit or "-", p.range_text()))
+        rows.append(
+            (
+                p.name,
+                _show_value(fast[p.name]),
+                "" if paper[p.name] == fast[p.name] else _show_value(paper[p.name]),
+                p.unit or "-",
+                p.range_text(),
+            )
+        )
     widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
     right = (False, True, True, False, False)
     for r, p in zip(rows, (None,) + tuple(sc.params)):
@@ -92,11 +99,15 @@ def cmd_show(args):
             print(f"preset {name}: " + ", ".join(f"{k}={v}" for k, v in values.items()))
     if sc.notes:
         print(sc.notes)
-    print("The column 'fast (run)' is the fast preset, what `contactfem run` uses unless --preset is given; 'paper' "
-          "shows where --preset paper differs. Values: --set NAME=VALUE.")
+    print(
+        "The column 'fast (run)' is the fast preset, what `contactfem run` uses unless --preset is given; 'paper' "
+        "shows where --preset paper differs. Values: --set NAME=VALUE."
+    )
     if sc.laws:
-        print(f"Laws: {' and '.join(sc.laws)}; replace them with --friction / --normal (a law file FILE.py:CLASS, "
-              "a module path or a shipped law), their fields with --set law.NAME=VALUE.")
+        print(
+            f"Laws: {' and '.join(sc.laws)}; replace them with --friction / --normal (a law file FILE.py:CLASS, "
+            "a module path or a shipped law), their fields with --set law.NAME=VALUE."
+        )
     else:
         print("Laws: none to replace (no contact interface of its own).")
     if sc.reports:
@@ -117,10 +128,10 @@ def cmd_run(args):
     from .scenes.base import check_resources, describe
 
     scene = scenes.get_scene(args.scene)
-    overrides, laws, notes = laws_from_args(args)      # law.NAME=... go to --friction / --normal
+    overrides, laws, notes = laws_from_args(args)  # law.NAME=... go to --friction / --normal
     params = scene.resolve(args.preset, overrides)
-    out = Outputs()                                   # every output checked before the run
-    if args.json is not None:                         # (an empty name is refused, not skipped)
+    out = Outputs()  # every output checked before the run
+    if args.json is not None:  # (an empty name is refused, not skipped)
         out.add("--json", args.json, (".json",))
     if args.save is not None:
         out.add("--save", args.save, (".json", ".npz"))
@@ -135,8 +146,8 @@ def cmd_run(args):
             if shutil.which("ffmpeg") is None:
                 raise ValueError(f"--gif {args.gif}: writing .mp4 needs ffmpeg on the PATH; write a .gif instead")
     est = check_resources(scene, params, args.force, args.linear_algebra)
-    warnings = scene.preflight(params, laws) if laws and not args.no_check else []   # the laws over the scene's range
-    for note in notes:                                # (after every refusal: a refusal is one line)
+    warnings = scene.preflight(params, laws) if laws and not args.no_check else []  # the laws over the scene's range
+    for note in notes:  # (after every refusal: a refusal is one line)
         print(f"contactfem: note: {note}", file=sys.stderr)
     for warning in warnings:
         print(f"contactfem: warning: {warning}", file=sys.stderr)
@@ -145,14 +156,24 @@ def cmd_run(args):
     progress = None
     if args.progress:
         from .io import progress_bar as progress
+
         _RUN["progress"] = True
     _RUN["phase"] = "run"
-    res, notes = run_quietly(lambda: scenes.run_scene(args.scene, args.preset, overrides, progress=progress,
-                                                      linear_algebra=args.linear_algebra, check=False, **laws))
-    if "imported" in _CLOCK:                          # what this process spent loading modules, up to here
+    res, notes = run_quietly(
+        lambda: scenes.run_scene(
+            args.scene,
+            args.preset,
+            overrides,
+            progress=progress,
+            linear_algebra=args.linear_algebra,
+            check=False,
+            **laws,
+        )
+    )
+    if "imported" in _CLOCK:  # what this process spent loading modules, up to here
         res["import_time_s"] = _CLOCK["imported"][0] + _CLOCK["own"]
     _RUN["phase"] = "write"
-    with out:                                         # temporaries first, then all renamed at once
+    with out:  # temporaries first, then all renamed at once
         if args.json is not None:
             import json
 
@@ -167,7 +188,7 @@ def cmd_run(args):
     _RUN["phase"] = "done"
     for note in notes:
         print(f"contactfem: warning: {note}", file=sys.stderr)
-    for k, v in res.items():                      # scalars, and short lists of numbers (the block's residuals)
+    for k, v in res.items():  # scalars, and short lists of numbers (the block's residuals)
         if not isinstance(v, (list, dict)):
             print(f"{k}: {v}")
         elif isinstance(v, list) and 0 < len(v) <= 8 and all(isinstance(x, (int, float)) for x in v):
@@ -175,7 +196,7 @@ def cmd_run(args):
     for what, path in out.paths.items():
         print(f"{what} -> {path}")
     if args.strict and any(note.startswith("accuracy:") for note in notes):
-        return 1                                      # an accuracy indicator past its threshold
+        return 1  # an accuracy indicator past its threshold
 
 
 def run_quietly(fn):
@@ -189,8 +210,7 @@ def run_quietly(fn):
     with warnings.catch_warnings(record=True) as caught, np.errstate(all="ignore"):
         warnings.simplefilter("always")
         res = fn()
-    own = [str(w.message) for w in caught
-           if issubclass(w.category, UserWarning) and "contactfem" in str(w.filename)]
+    own = [str(w.message) for w in caught if issubclass(w.category, UserWarning) and "contactfem" in str(w.filename)]
     return res, list(dict.fromkeys(own))
 
 
@@ -206,8 +226,9 @@ def laws_from_args(args, sets=None):
     if args.friction is None and args.normal is None and not any(law_sets.values()):
         return overrides, {}, []
     scene = scenes.get_scene(args.scene)
-    classes = {k: load_class(s, f"--{k}") for k, s in (("friction", args.friction), ("normal", args.normal))
-               if s is not None}
+    classes = {
+        k: load_class(s, f"--{k}") for k, s in (("friction", args.friction), ("normal", args.normal)) if s is not None
+    }
     scenes.check_laws(scene, classes, overrides)
     params = scene.resolve(args.preset, overrides)
     from_scene = {k: {n: params[n] for n in scene.law_params.get(k, ()) if n in params} for k in classes}
@@ -220,7 +241,9 @@ def cmd_figures(args):
     from .io.outputs import check_output_dir
     from .plots import default_outdir
 
-    check_output_dir(default_outdir(args.preset) if args.outdir is None else args.outdir, "--outdir")  # before anything heavy
+    check_output_dir(
+        default_outdir(args.preset) if args.outdir is None else args.outdir, "--outdir"
+    )  # before anything heavy
     from .lab.bench import figures as _bench  # noqa: F401  (registers the bench figures)
     from .plots import load_all, make_all
 
@@ -242,14 +265,25 @@ def cmd_sweep(args):
         raise ValueError("--time-limit applies to local workers; with --scheduler, the cluster's own limits apply")
     check_output_path(args.out, "--out", (".csv", ".json"))
     if not args.set:
-        raise ValueError("sweep needs at least one --set NAME=V1,V2,... (the values to sweep); for one run use "
-                         "contactfem run")
+        raise ValueError(
+            "sweep needs at least one --set NAME=V1,V2,... (the values to sweep); for one run use contactfem run"
+        )
     grid = parse_grid(parse_sets(args.set))
-    table = Table(args.out, resume=args.resume)        # with --resume, the rows already done are read now
+    table = Table(args.out, resume=args.resume)  # with --resume, the rows already done are read now
     _RUN.update(phase="sweep", table=table)
-    rows = sweep(args.scene, grid, args.preset, args.jobs, args.scheduler, friction=args.friction,
-                 normal=args.normal, check=not args.no_check, force=args.force, table=table,
-                 timeout=args.time_limit)
+    rows = sweep(
+        args.scene,
+        grid,
+        args.preset,
+        args.jobs,
+        args.scheduler,
+        friction=args.friction,
+        normal=args.normal,
+        check=not args.no_check,
+        force=args.force,
+        table=table,
+        timeout=args.time_limit,
+    )
     _RUN["phase"] = "done"
     done, failed, left = table.counts()
     kept = f" ({table.kept} kept from the table)" if table.kept else ""
@@ -259,8 +293,10 @@ def cmd_sweep(args):
             point = ", ".join(f"{k[6:]}={v}" for k, v in r.items() if k.startswith("param."))
             print(f"  failed: {point}: {r['error']}")
     if failed:
-        print(f"contactfem: sweep: {failed} of {len(rows)} points failed (the table's error column says why)",
-              file=sys.stderr)
+        print(
+            f"contactfem: sweep: {failed} of {len(rows)} points failed (the table's error column says why)",
+            file=sys.stderr,
+        )
         return 1
     return 0
 
@@ -309,10 +345,16 @@ def cmd_course_build(args):
 
     out = course.check_out_dir(course.default_out(args.instructor) if args.out is None else args.out)
     _RUN["said"] = f"during the course build; nothing written in {out}"
-    written = course.build_versions({"instructor" if args.instructor else "student": out}, force=args.force,
-                                    on_write=lambda: _RUN.update(phase="done"))
-    version = "instructor (solutions, check cells, autograder/)" if args.instructor else \
-        f"student (no solutions; the handout: {out / STUDENT_ZIP})"
+    written = course.build_versions(
+        {"instructor" if args.instructor else "student": out},
+        force=args.force,
+        on_write=lambda: _RUN.update(phase="done"),
+    )
+    version = (
+        "instructor (solutions, check cells, autograder/)"
+        if args.instructor
+        else f"student (no solutions; the handout: {out / STUDENT_ZIP})"
+    )
     print(f"{len(next(iter(written.values())))} lectures, {version} -> {out}")
 
 
@@ -322,18 +364,31 @@ def cmd_course_grade(args):
     from .io.outputs import check_output_path, make_parents
 
     course = _course_layer()
-    limits = course.Limits(notebook=args.notebook_timeout, check=args.check_timeout,
-                           memory=int(args.memory * 2**20) if args.memory else None)
-    make_parents(check_output_path(args.out, "--out", (".csv",)))     # the table's folder, as every output's
+    limits = course.Limits(
+        notebook=args.notebook_timeout,
+        check=args.check_timeout,
+        memory=int(args.memory * 2**20) if args.memory else None,
+    )
+    make_parents(check_output_path(args.out, "--out", (".csv",)))  # the table's folder, as every output's
     t0 = time.perf_counter()
 
     def progress(done, total):
         print(f"\r{done} of {total} notebooks graded", end="\n" if done == total else "", file=sys.stderr, flush=True)
 
     try:
-        rows = course.grade(args.folder, args.out, autograders=args.autograders, jobs=args.jobs, roster=args.roster,
-                            deadline=args.deadline, lecture=args.lecture, limits=limits, review=args.review,
-                            feedback=args.feedback, progress=progress if sys.stderr.isatty() else None)
+        rows = course.grade(
+            args.folder,
+            args.out,
+            autograders=args.autograders,
+            jobs=args.jobs,
+            roster=args.roster,
+            deadline=args.deadline,
+            lecture=args.lecture,
+            limits=limits,
+            review=args.review,
+            feedback=args.feedback,
+            progress=progress if sys.stderr.isatty() else None,
+        )
     except course.GradingInterrupted as exc:
         print(f"\ncontactfem: {exc.message}" if sys.stderr.isatty() else f"contactfem: {exc.message}", file=sys.stderr)
         return 130
@@ -348,21 +403,21 @@ def cmd_site(args):
     out = check_out(default_out(args.instructor) if args.out is None else args.out)
     pages = f"the site in {out} is unchanged" if (out / "index.html").exists() else f"no page written in {out}"
 
-    def said():                                    # read when the interrupt is reported, after the clean-up
+    def said():  # read when the interrupt is reported, after the clean-up
         cache = work_dir(out) / "cache"
-        return f"during the site build; {pages}" + (f" (notebooks executed so far are cached in {work_dir(out)})"
-                                                     if cache.is_dir() else "")
+        return f"during the site build; {pages}" + (
+            f" (notebooks executed so far are cached in {work_dir(out)})" if cache.is_dir() else ""
+        )
 
     _RUN["said"] = said
     try:
         index = build(out, instructor=args.instructor, on_write=lambda: _RUN.update(phase="done"))
-    except RuntimeError as err:                    # Sphinx's own messages, then one line of ours
+    except RuntimeError as err:  # Sphinx's own messages, then one line of ours
         head, _, detail = str(err).partition("\n")
         head = head.rstrip(":")
         if detail.strip():
             print(detail.rstrip(), file=sys.stderr)
-        print(f"contactfem: error: {head}" + (" (Sphinx's messages above)" if detail.strip() else ""),
-              file=sys.stderr)
+        print(f"contactfem: error: {head}" + (" (Sphinx's messages above)" if detail.strip() else ""), file=sys.stderr)
         raise SystemExit(1) from None
     print(f"site -> {index}")
 
@@ -371,15 +426,24 @@ def cmd_reconstruct(args):
     from .io.outputs import check_output_path
 
     if args.json is not None:
-        check_output_path(args.json, "--json", (".json",))      # before anything heavy
+        check_output_path(args.json, "--json", (".json",))  # before anything heavy
     from .lab.reconstruct import main as reconstruct
 
     reconstruct(args.scene, quick=args.quick, top=args.top, json_path=args.json, cache=not args.no_cache)
 
 
-BENCH_STUDIES = ("tangents", "work_precision", "cost", "targets", "enforcement", "speed", "semismooth",
-                 "scaling", "extremes",
-                 "adaptive")  # = lab.bench.STUDIES
+BENCH_STUDIES = (
+    "tangents",
+    "work_precision",
+    "cost",
+    "targets",
+    "enforcement",
+    "speed",
+    "semismooth",
+    "scaling",
+    "extremes",
+    "adaptive",
+)  # = lab.bench.STUDIES
 
 
 def cmd_bench(args):
@@ -404,11 +468,12 @@ def cmd_bench(args):
             earlier = None
     if earlier is not None and bool(earlier.get("quick")) != bool(args.quick):
         kind = "a quick" if earlier.get("quick") else "a full"
-        raise ValueError(f"--out {out}: {old} holds {kind} bench run; a {'quick' if args.quick else 'full'} run "
-                         "would replace or mix with it: write it to another folder (--out DIR)")
-    res = run_bench(quick=args.quick, only=args.only,
-                    progress=lambda m: print(m, file=sys.stderr, flush=True))
-    if args.only and earlier is not None:           # keep the other studies of an earlier run
+        raise ValueError(
+            f"--out {out}: {old} holds {kind} bench run; a {'quick' if args.quick else 'full'} run "
+            "would replace or mix with it: write it to another folder (--out DIR)"
+        )
+    res = run_bench(quick=args.quick, only=args.only, progress=lambda m: print(m, file=sys.stderr, flush=True))
+    if args.only and earlier is not None:  # keep the other studies of an earlier run
         res = dict(earlier, **res)
     for path in write_outputs(res, out):
         print(path)
@@ -425,9 +490,15 @@ def write_animation(res, path):
     anim = res.get("animation") or {}
     outlines = anim.get("outlines", res["outlines"])
     frames = [[np.asarray(f)] if np.asarray(f).ndim == 2 else [np.asarray(p) for p in f] for f in outlines]
-    animate_outlines(frames, path, times=anim.get("t", res.get("outline_t")), closed=True,
-                     obstacles=anim.get("obstacles", res.get("obstacles", ())), title=res["scene"],
-                     marks=anim.get("marks"))
+    animate_outlines(
+        frames,
+        path,
+        times=anim.get("t", res.get("outline_t")),
+        closed=True,
+        obstacles=anim.get("obstacles", res.get("obstacles", ())),
+        title=res["scene"],
+        marks=anim.get("marks"),
+    )
     return path
 
 
@@ -440,43 +511,78 @@ def build_parser():
     sp.set_defaults(func=cmd_show)
     rp = sub.add_parser("run", help="run a scene")
     rp.add_argument("scene")
-    rp.add_argument("--preset", default="fast",
-                    help="fast (default): coarse meshes and steps, seconds; paper: the paper's data; "
-                         "or a named variant of the scene (listed by show)")
-    rp.add_argument("--set", action="extend", nargs="+", metavar="NAME=VALUE",
-                    help="override parameters, or fields of the --friction / --normal law as law.NAME=VALUE "
-                         "(friction.NAME, normal.NAME where both laws have it); several after one --set, or "
-                         "--set repeated")
-    rp.add_argument("--friction", metavar="LAW", help="replace the scene's friction law: FILE.py:CLASS (a law file), "
-                    "package.module:CLASS, or a shipped law (coulomb, parabolic_slip, slip_hardening, frictionless, "
-                    "stribeck, dieterich_ruina, archard_wear)")
-    rp.add_argument("--normal", metavar="LAW", help="replace the scene's normal law: FILE.py:CLASS, "
-                    "package.module:CLASS, or a shipped law (power_law, exponential_law)")
-    rp.add_argument("--no-check", action="store_true",
-                    help="skip the check of the --friction / --normal law over the range the scene meets before "
-                         "solving (the values it returns are still checked during the run)")
+    rp.add_argument(
+        "--preset",
+        default="fast",
+        help="fast (default): coarse meshes and steps, seconds; paper: the paper's data; "
+        "or a named variant of the scene (listed by show)",
+    )
+    rp.add_argument(
+        "--set",
+        action="extend",
+        nargs="+",
+        metavar="NAME=VALUE",
+        help="override parameters, or fields of the --friction / --normal law as law.NAME=VALUE "
+        "(friction.NAME, normal.NAME where both laws have it); several after one --set, or "
+        "--set repeated",
+    )
+    rp.add_argument(
+        "--friction",
+        metavar="LAW",
+        help="replace the scene's friction law: FILE.py:CLASS (a law file), "
+        "package.module:CLASS, or a shipped law (coulomb, parabolic_slip, slip_hardening, frictionless, "
+        "stribeck, dieterich_ruina, archard_wear)",
+    )
+    rp.add_argument(
+        "--normal",
+        metavar="LAW",
+        help="replace the scene's normal law: FILE.py:CLASS, "
+        "package.module:CLASS, or a shipped law (power_law, exponential_law)",
+    )
+    rp.add_argument(
+        "--no-check",
+        action="store_true",
+        help="skip the check of the --friction / --normal law over the range the scene meets before "
+        "solving (the values it returns are still checked during the run)",
+    )
     rp.add_argument("--json", metavar="FILE", help="write all results to FILE as JSON")
     rp.add_argument("--gif", metavar="FILE", help="animate the recorded outlines (.gif, or .mp4 with ffmpeg)")
     rp.add_argument("--progress", action="store_true", help="show a progress bar on stderr during the time loop")
-    rp.add_argument("--linear-algebra", default=None, choices=["auto", "dense", "banded", "sparse"],
-                    help="how K is stored and factorised (default auto: dense up to 100 unknowns, banded where "
-                         "the band is narrow, else sparse); the JSON's linear_algebra says what was used")
-    rp.add_argument("--strict", action="store_true",
-                    help="exit with code 1 when an accuracy indicator of the run is past its threshold (each one "
-                         "prints a warning line either way)")
+    rp.add_argument(
+        "--linear-algebra",
+        default=None,
+        choices=["auto", "dense", "banded", "sparse"],
+        help="how K is stored and factorised (default auto: dense up to 100 unknowns, banded where "
+        "the band is narrow, else sparse); the JSON's linear_algebra says what was used",
+    )
+    rp.add_argument(
+        "--strict",
+        action="store_true",
+        help="exit with code 1 when an accuracy indicator of the run is past its threshold (each one "
+        "prints a warning line either way)",
+    )
     rp.add_argument("--save", metavar="FILE", help="save the run (.json or .npz) for contactfem.io.load_run")
-    rp.add_argument("--force", action="store_true",
-                    help="run even if the estimated size exceeds the limits (2 GB, 1e6 unknowns, 1e6 steps)")
+    rp.add_argument(
+        "--force",
+        action="store_true",
+        help="run even if the estimated size exceeds the limits (2 GB, 1e6 unknowns, 1e6 steps)",
+    )
     rp.set_defaults(func=cmd_run)
-    fp = sub.add_parser("figures", help="regenerate every figure and table of the paper, each with NAME.json beside it (the "
-                                        "numbers it plots, its parameters and the code version); --preset paper: into "
-                                        "figures/; the default fast preset: into figures/fast/. The runs are kept in "
-                                        "$CONTACTFEM_CACHE/figures (default ~/.cache/contactfem/figures) and reused by the "
-                                        "same code")
+    fp = sub.add_parser(
+        "figures",
+        help="regenerate every figure and table of the paper, each with NAME.json beside it (the "
+        "numbers it plots, its parameters and the code version); --preset paper: into "
+        "figures/; the default fast preset: into figures/fast/. The runs are kept in "
+        "$CONTACTFEM_CACHE/figures (default ~/.cache/contactfem/figures) and reused by the "
+        "same code",
+    )
     fp.add_argument("--preset", default="fast", choices=["fast", "paper"])
-    fp.add_argument("--outdir", default=None,
-                    help="default: the repo's figures/ folder for --preset paper (the figures kept with the code), "
-                         "figures/fast/ for the fast preset")
+    fp.add_argument(
+        "--outdir",
+        default=None,
+        help="default: the repo's figures/ folder for --preset paper (the figures kept with the code), "
+        "figures/fast/ for the fast preset",
+    )
     fp.add_argument("--only", default=None, help="only figures whose file name contains this text")
     fp.set_defaults(func=cmd_figures)
     ep = sub.add_parser("equations", help="the equation index: paper equation -> implementing function")
@@ -484,104 +590,221 @@ def build_parser():
     ep.set_defaults(func=cmd_equations)
     sw = sub.add_parser("sweep", help="run a scene over a grid of parameter values, in parallel")
     sw.add_argument("scene")
-    sw.add_argument("--preset", default="fast",
-                    help="the preset every run starts from, as for run: fast (default), paper, or a named variant "
-                         "of the scene (listed by show)")
-    sw.add_argument("--set", action="extend", nargs="+", metavar="NAME=V1,V2,...",
-                    help="values of parameters, or of a law's field as law.NAME=V1,V2,... (several after one "
-                         "--set, or --set repeated; at least one)")
-    sw.add_argument("--jobs", type=int, default=1, help="local worker processes (default 1); a worker that dies "
-                    "is replaced and its point run once more, then recorded as failed with the reason")
-    sw.add_argument("--scheduler", default=None, metavar="ADDRESS",
-                    help="Dask scheduler address (tcp://HOST:PORT): run on that cluster instead")
-    sw.add_argument("--out", default="sweep.csv", help="table of results, .csv or .json (default: sweep.csv), "
-                    "rewritten as each point ends: always a complete table of the points done")
-    sw.add_argument("--resume", action="store_true",
-                    help="keep the points of the --out table done by the same scene, preset, laws and code "
-                         "(its code_version column) and run only the others (failed ones included)")
-    sw.add_argument("--time-limit", type=float, default=None, metavar="SECONDS",
-                    help="stop a run that takes longer and record it as failed (local workers)")
-    sw.add_argument("--friction", metavar="LAW", help="the friction law of every run, as for run; sweep its fields "
-                    "with --set law.NAME=V1,V2,...")
+    sw.add_argument(
+        "--preset",
+        default="fast",
+        help="the preset every run starts from, as for run: fast (default), paper, or a named variant "
+        "of the scene (listed by show)",
+    )
+    sw.add_argument(
+        "--set",
+        action="extend",
+        nargs="+",
+        metavar="NAME=V1,V2,...",
+        help="values of parameters, or of a law's field as law.NAME=V1,V2,... (several after one "
+        "--set, or --set repeated; at least one)",
+    )
+    sw.add_argument(
+        "--jobs",
+        type=int,
+        default=1,
+        help="local worker processes (default 1); a worker that dies "
+        "is replaced and its point run once more, then recorded as failed with the reason",
+    )
+    sw.add_argument(
+        "--scheduler",
+        default=None,
+        metavar="ADDRESS",
+        help="Dask scheduler address (tcp://HOST:PORT): run on that cluster instead",
+    )
+    sw.add_argument(
+        "--out",
+        default="sweep.csv",
+        help="table of results, .csv or .json (default: sweep.csv), "
+        "rewritten as each point ends: always a complete table of the points done",
+    )
+    sw.add_argument(
+        "--resume",
+        action="store_true",
+        help="keep the points of the --out table done by the same scene, preset, laws and code "
+        "(its code_version column) and run only the others (failed ones included)",
+    )
+    sw.add_argument(
+        "--time-limit",
+        type=float,
+        default=None,
+        metavar="SECONDS",
+        help="stop a run that takes longer and record it as failed (local workers)",
+    )
+    sw.add_argument(
+        "--friction",
+        metavar="LAW",
+        help="the friction law of every run, as for run; sweep its fields with --set law.NAME=V1,V2,...",
+    )
     sw.add_argument("--normal", metavar="LAW", help="the normal law of every run, as for run")
     sw.add_argument("--no-check", action="store_true", help="skip the laws' check before the runs, as for run")
-    sw.add_argument("--force", action="store_true",
-                    help="run even if a run's estimated size, or the memory of the runs going at once, exceeds "
-                         "the limits (2 GB, 1e6 unknowns, 1e6 steps)")
+    sw.add_argument(
+        "--force",
+        action="store_true",
+        help="run even if a run's estimated size, or the memory of the runs going at once, exceeds "
+        "the limits (2 GB, 1e6 unknowns, 1e6 steps)",
+    )
     sw.set_defaults(func=cmd_sweep)
     st = sub.add_parser("site", help="build the course website (lectures executed, gallery, equation index, API)")
-    st.add_argument("--out", default=None, metavar="DIR", help="output folder, DIR/index.html (default: build/site "
-                    "in the checkout, build/site-instructor with --instructor): new, empty, or a site built "
-                    "before; every file of the build is written there, its cache in DIR/.contactfem-site")
-    st.add_argument("--instructor", action="store_true",
-                    help="the instructor version of the lectures (with the solutions) instead of the student version")
+    st.add_argument(
+        "--out",
+        default=None,
+        metavar="DIR",
+        help="output folder, DIR/index.html (default: build/site "
+        "in the checkout, build/site-instructor with --instructor): new, empty, or a site built "
+        "before; every file of the build is written there, its cache in DIR/.contactfem-site",
+    )
+    st.add_argument(
+        "--instructor",
+        action="store_true",
+        help="the instructor version of the lectures (with the solutions) instead of the student version",
+    )
     st.set_defaults(func=cmd_site)
     cp = sub.add_parser("course", help="the course: student and instructor versions of the lectures, grading")
     csub = cp.add_subparsers(dest="course_command", required=True)
-    cb = csub.add_parser("build", help="build the student version (no solutions) or, with --instructor, the "
-                         "instructor version (solutions, checks and the grading configurations)")
+    cb = csub.add_parser(
+        "build",
+        help="build the student version (no solutions) or, with --instructor, the "
+        "instructor version (solutions, checks and the grading configurations)",
+    )
     cb.add_argument("--instructor", action="store_true", help="the instructor version")
-    cb.add_argument("--out", default=None, metavar="DIR",
-                    help="output folder (default: build/course/student or build/course/instructor); the student "
-                         "version also goes into one zip there, the handout")
-    cb.add_argument("--force", action="store_true",
-                    help="replace notebooks that differ from what the build writes (answered or edited ones), "
-                         "after moving them to DIR/backup-TIME/ (without --force the build refuses)")
+    cb.add_argument(
+        "--out",
+        default=None,
+        metavar="DIR",
+        help="output folder (default: build/course/student or build/course/instructor); the student "
+        "version also goes into one zip there, the handout",
+    )
+    cb.add_argument(
+        "--force",
+        action="store_true",
+        help="replace notebooks that differ from what the build writes (answered or edited ones), "
+        "after moving them to DIR/backup-TIME/ (without --force the build refuses)",
+    )
     cb.set_defaults(func=cmd_course_build)
-    cg = csub.add_parser("grade", help="grade a folder of submitted notebooks into a CSV: one row per submission, "
-                         "one column per exercise, the total and the hints of what failed")
+    cg = csub.add_parser(
+        "grade",
+        help="grade a folder of submitted notebooks into a CSV: one row per submission, "
+        "one column per exercise, the total and the hints of what failed",
+    )
     cg.add_argument("folder", help="a folder of submitted notebooks (*.ipynb, subfolders included)")
     cg.add_argument("--out", required=True, metavar="FILE.csv", help="the table of scores")
-    cg.add_argument("--autograders", default=None, metavar="DIR",
-                    help="the instructor's grading material: a folder holding hidden_checks.py (the hidden "
-                         "checks), e.g. the autograder/ folder of an instructor build (default, and where DIR has "
-                         "none: the checkout's lectures/hidden_checks.py)")
+    cg.add_argument(
+        "--autograders",
+        default=None,
+        metavar="DIR",
+        help="the instructor's grading material: a folder holding hidden_checks.py (the hidden "
+        "checks), e.g. the autograder/ folder of an instructor build (default, and where DIR has "
+        "none: the checkout's lectures/hidden_checks.py)",
+    )
     cg.add_argument("--jobs", type=int, default=1, help="submissions graded in parallel (default 1)")
-    cg.add_argument("--roster", default=None, metavar="FILE.csv",
-                    help="the class: a CSV with the columns id, name, file (the submission's path in FOLDER) and "
-                         "optionally submitted (ISO time); every student gets a row, missing submissions marked")
-    cg.add_argument("--deadline", default=None, metavar="TIME",
-                    help="ISO time (e.g. 2026-12-03T23:59); a submission after it is flagged late (its time: the "
-                         "roster's submitted, else the file's modification time)")
-    cg.add_argument("--lecture", default=None, metavar="NN_topic",
-                    help="the lecture every submission answers (default: from each notebook's metadata or NN_ prefix)")
-    cg.add_argument("--notebook-timeout", type=float, default=900.0, metavar="S",
-                    help="seconds for one notebook, its cells and checks (default 900: over three times the slowest "
-                         "lecture's solution graded two at a time on a shared 2-core machine); a notebook over it "
-                         "gets its row with the reason")
-    cg.add_argument("--check-timeout", type=float, default=20.0, metavar="S",
-                    help="seconds for one call of a student's function in a check (default 20: the calls take "
-                         "milliseconds; checks that run a scene allow their calls 60-120 s)")
-    cg.add_argument("--memory", type=float, default=4096.0, metavar="MB",
-                    help="memory limit of each submission's process in MB (default 4096; 0: none)")
-    cg.add_argument("--review", default=None, metavar="DIR",
-                    help="the review files of the written answers, one per lecture, and the sheets for their "
-                         "scores (default: next to --out, named after it, with -review)")
-    cg.add_argument("--feedback", default=None, metavar="DIR",
-                    help="one feedback file per student (default: next to --out, named after it, with -feedback)")
+    cg.add_argument(
+        "--roster",
+        default=None,
+        metavar="FILE.csv",
+        help="the class: a CSV with the columns id, name, file (the submission's path in FOLDER) and "
+        "optionally submitted (ISO time); every student gets a row, missing submissions marked",
+    )
+    cg.add_argument(
+        "--deadline",
+        default=None,
+        metavar="TIME",
+        help="ISO time (e.g. 2026-12-03T23:59); a submission after it is flagged late (its time: the "
+        "roster's submitted, else the file's modification time)",
+    )
+    cg.add_argument(
+        "--lecture",
+        default=None,
+        metavar="NN_topic",
+        help="the lecture every submission answers (default: from each notebook's metadata or NN_ prefix)",
+    )
+    cg.add_argument(
+        "--notebook-timeout",
+        type=float,
+        default=900.0,
+        metavar="S",
+        help="seconds for one notebook, its cells and checks (default 900: over three times the slowest "
+        "lecture's solution graded two at a time on a shared 2-core machine); a notebook over it "
+        "gets its row with the reason",
+    )
+    cg.add_argument(
+        "--check-timeout",
+        type=float,
+        default=20.0,
+        metavar="S",
+        help="seconds for one call of a student's function in a check (default 20: the calls take "
+        "milliseconds; checks that run a scene allow their calls 60-120 s)",
+    )
+    cg.add_argument(
+        "--memory",
+        type=float,
+        default=4096.0,
+        metavar="MB",
+        help="memory limit of each submission's process in MB (default 4096; 0: none)",
+    )
+    cg.add_argument(
+        "--review",
+        default=None,
+        metavar="DIR",
+        help="the review files of the written answers, one per lecture, and the sheets for their "
+        "scores (default: next to --out, named after it, with -review)",
+    )
+    cg.add_argument(
+        "--feedback",
+        default=None,
+        metavar="DIR",
+        help="one feedback file per student (default: next to --out, named after it, with -feedback)",
+    )
     cg.set_defaults(func=cmd_course_grade)
-    rc = sub.add_parser("reconstruct", help="the scan's lost values as an inverse problem: run every reading "
-                        "the scan allows, record how it ends (converged, no equilibrium, no convergence, "
-                        "physically rejected), score the admissible ones against what the paper prints, print "
-                        "the ranked table")
+    rc = sub.add_parser(
+        "reconstruct",
+        help="the scan's lost values as an inverse problem: run every reading "
+        "the scan allows, record how it ends (converged, no equilibrium, no convergence, "
+        "physically rejected), score the admissible ones against what the paper prints, print "
+        "the ranked table",
+    )
     rc.add_argument("scene", help="block | sloping_impact")
     rc.add_argument("--quick", action="store_true", help="a small profile of the search (seconds)")
     rc.add_argument("--top", type=int, default=25, help="rows of the ranked table to print")
-    rc.add_argument("--json", metavar="FILE.json", help="write every reading, its outcome and its scores to "
-                    "FILE.json (checked before the study)")
-    rc.add_argument("--no-cache", action="store_true", help="recompute every reading (default: reuse the "
-                    "results of earlier runs of the same code, in $CONTACTFEM_CACHE or ~/.cache/contactfem)")
+    rc.add_argument(
+        "--json",
+        metavar="FILE.json",
+        help="write every reading, its outcome and its scores to FILE.json (checked before the study)",
+    )
+    rc.add_argument(
+        "--no-cache",
+        action="store_true",
+        help="recompute every reading (default: reuse the "
+        "results of earlier runs of the same code, in $CONTACTFEM_CACHE or ~/.cache/contactfem)",
+    )
     rc.set_defaults(func=cmd_reconstruct)
-    bp = sub.add_parser("bench", help="speed against accuracy: tangents, work-precision, cost, targets, "
-                                      "enforcement, speed, semi-smooth Newton, scaling against plain scikit-fem, the extremes grid "
-                                      "(writes bench.json and BENCHMARKS.md)")
+    bp = sub.add_parser(
+        "bench",
+        help="speed against accuracy: tangents, work-precision, cost, targets, "
+        "enforcement, speed, semi-smooth Newton, scaling against plain scikit-fem, the extremes grid "
+        "(writes bench.json and BENCHMARKS.md)",
+    )
     bp.add_argument("--quick", action="store_true", help="fast presets and fewer points (seconds)")
-    bp.add_argument("--out", default=None,
-                    help="folder for bench.json and BENCHMARKS.md (default: . for a full run, bench-quick/ for "
-                         "--quick); a quick run never replaces or mixes with a full one")
-    bp.add_argument("--only", action="extend", nargs="+", choices=list(BENCH_STUDIES), metavar="STUDY",
-                    help="run only these studies (several after one --only, or --only repeated: "
-                         f"{', '.join(BENCH_STUDIES)}); the other studies of OUT/bench.json are kept")
+    bp.add_argument(
+        "--out",
+        default=None,
+        help="folder for bench.json and BENCHMARKS.md (default: . for a full run, bench-quick/ for "
+        "--quick); a quick run never replaces or mixes with a full one",
+    )
+    bp.add_argument(
+        "--only",
+        action="extend",
+        nargs="+",
+        choices=list(BENCH_STUDIES),
+        metavar="STUDY",
+        help="run only these studies (several after one --only, or --only repeated: "
+        f"{', '.join(BENCH_STUDIES)}); the other studies of OUT/bench.json are kept",
+    )
     bp.set_defaults(func=cmd_bench)
     return ap
 
@@ -595,7 +818,7 @@ def interrupted(exc):
     phase = _RUN.get("phase")
     if phase == "done":
         return "contactfem: interrupted after the outputs were written"
-    said = _RUN.get("said")              # a command's own account: where it was, what is on disk
+    said = _RUN.get("said")  # a command's own account: where it was, what is on disk
     if said:
         return f"contactfem: interrupted {said() if callable(said) else said}"
     if getattr(exc, "step", None) is not None:
@@ -609,8 +832,10 @@ def interrupted(exc):
         table = _RUN.get("table")
         if table is not None and table.written is not None:
             done, failed, left = table.written
-            return (f"contactfem: interrupted during the sweep; {table.path} holds the points done ({done} done, "
-                    f"{failed} failed, {left} left: --resume runs the rest)")
+            return (
+                f"contactfem: interrupted during the sweep; {table.path} holds the points done ({done} done, "
+                f"{failed} failed, {left} left: --resume runs the rest)"
+            )
         where = " during the sweep"
     else:
         where = " before the run started"
@@ -646,7 +871,7 @@ _INTERRUPTED = []
 
 def _on_sigint(signum, frame):
     _INTERRUPTED.append(True)
-    if not defer_interrupt():            # inside a library's import: raised when it returns
+    if not defer_interrupt():  # inside a library's import: raised when it returns
         raise KeyboardInterrupt
 
 
@@ -684,7 +909,7 @@ def _main(argv):
     try:
         _report_ready()
         args = build_parser().parse_args(argv)
-        code = args.func(args)                       # None: done (0); a command may return its own code
+        code = args.func(args)  # None: done (0); a command may return its own code
         if code:
             return code
     except KeyboardInterrupt as exc:
@@ -694,44 +919,50 @@ def _main(argv):
         print(f"contactfem: error: {exc}", file=sys.stderr)
         return 2
     except ValueError as exc:
-        if _INTERRUPTED:                              # the interrupt, turned into another error by a library
+        if _INTERRUPTED:  # the interrupt, turned into another error by a library
             print(("\n" if _RUN.get("progress") else "") + interrupted(exc), file=sys.stderr)
             return 130
         from .laws.protocol import LawValueError
 
-        if isinstance(exc, LawValueError):           # a law returned a bad value during the run: the run failed
-            print(("\n" if _RUN.get("progress") else "") + f"contactfem: law failed: {_one_line(exc)}",
-                  file=sys.stderr)
+        if isinstance(exc, LawValueError):  # a law returned a bad value during the run: the run failed
+            print(("\n" if _RUN.get("progress") else "") + f"contactfem: law failed: {_one_line(exc)}", file=sys.stderr)
             return 1
         print(f"contactfem: error: {_one_line(exc)}", file=sys.stderr)
         return 2
-    except BrokenPipeError:                          # the reader went away (`contactfem equations | head`)
+    except BrokenPipeError:  # the reader went away (`contactfem equations | head`)
         devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, sys.stdout.fileno())         # so that Python's exit flush does not fail again
+        os.dup2(devnull, sys.stdout.fileno())  # so that Python's exit flush does not fail again
         return 0
     except MemoryError:
         print("contactfem: out of memory: use a coarser mesh (see contactfem show SCENE)", file=sys.stderr)
         return 1
     except Exception as exc:
-        if _INTERRUPTED:                              # the interrupt, turned into another error by a library
+        if _INTERRUPTED:  # the interrupt, turned into another error by a library
             print(("\n" if _RUN.get("progress") else "") + interrupted(exc), file=sys.stderr)
             return 130
         from .scenes import SceneError
         from .solver.newton import NewtonError
 
-        if isinstance(exc, SceneError):              # a scene file's own code failed during the run
-            print(("\n" if _RUN.get("progress") else "") + f"contactfem: scene failed: {_one_line(exc)}",
-                  file=sys.stderr)
+        if isinstance(exc, SceneError):  # a scene file's own code failed during the run
+            print(
+                ("\n" if _RUN.get("progress") else "") + f"contactfem: scene failed: {_one_line(exc)}", file=sys.stderr
+            )
             return 1
-        if isinstance(exc, (ZeroDivisionError, OverflowError)):       # Python arithmetic at the float limits
-            print(f"contactfem: solver failed: {_one_line(exc)} in {_where(exc)} (parameter values near the limits "
-                  "of floating point?)", file=sys.stderr)
+        if isinstance(exc, (ZeroDivisionError, OverflowError)):  # Python arithmetic at the float limits
+            print(
+                f"contactfem: solver failed: {_one_line(exc)} in {_where(exc)} (parameter values near the limits "
+                "of floating point?)",
+                file=sys.stderr,
+            )
             return 1
-        if not isinstance(exc, (FloatingPointError, NewtonError)):   # Newton, return map, inverted elements
+        if not isinstance(exc, (FloatingPointError, NewtonError)):  # Newton, return map, inverted elements
             if os.environ.get("CONTACTFEM_DEBUG") == "1":
                 raise
-            print(f"contactfem: internal error: {type(exc).__name__}: {_one_line(exc)} "
-                  "(CONTACTFEM_DEBUG=1 shows the traceback)", file=sys.stderr)
+            print(
+                f"contactfem: internal error: {type(exc).__name__}: {_one_line(exc)} "
+                "(CONTACTFEM_DEBUG=1 shows the traceback)",
+                file=sys.stderr,
+            )
             return 3
         print(f"contactfem: solver failed: {_one_line(exc)}", file=sys.stderr)
         hist = getattr(exc, "history", None)

@@ -22,9 +22,9 @@ import sys
 import time
 from contextlib import contextmanager
 
-_running = []           # the accumulators ([seconds]) of the clocks active now
-_inside = [False]       # within a timed module body (the modules it loads are its own time)
-_pending = [False]      # a Ctrl-C met inside a timed module body: raised when the body returns
+_running = []  # the accumulators ([seconds]) of the clocks active now
+_inside = [False]  # within a timed module body (the modules it loads are its own time)
+_pending = [False]  # a Ctrl-C met inside a timed module body: raised when the body returns
 
 
 def defer_interrupt():
@@ -50,7 +50,7 @@ class _TimedLoader:
         return self.loader.create_module(spec)
 
     def exec_module(self, module):
-        module.__spec__.loader = module.__loader__ = self.loader     # the module sees its own loader only
+        module.__spec__.loader = module.__loader__ = self.loader  # the module sees its own loader only
         if _inside[0] or not _running:
             return self.loader.exec_module(module)
         _inside[0] = True
@@ -100,6 +100,6 @@ def imports_timed():
     try:
         yield acc
     finally:
-        del _running[next(i for i, a in enumerate(_running) if a is acc)]    # this clock, not an equal one
+        del _running[next(i for i, a in enumerate(_running) if a is acc)]  # this clock, not an equal one
         if not _running and _FINDER in sys.meta_path:
             sys.meta_path.remove(_FINDER)

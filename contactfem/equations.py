@@ -25,60 +25,68 @@ from pathlib import Path
 class Equation:
     number: int
     what: str
-    where: str      # dotted name: a module, or a function/class/method in a module
+    where: str  # dotted name: a module, or a function/class/method in a module
 
 
 _K = "contactfem.contact.kinematics"
 _E = "contactfem.contact.element.contact_element"
 _R = "contactfem.laws.return_map.return_map"
 _P = "contactfem.plots.laws"
-_REF = "contactfem.contact.reference"    # one pair at a time, in the paper's symbols (not used by the solver)
+_REF = "contactfem.contact.reference"  # one pair at a time, in the paper's symbols (not used by the solver)
 
-INDEX = {e.number: e for e in [
-    Equation(3, "true contact area A_r/A = (|t_N|/(A H))^n", f"{_P}.true_contact_area_ratio"),
-    Equation(4, "normal interface law |t_N| = c_N |g_N|^m", "contactfem.laws.normal.PowerLaw"),
-    Equation(5, "stick law t_T = c_T g_T^e", "contactfem.laws.friction"),
-    Equation(6, "junction shear strength |t_T| = tau_0 A_r + beta |t_N|", f"{_P}.junction_shear_strength"),
-    Equation(7, "friction coefficient mu = tau_0 / p_r + beta", f"{_P}.friction_coefficient"),
-    Equation(8, "eq (3) in eq (6): |t_T| = tau_0 A (|t_N|/(A H))^n + beta |t_N|", f"{_P}.parabolic_alpha"),
-    Equation(9, "the same as alpha |t_N|^n + beta |t_N|", f"{_P}.parabolic_alpha"),
-    Equation(10, "parabolic slip surface f = -alpha |t_N|^n - beta |t_N| + ||t_T|| <= 0",
-             "contactfem.laws.friction.ParabolicSlip"),
-    Equation(11, "Coulomb f = -mu |t_N| + ||t_T|| <= 0 (n = 1)", "contactfem.laws.friction.Coulomb"),
-    Equation(13, "associated slip rule dg^s = lambda df/dt (rejected: uplift)", f"{_P}.associated_direction"),
-    Equation(14, "non-associated slip rule dg_T^s = lambda t_T/||t_T||, dg_N^s = 0", "contactfem.laws.friction"),
-    Equation(17, "gap g_N = (x_s - x_1) . n", f"{_K}.segment_geometry"),
-    Equation(18, "l = ||x_2 - x_1||, t = (x_2 - x_1)/l, n = e_3 x t", f"{_K}.segment_geometry"),
-    Equation(19, "natural coordinate alpha = (x_s - x_1) . t / l", f"{_K}.segment_geometry"),
-    Equation(20, "slip increment Delta g_T = (alpha - alpha_bar) l_bar", "contactfem.contact.masters"),
-    Equation(24, "element unknowns v_c = (v_s, v_1, v_2)", _K),
-    Equation(25, "N_s, N_0", f"{_K}.segment_vectors"),
-    Equation(26, "T_s, T_0", f"{_K}.segment_vectors"),
-    Equation(27, "delta g_N = N_s . dv, delta g_T = (l_bar/l)(T_s + g_N/l N_0) . dv", f"{_K}.segment_variations"),
-    Equation(28, "contact residual R_c = t_N N_s + t_T (l_bar/l)(T_s + g_N/l N_0)", _E),
-    Equation(29, "G = M a + R(v) + R_c - P = 0", "contactfem.solver.system.System.evaluate"),
-    Equation(30, "linearisation of t_N delta g_N (its result is eq 33)", f"{_REF}.segment_element"),
-    Equation(31, "second variation of the gap (first part)", f"{_K}.segment_variations"),
-    Equation(32, "second variation of the gap", f"{_K}.segment_variations"),
-    Equation(33, "normal tangent K_N", _E),
-    Equation(34, "linearisation of t_T delta g_T while sticking (its result is eq 39)", f"{_REF}.segment_element"),
-    Equation(35, "Delta g_T delta g_T = dv^T (l_bar/l)^2 A Dv", f"{_REF}.pair_variations"),
-    Equation(36, "A = (T_s + g_N/l N_0)(T_s + g_N/l N_0)^T", f"{_REF}.pair_variations"),
-    Equation(37, "second variation of alpha, Delta delta alpha = dv^T B/l^2 Dv", f"{_K}.segment_variations"),
-    Equation(38, "matrix B", f"{_K}.segment_variations"),
-    Equation(39, "stick tangent K_T = c_T (l_bar/l)^2 A + t_T l_bar/l^2 B", _E),
-    Equation(40, "slip function f(t_N, t_T) of the plane case", _R),
-    Equation(41, "slip rule of the plane case, Delta g_N^s = 0, Delta g_T^s = lambda sign(t_T)", f"{_REF}.return_map"),
-    Equation(42, "elastic predictor t_T^tr = t_T_bar + c_T Delta g_T", _R),
-    Equation(43, "return t_T = t_T^tr - c_T lambda sign(t_T^tr)", _R),
-    Equation(44, "lambda from f(t_N, t_T) = 0 (closed form or local Newton)", _R),
-    Equation(45, "inelastic slip increment Delta g_T^s = lambda sign(t_T)", f"{_REF}.return_map"),
-    Equation(46, "linearisation of t_T delta g_T while slipping (its result is eq 49)", f"{_REF}.segment_element"),
-    Equation(47, "consistent modulus c_T^s = dt_T/dg_T", _R),
-    Equation(48, "consistent moduli c_T^s, c_N^s = dt_T/dg_N", _R),
-    Equation(49, "slip tangent K_T = c_T^s (l_bar/l)^2 A + t_T l_bar/l^2 B + c_N^s C", _E),
-    Equation(50, "non-symmetric coupling C = (l_bar/l)(T_s + g_N/l N_0) N_s^T", _E),
-]}
+INDEX = {
+    e.number: e
+    for e in [
+        Equation(3, "true contact area A_r/A = (|t_N|/(A H))^n", f"{_P}.true_contact_area_ratio"),
+        Equation(4, "normal interface law |t_N| = c_N |g_N|^m", "contactfem.laws.normal.PowerLaw"),
+        Equation(5, "stick law t_T = c_T g_T^e", "contactfem.laws.friction"),
+        Equation(6, "junction shear strength |t_T| = tau_0 A_r + beta |t_N|", f"{_P}.junction_shear_strength"),
+        Equation(7, "friction coefficient mu = tau_0 / p_r + beta", f"{_P}.friction_coefficient"),
+        Equation(8, "eq (3) in eq (6): |t_T| = tau_0 A (|t_N|/(A H))^n + beta |t_N|", f"{_P}.parabolic_alpha"),
+        Equation(9, "the same as alpha |t_N|^n + beta |t_N|", f"{_P}.parabolic_alpha"),
+        Equation(
+            10,
+            "parabolic slip surface f = -alpha |t_N|^n - beta |t_N| + ||t_T|| <= 0",
+            "contactfem.laws.friction.ParabolicSlip",
+        ),
+        Equation(11, "Coulomb f = -mu |t_N| + ||t_T|| <= 0 (n = 1)", "contactfem.laws.friction.Coulomb"),
+        Equation(13, "associated slip rule dg^s = lambda df/dt (rejected: uplift)", f"{_P}.associated_direction"),
+        Equation(14, "non-associated slip rule dg_T^s = lambda t_T/||t_T||, dg_N^s = 0", "contactfem.laws.friction"),
+        Equation(17, "gap g_N = (x_s - x_1) . n", f"{_K}.segment_geometry"),
+        Equation(18, "l = ||x_2 - x_1||, t = (x_2 - x_1)/l, n = e_3 x t", f"{_K}.segment_geometry"),
+        Equation(19, "natural coordinate alpha = (x_s - x_1) . t / l", f"{_K}.segment_geometry"),
+        Equation(20, "slip increment Delta g_T = (alpha - alpha_bar) l_bar", "contactfem.contact.masters"),
+        Equation(24, "element unknowns v_c = (v_s, v_1, v_2)", _K),
+        Equation(25, "N_s, N_0", f"{_K}.segment_vectors"),
+        Equation(26, "T_s, T_0", f"{_K}.segment_vectors"),
+        Equation(27, "delta g_N = N_s . dv, delta g_T = (l_bar/l)(T_s + g_N/l N_0) . dv", f"{_K}.segment_variations"),
+        Equation(28, "contact residual R_c = t_N N_s + t_T (l_bar/l)(T_s + g_N/l N_0)", _E),
+        Equation(29, "G = M a + R(v) + R_c - P = 0", "contactfem.solver.system.System.evaluate"),
+        Equation(30, "linearisation of t_N delta g_N (its result is eq 33)", f"{_REF}.segment_element"),
+        Equation(31, "second variation of the gap (first part)", f"{_K}.segment_variations"),
+        Equation(32, "second variation of the gap", f"{_K}.segment_variations"),
+        Equation(33, "normal tangent K_N", _E),
+        Equation(34, "linearisation of t_T delta g_T while sticking (its result is eq 39)", f"{_REF}.segment_element"),
+        Equation(35, "Delta g_T delta g_T = dv^T (l_bar/l)^2 A Dv", f"{_REF}.pair_variations"),
+        Equation(36, "A = (T_s + g_N/l N_0)(T_s + g_N/l N_0)^T", f"{_REF}.pair_variations"),
+        Equation(37, "second variation of alpha, Delta delta alpha = dv^T B/l^2 Dv", f"{_K}.segment_variations"),
+        Equation(38, "matrix B", f"{_K}.segment_variations"),
+        Equation(39, "stick tangent K_T = c_T (l_bar/l)^2 A + t_T l_bar/l^2 B", _E),
+        Equation(40, "slip function f(t_N, t_T) of the plane case", _R),
+        Equation(
+            41, "slip rule of the plane case, Delta g_N^s = 0, Delta g_T^s = lambda sign(t_T)", f"{_REF}.return_map"
+        ),
+        Equation(42, "elastic predictor t_T^tr = t_T_bar + c_T Delta g_T", _R),
+        Equation(43, "return t_T = t_T^tr - c_T lambda sign(t_T^tr)", _R),
+        Equation(44, "lambda from f(t_N, t_T) = 0 (closed form or local Newton)", _R),
+        Equation(45, "inelastic slip increment Delta g_T^s = lambda sign(t_T)", f"{_REF}.return_map"),
+        Equation(46, "linearisation of t_T delta g_T while slipping (its result is eq 49)", f"{_REF}.segment_element"),
+        Equation(47, "consistent modulus c_T^s = dt_T/dg_T", _R),
+        Equation(48, "consistent moduli c_T^s, c_N^s = dt_T/dg_N", _R),
+        Equation(49, "slip tangent K_T = c_T^s (l_bar/l)^2 A + t_T l_bar/l^2 B + c_N^s C", _E),
+        Equation(50, "non-symmetric coupling C = (l_bar/l)(T_s + g_N/l N_0) N_s^T", _E),
+    ]
+}
 
 NOT_MAPPED = {
     1: "continuum gap g_N = (x^2 - x^1) . n^2; its discrete form is eq (17)",
@@ -153,6 +161,7 @@ def where(number):
 
 def markdown_table():
     """The index as a markdown table, every equation 1-50 in order ('|' inside cells escaped)."""
+
     def cell(text):
         return text.replace("|", "\\|")
 

@@ -13,11 +13,19 @@ answers (by name) as the part it belongs to, and raises AssertionError with a hi
 
 import numpy as np
 
-from contactfem.lab.course.checks import (_tresca, call, compare, parts, tolerance_budget_at, tolerance_error_at,
-                                           tolerance_indicators_at)
+from contactfem.lab.course.checks import (
+    _tresca,
+    call,
+    compare,
+    parts,
+    tolerance_budget_at,
+    tolerance_error_at,
+    tolerance_indicators_at,
+)
 
 
 # -- lecture 01 ---------------------------------------------------------------------------------
+
 
 def _power(power_law, g, c_N, m):
     return parts(call(power_law, "power_law", g, c_N, m), 2, "power_law", "t_N and dt_N/dg_N")
@@ -34,16 +42,22 @@ def power_law_traction_other(power_law):
     g = np.array([-0.003, -0.07, -0.9])
     for c_N, m in ((37.0, 1.5), (2.0e4, 3.0)):
         t_N, _ = _power(power_law, g, c_N, m)
-        compare(f"t_N (c_N = {c_N:g}, m = {m:g})", t_N, -c_N * (-g) ** m, {"g_N": g},
-                rule="t_N = -c_N (-g_N)^m in contact")
+        compare(
+            f"t_N (c_N = {c_N:g}, m = {m:g})", t_N, -c_N * (-g) ** m, {"g_N": g}, rule="t_N = -c_N (-g_N)^m in contact"
+        )
 
 
 def power_law_derivative_other(power_law):
     g = np.array([-0.003, -0.07, -0.9])
     for c_N, m in ((37.0, 1.5), (2.0e4, 3.0)):
         _, dt_N = _power(power_law, g, c_N, m)
-        compare(f"dt_N/dg_N (c_N = {c_N:g}, m = {m:g})", dt_N, c_N * m * (-g) ** (m - 1.0), {"g_N": g},
-                rule="dt_N/dg_N = c_N m (-g_N)^(m-1) in contact")
+        compare(
+            f"dt_N/dg_N (c_N = {c_N:g}, m = {m:g})",
+            dt_N,
+            c_N * m * (-g) ** (m - 1.0),
+            {"g_N": g},
+            rule="dt_N/dg_N = c_N m (-g_N)^(m-1) in contact",
+        )
 
 
 def _tresca_other(Tresca):
@@ -73,6 +87,7 @@ def tresca_fields_other(Tresca):
 
 # -- lecture 02 ---------------------------------------------------------------------------------
 
+
 def circle_gap_value_other(circle_gap):
     x_s = np.array([[-2.0, 1.4], [-1.0, 0.5], [-2.3, 0.1], [0.5, -3.0]])
     c, R = np.array([-2.0, 0.5]), 0.7
@@ -81,19 +96,26 @@ def circle_gap_value_other(circle_gap):
     r = np.linalg.norm(d, axis=1)
     at = {"x_s": [f"({x:g}, {y:g})" for x, y in x_s]}
     compare("g_N (centre (-2, 0.5), R = 0.7)", g_N, r - R, at, rule="g_N = |x_s - centre| - R")
-    compare("n (centre (-2, 0.5), R = 0.7)", np.asarray(n, float), d / r[:, None],
-            {"x_s": np.repeat(np.array(at["x_s"])[:, None], 2, axis=1)}, rule="n = (x_s - centre)/|x_s - centre|")
+    compare(
+        "n (centre (-2, 0.5), R = 0.7)",
+        np.asarray(n, float),
+        d / r[:, None],
+        {"x_s": np.repeat(np.array(at["x_s"])[:, None], 2, axis=1)},
+        rule="n = (x_s - centre)/|x_s - centre|",
+    )
 
 
 # -- lecture 12 ---------------------------------------------------------------------------------
+
 
 def _cn_other(C_N):
     from contactfem.contact.complementarity import normal_complementarity
 
     t_N = np.array([-7.0, -0.1, 0.0, -0.4, -2.5])
     g_N = np.array([-0.2, 0.05, 1.0, -0.001, 0.4])
-    C, dt, dg = (np.asarray(x, float) for x in parts(call(C_N, "C_N", t_N, g_N, 3.0), 3, "C_N",
-                                                    "C_N, dC_N/dt_N and dC_N/dg_N"))
+    C, dt, dg = (
+        np.asarray(x, float) for x in parts(call(C_N, "C_N", t_N, g_N, 3.0), 3, "C_N", "C_N, dC_N/dt_N and dC_N/dg_N")
+    )
     return C, dt, dg, normal_complementarity(t_N, g_N, 3.0), {"t_N": t_N, "g_N": g_N}
 
 
@@ -110,6 +132,7 @@ def cn_derivatives_other(C_N):
 
 # -- lecture 02: the tangent at another segment -------------------------------------------------
 
+
 def normal_tangent_fd_other(normal_tangent):
     from contactfem.lab.course.checks import LABELS6, _residual_fd
 
@@ -120,11 +143,14 @@ def normal_tangent_fd_other(normal_tangent):
         raise AssertionError(f"normal_tangent should return a 6x6 matrix, it returned shape {K.shape}")
     if np.abs(K - fd).max() > 1e-6 * np.abs(fd).max():
         i, j = np.unravel_index(np.argmax(np.abs(K - fd)), K.shape)
-        raise AssertionError(f"at x_s = (-0.2, 0.45), x_1 = (-1, 0.3), x_2 = (0.8, 0.6), c_N = 7 your K_N entry "
-                             f"({LABELS6[i]}, {LABELS6[j]}) is {K[i, j]:.6g}, finite differences give {fd[i, j]:.6g}")
+        raise AssertionError(
+            f"at x_s = (-0.2, 0.45), x_1 = (-1, 0.3), x_2 = (0.8, 0.6), c_N = 7 your K_N entry "
+            f"({LABELS6[i]}, {LABELS6[j]}) is {K[i, j]:.6g}, finite differences give {fd[i, j]:.6g}"
+        )
 
 
 # -- lecture 03 --------------------------------------------------------------------------------
+
 
 def _coulomb_other(coulomb_return, t_bar, dg, p):
     from contactfem.lab.course.checks import _coulomb_ref, _coulomb_student
@@ -158,12 +184,18 @@ def moduli_other(slip_moduli):
 
 # -- lecture 09 ----------------------------------------------------------------------------------
 
+
 def observed_order_other(observed_order):
     h = np.array([0.3, 0.2, 0.1, 0.07, 0.04])
-    e = -0.7 * h ** 3 * np.array([1.0, 0.9, 1.2, 1.05, 0.97])
+    e = -0.7 * h**3 * np.array([1.0, 0.9, 1.2, 1.05, 0.97])
     want = np.polyfit(np.log(h), np.log(np.abs(e)), 1)[0]
-    compare("observed order of e ~ -0.7 h^3 (noisy)", call(observed_order, "observed_order", h, e), want,
-            {"h": "0.3 ... 0.04"}, rtol=1e-8)
+    compare(
+        "observed order of e ~ -0.7 h^3 (noisy)",
+        call(observed_order, "observed_order", h, e),
+        want,
+        {"h": "0.3 ... 0.04"},
+        rtol=1e-8,
+    )
 
 
 def convergence_order_other(convergence_order):
@@ -172,8 +204,13 @@ def convergence_order_other(convergence_order):
         r.append(0.8 * r[-1] ** 3)
     r = np.array(r)
     want = np.log(r[-1] / r[-2]) / np.log(r[-2] / r[-3])
-    compare("convergence order of r_(k+1) = 0.8 r_k^3 (last three)", call(convergence_order, "convergence_order", r),
-            want, {"r": "0.9, 0.6, ..."}, rtol=1e-8)
+    compare(
+        "convergence order of r_(k+1) = 0.8 r_k^3 (last three)",
+        call(convergence_order, "convergence_order", r),
+        want,
+        {"r": "0.9, 0.6, ..."},
+        rtol=1e-8,
+    )
 
 
 def tolerance_indicators_tight(settings_for):
@@ -190,12 +227,17 @@ def tolerance_budget_tight(settings_for):
 
 # -- lecture 10 ----------------------------------------------------------------------------------
 
+
 def hardening_other(LinearHardening):
     law = LinearHardening(c_T=5.0, mu_0=0.12, h=2.0)
     p = np.array([0.01, 3.0, 50.0, 0.01, 3.0, 50.0])
     q = np.array([0.0, 0.0, 0.0, 0.05, 1.0, 2.5])
-    Y, Y_p, Y_q = parts(call(law.slip_bound, "LinearHardening(c_T=5.0, mu_0=0.12, h=2.0).slip_bound", p, q), 3,
-                        "slip_bound", "Y, dY/dp, dY/dq")
+    Y, Y_p, Y_q = parts(
+        call(law.slip_bound, "LinearHardening(c_T=5.0, mu_0=0.12, h=2.0).slip_bound", p, q),
+        3,
+        "slip_bound",
+        "Y, dY/dp, dY/dq",
+    )
     at = {"p": p, "q": q}
     compare("Y (mu_0 = 0.12, h = 2)", Y, (0.12 + 2.0 * q) * p, at, rule="Y = (mu_0 + h q) p")
     compare("dY/dp (mu_0 = 0.12, h = 2)", Y_p, 0.12 + 2.0 * q + 0 * p, at)
@@ -206,7 +248,7 @@ def quadratic_other(QuadraticNormal):
     law = QuadraticNormal(c_N=7.0)
     g = np.array([0.3, -0.002, -0.6, -2.0])
     t_N, dt_N = parts(call(law.traction, "QuadraticNormal(c_N=7.0).traction", g), 2, "traction", "t_N, dt_N/dg_N")
-    compare("t_N (c_N = 7)", t_N, np.where(g < 0, -7.0 * g ** 2, 0.0), {"g_N": g})
+    compare("t_N (c_N = 7)", t_N, np.where(g < 0, -7.0 * g**2, 0.0), {"g_N": g})
     compare("dt_N/dg_N (c_N = 7)", dt_N, np.where(g < 0, -14.0 * g, 0.0), {"g_N": g})
 
 
@@ -214,11 +256,17 @@ def quadratic_energy_other(QuadraticNormal):
     law = QuadraticNormal(c_N=7.0)
     g = np.array([0.3, -0.002, -0.6, -2.0])
     E = np.asarray(call(law.energy, "QuadraticNormal(c_N=7.0).energy", g), dtype=float)
-    compare("energy (c_N = 7)", E, np.where(g < 0, 7.0 * (-g) ** 3 / 3.0, 0.0), {"g_N": g},
-            rule="the energy whose derivative is t_N = -c_N g_N^2: c_N (-g_N)^3 / 3")
+    compare(
+        "energy (c_N = 7)",
+        E,
+        np.where(g < 0, 7.0 * (-g) ** 3 / 3.0, 0.0),
+        {"g_N": g},
+        rule="the energy whose derivative is t_N = -c_N g_N^2: c_N (-g_N)^3 / 3",
+    )
 
 
 # -- lecture 11 ----------------------------------------------------------------------------------
+
 
 def uzawa_other(uzawa_1dof):
     from contactfem.lab.course.checks import _uzawa
@@ -237,11 +285,17 @@ def secant_other(secant_traction):
     for g0, g1 in ((0.3, -0.2), (-0.5, -0.45), (-0.1, -0.9)):
         F = float(np.asarray(call(secant_traction, "secant_traction", law, g0, g1), dtype=float))
         want = float((law.energy(np.array([g1])) - law.energy(np.array([g0])))[0] / (g1 - g0))
-        compare("secant traction (c_N = 7, m = 1.7)", F, want, {"g0": g0, "g1": g1},
-                rule="F (g1 - g0) = energy(g1) - energy(g0)")
+        compare(
+            "secant traction (c_N = 7, m = 1.7)",
+            F,
+            want,
+            {"g0": g0, "g1": g1},
+            rule="F (g1 - g0) = energy(g1) - energy(g0)",
+        )
 
 
 # -- lectures 04-08 (the closed forms) -----------------------------------------------------------------
+
 
 def margin_other(slip_margin):
     from contactfem.laws import Coulomb
@@ -259,8 +313,12 @@ def rolling_other(rolling_point):
     case = (120.0, 0.4, 981.0, 30.0, 400.0)
     got = parts(call(rolling_point, "rolling_point", *case), 3, "rolling_point", "t*, x*, v*")
     ref = rigid_ring_exact(*case)
-    compare("(t*, x*, v*) at v0 = 120, mu = 0.4, a = 30, k^2 = 400", np.array([float(np.asarray(x)) for x in got]),
-            np.array([ref["t_star"], ref["x_star"], ref["v_star"]]), {"value": ["t*", "x*", "v*"]})
+    compare(
+        "(t*, x*, v*) at v0 = 120, mu = 0.4, a = 30, k^2 = 400",
+        np.array([float(np.asarray(x)) for x in got]),
+        np.array([ref["t_star"], ref["x_star"], ref["v_star"]]),
+        {"value": ["t*", "x*", "v*"]},
+    )
 
 
 def rebound_other(rebound):
@@ -281,15 +339,24 @@ def energy_other(interface_energy):
     t_T = np.array([0.5, 0.0, -3.0])
     w = np.array([0.25, 1.0, 3.0])
     got = _interface(interface_energy, g, t_T, w, 9.0, 2.0, 4.0)
-    compare("interface energy (c_N = 9, m = 2, c_T = 4)", got, _energy_ref(g, t_T, w, 9.0, 2.0, 4.0),
-            {"g_N": "-0.4, 0.1, -0.01"})
+    compare(
+        "interface energy (c_N = 9, m = 2, c_T = 4)",
+        got,
+        _energy_ref(g, t_T, w, 9.0, 2.0, 4.0),
+        {"g_N": "-0.4, 0.1, -0.01"},
+    )
 
 
 def escape_other(escape_angle):
     p = np.array([0.02, 0.7, 25.0])
     got = np.asarray(call(escape_angle, "escape_angle", p, 0.5, 0.05, 0.6), dtype=float)
-    compare("escape angle (deg; alpha = 0.5, beta = 0.05, n = 0.6)", got,
-            np.degrees(np.arctan(0.5 * p ** -0.4 + 0.05)), {"p": p}, rule="tan(phi) = alpha p^(n-1) + beta")
+    compare(
+        "escape angle (deg; alpha = 0.5, beta = 0.05, n = 0.6)",
+        got,
+        np.degrees(np.arctan(0.5 * p**-0.4 + 0.05)),
+        {"p": p},
+        rule="tan(phi) = alpha p^(n-1) + beta",
+    )
 
 
 def gas_other(gas_pressure):
@@ -305,11 +372,16 @@ def hardening_return_other(hardening_return):
     for case in ((0.5, 0.3, 1.2, 0.4), (-0.3, -0.5, 2.0, 2.0)):
         got = _hardening_return(hardening_return, *case, c_T=6.0, mu0=0.25, h=0.3)
         want = _hardening_ref(*case, c_T=6.0, mu0=0.25, h=0.3)
-        compare("(t_T, lambda, q) (c_T = 6, mu0 = 0.25, h = 0.3)", np.array(got), np.array(want),
-                {"value": ["t_T", "lambda", "q"]})
+        compare(
+            "(t_T, lambda, q) (c_T = 6, mu0 = 0.25, h = 0.3)",
+            np.array(got),
+            np.array(want),
+            {"value": ["t_T", "lambda", "q"]},
+        )
 
 
 # -- lecture 12 -----------------------------------------------------------------------------------
+
 
 def ct_other(C_T):
     from contactfem.lab.course.checks import _ct, _ct_ref
@@ -335,6 +407,7 @@ def ssn_other(semismooth_1dof):
 
 # -- the time loops (lectures 04 and 07): another number of steps ------------------------------------
 
+
 def load_steps_two(load_steps):
     from contactfem.lab.course.checks import _load_steps, _load_steps_ref
 
@@ -342,9 +415,13 @@ def load_steps_two(load_steps):
     want = _load_steps_ref(2)
     if t.size != 2:
         raise AssertionError(f"load_steps(stepper, 2) should give one entry per load step, 2, got {t.size}")
-    compare("the load in two steps: (t, solves, slipping nodes)", np.r_[t, its, slip],
-            np.r_[want[0], want[1], want[2]], {"entry": ["t1", "t2", "solves1", "solves2", "slip1", "slip2"]},
-            rule="Steps(1 / n, n_steps=n), rec.iterations, the SLIP states of each record")
+    compare(
+        "the load in two steps: (t, solves, slipping nodes)",
+        np.r_[t, its, slip],
+        np.r_[want[0], want[1], want[2]],
+        {"entry": ["t1", "t2", "solves1", "solves2", "slip1", "slip2"]},
+        rule="Steps(1 / n, n_steps=n), rec.iterations, the SLIP states of each record",
+    )
 
 
 def _census_short(census):
@@ -375,8 +452,10 @@ def _census_short(census):
 def census_short(census):
     (t, n_c, n_s), (w_t, w_c, w_s) = _census_short(census)
     if t.size != w_t.size:
-        raise AssertionError(f"on a schedule of 12 steps your census has {t.size} entries, the run {w_t.size} "
-                             "records (the initial state included): loop over the schedule you are given")
+        raise AssertionError(
+            f"on a schedule of 12 steps your census has {t.size} entries, the run {w_t.size} "
+            "records (the initial state included): loop over the schedule you are given"
+        )
     at = {"record": np.arange(t.size)}
     compare("time of each record (12 steps)", t, w_t, at)
     compare("nodes in contact (12 steps)", n_c, w_c, at)

@@ -1,5 +1,6 @@
 """Every run knows how accurate it is: Newton's force test, the accuracy indicators, and each
 run of the accuracy study right to its tolerance, flagged by a named indicator, or refused."""
+
 import subprocess
 import sys
 import warnings
@@ -17,7 +18,7 @@ def _run(name, overrides, preset="fast"):
         warnings.simplefilter("always")
         r = run_scene(name, preset, overrides)
     flagged = {str(w.message).split(" = ")[0].split(": ")[1] for w in caught if issubclass(w.category, AccuracyWarning)}
-    assert flagged == {k for k, v in r["accuracy"].items() if not v["ok"]}     # one warning per indicator past it
+    assert flagged == {k for k, v in r["accuracy"].items() if not v["ok"]}  # one warning per indicator past it
     return r, flagged
 
 
@@ -29,6 +30,7 @@ def test_newton_ignores_a_huge_first_residual():
     def fun(u):
         G = np.array([k * (u[0] - 1.0) + 1e12 * min(u[0], 0.0)])
         return G, np.array([[k + (1e12 if u[0] < 0 else 0.0)]])
+
     res = newton(fun, np.array([-1.0]), [0], atol=0.0)
     assert abs(res.u[0] - 1.0) <= 10 * RTOL
     assert res.residual_ratio <= RTOL
@@ -38,8 +40,9 @@ def test_hertz_too_stiff_penalty_is_refused_in_one_line():
     with pytest.raises(ValueError, match=r"^parameter c_N = 1e\+18 is out of range") as err:
         run_scene("hertz", "fast", {"c_N": 1e18})
     assert "\n" not in str(err.value)
-    out = subprocess.run([sys.executable, "-m", "contactfem", "run", "hertz", "--set", "c_N=1e18"], capture_output=True,
-                         text=True)
+    out = subprocess.run(
+        [sys.executable, "-m", "contactfem", "run", "hertz", "--set", "c_N=1e18"], capture_output=True, text=True
+    )
     assert out.returncode == 2 and len(out.stderr.strip().splitlines()) == 1
 
 
@@ -47,7 +50,7 @@ def test_hertz_too_stiff_penalty_is_refused_in_one_line():
 def test_lagrange_patch_converges_at_stiff_steering(discretization):
     r, flagged = _run("patch", {"enforcement": "lagrange", "c_N": 1e8, "contact_discretization": discretization})
     assert not flagged
-    assert r["pressure_deviation_max"] < 0.03                   # the default c_N's answer (c_N only steers)
+    assert r["pressure_deviation_max"] < 0.03  # the default c_N's answer (c_N only steers)
     assert r["gap_violation"] < 1e-12
 
 
@@ -72,7 +75,7 @@ def test_the_same_run_twice_warns_twice_under_the_default_filters():
         warnings.showwarning = lambda message, category, filename, lineno, *a, **k: shown.append((category, filename))
         for _ in range(2):
             run_scene("block", "fast", {"c_N": 10})
-    assert [c for c, _ in shown].count(AccuracyWarning) >= 4           # penetration and penetration_body, twice
+    assert [c for c, _ in shown].count(AccuracyWarning) >= 4  # penetration and penetration_body, twice
 
 
 @pytest.mark.parametrize("over", [{"n_el": 4}, {"n_el": 20}, {"c_N_factor": 0.1}])
@@ -97,7 +100,7 @@ def test_rolling_ring_coarse_step_is_flagged_by_v_final(integration):
 
 def test_rolling_ring_sliding_reference():
     r, flagged = _run("rolling_ring", {"mu": 1e-9})
-    assert r["v_final_exact"] == pytest.approx(300.0, rel=1e-6)   # the ring slides to the end: v0 - mu g t
+    assert r["v_final_exact"] == pytest.approx(300.0, rel=1e-6)  # the ring slides to the end: v0 - mu g t
     assert abs(r["v_final_rel_err"]) < 1e-6 and not flagged
 
 
@@ -120,37 +123,41 @@ def test_funnel_paper_penalty_is_flagged_by_its_penetration_alone():
 @pytest.mark.slow
 def test_energy_consistent_stiff_penalty_keeps_energy_or_is_flagged():
     r, flagged = _run("sloping_impact", {"contact_integration": "energy_consistent", "c_N": 5e7})
-    assert abs(r["energy_error"]) < 1e-8                          # the force test resolves it (was 3.3e-6)
-    assert "impact_steps" in flagged                              # one step for the whole impact
+    assert abs(r["energy_error"]) < 1e-8  # the force test resolves it (was 3.3e-6)
+    assert "impact_steps" in flagged  # one step for the whole impact
 
 
 @pytest.mark.slow
 def test_cli_strict_exits_1_with_one_line_per_indicator(tmp_path):
-    out = subprocess.run([sys.executable, "-m", "contactfem", "run", "block", "--set", "c_N=10", "--strict"],
-                         capture_output=True, text=True)
+    out = subprocess.run(
+        [sys.executable, "-m", "contactfem", "run", "block", "--set", "c_N=10", "--strict"],
+        capture_output=True,
+        text=True,
+    )
     lines = [x for x in out.stderr.splitlines() if "accuracy:" in x]
     assert out.returncode == 1 and len(lines) == 2
-    out = subprocess.run([sys.executable, "-m", "contactfem", "run", "block", "--set", "c_N=10"], capture_output=True,
-                         text=True)
+    out = subprocess.run(
+        [sys.executable, "-m", "contactfem", "run", "block", "--set", "c_N=10"], capture_output=True, text=True
+    )
     assert out.returncode == 0
 
 
 @pytest.mark.parametrize("lower, upper, off", [(11, 5, 1.0), (17, 3, 3.78)])
 def test_patch_pressure_covers_both_blocks(lower, upper, off):
     r, flagged = _run("patch", {"nx_lower": lower, "nx_upper": upper})
-    assert r["pressure_deviation_lower"] == pytest.approx(off, rel=0.01)    # master nodes that get no load
+    assert r["pressure_deviation_lower"] == pytest.approx(off, rel=0.01)  # master nodes that get no load
     assert r["pressure_deviation_max"] >= r["pressure_deviation_lower"]
     assert "pressure_deviation" in flagged
     mortar, flagged = _run("patch", {"nx_lower": lower, "nx_upper": upper, "contact_discretization": "mortar"})
-    assert mortar["pressure_deviation_max"] < 1e-9 and not flagged       # mortar passes on both blocks
+    assert mortar["pressure_deviation_max"] < 1e-9 and not flagged  # mortar passes on both blocks
 
 
 def test_hertz_mortar_half_width_from_the_forces_moments():
     m, flagged = _run("hertz", {"contact_discretization": "mortar"})
     n, _ = _run("hertz", {})
-    assert abs(m["error_a_fit"]) > 0.04                    # the fit through mortar's smeared edge tractions
+    assert abs(m["error_a_fit"]) > 0.04  # the fit through mortar's smeared edge tractions
     assert abs(m["error_a"]) < 0.03 and m["a"] == m["a_moments"] and not flagged
-    assert n["a"] == n["a_fit"] and abs(n["error_a_moments"]) < 5e-3      # node-to-segment: both agree with Hertz
+    assert n["a"] == n["a_fit"] and abs(n["error_a_moments"]) < 5e-3  # node-to-segment: both agree with Hertz
 
 
 @pytest.mark.parametrize("ext", ["json", "npz"])

@@ -1,6 +1,7 @@
 """A tolerance the user can ask for (a dynamic scene's ``accuracy``): the local error estimate
 of a step (solver/schedule.py: Estimated, error_step) against the exact motion of an
 oscillator, the rule's fixed point, and the scenes' adaptive runs."""
+
 import math
 import warnings
 
@@ -14,17 +15,19 @@ from contactfem.solver.schedule import Estimated, StepRejected, error_step
 
 class _Oscillator:
     """Newmark (delta, beta) on m u'' + k u = 0 (m = 2, one dof), solved in closed form."""
+
     dynamic = True
 
     def __init__(self, delta, beta, k=3.0, m=2.0):
         self.delta, self.beta, self.k, self.m = delta, beta, k, m
         body = type("B", (), {"xdofs": np.array([[0, 0]])})()
-        self.system = type("S", (), {"lumped_mass": lambda s: np.array([m]), "bodies": [body], "ndof": 1,
-                                     "offset": lambda s, obj: 0})()
+        self.system = type(
+            "S", (), {"lumped_mass": lambda s: np.array([m]), "bodies": [body], "ndof": 1, "offset": lambda s, obj: 0}
+        )()
 
     def step(self, t, u, v, a, dt, label="", *, state=None):
-        u_pred = u + dt * v + dt ** 2 * (0.5 - self.beta) * a
-        u1 = u_pred / (1.0 + self.beta * dt ** 2 * self.k / self.m)
+        u_pred = u + dt * v + dt**2 * (0.5 - self.beta) * a
+        u1 = u_pred / (1.0 + self.beta * dt**2 * self.k / self.m)
         a1 = -self.k / self.m * u1
         v1 = v + dt * ((1.0 - self.delta) * a + self.delta * a1)
         return u1, v1, a1, NewtonResult(u=u1)
@@ -42,13 +45,13 @@ def _velocity_error(osc, dt, u=np.array([1.0]), v=np.array([0.5])):
 @pytest.mark.parametrize("dt", [1e-2, 1e-3])
 def test_estimate_is_the_first_order_error_of_newmark_delta_07(dt):
     est, err = _velocity_error(_Oscillator(0.7, 0.4), dt)
-    assert est == pytest.approx(err, rel=20 * dt)         # the leading term, to O(dt)
+    assert est == pytest.approx(err, rel=20 * dt)  # the leading term, to O(dt)
 
 
 @pytest.mark.parametrize("dt", [1e-1, 1e-2, 1e-3])
 def test_estimate_bounds_the_trapezoidal_rule_error(dt):
     est, err = _velocity_error(_Oscillator(0.5, 0.25), dt)
-    assert err <= est and est < 10 * err / dt              # a bound, one order of dt above the error
+    assert err <= est and est < 10 * err / dt  # a bound, one order of dt above the error
 
 
 @pytest.mark.parametrize("dt", [1e-1, 1e-2, 1e-3])
@@ -64,7 +67,7 @@ def test_second_difference_is_the_trapezoidal_rule_error(dt, ratio):
     a0 = -osc.k / osc.m * u0
     u1, v1, a1, _ = osc.step(0.0, u0, v0, a0, dt)
     before = type("State", (), {"stepper": ((a1 - a0) / dt, dt)})()
-    u1, v1 = (np.array([x]) for x in exact(dt))                      # the step from the exact state
+    u1, v1 = (np.array([x]) for x in exact(dt))  # the step from the exact state
     h = ratio * dt
     _, v2, _, second = Estimated(osc).step(dt, u1, v1, -osc.k / osc.m * u1, h, state=before)
     assert second.local_error == pytest.approx(abs(v2[0] - exact(dt + h)[1]), rel=dt)
@@ -92,7 +95,7 @@ def test_a_step_past_twice_its_share_is_rejected_down_to_the_floor():
     with pytest.raises(StepRejected, match="local error"):
         strict.step(0.0, u, v, a, 0.1, state=None)
     assert Estimated(osc, share=lambda dt: 0.6 * e, floor=0.01).step(0.0, u, v, a, 0.1, state=None)[3].local_error == e
-    assert strict.step(0.0, u, v, a, 0.01, state=None)[3].local_error > 0     # at the floor: kept
+    assert strict.step(0.0, u, v, a, 0.01, state=None)[3].local_error > 0  # at the floor: kept
 
 
 def test_error_step_fixed_point_first_step_and_cap():
@@ -100,16 +103,16 @@ def test_error_step_fixed_point_first_step_and_cap():
     rec.k, rec.dt = 5, 0.01
     tol, speed, duration = 1e-3, 2.0, 4.0
     rec.result = NewtonResult(u=None, local_error=tol * speed * rec.dt / duration)
-    assert error_step(rec, tol, speed, duration, 1e-5, 1.0) == pytest.approx(rec.dt)   # on target: kept
+    assert error_step(rec, tol, speed, duration, 1e-5, 1.0) == pytest.approx(rec.dt)  # on target: kept
     rec.result.local_error *= 4.0
     assert error_step(rec, tol, speed, duration, 1e-5, 1.0) == pytest.approx(rec.dt / 4)
     assert error_step(rec, tol, speed, duration, 1e-5, 1.0, power=0.5) == pytest.approx(rec.dt / 2)
     rec.result.local_error *= 1e6
-    assert error_step(rec, tol, speed, duration, 1e-5, 1.0) == 1e-5      # never below the first step
+    assert error_step(rec, tol, speed, duration, 1e-5, 1.0) == 1e-5  # never below the first step
     rec.result.local_error = 0.0
-    assert error_step(rec, tol, speed, duration, 1e-5, 0.02) == 0.02      # nothing to resolve: dt_max
+    assert error_step(rec, tol, speed, duration, 1e-5, 0.02) == 0.02  # nothing to resolve: dt_max
     rec.k = 0
-    assert error_step(rec, tol, speed, duration, 1e-5, 0.02) == 1e-5      # no estimate yet
+    assert error_step(rec, tol, speed, duration, 1e-5, 0.02) == 1e-5  # no estimate yet
 
 
 @pytest.mark.parametrize("scene", ["sloping_impact", "rolling_ring", "bar_impact", "cork"])
@@ -117,7 +120,7 @@ def test_accuracy_is_a_parameter_off_by_default(scene):
     s = get_scene(scene)
     assert s.resolve("fast")["accuracy"] == 0.0
     assert s.resolve("fast", {"accuracy": "1e-3"})["accuracy"] == 1e-3
-    for bad in (-1e-3, 0.5, "tight", 1e-4, 1e-300, float("nan")):     # below 1e-3: steps below round-off
+    for bad in (-1e-3, 0.5, "tight", 1e-4, 1e-300, float("nan")):  # below 1e-3: steps below round-off
         with pytest.raises(ValueError, match=r"parameter accuracy = .* allowed 0 \(fixed steps\) or \[0.001, 0.1\]"):
             s.resolve("fast", {"accuracy": bad})
 
@@ -142,9 +145,15 @@ def test_adaptive_run_reports_its_steps_and_repeats_bit_for_bit():
     assert a["stepping"]["dt_min"] < a["stepping"]["dt_max"]
     assert np.array_equal(a["time"], b["time"]) and np.array_equal(a["contact_stress"], b["contact_stress"])
     fixed = _bar({})
-    assert fixed["stepping"] == dict(mode="fixed", accuracy=None, integrator="newmark delta = 0.5, beta = 0.25 "
-                                     "(trapezoidal rule)", steps=fixed["n_steps"], dt_min=pytest.approx(fixed["dt"]),
-                                     dt_max=pytest.approx(fixed["dt"]), at_floor=None)
+    assert fixed["stepping"] == dict(
+        mode="fixed",
+        accuracy=None,
+        integrator="newmark delta = 0.5, beta = 0.25 (trapezoidal rule)",
+        steps=fixed["n_steps"],
+        dt_min=pytest.approx(fixed["dt"]),
+        dt_max=pytest.approx(fixed["dt"]),
+        at_floor=None,
+    )
 
 
 def test_steps_kept_past_twice_their_share_are_at_the_floor_and_their_time_is_reported():
@@ -170,7 +179,7 @@ def test_steps_kept_past_twice_their_share_are_at_the_floor_and_their_time_is_re
     budget = r["accuracy"]["error_budget"]
     assert budget["value"] > 2 and f"{100 * r['stepping']['at_floor']:.0f} % of the run's time" in budget["what"]
     assert any("error_budget" in str(w.message) for w in caught)
-    bar = _bar({"accuracy": 1e-3})                          # within its budget: no step past twice its share
+    bar = _bar({"accuracy": 1e-3})  # within its budget: no step past twice its share
     assert bar["stepping"]["at_floor"] == 0.0 and bar["accuracy"]["error_budget"]["value"] <= 2
 
 
@@ -192,7 +201,7 @@ def test_a_run_at_a_tolerance_is_trapezoidal_and_carries_its_slope_as_a_value():
     assert h == records[k].dt and np.array_equal(slope, (records[k].a - records[k - 1].a) / h)
     again = list(resume(model.stage.stepper, model.stage.schedule, records[k]))
     assert len(again) == len(records) - k - 1
-    for a, b in zip(again, records[k + 1:]):
+    for a, b in zip(again, records[k + 1 :]):
         assert a.t == b.t and np.array_equal(a.u, b.u) and a.result.local_error == b.result.local_error
 
 
@@ -209,11 +218,12 @@ def test_a_tolerance_the_run_cannot_vouch_for_warns():
             budget = run_scene(scene, "fast", over)["accuracy"]["error_budget"]
         warned = any(issubclass(w.category, AccuracyWarning) and "error_budget" in str(w.message) for w in caught)
         assert warned == (budget["value"] > 2.0) == (not budget["ok"]), scene
-        assert budget["ok"] or scene == "rolling_ring", (scene, budget["value"])   # the bar's impact: resolved
-    assert "error_budget" not in _bar({})["accuracy"]                 # fixed steps: no tolerance to keep
+        assert budget["ok"] or scene == "rolling_ring", (scene, budget["value"])  # the bar's impact: resolved
+    assert "error_budget" not in _bar({})["accuracy"]  # fixed steps: no tolerance to keep
 
 
 # -- the adaptive mode against a reference refined in time (the bench's study 10, in small) ---------
+
 
 def _largest_fixed_reaching(scene, ladder, error, ref, trapezoidal=False):
     """The first step of the ladder (coarse to fine) whose run is within ``error`` of ``ref``, with its cost
@@ -245,7 +255,7 @@ def test_bar_impact_at_a_tolerance(tol, bar_reference):
     run = study.adaptive_run("bar_impact", tol)
     error = study.max_error(run, ref)
     assert error <= tol and run["error_budget"] <= 2.0
-    ladder = study.STUDY["bar_impact"]["ladder"] + (2 * bar_reference["h_ref"],)   # (not the reference's run itself)
+    ladder = study.STUDY["bar_impact"]["ladder"] + (2 * bar_reference["h_ref"],)  # (not the reference's run itself)
     h, fixed = _largest_fixed_reaching("bar_impact", ladder, error, ref)
     assert h is not None, f"no fixed step of the ladder reaches {error:.2e}"
     assert run["residual_evaluations"] <= fixed["residual_evaluations"]
@@ -308,28 +318,32 @@ def test_command_line_equals_python(tmp_path):
 
 def test_matching_fixed_is_the_largest_step_that_stays_within_the_error():
     """A coarse step whose error dips below, with a finer step above it, is not a match."""
-    fixed = [dict(h=1.0, error=0.02, residual_evaluations=10, newton_iterations=5, wall_time_s=0.1),
-             dict(h=0.5, error=0.004, residual_evaluations=20, newton_iterations=10, wall_time_s=0.2),
-             dict(h=0.25, error=0.006, residual_evaluations=40, newton_iterations=20, wall_time_s=0.4),
-             dict(h=0.125, error=0.001, residual_evaluations=80, newton_iterations=40, wall_time_s=0.8)]
-    assert study.matching_fixed(fixed, 0.005)["h"] == 0.125        # 0.5 dips below, 0.25 does not
-    assert study.matching_fixed(fixed, 0.007)["h"] == 0.5          # 0.5, 0.25 and 0.125 all within
+    fixed = [
+        dict(h=1.0, error=0.02, residual_evaluations=10, newton_iterations=5, wall_time_s=0.1),
+        dict(h=0.5, error=0.004, residual_evaluations=20, newton_iterations=10, wall_time_s=0.2),
+        dict(h=0.25, error=0.006, residual_evaluations=40, newton_iterations=20, wall_time_s=0.4),
+        dict(h=0.125, error=0.001, residual_evaluations=80, newton_iterations=40, wall_time_s=0.8),
+    ]
+    assert study.matching_fixed(fixed, 0.005)["h"] == 0.125  # 0.5 dips below, 0.25 does not
+    assert study.matching_fixed(fixed, 0.007)["h"] == 0.5  # 0.5, 0.25 and 0.125 all within
     assert study.matching_fixed(fixed, 0.002)["residual_evaluations"] == 80
     assert study.matching_fixed(fixed, 1e-4) is None
     assert study.matching_fixed(fixed, float("nan")) is None and study.matching_fixed(fixed, None) is None
     assert study.matching_fixed([], 0.1) is None
     failed = [dict(fixed[0]), dict(fixed[1]), dict(fixed[2], error=None), dict(fixed[3])]
-    assert study.matching_fixed(failed, 0.05)["h"] == 0.125        # a failed point ends the search
+    assert study.matching_fixed(failed, 0.05)["h"] == 0.125  # a failed point ends the search
     nan = [dict(f) for f in fixed[:3]] + [dict(fixed[3], error=float("nan"))]
-    assert study.matching_fixed(nan, 0.05) is None                 # NaN is not within
+    assert study.matching_fixed(nan, 0.05) is None  # NaN is not within
 
 
 def test_matches_below_the_reference_change_and_at_the_tolerance():
     """A run's error below the reference's own change is matched at that change (the finest step of
     a ladder is the reference's neighbour, its error that change); the tolerance's own match is the
     cheaper ladder's, and none where the reference moves by more than half the tolerance."""
-    ladder = [dict(h=h, error=e, residual_evaluations=n, newton_iterations=n, wall_time_s=0.0)
-              for h, e, n in ((0.4, 2e-2, 10), (0.2, 4e-3, 20), (0.1, 1e-3, 40), (0.05, 2e-4, 80))]
+    ladder = [
+        dict(h=h, error=e, residual_evaluations=n, newton_iterations=n, wall_time_s=0.0)
+        for h, e, n in ((0.4, 2e-2, 10), (0.2, 4e-3, 20), (0.1, 1e-3, 40), (0.05, 2e-4, 80))
+    ]
     trap = [dict(f, residual_evaluations=f["residual_evaluations"] // 2) for f in ladder[1:]]
     a = dict(accuracy=1e-2, error=1e-5)
     m = study.matches(a, ladder, trap, reference_change=2e-4)

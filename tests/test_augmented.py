@@ -7,6 +7,7 @@
   6 multiplier updates at the scene's c_N, and the results (p0, totals, nodal tractions)
   the same to 1e-6 with c_N 100 times smaller and larger.
 """
+
 from dataclasses import replace
 
 import numpy as np
@@ -22,8 +23,11 @@ from contactfem.scenes.hertz import hertz_exact
 from contactfem.solver import NewtonError
 
 NORMALS = {"penalty": PowerLaw(c_N=50.0), "power2.5": PowerLaw(c_N=80.0, m=2.5)}
-FRICTIONS = {"none": None, "coulomb": Coulomb(c_T=30.0, mu=0.3),
-             "parabolic": ParabolicSlip(c_T=30.0, alpha=0.2, beta=0.3, n=0.5)}
+FRICTIONS = {
+    "none": None,
+    "coulomb": Coulomb(c_T=30.0, mu=0.3),
+    "parabolic": ParabolicSlip(c_T=30.0, alpha=0.2, beta=0.3, n=0.5),
+}
 
 
 def with_multipliers(iface, rng, u, h):
@@ -41,8 +45,14 @@ def with_multipliers(iface, rng, u, h):
 @pytest.mark.parametrize("regime", ["stick", "slip+", "slip-"])
 def test_augmented_rigid_master_tangent(rng, master, nlaw, flaw, regime):
     body, u = slave_cloud(rng)
-    iface = AugmentedNodeToSegment(body, np.arange(4), make_master(master), normal=NORMALS[nlaw],
-                                   friction=FRICTIONS[flaw], weights=rng.uniform(0.5, 1.5, 4))
+    iface = AugmentedNodeToSegment(
+        body,
+        np.arange(4),
+        make_master(master),
+        normal=NORMALS[nlaw],
+        friction=FRICTIONS[flaw],
+        weights=rng.uniform(0.5, 1.5, 4),
+    )
     dg = {"stick": 1e-6, "slip+": 0.5, "slip-": -0.5}[regime]
     h = with_multipliers(iface, rng, u, set_history(iface, u, t_T_bar=0.0, dg=dg))
     e = iface.evaluate(u, dt=DT, history=h)
@@ -59,15 +69,17 @@ def test_augmented_deformable_master_tangent(rng, flaw, regime):
     mb = PointCloud(Xm, "master")
     sb = PointCloud(np.stack([np.linspace(0.1, 0.9, 3), np.zeros(3)], axis=1), "slave", dof_offset=mb.ndof)
     u = np.zeros(mb.ndof + sb.ndof)
-    u[:mb.ndof] = 0.02 * rng.standard_normal(mb.ndof)
-    u[mb.ndof + 1::2] = -0.06 - 0.02 * rng.random(3)
+    u[: mb.ndof] = 0.02 * rng.standard_normal(mb.ndof)
+    u[mb.ndof + 1 :: 2] = -0.06 - 0.02 * rng.random(3)
     surface = BodySurface(mb, np.arange(5))
-    iface = AugmentedNodeToSegment(sb, np.arange(3), surface, normal=NORMALS["penalty"], friction=FRICTIONS[flaw],
-                                   weights=0.7)
+    iface = AugmentedNodeToSegment(
+        sb, np.arange(3), surface, normal=NORMALS["penalty"], friction=FRICTIONS[flaw], weights=0.7
+    )
     u_old = u.copy()
-    u_old[:mb.ndof] *= 0.3
-    h = set_history(iface, u, t_T_bar=0.01, dg={"stick": 1e-6, "slip+": 0.5, "slip-": -0.5}[regime],
-                    master=surface.reference(u_old))
+    u_old[: mb.ndof] *= 0.3
+    h = set_history(
+        iface, u, t_T_bar=0.01, dg={"stick": 1e-6, "slip+": 0.5, "slip-": -0.5}[regime], master=surface.reference(u_old)
+    )
     h = with_multipliers(iface, rng, u, h)
     assert np.all(iface.evaluate(u, dt=DT, history=h).active)
     check_tangent(iface, u, h)
@@ -79,8 +91,9 @@ def test_multiplier_opens_and_closes_contact(rng):
     does too, a node above the plane with lam_N = 0 is open (no force, no tangent)."""
     body = PointCloud([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]], "slave")
     u = np.array([0.0, 0.01, 0.0, -0.01, 0.0, 0.01])
-    iface = AugmentedNodeToSegment(body, np.arange(3), make_master("line"), normal=PowerLaw(50.0),
-                                   friction=Coulomb(30.0, 0.3))
+    iface = AugmentedNodeToSegment(
+        body, np.arange(3), make_master("line"), normal=PowerLaw(50.0), friction=Coulomb(30.0, 0.3)
+    )
     h = replace(iface.start(u), lam_N=np.array([-1.0, 0.0, 0.0]))
     e = iface.evaluate(u, history=h)
     assert list(e.active) == [True, True, False]
@@ -95,8 +108,9 @@ def test_multiplier_opens_and_closes_contact(rng):
 
 def test_constitutive_power_law_keeps_its_meaning():
     body = PointCloud([[0.0, 0.0]], "slave")
-    iface = AugmentedNodeToSegment(body, [0], make_master("line"), normal=PowerLaw(80.0, m=2.5),
-                                   friction=Coulomb(30.0, 0.3))
+    iface = AugmentedNodeToSegment(
+        body, [0], make_master("line"), normal=PowerLaw(80.0, m=2.5), friction=Coulomb(30.0, 0.3)
+    )
     assert not iface.augment_normal
     u = np.array([0.0, -0.1])
     h = iface.start(u)
@@ -104,7 +118,7 @@ def test_constitutive_power_law_keeps_its_meaning():
     v = iface.violation(e)
     h = iface.update_multipliers(e)
     assert v["penetration"] == 0.0 and np.all(h.lam_N == 0.0)
-    assert np.isclose(iface.evaluate(u, history=h).t_N[0], -80.0 * 0.1 ** 2.5)
+    assert np.isclose(iface.evaluate(u, history=h).t_N[0], -80.0 * 0.1**2.5)
 
 
 def test_bad_enforcement_raises():
@@ -125,6 +139,7 @@ def test_too_few_updates_raise_with_history():
 
 # -- Hertz and the block -------------------------------------------------------------
 
+
 def _tol(c_N, p, L):
     """A gap tolerance that bounds the traction error c_N * gap below 1e-7 p (the last
     multiplier update changes the traction by about c_N times the remaining penetration)."""
@@ -133,11 +148,10 @@ def _tol(c_N, p, L):
 
 @pytest.fixture(scope="module")
 def hertz_runs():
-    a, p0 = hertz_exact(2000.0, 10.0, 2.0e5, 0.3)          # the scene's defaults
+    a, p0 = hertz_exact(2000.0, 10.0, 2.0e5, 0.3)  # the scene's defaults
     out = {}
     for c_N in (1e7, 1e9, 1e11):
-        out[c_N] = run_scene("hertz", "fast", {"enforcement": "augmented", "c_N": c_N,
-                                               "uzawa_tol": _tol(c_N, p0, a)})
+        out[c_N] = run_scene("hertz", "fast", {"enforcement": "augmented", "c_N": c_N, "uzawa_tol": _tol(c_N, p0, a)})
     out["default"] = run_scene("hertz", "fast", {"enforcement": "augmented", "uzawa_tol": 1e-8})
     return out
 
@@ -145,10 +159,10 @@ def hertz_runs():
 @pytest.mark.slow
 def test_hertz_augmented_reaches_1e8_in_6_updates(hertz_runs):
     r = hertz_runs["default"]
-    assert r["c_N_per_length_min"] == 1e9                 # the scene's default c_N
+    assert r["c_N_per_length_min"] == 1e9  # the scene's default c_N
     assert r["gap_violation"] < 1e-8 and r["multiplier_updates"] <= 6, (r["gap_violation"], r["multiplier_updates"])
     pen = run_scene("hertz", "fast")
-    assert pen["gap_violation"] > 1e-6                    # the penalty: a penetration of ~1e-5 a
+    assert pen["gap_violation"] > 1e-6  # the penalty: a penetration of ~1e-5 a
 
 
 @pytest.mark.slow
@@ -166,12 +180,12 @@ def test_hertz_augmented_independent_of_penalty(hertz_runs, c_N):
 def test_block_augmented(law):
     # the canonical block (4 x 3.5, 20 x 10: element size 4 / 20) of the augmented-Lagrangian study
     base = {"law": law, "enforcement": "augmented"}
-    h, p = 4.0 / 20, 200.0                                  # element size, traction scale (p_y)
+    h, p = 4.0 / 20, 200.0  # element size, traction scale (p_y)
     runs = {c: run_scene("block", "canonical", dict(base, c_N=c, uzawa_tol=_tol(c, p, h))) for c in (1e3, 1e5, 1e7)}
     ref = runs[1e5]
     # at the scene's c_N: penetration / element size < 1e-8 after at most 6 multiplier updates
     gaps = ref["gap_violation_per_outer"]
-    first = next(k for k, g in enumerate(gaps) if g < 1e-8)   # outer iteration k follows k updates
+    first = next(k for k, g in enumerate(gaps) if g < 1e-8)  # outer iteration k follows k updates
     assert first <= 6, gaps
     for c in (1e3, 1e7):
         r = runs[c]

@@ -1,5 +1,6 @@
 """The bar_impact scene against 1-D wave theory: contact lasts 2 L / c, the contact
 stress is rho c v0, the bar rebounds at v0, and no energy is lost (delta = 1/2, beta = 1/4)."""
+
 import pytest
 
 from contactfem.scenes import run_scene
@@ -47,12 +48,12 @@ def test_energy_when_contact_starts_between_steps(fast, fraction):
     assert r["energy_error_max"] < 5e-3
     finer = run_scene("bar_impact", "fast", {"n_el": 80, "gap": fraction * r["parameters"]["v0"] * r["dt"] / 2})
     ratio = r["energy_error"] / finer["energy_error"]
-    assert 1.6 < ratio < 2.6, (r["energy_error"], finer["energy_error"])     # first order in dt
+    assert 1.6 < ratio < 2.6, (r["energy_error"], finer["energy_error"])  # first order in dt
 
 
 def test_dissipative_newmark_loses_energy():
     r = run_scene("bar_impact", "fast", {"delta": 0.7, "beta_newmark": 0.4})
-    assert -0.5 < r["energy_error"] < -1e-3        # the paper's 0.7/0.4 damps
+    assert -0.5 < r["energy_error"] < -1e-3  # the paper's 0.7/0.4 damps
 
 
 def test_bad_parameters_raise():
@@ -69,4 +70,4 @@ def test_explicit_central_differences_through_the_same_scene(fast):
     assert r["newton_iterations_total"] == 0
     assert abs(r["error_duration"]) < 0.05, (r["duration"], r["duration_exact"])
     assert abs(r["error_rebound"]) < 0.03, r["rebound_velocity"]
-    assert r["n_steps"] == 2 * fast["n_steps"]          # half the step of the implicit run (courant 1)
+    assert r["n_steps"] == 2 * fast["n_steps"]  # half the step of the implicit run (courant 1)

@@ -53,7 +53,7 @@ def act(how, arg=None):
         return os.getpid()
     if how == "allocate":
         return len(bytearray(arg))
-    if how == "once":                        # dies on its first attempt only (a marker file says it tried)
+    if how == "once":  # dies on its first attempt only (a marker file says it tried)
         marker = Path(arg)
         if not marker.exists():
             marker.write_text("tried")
@@ -71,7 +71,7 @@ def by_key(outcomes):
 def test_values_come_back_by_key_from_several_workers():
     out = list(run_batch(square, [(i, (i,)) for i in range(7)], jobs=3))
     assert sorted(o.key for o in out) == list(range(7))
-    assert all(o.ok and o.value == o.key ** 2 and o.reason is None and o.attempts == 1 for o in out)
+    assert all(o.ok and o.value == o.key**2 and o.reason is None and o.attempts == 1 for o in out)
     assert all(isinstance(o, Outcome) for o in out)
 
 
@@ -79,13 +79,13 @@ def test_values_come_back_by_key_from_several_workers():
 def test_outcomes_come_in_completion_order():
     out = list(run_batch(act, [("slow", ("sleep", 1.0)), ("fast", ("sleep", 0.0))], jobs=2))
     assert [o.key for o in out] == ["fast", "slow"]
-    assert out[0].value != out[1].value                  # two workers
+    assert out[0].value != out[1].value  # two workers
 
 
 def test_an_exception_is_reported_once_and_not_run_again():
     out = by_key(run_batch(act, [("bad", ("raise", "x")), ("good", ("pid",))], jobs=1))
     assert out["bad"] == Outcome("bad", False, None, "error: ValueError: bad value x", 1)
-    assert out["good"].ok and out["good"].value != os.getpid()       # in a worker, not here
+    assert out["good"].ok and out["good"].value != os.getpid()  # in a worker, not here
 
 
 def test_a_task_that_ends_its_worker_is_retried_then_reported_and_the_others_complete():
@@ -117,15 +117,15 @@ def test_a_task_over_its_time_limit_is_stopped_and_not_retried():
 def test_the_memory_limit_turns_a_large_allocation_into_an_error():
     pytest.importorskip("resource")
     now = next(int(line.split()[1]) * 1024 for line in open("/proc/self/status") if line.startswith("VmSize"))
-    out = by_key(run_batch(act, [("big", ("allocate", 4 << 30)), ("small", ("allocate", 1 << 20))],
-                           memory_limit=now + (1 << 30)))                # the workers start as copies of this one
+    out = by_key(
+        run_batch(act, [("big", ("allocate", 4 << 30)), ("small", ("allocate", 1 << 20))], memory_limit=now + (1 << 30))
+    )  # the workers start as copies of this one
     assert not out["big"].ok and out["big"].reason.startswith("error: MemoryError")
     assert out["small"].ok and out["small"].value == 1 << 20
 
 
 def test_the_initializer_runs_in_each_worker_and_its_failure_is_every_tasks_reason():
-    out = list(run_batch(os.environ.get, [(i, ("BATCH_TEST",)) for i in range(3)], jobs=2,
-                         initializer=_set_env))
+    out = list(run_batch(os.environ.get, [(i, ("BATCH_TEST",)) for i in range(3)], jobs=2, initializer=_set_env))
     assert [o.value for o in out] == ["set"] * 3 and "BATCH_TEST" not in os.environ
     out = list(run_batch(square, [(1, (1,))], initializer=_fail))
     assert out[0].reason == "error: initializer: RuntimeError: no licence"
@@ -149,7 +149,7 @@ def test_a_value_that_cannot_be_sent_back_is_an_error():
 def test_workers_ignore_ctrl_c():
     out = run_batch(act, [("a", ("pid",)), ("b", ("sleep", 1.0))], jobs=1)
     pid = next(out).value
-    os.kill(pid, signal.SIGINT)                          # the worker now sleeps in task b
+    os.kill(pid, signal.SIGINT)  # the worker now sleeps in task b
     rest = list(out)
     assert rest[0].ok and rest[0].value == pid
 
@@ -215,8 +215,12 @@ def test_a_stopped_batch_process_leaves_no_worker(tmp_path, sig, code):
     """Ctrl-C and SIGTERM to the batch's process end it at once with every worker and the
     processes they started; killed outright, its workers end themselves."""
     script = PARENT.format(tests=str(Path(__file__).parent), folder=str(tmp_path))
-    p = subprocess.Popen([sys.executable, "-c", script], env=dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path)),
-                         stderr=subprocess.PIPE, text=True)
+    p = subprocess.Popen(
+        [sys.executable, "-c", script],
+        env=dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path)),
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     try:
         pids = _wait_for_pids(tmp_path, 2)
         t0 = time.monotonic()
@@ -243,5 +247,5 @@ def test_a_task_whose_worker_died_runs_again_on_a_fresh_worker_not_an_idle_one(t
 
 def _pid_and(how, arg=None):
     if how == "once":
-        time.sleep(0.3)                      # the other worker is idle by now
+        time.sleep(0.3)  # the other worker is idle by now
     return os.getpid(), act(how, arg)

@@ -39,17 +39,17 @@ def test_tangent_matches_finite_differences(closed, plastic, integration):
     X = ring(2.0, 7) if closed else np.column_stack([np.linspace(0, 3, 6), 0.2 * np.linspace(0, 3, 6) ** 2])
     beam = Beam(X, closed, E=100.0, A=1.0, I=0.1, rho=1.0, plastic=plastic, integration=integration)
     u = 0.1 * rng.standard_normal(beam.ndof)
-    u[2::3] = 1.5 * rng.standard_normal(X.shape[0])          # large rotations
+    u[2::3] = 1.5 * rng.standard_normal(X.shape[0])  # large rotations
     dt = 0.1 if plastic else None
     if plastic:
         ep = 0.005 * rng.standard_normal(beam.start(u).shape)
         S = beam.resultants(u, dt=dt, state=ep)[0]
         yielding = np.abs(S) > beam.S0
-        assert yielding.any() and not yielding.all()          # both branches are exercised
+        assert yielding.any() and not yielding.all()  # both branches are exercised
     R, K = beam.internal(u, dt)
     Kfd = fd_tangent(beam, u, dt=dt)
     assert np.abs(K.toarray() - Kfd).max() <= 1e-6 * np.abs(Kfd).max()
-    if not plastic:   # R is the gradient of the strain energy
+    if not plastic:  # R is the gradient of the strain energy
         h = 1e-6
         g = [(beam.strain_energy(u + h * e) - beam.strain_energy(u - h * e)) / (2 * h) for e in np.eye(beam.ndof)]
         assert np.allclose(g, R, atol=1e-6 * np.abs(R).max())
@@ -61,16 +61,16 @@ def test_cantilever_rolls_into_a_circle():
     errors = []
     for n_el in (8, 16, 32):
         beam = Beam(straight(L, n_el), False, E=EI / 0.01, A=1.0, I=0.01, rho=0.0)
-        free = np.arange(3, beam.ndof)                        # clamp node 0
+        free = np.arange(3, beam.ndof)  # clamp node 0
         u, P = np.zeros(beam.ndof), np.zeros(beam.ndof)
-        for lam in np.linspace(0, 1, 9)[1:]:                  # 8 load steps
+        for lam in np.linspace(0, 1, 9)[1:]:  # 8 load steps
             P[-1] = lam * 2 * np.pi * EI / L
             u = newton(beam, P, free, u)
         x = beam.positions(u)
-        assert np.linalg.norm(x[-1] - x[0]) < 1e-8 * L        # the tip returns to the clamp
-        assert abs(u[-1] - 2 * np.pi) < 1e-8                  # after a full turn
+        assert np.linalg.norm(x[-1] - x[0]) < 1e-8 * L  # the tip returns to the clamp
+        assert abs(u[-1] - 2 * np.pi) < 1e-8  # after a full turn
         radius = np.linalg.norm(x - x[:-1].mean(axis=0), axis=1)
-        assert np.ptp(radius) < 1e-8 * L                      # the nodes lie on one circle
+        assert np.ptp(radius) < 1e-8 * L  # the nodes lie on one circle
         errors.append(abs(radius.mean() - L / (2 * np.pi)))
     assert errors[0] < 0.03 * L / (2 * np.pi)
     assert errors[1] < errors[0] / 3.5 and errors[2] < errors[1] / 3.5  # O(h^2) convergence
@@ -123,21 +123,22 @@ def test_lumped_mass_and_gravity(closed):
 def test_viscoplastic_bar_follows_the_closed_form():
     """Uniaxial stretch past N0: N = N0 + (EA eps - N0) eta/(eta + dt); commit keeps the plastic strain."""
     EA, N0, eta, dt = 100.0, 1.0, 0.1, 0.05
-    beam = Beam(straight(1.0, 2), False, E=EA, A=1.0, I=0.1, rho=0.0,
-                plastic=dict(N0=N0, Q0=0.5, M0=0.25, eta=eta))
+    beam = Beam(straight(1.0, 2), False, E=EA, A=1.0, I=0.1, rho=0.0, plastic=dict(N0=N0, Q0=0.5, M0=0.25, eta=eta))
     u = np.zeros(beam.ndof)
-    u[3 * np.arange(3)] = 0.03 * np.linspace(0, 1, 3)        # eps = 0.03
+    u[3 * np.arange(3)] = 0.03 * np.linspace(0, 1, 3)  # eps = 0.03
     N = beam.resultants(u, dt=dt)[0][:, 0]
     assert np.allclose(N, N0 + (EA * 0.03 - N0) * eta / (eta + dt))
     ep = beam.commit(u, dt, beam.start(u))
-    assert np.allclose(beam.resultants(np.zeros(beam.ndof), dt=dt, state=ep)[0][:, 0], -(EA * 0.03 - N))  # residual strain
-    assert np.all(beam.resultants(np.zeros(beam.ndof), dt=dt)[0][:, 0] == 0)    # the beam itself kept nothing
+    assert np.allclose(
+        beam.resultants(np.zeros(beam.ndof), dt=dt, state=ep)[0][:, 0], -(EA * 0.03 - N)
+    )  # residual strain
+    assert np.all(beam.resultants(np.zeros(beam.ndof), dt=dt)[0][:, 0] == 0)  # the beam itself kept nothing
 
 
 def test_offset_positions_and_jacobian():
     beam = Beam(ring(2.0, 8), True, E=1.0, A=1.0, I=1.0, rho=1.0)
     u = np.random.default_rng(3).standard_normal(beam.ndof)
-    h = -0.25                                                 # outward for a counter-clockwise ring
+    h = -0.25  # outward for a counter-clockwise ring
     x0 = beam.offset_positions(np.zeros(beam.ndof), h)
     assert np.allclose(np.linalg.norm(x0, axis=1), 2.25)
     J = beam.offset_jacobian(u, h)
@@ -148,12 +149,22 @@ def test_offset_positions_and_jacobian():
         assert np.allclose(fd, J[:, :, k], atol=1e-8)
 
 
-@pytest.mark.parametrize("kwargs, name", [
-    (dict(E=-1.0), "E"), (dict(A=0.0), "A"), (dict(I=np.nan), "I"), (dict(rho=-1.0), "rho"),
-    (dict(nu=0.7), "nu"), (dict(kappa_s=0.0), "kappa_s"), (dict(X=np.zeros((1, 2))), "X"),
-    (dict(X=np.zeros((3, 2))), "X"), (dict(plastic=dict(N0=-1.0)), "N0"),
-    (dict(plastic=dict(eta=0.0)), "eta"), (dict(plastic=dict(K0=1.0)), "plastic"),
-])
+@pytest.mark.parametrize(
+    "kwargs, name",
+    [
+        (dict(E=-1.0), "E"),
+        (dict(A=0.0), "A"),
+        (dict(I=np.nan), "I"),
+        (dict(rho=-1.0), "rho"),
+        (dict(nu=0.7), "nu"),
+        (dict(kappa_s=0.0), "kappa_s"),
+        (dict(X=np.zeros((1, 2))), "X"),
+        (dict(X=np.zeros((3, 2))), "X"),
+        (dict(plastic=dict(N0=-1.0)), "N0"),
+        (dict(plastic=dict(eta=0.0)), "eta"),
+        (dict(plastic=dict(K0=1.0)), "plastic"),
+    ],
+)
 def test_bad_input_names_the_parameter(kwargs, name):
     args = dict(X=straight(1.0, 4), closed=False, E=1.0, A=1.0, I=1.0, rho=1.0) | kwargs
     with pytest.raises(ValueError, match=name):
@@ -176,7 +187,7 @@ def test_two_point_integration_is_exact_for_a_rigid_motion_and_stiffer_in_bendin
         f = np.zeros(beam.ndof)
         f[-2] = -1e-3
         deflection[n] = -spsolve(K[free][:, free].tocsc(), f[free])[-2]
-    assert 0 < deflection[2] < 0.75 * deflection[1], deflection   # 4 elements: 0.54 of the midpoint rule
+    assert 0 < deflection[2] < 0.75 * deflection[1], deflection  # 4 elements: 0.54 of the midpoint rule
 
 
 def test_bad_helper_input():

@@ -28,8 +28,9 @@ from conftest import PointCloud
 def _block_staggered(params, max_cycles=200):
     b = block.build(params)
     system = b.system
-    stepper = Staggered(Static(system, atol=params["atol"], rtol=params["rtol"], maxit=params["maxit"]),
-                        max_cycles=max_cycles)
+    stepper = Staggered(
+        Static(system, atol=params["atol"], rtol=params["rtol"], maxit=params["maxit"]), max_cycles=max_cycles
+    )
     u = np.zeros(system.ndof)
     state = system.start(u)
     u1, _, _, res = stepper.step(0.0, u, u, u, 1.0, state=state)
@@ -85,20 +86,23 @@ def test_phase_tangents_match_finite_differences(phase, friction):
     rng = np.random.default_rng(3)
     X = np.stack([np.linspace(0.1, 0.9, 5), np.zeros(5)], axis=1)
     body = PointCloud(X, "slave")
-    c = NodeToSegment(body, np.arange(5), RigidLine((0.0, 0.0), (0.0, 1.0)), normal=PowerLaw(50.0, 1.0),
-                      friction=friction)
+    c = NodeToSegment(
+        body, np.arange(5), RigidLine((0.0, 0.0), (0.0, 1.0)), normal=PowerLaw(50.0, 1.0), friction=friction
+    )
     u0 = np.zeros(body.ndof)
     h = c.start(u0)
     u = u0.copy()
     u[1::2] = -0.05 * (0.5 + rng.random(5))
-    u[0::2] = 0.02 * rng.standard_normal(5)        # some nodes slip, some stick
-    frozen = freeze(c.evaluate(u + 0.003 * rng.standard_normal(len(u)), history=h), phase)   # frozen data from another state
+    u[0::2] = 0.02 * rng.standard_normal(5)  # some nodes slip, some stick
+    frozen = freeze(
+        c.evaluate(u + 0.003 * rng.standard_normal(len(u)), history=h), phase
+    )  # frozen data from another state
     _, rows, cols, vals = c.evaluate(u, phase=frozen, history=h).scatter(len(u))
     K = np.zeros((len(u), len(u)))
     np.add.at(K, (rows, cols), vals)
     Kfd = fd_jacobian(lambda v: c.evaluate(v, phase=frozen, history=h).scatter(len(u))[0], u)
     assert rel_error(K, Kfd) < 1e-6
-    if phase == "friction":        # no coupling c_N^s C: the tangent differs from the consistent one
+    if phase == "friction":  # no coupling c_N^s C: the tangent differs from the consistent one
         _, r2, c2, v2 = c.evaluate(u, history=h).scatter(len(u))
         K2 = np.zeros_like(K)
         np.add.at(K2, (r2, c2), v2)
@@ -115,7 +119,7 @@ def test_a_bad_phase_is_refused():
 
 def test_observed_order_of_a_power_law():
     h = np.array([0.1, 0.05, 0.025])
-    assert observed_order(h, 3.0 * h ** 2) == pytest.approx(2.0)
+    assert observed_order(h, 3.0 * h**2) == pytest.approx(2.0)
     assert observed_order(h[:1], h[:1]) is None
 
 
@@ -128,14 +132,20 @@ def test_quick_bench_writes_json_and_markdown(tmp_path):
     res = json.loads((tmp_path / "bench.json").read_text())
     md = (tmp_path / "BENCHMARKS.md").read_text()
     assert md == write_markdown(res)
-    for section in ("## The paper's claim", "## Work against precision", "## Cost of one Newton iteration",
-                    "## Targets", "## Penalty, Uzawa, semi-smooth Newton", "## Scaling"):
+    for section in (
+        "## The paper's claim",
+        "## Work against precision",
+        "## Cost of one Newton iteration",
+        "## Targets",
+        "## Penalty, Uzawa, semi-smooth Newton",
+        "## Scaling",
+    ):
         assert section in md
     assert "nan" not in md.lower()
-    loads = res["speed"]["startup"]["loads"]           # the start-up account's claims, from the run
+    loads = res["speed"]["startup"]["loads"]  # the start-up account's claims, from the run
     assert loads["run_rings"] == [] and "skfem" in loads["run_block_canonical"]
     assert "What the block's process loads" in md and "The run of rings loads none of" in md
-    lim = res["speed"]["limit"]                        # the account of one iteration against its floor
+    lim = res["speed"]["limit"]  # the account of one iteration against its floor
     assert lim["n"] == 48 and lim["entries"] == 576 and 0 < lim["assembly_s"] < lim["limit_s"]
     assert "### Where the microseconds of one iteration go: sloping impact, frictional (48 unknowns" in md
 
@@ -158,12 +168,12 @@ def test_quick_bench_writes_json_and_markdown(tmp_path):
     c = res["cost"]
     for name, r in c["cases"].items():
         assert r["ndof"] > 0 and r["solve_s"] > 0
-    ring = c["cases"]["rolling ring 120 beams"]      # the solve newton() uses: banded for the ring
+    ring = c["cases"]["rolling ring 120 beams"]  # the solve newton() uses: banded for the ring
     assert ring["linear_algebra"] == "banded" and ring["solve_s"] == ring["solve_banded_s"]
     assert all(r["solve_banded_s"] is None for n, r in c["cases"].items() if n.startswith("hertz"))
     wp = res["work_precision"]
     assert all(r["ok"] for r in wp["hertz_mesh"]["rows"])
-    assert abs(wp["hertz_mesh"]["rows"][-1]["error_p0"]) < 0.005        # 32^2 quads: p0 within 0.5 %
+    assert abs(wp["hertz_mesh"]["rows"][-1]["error_p0"]) < 0.005  # 32^2 quads: p0 within 0.5 %
     assert res["targets"]["hertz"]["p0_within"]
 
 
@@ -171,8 +181,8 @@ def test_bench_cli_names_every_study():
     """`contactfem bench --only NAME` offers exactly the studies run_bench knows."""
     from contactfem.cli import BENCH_STUDIES
     from contactfem.lab.bench import STUDIES
-    assert tuple(STUDIES) == BENCH_STUDIES
 
+    assert tuple(STUDIES) == BENCH_STUDIES
 
 
 def test_a_quick_bench_never_replaces_or_mixes_with_a_full_run(tmp_path, monkeypatch, capsys):
@@ -181,8 +191,11 @@ def test_a_quick_bench_never_replaces_or_mixes_with_a_full_run(tmp_path, monkeyp
     import contactfem.lab.bench as bench
 
     ran = []
-    monkeypatch.setattr(bench, "run_bench", lambda quick=False, only=None, progress=None:
-                        ran.append(quick) or {"quick": quick, "machine": {}})
+    monkeypatch.setattr(
+        bench,
+        "run_bench",
+        lambda quick=False, only=None, progress=None: ran.append(quick) or {"quick": quick, "machine": {}},
+    )
     monkeypatch.chdir(tmp_path)
     assert main(["bench", "--quick", "--only", "speed"]) == 0
     assert (tmp_path / "bench-quick" / "bench.json").exists() and not (tmp_path / "bench.json").exists()
@@ -193,7 +206,8 @@ def test_a_quick_bench_never_replaces_or_mixes_with_a_full_run(tmp_path, monkeyp
     (tmp_path / "afile").write_text("")
     assert main(["bench", "--quick", "--out", "afile"]) == 2
     assert "--out afile: is a file" in capsys.readouterr().err
-    assert ran == [True]                                         # nothing ran for the refused ones
+    assert ran == [True]  # nothing ran for the refused ones
+
 
 def test_readme_states_the_committed_benchmark_numbers():
     """The README's sentence on the tangents gives the numbers of the committed bench.json
@@ -205,13 +219,18 @@ def test_readme_states_the_committed_benchmark_numbers():
     readme = " ".join((root / "README.md").read_text().split())
     blk = bench["tangents"]["block"]
     n = {law: {v: blk[law][v]["iterations"] for v in ("consistent", "frozen", "staggered")} for law in blk}
-    assert (f"the consistent non-symmetric tangent needs {n['coulomb']['consistent']} (Coulomb) and "
-            f"{n['parabolic']['consistent']} (parabolic)") in readme
+    assert (
+        f"the consistent non-symmetric tangent needs {n['coulomb']['consistent']} (Coulomb) and "
+        f"{n['parabolic']['consistent']} (parabolic)"
+    ) in readme
     assert f"eq (50) needs {n['coulomb']['frozen']} and {n['parabolic']['frozen']}" in readme
     assert f"algorithm needs {n['coulomb']['staggered']} and {n['parabolic']['staggered']}" in readme
-    assert not any(blk[law]["symmetric"]["converged"] for law in blk)      # "diverges once nodes slip"
+    assert not any(blk[law]["symmetric"]["converged"] for law in blk)  # "diverges once nodes slip"
     # "two to four times faster than SuperLU there": every banded case of the cost study
-    speedups = [r["solve_splu_MMD_AT_PLUS_A_s"] / r["solve_banded_s"] for r in bench["cost"]["cases"].values()
-                if r.get("solve_banded_s")]
+    speedups = [
+        r["solve_splu_MMD_AT_PLUS_A_s"] / r["solve_banded_s"]
+        for r in bench["cost"]["cases"].values()
+        if r.get("solve_banded_s")
+    ]
     assert "two to four times faster than SuperLU" in readme and speedups
-    assert all(1.5 <= x <= 4.5 for x in speedups), speedups      # "two to four": the ratios rounded
+    assert all(1.5 <= x <= 4.5 for x in speedups), speedups  # "two to four": the ratios rounded

@@ -10,6 +10,7 @@ what they must show, computed by the runs.
   no dependence on c_N or c_T, quadratic convergence, the augmented Lagrangian's tractions;
 * bar_impact and the refusals of combinations that do not exist.
 """
+
 import numpy as np
 import pytest
 
@@ -17,8 +18,12 @@ from contactfem.scenes import run_scene
 
 # -- the patch test ----------------------------------------------------------------------------
 
-MESHES = [("fast", {}), ("paper", {}), ("fast", {"nx_lower": 3, "nx_upper": 11}),
-          ("fast", {"nx_lower": 11, "nx_upper": 5})]
+MESHES = [
+    ("fast", {}),
+    ("paper", {}),
+    ("fast", {"nx_lower": 3, "nx_upper": 11}),
+    ("fast", {"nx_lower": 11, "nx_upper": 5}),
+]
 MESH_IDS = ["fast-4|7", "paper-8|13", "3|11", "11|5"]
 
 
@@ -30,8 +35,10 @@ def test_mortar_passes_the_patch_test(preset, mesh, mu, enforcement):
     # The exact answer is homogeneous; with every interface node closed at the first iterate the
     # problem is linear, so one Newton solve lands on it to round-off (1e-11 or less measured):
     # 1e-10 is the bar asked of the method, a decade above what round-off leaves.
-    print(f"{preset} {mesh} mu={mu} {enforcement}: pressure {r['pressure_deviation_max']:.1e}, "
-          f"sigma_yy {r['stress_deviation_max']:.1e}, gap violation {r['gap_violation']:.1e}")
+    print(
+        f"{preset} {mesh} mu={mu} {enforcement}: pressure {r['pressure_deviation_max']:.1e}, "
+        f"sigma_yy {r['stress_deviation_max']:.1e}, gap violation {r['gap_violation']:.1e}"
+    )
     assert r["pressure_deviation_max"] < 1e-10
     assert r["stress_deviation_max"] < 1e-10
     assert r["load_carried"] == pytest.approx(r["load_applied"], rel=1e-10)
@@ -49,25 +56,33 @@ def test_node_to_segment_fails_it_whatever_the_enforcement(preset, mesh, enforce
     projections, not as the master's consistent load: errors of 0.6-5 % (2.6 % fast, 5.2 %
     paper), the same with exact multipliers (the error is the load transfer, not c_N)."""
     r = run_scene("patch", preset, dict(mesh, contact_discretization="node_to_segment", enforcement=enforcement))
-    print(f"{preset} {mesh} {enforcement}: pressure {r['pressure_deviation_max']:.1e}, "
-          f"sigma_yy {r['stress_deviation_max']:.1e}")
+    print(
+        f"{preset} {mesh} {enforcement}: pressure {r['pressure_deviation_max']:.1e}, "
+        f"sigma_yy {r['stress_deviation_max']:.1e}"
+    )
     assert r["pressure_deviation_max"] > 1e-3 and r["stress_deviation_max"] > 1e-3
 
 
 # -- Hertz on non-matching meshes ------------------------------------------------------------
 
+
 @pytest.fixture(scope="module")
 def hertz_elastic():
-    return {(d, e): run_scene("hertz", "paper", dict(foundation="elastic", contact_discretization=d, enforcement=e))
-            for d in ("node_to_segment", "mortar") for e in ("penalty", "lagrange")}
+    return {
+        (d, e): run_scene("hertz", "paper", dict(foundation="elastic", contact_discretization=d, enforcement=e))
+        for d in ("node_to_segment", "mortar")
+        for e in ("penalty", "lagrange")
+    }
 
 
 @pytest.mark.slow
 def test_mortar_hertz_on_non_matching_meshes(hertz_elastic):
     for e in ("penalty", "lagrange"):
         m, n = hertz_elastic[("mortar", e)], hertz_elastic[("node_to_segment", e)]
-        print(f"{e}: p0 error mortar {m['error_p0']:+.4f}, node-to-segment {n['error_p0']:+.4f}; oscillation "
-              f"{m['oscillation']:.3f} vs {n['oscillation']:.3f}; largest jump {m['max_jump']:.3f} vs {n['max_jump']:.3f}")
+        print(
+            f"{e}: p0 error mortar {m['error_p0']:+.4f}, node-to-segment {n['error_p0']:+.4f}; oscillation "
+            f"{m['oscillation']:.3f} vs {n['oscillation']:.3f}; largest jump {m['max_jump']:.3f} vs {n['max_jump']:.3f}"
+        )
         # 0.5 %: the bar asked of mortar. Measured +0.09 % on 64^2 (the closed form is for two
         # half-planes; the foundation block of size R = 30 a and the mesh together stay below 0.1 %).
         assert abs(m["error_p0"]) < 5e-3
@@ -89,8 +104,10 @@ def test_mortar_on_the_rigid_foundation_misses_hertz_by_a_few_percent():
     to a few percent (below 10 %), more than node-to-segment's errors there."""
     m = run_scene("hertz", "fast", dict(contact_discretization="mortar"))
     n = run_scene("hertz", "fast", {})
-    print(f"mortar: p0 {m['error_p0']:+.4f}, a {m['error_a']:+.4f}; node-to-segment: p0 {n['error_p0']:+.4f}, "
-          f"a {n['error_a']:+.4f}")
+    print(
+        f"mortar: p0 {m['error_p0']:+.4f}, a {m['error_a']:+.4f}; node-to-segment: p0 {n['error_p0']:+.4f}, "
+        f"a {n['error_a']:+.4f}"
+    )
     assert max(abs(m["error_p0"]), abs(m["error_a"])) < 0.1
     assert abs(m["error_a"]) > abs(n["error_a"]) and abs(m["error_p0"]) > abs(n["error_p0"])
 
@@ -115,17 +132,19 @@ def block_ssn():
 def test_semismooth_newton_on_the_block(block_ssn, law):
     r = block_ssn[law]
     res = r["newton_residuals"]
-    print(f"{law}: {r['iterations']} iterations, {r['n_slip']} slipping nodes, residuals "
-          + " ".join(f"{x:.1e}" for x in res))
+    print(
+        f"{law}: {r['iterations']} iterations, {r['n_slip']} slipping nodes, residuals "
+        + " ".join(f"{x:.1e}" for x in res)
+    )
     # at most 10 linear solves, or one per slipping node where the slip zone is wider: from the
     # bonded first iterate it grows by about one node an iteration (Coulomb mu = 0.3: 12 nodes, 11)
     assert r["iterations"] <= max(10, r["n_slip"])
     assert r["equilibrium_error"] < 1e-9
     c = r["contact"]
     closed = np.array(c["t_N"]) < 0.0
-    assert np.max(np.abs(np.array(c["g_N"])[closed])) < 1e-12 * 3.25       # zero penetration: of the height
+    assert np.max(np.abs(np.array(c["g_N"])[closed])) < 1e-12 * 3.25  # zero penetration: of the height
     assert r["max_penetration"] < 1e-12 * 3.25
-    assert r["max_slip_violation"] < 1e-9 and r["max_slip_surface_distance"] < 1e-9     # Coulomb holds
+    assert r["max_slip_violation"] < 1e-9 and r["max_slip_surface_distance"] < 1e-9  # Coulomb holds
     # the sets settle, then Newton on a linear system: the last solve lands at round-off
     assert res[-1] < 1e-12 * res[0] and res[-2] > 1e3 * res[-1]
 
@@ -163,8 +182,19 @@ def test_quadratic_convergence_at_finite_strain(discretization):
     gap and the slip are nonlinear in u, and once the sets settle Newton's residual squares
     from one iteration to the next: r_k+1 <= C r_k^2 / r_0 (C = 10, the measured C ~ 0.1-1)
     on the last two steps that end above the round-off floor (1e-10 r_0)."""
-    r = run_scene("block", "paper", dict(law="conical", enforcement="lagrange", material="svk", plane="strain",
-                                         p_y=50.0, p_x=15.0, contact_discretization=discretization))
+    r = run_scene(
+        "block",
+        "paper",
+        dict(
+            law="conical",
+            enforcement="lagrange",
+            material="svk",
+            plane="strain",
+            p_y=50.0,
+            p_x=15.0,
+            contact_discretization=discretization,
+        ),
+    )
     res = r["newton_residuals"]
     tail = [(a, b) for a, b in zip(res[:-1], res[1:]) if b > 1e-10 * res[0]][-2:]
     print(discretization, " ".join(f"{x:.1e}" for x in res))
@@ -181,6 +211,7 @@ def test_mortar_semismooth_newton_on_the_block():
 
 
 # -- bar impact and refusals -------------------------------------------------------------------
+
 
 @pytest.mark.slow
 def test_bar_impact_takes_both_options():
@@ -200,13 +231,16 @@ def test_bar_impact_takes_both_options():
     assert trapezoidal["energy_error"] > 2.0
 
 
-@pytest.mark.parametrize("scene, over, match", [
-    ("block", {"contact_discretization": "mortar", "enforcement": "augmented"}, "node_to_segment only"),
-    ("bar_impact", {"enforcement": "lagrange", "integrator": "central_difference"}, "implicit"),
-    ("bar_impact", {"contact_discretization": "mortar", "contact_integration": "energy_consistent"}, "penalty"),
-    ("block", {"enforcement": "lagrange", "m": 2.0}, "PowerLaw"),
-    ("patch", {"contact_discretization": "mortar", "passes": 2}, "passes"),
-])
+@pytest.mark.parametrize(
+    "scene, over, match",
+    [
+        ("block", {"contact_discretization": "mortar", "enforcement": "augmented"}, "node_to_segment only"),
+        ("bar_impact", {"enforcement": "lagrange", "integrator": "central_difference"}, "implicit"),
+        ("bar_impact", {"contact_discretization": "mortar", "contact_integration": "energy_consistent"}, "penalty"),
+        ("block", {"enforcement": "lagrange", "m": 2.0}, "PowerLaw"),
+        ("patch", {"contact_discretization": "mortar", "passes": 2}, "passes"),
+    ],
+)
 def test_combinations_that_do_not_exist_are_refused(scene, over, match):
     with pytest.raises(ValueError, match=match):
         run_scene(scene, "fast", over)

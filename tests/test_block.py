@@ -35,7 +35,7 @@ def test_equilibrium_and_json(results, law):
     c = r["contact"]
     n = len(c["x"])
     P = r["parameters"]
-    assert n == P["nx"] + 1 - 2 * P["free_end_nodes"]          # the bottom nodes less those kept out at each end
+    assert n == P["nx"] + 1 - 2 * P["free_end_nodes"]  # the bottom nodes less those kept out at each end
     assert all(len(c[k]) == n for k in ("t_N", "t_T", "state"))
     assert set(c["state"]) <= {"open", "stick", "slip"}
     assert r["newton_iterations_total"] == r["iterations"] == len(r["newton_residuals"]) - 1
@@ -95,8 +95,8 @@ def test_frozen_tangent_converges_only_linearly():
     assert r["iterations"] > consistent["iterations"], (r["iterations"], consistent["iterations"])
     e = np.array(r["newton_residuals"])
     ratios = e[-4:] / e[-5:-1]
-    assert np.all(ratios > 1e-3), ratios          # no superlinear drop: linear convergence
-    assert abs(r["total_tangential"] - 210.0) < 1e-6   # same solution
+    assert np.all(ratios > 1e-3), ratios  # no superlinear drop: linear convergence
+    assert abs(r["total_tangential"] - 210.0) < 1e-6  # same solution
 
 
 def test_symmetric_tangent_fails_with_slip():
@@ -122,7 +122,7 @@ def test_the_friction_law_barely_changes_the_normal_stress(results):
     t_N, t_N_c = np.array(c["t_N"]), np.array(rc["t_N"])
     assert np.sum(np.array(c["state"]) == "slip") > len(t_N) / 2 < np.sum(np.array(rc["state"]) == "slip")
     assert rel_error(t_N, t_N_c) < 1e-2
-    assert (t_N.max() - t_N.min()) / abs(t_N).mean() > 0.1            # against a spread of > 10 %
+    assert (t_N.max() - t_N.min()) / abs(t_N).mean() > 0.1  # against a spread of > 10 %
 
 
 def newton_states(params, n_iter):
@@ -139,9 +139,16 @@ def newton_states(params, n_iter):
     return sc, start, states
 
 
-@pytest.mark.parametrize("law,material,which", [("coulomb", "linear", 1), ("coulomb", "linear", 5),
-                                                 ("parabolic", "linear", 2), ("parabolic", "linear", 6),
-                                                 ("coulomb", "svk", 1)])
+@pytest.mark.parametrize(
+    "law,material,which",
+    [
+        ("coulomb", "linear", 1),
+        ("coulomb", "linear", 5),
+        ("parabolic", "linear", 2),
+        ("parabolic", "linear", 6),
+        ("coulomb", "svk", 1),
+    ],
+)
 def test_full_tangent_finite_differences(law, material, which):
     """dG/du of the whole system (bulk + contact, eqs 33, 39, 49-50) against central
     differences at a mid-iteration state and at the converged state (the last
@@ -149,7 +156,7 @@ def test_full_tangent_finite_differences(law, material, which):
     columns. Relative error < 1e-6."""
     over = {"law": law, "material": material}
     if material != "linear":
-        over.update(p_y=20.0, p_x=6.0)        # finite strain: lighter loads (see the scene's doc)
+        over.update(p_y=20.0, p_x=6.0)  # finite strain: lighter loads (see the scene's doc)
     sc, start, states = newton_states(SCENE.resolve("canonical", over), which)
     system, contact = sc.system, sc.parts["contact"]
     u = states[-1]
@@ -171,12 +178,29 @@ def test_bad_input(over):
 @pytest.mark.slow
 def test_cli_json(tmp_path):
     out = tmp_path / "block.json"
-    subprocess.run([sys.executable, "-m", "contactfem", "run", "block", "--preset", "canonical", "--set", "law=coulomb",
-                    "--set", "mu=0.3", "--json", str(out)], check=True, capture_output=True)
+    subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "contactfem",
+            "run",
+            "block",
+            "--preset",
+            "canonical",
+            "--set",
+            "law=coulomb",
+            "--set",
+            "mu=0.3",
+            "--json",
+            str(out),
+        ],
+        check=True,
+        capture_output=True,
+    )
     r = json.loads(out.read_text())
     for key in ("newton_residuals", "iterations", "total_normal", "total_tangential", "contact"):
         assert key in r
-    py = run_scene("block", "canonical", {"law": "coulomb", "mu": 0.3})      # the command line = Python
+    py = run_scene("block", "canonical", {"law": "coulomb", "mu": 0.3})  # the command line = Python
     assert r["contact"]["state"] == list(py["contact"]["state"])
     assert r["newton_residuals"] == pytest.approx(py["newton_residuals"], rel=1e-12, abs=1e-14)
 

@@ -32,15 +32,18 @@ def test_show_gives_defaults_units_ranges(name, capsys):
         assert p.name in text
 
 
-@pytest.mark.parametrize("args,needle", [
-    (["show", "no_such_scene"], "unknown scene 'no_such_scene'"),
-    (["run", "no_such_scene"], "unknown scene 'no_such_scene'"),
-    (["run", "block", "--set", "no_such=1"], "unknown parameter 'no_such'"),
-    (["run", "block", "--set", "c_T=-5"], "parameter c_T = -5 is out of range"),
-    (["run", "block", "--set", "mu=abc"], "parameter mu must be a number"),
-    (["run", "block", "--set", "law=magic"], "parameter law = 'magic' is not allowed"),
-    (["run", "block", "--set", "nonsense"], "--set expects NAME=VALUE"),
-])
+@pytest.mark.parametrize(
+    "args,needle",
+    [
+        (["show", "no_such_scene"], "unknown scene 'no_such_scene'"),
+        (["run", "no_such_scene"], "unknown scene 'no_such_scene'"),
+        (["run", "block", "--set", "no_such=1"], "unknown parameter 'no_such'"),
+        (["run", "block", "--set", "c_T=-5"], "parameter c_T = -5 is out of range"),
+        (["run", "block", "--set", "mu=abc"], "parameter mu must be a number"),
+        (["run", "block", "--set", "law=magic"], "parameter law = 'magic' is not allowed"),
+        (["run", "block", "--set", "nonsense"], "--set expects NAME=VALUE"),
+    ],
+)
 def test_bad_input_is_one_line_exit_2(args, needle):
     out = cli(*args)
     assert out.returncode == 2, out.stderr
@@ -67,6 +70,7 @@ def test_bench_only_keeps_the_other_studies_of_an_earlier_run(tmp_path, monkeypa
     written = []
     monkeypatch.setattr(bench, "write_outputs", lambda res, out: written.append(res) or [])
     from contactfem.cli import main
+
     assert main(["bench", "--only", "speed", "--out", str(tmp_path)]) == 0
     assert written[0]["tangents"] == {"kept": 1} and written[0]["speed"] == {"new": 2}
 
@@ -75,8 +79,10 @@ def test_a_closed_pipe_is_not_an_error():
     """`contactfem equations | head -1`: the reader leaves early; no error line, exit 0."""
     import subprocess
     import sys
-    p = subprocess.run(f"{sys.executable} -m contactfem equations | head -1", shell=True,
-                       capture_output=True, text=True)
+
+    p = subprocess.run(
+        f"{sys.executable} -m contactfem equations | head -1", shell=True, capture_output=True, text=True
+    )
     assert p.stdout.count("\n") == 1 and p.stderr == ""
 
 
@@ -84,7 +90,9 @@ def test_a_failed_site_build_shows_sphinx_then_one_line(monkeypatch, capsys):
     import contactfem.lab.site as site
 
     def broken(out=None, instructor=False, **kwargs):
-        raise RuntimeError("the site build failed (Sphinx exit code 1):\nlectures/03.ipynb:12: WARNING: undefined label")
+        raise RuntimeError(
+            "the site build failed (Sphinx exit code 1):\nlectures/03.ipynb:12: WARNING: undefined label"
+        )
 
     monkeypatch.setattr(site, "build", broken)
     with pytest.raises(SystemExit) as exit_:
@@ -98,27 +106,51 @@ def test_a_failed_site_build_shows_sphinx_then_one_line(monkeypatch, capsys):
 
 # ---- every command checks its outputs before any work -----------------------------------
 
+
 def _no_work(*args, **kwargs):
     raise AssertionError("the work started before the output was checked")
 
 
-@pytest.mark.parametrize("argv,target,pattern", [
-    (["site", "--out", "{file}"], ("contactfem.lab.site", "build"), r"--out .*: is a file, give a folder"),
-    (["figures", "--outdir", "{file}"], ("contactfem.plots", "make_all"), r"--outdir .*: is a file, give a folder"),
-    (["figures", "--outdir", "{file}/sub"], ("contactfem.plots", "make_all"), r"--outdir .*/sub: .* is a file"),
-    (["reconstruct", "block", "--quick", "--json", "{file}/x.json"], ("contactfem.lab.reconstruct", "main"),
-     r"--json .*/x.json: .*a_file is a file, not a folder"),
-    (["reconstruct", "block", "--quick", "--json", ""], ("contactfem.lab.reconstruct", "main"),
-     r"--json: empty file name"),
-    (["figures", "--outdir", ""], ("contactfem.plots", "make_all"), r"--outdir: empty folder name"),
-    (["site", "--out", ""], ("contactfem.lab.site", "build"), r"--out: empty folder name"),
-    (["reconstruct", "block", "--quick", "--json", "{dir}/r.txt"], ("contactfem.lab.reconstruct", "main"),
-     r"--json .*r.txt: the file name must end in .json"),
-    (["bench", "--quick", "--out", "{file}/sub"], ("contactfem.lab.bench", "run_bench"), r"--out .*/sub: .* is a file"),
-    (["sweep", "block", "--set", "mu=0.3", "--out", "{file}/sub/s.csv"], ("contactfem.lab.sweep", "sweep"),
-     r"--out .*/sub/s.csv: .*a_file is a file, not a folder"),
-    (["sweep", "block", "--set", "mu=0.3", "--out", ""], ("contactfem.lab.sweep", "sweep"), r"--out: empty file name"),
-])
+@pytest.mark.parametrize(
+    "argv,target,pattern",
+    [
+        (["site", "--out", "{file}"], ("contactfem.lab.site", "build"), r"--out .*: is a file, give a folder"),
+        (["figures", "--outdir", "{file}"], ("contactfem.plots", "make_all"), r"--outdir .*: is a file, give a folder"),
+        (["figures", "--outdir", "{file}/sub"], ("contactfem.plots", "make_all"), r"--outdir .*/sub: .* is a file"),
+        (
+            ["reconstruct", "block", "--quick", "--json", "{file}/x.json"],
+            ("contactfem.lab.reconstruct", "main"),
+            r"--json .*/x.json: .*a_file is a file, not a folder",
+        ),
+        (
+            ["reconstruct", "block", "--quick", "--json", ""],
+            ("contactfem.lab.reconstruct", "main"),
+            r"--json: empty file name",
+        ),
+        (["figures", "--outdir", ""], ("contactfem.plots", "make_all"), r"--outdir: empty folder name"),
+        (["site", "--out", ""], ("contactfem.lab.site", "build"), r"--out: empty folder name"),
+        (
+            ["reconstruct", "block", "--quick", "--json", "{dir}/r.txt"],
+            ("contactfem.lab.reconstruct", "main"),
+            r"--json .*r.txt: the file name must end in .json",
+        ),
+        (
+            ["bench", "--quick", "--out", "{file}/sub"],
+            ("contactfem.lab.bench", "run_bench"),
+            r"--out .*/sub: .* is a file",
+        ),
+        (
+            ["sweep", "block", "--set", "mu=0.3", "--out", "{file}/sub/s.csv"],
+            ("contactfem.lab.sweep", "sweep"),
+            r"--out .*/sub/s.csv: .*a_file is a file, not a folder",
+        ),
+        (
+            ["sweep", "block", "--set", "mu=0.3", "--out", ""],
+            ("contactfem.lab.sweep", "sweep"),
+            r"--out: empty file name",
+        ),
+    ],
+)
 def test_every_command_checks_its_outputs_before_any_work(argv, target, pattern, tmp_path, monkeypatch, capsys):
     import importlib
 
@@ -143,8 +175,9 @@ def test_one_rule_for_missing_folders(tmp_path, monkeypatch, capsys):
     assert main(["run", "block", "--json", str(gone)]) == 1
     assert not (tmp_path / "c").exists()
     made = []
-    monkeypatch.setattr(importlib.import_module("contactfem.plots"), "make_all",
-                        lambda preset, outdir, only: made.append(outdir) or [])
+    monkeypatch.setattr(
+        importlib.import_module("contactfem.plots"), "make_all", lambda preset, outdir, only: made.append(outdir) or []
+    )
     assert main(["figures", "--outdir", str(tmp_path / "e" / "f")]) == 0 and made == [str(tmp_path / "e" / "f")]
     capsys.readouterr()
 
@@ -161,7 +194,7 @@ def test_help_names_every_command():
     text = cli("--help").stdout
     for name in ("list", "show", "run", "figures", "equations", "sweep", "site", "reconstruct", "bench"):
         assert re.search(rf"^    {name} +\S", text, re.M), name
-    assert "reconstruct" in text.split("positional arguments")[0]          # the description names it too
+    assert "reconstruct" in text.split("positional arguments")[0]  # the description names it too
 
 
 def test_show_says_which_preset_its_columns_are(capsys):
@@ -170,6 +203,6 @@ def test_show_says_which_preset_its_columns_are(capsys):
     head = text.splitlines()[1].split()
     assert head[:4] == ["parameter", "fast", "(run)", "paper"]
     row = next(ln for ln in text.splitlines() if ln.startswith("n_el "))
-    assert row.split()[1:3] == ["40", "120"]                       # the fast preset's, then where paper differs
+    assert row.split()[1:3] == ["40", "120"]  # the fast preset's, then where paper differs
     assert "what `contactfem run` uses unless --preset is given" in text
     assert "c_T " in text and "builds the friction law" in text

@@ -1,6 +1,7 @@
 """The closing step: a node that touches during a step starts its stick spring where it
 touched (the gap interpolated linearly within the step), not with the tangential travel
 it made while still open; its tangent (r depends on the gap) against finite differences."""
+
 import numpy as np
 import pytest
 from conftest import PointCloud
@@ -16,7 +17,7 @@ def closing_node(dx=0.02, g0=0.01, g1=-0.01, mu=10.0):
     iface = NodeToSegment(body, [0], RigidLine(), normal=PowerLaw(100.0), friction=Coulomb(50.0, mu))
     u0 = np.array([0.0, g0])
     h = iface.start(u0)
-    h = iface.commit(iface.evaluate(u0, history=h))          # open at the start of the step: g_bar = g0 > 0
+    h = iface.commit(iface.evaluate(u0, history=h))  # open at the start of the step: g_bar = g0 > 0
     return iface, np.array([dx, g1]), h
 
 
@@ -35,7 +36,7 @@ def test_without_the_closing_step_the_whole_travel_loads_the_spring():
     e = without.evaluate(u1, history=h)
     assert e.slip[0] == STICK
     assert e.t_T[0] == pytest.approx(50.0 * 0.02, rel=1e-12)
-    assert iface.closing_step is True                         # the contact it was made from is untouched
+    assert iface.closing_step is True  # the contact it was made from is untouched
     assert iface.evaluate(u1, history=h).t_T[0] == pytest.approx(50.0 * 0.01, rel=1e-12)
     with pytest.raises(ValueError, match="closing_step"):
         NodeToSegment(iface.slave, [0], RigidLine(), normal=PowerLaw(100.0), closing_step=0)
@@ -62,8 +63,8 @@ def test_closing_tangent_deformable_master(rng, mu):
     h = iface.start(u0)
     h = iface.commit(iface.evaluate(u0, history=h))
     u1 = u0.copy()
-    u1[:mb.ndof] = 0.003 * rng.standard_normal(mb.ndof)
-    u1[mb.ndof:] = [0.03, -0.04, -0.02, -0.05]
+    u1[: mb.ndof] = 0.003 * rng.standard_normal(mb.ndof)
+    u1[mb.ndof :] = [0.03, -0.04, -0.02, -0.05]
     e = iface.evaluate(u1, history=h)
     assert np.all(e.active) and np.all(e.r < 1.0)
     check_tangent(iface, u1, h)
@@ -74,6 +75,7 @@ def test_closing_tangent_staggered_phases(phase):
     """The two phases of the staggered algorithm at a closing node: the normal phase's stick
     about the frozen state varies with s alone, the friction phase's slip with r (s - s_bar)."""
     from contactfem.contact.tangents import freeze
+
     iface, u1, h = closing_node(mu=0.3)
     frozen = freeze(iface.evaluate(u1, history=h), phase)
     R, rows, cols, vals = iface.evaluate(u1, phase=frozen, history=h).scatter(2)

@@ -4,6 +4,7 @@ case of the cork's neck (wall, clockwise mouth, top; tests/test_cork.py). The ar
 coordinate runs on across the joints, the normal is continuous, the first and second
 variations of g_N and s match finite differences on every piece, and a prescribed motion
 moves the master without changing s."""
+
 import numpy as np
 import pytest
 
@@ -15,9 +16,14 @@ from conftest import PointCloud, assert_locate_matches_fd
 
 
 def fillet(offset=(0.0, 0.0)):
-    return RigidComposite([("line", (-5.0, 0.0), (0.0, 0.0)),
-                           ("arc", (0.0, 1.0), 1.0, -np.pi / 2, 0.0),
-                           ("line", (1.0, 1.0), (1.0, 5.0))], offset=offset)
+    return RigidComposite(
+        [
+            ("line", (-5.0, 0.0), (0.0, 0.0)),
+            ("arc", (0.0, 1.0), 1.0, -np.pi / 2, 0.0),
+            ("line", (1.0, 1.0), (1.0, 5.0)),
+        ],
+        offset=offset,
+    )
 
 
 def test_joints_are_continuous_and_s_runs_on():
@@ -29,12 +35,12 @@ def test_joints_are_continuous_and_s_runs_on():
     assert np.allclose(k["n"][0], k["n"][1], atol=1e-6) and np.allclose(k["n"][2], k["n"][3], atol=1e-6)
     assert k["s"][1] - k["s"][0] == pytest.approx(0.0, abs=1e-6)
     assert k["s"][3] - k["s"][2] == pytest.approx(0.0, abs=1e-6)
-    assert k["s"][3] == pytest.approx(5.0 + np.pi / 2, abs=1e-6)           # floor + quarter circle
-    assert np.allclose(k["n"], np.stack([-k["t"][:, 1], k["t"][:, 0]], axis=1))   # n = e3 x t (eq 18)
+    assert k["s"][3] == pytest.approx(5.0 + np.pi / 2, abs=1e-6)  # floor + quarter circle
+    assert np.allclose(k["n"], np.stack([-k["t"][:, 1], k["t"][:, 0]], axis=1))  # n = e3 x t (eq 18)
     assert k["g_N"][0] == pytest.approx(0.1) and k["g_N"][3] == pytest.approx(0.1)
-    assert np.allclose(k["n"][0], [0, 1]) and np.allclose(k["n"][3], [-1, 0])   # into the fillet
+    assert np.allclose(k["n"][0], [0, 1]) and np.allclose(k["n"][3], [-1, 0])  # into the fillet
     inside = m.locate(np.array([[-6.0, 0.5], [0.5, 6.0], [0.5, 0.5]]), np.zeros(3), None)["inside"]
-    assert list(inside) == [False, False, True]                                # beyond either end
+    assert list(inside) == [False, False, True]  # beyond either end
 
 
 @pytest.mark.parametrize("x", [[-2.0, 0.2], [0.3, 0.4], [0.7, 0.8], [0.8, 3.0]])
@@ -43,14 +49,19 @@ def test_variations_match_finite_differences(x):
 
 
 def test_motion_keeps_s_and_moves_the_gap():
-    m = RigidComposite([("line", (-5.0, 0.0), (0.0, 0.0)),
-                                            ("arc", (0.0, 1.0), 1.0, -np.pi / 2, 0.0),
-                                            ("line", (1.0, 1.0), (1.0, 5.0))], motion=lambda t: (0.0, 0.1 * t))
+    m = RigidComposite(
+        [
+            ("line", (-5.0, 0.0), (0.0, 0.0)),
+            ("arc", (0.0, 1.0), 1.0, -np.pi / 2, 0.0),
+            ("line", (1.0, 1.0), (1.0, 5.0)),
+        ],
+        motion=lambda t: (0.0, 0.1 * t),
+    )
     x = np.array([[0.5, 0.3], [0.9, 2.0]])
     k0 = m.locate(x, np.zeros(2), None, t=0.0)
     k1 = m.locate(x + [0.0, 0.1], np.zeros(2), None, t=1.0)
     assert np.allclose(k0["s"], k1["s"]) and np.allclose(k0["g_N"], k1["g_N"])
-    assert np.allclose(m.locate(x, np.zeros(2), None)["g_N"], k0["g_N"])     # no time: no motion
+    assert np.allclose(m.locate(x, np.zeros(2), None)["g_N"], k0["g_N"])  # no time: no motion
 
 
 def test_a_node_sliding_round_the_fillet_keeps_its_friction_history():
@@ -62,7 +73,7 @@ def test_a_node_sliding_round_the_fillet_keeps_its_friction_history():
     h = contact.start(u)
     s0 = h.s_bar.copy()
     th = np.linspace(-np.pi / 2, 0.0, 7)
-    for a in th:                                # along the arc, just inside the glass
+    for a in th:  # along the arc, just inside the glass
         x = np.array([0.0, 1.0]) + 1.01 * np.array([np.cos(a), np.sin(a)])
         h = contact.commit(contact.evaluate(x - body.X[0], history=h))
     assert h.s_bar[0] - s0[0] == pytest.approx(0.5 + np.pi / 2, rel=1e-9)

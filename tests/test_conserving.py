@@ -11,6 +11,7 @@
 * sloping impact: frictionless, the energy after rebound within 1e-3 of the energy before;
   frictional, the energy never increases and the dissipation equals the loss within 1 %.
 """
+
 import numpy as np
 import pytest
 from conftest import PointCloud
@@ -25,11 +26,19 @@ from contactfem.scenes import run_scene
 from contactfem.scenes.bar_impact import bar_exact
 from contactfem.solver.conserving import EnergyConsistent
 
-FRICTIONS = {"none": None, "stick": Coulomb(30.0, 10.0), "slip": Coulomb(30.0, 0.05),
-             "parabolic": ParabolicSlip(30.0, 0.02, 0.03, 0.5)}
+FRICTIONS = {
+    "none": None,
+    "stick": Coulomb(30.0, 10.0),
+    "slip": Coulomb(30.0, 0.05),
+    "parabolic": ParabolicSlip(30.0, 0.02, 0.03, 0.5),
+}
 # slave y at the start and the end of the step (gap of a node on the line y = 0)
-PHASES = {"contact": (-0.02, -0.05), "closing": (0.02, -0.04), "opening": (-0.03, 0.01),
-          "opening_far": (-0.03, 1.5)}        # a node leaving by more than a unit length in one step
+PHASES = {
+    "contact": (-0.02, -0.05),
+    "closing": (0.02, -0.04),
+    "opening": (-0.03, 0.01),
+    "opening_far": (-0.03, 1.5),
+}  # a node leaving by more than a unit length in one step
 
 
 def pair(master, friction, phase, rng):
@@ -46,15 +55,22 @@ def pair(master, friction, phase, rng):
     off = sum(b.ndof for b in bodies)
     sb = PointCloud([[0.3, 0.0], [0.6, 0.0]], "slave", dof_offset=off)
     n = off + sb.ndof
-    iface = NodeToSegment(sb, [0, 1], m, normal=PowerLaw(80.0), friction=friction, weights=np.array([0.7, 1.2]),
-                          integration="energy_consistent")
+    iface = NodeToSegment(
+        sb,
+        [0, 1],
+        m,
+        normal=PowerLaw(80.0),
+        friction=friction,
+        weights=np.array([0.7, 1.2]),
+        integration="energy_consistent",
+    )
     u_prev = np.zeros(n)
-    u_prev[off + 1::2] = y0
+    u_prev[off + 1 :: 2] = y0
     u0 = u_prev.copy()
-    u0[off::2] += 0.01 if phase != "closing" else 0.0       # a stick load before the step
+    u0[off::2] += 0.01 if phase != "closing" else 0.0  # a stick load before the step
     u1 = u0.copy()
     u1[off::2] += np.array([0.04, -0.03])
-    u1[off + 1::2] = y1 + 0.003 * rng.standard_normal(2)
+    u1[off + 1 :: 2] = y1 + 0.003 * rng.standard_normal(2)
     if master == "body":
         u1[:off] = 0.003 * rng.standard_normal(off)
     h = iface.start(u_prev)
@@ -88,8 +104,8 @@ def test_step_force_tangent(rng, master, fric, phase):
 def test_step_work_is_energy_change_plus_dissipation(rng, master, fric, phase):
     iface, u0, u1, h = pair(master, FRICTIONS[fric], phase, rng)
     G, _ = force(iface, u0, u1, h)
-    W0 = iface.evaluate(u0, history=h).energy             # interface energy at the committed state
-    W1 = iface.evaluate(u1, history=h).energy             # at the end (not committed: t_T from the return map)
+    W0 = iface.evaluate(u0, history=h).energy  # interface energy at the committed state
+    W1 = iface.evaluate(u1, history=h).energy  # at the end (not committed: t_T from the return map)
     D = iface.evaluate(u1, u0=u0, history=h).dissipation  # of the step
     assert D >= -1e-14
     assert G @ (u1 - u0) == pytest.approx(W1 - W0 + D, rel=1e-10, abs=1e-14)
@@ -100,10 +116,13 @@ def test_unresolved_penalty_conserves_energy():
     the trapezoidal rule ends with ~4 E0) with the energy-consistent stepper."""
     from contactfem.solver import integrate
     from test_extremes import quad
+
     body = quad()
-    contact = NodeToSegment(body, np.arange(4), make_master("line"), normal=PowerLaw(1e8), weights=0.5,
-                            integration="energy_consistent")
+    contact = NodeToSegment(
+        body, np.arange(4), make_master("line"), normal=PowerLaw(1e8), weights=0.5, integration="energy_consistent"
+    )
     from contactfem.solver import System
+
     system = System([body], [contact])
     u0, v0 = np.zeros(system.ndof), np.zeros(system.ndof)
     v0[body.xdofs[:, 0]], v0[body.xdofs[:, 1]] = 0.5, -1.0
@@ -119,11 +138,12 @@ def test_unresolved_penalty_conserves_energy():
 
 # -- bar impact: 5 phases of first contact within a step, c_N over 4 decades ------------
 
+
 def bar(phase=0.5, c_N_factor=1.0):
     p = dict(n_el=20, courant=1.0, c_N_factor=c_N_factor, contact_integration="energy_consistent")
-    ex = bar_exact(100.0, 2.1e5, 7.85e-9, 1000.0)                 # the scene's defaults
+    ex = bar_exact(100.0, 2.1e5, 7.85e-9, 1000.0)  # the scene's defaults
     dt = p["courant"] * (100.0 / p["n_el"]) / ex["c"]
-    p["gap"] = phase * 1000.0 * dt                                # contact begins at this phase of step 1
+    p["gap"] = phase * 1000.0 * dt  # contact begins at this phase of step 1
     return run_scene("bar_impact", "fast", p)
 
 
@@ -131,7 +151,7 @@ def bar(phase=0.5, c_N_factor=1.0):
 def test_bar_impact_energy_any_phase(phase):
     r = bar(phase=phase)
     assert abs(r["energy_error_max"]) < 1e-4, r["energy_error_max"]
-    assert abs(r["error_rebound"]) < 0.05                      # it did rebound
+    assert abs(r["error_rebound"]) < 0.05  # it did rebound
 
 
 @pytest.mark.slow
@@ -139,21 +159,24 @@ def test_bar_impact_energy_any_phase(phase):
 def test_bar_impact_energy_any_penalty(c_N_factor):
     r = bar(phase=0.3, c_N_factor=c_N_factor)
     assert abs(r["energy_error_max"]) < 1e-4, r["energy_error_max"]
+
     def standard():
         return run_scene("bar_impact", "fast", dict(n_el=20, c_N_factor=c_N_factor, gap=r["parameters"]["gap"]))
+
     if c_N_factor >= 100:
-        with pytest.warns(AccuracyWarning, match="energy_gain"):           # and says so
-            assert standard()["energy_error"] > 1e-2            # Newmark 1/2, 1/4 gains energy here
+        with pytest.warns(AccuracyWarning, match="energy_gain"):  # and says so
+            assert standard()["energy_error"] > 1e-2  # Newmark 1/2, 1/4 gains energy here
 
 
 # -- sloping impact ---------------------------------------------------------------------
+
 
 @pytest.mark.slow
 def test_sloping_impact_frictionless_conserves_energy():
     r = run_scene("sloping_impact", "fast", {"contact_integration": "energy_consistent"})
     assert r["rebounded"]
     assert abs(r["energy_after_rebound_rel"]) < 1e-3, r["energy_after_rebound_rel"]
-    paper = run_scene("sloping_impact", "fast")               # Newmark 0.7/0.4 loses 16 %
+    paper = run_scene("sloping_impact", "fast")  # Newmark 0.7/0.4 loses 16 %
     assert paper["energy_after_rebound_rel"] < -0.05
 
 
@@ -184,6 +207,7 @@ def test_other_ring_scenes_balance_energy(scene, over):
 
 # -- momentum ---------------------------------------------------------------------------
 
+
 def flying_ring(kind="beam", omega=0.3, wobble=0.3, n_steps=200, atol=1e-11):
     """The sloping impact's ring (R = 10, A = 1, E = 100, rho = 0.01, 16 elements) flying
     freely with v = (2, -2), a spin omega and a random velocity field of size `wobble` on top
@@ -196,8 +220,15 @@ def flying_ring(kind="beam", omega=0.3, wobble=0.3, n_steps=200, atol=1e-11):
     system = System([ring.body])
     v0 = ring.initial_velocity((2.0, -2.0), omega=omega)
     v0 = v0 + wobble * np.random.default_rng(0).standard_normal(len(v0))
-    records = list(march(EnergyConsistent(system, atol=atol, rtol=1e-14, maxit=40), Steps(0.1, n_steps=n_steps),
-                         0.0, np.zeros(system.ndof), v0))
+    records = list(
+        march(
+            EnergyConsistent(system, atol=atol, rtol=1e-14, maxit=40),
+            Steps(0.1, n_steps=n_steps),
+            0.0,
+            np.zeros(system.ndof),
+            v0,
+        )
+    )
     M, b = system.mass(), ring.body
     rot = b.rotation_dofs
 
@@ -210,6 +241,7 @@ def flying_ring(kind="beam", omega=0.3, wobble=0.3, n_steps=200, atol=1e-11):
         r, w = x - xc, v - vc
         L = np.sum(m * (r[:, 0] * w[:, 1] - r[:, 1] * w[:, 0])) + np.sum(M[rot] * rec.v[rot])
         return m @ v, L
+
     return records, momenta
 
 
@@ -252,10 +284,11 @@ def test_free_flight_keeps_the_angular_momentum(kind, wobble):
     assert np.max(np.abs(E - E[0])) <= 1e-10 * E[0]
     if wobble:
         strain = np.array([r.energy["strain"] for r in records])
-        assert np.max(strain) > 1e-3 * records[0].energy["kinetic"]       # it does deform
+        assert np.max(strain) > 1e-3 * records[0].energy["kinetic"]  # it does deform
 
 
 # -- the beam's discrete gradient and the step's tangent -------------------------------
+
 
 @pytest.mark.parametrize("integration", [1, 2])
 def test_beam_discrete_gradient_is_exact_and_has_no_resultant_or_moment(rng, integration):
@@ -267,20 +300,21 @@ def test_beam_discrete_gradient_is_exact_and_has_no_resultant_or_moment(rng, int
     crosses into the closed form's cancellation)."""
     from contactfem.bodies.discrete_gradient import cayley
     from contactfem.bodies.ring import make_ring
+
     b = make_ring(kind="beam", R=10.0, thickness=1.0, n_el=8, E=100.0, rho=0.01, integration=integration).body
     u0 = 0.3 * rng.standard_normal(b.ndof)
     u0[2::3] = 0.2 * rng.standard_normal(8)
     u1 = u0 + 0.3 * rng.standard_normal(b.ndof)
     u1[2::3] = u0[2::3] + 0.5 * rng.uniform(-1, 1, 8)
     alike = u1.copy()
-    alike[5] = u0[5] + (u1[2] - u0[2])                                 # nodes 0 and 1 turn alike
+    alike[5] = u0[5] + (u1[2] - u0[2])  # nodes 0 and 1 turn alike
     for x in (u1, alike):
         F = b.discrete_gradient(u0, x)[0]
         dq = cayley(x - u0, b.rotation_dofs)[0]
         W0, W1 = b.strain_energy(u0), b.strain_energy(x)
         assert abs(F @ dq - (W1 - W0)) <= 1e-12 * (W0 + W1)
         xm = b.positions(0.5 * (u0 + x))
-        scale = np.max(np.abs(F)) * 10.0                                # (10: the ring's radius)
+        scale = np.max(np.abs(F)) * 10.0  # (10: the ring's radius)
         assert abs(F[0::3].sum()) <= 1e-12 * scale and abs(F[1::3].sum()) <= 1e-12 * scale
         assert abs(np.sum(xm[:, 0] * F[1::3] - xm[:, 1] * F[0::3]) + F[2::3].sum()) <= 1e-12 * scale * 10.0
     # the series and the closed form agree across the switch (|phi_b - phi_a| = 1e-6)
@@ -288,7 +322,7 @@ def test_beam_discrete_gradient_is_exact_and_has_no_resultant_or_moment(rng, int
     near[0][5] += 0.9e-6
     near[1][5] += 1.1e-6
     Fa, Fb = (b.discrete_gradient(u0, x)[0] for x in near)
-    assert np.max(np.abs(Fa - Fb)) <= 1e-5 * np.max(np.abs(Fa))      # (the step itself moves F by ~1e-6)
+    assert np.max(np.abs(Fa - Fb)) <= 1e-5 * np.max(np.abs(Fa))  # (the step itself moves F by ~1e-6)
     F, rows, cols, vals = b.discrete_gradient(u0, u1)
     K = np.zeros((b.ndof, b.ndof))
     np.add.at(K, (rows, cols), vals)
@@ -300,6 +334,7 @@ def step_residual(stepper, u, v, dt):
     """The residual function (u1 -> Evaluation) that an EnergyConsistent step from (u, v) hands to
     Newton, and Newton's first guess: taken from the call, which is stopped there."""
     import contactfem.solver.conserving as conserving
+
     captured = {}
 
     def capture(fun, guess, free, **options):
@@ -323,16 +358,17 @@ def test_energy_consistent_step_tangent_with_a_contact_on_the_ring(rng, variant)
     Newton's tangent against central differences."""
     import contactfem.solver.conserving as conserving
     from contactfem.scenes import get_scene, sloping_impact
+
     p = get_scene("sloping_impact").resolve("fast", {"variant": variant, "contact_integration": "energy_consistent"})
     m = sloping_impact.build(p)
     ring, system = m.parts["ring"], m.system
     stepper = conserving.EnergyConsistent(system)
     u = np.zeros(system.ndof)
-    u[ring.body.xdofs[:, 1]] = -(p["gap0"] + 0.02)                      # the lowest nodes pressed in
+    u[ring.body.xdofs[:, 1]] = -(p["gap0"] + 0.02)  # the lowest nodes pressed in
     v = ring.initial_velocity((p["vx0"], p["vy0"]), omega=0.1)
     fun, guess = step_residual(stepper, u, v, p["dt"])
     u1 = guess + 1e-3 * rng.standard_normal(system.ndof)
-    u1[ring.body.xdofs[:, 0]] += 0.05                                    # slip along the plane
+    u1[ring.body.xdofs[:, 0]] += 0.05  # slip along the plane
     ev = fun(u1)
     assert np.any([np.any(c.active) for c in ev.contacts])
     J = fd_jacobian(lambda x: fun(x).G, u1, h=1e-7)
@@ -348,6 +384,7 @@ def test_continuum_discrete_gradient_is_exact_and_has_no_resultant_or_moment(rng
     differences."""
     from contactfem.bodies.continuum import Continuum
     from skfem import MeshQuad
+
     mesh = MeshQuad.init_tensor(np.linspace(1.0, 2.0, 4), np.linspace(0.0, 1.0, 3))
     b = Continuum(mesh, E=100.0, nu=0.3, rho=1.0, kind=kind, material=material)
     u0 = 0.05 * rng.standard_normal(b.ndof)
@@ -355,7 +392,7 @@ def test_continuum_discrete_gradient_is_exact_and_has_no_resultant_or_moment(rng
     F, rows, cols, vals = b.discrete_gradient(u0, u1)
     W0, W1 = b.strain_energy(u0), b.strain_energy(u1)
     assert abs(F @ (u1 - u0) - (W1 - W0)) <= 1e-12 * (W0 + W1)
-    scale = np.max(np.abs(F)) * 2.0                                     # (2: the mesh's size)
+    scale = np.max(np.abs(F)) * 2.0  # (2: the mesh's size)
     assert abs(F[b.xdofs[:, 1]].sum()) <= 1e-12 * scale
     if kind == "plane_strain":
         assert abs(F[b.xdofs[:, 0]].sum()) <= 1e-12 * scale
@@ -377,8 +414,11 @@ def spun_ring_with_moments():
 
     from contactfem.bodies.ring import make_ring
     from contactfem.solver import System
+
     ring = make_ring(kind="beam", R=10.0, thickness=1.0, n_el=16, E=100.0, rho=0.01)
-    system = System([ring.body], loads=[DeadLoad(ring.body, [5 * 3 + 2], 0.005), SpringLoad(ring.body, 2, 0.005, 0.003)])
+    system = System(
+        [ring.body], loads=[DeadLoad(ring.body, [5 * 3 + 2], 0.005), SpringLoad(ring.body, 2, 0.005, 0.003)]
+    )
     return ring, system, ring.initial_velocity((1.0, 0.0), omega=1.0)
 
 
@@ -387,9 +427,11 @@ def test_moments_on_the_angles_balance_the_energy():
     the loads' work, exactly (to the Newton tolerance; both loads are linear in u, so the
     trapezoidal work the records sum is their exact work), 40 steps of a quarter radian."""
     from contactfem.solver import integrate
+
     ring, system, v0 = spun_ring_with_moments()
-    hist = integrate(EnergyConsistent(system, atol=1e-11, rtol=1e-14, maxit=40), 0.0, np.zeros(system.ndof), v0,
-                     n_steps=40, dt=0.25)
+    hist = integrate(
+        EnergyConsistent(system, atol=1e-11, rtol=1e-14, maxit=40), 0.0, np.zeros(system.ndof), v0, n_steps=40, dt=0.25
+    )
     E = hist.kinetic + hist.strain - hist.external_work
     # the loads do work, 1e-3 E0; without the factor the balance misses 7e-6 E0
     assert np.max(np.abs(hist.external_work)) > 1e-4 * E[0]
@@ -400,6 +442,7 @@ def test_energy_consistent_step_tangent_with_moments_on_the_angles(rng):
     """Newton's tangent of a step of the spun ring under moments (the factor Delta theta / phi
     on the loads' rows and its derivative on the diagonal) against central differences."""
     import contactfem.solver.conserving as conserving
+
     ring, system, v = spun_ring_with_moments()
     stepper = conserving.EnergyConsistent(system)
     fun, guess = step_residual(stepper, np.zeros(system.ndof), v, 0.25)
@@ -412,6 +455,7 @@ def test_a_step_turning_an_angle_by_pi_is_refused():
     """The Cayley update phi = 2 tan(Delta theta / 2) holds for |Delta theta| < pi: beyond, one
     FloatingPointError naming the dof (Newton reports it as a failed iteration)."""
     from contactfem.bodies.discrete_gradient import cayley
+
     dq, D, chord, dchord = cayley(np.array([0.3, 1.0, 0.2]), np.array([1]))
     assert dq[1] == pytest.approx(2 * np.tan(0.5)) and chord[1] * dq[1] == pytest.approx(1.0)
     with pytest.raises(FloatingPointError, match="dof 1: the Cayley update allows less than pi"):

@@ -10,20 +10,34 @@ from conftest import PointCloud
 from fd import fd_jacobian, rel_error
 
 from contactfem.contact import BodySurface, NodeToSegment, RigidArc, RigidLine, RigidPolyline, SLIP, STICK, OPEN
-from contactfem.laws import (ArchardWear, Coulomb, DieterichRuina, ExponentialLaw, ParabolicSlip, PowerLaw,
-                             SlipHardening, Stribeck)
+from contactfem.laws import (
+    ArchardWear,
+    Coulomb,
+    DieterichRuina,
+    ExponentialLaw,
+    ParabolicSlip,
+    PowerLaw,
+    SlipHardening,
+    Stribeck,
+)
 
-NORMALS = {"penalty": PowerLaw(c_N=50.0, m=1.0), "power2.5": PowerLaw(c_N=80.0, m=2.5),
-           "exp": ExponentialLaw(a=20.0, b=8.0)}
-FRICTIONS = {"none": None, "coulomb": Coulomb(c_T=30.0, mu=0.3),
-             "parabolic": ParabolicSlip(c_T=30.0, alpha=0.2, beta=0.3, n=0.5),
-             "parabolic08": ParabolicSlip(c_T=30.0, alpha=0.2, beta=0.3, n=0.8),
-             "hardening": SlipHardening(c_T=30.0, mu=0.2, h=0.5),
-             "softening": SlipHardening(c_T=30.0, mu=0.4, h=-0.3),
-             # laws with a slip rate and internal variables (time step DT, states advanced in set_history)
-             "stribeck": Stribeck(c_T=30.0, mu_s=0.5, mu_d=0.3, v_s=0.5, mu_v=0.05),
-             "rate_state": DieterichRuina(c_T=30.0, mu_0=0.3, a=0.02, b=0.03, d_c=0.05),
-             "wear": ArchardWear(c_T=30.0, mu=0.3, k_w=0.2)}
+NORMALS = {
+    "penalty": PowerLaw(c_N=50.0, m=1.0),
+    "power2.5": PowerLaw(c_N=80.0, m=2.5),
+    "exp": ExponentialLaw(a=20.0, b=8.0),
+}
+FRICTIONS = {
+    "none": None,
+    "coulomb": Coulomb(c_T=30.0, mu=0.3),
+    "parabolic": ParabolicSlip(c_T=30.0, alpha=0.2, beta=0.3, n=0.5),
+    "parabolic08": ParabolicSlip(c_T=30.0, alpha=0.2, beta=0.3, n=0.8),
+    "hardening": SlipHardening(c_T=30.0, mu=0.2, h=0.5),
+    "softening": SlipHardening(c_T=30.0, mu=0.4, h=-0.3),
+    # laws with a slip rate and internal variables (time step DT, states advanced in set_history)
+    "stribeck": Stribeck(c_T=30.0, mu_s=0.5, mu_d=0.3, v_s=0.5, mu_v=0.05),
+    "rate_state": DieterichRuina(c_T=30.0, mu_0=0.3, a=0.02, b=0.03, d_c=0.05),
+    "wear": ArchardWear(c_T=30.0, mu=0.3, k_w=0.2),
+}
 DT = 0.1
 
 
@@ -43,7 +57,7 @@ def slave_cloud(rng, n=4, y=-0.05):
     X = np.stack([np.linspace(0.15, 0.85, n), np.full(n, 0.0)], axis=1)
     body = PointCloud(X, "slave")
     u = np.zeros(body.ndof)
-    u[1::2] = y * (0.5 + rng.random(n))      # penetrations of various depth
+    u[1::2] = y * (0.5 + rng.random(n))  # penetrations of various depth
     u[0::2] = 0.01 * rng.standard_normal(n)
     return body, u
 
@@ -57,7 +71,7 @@ def set_history(iface, u, t_T_bar, dg, master=None):
         h = replace(h, s_bar=iface.evaluate(u, dt=DT, history=h).s)
     n = len(iface.nodes)
     z = h.z_bar
-    if iface.friction is not None and iface._law.n_state:     # a state reached by earlier slip (wear: 0.01 deep)
+    if iface.friction is not None and iface._law.n_state:  # a state reached by earlier slip (wear: 0.01 deep)
         z = iface._law.evolve(h.z_bar, np.ones(n), np.full(n, 0.05), DT)[0]
     return replace(h, s_bar=h.s_bar - dg, t_T_bar=np.full(n, t_T_bar), z_bar=z)
 
@@ -82,8 +96,14 @@ def make_master(kind):
 @pytest.mark.parametrize("regime", ["stick", "slip+", "slip-"])
 def test_rigid_master_tangent(rng, master, nlaw, flaw, regime):
     body, u = slave_cloud(rng)
-    iface = NodeToSegment(body, np.arange(4), make_master(master), normal=NORMALS[nlaw], friction=FRICTIONS[flaw],
-                          weights=rng.uniform(0.5, 1.5, 4))
+    iface = NodeToSegment(
+        body,
+        np.arange(4),
+        make_master(master),
+        normal=NORMALS[nlaw],
+        friction=FRICTIONS[flaw],
+        weights=rng.uniform(0.5, 1.5, 4),
+    )
     dg = {"stick": 1e-6, "slip+": 0.5, "slip-": -0.5}[regime]
     h = set_history(iface, u, t_T_bar=0.0, dg=dg)
     e = iface.evaluate(u, dt=DT, history=h)
@@ -106,10 +126,12 @@ def test_deformable_master_tangent(rng, flaw, regime, nlaw):
     slave_body = PointCloud(Xs, "slave", dof_offset=master_body.ndof)
     u = np.zeros(master_body.ndof + slave_body.ndof)
     u[: master_body.ndof] = 0.02 * rng.standard_normal(master_body.ndof)
-    u[master_body.ndof + 1::2] = -0.06 - 0.02 * rng.random(3)
+    u[master_body.ndof + 1 :: 2] = -0.06 - 0.02 * rng.random(3)
     # move the master a little first so that l_bar differs from l
     surface = BodySurface(master_body, np.arange(5))
-    iface = NodeToSegment(slave_body, np.arange(3), surface, normal=NORMALS[nlaw], friction=FRICTIONS[flaw], weights=0.7)
+    iface = NodeToSegment(
+        slave_body, np.arange(3), surface, normal=NORMALS[nlaw], friction=FRICTIONS[flaw], weights=0.7
+    )
     u_old = u.copy()
     u_old[: master_body.ndof] *= 0.3
     dg = {"stick": 1e-6, "slip+": 0.5, "slip-": -0.5}[regime]
@@ -142,7 +164,7 @@ def test_node_switches_segment_and_keeps_history(rng):
     h = iface.commit(iface.evaluate(u, history=h))
     e0 = iface.evaluate(u, history=h)
     assert e0.seg[0] == 0
-    u1 = np.array([0.2, -0.01 + 0.1 * 0.1])     # now above segment 1
+    u1 = np.array([0.2, -0.01 + 0.1 * 0.1])  # now above segment 1
     e1 = iface.evaluate(u1, history=h)
     assert e1.seg[0] == 1
     L1 = np.hypot(1.0, 0.1)
@@ -156,15 +178,16 @@ def test_deformable_master_node_switch_tangent(rng):
     mb = PointCloud(Xm, "master")
     sb = PointCloud([[0.95, 0.0]], "slave", dof_offset=mb.ndof)
     surf = BodySurface(mb, [0, 1, 2])
-    iface = NodeToSegment(sb, [0], surf, normal=NORMALS["penalty"],
-                          friction=ParabolicSlip(c_T=40.0, alpha=0.2, beta=0.3, n=0.5))
+    iface = NodeToSegment(
+        sb, [0], surf, normal=NORMALS["penalty"], friction=ParabolicSlip(c_T=40.0, alpha=0.2, beta=0.3, n=0.5)
+    )
     u = np.zeros(mb.ndof + 2)
     u[-1] = -0.03
     h = iface.start(u)
     h = iface.commit(iface.evaluate(u, history=h))
     u2 = u.copy()
-    u2[-2] = 0.12                     # slides past the middle master node
-    u2[:mb.ndof] = 0.01 * rng.standard_normal(mb.ndof)
+    u2[-2] = 0.12  # slides past the middle master node
+    u2[: mb.ndof] = 0.01 * rng.standard_normal(mb.ndof)
     e = iface.evaluate(u2, history=h)
     assert e.seg[0] == 1 and e.slip[0] == SLIP
     check_tangent(iface, u2, h)

@@ -1,4 +1,5 @@
 """Continuum bodies and their loads: Jacobians, patch tests, closed forms."""
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -12,9 +13,15 @@ E, NU = 100.0, 0.3
 LAM = E * NU / ((1 + NU) * (1 - 2 * NU))
 MU = E / (2 * (1 + NU))
 
-COMBOS = [("plane_strain", "linear"), ("plane_strain", "svk"), ("plane_strain", "neohooke"),
-          ("plane_stress", "linear"),
-          ("axisymmetric", "linear"), ("axisymmetric", "svk"), ("axisymmetric", "neohooke")]
+COMBOS = [
+    ("plane_strain", "linear"),
+    ("plane_strain", "svk"),
+    ("plane_strain", "neohooke"),
+    ("plane_stress", "linear"),
+    ("axisymmetric", "linear"),
+    ("axisymmetric", "svk"),
+    ("axisymmetric", "neohooke"),
+]
 
 
 def block(r0=1.0, r1=2.0, h=1.0, nx=4, ny=3, tri=False):
@@ -22,8 +29,14 @@ def block(r0=1.0, r1=2.0, h=1.0, nx=4, ny=3, tri=False):
     Mesh = MeshTri if tri else MeshQuad
     m = Mesh.init_tensor(np.linspace(r0, r1, nx + 1), np.linspace(0.0, h, ny + 1))
     tol = 1e-9
-    return m.with_boundaries({"inner": lambda x: x[0] < r0 + tol, "outer": lambda x: x[0] > r1 - tol,
-                              "bottom": lambda x: x[1] < tol, "top": lambda x: x[1] > h - tol})
+    return m.with_boundaries(
+        {
+            "inner": lambda x: x[0] < r0 + tol,
+            "outer": lambda x: x[0] > r1 - tol,
+            "bottom": lambda x: x[1] < tol,
+            "top": lambda x: x[1] > h - tol,
+        }
+    )
 
 
 def dof_field(body, fx, fy):
@@ -42,6 +55,7 @@ def fd_jacobian_error(f, jac, u, seed=0, h=1e-6):
 
 
 # -- tangents ----------------------------------------------------------------
+
 
 @pytest.mark.parametrize("tri", [False, True])
 @pytest.mark.parametrize("kind,material", COMBOS)
@@ -100,6 +114,7 @@ def test_linear_stiffness_is_the_general_tangent_form_with_C(kind, tri):
 
 # -- patch tests -------------------------------------------------------------
 
+
 @pytest.mark.parametrize("material", ["linear", "svk", "neohooke"])
 def test_uniform_stretch_gives_uniform_stress(material):
     body = Continuum(block(tri=True), E, NU, 1.0, material=material)
@@ -118,7 +133,7 @@ def test_uniform_stretch_gives_uniform_stress(material):
 @pytest.mark.parametrize("material", ["svk", "neohooke"])
 def test_rigid_rotation_is_stress_free(material):
     body = Continuum(block(), E, NU, 1.0, material=material)
-    u = dof_field(body, lambda X, Y: -Y - X, lambda X, Y: X - Y)   # 90 deg: x = -Y, y = X
+    u = dof_field(body, lambda X, Y: -Y - X, lambda X, Y: X - Y)  # 90 deg: x = -Y, y = X
     R, _ = body.internal(u)
     assert np.abs(R).max() < 1e-10 * E
     assert abs(body.strain_energy(u)) < 1e-10 * E
@@ -135,12 +150,13 @@ def test_linear_agrees_with_svk_at_tiny_strain(kind):
 
 # -- axisymmetric closed forms -----------------------------------------------
 
+
 def test_uniform_radial_expansion():
     body = Continuum(block(tri=True), E, NU, 1.0, kind="axisymmetric")
     eps = 1e-3
     sigma = body.cauchy_stress(dof_field(body, lambda r, z: eps * r, lambda r, z: 0 * z))
     expected = np.diag([2 * (LAM + MU) * eps, 2 * LAM * eps, 2 * (LAM + MU) * eps])
-    assert np.allclose(sigma, expected)      # [rr, zz, hoop]
+    assert np.allclose(sigma, expected)  # [rr, zz, hoop]
 
 
 @pytest.mark.parametrize("follower", [False, True])
@@ -151,7 +167,7 @@ def test_thick_cylinder_under_internal_pressure_vs_lame(follower):
     load = Pressure(body, "inner", p, follower=follower)
     P = load.assemble(np.zeros(body.ndof), 0.0)[0]
     _, K = body.internal(np.zeros(body.ndof))
-    free = body.xdofs[:, 0]                                   # u_z = 0 everywhere: plane strain in z
+    free = body.xdofs[:, 0]  # u_z = 0 everywhere: plane strain in z
     u = np.zeros(body.ndof)
     u[free] = spsolve(K[free][:, free].tocsc(), P[free])
     # Lame, u = A r + B / r, sigma_rr = 2 (lam + mu) A - 2 mu B / r^2, sigma_rr(a) = -p, sigma_rr(b) = 0
@@ -161,6 +177,7 @@ def test_thick_cylinder_under_internal_pressure_vs_lame(follower):
 
 
 # -- mass --------------------------------------------------------------------
+
 
 @pytest.mark.parametrize("kind,volume", [("plane_strain", 3.0 * 1.0), ("axisymmetric", np.pi * 3.0)])
 def test_lumped_mass_sums_to_rho_volume(kind, volume):
@@ -174,12 +191,13 @@ def test_lumped_mass_sums_to_rho_volume(kind, volume):
 
 # -- loads -------------------------------------------------------------------
 
+
 @pytest.mark.parametrize("kind", ["plane_strain", "axisymmetric"])
 def test_follower_pressure_tangent(kind):
     body = Continuum(block(), E, NU, 1.0, kind=kind)
-    body.dof_offset = 3                                        # placed inside a larger system
+    body.dof_offset = 3  # placed inside a larger system
     u = np.zeros(body.ndof + 5)
-    u[3:3 + body.ndof] = 0.1 * np.random.default_rng(3).standard_normal(body.ndof)
+    u[3 : 3 + body.ndof] = 0.1 * np.random.default_rng(3).standard_normal(body.ndof)
     for name in ["inner", "top"]:
         load = Pressure(body, name, lambda t: 2.0 * t, follower=True)
         P, rows, cols, vals = load.assemble(u, 1.5)
@@ -197,22 +215,31 @@ def test_load_resultants():
         assert np.allclose(Pressure(body, "top", 2.0, follower).total_force(u0, 0.0), [0.0, -2.0])
     # axisymmetric: dead traction on the top annulus r in [1, 2]: t * pi (2^2 - 1^2)
     axi = Continuum(block(), E, NU, 1.0, kind="axisymmetric")
-    assert np.allclose(Traction(axi, "top", (0.0, 1.0)).total_force(np.zeros(axi.ndof), 0.0),
-                       [0.0, 3 * np.pi])
+    assert np.allclose(Traction(axi, "top", (0.0, 1.0)).total_force(np.zeros(axi.ndof), 0.0), [0.0, 3 * np.pi])
 
 
 def test_boundary_nodes_are_ordered_with_body_on_the_right():
     body = Continuum(block(), E, NU, 1.0)
     X = body.X[body.boundary_nodes("bottom")]
-    assert np.all(X[:, 1] == 0.0) and np.all(np.diff(X[:, 0]) < 0)   # walk -x: body (y > 0) on the right
+    assert np.all(X[:, 1] == 0.0) and np.all(np.diff(X[:, 0]) < 0)  # walk -x: body (y > 0) on the right
 
 
 # -- errors ------------------------------------------------------------------
 
-@pytest.mark.parametrize("kwargs,word", [
-    (dict(E=-1.0), "E"), (dict(nu=0.5), "nu"), (dict(nu=-1.0), "nu"), (dict(rho=-1.0), "rho"),
-    (dict(kind="3d"), "kind"), (dict(material="steel"), "material"),
-    (dict(kind="plane_stress", material="svk"), "material"), (dict(thickness=0.0), "thickness")])
+
+@pytest.mark.parametrize(
+    "kwargs,word",
+    [
+        (dict(E=-1.0), "E"),
+        (dict(nu=0.5), "nu"),
+        (dict(nu=-1.0), "nu"),
+        (dict(rho=-1.0), "rho"),
+        (dict(kind="3d"), "kind"),
+        (dict(material="steel"), "material"),
+        (dict(kind="plane_stress", material="svk"), "material"),
+        (dict(thickness=0.0), "thickness"),
+    ],
+)
 def test_bad_input_raises(kwargs, word):
     args = dict(mesh=block(), E=E, nu=NU, rho=1.0) | kwargs
     with pytest.raises(ValueError, match=word):
@@ -227,7 +254,7 @@ def test_unknown_boundary_raises():
 @pytest.mark.parametrize("material", ["svk", "neohooke"])
 def test_inverted_element_raises(material):
     body = Continuum(block(), E, NU, 1.0, material=material)
-    u = dof_field(body, lambda X, Y: -2.0 * X, lambda X, Y: 0 * Y)    # x = -X: mirrored
+    u = dof_field(body, lambda X, Y: -2.0 * X, lambda X, Y: 0 * Y)  # x = -X: mirrored
     with pytest.raises(InvertedElementError, match="element volume non-positive"):
         body.internal(u)
 
@@ -237,7 +264,7 @@ def test_corner_jacobian_ratios(tri):
     """det J of the deformed over the reference element at its corners: det F for a homogeneous
     deformation (any element shape), 1 for a rigid rotation; <= 0 where an element is folded,
     which a small-strain (linear) body reports instead of raising."""
-    body = Continuum(block(tri=tri), E, NU, 1.0)                        # linear: no error raised
+    body = Continuum(block(tri=tri), E, NU, 1.0)  # linear: no error raised
     F = np.array([[1.3, 0.2], [-0.1, 0.7]])
     u = dof_field(body, lambda X, Y: (F[0, 0] - 1) * X + F[0, 1] * Y, lambda X, Y: F[1, 0] * X + (F[1, 1] - 1) * Y)
     assert np.allclose(body.corner_jacobian_ratios(u), np.linalg.det(F), rtol=1e-12)
@@ -245,11 +272,11 @@ def test_corner_jacobian_ratios(tri):
     u = dof_field(body, lambda X, Y: c * X - s * Y - X, lambda X, Y: s * X + c * Y - Y)
     assert np.allclose(body.corner_jacobian_ratios(u), 1.0, rtol=1e-12)
     assert body.inverted_elements(u).size == 0
-    u = dof_field(body, lambda X, Y: -2.0 * X, lambda X, Y: 0 * Y)      # x = -X: every element mirrored
+    u = dof_field(body, lambda X, Y: -2.0 * X, lambda X, Y: 0 * Y)  # x = -X: every element mirrored
     assert np.array_equal(body.inverted_elements(u), np.arange(body.mesh.t.shape[1]))
     # one node pushed through its element's opposite side folds the elements around it
     u = np.zeros(body.ndof)
-    k = int(np.argmin(np.linalg.norm(body.X - [1.5, 2.0 / 3.0], axis=1)))     # an interior node
+    k = int(np.argmin(np.linalg.norm(body.X - [1.5, 2.0 / 3.0], axis=1)))  # an interior node
     u[body.xdofs[k, 1]] = -0.9
     bad = body.inverted_elements(u)
     assert 0 < bad.size and all(k in body.mesh.t[:, e] for e in bad)

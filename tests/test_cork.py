@@ -20,7 +20,7 @@ from contactfem.scenes.cork import PAPER
 from contactfem.solver import NewtonError
 from conftest import assert_locate_matches_fd
 
-PAPER_V = PAPER["exit_velocity_m_s"]          # 28 m/s
+PAPER_V = PAPER["exit_velocity_m_s"]  # 28 m/s
 
 
 @pytest.fixture(scope="module")
@@ -107,7 +107,7 @@ def test_boyle_pressure_is_explicit_in_the_volume(fast):
     # bottom face is not flat). 0.03 MPa is the pressure change over ~4 mm of travel
     # (p0 V0 / V^2 dV = 0.8 * 30 / 54^2 = 0.008 MPa per mm): the exit located within 4 mm
     assert abs(fast["pressure_before_exit_MPa"] - 0.8 * 30 / 54) < 0.03, fast["pressure_before_exit_MPa"]
-    assert p[-1] == 0.0                      # the gas escaped
+    assert p[-1] == 0.0  # the gas escaped
 
 
 def test_swept_volume_closed_form():
@@ -119,14 +119,22 @@ def test_swept_volume_closed_form():
 
 def test_neck_normal_points_into_the_neck_and_is_continuous():
     neck = Neck(10.0, 24.0, 2.0)
-    x = np.array([[9.0, 5.0], [10.1, 5.0], [10.0 - 1e-9, 24.0 - 1e-9], [10.0 - 1e-9, 24.0 + 1e-9],
-                  [12.0 - 1e-9, 26.0 + 1e-9], [12.0 + 1e-9, 26.0 + 1e-9]])
+    x = np.array(
+        [
+            [9.0, 5.0],
+            [10.1, 5.0],
+            [10.0 - 1e-9, 24.0 - 1e-9],
+            [10.0 - 1e-9, 24.0 + 1e-9],
+            [12.0 - 1e-9, 26.0 + 1e-9],
+            [12.0 + 1e-9, 26.0 + 1e-9],
+        ]
+    )
     k = neck.locate(x, np.zeros(len(x)), None)
-    assert k["g_N"][0] > 0 and k["g_N"][1] < 0                 # inside the neck open, in the glass closed
-    assert np.allclose(k["n"][0], [-1, 0])                      # towards the cork (the axis)
+    assert k["g_N"][0] > 0 and k["g_N"][1] < 0  # inside the neck open, in the glass closed
+    assert np.allclose(k["n"][0], [-1, 0])  # towards the cork (the axis)
     assert np.allclose(k["n"][2], k["n"][3], atol=1e-6) and abs(k["s"][2] - k["s"][3]) < 1e-6
     assert np.allclose(k["n"][4], k["n"][5], atol=1e-6) and abs(k["s"][4] - k["s"][5]) < 1e-6
-    assert np.allclose(k["n"], np.stack([-k["t"][:, 1], k["t"][:, 0]], axis=1))   # n = e3 x t (eq 18)
+    assert np.allclose(k["n"], np.stack([-k["t"][:, 1], k["t"][:, 0]], axis=1))  # n = e3 x t (eq 18)
 
 
 @pytest.mark.parametrize("x", [[10.2, 7.0], [10.3, 24.8], [11.4, 25.7], [14.0, 25.9]])
@@ -165,7 +173,7 @@ def paper():
 def test_paper_preset_leaves_by_static_breakaway_near_28_m_s(paper):
     r = paper
     assert r["press_fit_calibrated"] is True
-    assert r["breakaway_margin_MPa"] > 0, r["breakaway_margin_MPa"]        # the mechanism
+    assert r["breakaway_margin_MPa"] > 0, r["breakaway_margin_MPa"]  # the mechanism
     assert r["exited"]
     v = r["exit_velocity_m_s"]
     # paper "about 28 m/s" (two digits, +-2 %). Tolerance 10 %: on the knife's edge
@@ -181,16 +189,24 @@ def test_knife_edge_figure_draws_from_its_data(tmp_path, monkeypatch):
     # the figure is computed by `contactfem figures` (minutes); here it is drawn from data of
     # the same shape, and the grid switches to the full one with CONTACTFEM_SLOW
     import matplotlib
+
     matplotlib.use("Agg")
     from contactfem.plots import cork as F
 
-    field = [dict(mu=m, R_tip=R, breakaway_margin_MPa=0.8 - m * 2470 * (1 + (R - 10)) / (np.pi * 100), error=None)
-             for m in (0.095, 0.1, 0.105) for R in (10.0, 10.1)]
-    runs = [dict(mu=0.1, R_tip=10.0, exited=True, v=30.7, margin=0.014, error=None),
-            dict(mu=0.105, R_tip=10.0, exited=False, v=None, margin=-0.028, error=None),
-            dict(mu=0.1, R_tip=10.1, exited=None, v=None, margin=None, error="NewtonError")]
-    line = [dict(p0=p, p_step=p / 8, n_ramp=8, exited=p > 0.79, v=30.0 if p > 0.79 else None,
-                 margin=p - 0.786, error=None) for p in (0.78, 0.8)]
+    field = [
+        dict(mu=m, R_tip=R, breakaway_margin_MPa=0.8 - m * 2470 * (1 + (R - 10)) / (np.pi * 100), error=None)
+        for m in (0.095, 0.1, 0.105)
+        for R in (10.0, 10.1)
+    ]
+    runs = [
+        dict(mu=0.1, R_tip=10.0, exited=True, v=30.7, margin=0.014, error=None),
+        dict(mu=0.105, R_tip=10.0, exited=False, v=None, margin=-0.028, error=None),
+        dict(mu=0.1, R_tip=10.1, exited=None, v=None, margin=None, error="NewtonError"),
+    ]
+    line = [
+        dict(p0=p, p_step=p / 8, n_ramp=8, exited=p > 0.79, v=30.0 if p > 0.79 else None, margin=p - 0.786, error=None)
+        for p in (0.78, 0.8)
+    ]
     files = F.cork_knife_edge(outdir=str(tmp_path), data=dict(field=field, runs=runs, p0=line, preset="fast"))
     assert all((tmp_path / f).exists() for f in ("cork_knife_edge.png", "cork_knife_edge.json")), files
     monkeypatch.delenv("CONTACTFEM_SLOW", raising=False)
@@ -258,7 +274,7 @@ def test_refined_exit_lies_within_the_paper_steps_error_of_the_window(exit_study
     d, s = exit_study
     on, off = s["refined_ms"]["with"], s["refined_ms"]["without"]
     assert abs(on - off) < 2 * ONE_STEP_MS
-    error = abs(paper["exit_time_ms"] - on)            # the paper step's discretisation error
+    error = abs(paper["exit_time_ms"] - on)  # the paper step's discretisation error
     gap = max(PAPER_WINDOW_MS[0] - on, on - PAPER_WINDOW_MS[1], 0.0)
     assert gap <= error, (gap, error)
     readme = " ".join((Path(__file__).resolve().parents[1] / "README.md").read_text().split())
@@ -278,9 +294,11 @@ def test_published_exit_numbers_are_the_run(exit_study, paper):
     fine = [r for r in d["cases"] if r["ramp_step_s"] is not None]
     assert f"({fine[0]['exit_time_ms']:.2f} ms with the step in the neck refined" in summary
     study = (repo / "figures" / "cork_exit_time.md").read_text()
-    assert "every case (CONTACTFEM_SLOW=1)" in study                  # the committed table is the full one
+    assert "every case (CONTACTFEM_SLOW=1)" in study  # the committed table is the full one
     onoff = {True: "on", False: "off"}
     for r in d["cases"]:
-        row = (f"| {r['group']} | {r['label']} | {onoff[r['closing_step_press_fit']]}, {onoff[r['closing_step_pop']]} "
-               f"| {r['exit_time_ms']:.3f} | {r['exit_velocity_m_s']:.2f} |")
+        row = (
+            f"| {r['group']} | {r['label']} | {onoff[r['closing_step_press_fit']]}, {onoff[r['closing_step_pop']]} "
+            f"| {r['exit_time_ms']:.3f} | {r['exit_velocity_m_s']:.2f} |"
+        )
         assert row in study, f"figures/cork_exit_time.md lacks the row {row!r}: regenerate it"

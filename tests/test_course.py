@@ -38,8 +38,9 @@ def require(module):
         try:
             return __import__(module)
         except ImportError as err:
-            pytest.fail(f"CI=true but the course dependency {module!r} is missing ({err}): install '.[all]'",
-                        pytrace=False)
+            pytest.fail(
+                f"CI=true but the course dependency {module!r} is missing ({err}): install '.[all]'", pytrace=False
+            )
     return pytest.importorskip(module)
 
 
@@ -88,6 +89,7 @@ def _wrong(name):
 
 # -- the course's shape ---------------------------------------------------------------------
 
+
 @pytest.mark.slow
 def test_every_lecture_opens_with_objectives_prerequisites_and_time():
     nbformat = _nbformat()
@@ -96,7 +98,7 @@ def test_every_lecture_opens_with_objectives_prerequisites_and_time():
         head = "\n".join(c.source for c in nb.cells[:3] if c.cell_type == "markdown")
         for what in ("**Learning objectives.**", "**Prerequisites.**", "**Time.**"):
             assert what in head, f"{src.name}: no {what} at the top"
-        objectives = re.findall(r"^\d\. \*[a-z ]+\*", head, re.M)      # "1. *compute* ..."
+        objectives = re.findall(r"^\d\. \*[a-z ]+\*", head, re.M)  # "1. *compute* ..."
         assert 3 <= len(objectives) <= 5, f"{src.name}: {len(objectives)} learning objectives (3-5, each a verb)"
 
 
@@ -127,13 +129,19 @@ def test_each_exercise_is_in_its_lecture_labelled_and_last():
         qs = questions(nb)
         for name, i in qs:
             found[name] = src.stem
-            prompt = next(c.source for c in nb.cells[i + 1:] if c.cell_type == "markdown")
-            assert re.search(rf"\*{ex[name].difficulty.capitalize()}[.;]", prompt), \
+            prompt = next(c.source for c in nb.cells[i + 1 :] if c.cell_type == "markdown")
+            assert re.search(rf"\*{ex[name].difficulty.capitalize()}[.;]", prompt), (
                 f"{name}: its prompt does not say {ex[name].difficulty}"
+            )
             assert ("implement part of the method" in prompt) == ex[name].implements, name
         if qs:
-            headings = [ln for c in nb.cells if c.cell_type == "markdown" for ln in c.source.splitlines()
-                        if ln.startswith("## ")]
+            headings = [
+                ln
+                for c in nb.cells
+                if c.cell_type == "markdown"
+                for ln in c.source.splitlines()
+                if ln.startswith("## ")
+            ]
             assert headings[-1] == "## Exercises", f"{src.name}: the last section is {headings[-1]!r}"
     assert found == {n: e.lecture for n, e in ex.items()}
     assert sorted(p.stem for p in WRONG.glob("*.py")) == sorted(ex)
@@ -143,8 +151,10 @@ def test_course_plan_lists_every_exercise_as_graded():
     """The README's tables of exercises (plan and checks) say what checks.EXERCISES holds."""
     text = (REPO / "lectures" / "README.md").read_text()
     ex = _exercises()
-    rows = {m.group(1): [c.strip() for c in m.group(2).split("|")]
-            for m in re.finditer(r"^\| `(ex\w+)` \|(.*)\|$", text, re.M)}
+    rows = {
+        m.group(1): [c.strip() for c in m.group(2).split("|")]
+        for m in re.finditer(r"^\| `(ex\w+)` \|(.*)\|$", text, re.M)
+    }
     assert sorted(rows) == sorted(ex)
     for name, (difficulty, implements, points, what) in rows.items():
         e = ex[name]
@@ -156,6 +166,7 @@ def test_course_plan_lists_every_exercise_as_graded():
 
 
 # -- the checks, in this process --------------------------------------------------------------
+
 
 def _run(name, code):
     from contactfem.lab.course.checks import run
@@ -196,6 +207,7 @@ def test_check_stops_an_endless_loop():
 
 
 # -- the real path: otter builds the versions and grades the notebooks ---------------------------
+
 
 def _answer_cells(nb):
     """{exercise: the answer cell} of a built notebook (the code cell before grader.check)."""
@@ -307,8 +319,11 @@ def test_grade_a_folder_of_three_from_the_command_line(course, tmp_path, capsys)
     shutil.copy2(root / "instructor" / f"{lec}.ipynb", folder / "anna.ipynb")
     shutil.copy2(root / "student" / f"{lec}.ipynb", folder / "ben.ipynb")
     sol = "\n".join(_solutions()["ex01_power_law"])
-    _with_answers(root / "student" / f"{lec}.ipynb", {"ex01_power_law": sol, "ex01_tresca": _wrong("ex01_tresca")[0]},
-                  folder / "carla.ipynb")
+    _with_answers(
+        root / "student" / f"{lec}.ipynb",
+        {"ex01_power_law": sol, "ex01_tresca": _wrong("ex01_tresca")[0]},
+        folder / "carla.ipynb",
+    )
     out = tmp_path / "scores.csv"
     t0 = time.perf_counter()
     assert main(["course", "grade", str(folder), "--out", str(out)]) == 0
@@ -316,10 +331,25 @@ def test_grade_a_folder_of_three_from_the_command_line(course, tmp_path, capsys)
     with open(out) as f:
         rows = list(csv.DictReader(f))
     assert [r["submission"] for r in rows] == ["anna.ipynb", "ben.ipynb", "carla.ipynb"]
-    assert list(rows[0]) == ["id", "name", "submission", "lecture", "ex01_power_law", "ex01_tresca",
-                             "ex01_discussion", "total", "possible", "status", "late", "notes"]
-    assert [(r["ex01_power_law"], r["ex01_tresca"], r["total"]) for r in rows] == \
-        [("5", "5", "10"), ("0", "0", "0"), ("5", "2", "7")]
+    assert list(rows[0]) == [
+        "id",
+        "name",
+        "submission",
+        "lecture",
+        "ex01_power_law",
+        "ex01_tresca",
+        "ex01_discussion",
+        "total",
+        "possible",
+        "status",
+        "late",
+        "notes",
+    ]
+    assert [(r["ex01_power_law"], r["ex01_tresca"], r["total"]) for r in rows] == [
+        ("5", "5", "10"),
+        ("0", "0", "0"),
+        ("5", "2", "7"),
+    ]
     assert "grows with the pressure" in rows[2]["notes"]
 
 
@@ -337,8 +367,18 @@ def test_course_command_line_refuses_bad_input(tmp_path, capsys):
         (["course", "grade", str(tmp_path / "subs"), "--out", str(tmp_path / "x.txt")], "must end in .csv"),
         (["course", "grade", str(tmp_path / "subs"), "--out", str(tmp_path / "file" / "x.csv")], "is a file"),
         (["course", "grade", str(tmp_path / "subs"), "--out", str(tmp_path / "x.csv"), "--jobs", "0"], "--jobs"),
-        (["course", "grade", str(tmp_path / "subs"), "--out", str(tmp_path / "x.csv"), "--autograders",
-          str(tmp_path / "empty")], "no grading configurations"),
+        (
+            [
+                "course",
+                "grade",
+                str(tmp_path / "subs"),
+                "--out",
+                str(tmp_path / "x.csv"),
+                "--autograders",
+                str(tmp_path / "empty"),
+            ],
+            "no grading configurations",
+        ),
         (["course", "build", "--out", str(tmp_path / "file")], "is a file"),
     ]
     for argv, what in cases:

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import pytest
 
-pytestmark = pytest.mark.slow      # end-to-end: command lines and processes (the fast tier leaves them out)
+pytestmark = pytest.mark.slow  # end-to-end: command lines and processes (the fast tier leaves them out)
 
 ON_CI = os.environ.get("CI", "").lower() in ("true", "1", "yes")
 REPO = Path(__file__).resolve().parents[1]
@@ -60,7 +60,7 @@ def test_a_rebuild_refuses_to_overwrite_an_answered_notebook(tmp_path, capsys):
     out = tmp_path / "student"
     assert _main(["course", "build", "--out", str(out)], capsys)[0] == 0
     fresh = (out / f"{LEC}.ipynb").read_bytes()
-    assert _main(["course", "build", "--out", str(out)], capsys)[0] == 0       # nothing changed: replaced
+    assert _main(["course", "build", "--out", str(out)], capsys)[0] == 0  # nothing changed: replaced
     _answer(out / f"{LEC}.ipynb")
     answered = (out / f"{LEC}.ipynb").read_bytes()
     before = {p.name: p.stat().st_mtime_ns for p in out.iterdir()}
@@ -68,7 +68,7 @@ def test_a_rebuild_refuses_to_overwrite_an_answered_notebook(tmp_path, capsys):
     assert code == 2 and len(err) == 1, err
     assert f"{LEC}.ipynb" in err[0] and "--force" in err[0], err
     assert (out / f"{LEC}.ipynb").read_bytes() == answered
-    assert {p.name: p.stat().st_mtime_ns for p in out.iterdir()} == before      # nothing written at all
+    assert {p.name: p.stat().st_mtime_ns for p in out.iterdir()} == before  # nothing written at all
     code, err = _main(["course", "build", "--out", str(out), "--force"], capsys)
     assert code == 0, err
     backups = list(out.glob(f"backup-*/{LEC}.ipynb"))
@@ -97,7 +97,7 @@ def test_a_folder_of_work_is_not_built_over(tmp_path):
     same.mkdir()
     shutil.copy2(made, same / made.name)
     assert build(same, only=[LEC]) == [same / made.name]
-    older = tmp_path / "older"                 # what an earlier build wrote, untouched: the lecture changed since
+    older = tmp_path / "older"  # what an earlier build wrote, untouched: the lecture changed since
     older.mkdir()
     (older / made.name).write_text('{"an": "older build"}')
     handout.write_manifest(older, "student", [made.name])
@@ -109,15 +109,20 @@ def _no_work(*args, **kwargs):
     raise AssertionError("the work started before the outputs were checked")
 
 
-@pytest.mark.parametrize("argv, pattern", [
-    (["course", "build", "--out", "/proc/x"], r"^contactfem: error: --out /proc/x: cannot write in /proc"),
-    (["course", "build", "--out", "{file}/sub"], r"--out .*/sub: .* is a file"),
-    (["course", "build", "--instructor", "--out", "{student}"],
-     r"--out .*: holds the student version of the course; build the instructor version into another folder"),
-    (["course", "build", "--out", "{changed}"], rf"--out .*: {LEC}.ipynb differs from what the build would write"),
-    (["site", "--out", "/proc/x"], r"^contactfem: error: --out /proc/x: cannot write in /proc"),
-    (["site", "--out", "{dir}"], r"--out .*: holds files that are not a site built by contactfem site \(a_file, "),
-])
+@pytest.mark.parametrize(
+    "argv, pattern",
+    [
+        (["course", "build", "--out", "/proc/x"], r"^contactfem: error: --out /proc/x: cannot write in /proc"),
+        (["course", "build", "--out", "{file}/sub"], r"--out .*/sub: .* is a file"),
+        (
+            ["course", "build", "--instructor", "--out", "{student}"],
+            r"--out .*: holds the student version of the course; build the instructor version into another folder",
+        ),
+        (["course", "build", "--out", "{changed}"], rf"--out .*: {LEC}.ipynb differs from what the build would write"),
+        (["site", "--out", "/proc/x"], r"^contactfem: error: --out /proc/x: cannot write in /proc"),
+        (["site", "--out", "{dir}"], r"--out .*: holds files that are not a site built by contactfem site \(a_file, "),
+    ],
+)
 def test_course_and_site_check_their_outputs_before_any_work(argv, pattern, tmp_path, monkeypatch, capsys):
     """One line, exit code 2, and the work (otter assign, the site's staging) never started."""
     import contactfem.lab.course as course
@@ -125,7 +130,7 @@ def test_course_and_site_check_their_outputs_before_any_work(argv, pattern, tmp_
     from contactfem.lab.course import handout
 
     (tmp_path / "a_file").write_text("")
-    for name in ("student", "changed"):                      # folders an earlier build wrote (recorded)
+    for name in ("student", "changed"):  # folders an earlier build wrote (recorded)
         folder = tmp_path / name
         folder.mkdir()
         (folder / f"{LEC}.ipynb").write_text("{}")
@@ -133,8 +138,10 @@ def test_course_and_site_check_their_outputs_before_any_work(argv, pattern, tmp_
     (tmp_path / "changed" / f"{LEC}.ipynb").write_text('{"answered": 1}')
     monkeypatch.setattr(course, "_assign", _no_work)
     monkeypatch.setattr(pages, "stage", _no_work)
-    argv = [a.format(file=tmp_path / "a_file", dir=tmp_path, student=tmp_path / "student",
-                     changed=tmp_path / "changed") for a in argv]
+    argv = [
+        a.format(file=tmp_path / "a_file", dir=tmp_path, student=tmp_path / "student", changed=tmp_path / "changed")
+        for a in argv
+    ]
     code, err = _main(argv, capsys)
     assert code == 2 and len(err) == 1 and re.search(pattern, err[0]), err
 
@@ -154,14 +161,16 @@ def test_the_student_zip_holds_no_solution(tmp_path):
         files = {Path(n).name: z.read(n).decode() for n in z.namelist()}
     sources = lecture_sources()
     examples = sorted(f.name for f in (REPO / "lectures" / "examples").glob("*.*"))
-    assert sorted(files) == sorted(["README.md"] + [s.name for s in sources] + examples)   # the lectures' example files too
+    assert sorted(files) == sorted(
+        ["README.md"] + [s.name for s in sources] + examples
+    )  # the lectures' example files too
     nbs = {s.name: nbformat.read(s, as_version=4) for s in sources}
-    public = {name: _public_text(nb) for name, nb in nbs.items()}   # a lecture may show another's line as text
+    public = {name: _public_text(nb) for name, nb in nbs.items()}  # a lecture may show another's line as text
     searched = 0
     for src in sources:
         teacher = (outs["instructor"] / src.name).read_text()
         for line in solution_lines(nbs[src.name]):
-            for form in (line, json.dumps(line)[1:-1]):       # as written, and as a notebook's JSON holds it
+            for form in (line, json.dumps(line)[1:-1]):  # as written, and as a notebook's JSON holds it
                 holders = [n for n, text in files.items() if form in text and line not in public.get(n, "")]
                 assert not holders, f"{holders} hold {line!r}, a line of the solutions of {src.name}"
             assert json.dumps(line)[1:-1] in teacher
@@ -192,14 +201,20 @@ def test_ctrl_c_during_the_course_build_says_nothing_was_written(tmp_path):
     tmp, out = tmp_path / "tmp", tmp_path / "out"
     tmp.mkdir()
     env = dict(os.environ, TMPDIR=str(tmp), PYTHONPATH=str(REPO))
-    p = subprocess.Popen([sys.executable, "-m", "contactfem", "course", "build", "--out", str(out)], env=env,
-                         text=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True,
-                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    p = subprocess.Popen(
+        [sys.executable, "-m", "contactfem", "course", "build", "--out", str(out)],
+        env=env,
+        text=True,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        start_new_session=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
     t0 = time.monotonic()
     while p.poll() is None and not list(tmp.glob("contactfem-course-*/*")) and time.monotonic() - t0 < 120:
         time.sleep(0.01)
     assert p.poll() is None, p.communicate()
-    os.killpg(p.pid, signal.SIGINT)                           # as Ctrl-C in a terminal: the whole group
+    os.killpg(p.pid, signal.SIGINT)  # as Ctrl-C in a terminal: the whole group
     _, err = p.communicate(timeout=120)
     assert p.returncode == 130, err
     assert err.strip() == f"contactfem: interrupted during the course build; nothing written in {out}", err
@@ -214,12 +229,15 @@ def test_the_readme_counts_the_exercises_the_course_has():
     from contactfem.lab.course.checks import EXERCISES
 
     text = (REPO / "README.md").read_text()
-    section = text[text.index("## The course: exercises"):]
-    section = " ".join(section[:section.index("\n## ", 1)].split())
-    m = re.search(r"Every lecture opens with [^.]*?, and ends with graded\s+exercises: (\d+) in all, (\d+) of which "
-                  r"implement part of the method", section)
+    section = text[text.index("## The course: exercises") :]
+    section = " ".join(section[: section.index("\n## ", 1)].split())
+    m = re.search(
+        r"Every lecture opens with [^.]*?, and ends with graded\s+exercises: (\d+) in all, (\d+) of which "
+        r"implement part of the method",
+        section,
+    )
     assert m, "the README no longer says which lectures have exercises and how many"
-    assert {e.lecture for e in EXERCISES.values()} == {s.stem for s in lecture_sources()}     # every lecture
+    assert {e.lecture for e in EXERCISES.values()} == {s.stem for s in lecture_sources()}  # every lecture
     assert int(m.group(1)) == len(EXERCISES)
     assert int(m.group(2)) == sum(e.implements for e in EXERCISES.values())
     assert not re.search(r"lectures \d\d-\d\d", section), "a range of lectures the code does not check"

@@ -12,54 +12,58 @@ import time
 
 import pytest
 
-pytestmark = pytest.mark.slow      # end-to-end: command lines and processes (the fast tier leaves them out)
+pytestmark = pytest.mark.slow  # end-to-end: command lines and processes (the fast tier leaves them out)
 
 nbformat = pytest.importorskip("nbformat")
 
 LECTURE = "01_interface_laws"
 HEAD = "import numpy as np\nfrom dataclasses import dataclass"
-PL = '''def power_law(g_N, c_N, m):
+PL = """def power_law(g_N, c_N, m):
     g_N = np.asarray(g_N, dtype=float)
     approach = np.where(g_N < 0.0, -g_N, 0.0)
-    return -c_N * approach ** m, np.where(g_N < 0.0, c_N * m * approach ** (m - 1.0), 0.0)'''
-TR = '''@dataclass(frozen=True)
+    return -c_N * approach ** m, np.where(g_N < 0.0, c_N * m * approach ** (m - 1.0), 0.0)"""
+TR = """@dataclass(frozen=True)
 class Tresca:
     c_T: float
     tau_y: float
 
     def slip_bound(self, p, q):
         Y = np.full(np.broadcast(p, q).shape, float(self.tau_y))
-        return Y, np.zeros_like(Y), np.zeros_like(Y)'''
+        return Y, np.zeros_like(Y), np.zeros_like(Y)"""
 PL_STUB = "def power_law(g_N, c_N, m):\n    ..."
 TR_STUB = "@dataclass(frozen=True)\nclass Tresca:\n    c_T: float\n    tau_y: float\n\n    def slip_bound(self, p, q):\n        ..."
-PL_SIGN = PL.replace("return -c_N", "return c_N")                          # t_N of the wrong sign
-PL_NO_M = PL.replace("c_N * m * approach", "c_N * approach")               # dt_N without the factor m
-PL_C100 = PL.replace("c_N", "100.0").replace("100.0, m", "c_N, m")          # c_N ignored: right only at c_N = 100
-TR_COULOMB = TR.replace("Y = np.full(np.broadcast(p, q).shape, float(self.tau_y))",
-                        "Y = self.tau_y * np.asarray(p, dtype=float) + 0.0 * np.asarray(q)")
-PL_ONE = PL.replace("return -c_N * approach ** m, np.where(g_N < 0.0, c_N * m * approach ** (m - 1.0), 0.0)",
-                    "return -c_N * approach ** m")
+PL_SIGN = PL.replace("return -c_N", "return c_N")  # t_N of the wrong sign
+PL_NO_M = PL.replace("c_N * m * approach", "c_N * approach")  # dt_N without the factor m
+PL_C100 = PL.replace("c_N", "100.0").replace("100.0, m", "c_N, m")  # c_N ignored: right only at c_N = 100
+TR_COULOMB = TR.replace(
+    "Y = np.full(np.broadcast(p, q).shape, float(self.tau_y))",
+    "Y = self.tau_y * np.asarray(p, dtype=float) + 0.0 * np.asarray(q)",
+)
+PL_ONE = PL.replace(
+    "return -c_N * approach ** m, np.where(g_N < 0.0, c_N * m * approach ** (m - 1.0), 0.0)",
+    "return -c_N * approach ** m",
+)
 PL_RAISES = "def power_law(g_N, c_N, m):\n    return 1 / 0"
 PL_FOREVER = "import time\n\ndef power_law(g_N, c_N, m):\n    while True:\n        time.sleep(0.01)"
-PL_LIBRARY = '''from contactfem.laws.normal import PowerLaw
+PL_LIBRARY = """from contactfem.laws.normal import PowerLaw
 
 def power_law(g_N, c_N, m):
-    return PowerLaw(c_N, m).traction(g_N)'''
-PL_LIBRARY_HIDDEN = '''import importlib
+    return PowerLaw(c_N, m).traction(g_N)"""
+PL_LIBRARY_HIDDEN = """import importlib
 
 def power_law(g_N, c_N, m):
     law = getattr(importlib.import_module("contactfem.laws." + "normal"), "Power" + "Law")
-    return law(c_N, m).traction(g_N)'''
-PATCH_CHECKS = '''import contactfem.lab.course.checks as checks
+    return law(c_N, m).traction(g_N)"""
+PATCH_CHECKS = """import contactfem.lab.course.checks as checks
 for name in dir(checks):
     if not name.startswith("__"):
-        setattr(checks, name, lambda *a, **k: None)'''
-PATCH_NUMPY = '''np.allclose = lambda *a, **k: True
+        setattr(checks, name, lambda *a, **k: None)"""
+PATCH_NUMPY = """np.allclose = lambda *a, **k: True
 np.all = lambda *a, **k: True
-np.testing.assert_allclose = lambda *a, **k: None'''
-PATCH_BUILTINS = '''import builtins
+np.testing.assert_allclose = lambda *a, **k: None"""
+PATCH_BUILTINS = """import builtins
 builtins.isinstance = lambda *a: True
-builtins.AssertionError = type("Nothing", (Exception,), {})'''
+builtins.AssertionError = type("Nothing", (Exception,), {})"""
 PL_ZEROS = "def power_law(g_N, c_N, m):\n    return np.zeros_like(g_N), np.zeros_like(g_N)"
 
 # (name, cells, the scores intended for (ex01_power_law, ex01_tresca), a note the row must hold)
@@ -73,11 +77,15 @@ CLASS = [
     ("sign", [HEAD, PL_SIGN, TR], (3, 5), "the sign is wrong"),
     ("no_m", [HEAD, PL_NO_M, TR], (3, 5), "off by a factor 0.4"),
     ("coulomb", [HEAD, PL, TR_COULOMB], (5, 2), "grows with the pressure"),
-    ("c_N_ignored", [HEAD, PL_C100, TR], (1, 5), "c_N = 37"),                # passes the public checks only
+    ("c_N_ignored", [HEAD, PL_C100, TR], (1, 5), "c_N = 37"),  # passes the public checks only
     ("one_value", [HEAD, PL_ONE, TR], (0, 5), "should return 2 values"),
     ("raises", [HEAD, PL_RAISES, TR], (0, 5), "raised ZeroDivisionError"),
-    ("patch_checks", [HEAD, PATCH_CHECKS, "def power_law(g_N, c_N, m):\n    return None", TR_STUB], (0, 0),
-     "returned None"),
+    (
+        "patch_checks",
+        [HEAD, PATCH_CHECKS, "def power_law(g_N, c_N, m):\n    return None", TR_STUB],
+        (0, 0),
+        "returned None",
+    ),
     ("patch_numpy", [HEAD, PATCH_NUMPY, PL_ZEROS, TR_STUB], (1, 0), "expected"),
     ("patch_builtins", [HEAD, PATCH_BUILTINS, PL_ZEROS, TR_STUB], (1, 0), "expected"),
     ("library", [HEAD, PL_LIBRARY, TR], (0, 5), "the library's own contactfem.laws.normal.PowerLaw"),
@@ -91,14 +99,37 @@ CLASS = [
     ("flood", [HEAD, PL, 'print("x" * 100_000_000)', TR], (5, 5), "printed 95 MB"),
     ("memory", [HEAD, PL, "hog = bytearray(3 * 2**30)", TR], (5, 5), "MemoryError"),
     ("late", [HEAD, PL, TR], (5, 5), "late by 2 h 00 min"),
-    ("magic", [HEAD, "%matplotlib inline\n" + PL, "import otter\ngrader = otter.Notebook('x.ipynb')", TR,
-               'grader.check("ex01_power_law")'], (5, 5), ""),
+    (
+        "magic",
+        [
+            HEAD,
+            "%matplotlib inline\n" + PL,
+            "import otter\ngrader = otter.Notebook('x.ipynb')",
+            TR,
+            'grader.check("ex01_power_law")',
+        ],
+        (5, 5),
+        "",
+    ),
     ("tr_only_fields", [HEAD, PL, TR.replace("float(self.tau_y)", "0.2")], (5, 3), "tau_y = 1.3"),
-    ("kills_the_grader", [HEAD, PL, TR, "import os, signal\nos.kill(os.getppid(), signal.SIGKILL)"], (0, 0),
-     "worker died: signal 9"),                                            # it can stop its grading, not score
+    (
+        "kills_the_grader",
+        [HEAD, PL, TR, "import os, signal\nos.kill(os.getppid(), signal.SIGKILL)"],
+        (0, 0),
+        "worker died: signal 9",
+    ),  # it can stop its grading, not score
     ("full3", [HEAD, PL, TR], (5, 5), ""),
-    ("compares_with_library", [HEAD, PL + "\n\nfrom contactfem.laws import PowerLaw\n"
-                               "print(PowerLaw(100.0, 2.5).traction(-0.1), power_law(-0.1, 100.0, 2.5))", TR], (5, 5), ""),
+    (
+        "compares_with_library",
+        [
+            HEAD,
+            PL + "\n\nfrom contactfem.laws import PowerLaw\n"
+            "print(PowerLaw(100.0, 2.5).traction(-0.1), power_law(-0.1, 100.0, 2.5))",
+            TR,
+        ],
+        (5, 5),
+        "",
+    ),
     ("full4", [HEAD, PL, TR], (5, 5), ""),
 ]
 CORRUPT = "corrupt"
@@ -110,9 +141,11 @@ def _notebook(cells, path, written="Penetration against conditioning."):
     nb = nbformat.v4.new_notebook()
     nb.metadata["otter"] = {"assignment_name": LECTURE}
     nb.cells = [nbformat.v4.new_code_cell(c) for c in cells]
-    nb.cells += [nbformat.v4.new_markdown_cell("<!-- manual: ex01_discussion -->\n**Discuss** c_N."),
-                 nbformat.v4.new_code_cell("stiffness = [1e2, 1e4]"),
-                 nbformat.v4.new_markdown_cell(written)]
+    nb.cells += [
+        nbformat.v4.new_markdown_cell("<!-- manual: ex01_discussion -->\n**Discuss** c_N."),
+        nbformat.v4.new_code_cell("stiffness = [1e2, 1e4]"),
+        nbformat.v4.new_markdown_cell(written),
+    ]
     nbformat.write(nb, path)
 
 
@@ -129,8 +162,14 @@ def make_class(root):
         w = csv.writer(f)
         w.writerow(["id", "name", "file", "submitted"])
         for i, (name, *_) in enumerate(CLASS):
-            w.writerow([f"u{i:02d}", f"Student {name}", f"{name}.ipynb",
-                        "2026-12-03T14:00:00+00:00" if name == "late" else "2026-12-03T10:00:00+00:00"])
+            w.writerow(
+                [
+                    f"u{i:02d}",
+                    f"Student {name}",
+                    f"{name}.ipynb",
+                    "2026-12-03T14:00:00+00:00" if name == "late" else "2026-12-03T10:00:00+00:00",
+                ]
+            )
         w.writerow(["u90", "Student corrupt", f"{CORRUPT}.ipynb", ""])
         w.writerow(["u91", "Student absent", f"{MISSING}.ipynb", ""])
     return subs, roster, "2026-12-03T12:00:00+00:00"
@@ -144,8 +183,27 @@ def graded(tmp_path_factory):
     subs, roster, deadline = make_class(root)
     out = root / "scores.csv"
     t0 = time.perf_counter()
-    code = main(["course", "grade", str(subs), "--out", str(out), "--roster", str(roster), "--deadline", deadline,
-                 "--jobs", "2", "--notebook-timeout", "20", "--check-timeout", "1", "--memory", "2048"])
+    code = main(
+        [
+            "course",
+            "grade",
+            str(subs),
+            "--out",
+            str(out),
+            "--roster",
+            str(roster),
+            "--deadline",
+            deadline,
+            "--jobs",
+            "2",
+            "--notebook-timeout",
+            "20",
+            "--check-timeout",
+            "1",
+            "--memory",
+            "2048",
+        ]
+    )
     seconds = time.perf_counter() - t0
     assert code == 0
     with open(out) as f:
@@ -169,7 +227,7 @@ def test_a_class_of_thirty_gets_the_scores_intended(graded):
     corrupt = rows[f"{CORRUPT}.ipynb"]
     assert corrupt["status"] == "not graded" and "not a notebook" in corrupt["notes"]
     assert rows["u91"]["status"] == "missing" and "no submission" in rows["u91"]["notes"]
-    for r in (corrupt, rows["u91"]):        # the gradebook's columns for every student of the roster
+    for r in (corrupt, rows["u91"]):  # the gradebook's columns for every student of the roster
         assert (r["lecture"], r["total"], r["possible"]) == (LECTURE, "0", "12"), r
     assert rows[f"{STRAY}.ipynb"]["id"] == "" and "not on the roster" in rows[f"{STRAY}.ipynb"]["notes"]
     assert rows["endless_cell.ipynb"]["status"] == "stopped"
@@ -185,12 +243,16 @@ def test_the_class_review_and_feedback_files_are_complete(graded):
     for name, *_ in CLASS:
         assert f"{name} says: stiff is accurate" in page, name
         assert sum(1 for r in sheet if r["submission"] == f"{name}.ipynb") == 1
-    assert page.count("<section") == len(CLASS) + 2          # the class, the stray and the corrupt one
+    assert page.count("<section") == len(CLASS) + 2  # the class, the stray and the corrupt one
     assert "stiffness = [1e2, 1e4]" in page
     files = sorted(p.name for p in (root / "scores-feedback").glob("*.md"))
     assert len(files) == len(rows)
     text = (root / "scores-feedback" / f"u{[c[0] for c in CLASS].index('sign'):02d}-{LECTURE}.md").read_text()
-    assert "Total: 8 of 12" in text and "the sign is wrong" in text and "ex01_discussion (written): to be scored, 2 points" in text
+    assert (
+        "Total: 8 of 12" in text
+        and "the sign is wrong" in text
+        and "ex01_discussion (written): to be scored, 2 points" in text
+    )
 
 
 def test_written_scores_are_read_back_into_the_csv(tmp_path):
@@ -214,7 +276,7 @@ def test_written_scores_are_read_back_into_the_csv(tmp_path):
     rows = grade(subs, out, jobs=2)
     assert (rows[0]["ex01_discussion"], rows[0]["total"], rows[0]["possible"]) == ("1.5", "6.5", "12")
     assert rows[1]["ex01_discussion"] == "" and rows[1]["total"] == "0"
-    assert open(sheet).read().count("1.5") == 1             # the instructor's sheet is kept
+    assert open(sheet).read().count("1.5") == 1  # the instructor's sheet is kept
 
 
 def test_patching_the_checks_in_the_notebook_scores_nothing(tmp_path):
@@ -224,8 +286,9 @@ def test_patching_the_checks_in_the_notebook_scores_nothing(tmp_path):
 
     subs = tmp_path / "subs"
     subs.mkdir()
-    _notebook([HEAD, PATCH_CHECKS, PATCH_NUMPY, "def power_law(g_N, c_N, m):\n    return None", TR_STUB],
-              subs / "cheat.ipynb")
+    _notebook(
+        [HEAD, PATCH_CHECKS, PATCH_NUMPY, "def power_law(g_N, c_N, m):\n    return None", TR_STUB], subs / "cheat.ipynb"
+    )
     row = grade(subs, tmp_path / "s.csv")[0]
     assert (row["ex01_power_law"], row["ex01_tresca"], row["total"]) == ("0", "0", "0"), row["notes"]
 
@@ -333,7 +396,7 @@ def test_implement_exercises_guard_the_library_or_say_they_build_on_it():
     for src in lecture_sources():
         nb = nbformat.read(src, as_version=4)
         for name, i in questions(nb):
-            prompt = next(c.source for c in nb.cells[i + 1:] if c.cell_type == "markdown")
+            prompt = next(c.source for c in nb.cells[i + 1 :] if c.cell_type == "markdown")
             says = bool(re.search(r"builds on the library on purpose", prompt))
             assert says == (name in BUILDS_ON), name
 
@@ -367,7 +430,7 @@ def test_hidden_checks_pass_every_solution_and_cover_the_exercises():
     hidden = load_hidden(hidden_checks_file())
     parts = {p.name for e in EXERCISES.values() for p in e.parts}
     assert set(hidden) <= parts
-    scenes = {"ex05_incline"}          # two scene runs of 120 s allowed each: public only
+    scenes = {"ex05_incline"}  # two scene runs of 120 s allowed each: public only
     for name, e in EXERCISES.items():
         assert any(p.name in hidden for p in e.parts) == (name not in scenes), name
     sols = {}
@@ -381,8 +444,14 @@ def test_hidden_checks_pass_every_solution_and_cover_the_exercises():
         env = {"np": np, "dataclass": dataclass}
         exec(compile("\n".join(sols[name]), f"<{name}>", "exec"), env)
         stub = {"np": np, "dataclass": dataclass}
-        exec(compile("\n".join("\n".join(replace_solutions(s.split("\n"), "python")) for s in sols[name]),
-                     f"<{name} stub>", "exec"), stub)
+        exec(
+            compile(
+                "\n".join("\n".join(replace_solutions(s.split("\n"), "python")) for s in sols[name]),
+                f"<{name} stub>",
+                "exec",
+            ),
+            stub,
+        )
         failed = 0
         for p in e.parts:
             for check in hidden.get(p.name, ()):
@@ -401,8 +470,16 @@ def test_what_a_submission_started_ends_with_its_grading(tmp_path):
     subs = tmp_path / "subs"
     subs.mkdir()
     pid_file = tmp_path / "pid"
-    _notebook([HEAD, PL, TR, f"import subprocess\nchild = subprocess.Popen(['sleep', '300'])\n"
-                             f"open({str(pid_file)!r}, 'w').write(str(child.pid))"], subs / "a.ipynb")
+    _notebook(
+        [
+            HEAD,
+            PL,
+            TR,
+            f"import subprocess\nchild = subprocess.Popen(['sleep', '300'])\n"
+            f"open({str(pid_file)!r}, 'w').write(str(child.pid))",
+        ],
+        subs / "a.ipynb",
+    )
     row = grade(subs, tmp_path / "s.csv")[0]
     assert row["total"] == "10", row["notes"]
     pid = int(pid_file.read_text())
@@ -422,7 +499,7 @@ def test_the_answers_own_code_is_read_for_the_library_not_the_rest_of_the_cell()
     assert library_named("power_law = lambda g, c, m: PowerLaw(c, m).traction(g)", guard, names)
     compare = PL + "\n\nfrom contactfem.laws import PowerLaw\nprint(PowerLaw(100.0, 2.5).traction(-0.1))"
     assert library_named(compare, guard, names) == set()
-    assert library_named(PL_LIBRARY_HIDDEN, guard, names) == set()      # the tripwire catches that one
+    assert library_named(PL_LIBRARY_HIDDEN, guard, names) == set()  # the tripwire catches that one
 
 
 def test_a_bad_score_in_the_review_sheet_stops_before_any_grading(tmp_path, capsys):
@@ -433,7 +510,8 @@ def test_a_bad_score_in_the_review_sheet_stops_before_any_grading(tmp_path, caps
     _notebook([HEAD, PL, TR], subs / "a.ipynb")
     (tmp_path / "s-review").mkdir()
     (tmp_path / "s-review" / f"{LECTURE}-scores.csv").write_text(
-        "submission,id,name,question,points,score\na.ipynb,,,ex01_discussion,2,3\n")
+        "submission,id,name,question,points,score\na.ipynb,,,ex01_discussion,2,3\n"
+    )
     t0 = time.perf_counter()
     assert main(["course", "grade", str(subs), "--out", str(tmp_path / "s.csv")]) == 2
     assert time.perf_counter() - t0 < 10
@@ -490,11 +568,27 @@ def test_ctrl_c_on_the_command_stops_at_once_and_says_what_was_written(tmp_path)
     for name in ("a", "b"):
         _notebook([HEAD, "while True:\n    pass"], subs / f"{name}.ipynb")
     out = tmp_path / "s.csv"
-    proc = subprocess.Popen([sys.executable, "-m", "contactfem.cli", "course", "grade", str(subs), "--out", str(out),
-                             "--jobs", "2", "--notebook-timeout", "300"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "contactfem.cli",
+            "course",
+            "grade",
+            str(subs),
+            "--out",
+            str(out),
+            "--jobs",
+            "2",
+            "--notebook-timeout",
+            "300",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     deadline = time.monotonic() + 120
-    while len(_sandboxes_of(proc.pid)) < 2 and time.monotonic() < deadline:     # both notebooks running
+    while len(_sandboxes_of(proc.pid)) < 2 and time.monotonic() < deadline:  # both notebooks running
         time.sleep(0.2)
     running = _sandboxes_of(proc.pid)
     proc.send_signal(signal.SIGINT)
@@ -505,7 +599,7 @@ def test_ctrl_c_on_the_command_stops_at_once_and_says_what_was_written(tmp_path)
     assert "0 of 2 notebooks graded; their rows are in" in err and "nothing written" not in err, err
     assert list(csv.DictReader(open(out))) == []
     assert len(running) == 2
-    deadline = time.monotonic() + 10      # the submissions' processes end with their workers
+    deadline = time.monotonic() + 10  # the submissions' processes end with their workers
     while any(_alive(pid) for pid in running) and time.monotonic() < deadline:
         time.sleep(0.2)
     assert not any(_alive(pid) for pid in running)

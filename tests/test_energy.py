@@ -14,6 +14,7 @@ the next, and the recorded dissipation (the trapezoidal slip work 1/2 (t_T_bar +
 summed with the weights) equals the energy lost to within 1 % at omega_p dt = 0.13 to 0.14;
 energy + dissipation never exceeds the initial energy, and the final mismatch shrinks with dt.
 """
+
 import numpy as np
 import pytest
 
@@ -38,7 +39,7 @@ def test_frictionless_trapezoidal_conserves_energy(master):
     assert omega_dt(1e2, 0.01) <= 0.15
     hist, _ = throw(normal=PowerLaw(1e2), v=(0.5, -1.0), dt=0.01, n_steps=100, delta=0.5, beta=0.25, master=master)
     E = energy(hist)
-    assert np.count_nonzero(hist.contact > 0) > 10            # a real impact happened
+    assert np.count_nonzero(hist.contact > 0) > 10  # a real impact happened
     err = np.max(np.abs(E - E[0])) / E[0]
     assert err <= 2e-3, f"energy error {err:.2e} > bound 2e-3"
 
@@ -47,33 +48,40 @@ def test_frictionless_trapezoidal_conserves_energy(master):
 def test_energy_error_falls_with_the_step():
     errs = []
     for dt in (0.004, 0.002):
-        hist, _ = throw(normal=PowerLaw(1e3), v=(0.5, -1.0), dt=dt, n_steps=int(round(1.0 / dt)),
-                        delta=0.5, beta=0.25)
+        hist, _ = throw(normal=PowerLaw(1e3), v=(0.5, -1.0), dt=dt, n_steps=int(round(1.0 / dt)), delta=0.5, beta=0.25)
         E = energy(hist)
         errs.append(np.max(np.abs(E - E[0])) / E[0])
     assert errs[1] < 0.5 * errs[0], errs
 
 
 def test_bar_impact_loses_no_energy():
-    r = run_scene("bar_impact", "fast")                         # exact: no loss
+    r = run_scene("bar_impact", "fast")  # exact: no loss
     assert abs(r["energy_error_max"]) < 1e-3, r["energy_error_max"]
 
 
 @pytest.mark.parametrize("c_N, dt, tol", [(1e2, 0.01, 0.01), (1e3, 0.003, 0.01)])
 def test_friction_dissipation_balances_energy_loss(c_N, dt, tol):
-    hist, contact = throw(normal=PowerLaw(c_N), friction=Coulomb(c_N, 0.3), v=(2.0, -0.5), dt=dt,
-                          n_steps=int(round(0.6 / dt)), delta=0.5, beta=0.25)
+    hist, contact = throw(
+        normal=PowerLaw(c_N),
+        friction=Coulomb(c_N, 0.3),
+        v=(2.0, -0.5),
+        dt=dt,
+        n_steps=int(round(0.6 / dt)),
+        delta=0.5,
+        beta=0.25,
+    )
     E = energy(hist)
     assert np.max(np.diff(E)) <= 1e-10 * E[0], "total energy increased in a step"
     lost, D = E[0] - E[-1], hist.dissipation[-1]
-    assert lost > 0.05 * E[0]                                   # friction did real work
+    assert lost > 0.05 * E[0]  # friction did real work
     assert D == pytest.approx(lost, rel=tol), f"dissipation {D:.5g} vs energy lost {lost:.5g} (tol {tol:.0%})"
     assert np.all(np.diff(hist.dissipation) >= 0)
 
 
 def test_energy_plus_dissipation_never_exceeds_the_start():
-    hist, _ = throw(normal=PowerLaw(1e3), friction=Coulomb(1e3, 0.3), v=(2.0, -1.0), dt=0.01,
-                    n_steps=60, delta=0.5, beta=0.25)
+    hist, _ = throw(
+        normal=PowerLaw(1e3), friction=Coulomb(1e3, 0.3), v=(2.0, -1.0), dt=0.01, n_steps=60, delta=0.5, beta=0.25
+    )
     E = energy(hist)
     assert np.max(E + hist.dissipation) <= E[0] * (1 + 1e-10)
 
@@ -81,8 +89,15 @@ def test_energy_plus_dissipation_never_exceeds_the_start():
 def test_dissipation_mismatch_shrinks_with_dt():
     gaps = []
     for dt in (0.01, 0.005):
-        hist, _ = throw(normal=PowerLaw(1e3), friction=Coulomb(1e3, 0.3), v=(2.0, -1.0), dt=dt,
-                        n_steps=int(round(0.6 / dt)), delta=0.5, beta=0.25)
+        hist, _ = throw(
+            normal=PowerLaw(1e3),
+            friction=Coulomb(1e3, 0.3),
+            v=(2.0, -1.0),
+            dt=dt,
+            n_steps=int(round(0.6 / dt)),
+            delta=0.5,
+            beta=0.25,
+        )
         E = energy(hist)
         gaps.append(abs(hist.dissipation[-1] - (E[0] - E[-1])))
     assert gaps[1] < 0.75 * gaps[0], gaps
@@ -100,12 +115,17 @@ def test_a_run_that_gains_energy_warns():
 
     from contactfem import run_scene
     from contactfem import AccuracyWarning
+
     with pytest.warns(AccuracyWarning, match=r"accuracy: energy_gain = "):
         r = run_scene("sloping_impact", "fast", {"dt": 5.0})
     assert r["energy_error"] > 0.01
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert run_scene("sloping_impact", "fast")["energy_error"] < 0.01
-    p = subprocess.run([sys.executable, "-m", "contactfem", "run", "sloping_impact", "--set", "dt=5"],
-                       capture_output=True, text=True, timeout=300)
+    p = subprocess.run(
+        [sys.executable, "-m", "contactfem", "run", "sloping_impact", "--set", "dt=5"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert p.returncode == 0 and "contactfem: warning: accuracy: energy_gain = " in p.stderr, p.stderr

@@ -1,5 +1,6 @@
 """The bench's enforcement study: the augmented Lagrangian meets a gap violation of 1e-8 at
 each of three penalties; the penalty meets it at none of them (its gap falls like 1/c_N)."""
+
 import pytest
 
 from contactfem.lab.bench import STUDIES, write_markdown
@@ -37,6 +38,7 @@ def test_in_the_bench_and_its_markdown(study):
 
 # -- penalty, Uzawa and the semi-smooth Newton method to a gap violation of 1e-10 ------------
 
+
 @pytest.fixture(scope="module")
 def ssn_study():
     from contactfem.lab.bench.semismooth import semismooth_study
@@ -52,7 +54,7 @@ def test_semismooth_newton_meets_the_target_in_fewer_solves_than_uzawa(ssn_study
         rows = s["rows"]
         for key in ("uzawa", "semismooth", "semismooth_mortar"):
             assert rows[key]["ok"] and rows[key]["met"], (scene, key, rows[key])
-        assert rows["semismooth"]["gap_violation"] < 1e-3 * TARGET          # exact, not a tolerance
+        assert rows["semismooth"]["gap_violation"] < 1e-3 * TARGET  # exact, not a tolerance
         assert rows["semismooth"]["outer"] == 0 and rows["uzawa"]["outer"] >= 1
         assert rows["semismooth"]["solves"] < rows["uzawa"]["solves"], scene
         # Uzawa to 1e-10 gives the same tractions within c_N * length * 1e-10 (relative 1e-8 at most)

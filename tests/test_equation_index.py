@@ -25,8 +25,10 @@ def test_every_entry_imports_and_cites_its_equation():
     for number, entry in sorted(E.INDEX.items()):
         _, covered = E.parse_citations(_doc(E.resolve(entry.where)))
         if number not in covered:
-            wrong.append(f"{entry.where} implements eq ({number}) according to the index, but its docstring "
-                         f"cites only {sorted(covered)}")
+            wrong.append(
+                f"{entry.where} implements eq ({number}) according to the index, but its docstring "
+                f"cites only {sorted(covered)}"
+            )
     assert not wrong, "\n".join(wrong)
 
 
@@ -53,18 +55,23 @@ def test_every_cited_equation_is_indexed():
 def test_index_covers_1_to_50_once():
     mapped, reasons = set(E.INDEX), set(E.NOT_MAPPED)
     assert not mapped & reasons, f"both mapped and 'not mapped': {sorted(mapped & reasons)}"
-    assert mapped | reasons == set(range(1, 51)), f"equations without an entry: {sorted(set(range(1, 51)) - mapped - reasons)}"
+    assert mapped | reasons == set(range(1, 51)), (
+        f"equations without an entry: {sorted(set(range(1, 51)) - mapped - reasons)}"
+    )
     assert all(e.number == k for k, e in E.INDEX.items())
 
 
-@pytest.mark.parametrize("text, explicit, covered", [
-    ("Eq (4): |t_N| = c_N", {4}, {4}),
-    ("Eqs (17)-(19): length l", {17, 19}, {17, 18, 19}),
-    ("(eqs 33, 39, 49, 50)", {33, 39, 49, 50}, {33, 39, 49, 50}),
-    ("the stick law (eqs 5 and 10)", {5, 10}, {5, 10}),
-    ("Eq (42), the elastic predictor; eqn (8) and eqs 40-48)", {42, 8, 40, 48}, {42, 8} | set(range(40, 49))),
-    ("no equation here: equal, sequence 3", set(), set()),
-])
+@pytest.mark.parametrize(
+    "text, explicit, covered",
+    [
+        ("Eq (4): |t_N| = c_N", {4}, {4}),
+        ("Eqs (17)-(19): length l", {17, 19}, {17, 18, 19}),
+        ("(eqs 33, 39, 49, 50)", {33, 39, 49, 50}, {33, 39, 49, 50}),
+        ("the stick law (eqs 5 and 10)", {5, 10}, {5, 10}),
+        ("Eq (42), the elastic predictor; eqn (8) and eqs 40-48)", {42, 8, 40, 48}, {42, 8} | set(range(40, 49))),
+        ("no equation here: equal, sequence 3", set(), set()),
+    ],
+)
 def test_parse_citations(text, explicit, covered):
     assert E.parse_citations(text) == (explicit, covered)
 

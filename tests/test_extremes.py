@@ -12,6 +12,7 @@ than the energy lost (+5 %: the return map records lambda |t_T| at the end of th
 which over-counts the first slipping step by up to a factor 2, see test_energy.py). Where the penalty is NOT resolved, implicit Newmark
 pumps energy into an impact (see test_unresolved_penalty_gains_energy).
 """
+
 import numpy as np
 import pytest
 from skfem import MeshQuad
@@ -22,8 +23,8 @@ from contactfem.laws.return_map import return_map
 from contactfem.laws import Coulomb, ParabolicSlip, PowerLaw
 from contactfem.solver import Dirichlet, Newmark, NewtonError, System, integrate
 
-E, RHO, W = 100.0, 1.0, 0.5          # modulus, density, slave weight (half the quad side)
-M_NODE = RHO / 4                     # lumped mass of a node of the unit quad
+E, RHO, W = 100.0, 1.0, 0.5  # modulus, density, slave weight (half the quad side)
+M_NODE = RHO / 4  # lumped mass of a node of the unit quad
 
 
 def quad(origin=(0.0, 0.0), material="linear", name="quad"):
@@ -31,12 +32,30 @@ def quad(origin=(0.0, 0.0), material="linear", name="quad"):
     return Continuum(mesh, E, 0.3, RHO, kind="plane_strain", material=material, name=name)
 
 
-def throw(normal=None, friction=None, master=None, v=(0.5, -1.0), dt=0.01, n_steps=30, origin=(0.0, 0.0),
-          material="linear", delta=0.7, beta=0.4, extra_bodies=(), fixed=()):
+def throw(
+    normal=None,
+    friction=None,
+    master=None,
+    v=(0.5, -1.0),
+    dt=0.01,
+    n_steps=30,
+    origin=(0.0, 0.0),
+    material="linear",
+    delta=0.7,
+    beta=0.4,
+    extra_bodies=(),
+    fixed=(),
+):
     """Throw the unit quad at `master` with velocity v; returns (history, contact)."""
     body = quad(origin, material)
-    contact = NodeToSegment(body, np.arange(4), master or RigidLine((0, 0), (0, 1)),
-                            normal=normal or PowerLaw(1e3), friction=friction, weights=W)
+    contact = NodeToSegment(
+        body,
+        np.arange(4),
+        master or RigidLine((0, 0), (0, 1)),
+        normal=normal or PowerLaw(1e3),
+        friction=friction,
+        weights=W,
+    )
     system = System([body, *extra_bodies], [contact], fixed=list(fixed))
     u0, v0 = np.zeros(system.ndof), np.zeros(system.ndof)
     v0[body.xdofs[:, 0]], v0[body.xdofs[:, 1]] = v
@@ -54,7 +73,7 @@ def outcome(energy_check=True, **kw):
     total = hist.kinetic + hist.strain + hist.contact
     for name, a in dict(u=hist.u, v=hist.v, a=hist.a, energy=total, D=hist.dissipation).items():
         assert np.all(np.isfinite(a)), f"{name} is not finite"
-    state = hist.records[-1].contacts[0]             # the converged end state
+    state = hist.records[-1].contacts[0]  # the converged end state
     rep = state.report()
     if contact.friction is not None:
         Y = contact.friction.slip_bound(-rep["t_N"], state.q)[0]
@@ -62,8 +81,9 @@ def outcome(energy_check=True, **kw):
     if energy_check:
         E0, D = total[0], hist.dissipation[-1]
         assert np.max(total) <= E0 * (1 + 1e-6), f"energy grew: E0 = {E0:.4g}, max E = {np.max(total):.4g}"
-        assert D <= 1.05 * (E0 - total[-1]) + 1e-9 * E0, \
+        assert D <= 1.05 * (E0 - total[-1]) + 1e-9 * E0, (
             f"recorded dissipation {D:.4g} exceeds the energy lost {E0 - total[-1]:.4g} by more than 5 %"
+        )
     assert np.all(hist.dissipation >= -1e-14)
     return "ok"
 
@@ -115,17 +135,26 @@ def test_grazing():
     assert outcome(friction=Coulomb(1e3, 0.3), v=(1.0, -1e-12)) == "ok"
     # passing over the crest of a rigid cylinder with a 0.5 % interference
     arc = RigidArc((0.5, -5.0 + 0.005), 5.0)
-    assert outcome(friction=Coulomb(1e3, 0.3), master=arc, origin=(-3.0, 0.0), v=(3.0, 0.0), dt=0.05, n_steps=40) == "ok"
+    assert (
+        outcome(friction=Coulomb(1e3, 0.3), master=arc, origin=(-3.0, 0.0), v=(3.0, 0.0), dt=0.05, n_steps=40) == "ok"
+    )
 
 
-@pytest.mark.parametrize("points, origin", [
-    ([[-3.0, 0.0], [1.5, 0.0]], (0.0, 0.0)),                    # sliding off the end
-    ([[-3.0, 1.5], [1.5, 0.0], [4.0, 1.0]], (-2.5, 1.2)),        # into a valley (concave corner)
-    ([[-3.0, 0.0], [1.0, 0.5], [4.0, 0.0]], (-2.5, 0.1)),        # over a ridge (convex corner)
-])
+@pytest.mark.parametrize(
+    "points, origin",
+    [
+        ([[-3.0, 0.0], [1.5, 0.0]], (0.0, 0.0)),  # sliding off the end
+        ([[-3.0, 1.5], [1.5, 0.0], [4.0, 1.0]], (-2.5, 1.2)),  # into a valley (concave corner)
+        ([[-3.0, 0.0], [1.0, 0.5], [4.0, 0.0]], (-2.5, 0.1)),  # over a ridge (convex corner)
+    ],
+)
 def test_segment_ends_and_corners(points, origin):
-    assert outcome(friction=Coulomb(1e3, 0.3), master=RigidPolyline(points), origin=origin,
-                   v=(3.0, -0.5), dt=0.02, n_steps=40) == "ok"
+    assert (
+        outcome(
+            friction=Coulomb(1e3, 0.3), master=RigidPolyline(points), origin=origin, v=(3.0, -0.5), dt=0.02, n_steps=40
+        )
+        == "ok"
+    )
 
 
 def _on_base(origin, v, n_steps=40, dt=0.02, energy_check=True):
@@ -133,10 +162,18 @@ def _on_base(origin, v, n_steps=40, dt=0.02, energy_check=True):
     base = quad((0.0, -1.0), name="base")
     bottom = np.flatnonzero(base.X[:, 1] < -0.5)
     top = np.flatnonzero(base.X[:, 1] > -0.5)
-    top = top[np.argsort(base.X[top, 0])]                        # left to right: n = e3 x t = +y
-    return outcome(friction=Coulomb(1e3, 0.3), master=BodySurface(base, top), origin=origin, v=v,
-                   extra_bodies=(base,), fixed=(Dirichlet(base, base.xdofs[bottom].ravel(), 0.0),),
-                   n_steps=n_steps, dt=dt, energy_check=energy_check)
+    top = top[np.argsort(base.X[top, 0])]  # left to right: n = e3 x t = +y
+    return outcome(
+        friction=Coulomb(1e3, 0.3),
+        master=BodySurface(base, top),
+        origin=origin,
+        v=v,
+        extra_bodies=(base,),
+        fixed=(Dirichlet(base, base.xdofs[bottom].ravel(), 0.0),),
+        n_steps=n_steps,
+        dt=dt,
+        energy_check=energy_check,
+    )
 
 
 def test_sliding_off_a_deformable_master():
@@ -151,9 +188,12 @@ def test_entering_a_master_from_beyond_its_end():
     assert _on_base(origin=(-0.5, 0.0), v=(2.0, -0.2), energy_check=False) == "ok"
 
 
-@pytest.mark.xfail(strict=True, reason="known limitation of one-pass node-to-segment: a slave entering "
-                   "a master from beyond its end already penetrated gets the full penalty force at once "
-                   "and the energy jumps (ours: +0.2 at dt = 0.02, +0.4 at dt = 0.005, E0 = 2.02)")
+@pytest.mark.xfail(
+    strict=True,
+    reason="known limitation of one-pass node-to-segment: a slave entering "
+    "a master from beyond its end already penetrated gets the full penalty force at once "
+    "and the energy jumps (ours: +0.2 at dt = 0.02, +0.4 at dt = 0.005, E0 = 2.02)",
+)
 def test_entering_a_master_from_beyond_its_end_conserves_energy():
     assert _on_base(origin=(-0.5, 0.0), v=(2.0, -0.2)) == "ok"
 
@@ -162,25 +202,34 @@ def test_entering_a_master_from_beyond_its_end_conserves_energy():
 @pytest.mark.parametrize("material", ["linear", "neohooke"])
 def test_very_high_impact_speed(speed, material):
     # neo-Hooke at 1e6 inverts elements: a clear NewtonError after the cutbacks
-    r = outcome(friction=Coulomb(1e3, 0.3), v=(speed, -speed), material=material, n_steps=10,
-                energy_check=resolved(1e3, 0.01))
+    r = outcome(
+        friction=Coulomb(1e3, 0.3), v=(speed, -speed), material=material, n_steps=10, energy_check=resolved(1e3, 0.01)
+    )
     assert r in ("ok", "error")
     if speed <= 1e3:
         assert r == "ok"
 
 
-@pytest.mark.xfail(strict=True, reason="known limitation: implicit Newmark with an unresolved penalty "
-                   "(omega_p dt >> 1) pumps energy into an impact; the trapezoidal rule carries the "
-                   "contact acceleration spike into the next step (1 dof: v -> 3 v0 after one bounce); "
-                   "the energy-consistent stepper conserves it (test_conserving.py)")
+@pytest.mark.xfail(
+    strict=True,
+    reason="known limitation: implicit Newmark with an unresolved penalty "
+    "(omega_p dt >> 1) pumps energy into an impact; the trapezoidal rule carries the "
+    "contact acceleration spike into the next step (1 dof: v -> 3 v0 after one bounce); "
+    "the energy-consistent stepper conserves it (test_conserving.py)",
+)
 def test_unresolved_penalty_gains_energy():
-    hist, _ = throw(normal=PowerLaw(1e8), delta=0.5, beta=0.25)   # omega_p dt = 141
+    hist, _ = throw(normal=PowerLaw(1e8), delta=0.5, beta=0.25)  # omega_p dt = 141
     total = hist.kinetic + hist.strain + hist.contact
-    assert np.max(total) <= total[0] * 1.01                         # ours: about 4 x E0
+    assert np.max(total) <= total[0] * 1.01  # ours: about 4 x E0
 
 
 def test_bad_law_parameters_raise():
-    for make in (lambda: PowerLaw(0.0), lambda: PowerLaw(1.0, 0.5), lambda: Coulomb(1.0, -0.1),
-                 lambda: ParabolicSlip(1.0, 0.2, 0.3, 0.0), lambda: ParabolicSlip(1.0, 0.2, 0.3, 1.5)):
+    for make in (
+        lambda: PowerLaw(0.0),
+        lambda: PowerLaw(1.0, 0.5),
+        lambda: Coulomb(1.0, -0.1),
+        lambda: ParabolicSlip(1.0, 0.2, 0.3, 0.0),
+        lambda: ParabolicSlip(1.0, 0.2, 0.3, 1.5),
+    ):
         with pytest.raises(ValueError):
             make()

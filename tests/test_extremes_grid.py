@@ -7,6 +7,7 @@ Then the bench's grid (contactfem/lab/bench/extremes.py, `contactfem bench --onl
 quick slice, each run the full grid found wrong and unflagged before an indicator was added (the
 run is off its reference by more than 5 % and the named indicator flags it), and BENCHMARKS.md
 against the committed bench.json."""
+
 import json
 import warnings
 from pathlib import Path
@@ -63,8 +64,11 @@ def test_the_quick_slice_is_within_flagged_refused_or_stopped():
 
     res = extremes_study(quick=True, seconds=120)
     c = res["counts"]
-    bad = [(r["scene"], r["axis"], r["outcome"], r["errors"]) for r in res["rows"]
-           if r["outcome"] in ("wrong", "crashed", "late", "no reference")]
+    bad = [
+        (r["scene"], r["axis"], r["outcome"], r["errors"])
+        for r in res["rows"]
+        if r["outcome"] in ("wrong", "crashed", "late", "no reference")
+    ]
     assert not bad
     assert c["flagged (off)"] >= 5 and c["within"] >= 2 and c["refused"] >= 1 and c["stopped"] >= 1
     assert res["runs"] == sum(c.values())
@@ -92,7 +96,7 @@ def test_each_finding_is_off_and_flagged_by_its_indicator(scene, over, headline,
     run = attempt(scene, over, seconds=None)
     ref = attempt(scene, reference_overrides(scene, over), seconds=None)
     outcome, errors = classify(scene, run, ref)
-    assert errors[headline] > TOL, errors                   # the indicator is needed: the run is off
+    assert errors[headline] > TOL, errors  # the indicator is needed: the run is off
     assert flag in run["flags"], run["flags"]
     assert outcome == "flagged (off)"
 

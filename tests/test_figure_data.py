@@ -17,12 +17,14 @@ def test_save_figure_writes_the_png_and_its_numbers(tmp_path):
 
     fig, ax = plt.subplots()
     ax.plot([0, 1], [0, 2])
-    paths = D.save_figure(fig, tmp_path / "fig99_test.png", dict(v_final=np.float64(149.3), t=np.arange(3.0)),
-                          dict(mu=0.3))
+    paths = D.save_figure(
+        fig, tmp_path / "fig99_test.png", dict(v_final=np.float64(149.3), t=np.arange(3.0)), dict(mu=0.3)
+    )
     assert paths == [str(tmp_path / "fig99_test.png"), str(tmp_path / "fig99_test.json")]
     d = json.loads((tmp_path / "fig99_test.json").read_text())
-    assert d == dict(figure="fig99_test", code_version=D.code_version(), parameters=dict(mu=0.3),
-                     v_final=149.3, t=[0.0, 1.0, 2.0])
+    assert d == dict(
+        figure="fig99_test", code_version=D.code_version(), parameters=dict(mu=0.3), v_final=149.3, t=[0.0, 1.0, 2.0]
+    )
     assert (tmp_path / "fig99_test.png").stat().st_size > 0
     with pytest.raises(ValueError, match="reserved key"):
         D.save_figure(None, tmp_path / "x.png", dict(parameters=1), {})
@@ -37,11 +39,21 @@ def test_code_version_is_the_version_and_a_hash_of_the_sources():
 
 
 def test_differences_find_a_changed_number_and_ignore_roundoff_and_version():
-    a = dict(figure="f", code_version="0.1.0+src.aaaa", parameters=dict(mu=0.3), v_final=149.3,
-             residuals=[171.88, 3.2, 3e-12], slip=[150.0, 1e-12], n_slip=2, label="sticks", x=None)
+    a = dict(
+        figure="f",
+        code_version="0.1.0+src.aaaa",
+        parameters=dict(mu=0.3),
+        v_final=149.3,
+        residuals=[171.88, 3.2, 3e-12],
+        slip=[150.0, 1e-12],
+        n_slip=2,
+        label="sticks",
+        x=None,
+    )
     same = json.loads(json.dumps(a))
-    same.update(code_version="0.1.0+src.bbbb", residuals=[171.88, 3.2, 6e-12], slip=[150.0, 1e-7],
-                v_final=149.3 * (1 + 1e-10))
+    same.update(
+        code_version="0.1.0+src.bbbb", residuals=[171.88, 3.2, 6e-12], slip=[150.0, 1e-7], v_final=149.3 * (1 + 1e-10)
+    )
     assert D.differences(a, same) == []
     assert D.differences(a, dict(a, v_final=149.2)) == ["v_final: 149.3 in the file, 149.2 from the run"]
     assert D.differences(a, dict(a, parameters=dict(mu=0.31))) == ["parameters.mu: 0.3 in the file, 0.31 from the run"]
@@ -74,18 +86,44 @@ from pathlib import Path  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]
 FIGURES = REPO / "figures"
-FAST = ("bench_adaptive", "bench_cost", "bench_speed", "bench_tangents", "bench_work_precision",
-        "fig01_true_contact_area", "fig02_force_vs_microdisplacement", "fig03_shear_vs_normal",
-        "fig04_parabolic_slip_surface", "fig06_block_mesh_deformed", "fig07_block_conical_stresses",
-        "fig08_block_parabolic_stresses", "fig08b_block_fig8_readings", "table1_block_newton_residuals",
-        "fig09_rolling_ring",
-        "fig10_sloping_impact_frictionless", "fig11a_sloping_impact_frictional",
-        "fig11b_sloping_impact_viscoplastic", "table2_sloping_impact", "fig12_funnel_frictionless",
-        "fig13_funnel_frictional", "fig14_cork_mesh", "fig15_cork_configurations", "fig16_cork_pressure",
-        "fig17_cork_displacement", "verif_bar_impact", "verif_hertz_pressure", "verif_hertz_refinement",
-        "verif_patch")
-SLOW = ("fig09b_rolling_ring_convergence", "table_sloping_impact_discretisation", "table_cork_sensitivity",
-        "cork_knife_edge", "cork_exit_time")
+FAST = (
+    "bench_adaptive",
+    "bench_cost",
+    "bench_speed",
+    "bench_tangents",
+    "bench_work_precision",
+    "fig01_true_contact_area",
+    "fig02_force_vs_microdisplacement",
+    "fig03_shear_vs_normal",
+    "fig04_parabolic_slip_surface",
+    "fig06_block_mesh_deformed",
+    "fig07_block_conical_stresses",
+    "fig08_block_parabolic_stresses",
+    "fig08b_block_fig8_readings",
+    "table1_block_newton_residuals",
+    "fig09_rolling_ring",
+    "fig10_sloping_impact_frictionless",
+    "fig11a_sloping_impact_frictional",
+    "fig11b_sloping_impact_viscoplastic",
+    "table2_sloping_impact",
+    "fig12_funnel_frictionless",
+    "fig13_funnel_frictional",
+    "fig14_cork_mesh",
+    "fig15_cork_configurations",
+    "fig16_cork_pressure",
+    "fig17_cork_displacement",
+    "verif_bar_impact",
+    "verif_hertz_pressure",
+    "verif_hertz_refinement",
+    "verif_patch",
+)
+SLOW = (
+    "fig09b_rolling_ring_convergence",
+    "table_sloping_impact_discretisation",
+    "table_cork_sensitivity",
+    "cork_knife_edge",
+    "cork_exit_time",
+)
 # the committed exit-time study is the full one (every case); the others are the default profiles
 SLOW_ENV = {"cork_exit_time": "1"}
 
@@ -116,11 +154,12 @@ def assert_same_data(stem, folder, monkeypatch):
     assert not problems, (
         f"figures/{stem}.json (code {written['code_version']}) is not what the code computes today (code "
         f"{fresh['code_version']}), {len(problems)} difference(s); regenerate it with "
-        f"`{env}contactfem figures --preset paper --only {stem}`:\n  " + "\n  ".join(problems[:20]))
+        f"`{env}contactfem figures --preset paper --only {stem}`:\n  " + "\n  ".join(problems[:20])
+    )
 
 
 def test_every_figure_has_committed_data_and_a_test():
-    stems = set(registry()) - {"summary"}               # summary.md: tests/test_summary.py
+    stems = set(registry()) - {"summary"}  # summary.md: tests/test_summary.py
     assert set(FAST) | set(SLOW) == stems and not set(FAST) & set(SLOW)
     missing = [s for s in sorted(stems) if not (FIGURES / f"{s}.json").exists()]
     assert not missing, f"no committed data for {missing}: `contactfem figures --preset paper`"

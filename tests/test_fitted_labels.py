@@ -33,21 +33,38 @@ def drawn(monkeypatch, tmp_path):
         def save(fig, path_png, data, parameters):
             seen[Path(path_png).stem] = _texts(fig)
             return real(fig, tmp_path / Path(path_png).name, data, parameters)
+
         monkeypatch.setattr(module, "save_figure", save)
+
     capture(block)
     capture(sloping_impact)
     return seen
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("draw,stem,scene,over,to", [
-    (block.fig07, "fig07_block_conical_stresses", "block", dict(law="conical"), "Table 1"),
-    (block.fig08, "fig08_block_parabolic_stresses", "block", dict(law="parabolic"), "Table 1"),
-    (block.table1, "table1_block_newton_residuals", "block", dict(law="conical"), "Table 1"),
-    (sloping_impact.fig10, "fig10_sloping_impact_frictionless", "sloping_impact", dict(variant="frictionless"), "Table 2"),
-    (sloping_impact.fig11a, "fig11a_sloping_impact_frictional", "sloping_impact", dict(variant="frictional"), "Table 2"),
-    (sloping_impact.table2, "table2_sloping_impact", "sloping_impact", dict(variant="frictional"), "this table"),
-])
+@pytest.mark.parametrize(
+    "draw,stem,scene,over,to",
+    [
+        (block.fig07, "fig07_block_conical_stresses", "block", dict(law="conical"), "Table 1"),
+        (block.fig08, "fig08_block_parabolic_stresses", "block", dict(law="parabolic"), "Table 1"),
+        (block.table1, "table1_block_newton_residuals", "block", dict(law="conical"), "Table 1"),
+        (
+            sloping_impact.fig10,
+            "fig10_sloping_impact_frictionless",
+            "sloping_impact",
+            dict(variant="frictionless"),
+            "Table 2",
+        ),
+        (
+            sloping_impact.fig11a,
+            "fig11a_sloping_impact_frictional",
+            "sloping_impact",
+            dict(variant="frictional"),
+            "Table 2",
+        ),
+        (sloping_impact.table2, "table2_sloping_impact", "sloping_impact", dict(variant="frictional"), "this table"),
+    ],
+)
 def test_fitted_reading_is_labelled(drawn, tmp_path, draw, stem, scene, over, to):
     fitted = cached_run(scene, "fast", **over)["fitted"]
     assert fitted, f"{scene}: the run reports no fitted values"

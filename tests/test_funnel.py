@@ -87,7 +87,7 @@ def test_a_wider_funnel_lets_the_ring_go():
     friction coefficient of eq 10 at these pressures) the frictional ring slides back out."""
     r = run_scene("funnel", "fast", {"variant": "frictional", "phi_deg": 30.0, "n_steps": 100})
     assert not r["stuck"]
-    assert r["v_c_final"] > 0.02 * r["parameters"]["v0"]      # moving out (up) faster than `stuck` allows
+    assert r["v_c_final"] > 0.02 * r["parameters"]["v0"]  # moving out (up) faster than `stuck` allows
 
 
 def test_energy_never_increases(res):
@@ -101,7 +101,7 @@ def test_symmetry_conditions():
     ring, system = m.parts["ring"], m.system
     ends = [0, ring.body.X.shape[0] - 1]
     assert np.allclose(ring.body.X[ends, 0], 0.0)
-    assert set(system.fixed_dofs) == {0, 2, 3 * ends[1], 3 * ends[1] + 2}   # u_x and theta
+    assert set(system.fixed_dofs) == {0, 2, 3 * ends[1], 3 * ends[1] + 2}  # u_x and theta
 
 
 def test_bad_input():
@@ -114,5 +114,5 @@ def test_bad_input():
 @pytest.mark.slow
 def test_figures(tmp_path):
     files = plots.fig12(outdir=tmp_path) + plots.fig13(outdir=tmp_path)
-    assert sorted(f.rsplit(".", 1)[1] for f in files) == ["json", "json", "png", "png"]     # each PNG with its data
+    assert sorted(f.rsplit(".", 1)[1] for f in files) == ["json", "json", "png", "png"]  # each PNG with its data
     assert all((tmp_path / f).exists() for f in files)

@@ -47,21 +47,33 @@ from contactfem.scenes import all_scenes  # noqa: E402
 from contactfem.scenes.resources import LIMITS  # noqa: E402
 
 LONG = os.environ.get("CONTACTFEM_FUZZ") == "long"
-EXAMPLES = (dict(params=330, cli=120, files=120, laws=80, lawfiles=320) if LONG else
-            dict(params=30, cli=40, files=60, laws=40, lawfiles=40))
-BUDGET = 1500 if LONG else 300          # cost of a run: steps x (unknowns / 100); dearer cases are skipped
-TIMEOUT = 180 if LONG else 90           # seconds: a case running longer is a violation (a hang)
-SCENES = sorted(all_scenes()) if LONG else ["bar_impact", "block", "hertz", "patch", "rolling_ring",
-                                            "sloping_impact", "funnel"]
+EXAMPLES = (
+    dict(params=330, cli=120, files=120, laws=80, lawfiles=320)
+    if LONG
+    else dict(params=30, cli=40, files=60, laws=40, lawfiles=40)
+)
+BUDGET = 1500 if LONG else 300  # cost of a run: steps x (unknowns / 100); dearer cases are skipped
+TIMEOUT = 180 if LONG else 90  # seconds: a case running longer is a violation (a hang)
+SCENES = (
+    sorted(all_scenes())
+    if LONG
+    else ["bar_impact", "block", "hertz", "patch", "rolling_ring", "sloping_impact", "funnel"]
+)
 # shorter runs of the dynamic scenes (the fuzzed values override these)
-CHEAP = {"rolling_ring": {"t_end": 0.2}, "sloping_impact": {"n_steps": 20}, "funnel": {"n_steps": 20},
-         "cork": {"t_end": 4e-4}, "bar_impact": {"t_end": 0.5}}
-SIZE_CAP = {"n_steps": 40, "n_press": 12, "n_ramp": 10, "maxit": 60, "max_cuts": 8}   # other ints: low + 24
+CHEAP = {
+    "rolling_ring": {"t_end": 0.2},
+    "sloping_impact": {"n_steps": 20},
+    "funnel": {"n_steps": 20},
+    "cork": {"t_end": 4e-4},
+    "bar_impact": {"t_end": 0.5},
+}
+SIZE_CAP = {"n_steps": 40, "n_press": 12, "n_ramp": 10, "maxit": 60, "max_cuts": 8}  # other ints: low + 24
 
 COUNTS = Counter()
 VIOLATIONS = []
-SETTINGS = dict(deadline=None, database=None, derandomize=not LONG, print_blob=True,
-                suppress_health_check=list(HealthCheck))
+SETTINGS = dict(
+    deadline=None, database=None, derandomize=not LONG, print_blob=True, suppress_health_check=list(HealthCheck)
+)
 
 
 class CaseTimeout(BaseException):
@@ -80,8 +92,10 @@ def violation(kind, argv, why):
 
 def non_finite_json(text):
     """Parse JSON refusing NaN/Infinity; True if the text holds any."""
+
     def refuse(const):
         raise ValueError(const)
+
     try:
         json.loads(text, parse_constant=refuse)
     except ValueError:
@@ -114,11 +128,11 @@ def run_case(kind, argv, folder, outputs=()):
             warnings.simplefilter("always")
             try:
                 rc = main(argv)
-            except SystemExit as exc:                      # --help: argparse prints and exits 0
+            except SystemExit as exc:  # --help: argparse prints and exits 0
                 rc = exc.code
             except CaseTimeout:
                 rc, raised = "timeout", f"still running after {TIMEOUT} s"
-            except BaseException as exc:                   # would be a traceback
+            except BaseException as exc:  # would be a traceback
                 rc, raised = "traceback", f"{type(exc).__name__}: {exc}"
     finally:
         signal.alarm(0)
@@ -154,7 +168,7 @@ def run_case(kind, argv, folder, outputs=()):
         return rc
     if rc not in (1, 2):
         violation(kind, argv, f"exit code {rc}: {lines}")
-    if rc == 1:           # a run that started may have said what it found in the laws beforehand
+    if rc == 1:  # a run that started may have said what it found in the laws beforehand
         while len(lines) > 1 and lines[0].startswith(("contactfem: warning:", "contactfem: note:")):
             lines = lines[1:]
     if present:
@@ -165,8 +179,11 @@ def run_case(kind, argv, folder, outputs=()):
         if len(lines) != 1:
             violation(kind, argv, f"exit 1 of a law or a sweep needs one line, got {lines}")
     elif rc == 1:
-        ok = (1 <= len(lines) <= 2 and lines[0].startswith("contactfem: solver failed: ")
-              and all(ln.startswith("residual history: ") for ln in lines[1:]))
+        ok = (
+            1 <= len(lines) <= 2
+            and lines[0].startswith("contactfem: solver failed: ")
+            and all(ln.startswith("residual history: ") for ln in lines[1:])
+        )
         newton = "Newton" in lines[0] if lines else False
         if not ok or (newton and len(lines) != 2):
             violation(kind, argv, f"exit 1 needs the cause and the residual history, got {lines}")
@@ -174,6 +191,7 @@ def run_case(kind, argv, folder, outputs=()):
 
 
 # ---- parameter sets ---------------------------------------------------------------------
+
 
 def _in_range_float(p):
     lo, hi = p.low, p.high
@@ -214,8 +232,10 @@ def _value(p):
     if isinstance(p.default, int):
         hi = min(p.high if p.high is not None else 10**9, SIZE_CAP.get(p.name, (p.low or 0) + 24))
         good = st.integers(int(p.low if p.low is not None else -5), int(hi))
-        bad = st.sampled_from(["2.5", "abc", "", "1e3", str(10**12), str((p.low or 0) - 1)]
-                              + ([str(p.high + 1)] if p.high is not None else []))
+        bad = st.sampled_from(
+            ["2.5", "abc", "", "1e3", str(10**12), str((p.low or 0) - 1)]
+            + ([str(p.high + 1)] if p.high is not None else [])
+        )
         return st.one_of(good.map(str), good.map(str), bad)
     return st.one_of(_in_range_float(p).map(repr), _in_range_float(p).map(repr), _out_of_range_float(p).map(str))
 
@@ -267,11 +287,57 @@ def test_fuzz_parameters(case, tmp_path_factory):
 
 # ---- malformed command lines ------------------------------------------------------------
 
-TOKENS = ["run", "show", "list", "sweep", "equations", "block", "patch", "nosuch", "--set", "--preset", "fast",
-          "paper", "nonsense", "--json", "--save", "--gif", "--jobs", "--out", "--force", "--markdown", "--help",
-          "mu=0.3", "law=coulomb", "mu==1", "=3", "c_N=1e999", "nx=-1", "nx=3.5", "x.json", "x.npz", "x.gif",
-          "x.txt", "/proc/x.json", "/nonexistent/x.json", ".", "", " ", "é", "--set=mu=1", "--jobs=0", "--jobs=abc",
-          "-x", "--", "p_y=nan", "maxit=1", "maxit=1,40", "law=coulomb,parabolic", "out.csv", "out.json"]
+TOKENS = [
+    "run",
+    "show",
+    "list",
+    "sweep",
+    "equations",
+    "block",
+    "patch",
+    "nosuch",
+    "--set",
+    "--preset",
+    "fast",
+    "paper",
+    "nonsense",
+    "--json",
+    "--save",
+    "--gif",
+    "--jobs",
+    "--out",
+    "--force",
+    "--markdown",
+    "--help",
+    "mu=0.3",
+    "law=coulomb",
+    "mu==1",
+    "=3",
+    "c_N=1e999",
+    "nx=-1",
+    "nx=3.5",
+    "x.json",
+    "x.npz",
+    "x.gif",
+    "x.txt",
+    "/proc/x.json",
+    "/nonexistent/x.json",
+    ".",
+    "",
+    " ",
+    "é",
+    "--set=mu=1",
+    "--jobs=0",
+    "--jobs=abc",
+    "-x",
+    "--",
+    "p_y=nan",
+    "maxit=1",
+    "maxit=1,40",
+    "law=coulomb,parabolic",
+    "out.csv",
+    "out.json",
+]
 
 
 @st.composite
@@ -282,7 +348,7 @@ def command_lines(draw):
         return ["run", draw(st.sampled_from(["block", "patch", "nosuch", ""]))] + tail
     if kind == "sweep":
         return ["sweep", "block"] + tail
-    if kind == "figures":        # only texts that match no figure (figure names are lower case)
+    if kind == "figures":  # only texts that match no figure (figure names are lower case)
         return ["figures", "--only", draw(st.text(alphabet="QZ!%", min_size=1, max_size=4))]
     return tail
 
@@ -291,17 +357,24 @@ def command_lines(draw):
 @settings(max_examples=EXAMPLES["cli"], **SETTINGS)
 @given(argv=command_lines())
 def test_fuzz_command_lines(argv, tmp_path_factory):
-    assume("--jobs" not in " ".join(argv) or "sweep" not in argv)   # no worker processes in-process
+    assume("--jobs" not in " ".join(argv) or "sweep" not in argv)  # no worker processes in-process
     run_case("cli", argv, tmp_path_factory.mktemp("c"))
 
 
 # ---- corrupt and foreign saved runs -----------------------------------------------------
 
-SAVED = {"scene": "block", "t": np.linspace(0.0, 1.0, 40), "u": np.arange(24.0).reshape(8, 3),
-         "state": np.array(["stick", "slip"]), "nested": {"k": 3, "ok": True, "x": [1.0, 2.0]}}
-json_values = st.recursive(st.none() | st.booleans() | st.floats(allow_nan=False) | st.text(max_size=5),
-                           lambda c: st.lists(c, max_size=4) | st.dictionaries(st.text(max_size=6), c, max_size=4),
-                           max_leaves=12)
+SAVED = {
+    "scene": "block",
+    "t": np.linspace(0.0, 1.0, 40),
+    "u": np.arange(24.0).reshape(8, 3),
+    "state": np.array(["stick", "slip"]),
+    "nested": {"k": 3, "ok": True, "x": [1.0, 2.0]},
+}
+json_values = st.recursive(
+    st.none() | st.booleans() | st.floats(allow_nan=False) | st.text(max_size=5),
+    lambda c: st.lists(c, max_size=4) | st.dictionaries(st.text(max_size=6), c, max_size=4),
+    max_leaves=12,
+)
 
 
 @st.composite
@@ -320,10 +393,14 @@ def test_fuzz_saved_runs(case, tmp_path_factory):
     path = Path(save_run(SAVED, folder / f"run{suffix}"))
     raw = path.read_bytes()
     k = where % len(raw)
-    data = {"truncate": raw[:k], "flip": raw[:k] + bytes([raw[k] ^ blob[0]]) + raw[k + 1:],
-            "insert": raw[:k] + blob + raw[k:], "random": blob,
-            "json": json.dumps(value).encode(),
-            "formatted": json.dumps({"format": "contactfem-run/1", "results": value}).encode()}[how]
+    data = {
+        "truncate": raw[:k],
+        "flip": raw[:k] + bytes([raw[k] ^ blob[0]]) + raw[k + 1 :],
+        "insert": raw[:k] + blob + raw[k:],
+        "random": blob,
+        "json": json.dumps(value).encode(),
+        "formatted": json.dumps({"format": "contactfem-run/1", "results": value}).encode(),
+    }[how]
     path.write_bytes(data)
     COUNTS["cases"] += 1
     COUNTS["files"] += 1
@@ -346,21 +423,32 @@ def test_fuzz_saved_runs(case, tmp_path_factory):
 
 # ---- random interface laws --------------------------------------------------------------
 
-NUMBERS = st.one_of(st.floats(0.01, 10.0), st.floats(0.01, 10.0), st.floats(0.01, 10.0),
-                    st.sampled_from([0.0, 1.0, 1e-300, 1e300, 0.5]),
-                    st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.text(max_size=3), st.none()))
+NUMBERS = st.one_of(
+    st.floats(0.01, 10.0),
+    st.floats(0.01, 10.0),
+    st.floats(0.01, 10.0),
+    st.sampled_from([0.0, 1.0, 1e-300, 1e300, 0.5]),
+    st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.text(max_size=3), st.none()),
+)
 
 
 @settings(max_examples=EXAMPLES["laws"], **SETTINGS)
-@given(kind=st.sampled_from(["Coulomb", "ParabolicSlip", "SlipHardening", "PowerLaw", "ExponentialLaw"]),
-       values=st.lists(NUMBERS, min_size=4, max_size=4))
+@given(
+    kind=st.sampled_from(["Coulomb", "ParabolicSlip", "SlipHardening", "PowerLaw", "ExponentialLaw"]),
+    values=st.lists(NUMBERS, min_size=4, max_size=4),
+)
 def test_fuzz_laws(kind, values):
     from contactfem import laws
     from contactfem.laws import return_map
 
     cls = getattr(laws, kind)
-    names = {"Coulomb": ("c_T", "mu"), "ParabolicSlip": ("c_T", "alpha", "beta", "n"),
-             "SlipHardening": ("c_T", "mu", "h"), "PowerLaw": ("c_N", "m"), "ExponentialLaw": ("a", "b")}[kind]
+    names = {
+        "Coulomb": ("c_T", "mu"),
+        "ParabolicSlip": ("c_T", "alpha", "beta", "n"),
+        "SlipHardening": ("c_T", "mu", "h"),
+        "PowerLaw": ("c_N", "m"),
+        "ExponentialLaw": ("a", "b"),
+    }[kind]
     kw = dict(zip(names, values))
     COUNTS["cases"] += 1
     COUNTS["laws"] += 1
@@ -379,7 +467,7 @@ def test_fuzz_laws(kind, values):
     with np.errstate(all="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
-            report = check_law(law)                       # a report in words, whatever the values
+            report = check_law(law)  # a report in words, whatever the values
         except BaseException as exc:
             violation("laws", kw, f"check_law raised {type(exc).__name__}: {exc}")
     if not isinstance(str(report), str):
@@ -393,7 +481,7 @@ def test_fuzz_laws(kind, values):
             try:
                 r = return_map(law, -g * 10.0, np.full(5, 10.0), np.linspace(-0.1, 0.1, 5), np.zeros(5), np.zeros(5))
             except (FloatingPointError, ValueError):
-                return                                     # refused with a reason: allowed
+                return  # refused with a reason: allowed
             out = [v for v in vars(r).values() if isinstance(v, np.ndarray) and v.dtype.kind == "f"]
     if any(not np.all(np.isfinite(a)) for a in out):
         # a law at the edge of floating point may overflow: then the solver must say so
@@ -419,22 +507,52 @@ def _seen(method, args, out):
     except Exception:
         SEEN.append((method, None, None))
 """
-GOOD_Y = ["self.mu * p", "self.mu * p * (1.0 + 0.1 * q)", "self.mu * self.P * np.tanh(p / self.P)",
-          "self.mu * p + 0.0 * q", "self.mu * p ** 0.7"]
+GOOD_Y = [
+    "self.mu * p",
+    "self.mu * p * (1.0 + 0.1 * q)",
+    "self.mu * self.P * np.tanh(p / self.P)",
+    "self.mu * p + 0.0 * q",
+    "self.mu * p ** 0.7",
+]
 GOOD_YV = ["self.mu * p / (1.0 + v)", "p * (self.mu + 0.1 * np.exp(-v))"]
-BAD_Y = ["np.sqrt(p - self.P)", "np.where(p > self.P, np.nan, self.mu * p)",
-         "np.where(p > self.P, -self.mu * p, self.mu * p)", "-self.mu * p", "self.mu * p / (self.P - p)",
-         "np.log(p / self.P)", "np.exp(p * self.P)", "self.mu * p * np.inf", "np.where(q > self.P, np.nan, self.mu * p)"]
+BAD_Y = [
+    "np.sqrt(p - self.P)",
+    "np.where(p > self.P, np.nan, self.mu * p)",
+    "np.where(p > self.P, -self.mu * p, self.mu * p)",
+    "-self.mu * p",
+    "self.mu * p / (self.P - p)",
+    "np.log(p / self.P)",
+    "np.exp(p * self.P)",
+    "self.mu * p * np.inf",
+    "np.where(q > self.P, np.nan, self.mu * p)",
+]
 BAD_YV = ["np.where(v > self.P, np.nan, self.mu * p)", "self.mu * p * (1.0 - v / self.P)"]
-MODES = ["alone"] * 16 + ["derivs"] * 8 + ["wrong_derivs", "nan_deriv", "wrong_count", "shape", "text", "cast", "math",
-                                         "ifelse", "raise_above", "no_c_T", "syntax"]
+MODES = (
+    ["alone"] * 16
+    + ["derivs"] * 8
+    + [
+        "wrong_derivs",
+        "nan_deriv",
+        "wrong_count",
+        "shape",
+        "text",
+        "cast",
+        "math",
+        "ifelse",
+        "raise_above",
+        "no_c_T",
+        "syntax",
+    ]
+)
 C_T = ["30.0", "1e4", "1.0"] * 4 + [None] * 3 + ["0.0", "-1.0", "float('nan')", "float('inf')", "1e-300"]
 LAW_SETS = [None] * 24 + ["c_T=-1", "c_T=0", "c_T=nan", "c_T=10", "mu=0.5", "mu=-1", "P=1e-3", "P=1e6", "nu=1"]
 GOOD_T = ("np.where(g < 0, self.c_N * g, 0.0)", "np.where(g < 0, self.c_N, 0.0)")
-BAD_T = [("np.where(g < 0, -self.c_N * g, 0.0)", "np.where(g < 0, -self.c_N, 0.0)"),
-         ("np.where(g < -self.D, np.nan, self.c_N * np.minimum(g, 0.0))", "np.where(g < 0, self.c_N, 0.0)"),
-         ("np.where(g < 0, -(np.exp(-1e4 * g) - 1.0), 0.0)", "np.where(g < 0, 1e4 * np.exp(-1e4 * g), 0.0)"),
-         ("np.where(g < 0, self.c_N * g, 0.0)", "np.where(g < -self.D, np.inf, self.c_N)")]
+BAD_T = [
+    ("np.where(g < 0, -self.c_N * g, 0.0)", "np.where(g < 0, -self.c_N, 0.0)"),
+    ("np.where(g < -self.D, np.nan, self.c_N * np.minimum(g, 0.0))", "np.where(g < 0, self.c_N, 0.0)"),
+    ("np.where(g < 0, -(np.exp(-1e4 * g) - 1.0), 0.0)", "np.where(g < 0, 1e4 * np.exp(-1e4 * g), 0.0)"),
+    ("np.where(g < 0, self.c_N * g, 0.0)", "np.where(g < -self.D, np.inf, self.c_N)"),
+]
 FRICTION_SCENES = ["block", "rolling_ring"] + (["sloping_impact", "funnel", "cork"] if LONG else [])
 NORMAL_SCENES = ["patch", "block"] + (["hertz", "bar_impact", "rolling_ring"] if LONG else [])
 LAW_CHEAP = dict(CHEAP, rolling_ring={"t_end": 0.1}, cork={"t_end": 2e-4, "n_press": 2})
@@ -464,23 +582,40 @@ def _friction_source(draw):
         lines.append("        if np.any(np.real(p) > self.P):\n            raise RuntimeError('above P')")
     expr = f"self.mu * math.tanh(p)" if mode == "math" else y
     lines.append(f"        Y = {expr}")
-    out = {"alone": "Y", "derivs": None, "wrong_derivs": f"Y, 1.0 + 0.0 * p{zeros[len(', 0.0 * p'):]}",
-           "nan_deriv": f"Y, np.nan * p{zeros[len(', 0.0 * p'):]}", "wrong_count": "Y, 0.0",
-           "shape": "Y[:1] if np.ndim(Y) else Y", "text": "'Y'"}.get(mode, "Y")
-    if out is None:         # the derivatives by complex step, returned as the law's own (right)
+    out = {
+        "alone": "Y",
+        "derivs": None,
+        "wrong_derivs": f"Y, 1.0 + 0.0 * p{zeros[len(', 0.0 * p') :]}",
+        "nan_deriv": f"Y, np.nan * p{zeros[len(', 0.0 * p') :]}",
+        "wrong_count": "Y, 0.0",
+        "shape": "Y[:1] if np.ndim(Y) else Y",
+        "text": "'Y'",
+    }.get(mode, "Y")
+    if out is None:  # the derivatives by complex step, returned as the law's own (right)
         h = "1e-30"
-        parts = [f"np.imag(self._y(p + 1j * {h}, q{', v' if rate else ''})) / {h}",
-                 f"np.imag(self._y(p, q + 1j * {h}{', v' if rate else ''})) / {h}"]
+        parts = [
+            f"np.imag(self._y(p + 1j * {h}, q{', v' if rate else ''})) / {h}",
+            f"np.imag(self._y(p, q + 1j * {h}{', v' if rate else ''})) / {h}",
+        ]
         if rate:
             parts.append(f"np.imag(self._y(p, q, v + 1j * {h})) / {h}")
         lines[-1:] = [f"        Y = self._y(p, q{', v' if rate else ''})"]
         out = "Y, " + ", ".join(parts)
-        lines += [f"        _seen('slip_bound', ({args},), (Y,))", f"        return {out}", "",
-                  f"    def _y(self, {args}):", f"        return {y}"]
+        lines += [
+            f"        _seen('slip_bound', ({args},), (Y,))",
+            f"        return {out}",
+            "",
+            f"    def _y(self, {args}):",
+            f"        return {y}",
+        ]
     else:
         lines += [f"        _seen('slip_bound', ({args},), (Y,))", f"        return {out}"]
-    return LAW_HEAD + "\n".join(lines) + "\n", good and mode in ("alone", "derivs") and c_T not in ("0.0", "-1.0",
-                                                                    "float('nan')", "float('inf')")
+    return LAW_HEAD + "\n".join(lines) + "\n", good and mode in ("alone", "derivs") and c_T not in (
+        "0.0",
+        "-1.0",
+        "float('nan')",
+        "float('inf')",
+    )
 
 
 def _normal_source(draw):
@@ -490,10 +625,24 @@ def _normal_source(draw):
     c_N = draw(st.sampled_from(["10.0", "1e5", "1e3"] * 3 + ["-1.0"]))
     D = draw(st.sampled_from(["1e-6", "1e-3", "0.1"]))
     ret = "t, dt" if count == "two" else "t"
-    src = LAW_HEAD + "\n".join([
-        "", "", "@dataclass(frozen=True)", "class Law:", f"    c_N: float = {c_N}", f"    D: float = {D}", "",
-        "    def traction(self, g):", "        g = np.asarray(g, dtype=float)", f"        t = {t}", f"        dt = {dt}",
-        "        _seen('traction', (g,), (t, dt))", f"        return {ret}", ""])
+    src = LAW_HEAD + "\n".join(
+        [
+            "",
+            "",
+            "@dataclass(frozen=True)",
+            "class Law:",
+            f"    c_N: float = {c_N}",
+            f"    D: float = {D}",
+            "",
+            "    def traction(self, g):",
+            "        g = np.asarray(g, dtype=float)",
+            f"        t = {t}",
+            f"        dt = {dt}",
+            "        _seen('traction', (g,), (t, dt))",
+            f"        return {ret}",
+            "",
+        ]
+    )
     return src, good and count == "two"
 
 
@@ -504,7 +653,7 @@ def law_files(draw):
     option = kind if draw(st.integers(0, 19)) else ("normal" if kind == "friction" else "friction")
     scene = draw(st.sampled_from(FRICTION_SCENES if option == "friction" else NORMAL_SCENES))
     if not draw(st.integers(0, 24)):
-        scene = draw(st.sampled_from(["hertz", "patch"]))           # a scene without that law, now and then
+        scene = draw(st.sampled_from(["hertz", "patch"]))  # a scene without that law, now and then
     sets = dict(LAW_CHEAP.get(scene, {}))
     law_set = draw(st.sampled_from(LAW_SETS))
     extra = ["--no-check"] if draw(st.integers(0, 2)) == 0 else []
@@ -519,7 +668,7 @@ def _bad_values(module):
             continue
         try:
             ok_in = np.all([np.isfinite(a) for a in np.broadcast_arrays(*args)], axis=0)
-            vals = np.broadcast_arrays(*out, *args)[:len(out)]
+            vals = np.broadcast_arrays(*out, *args)[: len(out)]
         except ValueError:
             continue
         for a in vals:
@@ -566,16 +715,19 @@ def test_fuzz_law_files(case, tmp_path_factory):
 
 # ---- the counts ---------------------------------------------------------------------------
 
+
 def test_fuzz_summary(capsys):
     """Print the counts (run last in this module); the long profile must have run >= 500 cases."""
-    line = (f"fuzz ({'long' if LONG else 'quick'}): {COUNTS['cases']} cases "
-            f"(parameters {COUNTS['params']}, command lines {COUNTS['cli']}, saved files {COUNTS['files']}, "
-            f"laws {COUNTS['laws']}, law files {COUNTS['lawfiles']}: exit 0 {COUNTS['law file exit 0']}, "
-            f"1 {COUNTS['law file exit 1']}, 2 {COUNTS['law file exit 2']}); exit 0: {COUNTS['exit 0']}, "
-            f"exit 1: {COUNTS['exit 1']}, "
-            f"exit 2: {COUNTS['exit 2']}; load_run refused {COUNTS['load_run ValueError']}, "
-            f"read {COUNTS['load_run ok']}; laws refused {COUNTS['law refused']}, accepted {COUNTS['law accepted']}; "
-            f"violations: {len(VIOLATIONS)}")
+    line = (
+        f"fuzz ({'long' if LONG else 'quick'}): {COUNTS['cases']} cases "
+        f"(parameters {COUNTS['params']}, command lines {COUNTS['cli']}, saved files {COUNTS['files']}, "
+        f"laws {COUNTS['laws']}, law files {COUNTS['lawfiles']}: exit 0 {COUNTS['law file exit 0']}, "
+        f"1 {COUNTS['law file exit 1']}, 2 {COUNTS['law file exit 2']}); exit 0: {COUNTS['exit 0']}, "
+        f"exit 1: {COUNTS['exit 1']}, "
+        f"exit 2: {COUNTS['exit 2']}; load_run refused {COUNTS['load_run ValueError']}, "
+        f"read {COUNTS['load_run ok']}; laws refused {COUNTS['law refused']}, accepted {COUNTS['law accepted']}; "
+        f"violations: {len(VIOLATIONS)}"
+    )
     with capsys.disabled():
         print("\n" + line)
     assert not VIOLATIONS, VIOLATIONS[:5]

@@ -27,8 +27,10 @@ def run_cli(*args, cwd=None):
 @pytest.fixture
 def no_solve(monkeypatch):
     """Make any scene run an error: what is checked must be checked before the solve."""
+
     def refuse(*a, **k):
         raise AssertionError("a scene was run although the input was knowable beforehand")
+
     monkeypatch.setattr(scenes, "run_scene", refuse)
 
 
@@ -51,8 +53,8 @@ BAD_BEFORE_THE_RUN = [
     (["run", "hertz", "--set", "n_el=2000"], "add --force"),
     (["run", "hertz", "--set", "n_el=3"], "allowed [4, 2000]"),
     (["run", "hertz", "--set", "P=1e6"], "a/R < 0.5"),
-    (["run", "hertz", "--set", "n_el=128", "--linear-algebra", "dense"], "add --force"),     # K alone 8.9 GB
-    (["run", "hertz", "--set", "n_el=256", "--linear-algebra", "banded"], "add --force"),    # its band 3.4 GB
+    (["run", "hertz", "--set", "n_el=128", "--linear-algebra", "dense"], "add --force"),  # K alone 8.9 GB
+    (["run", "hertz", "--set", "n_el=256", "--linear-algebra", "banded"], "add --force"),  # its band 3.4 GB
     (["sweep", "hertz", "--set", "n_el=512", "--out", "{tmp}/s.csv"], "add --force"),
     (["sweep", "hertz", "--set", "n_el=300,310", "--jobs", "2", "--out", "{tmp}/s.csv"], "2 runs at once"),
     (["run", "rolling_ring", "--set", "dt=1e-9"], "steps"),
@@ -70,7 +72,7 @@ def test_bad_input_is_one_line_before_any_solve(args, needle, tmp_path, capsys, 
     err = capsys.readouterr().err
     lines = err.strip().splitlines()
     assert len(lines) == 1 and needle in lines[0], err
-    assert list(tmp_path.iterdir()) == []                      # nothing written, no probe left
+    assert list(tmp_path.iterdir()) == []  # nothing written, no probe left
 
 
 def test_bad_input_from_a_real_process_has_no_traceback():
@@ -93,8 +95,10 @@ def test_a_forced_solver_counts_its_own_matrices():
     size = {"elements": 16384, "unknowns": 33282, "steps": 1}
     auto = estimate(size)["memory_bytes"]
     assert estimate(size, "sparse")["memory_bytes"] == auto
-    assert estimate(size, "dense")["memory_bytes"] == pytest.approx(auto + DENSE_BYTES * 33282 ** 2, rel=1e-9)
-    assert estimate(size, "banded")["memory_bytes"] == pytest.approx(auto + BAND_BYTES * 33282 ** 1.5, rel=1e-9)   # whole bytes
+    assert estimate(size, "dense")["memory_bytes"] == pytest.approx(auto + DENSE_BYTES * 33282**2, rel=1e-9)
+    assert estimate(size, "banded")["memory_bytes"] == pytest.approx(
+        auto + BAND_BYTES * 33282**1.5, rel=1e-9
+    )  # whole bytes
 
 
 def test_large_meshes_announce_themselves(monkeypatch, capsys):
@@ -118,7 +122,7 @@ def test_a_failed_newton_prints_its_residuals_once(capsys):
     assert main(["run", "block", "--set", "law=coulomb", "--set", "maxit=1"]) == 1
     lines = capsys.readouterr().err.strip().splitlines()
     assert len(lines) == 2 and "no convergence in 1 iterations" in lines[0]
-    first = lines[1].split()[2]                                  # the first residual norm
+    first = lines[1].split()[2]  # the first residual norm
     assert first not in lines[0]
 
 
@@ -143,22 +147,24 @@ def test_show_columns_are_aligned_and_units_given(capsys):
         lines = capsys.readouterr().out.splitlines()
         head = lines[1]
         cols = [head.index(c) for c in ("fast (run)", "unit", "allowed")]
-        for line in lines[2:2 + len(sc.params)]:
+        for line in lines[2 : 2 + len(sc.params)]:
             row = line.split("  -- ")[0]
             for c in cols[1:]:
-                assert row[c - 2:c] == "  " and row[c] != " ", (name, line)
+                assert row[c - 2 : c] == "  " and row[c] != " ", (name, line)
         for key in ("E", "dt", "c_N", "R"):
             if key in {p.name for p in sc.params}:
                 assert sc.param(key).unit, (name, key)
 
 
 def test_time_steps_have_the_same_range_everywhere():
-    ranges = {n: sc.param("dt").range_text() for n, sc in scenes.all_scenes().items()
-              if "dt" in {p.name for p in sc.params}}
+    ranges = {
+        n: sc.param("dt").range_text() for n, sc in scenes.all_scenes().items() if "dt" in {p.name for p in sc.params}
+    }
     assert set(ranges.values()) == {"(0, inf)"}, ranges
 
 
 # ---- saved runs that are not runs ------------------------------------------------------
+
 
 def corrupt_files(tmp_path):
     good = {"scene": "x", "t": np.linspace(0, 1, 50), "u": np.arange(12.0).reshape(4, 3), "name": "ring"}
@@ -173,10 +179,12 @@ def corrupt_files(tmp_path):
         "noresults.json": json.dumps({"format": "contactfem-run/1"}).encode(),
         "foreign.json": json.dumps({"hello": "world"}).encode(),
         "otherformat.json": json.dumps({"format": "other/2", "results": {}}).encode(),
-        "badarray.json": json.dumps({"format": "contactfem-run/1",
-                                     "results": {"x": {"__ndarray__": [1, 2], "dtype": "O", "shape": [2]}}}).encode(),
-        "badshape.json": json.dumps({"format": "contactfem-run/1",
-                                     "results": {"x": {"__ndarray__": [1, 2], "dtype": "<f8", "shape": [5]}}}).encode(),
+        "badarray.json": json.dumps(
+            {"format": "contactfem-run/1", "results": {"x": {"__ndarray__": [1, 2], "dtype": "O", "shape": [2]}}}
+        ).encode(),
+        "badshape.json": json.dumps(
+            {"format": "contactfem-run/1", "results": {"x": {"__ndarray__": [1, 2], "dtype": "<f8", "shape": [5]}}}
+        ).encode(),
     }
     for name, data in files.items():
         (tmp_path / name).write_bytes(data)
@@ -202,7 +210,7 @@ def test_a_saved_cli_run_comes_back_as_arrays(tmp_path):
         r = load_run(path)
         assert isinstance(r["newton_residuals"], np.ndarray) and isinstance(r["contact"]["t_N"], np.ndarray)
         assert np.allclose(r["contact"]["t_N"] * 2, 2 * np.asarray(r["contact"]["t_N"]))
-    with np.load(tmp_path / "run.npz") as z:                   # stored natively, not as JSON lists
+    with np.load(tmp_path / "run.npz") as z:  # stored natively, not as JSON lists
         assert len(z.files) > 5
 
 
@@ -214,10 +222,11 @@ def test_outputs_are_renamed_into_place_together(tmp_path):
         with out:
             out.temp("--json").write_text("{}")
             raise RuntimeError("the second output failed")
-    assert list(tmp_path.iterdir()) == []                      # the first one's temporary is gone too
+    assert list(tmp_path.iterdir()) == []  # the first one's temporary is gone too
 
 
 # ---- Ctrl-C -----------------------------------------------------------------------------
+
 
 def _sigint_as_in_a_terminal():
     """Run in the child before it starts: Ctrl-C back to its default. A test suite started in
@@ -237,9 +246,15 @@ def _interrupt(folder, delay=None, when_part=False, timeout=300):
     of contactfem runs, where no program can answer Ctrl-C its way) takes any time at all."""
     ready = folder.parent / f"{folder.name}.ready"
     env = dict(os.environ, CONTACTFEM_READY_FILE=str(ready))
-    p = subprocess.Popen([sys.executable, "-m", "contactfem", *RING], cwd=folder, text=True, env=env,
-                         preexec_fn=_sigint_as_in_a_terminal,
-                         stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    p = subprocess.Popen(
+        [sys.executable, "-m", "contactfem", *RING],
+        cwd=folder,
+        text=True,
+        env=env,
+        preexec_fn=_sigint_as_in_a_terminal,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
     t0 = time.monotonic()
     while p.poll() is None and not ready.exists() and time.monotonic() - t0 < timeout:
         time.sleep(0.002)
@@ -280,8 +295,13 @@ def test_ctrl_c_turned_into_another_error_by_a_library_is_still_the_interrupt():
     """A Ctrl-C landing in numpy's import surfaces as an ImportError; the command line
     recorded the interrupt, so the user sees the interrupt's one line and exit code 130,
     not an internal error."""
-    p = subprocess.run([sys.executable, "-c", LIBRARY_TURNS_CTRL_C_INTO_IMPORT_ERROR], preexec_fn=_sigint_as_in_a_terminal,
-                       capture_output=True, text=True, timeout=120)
+    p = subprocess.run(
+        [sys.executable, "-c", LIBRARY_TURNS_CTRL_C_INTO_IMPORT_ERROR],
+        preexec_fn=_sigint_as_in_a_terminal,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert p.returncode == 130, p.stderr
     assert p.stderr.strip() == "contactfem: interrupted before the run started; nothing written", p.stderr
 
@@ -303,10 +323,10 @@ def test_the_whole_ring_run_writes_all_three(ring_run):
     from PIL import Image
 
     gif = Image.open(folder / "a.gif")
-    assert gif.n_frames >= 100                                  # rolling, frame by frame
+    assert gif.n_frames >= 100  # rolling, frame by frame
     res = load_run(folder / "a.npz")
     anim = res["animation"]
-    assert len(anim["marks"]) == gif.n_frames and anim["obstacles"][0].shape == (2, 2)   # a spoke, a floor
+    assert len(anim["marks"]) == gif.n_frames and anim["obstacles"][0].shape == (2, 2)  # a spoke, a floor
 
 
 @pytest.mark.slow
@@ -317,9 +337,9 @@ def test_ctrl_c_leaves_none_or_all_of_the_outputs(ring_run, tmp_path, fraction):
         rc, err, files = _interrupt(tmp_path, when_part=True)
     else:
         rc, err, files = _interrupt(tmp_path, delay=max(1.5, fraction * whole))
-    assert files in ([], sorted(OUTS)), files                   # none or all, no temporaries
+    assert files in ([], sorted(OUTS)), files  # none or all, no temporaries
     assert "Traceback" not in err
-    if rc == 0:                                                 # finished before the signal
+    if rc == 0:  # finished before the signal
         assert files == sorted(OUTS)
         return
     assert rc == 130, err
@@ -329,8 +349,11 @@ def test_ctrl_c_leaves_none_or_all_of_the_outputs(ring_run, tmp_path, fraction):
         assert lines[0] == "contactfem: interrupted after the outputs were written"
     else:
         assert lines[0].endswith("; nothing written"), lines[0]
-        assert re.match(r"contactfem: interrupted (at t = [-\d.e+]+, step \d+ of \d+|while writing the outputs"
-                        r"|during the run|before the run started); nothing written", lines[0]), lines[0]
+        assert re.match(
+            r"contactfem: interrupted (at t = [-\d.e+]+, step \d+ of \d+|while writing the outputs"
+            r"|during the run|before the run started); nothing written",
+            lines[0],
+        ), lines[0]
 
 
 @pytest.mark.parametrize("delay", [0.0, 0.01, 0.05, 0.1, 0.2, 0.3])
@@ -349,8 +372,14 @@ def test_sigterm_ends_a_run_with_143_and_leaves_no_outputs(tmp_path):
     none or all of the outputs and no temporaries (the run unwinds as from an exception)."""
     ready = tmp_path.parent / f"{tmp_path.name}.ready"
     env = dict(os.environ, CONTACTFEM_READY_FILE=str(ready))
-    p = subprocess.Popen([sys.executable, "-m", "contactfem", *RING], cwd=tmp_path, text=True, env=env,
-                         stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    p = subprocess.Popen(
+        [sys.executable, "-m", "contactfem", *RING],
+        cwd=tmp_path,
+        text=True,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
     t0 = time.monotonic()
     while p.poll() is None and not ready.exists() and time.monotonic() - t0 < 300:
         time.sleep(0.002)
@@ -359,7 +388,7 @@ def test_sigterm_ends_a_run_with_143_and_leaves_no_outputs(tmp_path):
         p.terminate()
     out, err = p.communicate(timeout=300)
     assert "Traceback" not in err, err
-    if p.returncode == 0:                                       # finished before the signal
+    if p.returncode == 0:  # finished before the signal
         return
     assert p.returncode == 143, err
     # none or all (a signal after the outputs were renamed into place finds them written), no temporaries

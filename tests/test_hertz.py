@@ -1,5 +1,6 @@
 """The hertz scene against Hertz's closed form (cylinder on a rigid plane, plane strain):
 a = sqrt(4 P R (1 - nu^2) / (pi E)), p0 = 2 P / (pi a)."""
+
 import numpy as np
 import pytest
 
@@ -10,7 +11,7 @@ from contactfem.scenes.hertz import fit_hertz, hertz_exact
 def test_closed_form_values():
     a, p0 = hertz_exact(P=2000.0, R=10.0, E=2e5, nu=0.3)
     assert a == pytest.approx(np.sqrt(4 * 2000 * 10 * 0.91 / (np.pi * 2e5)))
-    assert p0 * np.pi * a / 2 == pytest.approx(2000.0)      # the load is the integral of p(x)
+    assert p0 * np.pi * a / 2 == pytest.approx(2000.0)  # the load is the integral of p(x)
 
 
 def test_fit_recovers_an_exact_profile():
@@ -27,7 +28,7 @@ def test_fast_preset_matches_hertz():
     # fast mesh (32^2) must do at least as well as the next coarser one: 0.5 % on both.
     assert abs(r["error_p0"]) < 5e-3, f"p0 {r['p0']:.1f} vs Hertz {r['p0_exact']:.1f} (tol 0.5 %)"
     assert abs(r["error_a"]) < 5e-3, f"a {r['a']:.4f} vs Hertz {r['a_exact']:.4f} (tol 0.5 %)"
-    assert r["contact_force"] == pytest.approx(r["half_load"], rel=1e-6)   # equilibrium
+    assert r["contact_force"] == pytest.approx(r["half_load"], rel=1e-6)  # equilibrium
     assert r["n_contact_nodes"] >= 5
     assert r["newton_iterations_total"] >= 1
 
@@ -40,7 +41,7 @@ def test_half_width_is_measured_on_the_reference_configuration():
     x = np.asarray(r["profile_x"])
     p = np.asarray(r["profile_p"])
     assert fit_hertz(x, p)[0] == pytest.approx(r["a"], rel=1e-12)
-    assert np.all(np.diff(x) > 0) and x[0] == pytest.approx(0.0, abs=1e-12)   # B = (0, -R) stays at x = 0
+    assert np.all(np.diff(x) > 0) and x[0] == pytest.approx(0.0, abs=1e-12)  # B = (0, -R) stays at x = 0
 
 
 @pytest.mark.slow

@@ -8,13 +8,27 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-from contactfem.io import (ProgressBar, Recorder, animate_outlines, chain, export_continuum, export_polyline,
-                           load_run, save_run)
+from contactfem.io import (
+    ProgressBar,
+    Recorder,
+    animate_outlines,
+    chain,
+    export_continuum,
+    export_polyline,
+    load_run,
+    save_run,
+)
 
-RESULTS = {"wall_time_s": 1.5, "newton_iterations_total": np.int64(12), "name": "ring", "converged": True,
-           "t": np.linspace(0.0, 1.0, 5), "state": np.array(["open", "stick", "slip"]),
-           "nested": {"u": np.arange(6.0).reshape(3, 2), "ids": np.array([3, 1, 2]), "none": None},
-           "residuals": [[1.0, 1e-3, 1e-9], [2.0, 1e-11]]}
+RESULTS = {
+    "wall_time_s": 1.5,
+    "newton_iterations_total": np.int64(12),
+    "name": "ring",
+    "converged": True,
+    "t": np.linspace(0.0, 1.0, 5),
+    "state": np.array(["open", "stick", "slip"]),
+    "nested": {"u": np.arange(6.0).reshape(3, 2), "ids": np.array([3, 1, 2]), "none": None},
+    "residuals": [[1.0, 1e-3, 1e-9], [2.0, 1e-11]],
+}
 
 
 def check_same(a, b):
@@ -25,7 +39,7 @@ def check_same(a, b):
         elif isinstance(a[k], np.ndarray):
             assert isinstance(b[k], np.ndarray) and b[k].dtype == a[k].dtype and b[k].shape == a[k].shape, k
             assert np.array_equal(a[k], b[k]), k
-        elif isinstance(a[k], list):           # rectangular lists of numbers come back as arrays
+        elif isinstance(a[k], list):  # rectangular lists of numbers come back as arrays
             assert len(a[k]) == len(b[k]) and all(np.array_equal(x, y) for x, y in zip(a[k], b[k])), k
         else:
             assert a[k] == b[k], k
@@ -49,8 +63,9 @@ def test_nan_needs_npz(tmp_path):
 def test_load_cli_json(tmp_path):
     """The CLI writes arrays as plain lists: they come back as arrays; ragged lists stay lists."""
     p = tmp_path / "cli.json"
-    p.write_text(json.dumps({"scene": "block", "t_N": [[-1.0, -2.0], [0.0, -3.0]], "residuals": [[1.0, 0.1], [1.0]],
-                             "ok": True}))
+    p.write_text(
+        json.dumps({"scene": "block", "t_N": [[-1.0, -2.0], [0.0, -3.0]], "residuals": [[1.0, 0.1], [1.0]], "ok": True})
+    )
     r = load_run(p)
     assert isinstance(r["t_N"], np.ndarray) and r["t_N"].shape == (2, 2)
     assert isinstance(r["residuals"], list) and r["ok"] is True
@@ -71,8 +86,13 @@ def test_export_polyline(tmp_path):
 
     th = np.linspace(0, 2 * np.pi, 9)[:-1]
     frames = [np.column_stack([np.cos(th) + 0.1 * k, np.sin(th)]) for k in range(4)]
-    files = export_polyline(frames, np.arange(4) * 0.5, tmp_path / "ring.pvd", closed=True,
-                            point_data={"speed": [np.full(8, k) for k in range(4)]})
+    files = export_polyline(
+        frames,
+        np.arange(4) * 0.5,
+        tmp_path / "ring.pvd",
+        closed=True,
+        point_data={"speed": [np.full(8, k) for k in range(4)]},
+    )
     assert len(files) == 5 and files[-1].endswith(".pvd")
     ds = ET.parse(files[-1]).getroot().findall("./Collection/DataSet")
     assert [float(d.get("timestep")) for d in ds] == [0.0, 0.5, 1.0, 1.5]
@@ -90,7 +110,7 @@ def test_export_continuum(tmp_path):
 
     body = Continuum(MeshQuad.init_tensor(np.linspace(0, 2, 3), np.linspace(0, 1, 2)), E=100.0, nu=0.3, rho=1.0)
     u = np.zeros(body.ndof)
-    u[body.xdofs[:, 0]] = 0.01 * body.X[:, 0]          # uniaxial stretch eps_xx = 0.01
+    u[body.xdofs[:, 0]] = 0.01 * body.X[:, 0]  # uniaxial stretch eps_xx = 0.01
     files = export_continuum(body, [0.0, 1.0], [0 * u, u], tmp_path / "block.pvd")
     m = meshio.read(files[1])
     assert np.allclose(m.points[:, 0], 1.01 * body.X[:, 0])
@@ -104,8 +124,14 @@ def test_animate_outlines(tmp_path):
     from PIL import Image
 
     frames = [[np.array([[0, 0], [1, 0.1 * k], [1, 1]]), np.array([[2, 0], [3, k * 0.2]])] for k in range(6)]
-    path = animate_outlines(frames, tmp_path / "a.gif", times=np.arange(6.0), obstacles=[np.array([[-1, -0.1], [4, -0.1]])],
-                            closed=[True, False], fps=10)
+    path = animate_outlines(
+        frames,
+        tmp_path / "a.gif",
+        times=np.arange(6.0),
+        obstacles=[np.array([[-1, -0.1], [4, -0.1]])],
+        closed=[True, False],
+        fps=10,
+    )
     with Image.open(path) as im:
         assert im.n_frames == 6
     with pytest.raises(ValueError, match="gif or .mp4"):
@@ -137,10 +163,21 @@ def test_compare_runs_walks_every_number():
     (wall time, parameters) left out, entries the first lacks listed."""
     from contactfem.io import compare_runs
 
-    ref = {"a": [1.0, 2.0, 4.0], "b": {"c": 3.0, "s": ["stick", "slip"]}, "wall_time_s": 1.0,
-           "parameters": {"x": 1}, "empty": [], "none": None}
-    same = {"a": np.array([1.0, 2.0, 4.0]), "b": {"c": 3.0, "s": ["stick", "slip"]}, "wall_time_s": 9.0,
-            "empty": np.zeros((0, 2)), "none": None}
+    ref = {
+        "a": [1.0, 2.0, 4.0],
+        "b": {"c": 3.0, "s": ["stick", "slip"]},
+        "wall_time_s": 1.0,
+        "parameters": {"x": 1},
+        "empty": [],
+        "none": None,
+    }
+    same = {
+        "a": np.array([1.0, 2.0, 4.0]),
+        "b": {"c": 3.0, "s": ["stick", "slip"]},
+        "wall_time_s": 9.0,
+        "empty": np.zeros((0, 2)),
+        "none": None,
+    }
     d = compare_runs(same, ref)
     assert d["worst"] == 0.0 and d["compared"] == 4 and d["missing"] == []
     d = compare_runs(dict(same, a=np.array([1.0, 2.0, 4.0 + 4e-6])), ref)

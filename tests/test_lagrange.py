@@ -10,6 +10,7 @@
   kinematics;
 * bad input: laws the method cannot take, a contact outside a System.
 """
+
 import numpy as np
 import pytest
 from conftest import PointCloud
@@ -28,15 +29,19 @@ C_N, C_T, DT = 50.0, 30.0, 0.1
 H = 1e-6
 TOL = 1e-6
 
-FRICTIONS = {"frictionless": None, "coulomb": Coulomb(c_T=C_T, mu=0.3),
-             "parabolic": ParabolicSlip(c_T=C_T, alpha=0.2, beta=0.3, n=0.5)}
+FRICTIONS = {
+    "frictionless": None,
+    "coulomb": Coulomb(c_T=C_T, mu=0.3),
+    "parabolic": ParabolicSlip(c_T=C_T, alpha=0.2, beta=0.3, n=0.5),
+}
 
 
 # -- the complementarity functions ------------------------------------------------------
 
+
 def test_normal_function_vanishes_exactly_on_the_signorini_conditions():
     g = np.array([0.0, 0.0, 0.1, 0.1, -0.1, 0.0])
-    t_N = np.array([-2.0, 0.0, 0.0, -2.0, 0.0, 1.0])         # p = -t_N
+    t_N = np.array([-2.0, 0.0, 0.0, -2.0, 0.0, 1.0])  # p = -t_N
     C, *_ = normal_complementarity(t_N, g, c_N=7.0)
     holds = (g >= 0) & (-t_N >= 0) & (t_N * g == 0)
     assert np.array_equal(C == 0.0, holds), (C, holds)
@@ -44,8 +49,8 @@ def test_normal_function_vanishes_exactly_on_the_signorini_conditions():
 
 @pytest.mark.parametrize("c_N, c_T", [(1.0, 1.0), (1e5, 1e-3), (1e-3, 1e6)])
 def test_friction_function_vanishes_exactly_on_coulombs_conditions(c_N, c_T):
-    law, p = Coulomb(c_T=1.0, mu=0.5), 2.0                  # Y = 1 at a closed node with g_N = 0
-    xi = np.full(7, p)                                       # ... whatever c_N: xi = p - c_N * 0
+    law, p = Coulomb(c_T=1.0, mu=0.5), 2.0  # Y = 1 at a closed node with g_N = 0
+    xi = np.full(7, p)  # ... whatever c_N: xi = p - c_N * 0
     t_T = np.array([0.3, -0.7, 1.0, -1.0, 1.0, 0.3, 1.2])
     dg_T = np.array([0.0, 0.0, 0.2, -0.1, -0.1, 0.1, 0.0])
     C, _, _, _, state = friction_complementarity(law, t_T, dg_T, xi, c_T)
@@ -61,7 +66,7 @@ def test_friction_function_vanishes_exactly_on_coulombs_conditions(c_N, c_T):
 
 # -- the Jacobian against finite differences ---------------------------------------------
 
-X_SLAVE = np.array([(0.85, 0.0), (0.62, 0.01), (0.38, -0.005), (0.15, 0.0)])     # right to left: n = -y
+X_SLAVE = np.array([(0.85, 0.0), (0.62, 0.01), (0.38, -0.005), (0.15, 0.0)])  # right to left: n = -y
 X_MASTER = np.array([(-0.2, -0.02), (0.2, 0.01), (0.45, -0.01), (0.7, 0.0), (1.2, -0.015)])
 
 
@@ -76,12 +81,14 @@ def make(kind, master_kind, friction, kinematics="finite"):
         body = PointCloud(X_MASTER, "master", dof_offset=slave.ndof)
         master, nb = BodySurface(body, np.arange(len(X_MASTER))), slave.ndof + body.ndof
     if kind == "node_to_segment":
-        c = LagrangeNodeToSegment(slave, np.arange(4), master, normal=PowerLaw(c_N=C_N), friction=friction,
-                                  weights=[0.2, 0.25, 0.22, 0.18])
+        c = LagrangeNodeToSegment(
+            slave, np.arange(4), master, normal=PowerLaw(c_N=C_N), friction=friction, weights=[0.2, 0.25, 0.22, 0.18]
+        )
     else:
-        c = LagrangeMortar(slave, np.arange(4), master, normal=PowerLaw(c_N=C_N), friction=friction,
-                           kinematics=kinematics)
-    c.dof_offset = nb                     # as a System places it
+        c = LagrangeMortar(
+            slave, np.arange(4), master, normal=PowerLaw(c_N=C_N), friction=friction, kinematics=kinematics
+        )
+    c.dof_offset = nb  # as a System places it
     return c, nb
 
 
@@ -99,14 +106,14 @@ def with_sets(contact, u, nb, sets, h):
     p = np.where(np.array(sets) == "open", C_N * g - 0.5, C_N * np.maximum(g, 0.0) + 1.0 + np.arange(nc) * 0.3)
     assert np.all(p[np.array(sets) == "open"] >= 0.0), "an open node must have a positive gap here"
     u = u.copy()
-    u[nb:nb + nc] = -p
+    u[nb : nb + nc] = -p
     if contact.friction is not None:
         xi = p - C_N * g
         Y = contact.friction.slip_bound(np.maximum(xi, 0.5), np.zeros(nc))[0]
         tau = np.array([{"open": 0.4, "stick": 0.5, "slip+": 2.0, "slip-": -2.0}[s] for s in sets]) * Y
         t_T = tau - C_T * dg
         t_T[np.array(sets) == "open"] = 0.37
-        u[nb + nc:nb + 2 * nc] = t_T
+        u[nb + nc : nb + 2 * nc] = t_T
     return u
 
 
@@ -122,13 +129,24 @@ def check_jacobian(contact, u, h):
 
 
 # every set: open and stick nodes together, slip in either direction beside stick
-SETS = {"open-stick": ["open", "stick", "stick", "open"], "slip+": ["slip+", "slip+", "stick", "slip+"],
-        "slip-": ["slip-", "slip-", "slip-", "stick"]}
-LAWS_SETS = [("frictionless", "open-stick"), ("coulomb", "open-stick"), ("coulomb", "slip+"), ("coulomb", "slip-"),
-             ("parabolic", "slip+"), ("parabolic", "slip-")]
-CASES = [("node_to_segment", m, "finite") for m in ("line", "polyline", "deformable")] + \
-        [("mortar", m, "finite") for m in ("line", "polyline", "deformable")] + \
-        [("mortar", m, "small") for m in ("line", "deformable")]
+SETS = {
+    "open-stick": ["open", "stick", "stick", "open"],
+    "slip+": ["slip+", "slip+", "stick", "slip+"],
+    "slip-": ["slip-", "slip-", "slip-", "stick"],
+}
+LAWS_SETS = [
+    ("frictionless", "open-stick"),
+    ("coulomb", "open-stick"),
+    ("coulomb", "slip+"),
+    ("coulomb", "slip-"),
+    ("parabolic", "slip+"),
+    ("parabolic", "slip-"),
+]
+CASES = (
+    [("node_to_segment", m, "finite") for m in ("line", "polyline", "deformable")]
+    + [("mortar", m, "finite") for m in ("line", "polyline", "deformable")]
+    + [("mortar", m, "small") for m in ("line", "deformable")]
+)
 
 
 @pytest.mark.slow
@@ -139,9 +157,9 @@ def test_jacobian_matches_finite_differences(rng, kind, master, kinematics, law,
     u = np.zeros(nb + contact.unknowns)
     u[:nb] = 0.003 * rng.standard_normal(nb)
     h = contact.start(u)
-    u[0:8:2] += 0.02                                        # the slave slides along x (a slip of the step)
+    u[0:8:2] += 0.02  # the slave slides along x (a slip of the step)
     wanted = SETS[sets]
-    u[1:8:2] += np.where(np.array(wanted) == "open", 0.06, -0.02)    # open nodes lifted, the others pressed in
+    u[1:8:2] += np.where(np.array(wanted) == "open", 0.06, -0.02)  # open nodes lifted, the others pressed in
     u = with_sets(contact, u, nb, wanted, h)
     st = contact.evaluate(u, 0.0, DT, history=h)
     expected = {"open": OPEN, "stick": STICK, "slip+": SLIP, "slip-": SLIP}
@@ -151,19 +169,21 @@ def test_jacobian_matches_finite_differences(rng, kind, master, kinematics, law,
     if law != "frictionless" and "slip" in sets:
         sign = 1.0 if sets == "slip+" else -1.0
         on = np.array(wanted) == sets
-        assert np.all(np.sign(u[nb + 4:][on] + C_T * gaps_and_slips(contact, u, h)[1][on]) == sign)
+        assert np.all(np.sign(u[nb + 4 :][on] + C_T * gaps_and_slips(contact, u, h)[1][on]) == sign)
     check_jacobian(contact, u, h)
 
 
 # -- bad input ------------------------------------------------------------------------------
+
 
 def test_laws_it_cannot_take_are_refused():
     slave = PointCloud(X_SLAVE)
     with pytest.raises(ValueError, match="PowerLaw"):
         LagrangeNodeToSegment(slave, np.arange(4), RigidLine(), normal=PowerLaw(c_N=1.0, m=2.0))
     with pytest.raises(ValueError, match="Coulomb or ParabolicSlip"):
-        LagrangeMortar(slave, np.arange(4), RigidLine(), normal=PowerLaw(c_N=1.0),
-                       friction=SlipHardening(c_T=1.0, mu=0.2, h=0.5))
+        LagrangeMortar(
+            slave, np.arange(4), RigidLine(), normal=PowerLaw(c_N=1.0), friction=SlipHardening(c_T=1.0, mu=0.2, h=0.5)
+        )
     with pytest.raises(ValueError, match="tangent = consistent"):
         LagrangeNodeToSegment(slave, np.arange(4), RigidLine(), normal=PowerLaw(c_N=1.0), tangent="symmetric")
 

@@ -87,10 +87,12 @@ def test_a_complex_slip_bound_is_refused(lawfile, capsys):
 
 def test_a_law_file_that_exits_at_import_is_one_line(tmp_path, capsys):
     path = tmp_path / "quits.py"
-    path.write_text(textwrap.dedent('''
+    path.write_text(
+        textwrap.dedent("""
         import sys
         sys.exit(3)
-    '''))
+    """)
+    )
     assert main(["run", "block", "--friction", f"{path}:Anything"]) == 2
     line = _one_line(capsys)
     assert "law file quits.py, line 3" in line and "sys.exit(3)" in line, line
@@ -108,7 +110,7 @@ def test_a_complex_normal_traction_is_refused():
         c_N: float = 10.0
 
         def traction(self, g_N):
-            return self.c_N * np.sqrt(g_N + 0j), self.c_N * 0.5 / np.sqrt(g_N + 0j)   # imaginary where g_N < 0
+            return self.c_N * np.sqrt(g_N + 0j), self.c_N * 0.5 / np.sqrt(g_N + 0j)  # imaginary where g_N < 0
 
     with pytest.raises(LawValueError, match=r"ComplexPenalty.traction: t_N is complex, .* at g_N = -0.5"):
         as_normal_law(ComplexPenalty()).traction(np.array([0.5, -0.5]))

@@ -16,8 +16,7 @@ import pytest
 from contactfem.cli import main
 from contactfem.lab.lawfile import load_class
 from contactfem.laws import Coulomb, PowerLaw, Stribeck
-from contactfem.laws.protocol import (FrictionLaw, LawError, LawValueError, NormalLawView, as_friction_law,
-                                      as_normal_law)
+from contactfem.laws.protocol import FrictionLaw, LawError, LawValueError, NormalLawView, as_friction_law, as_normal_law
 from contactfem.scenes import get_scene, run_scene
 
 DATA = Path(__file__).parent / "data"
@@ -28,8 +27,13 @@ SCENES = ["block", "rolling_ring", "sloping_impact", "funnel", "cork"]
 REACHED = {"block": 50.0, "rolling_ring": 0.05, "sloping_impact": 0.2, "funnel": 0.1, "cork": 0.5}
 # pressures strictly between lo and hi that each scene meets, none of the law file's quick probe
 # (p = 0.5, 1, 2): such a law reaches the run with --no-check
-WINDOW = {"block": (50.0, 1e12), "rolling_ring": (0.01, 0.45), "sloping_impact": (0.01, 0.45),
-          "funnel": (0.01, 0.45), "cork": (0.01, 0.45)}
+WINDOW = {
+    "block": (50.0, 1e12),
+    "rolling_ring": (0.01, 0.45),
+    "sloping_impact": (0.01, 0.45),
+    "funnel": (0.01, 0.45),
+    "cork": (0.01, 0.45),
+}
 
 
 def cli(capsys, *argv):
@@ -51,9 +55,11 @@ def _one_line(lines, *needles):
 
 # ---- the adapters: each value checked where it returns ------------------------------------
 
+
 @dataclass(frozen=True)
 class Returns:
     """A friction law returning fixed arrays (Y, and optionally its derivatives)."""
+
     c_T: float = 1.0
     kind: str = "nan"
 
@@ -73,19 +79,22 @@ class Returns:
         return Y, 0.3 + 0 * p, 0 * p
 
 
-@pytest.mark.parametrize("kind,message", [
-    ("nan", r"^Returns\.slip_bound returned NaN or inf: Y = nan at p = 2, q = 0\.2$"),
-    ("inf_deriv", r"^Returns\.slip_bound returned NaN or inf: dY/dp = inf at p = 2, q = 0\.2$"),
-    ("negative", r"^Returns\.slip_bound returned a negative slip bound: Y = -0\.6 at p = 2, q = 0\.2 "),
-    ("shape", r"^Returns\.slip_bound: Y has shape \(1,\), expected \(3,\)"),
-    ("text", r"^Returns\.slip_bound: Y is not an array of numbers"),
-])
+@pytest.mark.parametrize(
+    "kind,message",
+    [
+        ("nan", r"^Returns\.slip_bound returned NaN or inf: Y = nan at p = 2, q = 0\.2$"),
+        ("inf_deriv", r"^Returns\.slip_bound returned NaN or inf: dY/dp = inf at p = 2, q = 0\.2$"),
+        ("negative", r"^Returns\.slip_bound returned a negative slip bound: Y = -0\.6 at p = 2, q = 0\.2 "),
+        ("shape", r"^Returns\.slip_bound: Y has shape \(1,\), expected \(3,\)"),
+        ("text", r"^Returns\.slip_bound: Y is not an array of numbers"),
+    ],
+)
 def test_a_bad_value_is_one_line_naming_the_law_the_method_the_value_and_the_point(kind, message):
     L = as_friction_law(Returns(kind=kind))
     with pytest.raises(LawValueError, match=message) as err:
         L.slip_bound(np.array([0.5, 1.0, 2.0]), np.array([0.0, 0.1, 0.2]))
     assert "\n" not in str(err.value)
-    assert not isinstance(err.value, FloatingPointError)          # Newton does not take it for a bad iterate
+    assert not isinstance(err.value, FloatingPointError)  # Newton does not take it for a bad iterate
 
 
 def test_a_point_the_solver_already_lost_is_not_blamed_on_the_law():
@@ -105,8 +114,11 @@ def test_the_normal_adapter_checks_sign_values_and_says_when_a_law_has_no_energy
     N = as_normal_law(law("Tensile"))
     t, dt = N.traction(np.array([0.1, -0.01]))
     assert t[0] == 0.0 and t[1] == pytest.approx(-0.1)
-    with pytest.raises(LawValueError, match=r"^Tensile\.traction returned a tensile traction: t_N = 1 > 0 at "
-                                            r"g_N = -0\.1 \(in contact"):
+    with pytest.raises(
+        LawValueError,
+        match=r"^Tensile\.traction returned a tensile traction: t_N = 1 > 0 at "
+        r"g_N = -0\.1 \(in contact",
+    ):
         N.traction(np.array([-0.01, -0.1]))
     assert not N.has_energy and not hasattr(N, "energy")
     with pytest.raises(AttributeError, match="Tensile has no method energy"):
@@ -135,6 +147,7 @@ def test_shipped_laws_are_called_directly_and_give_the_same_numbers():
 
 # ---- the scenes: a lying law stops the run, one line, nothing written ----------------------
 
+
 @pytest.mark.parametrize("scene", SCENES)
 @pytest.mark.parametrize("check", [True, False], ids=["checked", "no-check"])
 @pytest.mark.parametrize("which", ["NaNEverywhere", "NaNAbove", "NegativeAbove"])
@@ -160,8 +173,11 @@ def test_a_law_the_run_meets_stops_it_where_it_returns(scene, capsys, tmp_path):
     sets = ["--set", f"law.lo={lo}", "--set", f"law.hi={hi}"]
     rc, err, _ = cli(capsys, "run", scene, "--friction", f"{LAWS}:NaNWindow", *sets, "--no-check", "--json", str(out))
     assert rc == 1
-    _one_line(err, r"^contactfem: law failed: NaNWindow\.slip_bound returned NaN or inf: Y = nan at p = ([0-9.e+-]+), "
-                   r"q = [0-9.e+-]+$")
+    _one_line(
+        err,
+        r"^contactfem: law failed: NaNWindow\.slip_bound returned NaN or inf: Y = nan at p = ([0-9.e+-]+), "
+        r"q = [0-9.e+-]+$",
+    )
     p = float(re.search(r"at p = ([0-9.e+-]+)", err[0]).group(1))
     assert lo < p < hi
     rc, err, _ = cli(capsys, "run", scene, "--friction", f"{LAWS}:NaNWindow", *sets, "--json", str(out))
@@ -179,8 +195,9 @@ def test_a_law_the_run_meets_stops_it_where_it_returns(scene, capsys, tmp_path):
 @pytest.mark.parametrize("c_T", ["-1", "0", "nan"])
 def test_a_stick_stiffness_out_of_range_is_refused(scene, c_T, capsys, tmp_path):
     out = tmp_path / "r.json"
-    rc, err, _ = cli(capsys, "run", scene, "--friction", f"{LAWS}:OwnFields", "--set", f"law.c_T={c_T}",
-                     "--json", str(out))
+    rc, err, _ = cli(
+        capsys, "run", scene, "--friction", f"{LAWS}:OwnFields", "--set", f"law.c_T={c_T}", "--json", str(out)
+    )
     assert rc == 2 and not out.exists()
     _one_line(err, rf"^contactfem: error: .*OwnFields\.c_T = {c_T} is out of range")
     for check in (True, False):
@@ -197,19 +214,25 @@ def test_a_tensile_normal_law_is_refused_before_and_stopped_during_the_run(capsy
     _one_line(err, r"^contactfem: error: normal law Tensile\.traction returned a tensile traction: t_N = ")
     rc, err, _ = cli(capsys, "run", "block", "--normal", f"{LAWS}:Tensile", *sets, "--no-check")
     assert rc == 1
-    _one_line(err, r"^contactfem: law failed: Tensile\.traction returned a tensile traction: t_N = [0-9.e+-]+ > 0 at "
-                   r"g_N = -[0-9.e+-]+ ")
+    _one_line(
+        err,
+        r"^contactfem: law failed: Tensile\.traction returned a tensile traction: t_N = [0-9.e+-]+ > 0 at "
+        r"g_N = -[0-9.e+-]+ ",
+    )
 
 
 def test_a_block_its_friction_law_cannot_hold_is_refused_before_any_solve(capsys):
     rc, err, _ = cli(capsys, "run", "block", "--friction", f"{LAWS}:OwnFields", "--set", "law.mu=0.1")
     assert rc == 2
-    _one_line(err, r"no static equilibrium: the tangential load 195 exceeds the largest friction force 80 the "
-                   r"friction law OwnFields can carry")
+    _one_line(
+        err,
+        r"no static equilibrium: the tangential load 195 exceeds the largest friction force 80 the "
+        r"friction law OwnFields can carry",
+    )
     with pytest.raises(LawError, match="no static equilibrium"):
         run_scene("block", "fast", friction=law("OwnFields", mu=0.1))
     rc, err, _ = cli(capsys, "run", "block", "--friction", f"{LAWS}:OwnFields", "--set", "law.mu=0.25")
-    assert rc == 0, err                         # 0.25 x 800 = 200 > 195: held
+    assert rc == 0, err  # 0.25 x 800 = 200 > 195: held
 
 
 def test_a_wrong_derivative_is_a_warning_line_not_a_refusal(capsys):
@@ -218,29 +241,42 @@ def test_a_wrong_derivative_is_a_warning_line_not_a_refusal(capsys):
     wrong = DATA / "wrong_derivative.py"
     rc, err, out = cli(capsys, "run", "block", "--friction", f"{wrong}:WrongSlope")
     assert rc == 0
-    assert len(err) == 1 and err[0].startswith("contactfem: warning: friction law WrongSlope: dY/dp does not match "
-                                               "finite differences"), err
+    assert len(err) == 1 and err[0].startswith(
+        "contactfem: warning: friction law WrongSlope: dY/dp does not match finite differences"
+    ), err
     with pytest.warns(UserWarning, match="dY/dp does not match finite differences"):
         run_scene("block", "fast", friction=load_class(f"{wrong}:WrongSlope")())
 
 
 # ---- explicit fields: the law's own defaults, CLI = Python --------------------------------
 
+
 def test_a_laws_own_fields_keep_their_defaults_and_cli_equals_python(capsys, tmp_path):
     """OwnFields has fields m and delta, as the scene has parameters m (the normal law's
     exponent) and delta (Newmark's): they keep the law's own defaults. The command line and
     run_scene with the same law give the same JSON."""
     out = tmp_path / "r.json"
-    rc, err, _ = cli(capsys, "run", "rolling_ring", "--friction", f"{LAWS}:OwnFields", "--set", "t_end=0.3",
-                     "--set", "law.delta=0.05", "--json", str(out))
+    rc, err, _ = cli(
+        capsys,
+        "run",
+        "rolling_ring",
+        "--friction",
+        f"{LAWS}:OwnFields",
+        "--set",
+        "t_end=0.3",
+        "--set",
+        "law.delta=0.05",
+        "--json",
+        str(out),
+    )
     assert rc == 0 and err == [], err
     a = json.loads(out.read_text())
     assert a["friction_law"]["fields"] == {"c_T": 10.0, "mu": 0.2, "m": 0.5, "delta": 0.05}
-    assert a["parameters"]["m"] == 1.0 and a["parameters"]["delta"] == 0.7        # the scene's own, untouched
+    assert a["parameters"]["m"] == 1.0 and a["parameters"]["delta"] == 0.7  # the scene's own, untouched
     b = run_scene("rolling_ring", "fast", {"t_end": 0.3}, friction=law("OwnFields", delta=0.05))
     a.pop("wall_time_s")
     b.pop("wall_time_s")
-    assert a.pop("import_time_s") >= 0 and "import_time_s" not in b     # the process's: command line only
+    assert a.pop("import_time_s") >= 0 and "import_time_s" not in b  # the process's: command line only
     assert a == json.loads(json.dumps(b))
 
 
@@ -248,19 +284,30 @@ def test_a_field_without_default_takes_the_scenes_parameter_and_says_so(capsys, 
     out = tmp_path / "r.json"
     rc, err, _ = cli(capsys, "run", "block", "--friction", f"{DATA / 'coulomb_law.py'}:MyCoulomb", "--json", str(out))
     assert rc == 0
-    assert err == ["contactfem: note: friction law MyCoulomb: c_T = 10000, mu = 0.3 from the scene's parameters "
-                   "(fields without a default; --set law.NAME=VALUE sets them)"]
+    assert err == [
+        "contactfem: note: friction law MyCoulomb: c_T = 10000, mu = 0.3 from the scene's parameters "
+        "(fields without a default; --set law.NAME=VALUE sets them)"
+    ]
     assert json.loads(out.read_text())["friction_law"]["fields"] == {"c_T": 1e4, "mu": 0.3}
 
 
-@pytest.mark.parametrize("args,pattern", [
-    (("--set", "mu=0.4"), r"parameter mu builds the scene's friction law, which the friction law OwnFields replaces: "
-                          r"set OwnFields's own field instead: --set law\.mu=0\.4"),
-    (("--set", "c_T=10"), r"parameter c_T builds .* --set law\.c_T=10"),
-    (("--set", "alpha=0.1"), r"OwnFields has no field alpha \(its fields: c_T, mu, m, delta\)"),
-    (("--set", "law=coulomb"), r"parameter law = coulomb chooses the scene's friction law, which the friction law "
-                               r"OwnFields replaces: leave law out"),
-])
+@pytest.mark.parametrize(
+    "args,pattern",
+    [
+        (
+            ("--set", "mu=0.4"),
+            r"parameter mu builds the scene's friction law, which the friction law OwnFields replaces: "
+            r"set OwnFields's own field instead: --set law\.mu=0\.4",
+        ),
+        (("--set", "c_T=10"), r"parameter c_T builds .* --set law\.c_T=10"),
+        (("--set", "alpha=0.1"), r"OwnFields has no field alpha \(its fields: c_T, mu, m, delta\)"),
+        (
+            ("--set", "law=coulomb"),
+            r"parameter law = coulomb chooses the scene's friction law, which the friction law "
+            r"OwnFields replaces: leave law out",
+        ),
+    ],
+)
 def test_scene_parameters_a_law_replaces_are_refused_with_a_hint(args, pattern, capsys):
     rc, err, _ = cli(capsys, "run", "block", "--friction", f"{LAWS}:OwnFields", *args)
     assert rc == 2
@@ -271,39 +318,64 @@ def test_scene_parameters_a_law_replaces_are_refused_with_a_hint(args, pattern, 
 def test_a_friction_law_on_a_frictionless_scene_is_refused(scene, capsys):
     rc, err, _ = cli(capsys, "run", scene, "--friction", f"{LAWS}:OwnFields")
     assert rc == 2
-    _one_line(err, rf"^contactfem: error: scene {scene} has no friction law .*; scenes with a friction law: block, "
-                   r"cork, funnel, rolling_ring, sloping_impact$")
+    _one_line(
+        err,
+        rf"^contactfem: error: scene {scene} has no friction law .*; scenes with a friction law: block, "
+        r"cork, funnel, rolling_ring, sloping_impact$",
+    )
     with pytest.raises(ValueError, match=f"scene {scene} has no friction law"):
         run_scene(scene, "fast", friction=law("OwnFields"))
 
 
 def test_the_variant_is_the_users_law(capsys, tmp_path):
     out = tmp_path / "r.json"
-    rc, err, _ = cli(capsys, "run", "sloping_impact", "--friction", f"{LAWS}:OwnFields", "--set", "n_steps=30",
-                     "--json", str(out))
+    rc, err, _ = cli(
+        capsys, "run", "sloping_impact", "--friction", f"{LAWS}:OwnFields", "--set", "n_steps=30", "--json", str(out)
+    )
     assert rc == 0, err
     res = json.loads(out.read_text())
     assert res["variant"] == "OwnFields" and "variant" not in res["parameters"]
-    assert get_scene("sloping_impact").variant_of({"variant": "viscoplastic"}, law("OwnFields")) == \
-        "viscoplastic with OwnFields"
+    assert (
+        get_scene("sloping_impact").variant_of({"variant": "viscoplastic"}, law("OwnFields"))
+        == "viscoplastic with OwnFields"
+    )
 
 
-@pytest.mark.parametrize("spec,kind,cls", [("stribeck", "friction", "Stribeck"), ("DieterichRuina", "friction",
-                                           "DieterichRuina"), ("archard_wear", "friction", "ArchardWear"),
-                                           ("contactfem.laws:Coulomb", "friction", "Coulomb"),
-                                           ("contactfem.laws.PowerLaw", "normal", "PowerLaw"),
-                                           ("exponential_law", "normal", "ExponentialLaw")])
+@pytest.mark.parametrize(
+    "spec,kind,cls",
+    [
+        ("stribeck", "friction", "Stribeck"),
+        ("DieterichRuina", "friction", "DieterichRuina"),
+        ("archard_wear", "friction", "ArchardWear"),
+        ("contactfem.laws:Coulomb", "friction", "Coulomb"),
+        ("contactfem.laws.PowerLaw", "normal", "PowerLaw"),
+        ("exponential_law", "normal", "ExponentialLaw"),
+    ],
+)
 def test_shipped_laws_and_module_paths_are_named_on_the_command_line(spec, kind, cls):
     assert load_class(spec, f"--{kind}").__name__ == cls
 
 
 def test_a_shipped_law_runs_from_the_command_line_with_its_own_defaults(capsys, tmp_path):
     out = tmp_path / "r.json"
-    rc, err, _ = cli(capsys, "run", "block", "--friction", "stribeck", "--set", "law.mu_s=0.5", "--set", "law.mu_d=0.4",
-                     "--set", "law.v_s=0.1", "--json", str(out))
+    rc, err, _ = cli(
+        capsys,
+        "run",
+        "block",
+        "--friction",
+        "stribeck",
+        "--set",
+        "law.mu_s=0.5",
+        "--set",
+        "law.mu_d=0.4",
+        "--set",
+        "law.v_s=0.1",
+        "--json",
+        str(out),
+    )
     assert rc == 0, err
     fields = json.loads(out.read_text())["friction_law"]["fields"]
-    assert fields["delta"] == 2.0 and fields["mu_v"] == 0.0 and fields["c_T"] == 1e4      # delta: its own, not Newmark's
+    assert fields["delta"] == 2.0 and fields["mu_v"] == 0.0 and fields["c_T"] == 1e4  # delta: its own, not Newmark's
     rc, err, _ = cli(capsys, "run", "block", "--friction", "power_law")
     _one_line(err, r"--friction power_law: PowerLaw is a normal law \(it has traction\): give it with --normal")
     rc, err, _ = cli(capsys, "run", "block", "--friction", "nosuch")
@@ -311,6 +383,7 @@ def test_a_shipped_law_runs_from_the_command_line_with_its_own_defaults(capsys, 
 
 
 # ---- check_law's range ----------------------------------------------------------------------
+
 
 def test_check_law_reaches_the_pressures_a_scene_meets():
     """A law NaN only above p = 50: the default range reaches it (1e4 scale), and so does a
@@ -343,8 +416,11 @@ def test_check_laws_keywords_are_documented_in_its_docstring_and_the_readme():
 
 def test_the_readmes_example_of_a_lying_law_is_what_the_command_line_says(capsys):
     readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
-    block = re.search(r"\n\$ contactfem run block --friction tests/data/lying_laws.py:NaNAbove\n(.*?)\n```", readme,
-                      re.S).group(1).splitlines()
+    block = (
+        re.search(r"\n\$ contactfem run block --friction tests/data/lying_laws.py:NaNAbove\n(.*?)\n```", readme, re.S)
+        .group(1)
+        .splitlines()
+    )
     shown = {}
     cmd = ["run", "block", "--friction", "tests/data/lying_laws.py:NaNAbove"]
     shown[tuple(cmd)] = block[0]

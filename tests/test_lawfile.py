@@ -22,10 +22,15 @@ def test_load_and_set_fields():
 
 
 def test_fields_default_to_the_scene_parameters_of_the_same_name():
-    law = laws_from_options(friction=f"{DATA / 'coulomb_law.py'}:MyCoulomb", scene_params={"c_T": 7.0, "mu": 0.15})["friction"]
+    law = laws_from_options(friction=f"{DATA / 'coulomb_law.py'}:MyCoulomb", scene_params={"c_T": 7.0, "mu": 0.15})[
+        "friction"
+    ]
     assert (law.c_T, law.mu) == (7.0, 0.15)
-    law = laws_from_options(friction=f"{DATA / 'coulomb_law.py'}:MyCoulomb", scene_params={"c_T": 7.0, "mu": 0.15},
-                            law_sets=split_sets({"law.mu": "0.3"})[1])["friction"]
+    law = laws_from_options(
+        friction=f"{DATA / 'coulomb_law.py'}:MyCoulomb",
+        scene_params={"c_T": 7.0, "mu": 0.15},
+        law_sets=split_sets({"law.mu": "0.3"})[1],
+    )["friction"]
     assert law.mu == 0.3
 
 
@@ -34,17 +39,24 @@ def test_split_sets():
     assert scene == {"mu": "0.3"} and laws == {"law": {"mu0": "1"}, "friction": {"c_T": "3"}, "normal": {"c_N": "2"}}
 
 
-@pytest.mark.parametrize("spec,sets,pattern", [
-    ("saturating.py", {}, r"--friction expects FILE.py:CLASS"),
-    ("nowhere.py:X", {}, r"law file .*nowhere.py not found"),
-    ("saturating.py:Nope", {}, r"law file saturating.py has no class Nope \(it defines: Saturating\)"),
-    ("broken_syntax.py:Broken", {}, r"^law file broken_syntax.py, line 8: SyntaxError"),
-    ("math_law.py:MathTanh", {}, r"^law file math_law.py, line 11: .*np.tanh, not math.tanh"),
-    ("saturating.py:Saturating", {"law.mu0": "-1"}, r"parameter mu0 = -1.0 is out of range: allowed \[0, inf\)"),
-    ("saturating.py:Saturating", {"law.mu0": "abc"}, r"law parameter mu0 must be a number, got 'abc'"),
-    ("saturating.py:Saturating", {"law.nu": "1"}, r"unknown law parameter law.nu for Saturating: known are c_T, mu0, p0"),
-    ("coulomb_law.py:MyCoulomb", {}, r"law parameter c_T of MyCoulomb has no default .*--set law.c_T=VALUE"),
-])
+@pytest.mark.parametrize(
+    "spec,sets,pattern",
+    [
+        ("saturating.py", {}, r"--friction expects FILE.py:CLASS"),
+        ("nowhere.py:X", {}, r"law file .*nowhere.py not found"),
+        ("saturating.py:Nope", {}, r"law file saturating.py has no class Nope \(it defines: Saturating\)"),
+        ("broken_syntax.py:Broken", {}, r"^law file broken_syntax.py, line 8: SyntaxError"),
+        ("math_law.py:MathTanh", {}, r"^law file math_law.py, line 11: .*np.tanh, not math.tanh"),
+        ("saturating.py:Saturating", {"law.mu0": "-1"}, r"parameter mu0 = -1.0 is out of range: allowed \[0, inf\)"),
+        ("saturating.py:Saturating", {"law.mu0": "abc"}, r"law parameter mu0 must be a number, got 'abc'"),
+        (
+            "saturating.py:Saturating",
+            {"law.nu": "1"},
+            r"unknown law parameter law.nu for Saturating: known are c_T, mu0, p0",
+        ),
+        ("coulomb_law.py:MyCoulomb", {}, r"law parameter c_T of MyCoulomb has no default .*--set law.c_T=VALUE"),
+    ],
+)
 def test_errors_are_one_line(spec, sets, pattern):
     with pytest.raises(ValueError, match=pattern) as err:
         laws_from_options(friction=str(DATA / spec), law_sets=split_sets(sets)[1])
@@ -60,16 +72,23 @@ def test_law_sets_need_a_law_file():
 
 def test_runtime_error_in_a_law_names_the_file_and_line(tmp_path):
     f = tmp_path / "bad.py"
-    f.write_text("from dataclasses import dataclass\n\n\n@dataclass(frozen=True)\nclass Bad:\n    c_T: float = 1.0\n\n"
-                 "    def slip_bound(self, p, q):\n        return p / undefined_name\n")
-    with pytest.raises(ValueError, match=r"^law file bad.py, line 9: Bad.slip_bound raised NameError: name 'undefined_name' is not defined"):
+    f.write_text(
+        "from dataclasses import dataclass\n\n\n@dataclass(frozen=True)\nclass Bad:\n    c_T: float = 1.0\n\n"
+        "    def slip_bound(self, p, q):\n        return p / undefined_name\n"
+    )
+    with pytest.raises(
+        ValueError,
+        match=r"^law file bad.py, line 9: Bad.slip_bound raised NameError: name 'undefined_name' is not defined",
+    ):
         make_law(load_class(f"{f}:Bad"))
 
 
 def test_a_normal_law_from_a_file(tmp_path):
     f = tmp_path / "normal.py"
-    f.write_text("from dataclasses import dataclass\nimport numpy as np\n\n\n@dataclass(frozen=True)\nclass Lin:\n"
-                 "    c_N: float = 10.0\n\n    def traction(self, g):\n        g = np.asarray(g, float)\n"
-                 "        return np.where(g < 0, self.c_N * g, 0.0), np.where(g < 0, self.c_N, 0.0)\n")
+    f.write_text(
+        "from dataclasses import dataclass\nimport numpy as np\n\n\n@dataclass(frozen=True)\nclass Lin:\n"
+        "    c_N: float = 10.0\n\n    def traction(self, g):\n        g = np.asarray(g, float)\n"
+        "        return np.where(g < 0, self.c_N * g, 0.0), np.where(g < 0, self.c_N, 0.0)\n"
+    )
     laws = laws_from_options(normal=f"{f}:Lin", friction=SAT, law_sets=split_sets({"law.c_N": "3"})[1])
     assert laws["normal"].c_N == 3.0 and laws["friction"].mu0 == 0.3

@@ -11,10 +11,16 @@ from contactfem.laws import SLIP, STICK, return_map
 from contactfem.contact.kinematics import segment_geometry
 from contactfem.laws import Coulomb, ExponentialLaw, ParabolicSlip, PowerLaw, SlipHardening
 
-SHIPPED = [Coulomb(c_T=30.0, mu=0.3), ParabolicSlip(c_T=30.0, alpha=0.2, beta=0.3, n=0.5),
-           ParabolicSlip(c_T=1e4, alpha=0.2, beta=0.3, n=0.8), SlipHardening(c_T=10.0, mu=0.1, h=0.001),
-           SlipHardening(c_T=30.0, mu=0.4, h=-0.3), PowerLaw(c_N=1e3), PowerLaw(c_N=5.0, m=3.3),
-           ExponentialLaw(a=2.0, b=3.0)]
+SHIPPED = [
+    Coulomb(c_T=30.0, mu=0.3),
+    ParabolicSlip(c_T=30.0, alpha=0.2, beta=0.3, n=0.5),
+    ParabolicSlip(c_T=1e4, alpha=0.2, beta=0.3, n=0.8),
+    SlipHardening(c_T=10.0, mu=0.1, h=0.001),
+    SlipHardening(c_T=30.0, mu=0.4, h=-0.3),
+    PowerLaw(c_N=1e3),
+    PowerLaw(c_N=5.0, m=3.3),
+    ExponentialLaw(a=2.0, b=3.0),
+]
 
 
 @pytest.mark.parametrize("law", SHIPPED, ids=repr)
@@ -24,7 +30,7 @@ def test_every_shipped_law_passes_the_checker(law):
 
 
 def random_states(rng, n=400):
-    g_N = -10 ** rng.uniform(-6, 0, n)
+    g_N = -(10 ** rng.uniform(-6, 0, n))
     t_bar = rng.uniform(-0.3, 0.3, n)
     dg = rng.standard_normal(n) * 10 ** rng.uniform(-8, 0, n)
     q_bar = rng.uniform(0, 2, n)
@@ -43,8 +49,8 @@ def test_return_map_lands_on_slip_surface_and_dissipates(rng, law):
     f = np.abs(fr.t_T) - Y
     slip, stick = fr.state == SLIP, fr.state == STICK
     assert slip.sum() > 20 and stick.sum() > 20
-    assert np.max(np.abs(f[slip])) < 1e-10 * max(1.0, Y.max())       # on the surface
-    assert np.all(f[stick] <= 1e-12)                                  # inside when sticking
+    assert np.max(np.abs(f[slip])) < 1e-10 * max(1.0, Y.max())  # on the surface
+    assert np.all(f[stick] <= 1e-12)  # inside when sticking
     assert np.all(fr.dissipation >= 0.0) and np.all(fr.lam[slip] > 0)
     assert np.all(fr.lam[stick] == 0)
 
@@ -75,14 +81,17 @@ def test_first_touch_with_n_below_one_stays_finite():
 
 
 BAD = [
-    (lambda: PowerLaw(c_N=-1.0), "c_N"), (lambda: PowerLaw(c_N=1.0, m=0.5), "m"),
+    (lambda: PowerLaw(c_N=-1.0), "c_N"),
+    (lambda: PowerLaw(c_N=1.0, m=0.5), "m"),
     (lambda: ParabolicSlip(c_T=1.0, alpha=0.2, beta=0.3, n=0.0), "n"),
     (lambda: ParabolicSlip(c_T=1.0, alpha=0.2, beta=0.3, n=1.5), "n"),
     (lambda: ParabolicSlip(c_T=1.0, alpha=-0.2, beta=0.3), "alpha"),
     (lambda: ParabolicSlip(c_T=1.0, alpha=0.2, beta=-0.3), "beta"),
     (lambda: ParabolicSlip(c_T=-1.0, alpha=0.2, beta=0.3), "c_T"),
-    (lambda: Coulomb(c_T=1.0, mu=-0.1), "mu"), (lambda: Coulomb(c_T=1.0, mu=float("nan")), "mu"),
-    (lambda: ExponentialLaw(a=0.0, b=1.0), "a"), (lambda: SlipHardening(c_T=1.0, mu=0.1, h=float("inf")), "h"),
+    (lambda: Coulomb(c_T=1.0, mu=-0.1), "mu"),
+    (lambda: Coulomb(c_T=1.0, mu=float("nan")), "mu"),
+    (lambda: ExponentialLaw(a=0.0, b=1.0), "a"),
+    (lambda: SlipHardening(c_T=1.0, mu=0.1, h=float("inf")), "h"),
 ]
 
 
@@ -102,6 +111,7 @@ def test_checker_catches_a_wrong_derivative():
     @dataclass(frozen=True)
     class WrongQuadratic:
         """mu grows with pressure, but dY/dp forgets the factor 2."""
+
         c_T: float = 30.0
 
         def slip_bound(self, p, q):
@@ -116,6 +126,7 @@ def test_checker_accepts_a_student_law():
     @dataclass(frozen=True)
     class Tanh:
         """A friction coefficient saturating with pressure."""
+
         c_T: float = 30.0
         mu: float = 0.4
         p0: float = 1.0

@@ -14,6 +14,7 @@ values, parameter sweeps, and the command line's law files. Only the command lin
 the lab; the library imports nothing of it. The package's ``__init__`` is its public face
 and is exempt.
 """
+
 import ast
 from pathlib import Path
 
@@ -21,8 +22,17 @@ import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / "contactfem"
 
-ORDER = [("clock",), ("laws",), ("contact",), ("bodies",), ("solver",), ("scenes",),
-         ("plots", "io", "equations"), ("lab",), ("cli", "__main__")]
+ORDER = [
+    ("clock",),
+    ("laws",),
+    ("contact",),
+    ("bodies",),
+    ("solver",),
+    ("scenes",),
+    ("plots", "io", "equations"),
+    ("lab",),
+    ("cli", "__main__"),
+]
 LIBRARY = ("clock", "laws", "contact", "bodies", "solver", "scenes", "plots", "io", "equations")
 LAYER = {name: level for level, names in enumerate(ORDER) for name in names}
 
@@ -40,7 +50,7 @@ def unit(path):
 def imported_units(path, root=PACKAGE):
     """(line, unit) of every contactfem module that the file imports, anywhere in it."""
     rel = path.relative_to(root)
-    package = ["contactfem", *rel.parts[:-1]]          # the file's package, for relative imports
+    package = ["contactfem", *rel.parts[:-1]]  # the file's package, for relative imports
     tree = ast.parse(path.read_text(), filename=str(path))
     found = []
     for node in ast.walk(tree):
@@ -72,12 +82,17 @@ def test_every_module_has_a_layer():
 def test_no_import_from_a_higher_layer(path):
     own = unit(path)
     if own == "__init__":
-        return                                         # the package's public face
-    back = [f"{path.relative_to(PACKAGE)}:{line} imports contactfem.{target} "
-            f"(layer {LAYER[target]}) from layer {LAYER[own]} ({own})"
-            for line, target in imported_units(path)
-            if target in LAYER and LAYER[target] > LAYER[own]]
-    assert not back, "back edges against clock < laws < contact < bodies < solver < scenes < plots/io/equations < lab < cli:\n" + "\n".join(back)
+        return  # the package's public face
+    back = [
+        f"{path.relative_to(PACKAGE)}:{line} imports contactfem.{target} "
+        f"(layer {LAYER[target]}) from layer {LAYER[own]} ({own})"
+        for line, target in imported_units(path)
+        if target in LAYER and LAYER[target] > LAYER[own]
+    ]
+    assert not back, (
+        "back edges against clock < laws < contact < bodies < solver < scenes < plots/io/equations < lab < cli:\n"
+        + "\n".join(back)
+    )
 
 
 def test_the_walk_finds_a_back_edge(tmp_path):
@@ -85,14 +100,21 @@ def test_the_walk_finds_a_back_edge(tmp_path):
     relative imports resolve against the file's package."""
     src = tmp_path / "contactfem" / "solver" / "bad.py"
     src.parent.mkdir(parents=True)
-    src.write_text("from .newton import newton\nfrom .. import laws\n\n"
-                   "def f():\n    from ..scenes import block\n    return block\n")
+    src.write_text(
+        "from .newton import newton\nfrom .. import laws\n\n"
+        "def f():\n    from ..scenes import block\n    return block\n"
+    )
     assert imported_units(src, tmp_path / "contactfem") == [(1, "solver"), (2, "laws"), (5, "scenes")]
 
 
 def test_the_library_imports_nothing_of_the_lab():
     """The physics library stands alone: no module of it imports the lab (site, bench,
     reconstruct, sweep, law files), lazily or not."""
-    lab = [f"{p.relative_to(PACKAGE)}:{line}" for p in modules() if unit(p) in LIBRARY
-           for line, target in imported_units(p) if target == "lab"]
+    lab = [
+        f"{p.relative_to(PACKAGE)}:{line}"
+        for p in modules()
+        if unit(p) in LIBRARY
+        for line, target in imported_units(p)
+        if target == "lab"
+    ]
     assert not lab, "the library imports the lab:\n" + "\n".join(lab)

@@ -31,7 +31,7 @@ ON_CI = os.environ.get("CI", "").lower() in ("true", "1", "yes")
 REPO = Path(__file__).resolve().parents[1]
 LECTURES = sorted((REPO / "lectures").glob("*.ipynb"))
 TEXTS = sorted(p for p in (REPO / "lectures").glob("*.md") if p.name != "README.md")
-CELL_TIMEOUT = 300        # seconds per cell
+CELL_TIMEOUT = 300  # seconds per cell
 MAX_STORED_OUTPUT = 2000  # characters of stored output allowed per notebook ("small ones")
 
 
@@ -41,23 +41,31 @@ def require(module):
         try:
             return __import__(module)
         except ImportError as err:
-            pytest.fail(f"CI=true but the notebook dependency {module!r} is missing ({err}): "
-                        "install '.[all]'", pytrace=False)
+            pytest.fail(
+                f"CI=true but the notebook dependency {module!r} is missing ({err}): install '.[all]'", pytrace=False
+            )
     return pytest.importorskip(module)
 
 
 def _stored_output_size(nb):
-    return sum(len(json.dumps(c.get("outputs", []))) for c in nb["cells"] if c["cell_type"] == "code"
-               if c.get("outputs"))
+    return sum(
+        len(json.dumps(c.get("outputs", []))) for c in nb["cells"] if c["cell_type"] == "code" if c.get("outputs")
+    )
 
 
 @pytest.fixture
 def kernel_env(tmp_path, monkeypatch):
     spec = tmp_path / "jupyter" / "kernels" / "python3"
     spec.mkdir(parents=True)
-    (spec / "kernel.json").write_text(json.dumps({
-        "argv": [sys.executable, "-m", "ipykernel_launcher", "-f", "{connection_file}"],
-        "display_name": "Python 3 (contactfem tests)", "language": "python"}))
+    (spec / "kernel.json").write_text(
+        json.dumps(
+            {
+                "argv": [sys.executable, "-m", "ipykernel_launcher", "-f", "{connection_file}"],
+                "display_name": "Python 3 (contactfem tests)",
+                "language": "python",
+            }
+        )
+    )
     monkeypatch.setenv("JUPYTER_PATH", str(tmp_path / "jupyter"))
     monkeypatch.setenv("PYTHONPATH", os.pathsep.join([str(REPO)] + [p for p in [os.environ.get("PYTHONPATH")] if p]))
     monkeypatch.setenv("CONTACTFEM_PRESET", "fast")
@@ -96,13 +104,19 @@ def test_notebook_and_text_agree(path):
     for i, (a, b) in enumerate(zip(nb, md)):
         if a != b:
             what = "kind" if a[0] != b[0] else "source" if a[1] != b[1] else "metadata"
-            first = next((f"line {k + 1}: {x!r} in the notebook, {y!r} in the text"
-                          for k, (x, y) in enumerate(zip(a[1].splitlines() + [""], b[1].splitlines() + [""]))
-                          if x != y), "")
-            pytest.fail(f"{path.name} and {text.name} differ in cell {i + 1} ({what}) {first}: "
-                        f"edit one, then `{sync}`", pytrace=False)
-    assert len(nb) == len(md), (f"{path.name} has {len(nb)} cells, {text.name} {len(md)}: "
-                                f"edit one, then `{sync}`")
+            first = next(
+                (
+                    f"line {k + 1}: {x!r} in the notebook, {y!r} in the text"
+                    for k, (x, y) in enumerate(zip(a[1].splitlines() + [""], b[1].splitlines() + [""]))
+                    if x != y
+                ),
+                "",
+            )
+            pytest.fail(
+                f"{path.name} and {text.name} differ in cell {i + 1} ({what}) {first}: edit one, then `{sync}`",
+                pytrace=False,
+            )
+    assert len(nb) == len(md), f"{path.name} has {len(nb)} cells, {text.name} {len(md)}: edit one, then `{sync}`"
 
 
 def test_every_text_has_its_notebook():
@@ -119,8 +133,9 @@ def test_lecture_runs(path, kernel_env):
     work = kernel_env / "lectures"
     shutil.copytree(REPO / "lectures", work)
     nb = nbformat.read(work / path.name, as_version=4)
-    client = nbclient.NotebookClient(nb, timeout=CELL_TIMEOUT, kernel_name="python3",
-                                     resources={"metadata": {"path": str(work)}})
+    client = nbclient.NotebookClient(
+        nb, timeout=CELL_TIMEOUT, kernel_name="python3", resources={"metadata": {"path": str(work)}}
+    )
     try:
         client.execute()
     except nbclient.exceptions.CellExecutionError as err:

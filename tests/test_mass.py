@@ -11,6 +11,7 @@
 * momentum in free flight with either mass and either stepper;
 * the same run dense, banded and sparse; the ring scenes' parameter.
 """
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -27,8 +28,9 @@ def rect_continuum(mass_matrix="consistent", nx=6, ny=3, a=3.0, b=1.5, material=
     from contactfem.bodies.continuum import Continuum
 
     mesh = MeshQuad.init_tensor(np.linspace(0, a, nx + 1), np.linspace(0, b, ny + 1))
-    return Continuum(mesh, E=100.0, nu=0.3, rho=rho, kind="plane_strain", material=material,
-                     thickness=0.5, mass_matrix=mass_matrix)
+    return Continuum(
+        mesh, E=100.0, nu=0.3, rho=rho, kind="plane_strain", material=material, thickness=0.5, mass_matrix=mass_matrix
+    )
 
 
 @pytest.mark.parametrize("rotary", [True, False])
@@ -40,8 +42,8 @@ def test_beam_consistent_mass_is_the_p1_mass_on_the_arc_length(rotary):
     assert sp.issparse(M) and abs(M - M.T).max() == 0.0
     assert np.allclose(np.asarray(M.sum(axis=1)).ravel(), b.mass(), rtol=1e-14, atol=0)
     P1 = asm(BilinearForm(lambda u, v, w: u * v), Basis(MeshLine(b.s), ElementLineP1()))
-    F = sp.csr_matrix((np.ones(len(b.fold)), (np.arange(len(b.fold)), b.fold)))    # mesh node -> beam node
-    scalar = (F.T @ P1 @ F).toarray()                       # the closed ring: node L identified with node 0
+    F = sp.csr_matrix((np.ones(len(b.fold)), (np.arange(len(b.fold)), b.fold)))  # mesh node -> beam node
+    scalar = (F.T @ P1 @ F).toarray()  # the closed ring: node L identified with node 0
     for k, m in enumerate((b.A, b.A, b.I if rotary else 0.0)):
         assert np.allclose(M.toarray()[k::3, k::3], b.rho * m * scalar, rtol=1e-13, atol=1e-15)
 
@@ -60,10 +62,10 @@ def test_continuum_consistent_mass_rigid_motions_in_closed_form():
     assert v @ (M @ v) == pytest.approx(mass * 0.25, rel=1e-13) and v @ (m * v) == pytest.approx(mass * 0.25, rel=1e-13)
     r = body.X - [a / 2, b / 2]
     w = np.zeros(body.ndof)
-    w[body.xdofs[:, 0]], w[body.xdofs[:, 1]] = -r[:, 1], r[:, 0]            # omega = 1
+    w[body.xdofs[:, 0]], w[body.xdofs[:, 1]] = -r[:, 1], r[:, 0]  # omega = 1
     exact = rho * t * a * b * (a * a + b * b) / 12
     assert w @ (M @ w) == pytest.approx(exact, rel=1e-13)
-    assert abs(w @ (m * w) / exact - 1) > 1e-3                              # lumping moves mass outwards
+    assert abs(w @ (m * w) / exact - 1) > 1e-3  # lumping moves mass outwards
 
 
 @pytest.mark.parametrize("mass_matrix, omega2", [("consistent", 12.0), ("lumped", 4.0)])
@@ -83,7 +85,7 @@ def test_free_oscillator_follows_the_trapezoidal_closed_form(mass_matrix, omega2
     Omega = 2 * np.arctan(omega * dt / 2) / dt
     stretch = np.array([r.u[3] - r.u[0] for r in hist.records])
     assert np.allclose(stretch, a * np.cos(Omega * hist.t), rtol=0, atol=1e-10 * a)
-    assert np.allclose([r.u[0] + r.u[3] for r in hist.records], 0.0, atol=1e-14)   # no drift of the centre
+    assert np.allclose([r.u[0] + r.u[3] for r in hist.records], 0.0, atol=1e-14)  # no drift of the centre
 
 
 def test_newmark_trapezoidal_conserves_the_energy_with_the_consistent_mass():
@@ -92,12 +94,13 @@ def test_newmark_trapezoidal_conserves_the_energy_with_the_consistent_mass():
     body = rect_continuum("consistent")
     system = System([body])
     v0 = np.random.default_rng(3).normal(size=body.ndof)
-    hist = integrate(Newmark(system, 0.5, 0.25, atol=1e-13, rtol=1e-13), 0.0, np.zeros(body.ndof), v0,
-                     n_steps=30, dt=0.05)
+    hist = integrate(
+        Newmark(system, 0.5, 0.25, atol=1e-13, rtol=1e-13), 0.0, np.zeros(body.ndof), v0, n_steps=30, dt=0.05
+    )
     E = hist.kinetic + hist.strain
     assert hist.kinetic[0] == pytest.approx(0.5 * v0 @ (body.mass(consistent=True) @ v0), rel=1e-14)
     assert np.max(np.abs(E - E[0])) <= 1e-10 * E[0]
-    assert np.max(hist.strain) > 0.1 * E[0]                  # it does vibrate
+    assert np.max(hist.strain) > 0.1 * E[0]  # it does vibrate
 
 
 def test_initial_acceleration_solves_with_the_consistent_mass():
@@ -120,14 +123,18 @@ def test_free_flight_keeps_the_momentum_with_either_mass(stepper, mass_matrix):
     rg = make_ring("beam", R=10.0, thickness=1.0, n_el=16, E=100.0, rho=0.01, mass_matrix=mass_matrix)
     system = System([rg.body])
     v0 = rg.initial_velocity((2.0, -1.0), omega=0.05)
-    v0[rg.body.xdofs[:, 0]] += 0.3 * np.sin(np.arange(16))              # a deformation mode on top
-    step = (Newmark(system, 0.7, 0.4, atol=1e-12, rtol=1e-12) if stepper == "newmark"
-            else EnergyConsistent(system, atol=1e-12, rtol=1e-12))
+    v0[rg.body.xdofs[:, 0]] += 0.3 * np.sin(np.arange(16))  # a deformation mode on top
+    step = (
+        Newmark(system, 0.7, 0.4, atol=1e-12, rtol=1e-12)
+        if stepper == "newmark"
+        else EnergyConsistent(system, atol=1e-12, rtol=1e-12)
+    )
     hist = integrate(step, 0.0, np.zeros(system.ndof), v0, n_steps=30, dt=0.1)
     vc = np.array([rg.velocity_of_mass(r.v) for r in hist.records])
     assert np.max(np.abs(vc - vc[0])) <= 1e-10 * np.hypot(*vc[0])
-    assert rg.angular_velocity(np.zeros(system.ndof), rg.initial_velocity((0.0, 0.0), omega=0.05)) == \
-        pytest.approx(0.05, rel=1e-12)                     # a rigid spin measured exactly with either mass
+    assert rg.angular_velocity(np.zeros(system.ndof), rg.initial_velocity((0.0, 0.0), omega=0.05)) == pytest.approx(
+        0.05, rel=1e-12
+    )  # a rigid spin measured exactly with either mass
 
 
 def test_energy_consistent_conserves_the_energy_with_the_consistent_mass():
@@ -137,8 +144,9 @@ def test_energy_consistent_conserves_the_energy_with_the_consistent_mass():
     system = System([rg.body])
     v0 = rg.initial_velocity((1.0, 0.5))
     v0[rg.body.xdofs[:, 1]] += 0.5 * np.cos(2 * np.arange(16) * 2 * np.pi / 16)
-    hist = integrate(EnergyConsistent(system, atol=1e-12, rtol=1e-12), 0.0, np.zeros(system.ndof), v0,
-                     n_steps=40, dt=0.2)
+    hist = integrate(
+        EnergyConsistent(system, atol=1e-12, rtol=1e-12), 0.0, np.zeros(system.ndof), v0, n_steps=40, dt=0.2
+    )
     E = hist.kinetic + hist.strain
     assert np.max(np.abs(E - E[0])) <= 1e-9 * E[0]
     assert np.max(hist.strain) > 1e-3 * E[0]
@@ -161,9 +169,17 @@ def test_consistent_mass_run_is_the_same_dense_and_sparse(variant):
 # where they vanish): energy changes as fractions of the initial energy E0 (differences of nearly
 # equal numbers), the spin (0 to round-off without friction) against the ring's rigid spin scale
 # |v0| / R = 0.28 (absolutely, to 1e-12 of it).
-ABSOLUTE = dict.fromkeys(("energy_total_max_rel_increase_per_step", "energy_total_max_rel_change_impact",
-                          "energy_error", "energy_error_max", "energy_after_rebound_rel", "energy_total_final_rel"),
-                         1e-12) | {"rebound_spin": 0.28e-12, "outline_spin": 0.28e-12}
+ABSOLUTE = dict.fromkeys(
+    (
+        "energy_total_max_rel_increase_per_step",
+        "energy_total_max_rel_change_impact",
+        "energy_error",
+        "energy_error_max",
+        "energy_after_rebound_rel",
+        "energy_total_final_rel",
+    ),
+    1e-12,
+) | {"rebound_spin": 0.28e-12, "outline_spin": 0.28e-12}
 
 
 def same_run(a, b):
@@ -199,7 +215,8 @@ def test_ring_scenes_take_the_mass_matrix():
         assert get_scene(name).resolve("paper")["mass_matrix"] == "lumped"
     with pytest.raises(ValueError, match="mass_matrix"):
         get_scene("funnel").resolve("fast", {"mass_matrix": "diagonal"})
-    lumped, consistent = (run_scene("sloping_impact", "paper", dict(mass_matrix=m, n_steps=40))
-                          for m in ("lumped", "consistent"))
+    lumped, consistent = (
+        run_scene("sloping_impact", "paper", dict(mass_matrix=m, n_steps=40)) for m in ("lumped", "consistent")
+    )
     assert consistent["mass"] == pytest.approx(lumped["mass"], rel=1e-14)
     assert consistent["rebound_vy"] != lumped["rebound_vy"]

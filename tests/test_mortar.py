@@ -18,8 +18,15 @@ from conftest import PointCloud
 from fd import fd_jacobian, rel_error
 
 from contactfem.contact import BodySurface, RigidArc, RigidLine, RigidPolyline, segment_variations
-from contactfem.contact.mortar import (NormalLawError, Pairs, contact_forces, mortar_integrals, mortar_matrices,
-                                       nodal_gap, weighted_slip)
+from contactfem.contact.mortar import (
+    NormalLawError,
+    Pairs,
+    contact_forces,
+    mortar_integrals,
+    mortar_matrices,
+    nodal_gap,
+    weighted_slip,
+)
 from contactfem.contact.mortar_contact import MortarContact
 from contactfem.contact.segmentation import candidate_pairs, pair_geometry
 from contactfem.laws import OPEN, SLIP, STICK, ArchardWear, Coulomb, ParabolicSlip, PowerLaw
@@ -50,8 +57,9 @@ def make_contact(master_kind, normal=PowerLaw(c_N=50.0), friction=None, short=Fa
         master, ndof = RigidPolyline(Xm), slave.ndof
     else:
         master, ndof = RigidLine(point=(0.3, -0.01), normal=(0.05, 1.0)), slave.ndof
-    return MortarContact(slave, np.arange(len(X_SLAVE)), master, normal=normal, friction=friction,
-                         kinematics=kinematics), ndof
+    return MortarContact(
+        slave, np.arange(len(X_SLAVE)), master, normal=normal, friction=friction, kinematics=kinematics
+    ), ndof
 
 
 def pressed(ndof, rng, depth=0.05):
@@ -91,32 +99,36 @@ def test_tangent_matches_finite_differences(rng, master_kind, regime, short):
     contact, ndof = make_contact(master_kind, friction=friction, short=short)
     u = pressed(ndof, rng)
     h = contact.start(u)
-    u[0:8:2] += 0.002                                       # a converged sticking step: t_T_bar != 0
+    u[0:8:2] += 0.002  # a converged sticking step: t_T_bar != 0
     h = contact.commit(contact.evaluate(u, 0.0, DT, history=h))
-    u[0:8:2] += MOTION.get(regime, 0.02)                    # slide the slave along x
+    u[0:8:2] += MOTION.get(regime, 0.02)  # slide the slave along x
     st = check_tangent(contact, u, h)
     closed = st.g_N < 0
     assert closed.sum() >= 3
     if regime != "frictionless":
         assert np.all(st.state[closed] == (STICK if regime == "stick" else SLIP)), st.state
-    if master_kind != "line":                               # (a line is one master segment)
+    if master_kind != "line":  # (a line is one master segment)
         assert np.any(np.bincount(st.integrals.pairs.slave) >= 2), "no slave segment spans two master segments"
-    if short:                     # the first slave segment lies partly beyond the master end
+    if short:  # the first slave segment lies partly beyond the master end
         half_segment = 0.5 * np.linalg.norm(X_SLAVE[1] - X_SLAVE[0])
         assert 0.0 < st.weights[0] < 0.6 * half_segment
 
 
-@pytest.mark.parametrize("normal, friction", [
-    (PowerLaw(c_N=80.0, m=2.5), ParabolicSlip(c_T=30.0, alpha=0.2, beta=0.3, n=0.5)),
-    (PowerLaw(c_N=50.0), ArchardWear(c_T=30.0, mu=0.3, k_w=0.2)),       # internal variables, worn surface
-], ids=["power2.5-parabolic", "wear"])
+@pytest.mark.parametrize(
+    "normal, friction",
+    [
+        (PowerLaw(c_N=80.0, m=2.5), ParabolicSlip(c_T=30.0, alpha=0.2, beta=0.3, n=0.5)),
+        (PowerLaw(c_N=50.0), ArchardWear(c_T=30.0, mu=0.3, k_w=0.2)),  # internal variables, worn surface
+    ],
+    ids=["power2.5-parabolic", "wear"],
+)
 def test_tangent_other_laws(rng, normal, friction):
     contact, ndof = make_contact("deformable", normal=normal, friction=friction)
     u_bar = pressed(ndof, rng)
     h = contact.start(u_bar)
     u = u_bar.copy()
     u[0:8:2] += 0.05
-    h = contact.commit(contact.evaluate(u, 0.0, DT, history=h))            # one slipping step: wear, t_T_bar, q_bar
+    h = contact.commit(contact.evaluate(u, 0.0, DT, history=h))  # one slipping step: wear, t_T_bar, q_bar
     u[0:8:2] += 0.03
     st = check_tangent(contact, u, h)
     assert np.any(st.state == SLIP)
@@ -129,7 +141,7 @@ def test_segmentation_is_node_to_segment_projection(rng):
     xa, xb, xc, xd = (rng.standard_normal((6, 2)) for _ in range(4))
     geo = pair_geometry(xa, xb, xc, xd)
     for end, x, point_dofs in (("c", xc, [4, 5]), ("d", xd, [6, 7])):
-        ref = segment_variations(x, xa, xb)                 # its dofs: (point, x_a, x_b)
+        ref = segment_variations(x, xa, xb)  # its dofs: (point, x_a, x_b)
         order = point_dofs + [0, 1, 2, 3]
         g, xi = geo["g_" + end], geo["xi_" + end]
         assert np.allclose(g.val, ref["g_N"], rtol=1e-13, atol=1e-14)
@@ -149,7 +161,7 @@ def integrate_reference(xs, xm, s, m, n_gauss=12):
     n = np.array([-t[1], t[0]])
     tm = xd - xc
 
-    def hit(xi):                                            # x_a + xi (x_b - x_a) + g n on c + eta tm
+    def hit(xi):  # x_a + xi (x_b - x_a) + g n on c + eta tm
         A = np.column_stack([n, -tm])
         g, eta = np.linalg.solve(A, xc - (xa + xi * (xb - xa)))
         return g, eta
@@ -190,8 +202,8 @@ def flat_chains(g0=0.0, angle=0.2):
     """Non-matching straight chains on a line tilted by `angle`, the slave at distance g0
     (along the normal) from the master and covering an inner part of it."""
     R = np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
-    s_x = np.array([0.95, 0.71, 0.5, 0.33, 0.12])           # slave, right to left
-    m_x = np.array([-0.1, 0.2, 0.45, 0.6, 0.83, 1.1])       # master, left to right
+    s_x = np.array([0.95, 0.71, 0.5, 0.33, 0.12])  # slave, right to left
+    m_x = np.array([-0.1, 0.2, 0.45, 0.6, 0.83, 1.1])  # master, left to right
     xs = np.column_stack([s_x, np.full_like(s_x, g0)]) @ R.T
     xm = np.column_stack([m_x, np.zeros_like(m_x)]) @ R.T
     return xs, xm, s_x, m_x
@@ -225,10 +237,10 @@ def test_partition_of_unity():
     D, M = mortar_matrices(mi, len(xm))
     D, M = D.toarray(), M.toarray()
     tributary = hat_integrals(s_x, s_x.min(), s_x.max())
-    assert np.allclose(D.sum(axis=1), tributary, rtol=1e-14)        # rows: int N_j
-    assert np.allclose(M.sum(axis=1), D.sum(axis=1), rtol=1e-14)    # sum_l N_l = 1 on a covered slave
+    assert np.allclose(D.sum(axis=1), tributary, rtol=1e-14)  # rows: int N_j
+    assert np.allclose(M.sum(axis=1), D.sum(axis=1), rtol=1e-14)  # sum_l N_l = 1 on a covered slave
     assert np.allclose(mi.w, tributary, rtol=1e-14)
-    assert np.isclose(mi.w.sum(), s_x.max() - s_x.min(), rtol=1e-14)   # the slave's length
+    assert np.isclose(mi.w.sum(), s_x.max() - s_x.min(), rtol=1e-14)  # the slave's length
     assert np.allclose(M.sum(axis=0), hat_integrals(m_x, s_x.min(), s_x.max()), rtol=1e-13, atol=1e-15)
     assert np.allclose(D, D.T) and np.all(np.linalg.eigvalsh(D) > 0)
 
@@ -241,11 +253,11 @@ def test_weighted_gap_of_a_uniform_gap(g0):
     assert covered.all() and np.allclose(g_N, g0, rtol=1e-12)
     # also for partly covered nodes: the slave beyond the end of the master
     xs, xm, _, _ = flat_chains(g0)
-    xm = xm[:-2]                                         # master ends at x = 0.6, inside a slave segment
+    xm = xm[:-2]  # master ends at x = 0.6, inside a slave segment
     s, m = candidate_pairs(xs, xm)
     mi = mortar_integrals(xs, xm, Pairs.of(s, m, len(xs)))
     g_N, covered, _ = nodal_gap(mi)
-    assert not covered.all() and 0 < mi.w[1] < 0.12      # node 0.71 covered only on [0.6, 0.71]
+    assert not covered.all() and 0 < mi.w[1] < 0.12  # node 0.71 covered only on [0.6, 0.71]
     assert np.allclose(g_N[covered], g0, rtol=1e-12)
 
 
@@ -264,8 +276,8 @@ def test_patch_test_consistent_nodal_loads(g0):
     fr = dataclasses.make_dataclass("F", ["t_T", "c_T_s", "c_N_s"])(t_T, np.zeros(ns), np.zeros(ns))
     R, _ = contact_forces(mi, t_N, np.zeros(ns), slip=slip, friction=fr, w_bar=mi.w)
     R = R.reshape(-1, 2)
-    t_s = (xs[1] - xs[0]) / np.linalg.norm(xs[1] - xs[0])        # slave tangent (right to left)
-    n_s = np.array([-t_s[1], t_s[0]])                            # slave normal, towards the master
+    t_s = (xs[1] - xs[0]) / np.linalg.norm(xs[1] - xs[0])  # slave tangent (right to left)
+    n_s = np.array([-t_s[1], t_s[0]])  # slave normal, towards the master
     f_slave = hat_integrals(s_x, s_x.min(), s_x.max())
     f_master = hat_integrals(m_x, s_x.min(), s_x.max())
     # R = dPi/du: the contact force on a body is -R
@@ -304,8 +316,13 @@ def test_slip_is_frame_indifferent_and_exact_for_a_rigid_slide(rng):
     # a flat slave slid rigidly by delta along its tangent: every covered node slips delta
     xs, xm, _, _ = flat_chains(-0.01)
     slave, master = PointCloud(xs), PointCloud(xm, dof_offset=2 * len(xs))
-    contact = MortarContact(slave, np.arange(len(xs)), BodySurface(master, np.arange(len(xm))),
-                            normal=PowerLaw(c_N=50.0), friction=Coulomb(c_T=30.0, mu=0.3))
+    contact = MortarContact(
+        slave,
+        np.arange(len(xs)),
+        BodySurface(master, np.arange(len(xm))),
+        normal=PowerLaw(c_N=50.0),
+        friction=Coulomb(c_T=30.0, mu=0.3),
+    )
     u = np.zeros(2 * (len(xs) + len(xm)))
     h = contact.start(u)
     t_s = (xs[1] - xs[0]) / np.linalg.norm(xs[1] - xs[0])
@@ -324,7 +341,7 @@ def test_evaluate_is_pure_and_commit_takes_the_state(rng):
     assert np.array_equal(a.R, b.R) and np.array_equal(a.vals, b.vals)
     h = contact.commit(a)
     assert h is a.history and np.any(a.history.t_T != 0)
-    c = contact.evaluate(u, 0.0, DT, history=h)                         # nothing moved since the commit: no slip
+    c = contact.evaluate(u, 0.0, DT, history=h)  # nothing moved since the commit: no slip
     assert np.allclose(c.dg_T, 0.0, atol=1e-15) and np.allclose(c.t_T, a.t_T)
 
 
@@ -357,13 +374,14 @@ def test_energy_and_dissipation_of_a_sliding_flat_slave():
     stored energy L (c_N g0^2 / 2 + t_T^2 / (2 c_T)); once slipping at t_T = mu p, a further
     slide delta dissipates mu p delta L (L: the slave's length)."""
     c_N, c_T, mu, g0 = 50.0, 30.0, 0.3, -0.02
-    xs = np.column_stack([np.linspace(1.0, 0.0, 6) ** 1.3, np.full(6, g0)])     # non-uniform, right to left
+    xs = np.column_stack([np.linspace(1.0, 0.0, 6) ** 1.3, np.full(6, g0)])  # non-uniform, right to left
     L = xs[0, 0] - xs[-1, 0]
-    contact = MortarContact(PointCloud(xs), np.arange(6), RigidLine(), normal=PowerLaw(c_N=c_N),
-                            friction=Coulomb(c_T=c_T, mu=mu))
+    contact = MortarContact(
+        PointCloud(xs), np.arange(6), RigidLine(), normal=PowerLaw(c_N=c_N), friction=Coulomb(c_T=c_T, mu=mu)
+    )
     u = np.zeros(12)
     h = contact.start(u)
-    u[0::2] -= 0.1                                           # along the slave tangent (-x): positive slip
+    u[0::2] -= 0.1  # along the slave tangent (-x): positive slip
     st = contact.evaluate(u, 0.0, DT, history=h)
     p = -c_N * g0
     assert np.all(st.state == SLIP) and np.allclose(st.t_T, mu * p, rtol=1e-13)
@@ -375,17 +393,21 @@ def test_energy_and_dissipation_of_a_sliding_flat_slave():
 
 
 def test_search_distance_leaves_far_pairs_out():
-    xs, xm, _, _ = flat_chains(0.5)                          # the slave 0.5 above the master
+    xs, xm, _, _ = flat_chains(0.5)  # the slave 0.5 above the master
     assert len(candidate_pairs(xs, xm)[0]) > 0
     assert len(candidate_pairs(xs, xm, search=0.6)[0]) > 0
     assert len(candidate_pairs(xs, xm, search=0.4)[0]) == 0
-    assert len(candidate_pairs(xs[::-1], xm)[0]) == 0          # reversed slave: its normal faces away
+    assert len(candidate_pairs(xs[::-1], xm)[0]) == 0  # reversed slave: its normal faces away
 
 
 # -- small kinematics (the reference configuration held) --------------------------------
 
-@pytest.mark.parametrize("master_kind, short", [("line", False), ("deformable", False), ("deformable", True)],
-                         ids=["line", "deformable", "deformable-end"])
+
+@pytest.mark.parametrize(
+    "master_kind, short",
+    [("line", False), ("deformable", False), ("deformable", True)],
+    ids=["line", "deformable", "deformable-end"],
+)
 @pytest.mark.parametrize("regime", ["frictionless", "stick", "slip+", "slip-"])
 def test_small_kinematics_tangent(rng, master_kind, regime, short):
     friction = None if regime == "frictionless" else Coulomb(c_T=30.0, mu=0.3)
@@ -407,8 +429,8 @@ def test_small_kinematics_is_affine_and_starts_at_the_reference(rng):
     which vanishes there) they are the finite ones to first order; the weights are the
     reference ones whatever u."""
     hist = {}
-    g = lambda c, u: c.kinematics_at(u, hist[id(c)])["mi"].g             # noqa: E731 (weighted gaps)
-    gT = lambda c, u: c.kinematics_at(u, hist[id(c)])["slip"].g_T        # noqa: E731
+    g = lambda c, u: c.kinematics_at(u, hist[id(c)])["mi"].g  # noqa: E731 (weighted gaps)
+    gT = lambda c, u: c.kinematics_at(u, hist[id(c)])["slip"].g_T  # noqa: E731
     fin, ndof = make_contact("deformable", friction=Coulomb(c_T=30.0, mu=0.3))
     small, _ = make_contact("deformable", friction=Coulomb(c_T=30.0, mu=0.3), kinematics="small")
     zero = np.zeros(ndof)
@@ -420,13 +442,22 @@ def test_small_kinematics_is_affine_and_starts_at_the_reference(rng):
     assert np.array_equal(small.evaluate(0.2 * a, 0.0, DT, history=hist[id(small)]).weights, hist[id(small)].w)
     xs, xm, _, _ = flat_chains(0.0)
     slave, master = PointCloud(xs), PointCloud(xm, dof_offset=2 * len(xs))
-    pair = [MortarContact(slave, np.arange(len(xs)), BodySurface(master, np.arange(len(xm))), normal=PowerLaw(50.0),
-                          friction=Coulomb(c_T=30.0, mu=0.3), kinematics=k) for k in ("finite", "small")]
+    pair = [
+        MortarContact(
+            slave,
+            np.arange(len(xs)),
+            BodySurface(master, np.arange(len(xm))),
+            normal=PowerLaw(50.0),
+            friction=Coulomb(c_T=30.0, mu=0.3),
+            kinematics=k,
+        )
+        for k in ("finite", "small")
+    ]
     n = 2 * (len(xs) + len(xm))
     for c in pair:
         hist[id(c)] = c.start(np.zeros(n))
     d = rng.standard_normal(n)
-    for eps in (1e-4, 1e-5):                                # the difference is second order in eps
+    for eps in (1e-4, 1e-5):  # the difference is second order in eps
         for f in (g, gT):
             diff = np.abs(f(pair[0], eps * d) - f(pair[1], eps * d)).max()
             assert diff < 10 * eps**2, (eps, diff)
@@ -438,19 +469,24 @@ def test_small_kinematics_patch_test_at_any_deformation(rng):
     current ones)."""
     xs, xm, s_x, m_x = flat_chains(0.0, angle=0.0)
     slave, master = PointCloud(xs), PointCloud(xm, dof_offset=2 * len(xs))
-    contact = MortarContact(slave, np.arange(len(xs)), BodySurface(master, np.arange(len(xm))),
-                            normal=PowerLaw(c_N=50.0), kinematics="small")
+    contact = MortarContact(
+        slave,
+        np.arange(len(xs)),
+        BodySurface(master, np.arange(len(xm))),
+        normal=PowerLaw(c_N=50.0),
+        kinematics="small",
+    )
     n = 2 * (len(xs) + len(xm))
     h = contact.start(np.zeros(n))
     u = np.zeros(n)
-    u[0::2] = 0.1 * np.concatenate([s_x, m_x])               # a stretch of 10 % along x of both chains
-    u[1: 2 * len(xs):2] = -0.01                              # a uniform penetration of 0.01
+    u[0::2] = 0.1 * np.concatenate([s_x, m_x])  # a stretch of 10 % along x of both chains
+    u[1 : 2 * len(xs) : 2] = -0.01  # a uniform penetration of 0.01
     st = contact.evaluate(u, 0.0, DT, history=h)
     p = 50.0 * 0.01
     assert np.allclose(st.t_N, -p, rtol=1e-13)
     R = st.R.reshape(-1, 2)
-    assert np.allclose(R[:len(xs), 1], -p * hat_integrals(s_x, s_x.min(), s_x.max()), rtol=1e-13, atol=1e-15)
-    assert np.allclose(R[len(xs):, 1], p * hat_integrals(m_x, s_x.min(), s_x.max()), rtol=1e-13, atol=1e-15)
+    assert np.allclose(R[: len(xs), 1], -p * hat_integrals(s_x, s_x.min(), s_x.max()), rtol=1e-13, atol=1e-15)
+    assert np.allclose(R[len(xs) :, 1], p * hat_integrals(m_x, s_x.min(), s_x.max()), rtol=1e-13, atol=1e-15)
     assert np.allclose(R[:, 0], 0.0, atol=1e-15)
 
 

@@ -51,8 +51,10 @@ def out_of_range(scene, p):
 @pytest.fixture
 def no_work(monkeypatch):
     """Any build, simulation or measurement is a failure of the test: refusals come first."""
+
     def work(*args, **kwargs):
         raise AssertionError("the run started: the value was not refused before any work")
+
     monkeypatch.setattr(base, "run", work)
 
 
@@ -60,8 +62,14 @@ def test_every_scene_has_parameters_with_limits_and_ranges():
     """The test below covers the cases it claims: ranges, choices, and Limits (the block's free
     end nodes, the cork's radii, the rings' wall thickness)."""
     limited = {(n, p.name) for n, s in SCENES.items() for p in s.params if p.limit is not None}
-    assert {("block", "free_end_nodes"), ("cork", "R_tip"), ("cork", "R_cork"), ("sloping_impact", "thickness"),
-            ("rolling_ring", "thickness"), ("funnel", "thickness")} <= limited
+    assert {
+        ("block", "free_end_nodes"),
+        ("cork", "R_tip"),
+        ("cork", "R_cork"),
+        ("sloping_impact", "thickness"),
+        ("rolling_ring", "thickness"),
+        ("funnel", "thickness"),
+    } <= limited
     assert sum(len(out_of_range(s, p)) for s in SCENES.values() for p in s.params) > 400
 
 
@@ -124,7 +132,7 @@ def test_what_the_params_accept_the_build_accepts(name):
         for value in inside(p):
             try:
                 params = scene.resolve("fast", dict(activated(scene, p), **{p.name: value}))
-            except ValueError as err:              # a combination the scene refuses: in one line, naming a parameter
+            except ValueError as err:  # a combination the scene refuses: in one line, naming a parameter
                 if "\n" in str(err) or "parameter" not in str(err) and "no static equilibrium" not in str(err):
                     wrong.append((p.name, value, str(err)))
                 continue
@@ -135,6 +143,6 @@ def test_what_the_params_accept_the_build_accepts(name):
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore")
                     scene.build(params, system_options={})
-            except Exception as err:              # noqa: BLE001 (any refusal after the Params is the defect)
+            except Exception as err:  # noqa: BLE001 (any refusal after the Params is the defect)
                 wrong.append((p.name, value, type(err).__name__, str(err)))
     assert not wrong, wrong

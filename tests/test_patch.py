@@ -1,5 +1,6 @@
 """The contact patch test: stacked blocks with non-matching meshes under a uniform
 pressure; exact answer: the same pressure p all along the interface, sigma_yy = -p."""
+
 import pytest
 
 from contactfem.scenes import run_scene
@@ -51,8 +52,11 @@ def test_docstring_numbers_are_the_run(results):
     from contactfem.scenes import patch
 
     doc = " ".join(patch.__doc__.split())
-    m = re.search(r"Fast preset \(4 \| 7 elements\): one pass ([0-9.]+) % interface pressure and ([0-9.]+) % "
-                  r"stress deviation, two passes ([0-9.]+) % and ([0-9.]+) %", doc)
+    m = re.search(
+        r"Fast preset \(4 \| 7 elements\): one pass ([0-9.]+) % interface pressure and ([0-9.]+) % "
+        r"stress deviation, two passes ([0-9.]+) % and ([0-9.]+) %",
+        doc,
+    )
     ours = [100 * results[n][k] for n in (1, 2) for k in ("pressure_deviation_max", "stress_deviation_max")]
     assert [float(x) for x in m.groups()] == [round(x, 1) for x in ours], ours
 

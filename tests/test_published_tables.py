@@ -32,8 +32,10 @@ NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")
 # first residual (1.7e-8). Below 1e-9 a number is the rounding of the run, not its result.
 ROUNDOFF = 1e-9
 
-SUMMARY = ("`contactfem figures --only summary --preset paper`, then `python -m contactfem.plots.summary` "
-           "(copies it into the README)")
+SUMMARY = (
+    "`contactfem figures --only summary --preset paper`, then `python -m contactfem.plots.summary` "
+    "(copies it into the README)"
+)
 HOW = {
     "summary.md": SUMMARY,
     "table1_block_newton_residuals.md": "`contactfem figures --only table1 --preset paper`",
@@ -75,7 +77,7 @@ def assert_same_text(name, written, fresh):
     for i, (a, b) in enumerate(zip(w, f), 1):
         if a.startswith("|") and b.startswith("|"):
             ca, cb = _cells(a), _cells(b)
-            if set("".join(ca)) <= set("-:"):                     # the separator line
+            if set("".join(ca)) <= set("-:"):  # the separator line
                 continue
             if header is None:
                 header = ca
@@ -92,8 +94,10 @@ def assert_same_text(name, written, fresh):
             why = cell_difference(a, b)
             if why:
                 problems.append(f"line {i}: {why}\n    file: {a}\n    run:  {b}")
-    assert not problems, (f"figures/{name} is not what the code computes today ({len(problems)} difference(s)); "
-                          f"regenerate it with {HOW[name]}:\n" + "\n".join(problems))
+    assert not problems, (
+        f"figures/{name} is not what the code computes today ({len(problems)} difference(s)); "
+        f"regenerate it with {HOW[name]}:\n" + "\n".join(problems)
+    )
 
 
 def test_the_comparison_finds_a_changed_number_and_ignores_roundoff():
@@ -104,8 +108,11 @@ def test_the_comparison_finds_a_changed_number_and_ignores_roundoff():
     assert cell_difference("3e-12 (800 down)", "3e-12 (801 down)") is not None
     assert cell_difference("stays in", "28.8") == "the text differs"
     with pytest.raises(AssertionError, match=r"row 'Table 2', column 'ours': 1.46 in the file, 1.45 from the run"):
-        assert_same_text("summary.md", "| paper | ours |\n|---|---|\n| Table 2 | (2.00, 1.46) |\n",
-                         "| paper | ours |\n|---|---|\n| Table 2 | (2.00, 1.45) |\n")
+        assert_same_text(
+            "summary.md",
+            "| paper | ours |\n|---|---|\n| Table 2 | (2.00, 1.46) |\n",
+            "| paper | ours |\n|---|---|\n| Table 2 | (2.00, 1.45) |\n",
+        )
 
 
 @pytest.mark.slow
@@ -122,16 +129,20 @@ def test_summary_md_is_what_the_paper_preset_runs_give():
 def test_table1_md_is_what_the_block_runs_give():
     from contactfem.plots.block import residual_histories, table1_markdown
 
-    assert_same_text("table1_block_newton_residuals.md", (FIGURES / "table1_block_newton_residuals.md").read_text(),
-                     table1_markdown(residual_histories("paper")))
+    assert_same_text(
+        "table1_block_newton_residuals.md",
+        (FIGURES / "table1_block_newton_residuals.md").read_text(),
+        table1_markdown(residual_histories("paper")),
+    )
 
 
 @pytest.mark.slow
 def test_table2_md_is_what_the_ring_runs_give():
     from contactfem.plots.sloping_impact import table2_markdown
 
-    assert_same_text("table2_sloping_impact.md", (FIGURES / "table2_sloping_impact.md").read_text(),
-                     table2_markdown("paper"))
+    assert_same_text(
+        "table2_sloping_impact.md", (FIGURES / "table2_sloping_impact.md").read_text(), table2_markdown("paper")
+    )
 
 
 @pytest.mark.slow
@@ -162,12 +173,22 @@ def test_cork_exit_time_md_is_its_json_and_the_quick_cases_are_the_runs():
     assert d["slow"] and len(d["cases"]) == len(F.EXIT_CASES_SLOW)
     assert (FIGURES / "cork_exit_time.md").read_text() == F.exit_time_markdown(d), (
         "figures/cork_exit_time.md and figures/cork_exit_time.json disagree: regenerate both with "
-        + HOW["cork_exit_time.md"])
+        + HOW["cork_exit_time.md"]
+    )
     quick = F.exit_time_data(F.EXIT_CASES_QUICK)
-    fresh = dict(d, cases=[next(r for r in d["cases"] if (r["group"], r["label"], r["closing_step_press_fit"],
-                                                          r["closing_step_pop"]) == key) for key in
-                           [(r["group"], r["label"], r["closing_step_press_fit"], r["closing_step_pop"])
-                            for r in quick["cases"]]])
+    fresh = dict(
+        d,
+        cases=[
+            next(
+                r
+                for r in d["cases"]
+                if (r["group"], r["label"], r["closing_step_press_fit"], r["closing_step_pop"]) == key
+            )
+            for key in [
+                (r["group"], r["label"], r["closing_step_press_fit"], r["closing_step_pop"]) for r in quick["cases"]
+            ]
+        ],
+    )
     written = [ln for ln in F.exit_time_markdown(fresh).splitlines() if ln.startswith("|")]
     ran = [ln for ln in F.exit_time_markdown(dict(d, cases=quick["cases"])).splitlines() if ln.startswith("|")]
     assert_same_text("cork_exit_time.md", "\n".join(written), "\n".join(ran))

@@ -21,15 +21,19 @@ from contactfem.laws import ArchardWear, Coulomb, DieterichRuina, FrictionLaw, L
 from contactfem.scenes import block
 from contactfem.solver import Static
 
-C_T = 5.0e4          # the block's stick stiffness per unit length
+C_T = 5.0e4  # the block's stick stiffness per unit length
 RATE_LAWS = {
     "stribeck": Stribeck(c_T=C_T, mu_s=0.32, mu_d=0.28, v_s=0.02, mu_v=0.1),
     "rate_state": DieterichRuina(c_T=C_T, mu_0=0.1, a=0.01, b=0.015, d_c=0.01),
     "wear": ArchardWear(c_T=C_T, mu=0.3, k_w=1e-4),
 }
-SMALL = [Stribeck(c_T=30.0, mu_s=0.5, mu_d=0.3, v_s=0.1, mu_v=0.05), Stribeck(c_T=30.0, mu_s=0.3, mu_d=0.5, v_s=0.1, delta=1.0),
-         DieterichRuina(c_T=30.0, mu_0=0.4, a=0.01, b=0.015, d_c=0.01), DieterichRuina(c_T=30.0, mu_0=0.4, a=0.02, b=0.01, d_c=0.1),
-         ArchardWear(c_T=30.0, mu=0.3, k_w=1e-3)]
+SMALL = [
+    Stribeck(c_T=30.0, mu_s=0.5, mu_d=0.3, v_s=0.1, mu_v=0.05),
+    Stribeck(c_T=30.0, mu_s=0.3, mu_d=0.5, v_s=0.1, delta=1.0),
+    DieterichRuina(c_T=30.0, mu_0=0.4, a=0.01, b=0.015, d_c=0.01),
+    DieterichRuina(c_T=30.0, mu_0=0.4, a=0.02, b=0.01, d_c=0.1),
+    ArchardWear(c_T=30.0, mu=0.3, k_w=1e-3),
+]
 
 
 @pytest.mark.slow
@@ -62,9 +66,9 @@ def test_rate_law_return_map_and_history():
         return_map(law, t_N, 0.0, 0.5, 0.0, 0.0)
     dr = DieterichRuina(c_T=100.0, mu_0=0.3, a=0.01, b=0.02, d_c=0.01, theta_0=1.0)
     stick = return_map(dr, t_N, 0.0, 1e-6, 0.0, 0.0, dt=2.0)
-    assert stick.state[0] == STICK and np.isclose(stick.z[0, 0], 3.0)          # theta = theta_0 + dt: healing
+    assert stick.state[0] == STICK and np.isclose(stick.z[0, 0], 3.0)  # theta = theta_0 + dt: healing
     slip = return_map(dr, t_N, 0.0, 0.5, 0.0, 0.0, dt=2.0)
-    assert slip.state[0] == SLIP and slip.z[0, 0] < 0.1                         # renewed by the slip
+    assert slip.state[0] == SLIP and slip.z[0, 0] < 0.1  # renewed by the slip
     assert np.isclose(slip.z[0, 0], 3.0 / (1.0 + slip.lam[0] / 0.01))
 
 
@@ -73,10 +77,10 @@ def test_history_is_committed_only_on_convergence():
     s = block.solve(params, friction=RATE_LAWS["wear"])
     c, last = s["contact"], s["records"][-1]
     h = last.state.contacts[0]
-    assert np.all(h.z_bar >= 0) and h.z_bar.max() > 0                          # worn where it slipped
-    assert np.all(h.z_bar[h.q_bar == 0] == 0)                                  # no wear without slip
+    assert np.all(h.z_bar >= 0) and h.z_bar.max() > 0  # worn where it slipped
+    assert np.all(h.z_bar[h.q_bar == 0] == 0)  # no wear without slip
     before = h.z_bar.copy()
-    c.evaluate(s["u"] * 1.01, dt=0.5, history=h)                              # evaluations leave it alone
+    c.evaluate(s["u"] * 1.01, dt=0.5, history=h)  # evaluations leave it alone
     assert last.state.contacts[0] is h and np.array_equal(h.z_bar, before)
 
 
@@ -89,12 +93,12 @@ def test_wear_moves_the_surface():
     h = iface.start(u)
     t0 = iface.evaluate(u, dt=1.0, history=h).t_N.copy()
     u1 = u.copy()
-    u1[0] = 0.3                                                               # node 0 slides
+    u1[0] = 0.3  # node 0 slides
     h = iface.commit(iface.evaluate(u1, dt=1.0, history=h))
     w = h.z_bar[:, 0]
     assert w[0] > 0 and w[1] == 0
     e = iface.evaluate(u1, dt=1.0, history=h)
-    assert np.isclose(e.g_N[0], -0.02 + w[0]) and e.t_N[0] > t0[0]           # less compressive
+    assert np.isclose(e.g_N[0], -0.02 + w[0]) and e.t_N[0] > t0[0]  # less compressive
     assert e.t_N[1] == t0[1]
 
 
@@ -123,7 +127,7 @@ def test_block_newton_quadratic_with_rate_and_state_laws(name, n_steps):
             order = np.log(above[-1] / above[-2]) / np.log(above[-2] / above[-3])
             assert order > 1.7, (name, order, e)
     R = s["R_c"][s["body"].xdofs]
-    applied_x, applied_y = params["p_x"] * params["height"], params["p_y"] * params["width"]   # 60 H, 200 W
+    applied_x, applied_y = params["p_x"] * params["height"], params["p_y"] * params["width"]  # 60 H, 200 W
     assert abs(R[:, 0].sum() - applied_x) < 1e-6 and abs(R[:, 1].sum() + applied_y) < 1e-6
     assert np.sum(s["report"]["state"] == "slip") >= 2
 
@@ -155,9 +159,11 @@ def test_block_tangent_against_finite_differences(name):
 
 # -- derivatives by complex step and the checker's sentences --------------------------
 
+
 @dataclass(frozen=True)
 class RateOnlyY:
     """A rate-dependent law that gives Y alone: its derivatives come by complex step."""
+
     c_T: float = 30.0
     mu: float = 0.4
     v_0: float = 0.1
@@ -173,7 +179,7 @@ def test_complex_step_derivatives_equal_the_analytic_ones():
     class StribeckYOnly(Stribeck):
         def slip_bound(self, p, q, v):
             x = np.asarray(v) / self.v_s
-            return p * (self.mu_d + (self.mu_s - self.mu_d) * np.exp(-x ** self.delta) + self.mu_v * np.asarray(v))
+            return p * (self.mu_d + (self.mu_s - self.mu_d) * np.exp(-(x**self.delta)) + self.mu_v * np.asarray(v))
 
     rng = np.random.default_rng(3)
     p, q, v = rng.uniform(0.1, 5, 50), rng.uniform(0, 1, 50), rng.uniform(0, 1, 50)
@@ -193,7 +199,7 @@ class WrongDYdp:
 
     def slip_bound(self, p, q):
         p = np.asarray(p, float)
-        return 0.1 * p + 0.01 * p ** 2, 0.1 + 0.01 * p, 0 * p          # dY/dp misses the factor 2
+        return 0.1 * p + 0.01 * p**2, 0.1 + 0.01 * p, 0 * p  # dY/dp misses the factor 2
 
 
 @dataclass(frozen=True)
@@ -202,7 +208,7 @@ class WrongDYdv:
 
     def slip_bound(self, p, q, v):
         p, v = np.asarray(p, float), np.asarray(v, float)
-        return 0.3 * p / (1 + v), 0.3 / (1 + v), 0 * p, 0.3 * p / (1 + v) ** 2   # sign of dY/dv
+        return 0.3 * p / (1 + v), 0.3 / (1 + v), 0 * p, 0.3 * p / (1 + v) ** 2  # sign of dY/dv
 
 
 @dataclass(frozen=True)
@@ -275,7 +281,7 @@ def test_checker_names_each_common_mistake(law, sentence, recwarn):
     assert len(fails) == 1, fails
     assert re.search(sentence, fails[0]), fails[0]
     assert "\n" not in fails[0]
-    assert not [w for w in recwarn if "numpy" in str(w.filename)]       # no numpy warnings leak out
+    assert not [w for w in recwarn if "numpy" in str(w.filename)]  # no numpy warnings leak out
 
 
 def test_a_law_error_in_a_run_is_one_sentence():

@@ -25,8 +25,15 @@ def _private_cache(tmp_path, monkeypatch):
 
 # ---------------------------------------------------------------------------------------
 # block: the first residual, analytically
-@pytest.mark.parametrize("over", [{}, {"width": 3.5, "height": 4.0, "nx": 20, "ny": 10},
-                                  {"nx": 10, "ny": 20, "p_x_face": "right"}, {"p_y": 60.0, "p_x": 200.0}])
+@pytest.mark.parametrize(
+    "over",
+    [
+        {},
+        {"width": 3.5, "height": 4.0, "nx": 20, "ny": 10},
+        {"nx": 10, "ny": 20, "p_x_face": "right"},
+        {"p_y": 60.0, "p_x": 200.0},
+    ],
+)
 def test_first_residual_formula_is_the_nodal_load_norm(over):
     # the loads are set after resolving: the formula is about load vectors only, and the
     # swapped reading (p_x = 200 along, p_y = 60 down) has no static equilibrium, which
@@ -34,8 +41,9 @@ def test_first_residual_formula_is_the_nodal_load_norm(over):
     p = dict(get_scene("block").resolve("paper", {}), **over)
     b = build(p)
     top, side = load_norms(b.parts["body"], b.parts["loads"])
-    assert rc.block_first_residual(p["width"], p["height"], p["nx"], p["ny"], p["p_y"], p["p_x"]) == \
-        pytest.approx(np.hypot(top, side), rel=1e-12)
+    assert rc.block_first_residual(p["width"], p["height"], p["nx"], p["ny"], p["p_y"], p["p_x"]) == pytest.approx(
+        np.hypot(top, side), rel=1e-12
+    )
 
 
 def test_no_uniform_block_reaches_the_printed_first_residual():
@@ -56,14 +64,18 @@ def test_readme_closest_first_residual_states_its_filters():
     which it states, and it names the closest without them; on a grid of step 0.1 none, filtered or
     not, comes within 3e-6."""
     inf = float("inf")
-    text = " ".join(README[README.index("**First residual**"):README.index("**Residual pattern**")].split())
+    text = " ".join(README[README.index("**First residual**") : README.index("**Residual pattern**")].split())
     g, free = rc.block_geometries()[0], rc.block_geometries(block_aspect=inf, element_aspect=inf)[0]
     assert "width and height within a factor 3 of each other" in text and "a factor 4" in text
-    assert (rc.block_geometries.__defaults__[-2:]) == (3.0, 4.0)          # block_aspect, element_aspect
-    assert (f"the closest on its grid of step 0.25 is {g['first_residual']:.3f} ({g['width']:g} x {g['height']:g}, "
-            f"{g['nx']} x {g['ny']})") in text
-    assert (f"without those filters a {free['width']:g} x {free['height']:g} strip ({free['nx']} x {free['ny']}) "
-            f"gives {free['first_residual']:.3f}") in text
+    assert (rc.block_geometries.__defaults__[-2:]) == (3.0, 4.0)  # block_aspect, element_aspect
+    assert (
+        f"the closest on its grid of step 0.25 is {g['first_residual']:.3f} ({g['width']:g} x {g['height']:g}, "
+        f"{g['nx']} x {g['ny']})"
+    ) in text
+    assert (
+        f"without those filters a {free['width']:g} x {free['height']:g} strip ({free['nx']} x {free['ny']}) "
+        f"gives {free['first_residual']:.3f}"
+    ) in text
     for kw in ({}, dict(block_aspect=inf, element_aspect=inf)):
         assert abs(rc.block_geometries(step=0.1, **kw)[0]["first_residual"] / rc.PAPER_FIRST_RESIDUAL - 1) > 3e-6
 
@@ -120,7 +132,7 @@ def test_canonical_preset_is_the_earlier_reading():
     p = get_scene("block").resolve("canonical")
     assert (p["width"], p["height"], p["nx"], p["ny"], p["p_x_face"]) == (4.0, 3.5, 20, 10, "right")
     r = run_scene("block", "canonical")
-    assert r["n_slip"] == 0                                   # why it was replaced: no slip
+    assert r["n_slip"] == 0  # why it was replaced: no slip
     assert f"has no slip and {len(r['newton_residuals'])} residuals" in " ".join(README.split())
 
 
@@ -140,8 +152,9 @@ def study(tmp_path_factory):
                 path = d / f"{scene}.json"
                 assert main(["reconstruct", scene, "--top", "3", "--json", str(path)]) == 0
                 runs[scene] = json.loads(path.read_text())
-                assert (d / "cache").is_dir()                  # the private cache was used
+                assert (d / "cache").is_dir()  # the private cache was used
         return runs[scene]
+
     return get
 
 
@@ -159,7 +172,7 @@ def _check_outcomes(out, kinds, eligible=lambda r: True):
     assert [r["rank"] for r in ranked] == list(range(1, len(ranked) + 1))
     assert len(ranked) == sum(r["outcome"] == "converged" and eligible(r) for r in rows) > 0
     key = [(-r["n_facts"], r["distance"]) for r in ranked]
-    assert key == sorted(key)                                   # most facts, then nearest, first
+    assert key == sorted(key)  # most facts, then nearest, first
 
 
 @pytest.mark.slow
@@ -171,7 +184,11 @@ def test_block_study_records_every_outcome(study):
     # a reading without static equilibrium is recorded, not a crash: W = 3.5, H = 4 carries the
     # side load with the conical law but not with the parabolic one; the scene refuses it too
     r = next(r for r in rows if (r["width"], r["height"]) == (3.5, 4.0))
-    assert (r["outcome"], r["outcome_conical"], r["outcome_parabolic"]) == ("no_equilibrium", "converged", "no_equilibrium")
+    assert (r["outcome"], r["outcome_conical"], r["outcome_parabolic"]) == (
+        "no_equilibrium",
+        "converged",
+        "no_equilibrium",
+    )
     with pytest.raises(ValueError, match="no static equilibrium"):
         rc.block_reading_params(r, "parabolic")
     for r in rows:
@@ -194,7 +211,9 @@ def test_block_study_physical_screen(study):
     # c_N = 1e2 per length: the block sinks by about p_y / c_N = 2 on average; at the preset's
     # geometry more than its own height (the ranking once placed this reading second)
     paper = rc.block_paper_reading()
-    soft = next(r for r in rows if _key(r, rc.BLOCK_KEYS) == dict(_key(paper, rc.BLOCK_KEYS), c_N=100.0, plane="strain"))
+    soft = next(
+        r for r in rows if _key(r, rc.BLOCK_KEYS) == dict(_key(paper, rc.BLOCK_KEYS), c_N=100.0, plane="strain")
+    )
     assert soft["outcome"] == "rejected_penetration" and soft["max_penetration_ratio"] > 1.0
 
 
@@ -225,22 +244,29 @@ def test_readme_states_the_block_study(study):
     assert out["best_pulled_rank"] == pull["rank"]
     pushes = (best["p_x_face"], best["p_x"] > 0) == ("left", True)
     tied = [r for r in rows if r["n_facts"] == best["n_facts"]]
-    same = all((r["nx"], r["ny"], r["width"], r["height"], r["p_x_face"], r["plane"]) ==
-               (paper["nx"], paper["ny"], paper["width"], paper["height"], "left", "stress") for r in tied)
+    same = all(
+        (r["nx"], r["ny"], r["width"], r["height"], r["p_x_face"], r["plane"])
+        == (paper["nx"], paper["ny"], paper["width"], paper["height"], "left", "stress")
+        for r in tied
+    )
     n = out["outcomes"]
-    section = " ".join(README[README.index("### Table 1 and Fig 8"):README.index("### Table 2")].split())
+    section = " ".join(README[README.index("### Table 1 and Fig 8") : README.index("### Table 2")].split())
     assert ("The fit pushes where the paper pulls" in section) == pushes
     assert ("all with this geometry, the load on the left side and plane stress" in section) == same
-    for text in (f"runs {len(out['readings'])} readings", f"{len(rows)} admissible readings",
-                 f"{n['no_equilibrium']} have no static equilibrium",
-                 f"{n['rejected_penetration']} sink deeper than {100 * rc.PENETRATION_FRACTION:g} % of the height",
-                 f"{len(tied)} meet {best['n_facts']} of the {len(f)} facts", f"ours ranks {mine['rank']} ",
-                 f"({mine['distance']:.2f} against {best['distance']:.2f}",
-                 f"pulls ranks {pull['rank']} with {pull['n_facts']} of {len(f)} facts",
-                 f"takes {pull['n_parabolic']} residuals"):
+    for text in (
+        f"runs {len(out['readings'])} readings",
+        f"{len(rows)} admissible readings",
+        f"{n['no_equilibrium']} have no static equilibrium",
+        f"{n['rejected_penetration']} sink deeper than {100 * rc.PENETRATION_FRACTION:g} % of the height",
+        f"{len(tied)} meet {best['n_facts']} of the {len(f)} facts",
+        f"ours ranks {mine['rank']} ",
+        f"({mine['distance']:.2f} against {best['distance']:.2f}",
+        f"pulls ranks {pull['rank']} with {pull['n_facts']} of {len(f)} facts",
+        f"takes {pull['n_parabolic']} residuals",
+    ):
         assert text in section, f"README's block section lacks {text!r}"
-    assert n["rejected_inverted"] == n["no_convergence"] == 0     # the README names no such readings
-    intro = " ".join(README[README.index("### What the scan lost"):README.index("### Table 1 and Fig 8")].split())
+    assert n["rejected_inverted"] == n["no_convergence"] == 0  # the README names no such readings
+    intro = " ".join(README[README.index("### What the scan lost") : README.index("### Table 1 and Fig 8")].split())
     assert f"more than {100 * rc.PENETRATION_FRACTION:g} % of its height" in intro
 
 
@@ -248,11 +274,13 @@ def _fig8_docs():
     """Every text that states what the study finds about Fig 8's remark, whitespace-normalised."""
     repo = Path(__file__).resolve().parents[1]
     nb = json.loads((repo / "lectures" / "04_block.ipynb").read_text())
-    texts = {"README.md": README[README.index("### Table 1 and Fig 8"):README.index("### Table 2")],
-             "scenes/block_params.py": (repo / "contactfem" / "scenes" / "block_params.py").read_text(),
-             "scenes/block.py": get_scene("block").notes,
-             "lectures/04_block.md": (repo / "lectures" / "04_block.md").read_text(),
-             "lectures/04_block.ipynb": "".join("".join(c["source"]) for c in nb["cells"])}
+    texts = {
+        "README.md": README[README.index("### Table 1 and Fig 8") : README.index("### Table 2")],
+        "scenes/block_params.py": (repo / "contactfem" / "scenes" / "block_params.py").read_text(),
+        "scenes/block.py": get_scene("block").notes,
+        "lectures/04_block.md": (repo / "lectures" / "04_block.md").read_text(),
+        "lectures/04_block.ipynb": "".join("".join(c["source"]) for c in nb["cells"]),
+    }
     return {k: " ".join(v.split()).replace('" "', "").lower() for k, v in texts.items()}
 
 
@@ -275,9 +303,10 @@ def test_fig8_claim_is_the_studys(study):
     for name, text in _fig8_docs().items():
         assert (FIG8_NONE in text) == (not both), (
             f"{name} {'says' if FIG8_NONE in text else 'does not say'} {FIG8_NONE!r}; the study finds "
-            f"{len(both)} reading(s) that show Fig 8's remark with Table 1's conical facts")
+            f"{len(both)} reading(s) that show Fig 8's remark with Table 1's conical facts"
+        )
         assert "no block-shaped reading" not in text, name
-    section = " ".join(README[README.index("### Table 1 and Fig 8"):README.index("### Table 2")].split())
+    section = " ".join(README[README.index("### Table 1 and Fig 8") : README.index("### Table 2")].split())
     assert f"{len(shows)} of the {len(rows)} admissible readings show{'s' if len(shows) == 1 else ''} it" in section
     assert shows, "no reading shows Fig 8's remark any more: the README, preset fig8 and figure fig08b say one does"
     best = shows[0]
@@ -294,8 +323,10 @@ def test_fig8_claim_is_the_studys(study):
     mine = next(r for r in rows if _key(r, rc.BLOCK_KEYS) == _key(paper, rc.BLOCK_KEYS))
     for name, r in (("paper", mine), ("fig8", best)):
         d = data["readings"][name]
-        row = (f"| preset `{name}` | {r['rank']} | {r['n_facts']} of {len(r['facts'])} | "
-               f"{round(d['fig8_fraction'] * d['fig8_nodes'])} of {d['fig8_nodes']} | {100 * d['fig8_min_reduction']:+.1f} % |")
+        row = (
+            f"| preset `{name}` | {r['rank']} | {r['n_facts']} of {len(r['facts'])} | "
+            f"{round(d['fig8_fraction'] * d['fig8_nodes'])} of {d['fig8_nodes']} | {100 * d['fig8_min_reduction']:+.1f} % |"
+        )
         assert row in README, f"README lacks the row {row!r}"
 
 
@@ -304,14 +335,17 @@ def test_readme_block_residuals_are_the_run(block_paper):
     con, par = (np.array(block_paper[law]["newton_residuals"]) for law in ("conical", "parabolic"))
     paper = np.array(PAPER_TABLE1["parabolic"])
     ratio = paper[1:6] / par[1:6]
-    section = " ".join(README[README.index("### Table 1 and Fig 8"):README.index("### Table 2")].split())
+    section = " ".join(README[README.index("### Table 1 and Fig 8") : README.index("### Table 2")].split())
     # the last conical residual is at rounding (its digits move with the order of a sum): its bound
     assert con[-1] < 1e-11 < con[-2]
-    for text in ("conical " + ", ".join(f"{x:.2f}" for x in con[:-1]) + ", then one at rounding, below 1e-11",
-                 f"{block_paper['conical']['n_slip']} nodes slip", f"parabolic {len(par)} residuals",
-                 f"5th residuals {ratio[:4].min():.1f} to {ratio[:4].max():.1f} times smaller",
-                 f"the 6th {ratio[4]:.0f} times smaller",
-                 f"({block_paper['conical']['n_slip']} of {len(block_paper['conical']['contact']['x'])} nodes)"):
+    for text in (
+        "conical " + ", ".join(f"{x:.2f}" for x in con[:-1]) + ", then one at rounding, below 1e-11",
+        f"{block_paper['conical']['n_slip']} nodes slip",
+        f"parabolic {len(par)} residuals",
+        f"5th residuals {ratio[:4].min():.1f} to {ratio[:4].max():.1f} times smaller",
+        f"the 6th {ratio[4]:.0f} times smaller",
+        f"({block_paper['conical']['n_slip']} of {len(block_paper['conical']['contact']['x'])} nodes)",
+    ):
         assert text in section, f"README's block section lacks {text!r}"
 
 
@@ -340,21 +374,29 @@ def test_sloping_study_against_the_readme(study):
     the README's Table 2 section prints the study's rows (preset, midpoint, closest)."""
     rows = [r for r in study("sloping_impact")["readings"] if r["rank"]]
     assert len(rows) >= 40
-    best = max(r["n_facts"] for r in rows)            # the README's claim, whichever way the study moves
-    text = " ".join(README[README.index("### Table 2"):README.index("Verification problems")].split())
-    assert ("**Out of reach**: no reading that keeps the paper's mass and integrator brings any of the three "
-            "within 10 % of the paper's" in text) == (best == 0)
+    best = max(r["n_facts"] for r in rows)  # the README's claim, whichever way the study moves
+    text = " ".join(README[README.index("### Table 2") : README.index("Verification problems")].split())
+    assert (
+        "**Out of reach**: no reading that keeps the paper's mass and integrator brings any of the three "
+        "within 10 % of the paper's" in text
+    ) == (best == 0)
     last2 = max(r["rank"] for r in rows if r["integration"] == "2")
     first1 = min(r["rank"] for r in rows if r["integration"] == "1")
     assert last2 < first1
-    section = README[README.index("### Table 2"):README.index("Verification problems")]
+    section = README[README.index("### Table 2") : README.index("Verification problems")]
     preset = next(r for r in rows if _key(r, rc.SLOPING_KEYS) == rc.SLOPING_PAPER_READING)
     midpoint = next(r for r in rows if _key(r, rc.SLOPING_KEYS) == dict(rc.SLOPING_PAPER_READING, integration="1"))
     for r in (preset, midpoint, rows[0]):
-        line = next((ln for ln in section.splitlines() if ln.startswith("|") and
-                     f"{r['frictionless_vx']:.2f}, {r['frictionless_vy']:.2f}, {r['frictionless_angle']:.1f} deg" in ln
-                     and f"{r['frictional_vx']:.2f}, {r['frictional_vy']:.2f}, {r['frictional_angle']:.1f} deg" in ln),
-                    None)
+        line = next(
+            (
+                ln
+                for ln in section.splitlines()
+                if ln.startswith("|")
+                and f"{r['frictionless_vx']:.2f}, {r['frictionless_vy']:.2f}, {r['frictionless_angle']:.1f} deg" in ln
+                and f"{r['frictional_vx']:.2f}, {r['frictional_vy']:.2f}, {r['frictional_angle']:.1f} deg" in ln
+            ),
+            None,
+        )
         assert line is not None, f"README's Table 2 section lacks the row of {_key(r, rc.SLOPING_KEYS)}"
         assert f"{r['n_facts']} of {len(rc.TABLE2_SCORED)}" in line
     assert f"c_N = {rows[0]['c_N']:g}" in section and f"start gap {rows[0]['gap0']:g}" in section
@@ -363,16 +405,22 @@ def test_sloping_study_against_the_readme(study):
 
     def spread(group, k):
         return max(abs(r[k]) for r in group) - min(abs(r[k]) for r in group)
-    minor = max(spread([r for r in rows if r["integration"] == i and r["c_N"] == 50.0], k)
-                for i in ("1", "2") for k in scored)
+
+    minor = max(
+        spread([r for r in rows if r["integration"] == i and r["c_N"] == 50.0], k) for i in ("1", "2") for k in scored
+    )
     groups = {}
     for r in rows:
         groups.setdefault(tuple(r[k] for k in rc.SLOPING_KEYS if k != "c_N"), []).append(r)
     c_N = max(spread(g, k) for g in groups.values() if len({r["c_N"] for r in g}) > 1 for k in scored)
     rule = [abs(preset[k]) - abs(midpoint[k]) for k in scored]
     text = " ".join(section.split())
-    for t in (f"by at most {minor:.2f};", f"moves the frictionless v_y by {rule[0]:.2f}",
-              f"frictional v_x, v_y by {rule[1]:.2f} and {rule[2]:.2f}", f"moves them by at most {c_N:.2f}."):
+    for t in (
+        f"by at most {minor:.2f};",
+        f"moves the frictionless v_y by {rule[0]:.2f}",
+        f"frictional v_x, v_y by {rule[1]:.2f} and {rule[2]:.2f}",
+        f"moves them by at most {c_N:.2f}.",
+    ):
         assert t in text, f"README's Table 2 section lacks {t!r}"
 
 
@@ -392,36 +440,46 @@ def test_sloping_study_mass_and_integration_against_the_text(study):
     best = next(r for r in rows if r["rank"] == 1)
     bases = [rc.SLOPING_PAPER_READING, dict(rc.SLOPING_PAPER_READING, integration="1"), _key(best, rc.SLOPING_KEYS)]
     for b in bases:
-        for mass, integ in (("consistent", "standard"), ("lumped", "energy_consistent"),
-                            ("consistent", "energy_consistent")):
+        for mass, integ in (
+            ("consistent", "standard"),
+            ("lumped", "energy_consistent"),
+            ("consistent", "energy_consistent"),
+        ):
             key = dict(b, mass_matrix=mass, contact_integration=integ)
             assert sum(_key(r, rc.SLOPING_KEYS) == key for r in against) == 1, key
     for r in against:
         if r["contact_integration"] == "energy_consistent" and r["outcome"] == "converged":
-            assert r["frictionless_energy_final"] == pytest.approx(1.0, abs=1e-6)     # no damping, no friction
-            assert r["frictional_energy_final"] < 1.0                                  # friction dissipates
+            assert r["frictionless_energy_final"] == pytest.approx(1.0, abs=1e-6)  # no damping, no friction
+            assert r["frictional_energy_final"] < 1.0  # friction dissipates
     preset = next(r for r in rows if _key(r, rc.SLOPING_KEYS) == rc.SLOPING_PAPER_READING)
-    assert preset["frictionless_energy_final"] < 1.0                                   # Newmark 0.7/0.4 damps
+    assert preset["frictionless_energy_final"] < 1.0  # Newmark 0.7/0.4 damps
 
     def row(**kw):
         return next(r for r in rows if _key(r, rc.SLOPING_KEYS) == dict(rc.SLOPING_PAPER_READING, **kw))
-    cm, ec, both = row(mass_matrix="consistent"), row(contact_integration="energy_consistent"), \
-        row(mass_matrix="consistent", contact_integration="energy_consistent")
+
+    cm, ec, both = (
+        row(mass_matrix="consistent"),
+        row(contact_integration="energy_consistent"),
+        row(mass_matrix="consistent", contact_integration="energy_consistent"),
+    )
 
     def d(r, k):
         return abs(r[k]) - abs(preset[k])
+
     n = len(rc.TABLE2_SCORED)
-    text = " ".join(README[README.index("**Mass and time integration"):README.index("### The cork")].split())
-    for t in (f"the frictionless v_y by {d(cm, 'frictionless_vy'):+.2f}, the frictional v_x, v_y by "
-              f"{d(cm, 'frictional_vx'):+.2f} and {d(cm, 'frictional_vy'):+.2f}",
-              f"ends with {ec['frictionless_energy_final']:.2f} E0 against {preset['frictionless_energy_final']:.2f} E0 "
-              f"at t = {rc.SLOPING_STEPS * 0.1:g}, where the study stops",
-              f"v_y by {d(ec, 'frictionless_vy'):+.2f} to {ec['frictionless_vy']:.2f} ({ec['frictionless_angle']:.1f} deg)",
-              f"the frictional v_x by {d(ec, 'frictional_vx'):+.2f} to {ec['frictional_vx']:.2f} and its v_y by "
-              f"{d(ec, 'frictional_vy'):+.2f} to {ec['frictional_vy']:.2f} ({ec['frictional_angle']:.1f} deg)",
-              f"{ec['n_facts']} of {n} scored numbers within 10 %",
-              f"Both together: {both['frictionless_vy']:.2f}; {both['frictional_vx']:.2f} and "
-              f"{both['frictional_vy']:.2f} ({both['n_facts']} of {n})"):
+    text = " ".join(README[README.index("**Mass and time integration") : README.index("### The cork")].split())
+    for t in (
+        f"the frictionless v_y by {d(cm, 'frictionless_vy'):+.2f}, the frictional v_x, v_y by "
+        f"{d(cm, 'frictional_vx'):+.2f} and {d(cm, 'frictional_vy'):+.2f}",
+        f"ends with {ec['frictionless_energy_final']:.2f} E0 against {preset['frictionless_energy_final']:.2f} E0 "
+        f"at t = {rc.SLOPING_STEPS * 0.1:g}, where the study stops",
+        f"v_y by {d(ec, 'frictionless_vy'):+.2f} to {ec['frictionless_vy']:.2f} ({ec['frictionless_angle']:.1f} deg)",
+        f"the frictional v_x by {d(ec, 'frictional_vx'):+.2f} to {ec['frictional_vx']:.2f} and its v_y by "
+        f"{d(ec, 'frictional_vy'):+.2f} to {ec['frictional_vy']:.2f} ({ec['frictional_angle']:.1f} deg)",
+        f"{ec['n_facts']} of {n} scored numbers within 10 %",
+        f"Both together: {both['frictionless_vy']:.2f}; {both['frictional_vx']:.2f} and "
+        f"{both['frictional_vy']:.2f} ({both['n_facts']} of {n})",
+    ):
         assert t in text, f"README's Table 2 section lacks {t!r}"
 
 
@@ -450,11 +508,14 @@ def test_fig8_figure_carries_its_runs():
     data, params = B.fig8_reading_data("paper")
     assert differences(written, figure_record("fig08b_block_fig8_readings", data, params)) == []
     for name in ("paper", "fig8"):
-        runs = {law: dict(converged=True, **run_scene("block", name, {"law": law})["contact"])
-                for law in ("conical", "parabolic")}
+        runs = {
+            law: dict(converged=True, **run_scene("block", name, {"law": law})["contact"])
+            for law in ("conical", "parabolic")
+        }
         frac, red = rc.fig8_remark(runs["conical"], runs["parabolic"])
-        assert (frac, red) == pytest.approx((data["readings"][name]["fig8_fraction"],
-                                             data["readings"][name]["fig8_min_reduction"]), rel=1e-12)
+        assert (frac, red) == pytest.approx(
+            (data["readings"][name]["fig8_fraction"], data["readings"][name]["fig8_min_reduction"]), rel=1e-12
+        )
 
 
 @pytest.mark.parametrize("enabled", [True, False])
@@ -468,6 +529,7 @@ def test_the_studies_keep_their_cases_on_disk(enabled, monkeypatch):
     def case(params):
         solved.append(params["law"])
         return dict(converged=True, law=params["law"])
+
     monkeypatch.setattr(rc, "_block_case", case)
     params = get_scene("block").resolve("paper")
     solve = rc.cases(enabled)

@@ -12,6 +12,7 @@ from zero, so no compared quantity is a cancellation of terms more than ~100 tim
 (the worst, the gap of a slave 1 % of a segment deep, differed by 2e-14 relative when
 this was written). Each stage is fed the reference's inputs (see the first test).
 """
+
 import math
 
 import numpy as np
@@ -27,7 +28,7 @@ from contactfem.laws import Coulomb, ParabolicSlip, PowerLaw
 from contactfem.laws.return_map import OPEN, SLIP, STICK, return_map
 
 TOL = 1e-12
-NC = 12                                    # states per case: 6 masters x 3 laws x 2 (closing or not), 432 states
+NC = 12  # states per case: 6 masters x 3 laws x 2 (closing or not), 432 states
 REGIMES = ("stick", "slip+", "slip-")
 
 
@@ -41,7 +42,7 @@ def make_law(name, rng):
     c_T = rng.uniform(50.0, 500.0)
     if name == "coulomb":
         mu = rng.uniform(0.1, 0.6)
-        return Coulomb(c_T, mu), (c_T, mu, 0.0, 1.0)         # eq (11): n = 1, alpha + beta = mu
+        return Coulomb(c_T, mu), (c_T, mu, 0.0, 1.0)  # eq (11): n = 1, alpha + beta = mu
     a, b = rng.uniform(0.05, 0.4), rng.uniform(0.05, 0.4)
     n = 1.0 if name == "parabolic n=1" else rng.uniform(0.4, 0.9)
     return ParabolicSlip(c_T, a, b, n), (c_T, a, b, n)
@@ -51,6 +52,7 @@ def make_law(name, rng):
 # gives the reference kinematics of state i (its pair dofs moved by dx: 6 for a deformable
 # master; a rigid one reads the first 2) and its element; s0: an s_bar for a first look (the arc unwraps
 # theta near s_bar / R). Slaves lie at 20-80 % of a segment or piece, 1-8 % of its length deep.
+
 
 def _unit(phi):
     return np.array([math.cos(phi), math.sin(phi)])
@@ -67,22 +69,24 @@ def _segment_pairs(x_s, P, Pbar, j, rigid):
             else:
                 k = ref.pair_variations(x_s[i] + dx[:2], a + dx[2:4], b + dx[4:], l_bar=lb, S_bar=Sb)
             return k, lambda w, t_N, dt_N, fr, ddg_T=None: ref.segment_element(k, w, t_N, dt_N, fr, ddg_T, rigid)
+
         return kin
+
     return [pair(i) for i in range(len(x_s))]
 
 
 def _on_chain(rng, P, nc):
     j = rng.integers(0, len(P) - 1, nc)
     a, b = P[j], P[j + 1]
-    n = np.stack([a[:, 1] - b[:, 1], b[:, 0] - a[:, 0]], axis=1)           # e3 x (b - a), length l
+    n = np.stack([a[:, 1] - b[:, 1], b[:, 0] - a[:, 0]], axis=1)  # e3 x (b - a), length l
     x_s = a + rng.uniform(0.2, 0.8, (nc, 1)) * (b - a) - rng.uniform(0.01, 0.08, (nc, 1)) * n
     return x_s, j
 
 
 def line(rng, nc):
     n = _unit(rng.uniform(-math.pi, math.pi))
-    t, point = np.array([n[1], -n[0]]), rng.normal(size=2)                  # e3 x t = n
-    f = rng.choice([-1, 1], nc) * rng.uniform(0.3, 2.0, nc)                 # s = f, away from 0
+    t, point = np.array([n[1], -n[0]]), rng.normal(size=2)  # e3 x t = n
+    f = rng.choice([-1, 1], nc) * rng.uniform(0.3, 2.0, nc)  # s = f, away from 0
     x_s = point + f[:, None] * t - rng.uniform(0.01, 0.08, (nc, 1)) * n
     P = np.array([point, point + t])
     return RigidLine(point, n), x_s, None, np.full(nc, -1), np.zeros(nc), _segment_pairs(x_s, P, P, [0] * nc, True)
@@ -98,7 +102,7 @@ def body(rng, nc):
     X = np.stack([np.arange(5.0), 0.1 * rng.standard_normal(5)], axis=1)
     surface = BodySurface(PointCloud(X, "master"), np.arange(5))
     u_bar = 0.05 * rng.standard_normal(10)
-    surface.ref = surface.reference(u_bar)                                  # converged metric: l_bar != l
+    surface.ref = surface.reference(u_bar)  # converged metric: l_bar != l
     u = u_bar + 0.05 * rng.standard_normal(10)
     P, Pbar = X + u.reshape(-1, 2), X + u_bar.reshape(-1, 2)
     x_s, j = _on_chain(rng, P, nc)
@@ -107,20 +111,31 @@ def body(rng, nc):
 
 def _arc_pair(x, c, R, sigma, **kw):
     def kin(dx, s_bar):
-        k = ref.arc_pair(x + dx[:2], c, R, sigma, **kw) if "theta_ref" in kw else \
-            ref.arc_pair(x + dx[:2], c, R, sigma, theta_ref=s_bar / R)          # RigidArc: theta near s_bar / R
+        k = (
+            ref.arc_pair(x + dx[:2], c, R, sigma, **kw)
+            if "theta_ref" in kw
+            else ref.arc_pair(x + dx[:2], c, R, sigma, theta_ref=s_bar / R)
+        )  # RigidArc: theta near s_bar / R
         return k, lambda w, t_N, dt_N, fr, ddg_T=None: ref.obstacle_element(k, w, t_N, dt_N, fr, ddg_T)
+
     return kin
 
 
 def arc(inside):
     def build(rng, nc):
         c, R = rng.normal(size=2), rng.uniform(0.5, 3.0)
-        th = rng.choice([-1, 1], nc) * rng.uniform(0.3, 2.8, nc)           # s = R theta away from 0
+        th = rng.choice([-1, 1], nc) * rng.uniform(0.3, 2.8, nc)  # s = R theta away from 0
         sigma = -1.0 if inside else 1.0
         x_s = c + (R + sigma * rng.uniform(-0.08, -0.01, nc) * R)[:, None] * np.stack([np.cos(th), np.sin(th)], 1)
-        return (RigidArc(c, R, inside=inside), x_s, None, np.full(nc, -1), R * th,
-                [_arc_pair(x_s[i], c, R, sigma) for i in range(nc)])
+        return (
+            RigidArc(c, R, inside=inside),
+            x_s,
+            None,
+            np.full(nc, -1),
+            R * th,
+            [_arc_pair(x_s[i], c, R, sigma) for i in range(nc)],
+        )
+
     return build
 
 
@@ -128,8 +143,12 @@ def composite(rng, nc):
     """A wall, a rounded edge seen from outside (clockwise), a wall, a fillet seen from inside
     (counter-clockwise), moved by an offset; the states spread over the four pieces."""
     off = rng.normal(size=2)
-    pieces = [("line", (-2.0, 0.0), (0.0, 0.0)), ("arc", (0.0, -1.0), 1.0, math.pi / 2, 0.0),
-              ("line", (1.0, -1.0), (1.0, -3.0)), ("arc", (2.0, -3.0), 1.0, math.pi, 1.5 * math.pi)]
+    pieces = [
+        ("line", (-2.0, 0.0), (0.0, 0.0)),
+        ("arc", (0.0, -1.0), 1.0, math.pi / 2, 0.0),
+        ("line", (1.0, -1.0), (1.0, -3.0)),
+        ("arc", (2.0, -3.0), 1.0, math.pi, 1.5 * math.pi),
+    ]
     S = [0.0, 2.0, 2.0 + math.pi / 2, 4.0 + math.pi / 2]
     own = np.arange(nc) % 4
     x_s, pairs = np.zeros((nc, 2)), []
@@ -146,8 +165,11 @@ def composite(rng, nc):
             sigma, c = (1.0 if cw else -1.0), np.array(cc) + off
             th = th0 + f * (th1 - th0)
             x_s[i] = c + (R - sigma * depth) * _unit(th)
-            pairs.append(_arc_pair(x_s[i], c, R, sigma, theta_ref=0.5 * (th0 + th1), theta_0=th0,
-                                   direction=-1.0 if cw else 1.0, S=S[p]))
+            pairs.append(
+                _arc_pair(
+                    x_s[i], c, R, sigma, theta_ref=0.5 * (th0 + th1), theta_0=th0, direction=-1.0 if cw else 1.0, S=S[p]
+                )
+            )
     return RigidComposite(pieces, offset=off), x_s, None, own, np.zeros(nc), pairs
 
 
@@ -155,11 +177,18 @@ def _composite_line(x, A, B, S):
     def kin(dx, s_bar):
         k = ref.rigid_segment(x + dx[:2], A, B, S=S)
         return k, lambda w, t_N, dt_N, fr, ddg_T=None: ref.segment_element(k, w, t_N, dt_N, fr, ddg_T, True)
+
     return kin
 
 
-MASTERS = {"RigidLine": line, "RigidPolyline": polyline, "RigidArc outside": arc(False),
-           "RigidArc inside": arc(True), "RigidComposite": composite, "BodySurface": body}
+MASTERS = {
+    "RigidLine": line,
+    "RigidPolyline": polyline,
+    "RigidArc outside": arc(False),
+    "RigidArc inside": arc(True),
+    "RigidComposite": composite,
+    "BodySurface": body,
+}
 LAWS = ("coulomb", "parabolic n=1", "parabolic n<1")
 
 
@@ -190,15 +219,29 @@ def case(master_name, law_name, closing):
     for i in range(NC):
         k, _ = pairs[i](np.zeros(6), s0[i])
         p = -ref.power_law(k["g_N"], c_N, m)[0]
-        Y = a * p**n + b * p                                                  # eq (10)
+        Y = a * p**n + b * p  # eq (10)
         ratio = rng.uniform(0.05, 0.8) if regime[i] == "stick" else rng.uniform(1.25, 4.0)
         sign = {"stick": rng.choice([-1.0, 1.0]), "slip+": 1.0, "slip-": -1.0}[regime[i]]
         t_T_bar[i] = rng.uniform(-0.9, 0.9) * Y
-        Dg_T = (sign * ratio * Y - t_T_bar[i]) / c_T                         # puts t_tr there (eq 42)
-        r = -k["g_N"] / (g_bar[i] - k["g_N"]) if closing else 1.0            # closing: Delta g_T = r (s - s_bar)
+        Dg_T = (sign * ratio * Y - t_T_bar[i]) / c_T  # puts t_tr there (eq 42)
+        r = -k["g_N"] / (g_bar[i] - k["g_N"]) if closing else 1.0  # closing: Delta g_T = r (s - s_bar)
         s_bar[i] = k["s"] - Dg_T / r
-    return dict(master=master, x_s=x_s, u=u, seg=seg, pairs=pairs, law=law, params=params, c_N=c_N, m=m, w=w,
-                g_bar=g_bar, s_bar=s_bar, t_T_bar=t_T_bar, regime=regime)
+    return dict(
+        master=master,
+        x_s=x_s,
+        u=u,
+        seg=seg,
+        pairs=pairs,
+        law=law,
+        params=params,
+        c_N=c_N,
+        m=m,
+        w=w,
+        g_bar=g_bar,
+        s_bar=s_bar,
+        t_T_bar=t_T_bar,
+        regime=regime,
+    )
 
 
 CASES = [(mn, ln, cl) for mn in MASTERS for ln in LAWS for cl in (False, True)]
@@ -216,22 +259,40 @@ def test_vectorised_contact_equals_the_reference(master_name, law_name, closing)
     s_bar, t_T_bar, g_bar = c["s_bar"], c["t_T_bar"], c["g_bar"]
     k_v = c["master"].locate(c["x_s"], s_bar, c["u"], ref=getattr(c["master"], "ref", None))
     assert np.array_equal(k_v["seg"], c["seg"]) and np.all(k_v["inside"])
-    refs = [reference_pair(c["pairs"][i], np.zeros(6), s_bar[i], c["c_N"], c["m"], c["params"], t_T_bar[i],
-                           g_bar[i], c["w"][i]) for i in range(NC)]
+    refs = [
+        reference_pair(
+            c["pairs"][i], np.zeros(6), s_bar[i], c["c_N"], c["m"], c["params"], t_T_bar[i], g_bar[i], c["w"][i]
+        )
+        for i in range(NC)
+    ]
     k = {key: np.array([r[0][key] for r in refs]) for key in ("g_N", "s", "dg_N", "dg_T", "d2g_N", "d2g_T")}
     t_N, dt_N, fr = np.array([r[1] for r in refs]), np.array([r[2] for r in refs]), [r[3] for r in refs]
     R, K = [r[4] for r in refs], [r[5] for r in refs]
-    Dg_T, ddg_T = (np.array(x) for x in zip(*[ref.closing_step(g_bar[i], k["g_N"][i], k["s"][i], s_bar[i],
-                                                               k["dg_N"][i], k["dg_T"][i]) for i in range(NC)]))
+    Dg_T, ddg_T = (
+        np.array(x)
+        for x in zip(
+            *[
+                ref.closing_step(g_bar[i], k["g_N"][i], k["s"][i], s_bar[i], k["dg_N"][i], k["dg_T"][i])
+                for i in range(NC)
+            ]
+        )
+    )
     t_N_v, dt_N_v = PowerLaw(c["c_N"], c["m"]).traction(k["g_N"])
     fr_v = return_map(c["law"], t_N, dt_N, Dg_T, t_T_bar, np.zeros(NC))
     t_T, c_T_s, c_N_s = (np.array([f[key] for f in fr]) for key in ("t_T", "c_T_s", "c_N_s"))
-    R_v, K_v = contact_element(c["w"], t_N, dt_N, t_T, c_T_s, c_N_s, k["dg_N"], k["d2g_N"], k["dg_T"], k["d2g_T"],
-                               ddg_T if closing else None)
+    R_v, K_v = contact_element(
+        c["w"], t_N, dt_N, t_T, c_T_s, c_N_s, k["dg_N"], k["d2g_N"], k["dg_T"], k["d2g_T"], ddg_T if closing else None
+    )
     for i in range(NC):
         tag = f"state {i} ({c['regime'][i]})"
-        for mine, theirs in (("g_N", "g_N"), ("s", "s"), ("dg_N", "dg_N"), ("ds", "dg_T"),
-                             ("d2g_N", "d2g_N"), ("d2s", "d2g_T")):
+        for mine, theirs in (
+            ("g_N", "g_N"),
+            ("s", "s"),
+            ("dg_N", "dg_N"),
+            ("ds", "dg_T"),
+            ("d2g_N", "d2g_N"),
+            ("d2s", "d2g_T"),
+        ):
             close(k_v[mine][i], k[theirs][i], f"{tag}: locate {mine}")
         close(t_N_v[i], t_N[i], f"{tag}: t_N")
         close(dt_N_v[i], dt_N[i], f"{tag}: dt_N")
@@ -254,9 +315,20 @@ def test_reference_tangent_against_finite_differences(master_name, law_name, clo
     c = case(master_name, law_name, closing)
     ndof = 2 if c["master"].rigid else 6
     for i in range(3):
+
         def residual(dx):
-            return reference_pair(c["pairs"][i], dx, c["s_bar"][i], c["c_N"], c["m"], c["params"],
-                                  c["t_T_bar"][i], c["g_bar"][i], c["w"][i])
+            return reference_pair(
+                c["pairs"][i],
+                dx,
+                c["s_bar"][i],
+                c["c_N"],
+                c["m"],
+                c["params"],
+                c["t_T_bar"][i],
+                c["g_bar"][i],
+                c["w"][i],
+            )
+
         _, _, _, fr, R, K = residual(np.zeros(6))
         h, cols = 1e-6, []
         for j in range(ndof):
@@ -278,13 +350,25 @@ def test_segment_variations_equal_the_reference():
     x_1 = rng.normal(size=(nc, 2))
     x_2 = x_1 + rng.uniform(0.1, 5.0, (nc, 1)) * np.stack([np.cos(phi := rng.uniform(-4, 4, nc)), np.sin(phi)], 1)
     a = x_2 - x_1
-    x_s = x_1 + rng.uniform(0.1, 1.5, (nc, 1)) * a \
+    x_s = (
+        x_1
+        + rng.uniform(0.1, 1.5, (nc, 1)) * a
         + rng.choice([-1, 1], (nc, 1)) * rng.uniform(0.05, 0.5, (nc, 1)) * np.stack([-a[:, 1], a[:, 0]], 1)
+    )
     v = segment_variations(x_s, x_1, x_2)
     for i in range(nc):
         r = ref.pair_variations(x_s[i], x_1[i], x_2[i], l_bar=1.0)
-        for mine, theirs in (("l", "l"), ("t", "t"), ("n", "n"), ("g_N", "g_N"), ("alpha", "alpha"), ("dg_N", "dg_N"),
-                             ("d2g_N", "d2g_N"), ("dalpha", "dg_T"), ("d2alpha", "d2g_T")):
+        for mine, theirs in (
+            ("l", "l"),
+            ("t", "t"),
+            ("n", "n"),
+            ("g_N", "g_N"),
+            ("alpha", "alpha"),
+            ("dg_N", "dg_N"),
+            ("d2g_N", "d2g_N"),
+            ("dalpha", "dg_T"),
+            ("d2alpha", "d2g_T"),
+        ):
             close(v[mine][i], r[theirs], f"segment {i}: {mine}")
 
 

@@ -1,4 +1,5 @@
 """make_ring: masses, outline radius, rigid-body measures, the symmetric half ring."""
+
 import numpy as np
 import pytest
 
@@ -24,7 +25,7 @@ def rigid_motion(model, d, phi):
 @pytest.mark.parametrize("n", [8, 40])
 def test_beam_mass_is_rho_A_times_perimeter(n):
     ring = make_ring("beam", n_el=n, **KW)
-    perimeter = 2 * n * R * np.sin(np.pi / n)           # the polygon's
+    perimeter = 2 * n * R * np.sin(np.pi / n)  # the polygon's
     assert ring.total_mass() == pytest.approx(RHO * H * B * perimeter, rel=1e-12)
     assert ring.body.I == pytest.approx(B * H**3 / 12)
     # tends to rho A 2 pi R: relative error ~ (pi/n)^2 / 6
@@ -35,8 +36,8 @@ def test_beam_mass_is_rho_A_times_perimeter(n):
 def test_continuum_mass_is_rho_times_area(n):
     ring = make_ring("continuum", n_el=n, n_radial=2, **KW)
     Ro, Ri = R + H / 2, R - H / 2
-    area = 0.5 * n * np.sin(2 * np.pi / n) * (Ro**2 - Ri**2)   # polygonal annulus
-    assert ring.body.volume() == pytest.approx(B * area, rel=1e-12)   # positive: quads are CCW
+    area = 0.5 * n * np.sin(2 * np.pi / n) * (Ro**2 - Ri**2)  # polygonal annulus
+    assert ring.body.volume() == pytest.approx(B * area, rel=1e-12)  # positive: quads are CCW
     assert ring.total_mass() == pytest.approx(RHO * B * area, rel=1e-12)
 
 
@@ -47,8 +48,8 @@ def test_outline_radius_and_rigid_measures(kind):
     u = rigid_motion(ring, d, phi)
     c = ring.center + d
     P = ring.outline(u)
-    assert np.allclose(P[0], P[-1])                                 # closed polyline
-    assert np.allclose(np.hypot(*(P - c).T), R + H / 2, rtol=1e-12)   # outer surface radius
+    assert np.allclose(P[0], P[-1])  # closed polyline
+    assert np.allclose(np.hypot(*(P - c).T), R + H / 2, rtol=1e-12)  # outer surface radius
     assert np.allclose(ring.center_of_mass(u), c, atol=1e-9)
     # a rigid motion stores no strain (objectivity of both bodies)
     R_int, _ = ring.body.internal(u)
@@ -80,7 +81,7 @@ def test_half_ring_is_the_symmetric_half(kind):
     # the mirrored outline covers exactly the full ring's outline points
     P = half.outline(np.zeros(half.body.ndof), mirror=True)
     Q = full.outline(np.zeros(full.body.ndof))[:-1]
-    assert len(P) == len(Q) + 1                      # top point repeated (closed)
+    assert len(P) == len(Q) + 1  # top point repeated (closed)
     dist = np.min(np.linalg.norm(P[:, None] - Q[None], axis=2), axis=1)
     assert dist.max() < 1e-9
     # a vertical translation: same centre of mass as the full ring
@@ -98,11 +99,19 @@ def test_half_ring_is_the_symmetric_half(kind):
     assert half.angular_velocity(u, np.zeros_like(u)) == 0.0
 
 
-@pytest.mark.parametrize("bad, match", [
-    (dict(kind="shell"), "kind"), (dict(R=-1.0), "R"), (dict(thickness=200.0), "thickness"),
-    (dict(n_el=2), "n_el"), (dict(width=0.0), "width"), (dict(nu=0.5), "nu"),
-    (dict(kind="continuum", n_radial=0), "n_radial"), (dict(kind="continuum", plastic={}), "plastic"),
-])
+@pytest.mark.parametrize(
+    "bad, match",
+    [
+        (dict(kind="shell"), "kind"),
+        (dict(R=-1.0), "R"),
+        (dict(thickness=200.0), "thickness"),
+        (dict(n_el=2), "n_el"),
+        (dict(width=0.0), "width"),
+        (dict(nu=0.5), "nu"),
+        (dict(kind="continuum", n_radial=0), "n_radial"),
+        (dict(kind="continuum", plastic={}), "plastic"),
+    ],
+)
 def test_bad_input(bad, match):
     args = dict(KW, n_el=8)
     args.update(bad)

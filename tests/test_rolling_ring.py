@@ -1,5 +1,6 @@
 """Rolling ring (paper Sec. 5.2, Fig 9): closed form, rolling detection, the scene
 against the rigid thin-ring solution, and convergence under refinement."""
+
 import numpy as np
 import pytest
 
@@ -38,7 +39,7 @@ def test_detect_rolling_on_a_noisy_kink():
     t = np.arange(0, 2, 0.02)
     slip = np.maximum(V0 - 2 * MU * G * t, 0.0) + rng.normal(0, 2.0, t.size)
     assert detect_rolling(t, slip, V0) == pytest.approx(V0 / (2 * MU * G), abs=0.01)
-    assert detect_rolling(t, np.full_like(t, 100.0), V0) is None     # never rolls
+    assert detect_rolling(t, np.full_like(t, 100.0), V0) is None  # never rolls
 
 
 @pytest.fixture(scope="module")
@@ -61,7 +62,7 @@ def test_fast_preset_against_the_thin_ring(fast):
     # the rolling speed: on the coarse fast preset the 40-gon loses energy rolling over its
     # corners (a discretisation error that more than halves under refinement: test below); the
     # paper's discretisation is held against the exact value in test_paper_preset_rolling_speed
-    assert 0 < r["v_final"] < 150.0 and r["omega_final"] < 0                 # rolling forward, losing energy
+    assert 0 < r["v_final"] < 150.0 and r["omega_final"] < 0  # rolling forward, losing energy
     # sliding phase: the centre decelerates at mu g (Coulomb, eq 11)
     t, vx = np.asarray(r["t"]), np.asarray(r["vx_c"])
     sl = (t > 0.2) & (t < 0.8)
@@ -90,15 +91,15 @@ def test_refinement_reduces_the_error(fast):
     # mesh and step refined together (n_el 40 -> 80, dt 0.02 -> 0.01): both errors shrink
     fine = run_scene("rolling_ring", "fast", {"n_el": 80, "dt": 0.01})
     assert abs(fine["x_roll_rel_err"]) < abs(fast["x_roll_rel_err"])
-    assert abs(fine["v_final_rel_err"]) < 0.5 * abs(fast["v_final_rel_err"]), \
+    assert abs(fine["v_final_rel_err"]) < 0.5 * abs(fast["v_final_rel_err"]), (
         f"v error {fine['v_final_rel_err']:.4f} (80 el) vs {fast['v_final_rel_err']:.4f} (40 el)"
+    )
 
 
 @pytest.mark.slow
 def test_continuum_ring_rolls_too():
     # a short, coarse continuum run: rolling starts near the rigid-ring point
-    r = run_scene("rolling_ring", "fast", {"kind": "continuum", "n_radial": 1, "n_el": 24,
-                                            "dt": 1 / 30, "t_end": 1.4})
+    r = run_scene("rolling_ring", "fast", {"kind": "continuum", "n_radial": 1, "n_el": 24, "dt": 1 / 30, "t_end": 1.4})
     assert r["rolled"] and r["rolling_radius"] == pytest.approx(50.5)
     assert r["x_roll"] == pytest.approx(r["x_roll_model"], rel=0.03)
 
@@ -111,6 +112,7 @@ def test_bad_parameter():
 @pytest.mark.slow
 def test_fig09_draws_from_the_result(fast, tmp_path):
     import matplotlib
+
     matplotlib.use("Agg")
     from contactfem.plots import savefig
     from contactfem.plots.rolling_ring import draw_rolling

@@ -1,6 +1,7 @@
 """The run as a value: what a run remembers from step to step is the SystemState the records
 carry, never the bodies, contacts or loads. So marching the same model twice gives the same
 records bit for bit, and a run resumed from any of its records goes on exactly as it went."""
+
 import numpy as np
 import pytest
 
@@ -10,12 +11,25 @@ from contactfem.scenes.base import simulate
 from contactfem.solver.march import resume
 
 # every scene whose model is one Stage (the cork's two stages: test_cork_twice_gives_the_same_records)
-CASES = [("bar_impact", {}), ("bar_impact", {"contact_integration": "energy_consistent"}), ("block", {}),
-         ("block", {"law": "parabolic"}), ("block", {"enforcement": "augmented"}), ("block", {"enforcement": "lagrange"}),
-         ("funnel", {}), ("hertz", {}), ("hertz", {"enforcement": "augmented"}), ("patch", {}),
-         ("patch", {"enforcement": "lagrange"}), ("rolling_ring", {}), ("rolling_ring", {"kind": "continuum"}),
-         ("sloping_impact", {}), ("sloping_impact", {"variant": "frictional"}),
-         ("sloping_impact", {"variant": "viscoplastic"}), ("sloping_impact", {"contact_integration": "energy_consistent"})]
+CASES = [
+    ("bar_impact", {}),
+    ("bar_impact", {"contact_integration": "energy_consistent"}),
+    ("block", {}),
+    ("block", {"law": "parabolic"}),
+    ("block", {"enforcement": "augmented"}),
+    ("block", {"enforcement": "lagrange"}),
+    ("funnel", {}),
+    ("hertz", {}),
+    ("hertz", {"enforcement": "augmented"}),
+    ("patch", {}),
+    ("patch", {"enforcement": "lagrange"}),
+    ("rolling_ring", {}),
+    ("rolling_ring", {"kind": "continuum"}),
+    ("sloping_impact", {}),
+    ("sloping_impact", {"variant": "frictional"}),
+    ("sloping_impact", {"variant": "viscoplastic"}),
+    ("sloping_impact", {"contact_integration": "energy_consistent"}),
+]
 
 
 def same(r, q):
@@ -37,8 +51,9 @@ def model_of(name, over):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name,over", CASES, ids=[f"{n}{'-' + '-'.join(map(str, o.values())) if o else ''}"
-                                                  for n, o in CASES])
+@pytest.mark.parametrize(
+    "name,over", CASES, ids=[f"{n}{'-' + '-'.join(map(str, o.values())) if o else ''}" for n, o in CASES]
+)
 def test_marching_the_same_model_twice_gives_the_same_records(name, over):
     scene, params, model = model_of(name, over)
     run = scene.simulate or simulate
@@ -49,8 +64,9 @@ def test_marching_the_same_model_twice_gives_the_same_records(name, over):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name,over", [("sloping_impact", {"variant": "frictional"}), ("block", {"n_steps": 4}),
-                                       ("rolling_ring", {})])
+@pytest.mark.parametrize(
+    "name,over", [("sloping_impact", {"variant": "frictional"}), ("block", {"n_steps": 4}), ("rolling_ring", {})]
+)
 def test_a_run_resumed_from_its_kth_record_goes_on_as_it_went(name, over):
     scene, params, model = model_of(name, over)
     records = simulate(model, params)
@@ -58,16 +74,21 @@ def test_a_run_resumed_from_its_kth_record_goes_on_as_it_went(name, over):
     k = len(records) // 2
     rest = list(resume(st.stepper, st.schedule, records[k], label=st.label))
     assert len(rest) == len(records) - k - 1
-    for r, q in zip(rest, records[k + 1:]):
+    for r, q in zip(rest, records[k + 1 :]):
         same(r, q)
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name,over,suffix", [("sloping_impact", {"variant": "viscoplastic"}, ".json"),
-                                              ("bar_impact", {"enforcement": "augmented"}, ".npz"),
-                                              ("sloping_impact", {"variant": "frictional"}, ".npz"),
-                                              ("sloping_impact", {"accuracy": 1e-2, "n_steps": 5}, ".json"),
-                                              ("bar_impact", {"accuracy": 1e-2}, ".npz")])
+@pytest.mark.parametrize(
+    "name,over,suffix",
+    [
+        ("sloping_impact", {"variant": "viscoplastic"}, ".json"),
+        ("bar_impact", {"enforcement": "augmented"}, ".npz"),
+        ("sloping_impact", {"variant": "frictional"}, ".npz"),
+        ("sloping_impact", {"accuracy": 1e-2, "n_steps": 5}, ".json"),
+        ("bar_impact", {"accuracy": 1e-2}, ".npz"),
+    ],
+)
 def test_a_run_restarted_from_its_saved_kth_record_goes_on_as_it_went(name, over, suffix, tmp_path):
     """The record saved to a file and read back (its SystemState: plastic strains, multipliers,
     contact histories, the slope a run at a tolerance carries; its step's local error, which
@@ -80,12 +101,13 @@ def test_a_run_restarted_from_its_saved_kth_record_goes_on_as_it_went(name, over
     same(loaded, records[k])
     rest = list(resume(st.stepper, st.schedule, loaded, label=st.label))
     assert len(rest) == len(records) - k - 1 > 0
-    for r, q in zip(rest, records[k + 1:]):
+    for r, q in zip(rest, records[k + 1 :]):
         same(r, q)
 
 
 def test_a_record_that_is_not_one_is_refused(tmp_path):
     from contactfem.io import save_run
+
     path = save_run({"x": 1.0}, tmp_path / "run.json")
     with pytest.raises(ValueError, match="not a saved record"):
         load_record(path)
@@ -122,6 +144,7 @@ def _march_twice(name, monkeypatch):
     import sys
 
     import contactfem.solver as solver
+
     march_module = sys.modules["contactfem.solver.march"]
 
     runs, real = [], march_module.march
@@ -149,8 +172,9 @@ def _march_twice(name, monkeypatch):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name", ["04_block", "05_rolling_ring", "06_sloping_impact", "07_funnel",
-                                  "10_write_your_own_law"])
+@pytest.mark.parametrize(
+    "name", ["04_block", "05_rolling_ring", "06_sloping_impact", "07_funnel", "10_write_your_own_law"]
+)
 def test_a_lectures_march_cell_run_twice_gives_the_same_records(name, monkeypatch, tmp_path):
     monkeypatch.setenv("CONTACTFEM_FIGURES", str(tmp_path))
     first, second = _march_twice(name, monkeypatch)

@@ -1,6 +1,7 @@
 """The bench's scaling study: Hertz in contactfem and as a plain scikit-fem script, the same
 discrete problem (the same p0 to rounding), and its BENCHMARKS.md table printing the study's
 JSON. No timing is asserted (times depend on the machine and its load)."""
+
 import re
 
 import pytest
@@ -39,9 +40,9 @@ def test_the_table_prints_the_json(study):
     for line, r in zip(lines, study["rows"]):
         cells = [c.strip() for c in line.strip("|").split("|")]
         assert [int(c) for c in cells[:4]] == [r["n_el"], r["n_quads"], r["unknowns"], r["repeats"]]
-        for cell, key in ((cells[4], "contactfem_s"), (cells[5], "plain_s")):       # 3 significant digits
+        for cell, key in ((cells[4], "contactfem_s"), (cells[5], "plain_s")):  # 3 significant digits
             assert float(cell) == pytest.approx(r[key], rel=5e-3)
-        assert float(cells[6]) == pytest.approx(r["ratio"], abs=0.005 + 1e-12)       # 2 decimals
+        assert float(cells[6]) == pytest.approx(r["ratio"], abs=0.005 + 1e-12)  # 2 decimals
         assert cells[7] == f"{r['contactfem_solves']}, {r['plain_solves']}"
         assert cells[8].startswith(r["linear_algebra"])
         assert float(cells[9]) == pytest.approx(r["error_p0"], rel=5e-3)

@@ -35,8 +35,9 @@ def _leaves(obj, prefix=""):
     """(path, float array) for every numeric leaf of a results dict."""
     if isinstance(obj, dict):
         for k, v in obj.items():
-            if k in ("wall_time_s", "parameters", "friction_law", "normal_law", "scene", "preset") \
-                    or k.startswith("paper"):        # the paper's numbers: of its own laws, not a result
+            if k in ("wall_time_s", "parameters", "friction_law", "normal_law", "scene", "preset") or k.startswith(
+                "paper"
+            ):  # the paper's numbers: of its own laws, not a result
                 continue
             yield from _leaves(v, f"{prefix}/{k}")
     else:
@@ -60,11 +61,14 @@ def test_cli_runs_every_scene_with_a_law_file(scene, tmp_path):
     out = tmp_path / "r.json"
     proc = _cli("run", scene, "--friction", "tests/data/saturating.py:Saturating", "--json", str(out))
     assert proc.returncode == 0, proc.stderr
-    assert "note" not in proc.stderr                          # every field has a default: none from the scene
+    assert "note" not in proc.stderr  # every field has a default: none from the scene
     res = json.loads(out.read_text())
     rec = res["friction_law"]
-    assert rec == {"class": "Saturating", "file": "tests/data/saturating.py",
-                   "fields": {"c_T": 30.0, "mu0": 0.3, "p0": 1000.0}}
+    assert rec == {
+        "class": "Saturating",
+        "file": "tests/data/saturating.py",
+        "fields": {"c_T": 30.0, "mu0": 0.3, "p0": 1000.0},
+    }
     sc = get_scene(scene)
     assert not set(sc.law_params["friction"]) & set(res["parameters"])
     if "variant" in res:
@@ -77,17 +81,21 @@ def test_a_coulomb_law_file_equals_the_built_in_law(scene):
     over, mu_from = COULOMB_SETUPS[scene]
     params = get_scene(scene).resolve("fast", over)
     mu = params["alpha"] + params["beta"] if mu_from == "alpha+beta" else params["mu"]
-    law = laws_from_options(friction=f"{DATA / 'coulomb_law.py'}:MyCoulomb", scene_params=dict(params, mu=mu))["friction"]
+    law = laws_from_options(friction=f"{DATA / 'coulomb_law.py'}:MyCoulomb", scene_params=dict(params, mu=mu))[
+        "friction"
+    ]
     assert type(law).__name__ == "MyCoulomb" and law.mu == mu and law.c_T == params["c_T"]
     built_in = run_scene(scene, "fast", over)
     sc = get_scene(scene)
-    mine = run_scene(scene, "fast", {k: v for k, v in over.items() if sc.law_param_kind(k, v) != "friction"},
-                     friction=law)
+    mine = run_scene(
+        scene, "fast", {k: v for k, v in over.items() if sc.law_param_kind(k, v) != "friction"}, friction=law
+    )
     assert mine["friction_law"]["fields"] == {"c_T": params["c_T"], "mu": mu}
     if scene == "rolling_ring":
         # the rigid ring's closed forms are reference values for the Coulomb class the toolkit
         # knows, not results of the run: a law class of one's own has none (None)
         from contactfem.scenes.rolling_ring import CLOSED_FORM_KEYS
+
         assert all(mine[k] is None for k in CLOSED_FORM_KEYS) and built_in["exact_mu"] == mu
         mine = {k: v for k, v in mine.items() if k not in CLOSED_FORM_KEYS}
         built_in = {k: v for k, v in built_in.items() if k not in CLOSED_FORM_KEYS}
@@ -99,7 +107,7 @@ def test_a_coulomb_law_file_equals_the_built_in_law(scene):
     assert a.keys() == b.keys() and len(a) > 3
     for key in b:
         assert a[key].shape == b[key].shape, key
-        assert np.array_equal(np.isnan(a[key]), np.isnan(b[key])), key        # None (not reached) in both
+        assert np.array_equal(np.isnan(a[key]), np.isnan(b[key])), key  # None (not reached) in both
         x, y = a[key][~np.isnan(b[key])], b[key][~np.isnan(b[key])]
         scale = max(float(np.max(np.abs(y), initial=0.0)), 1e-300)
         assert np.all(np.abs(x - y) <= 1e-10 * scale), (key, np.max(np.abs(x - y)))
@@ -120,12 +128,25 @@ def test_a_shipped_law_object_from_python():
 @pytest.mark.slow
 def test_cli_law_fields_and_errors(tmp_path):
     out = tmp_path / "b.json"
-    ok = _cli("run", "block", "--friction", "tests/data/saturating.py:Saturating", "--set", "law.mu0=0.6",
-              "--set", "law.p0=500", "--json", str(out))
+    ok = _cli(
+        "run",
+        "block",
+        "--friction",
+        "tests/data/saturating.py:Saturating",
+        "--set",
+        "law.mu0=0.6",
+        "--set",
+        "law.p0=500",
+        "--json",
+        str(out),
+    )
     assert ok.returncode == 0, ok.stderr
     assert json.loads(out.read_text())["friction_law"]["fields"] == {"c_T": 30.0, "mu0": 0.6, "p0": 500.0}
     for args, pattern in [
-        (("--friction", "tests/data/saturating.py:Saturating", "--set", "law.mu0=-1"), "parameter mu0 = -1.0 is out of range"),
+        (
+            ("--friction", "tests/data/saturating.py:Saturating", "--set", "law.mu0=-1"),
+            "parameter mu0 = -1.0 is out of range",
+        ),
         (("--friction", "tests/data/broken_syntax.py:Broken"), "law file broken_syntax.py, line 8: SyntaxError"),
         (("--friction", "tests/data/math_law.py:MathTanh"), "law file math_law.py, line 11: .*math.tanh"),
         (("--friction", "tests/data/nowhere.py:X"), "law file tests/data/nowhere.py not found"),

@@ -55,6 +55,7 @@ def mathjax_dir(tmp_path_factory):
 
 # -- the checker's own tests: small hand-made sites, one thing broken in each -------------
 
+
 def _png(path, w=12, h=8):
     import numpy as np
     from PIL import Image
@@ -63,17 +64,21 @@ def _png(path, w=12, h=8):
 
 
 def _page(body):
-    return ("<!DOCTYPE html><html><head><meta charset='utf-8'>"
-            "<script>window.MathJax = {tex: {inlineMath: [['\\\\(', '\\\\)']], displayMath: [['\\\\[', '\\\\]']],"
-            "packages: {'[-]': ['noundefined']}}};</script>"
-            "<script defer src='_static/mathjax/tex-chtml.js'></script></head>"
-            f"<body>{body}</body></html>")
+    return (
+        "<!DOCTYPE html><html><head><meta charset='utf-8'>"
+        "<script>window.MathJax = {tex: {inlineMath: [['\\\\(', '\\\\)']], displayMath: [['\\\\[', '\\\\]']],"
+        "packages: {'[-]': ['noundefined']}}};</script>"
+        "<script defer src='_static/mathjax/tex-chtml.js'></script></head>"
+        f"<body>{body}</body></html>"
+    )
 
 
-GOOD = ("<h1 id='top'>A page</h1><p>Hertz: <span class='math'>\\(p_0 = \\sqrt{{P E^*/(\\pi R)}}\\)</span></p>"
-        "<div class='math'>\\[ g_N = (\\mathbf x_s - \\mathbf x_1) \\cdot \\mathbf n \\tag{{17}} \\]</div>"
-        "<img src='fig.png' alt='a figure'><p><a href='other.html#sec'>other</a> <a href='#top'>top</a></p>"
-        "<pre>price = '$$' in code is fine</pre>{extra}")
+GOOD = (
+    "<h1 id='top'>A page</h1><p>Hertz: <span class='math'>\\(p_0 = \\sqrt{{P E^*/(\\pi R)}}\\)</span></p>"
+    "<div class='math'>\\[ g_N = (\\mathbf x_s - \\mathbf x_1) \\cdot \\mathbf n \\tag{{17}} \\]</div>"
+    "<img src='fig.png' alt='a figure'><p><a href='other.html#sec'>other</a> <a href='#top'>top</a></p>"
+    "<pre>price = '$$' in code is fine</pre>{extra}"
+)
 OTHER = "<h2 id='sec'>Other</h2><p><a href='index.html'>back</a></p>"
 
 
@@ -110,11 +115,14 @@ def test_checker_fails_when_an_image_is_removed(mathjax_dir, chromium):
     assert any("broken link fig.png (HTTP 404)" in p for p in problems), problems
 
 
-@pytest.mark.parametrize("tex, expect", [
-    ("\\frac{a}", "1 equation(s) failed to typeset"),        # TeX error: MathJax shows an error box
-    ("\\notamacro{x}", "1 equation(s) failed to typeset"),   # undefined control sequence
-    ("\\frac{a}{", "1 untypeset \\( or \\[ left"),            # unbalanced: the delimiters stay raw
-])
+@pytest.mark.parametrize(
+    "tex, expect",
+    [
+        ("\\frac{a}", "1 equation(s) failed to typeset"),  # TeX error: MathJax shows an error box
+        ("\\notamacro{x}", "1 equation(s) failed to typeset"),  # undefined control sequence
+        ("\\frac{a}{", "1 untypeset \\( or \\[ left"),  # unbalanced: the delimiters stay raw
+    ],
+)
 def test_checker_fails_on_a_broken_equation(mathjax_dir, chromium, tex, expect):
     problems = _check(_site(mathjax_dir, extra=f"<div class='math'>\\[ {tex} \\]</div>"), chromium)["problems"]
     assert any(expect in p for p in problems), problems
@@ -134,8 +142,10 @@ def test_checker_fails_without_mathjax(mathjax_dir, chromium):
 
 
 def test_checker_fails_on_dead_links_and_offsite_scripts(mathjax_dir, chromium):
-    extra = ("<a href='missing.html'>x</a><a href='other.html#nowhere'>y</a>"
-             "<script src='https://cdn.example.org/mathjax.js'></script>")
+    extra = (
+        "<a href='missing.html'>x</a><a href='other.html#nowhere'>y</a>"
+        "<script src='https://cdn.example.org/mathjax.js'></script>"
+    )
     problems = _check(_site(mathjax_dir, extra=extra), chromium)["problems"]
     assert any("broken link missing.html (HTTP 404)" in p for p in problems), problems
     assert any("no #nowhere in other.html" in p for p in problems), problems
@@ -143,6 +153,7 @@ def test_checker_fails_on_dead_links_and_offsite_scripts(mathjax_dir, chromium):
 
 
 # -- the real site --------------------------------------------------------------------
+
 
 def _site_extra():
     pytest.importorskip("nbclient")
@@ -160,7 +171,7 @@ def site(chromium, tmp_path_factory):
     from contactfem.lab.site import build
 
     before = _tree(REPO)
-    index = build(tmp_path_factory.mktemp("site") / "out")    # all its files under out (its cache: out/.contactfem-site)
+    index = build(tmp_path_factory.mktemp("site") / "out")  # all its files under out (its cache: out/.contactfem-site)
     assert _tree(REPO) == before, "the site build wrote into the checkout"
     return index.parent
 
@@ -235,7 +246,7 @@ def _assert_student_zip(site, lectures):
     assert link, "the front page does not link the student zip"
     with zipfile.ZipFile(site / link.group(1)) as z:
         files = {Path(n).name: z.read(n).decode() for n in z.namelist()}
-    examples = [f.name for f in (REPO / "lectures" / "examples").glob("*.*")]     # the files lectures read
+    examples = [f.name for f in (REPO / "lectures" / "examples").glob("*.*")]  # the files lectures read
     assert sorted(files) == sorted(["README.md"] + [nb.name for nb in lectures] + examples)
     for nb_path in lectures:
         text = files[nb_path.name]
@@ -282,7 +293,7 @@ def test_gallery_page_keeps_the_readmes_tables_intact():
     assert [r[:4] for r in summary] == [r[:4] for r in readme[0]]
     for t in tables:
         assert all(len(r) == len(t[0]) for r in t), t[0]
-        assert all(set(c) <= set("-: ") for c in t[1]), t[1]        # the separator is the second row
+        assert all(set(c) <= set("-: ") for c in t[1]), t[1]  # the separator is the second row
     readings = [t for t in tables if t[0][0] == "reading"]
     assert len(readings) == 1 and readings[0] == readme[1]
     heads = [ln for ln in page.splitlines() if ln.startswith("## ")]
@@ -345,6 +356,7 @@ def test_site_command_line():
 
 # -- every file under --out -------------------------------------------------------------
 
+
 def _everything(root, skip=None):
     """Every path under `root` (folders too), with each file's size, outside `skip`."""
     out = set()
@@ -372,17 +384,32 @@ def test_an_instructor_site_writes_nothing_outside_out(tmp_path):
     for d in ("home", "tmp", "cache", "cwd"):
         (parent / d).mkdir(parents=True)
     out = parent / "X"
-    env = dict(os.environ, HOME=str(parent / "home"), TMPDIR=str(parent / "tmp"), PYTHONPATH=str(REPO),
-               CONTACTFEM_CACHE=str(parent / "cache"), MPLBACKEND="Agg")
+    env = dict(
+        os.environ,
+        HOME=str(parent / "home"),
+        TMPDIR=str(parent / "tmp"),
+        PYTHONPATH=str(REPO),
+        CONTACTFEM_CACHE=str(parent / "cache"),
+        MPLBACKEND="Agg",
+    )
     env.pop("MPLCONFIGDIR", None)
     env.pop("IPYTHONDIR", None)
     # the tools' own per-user caches exist on any machine that ran matplotlib once: made here first
     subprocess.run([sys.executable, "-c", "import matplotlib.font_manager"], env=env, cwd=parent / "cwd", check=True)
     before, checkout = _everything(parent), _tree(REPO)
     t0 = time.monotonic()
-    p = subprocess.run([sys.executable, "-c", "from contactfem.lab.site import build; "
-                        f"build({str(out)!r}, instructor=True, only=[{lecture.stem!r}])"],
-                       env=env, cwd=parent / "cwd", capture_output=True, text=True, timeout=1200)
+    p = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            f"from contactfem.lab.site import build; build({str(out)!r}, instructor=True, only=[{lecture.stem!r}])",
+        ],
+        env=env,
+        cwd=parent / "cwd",
+        capture_output=True,
+        text=True,
+        timeout=1200,
+    )
     print(f"\ninstructor site of one lecture built in {time.monotonic() - t0:.0f} s")
     assert p.returncode == 0, p.stderr[-3000:]
     assert _everything(parent, skip=out) == before, sorted(_everything(parent, skip=out) ^ before)[:20]
@@ -407,10 +434,16 @@ def test_ctrl_c_during_the_site_build_leaves_the_old_pages(tmp_path):
     (out / ".buildinfo").write_text("# an earlier build\n")
     (out / "index.html").write_text("<p>the old site</p>")
     env = dict(os.environ, PYTHONPATH=str(REPO), TMPDIR=str(tmp_path))
-    p = subprocess.Popen([sys.executable, "-m", "contactfem", "site", "--out", str(out)], env=env, text=True,
-                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True,
-                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
-    stamp = out / ".contactfem-site" / "cache" / "contactfem-code.txt"       # Sphinx starts next
+    p = subprocess.Popen(
+        [sys.executable, "-m", "contactfem", "site", "--out", str(out)],
+        env=env,
+        text=True,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        start_new_session=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
+    stamp = out / ".contactfem-site" / "cache" / "contactfem-code.txt"  # Sphinx starts next
     t0 = time.monotonic()
     while p.poll() is None and not stamp.exists() and time.monotonic() - t0 < 300:
         time.sleep(0.05)
@@ -419,8 +452,10 @@ def test_ctrl_c_during_the_site_build_leaves_the_old_pages(tmp_path):
     os.killpg(p.pid, signal.SIGINT)
     _, err = p.communicate(timeout=120)
     assert p.returncode == 130, err
-    assert err.strip() == (f"contactfem: interrupted during the site build; the site in {out} is unchanged "
-                           f"(notebooks executed so far are cached in {out / '.contactfem-site'})"), err
+    assert err.strip() == (
+        f"contactfem: interrupted during the site build; the site in {out} is unchanged "
+        f"(notebooks executed so far are cached in {out / '.contactfem-site'})"
+    ), err
     assert sorted(q.name for q in out.iterdir()) == [".buildinfo", ".contactfem-site", "index.html"]
     assert (out / "index.html").read_text() == "<p>the old site</p>"
     assert sorted(q.name for q in (out / ".contactfem-site").iterdir()) == ["cache"]

@@ -25,19 +25,28 @@ def res():
 
 def test_json_has_the_required_results(res):
     for r in res.values():
-        for key in ("rebound_vx", "rebound_vy", "rebound_angle_deg", "rebound_spin", "energy_kinetic",
-                    "energy_strain", "energy_contact", "energy_dissipation", "energy_total",
-                    "newton_iterations_total"):
+        for key in (
+            "rebound_vx",
+            "rebound_vy",
+            "rebound_angle_deg",
+            "rebound_spin",
+            "energy_kinetic",
+            "energy_strain",
+            "energy_contact",
+            "energy_dissipation",
+            "energy_total",
+            "newton_iterations_total",
+        ):
             assert key in r, key
         assert r["rebounded"], "the ring leaves the plane within the 200 steps"
         assert r["newton_iterations_total"] > 200
-        json.dumps(r)                                            # JSON-able, no NaN
+        json.dumps(r)  # JSON-able, no NaN
         assert len(r["energy_total"]) == len(r["t"]) == 201
 
 
 def test_rebound_angle_definition():
-    assert rebound_angle(2.0, 1.7) == pytest.approx(49.64, abs=0.01)    # Table 2: 50 deg
-    assert rebound_angle(1.2, -1.7) == pytest.approx(35.22, abs=0.01)   # Table 2: 35 deg
+    assert rebound_angle(2.0, 1.7) == pytest.approx(49.64, abs=0.01)  # Table 2: 50 deg
+    assert rebound_angle(1.2, -1.7) == pytest.approx(35.22, abs=0.01)  # Table 2: 35 deg
 
 
 # Table 2 prints the velocities to two digits (1.7, 1.2: +-0.05, 3-4 %). A number is reproduced
@@ -50,15 +59,23 @@ VELOCITY_TOL = rc.TABLE2_VELOCITY_TOL
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("over", [{}, {"integration": "1"}, {"mass_matrix": "consistent"},
-                                  {"contact_integration": "energy_consistent"}, {"kind": "continuum", "n_el": 24}])
+@pytest.mark.parametrize(
+    "over",
+    [
+        {},
+        {"integration": "1"},
+        {"mass_matrix": "consistent"},
+        {"contact_integration": "energy_consistent"},
+        {"kind": "continuum", "n_el": 24},
+    ],
+)
 def test_a_frictionless_plane_keeps_v_x(over):
     """Table 2's frictionless v_x = 2 is no test of a reading: a frictionless plane exerts no
     tangential force, so the momentum along it is kept, whatever the ring, its mass and the
     stepper (both keep linear momentum exactly when the resultant is zero): v_x = 2 to 1e-8."""
     r = run_scene("sloping_impact", "paper", dict(over, variant="frictionless", n_steps=60))
     assert r["rebounded"] and r["rebound_vx"] == pytest.approx(2.0, rel=1e-8)
-    assert np.allclose(r["vx_c"], 2.0, rtol=1e-8, atol=0)               # at every step, through the impact
+    assert np.allclose(r["vx_c"], 2.0, rtol=1e-8, atol=0)  # at every step, through the impact
 
 
 def test_readme_table2_row_is_the_run(res):
@@ -68,8 +85,11 @@ def test_readme_table2_row_is_the_run(res):
     whichever way a change moves the model (a better model, within 10 %, updates the count).
     The frictionless v_x is no test of a reading (test_a_frictionless_plane_keeps_v_x)."""
     readme = (Path(__file__).parents[1] / "README.md").read_text()
-    row = next(ln for ln in readme[readme.index("### Table 2"):].splitlines()
-               if ln.startswith("| two-point beam (preset `paper`"))
+    row = next(
+        ln
+        for ln in readme[readme.index("### Table 2") :].splitlines()
+        if ln.startswith("| two-point beam (preset `paper`")
+    )
     for v in ("frictionless", "frictional"):
         r = res[v]
         text = f"{abs(r['rebound_vx']):.2f}, {abs(r['rebound_vy']):.2f}, {r['rebound_angle_deg']:.1f} deg"
@@ -150,15 +170,18 @@ def test_discretisation_study_kept_with_the_figures_is_the_run():
     by_label = {r["label"]: r for r in kept["rows"]}
     readme = " ".join((base.parents[1] / "README.md").read_text().split())
     converged = by_label["128, 0.0125, 1/2 / 1/4"]["frictionless"]["angle"]
-    assert f"brings the frictionless angle to {converged:.1f} deg" in readme      # the README's Table 2 section
+    assert f"brings the frictionless angle to {converged:.1f} deg" in readme  # the README's Table 2 section
     rows = F.discretisation_rows(kept["preset"], quick=not os.environ.get("CONTACTFEM_SLOW"))
     assert rows
     for row in rows:
         for variant in ("frictionless", "frictional"):
             assert (variant in row) == (variant in by_label[row["label"]]), (row["label"], variant)
             for k, v in row.get(variant, {}).items():
-                assert v == pytest.approx(by_label[row["label"]][variant][k], rel=1e-9, abs=1e-12), \
-                    (row["label"], variant, k)
+                assert v == pytest.approx(by_label[row["label"]][variant][k], rel=1e-9, abs=1e-12), (
+                    row["label"],
+                    variant,
+                    k,
+                )
 
 
 @pytest.mark.slow
@@ -169,7 +192,8 @@ def test_a_fine_ring_runs():
     discretisation's change (n_el = 16 -> 1000 moves v_y by less than 10 %)."""
     from contactfem.scenes import get_scene
     from contactfem.scenes.sloping_impact import newton_atol
-    assert newton_atol(get_scene("sloping_impact").resolve("paper"), 48) == 1e-10    # the presets keep 1e-10
+
+    assert newton_atol(get_scene("sloping_impact").resolve("paper"), 48) == 1e-10  # the presets keep 1e-10
     fine = run_scene("sloping_impact", "fast", {"n_el": 1000})
     coarse = run_scene("sloping_impact", "fast")
     assert fine["rebounded"] and abs(fine["rebound_vy"] - coarse["rebound_vy"]) < 0.1 * abs(coarse["rebound_vy"])

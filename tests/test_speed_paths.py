@@ -56,8 +56,7 @@ def test_an_unknown_scene_name_lists_the_known_ones(name):
 def test_building_a_scene_loads_what_it_needs():
     """scikit-fem comes in when a scene builds a continuum, not before; a ring of beams
     (its mass summed with numpy) needs none of the heavy libraries."""
-    code = ("from contactfem.scenes import get_scene, {0}\n"
-            "{0}.build(get_scene('{0}').resolve('fast'))")
+    code = "from contactfem.scenes import get_scene, {0}\n{0}.build(get_scene('{0}').resolve('fast'))"
     assert "skfem" in heavy_modules_after(code.format("block"))
     assert heavy_modules_after(code.format("sloping_impact")) == []
 
@@ -67,13 +66,16 @@ def test_a_dense_run_from_the_command_line_loads_no_heavy_library(tmp_path):
     """The sloping impact (48 unknowns: a dense K, LAPACK through numpy) from the command
     line, its JSON written: no scipy, scikit-fem, matplotlib or joblib."""
     out = tmp_path / "r.json"
-    code = (f"from contactfem.cli import main\nassert main(['run', 'sloping_impact', '--set', 'n_steps=5', "
-            f"'--json', {str(out)!r}]) == 0")
+    code = (
+        f"from contactfem.cli import main\nassert main(['run', 'sloping_impact', '--set', 'n_steps=5', "
+        f"'--json', {str(out)!r}]) == 0"
+    )
     assert heavy_modules_after(code) == []
     assert json.loads(out.read_text())["linear_algebra"] == "dense"
 
 
 # -- dense and sparse tangents -----------------------------------------------------------
+
 
 def test_size_threshold_chooses_dense_then_sparse():
     assert choose_linear_algebra(DENSE_MAX) == "dense"
@@ -102,7 +104,7 @@ def test_fixed_pattern_grows_and_sums_like_coo():
         assert np.allclose(K.toarray(), ref + np.diag(diag), rtol=1e-15, atol=1e-14)
         dense = TangentAssembler(n, "dense").assemble([(body_rows, body_cols, vals, 0, "b"), (r, c, v, 0, None)], diag)
         assert np.allclose(dense, ref + np.diag(diag), rtol=1e-15, atol=1e-14)
-    assert asm.pattern_builds >= 2          # it grew at least once after the first assembly
+    assert asm.pattern_builds >= 2  # it grew at least once after the first assembly
 
 
 def impact(linear_algebra, n_steps=40):
@@ -111,8 +113,16 @@ def impact(linear_algebra, n_steps=40):
     m = sloping_impact.build(p, system_options=dict(linear_algebra=linear_algebra))
     ring, system = m.parts["ring"], m.system
     stepper = Newmark(system, p["delta"], p["beta_newmark"], atol=1e-10, rtol=1e-10, maxit=30)
-    hist = integrate(stepper, 0.0, np.zeros(system.ndof), ring.initial_velocity((p["vx0"], p["vy0"])),
-                     n_steps=n_steps, dt=p["dt"], cutback=True, max_cuts=6)
+    hist = integrate(
+        stepper,
+        0.0,
+        np.zeros(system.ndof),
+        ring.initial_velocity((p["vx0"], p["vy0"])),
+        n_steps=n_steps,
+        dt=p["dt"],
+        cutback=True,
+        max_cuts=6,
+    )
     return system, hist
 
 
@@ -138,6 +148,7 @@ def test_effective_tangent_is_the_same_matrix_dense_and_sparse():
 
 
 # -- the bench's split of a Newton iteration -----------------------------------------------
+
 
 def test_iteration_cost_splits_the_newton_time_of_a_real_run():
     """Each part is non-negative (the overhead, what the Newton time leaves after the timed
@@ -169,6 +180,7 @@ def test_run_json_reports_the_linear_algebra():
 
 # -- banded tangents (LAPACK's band LU after reverse Cuthill-McKee) -------------------------
 
+
 def scrambled_band(n, kl, ku, seed):
     """A random non-symmetric band matrix (kl below, ku above the diagonal) with its rows and
     columns numbered at random (the same permutation), as CSC, and the permutation."""
@@ -189,7 +201,7 @@ def test_band_solve_matches_a_dense_solve(free):
     A, _ = scrambled_band(n, 4, 7, seed=3)
     dofs = np.arange(n) if free is None else np.setdiff1d(np.arange(n), [0, 17, 55, 119])
     plan = BandPlan(A.indptr, A.indices, n, None if free is None else dofs)
-    assert plan.kl + plan.ku <= 2 * (4 + 7) < n // 4        # RCM finds a band of about the original width
+    assert plan.kl + plan.ku <= 2 * (4 + 7) < n // 4  # RCM finds a band of about the original width
     b = np.random.default_rng(4).normal(size=len(dofs))
     x = plan.solve(A.data, b)
     x_ref = np.linalg.solve(A.toarray()[np.ix_(dofs, dofs)], b)
@@ -205,7 +217,7 @@ def test_singular_banded_tangent_raises_through_newton():
     n = 120
     A, _ = scrambled_band(n, 3, 3, seed=5)
     A = A.tocoo()
-    vals = np.where(A.col == 40, 0.0, A.data)                    # column 40 zero: singular
+    vals = np.where(A.col == 40, 0.0, A.data)  # column 40 zero: singular
     asm = TangentAssembler(n, "banded")
     K = asm.assemble([(A.row, A.col, vals, 0, None)])
     assert asm.kind == "banded" and K.band_plan.fits(K, None)
@@ -231,8 +243,12 @@ def test_banded_tangent_is_the_sparse_matrix():
     assert np.array_equal(K1.toarray(), sparse.assemble([(A.row, A.col, A.data, 0, "body")], np.ones(n)).toarray())
     x = rng.normal(size=n)
     assert np.allclose(K1 @ x, ref @ x, rtol=1e-14, atol=1e-14)
-    assert sp.issparse(K1) and K1.format == "csc" and not hasattr(sparse.assemble([(A.row, A.col, A.data, 0, None)]), "band_plan")
-    with pytest.raises(ValueError):                 # the shared pattern is not changed in place
+    assert (
+        sp.issparse(K1)
+        and K1.format == "csc"
+        and not hasattr(sparse.assemble([(A.row, A.col, A.data, 0, None)]), "band_plan")
+    )
+    with pytest.raises(ValueError):  # the shared pattern is not changed in place
         K1.eliminate_zeros()
     assert np.array_equal(K2.toarray(), 2 * A.toarray())
     # the plan is for all dofs: a solve on other free dofs goes to SuperLU, with the same answer
@@ -240,15 +256,22 @@ def test_banded_tangent_is_the_sparse_matrix():
 
     sub = np.arange(1, n - 1)
     assert not K1.band_plan.fits(K1, sub)
-    assert np.allclose(solve_free(K1, x[sub], sub, False), np.linalg.solve(ref[np.ix_(sub, sub)], x[sub]),
-                       rtol=1e-12, atol=1e-12)
+    assert np.allclose(
+        solve_free(K1, x[sub], sub, False), np.linalg.solve(ref[np.ix_(sub, sub)], x[sub]), rtol=1e-12, atol=1e-12
+    )
 
 
 # Numbers that are differences of nearly equal numbers (relative errors against the exact
 # solution, the cork's margin over its static estimate) or rounding-level by construction
 # (the block's equilibrium error): their inputs are compared instead.
-DERIVED = ("x_roll_rel_err", "v_final_rel_err", "x_end_rel_err", "breakaway_margin_MPa", "equilibrium_error",
-           "accuracy")        # (the indicators: relative errors and ratios, derived like the rel_err)
+DERIVED = (
+    "x_roll_rel_err",
+    "v_final_rel_err",
+    "x_end_rel_err",
+    "breakaway_margin_MPa",
+    "equilibrium_error",
+    "accuracy",
+)  # (the indicators: relative errors and ratios, derived like the rel_err)
 
 
 # Components of one vector are compared against the vector's size: the rolling ring's
@@ -258,10 +281,14 @@ DERIVED = ("x_roll_rel_err", "v_final_rel_err", "x_end_rel_err", "breakaway_marg
 VECTORS = {"vy_c": ("vx_c", "vy_c"), "vx_c": ("vx_c", "vy_c")}
 
 
-def numbers_agree(a, b, rel=1e-12, skip=("wall_time_s", "linear_algebra", "ordering", "band_kl", "band_ku",
-                                          "import_time_s") + DERIVED,
-                  path="",
-                  scale=None):
+def numbers_agree(
+    a,
+    b,
+    rel=1e-12,
+    skip=("wall_time_s", "linear_algebra", "ordering", "band_kl", "band_ku", "import_time_s") + DERIVED,
+    path="",
+    scale=None,
+):
     """Every number of two results (nested dicts and lists) agrees to `rel` of the largest
     value of its entry (or of its vector, VECTORS); integers (iteration counts), flags and
     strings exactly."""
@@ -269,8 +296,11 @@ def numbers_agree(a, b, rel=1e-12, skip=("wall_time_s", "linear_algebra", "order
         assert set(a) == set(b), path
         for k in a:
             if k not in skip:
-                size = max(np.max(np.abs(a[v])) for v in VECTORS[k]) if k in VECTORS and all(
-                    v in a for v in VECTORS[k]) else None
+                size = (
+                    max(np.max(np.abs(a[v])) for v in VECTORS[k])
+                    if k in VECTORS and all(v in a for v in VECTORS[k])
+                    else None
+                )
                 numbers_agree(a[k], b[k], rel, skip, f"{path}.{k}", size)
         return
     if isinstance(a, (str, bool, type(None), int, np.integer)):
@@ -278,7 +308,7 @@ def numbers_agree(a, b, rel=1e-12, skip=("wall_time_s", "linear_algebra", "order
         return
     try:
         x, y = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
-    except (TypeError, ValueError):                     # a list of strings (contact states)
+    except (TypeError, ValueError):  # a list of strings (contact states)
         assert a == b, path
         return
     assert x.shape == y.shape, path
@@ -292,9 +322,14 @@ def cork_press_fit(preset):
     params = get_scene("cork").resolve(preset)
     model = cork.build(params)
     last, fit = cork_stages.press_fit(model, params)
-    system = model.systems[0]                    # the press fit's (the pop's is the second)
-    return dict(fit, **cork_measure.contact_forces(last.contacts), u=last.u, linear_algebra=system.linear_algebra,
-                ordering=system.ordering)
+    system = model.systems[0]  # the press fit's (the pop's is the second)
+    return dict(
+        fit,
+        **cork_measure.contact_forces(last.contacts),
+        u=last.u,
+        linear_algebra=system.linear_algebra,
+        ordering=system.ordering,
+    )
 
 
 def scene_run(scene, preset):
@@ -304,10 +339,15 @@ def scene_run(scene, preset):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("run, args, kl", [(scene_run, ("rolling_ring", "fast"), 8),
-                                           (scene_run, ("rolling_ring", "paper"), 8),
-                                           (scene_run, ("block", "paper"), 35),
-                                           (cork_press_fit, ("paper",), 28)])
+@pytest.mark.parametrize(
+    "run, args, kl",
+    [
+        (scene_run, ("rolling_ring", "fast"), 8),
+        (scene_run, ("rolling_ring", "paper"), 8),
+        (scene_run, ("block", "paper"), 35),
+        (cork_press_fit, ("paper",), 28),
+    ],
+)
 def test_banded_and_sparse_paths_give_the_same_run(run, args, kl, monkeypatch):
     """Solved banded (the choice for these sizes) and forced onto SuperLU (band limit
     zero), every number of the run agrees to 1e-12 of its largest value, iteration counts
@@ -342,15 +382,15 @@ def test_a_growing_pattern_gets_a_new_band_or_goes_sparse():
     asm = TangentAssembler(n, "auto")
     K0 = asm.assemble([body])
     kl0 = K0.band_plan.kl
-    first, last = np.argsort(p)[[0, -1]]                                # the two ends of the chain
+    first, last = np.argsort(p)[[0, -1]]  # the two ends of the chain
     ring = (np.array([first, last]), np.array([last, first]), np.array([0.5, -0.25]), 0, None)
     K1 = asm.assemble([body, ring])
     assert asm.kind == "banded" and asm.pattern_builds == 2 and K1.band_plan is not K0.band_plan
     b = np.random.default_rng(9).normal(size=n)
-    for K in (K0, K1):                                     # an earlier K keeps its own plan
+    for K in (K0, K1):  # an earlier K keeps its own plan
         x = solve_free(K, b, np.arange(n), True)
         assert np.max(np.abs(x - np.linalg.solve(K.toarray(), b))) <= 1e-12 * np.max(np.abs(x))
-    spread = np.random.default_rng(10).choice(n, 60, replace=False)     # one contact couples them all
+    spread = np.random.default_rng(10).choice(n, 60, replace=False)  # one contact couples them all
     r, c = np.meshgrid(spread, spread)
     wide = (r.ravel(), c.ravel(), np.full(r.size, 1e-3), 0, None)
     K2 = asm.assemble([body, ring, wide])
@@ -366,18 +406,24 @@ def grid_pattern(m, dofs=2):
     return sp.kron(node, np.ones((dofs, dofs))).tocsc()
 
 
-@pytest.mark.parametrize("A, free", [
-    (scrambled_band(300, 6, 6, seed=11)[0], None),
-    (scrambled_band(300, 6, 6, seed=12)[0], np.arange(0, 300, 3)),
-    (grid_pattern(12), None), (grid_pattern(12), np.arange(5, 338)), (grid_pattern(30), None),
-    (grid_pattern(30, 1), np.setdiff1d(np.arange(961), np.arange(0, 961, 31)))])
+@pytest.mark.parametrize(
+    "A, free",
+    [
+        (scrambled_band(300, 6, 6, seed=11)[0], None),
+        (scrambled_band(300, 6, 6, seed=12)[0], np.arange(0, 300, 3)),
+        (grid_pattern(12), None),
+        (grid_pattern(12), np.arange(5, 338)),
+        (grid_pattern(30), None),
+        (grid_pattern(30, 1), np.setdiff1d(np.arange(961), np.arange(0, 961, 31))),
+    ],
+)
 def test_the_band_bound_never_excludes_a_band_the_plan_would_take(A, free):
     """banded.band_too_wide (a breadth-first bound, instead of the plan) says 'too wide' only
     where the plan's band LU work is above the limit, at every limit; it does say so for a
     fine 2-D mesh at the limit the System uses."""
     from contactfem.solver.banded import BANDED_WORK, BandPlan, band_too_wide
 
-    A = sp.csc_matrix((A + A.T) != 0)                     # a structurally symmetric pattern
+    A = sp.csc_matrix((A + A.T) != 0)  # a structurally symmetric pattern
     A.sort_indices()
     n = A.shape[0]
     plan = BandPlan(A.indptr, A.indices, n, free)
@@ -385,7 +431,7 @@ def test_the_band_bound_never_excludes_a_band_the_plan_would_take(A, free):
     for work in (0.0, 10.0, 100.0, 1e3, 1e4, BANDED_WORK, 1e5):
         if band_too_wide(A.indptr, A.indices, n, free, work):
             assert plan.work > work
-    fine = grid_pattern(120)                            # 29282 unknowns: no numbering has a band under ~120
+    fine = grid_pattern(120)  # 29282 unknowns: no numbering has a band under ~120
     assert band_too_wide(fine.indptr, fine.indices, fine.shape[0], None, BANDED_WORK)
 
 
@@ -403,6 +449,7 @@ def test_the_band_bound_gives_no_verdict_on_an_unsymmetric_pattern():
 
 
 # -- nested dissection (METIS) for large sparse tangents ---------------------------------
+
 
 def test_supervariables_merge_the_dofs_of_a_node():
     """The two dofs of each node of a quad mesh have the same column in the pattern: one
@@ -498,8 +545,25 @@ def test_a_scene_runs_with_the_linear_algebra_a_user_forces(kind, tmp_path):
         a, b = np.asarray(auto[key]), np.asarray(forced[key])
         assert np.max(np.abs(a - b)) <= 1e-12 * np.max(np.abs(a)), key
     out = tmp_path / "r.json"
-    assert main(["run", "sloping_impact", "--preset", "paper", "--set", "variant=frictional", "--set", "n_steps=40",
-                 "--linear-algebra", kind, "--json", str(out)]) == 0
+    assert (
+        main(
+            [
+                "run",
+                "sloping_impact",
+                "--preset",
+                "paper",
+                "--set",
+                "variant=frictional",
+                "--set",
+                "n_steps=40",
+                "--linear-algebra",
+                kind,
+                "--json",
+                str(out),
+            ]
+        )
+        == 0
+    )
     assert json.loads(out.read_text())["linear_algebra"] == kind
 
 
@@ -535,14 +599,14 @@ def test_a_contact_set_kept_reuses_its_pattern_and_gives_the_same_tangent(kind):
         return s, s.start(np.zeros(s.ndof))
 
     s, state = system()
-    lowest = np.argmin(s.contacts[0].slave.X[s.contacts[0].nodes, 1])   # the node touching the floor
+    lowest = np.argmin(s.contacts[0].slave.X[s.contacts[0].nodes, 1])  # the node touching the floor
     dofs = s.contacts[0].slave_dofs()
     u1 = np.zeros(s.ndof)
-    u1[dofs[lowest, 1]] = -1e-3                                          # one node pressed in
+    u1[dofs[lowest, 1]] = -1e-3  # one node pressed in
     u2 = u1.copy()
-    u2[dofs[lowest, 0]] = 2e-4                                           # the same node, moved along
+    u2[dofs[lowest, 0]] = 2e-4  # the same node, moved along
     u3 = u2.copy()
-    u3[dofs[(lowest + 1) % len(dofs), 1]] -= 5.0                         # and its neighbour pressed in
+    u3[dofs[(lowest + 1) % len(dofs), 1]] -= 5.0  # and its neighbour pressed in
     first = s.evaluate(u1, 0.0, params["dt"], u1, mass_coefficient=1.0, state=state)
     runs = []
     for u in (u2, u3):
@@ -550,7 +614,9 @@ def test_a_contact_set_kept_reuses_its_pattern_and_gives_the_same_tangent(kind):
         other, other_state = system()
         fresh = other.evaluate(u, 0.0, params["dt"], u1, mass_coefficient=1.0, state=other_state)
         np.testing.assert_array_equal(ev.G, fresh.G)
-        np.testing.assert_allclose(as_array(ev.K), as_array(fresh.K), rtol=0, atol=1e-12 * np.abs(as_array(fresh.K)).max())
+        np.testing.assert_allclose(
+            as_array(ev.K), as_array(fresh.K), rtol=0, atol=1e-12 * np.abs(as_array(fresh.K)).max()
+        )
         runs.append(ev)
     n1, n2, n3 = (e.contacts[0].n_active for e in (first, *runs))
     assert n1 == n2 == 1 and n3 == 2

@@ -19,8 +19,23 @@ from contactfem.io import load_run
 
 def test_sweep_runs_a_grid_in_parallel_into_one_table(tmp_path):
     out = tmp_path / "sweep.csv"
-    assert main(["sweep", "block", "--set", "law=coulomb,parabolic", "--set", "c_N=1e5,1e6",
-                 "--jobs", "2", "--out", str(out)]) == 0
+    assert (
+        main(
+            [
+                "sweep",
+                "block",
+                "--set",
+                "law=coulomb,parabolic",
+                "--set",
+                "c_N=1e5,1e6",
+                "--jobs",
+                "2",
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
     rows = list(csv.DictReader(out.open()))
     assert len(rows) == 4 and all(r["error"] == "" for r in rows)
     assert {r["param.law"] for r in rows} == {"coulomb", "parabolic"}
@@ -28,7 +43,9 @@ def test_sweep_runs_a_grid_in_parallel_into_one_table(tmp_path):
 
 
 def test_sweep_validates_every_point_before_running(tmp_path, capsys):
-    assert main(["sweep", "block", "--set", "law=coulomb", "--set", "mu=0.3,-1", "--out", str(tmp_path / "s.json")]) == 2
+    assert (
+        main(["sweep", "block", "--set", "law=coulomb", "--set", "mu=0.3,-1", "--out", str(tmp_path / "s.json")]) == 2
+    )
     assert "parameter mu = -1 is out of range" in capsys.readouterr().err
 
 
@@ -37,8 +54,23 @@ def test_sweep_on_a_cluster_without_dask_is_one_clear_error(tmp_path, capsys, mo
     is refused in one line naming what to install."""
     monkeypatch.setitem(sys.modules, "dask", None)
     monkeypatch.setitem(sys.modules, "dask.distributed", None)
-    assert main(["sweep", "block", "--set", "law=coulomb", "--set", "mu=0.3", "--scheduler", "tcp://127.0.0.1:1",
-                 "--out", str(tmp_path / "s.csv")]) == 2
+    assert (
+        main(
+            [
+                "sweep",
+                "block",
+                "--set",
+                "law=coulomb",
+                "--set",
+                "mu=0.3",
+                "--scheduler",
+                "tcp://127.0.0.1:1",
+                "--out",
+                str(tmp_path / "s.csv"),
+            ]
+        )
+        == 2
+    )
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "dask[distributed]" in err[0]
     assert not (tmp_path / "s.csv").exists()
@@ -52,13 +84,15 @@ def test_sweep_on_a_dask_cluster_is_the_local_sweep(tmp_path):
     grid = ["--set", "law=coulomb", "--set", "mu=0.3,0.4"]
     local, remote = tmp_path / "local.json", tmp_path / "remote.json"
     assert main(["sweep", "block", *grid, "--out", str(local)]) == 0
-    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
-                                  dashboard_address=None) as cluster:
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+    ) as cluster:
         assert main(["sweep", "block", *grid, "--scheduler", cluster.scheduler_address, "--out", str(remote)]) == 0
     a, b = json.loads(local.read_text()), json.loads(remote.read_text())
     drop = ("wall_time_s", "import_time_s")
-    assert [{k: v for k, v in r.items() if k not in drop} for r in a] == \
-        [{k: v for k, v in r.items() if k not in drop} for r in b]
+    assert [{k: v for k, v in r.items() if k not in drop} for r in a] == [
+        {k: v for k, v in r.items() if k not in drop} for r in b
+    ]
 
 
 @pytest.mark.slow
@@ -68,10 +102,10 @@ def test_run_animates_saves_and_reloads(tmp_path, capsys):
     from PIL import Image
 
     assert Image.open(gif).n_frames >= 5
-    assert "100%" in capsys.readouterr().err                 # the progress bar finished
+    assert "100%" in capsys.readouterr().err  # the progress bar finished
     res = load_run(saved)
     assert res["rebound_angle_deg"] == pytest.approx(json.loads(saved.read_text())["results"]["rebound_angle_deg"])
-    assert isinstance(res["outlines"], np.ndarray) and len(res["outlines"]) >= 5     # arrays, not lists
+    assert isinstance(res["outlines"], np.ndarray) and len(res["outlines"]) >= 5  # arrays, not lists
 
 
 def test_gif_of_a_scene_without_outlines_is_a_clear_error(tmp_path, capsys):
@@ -90,7 +124,7 @@ def test_a_quick_figure_run_never_writes_over_the_paper_figures(monkeypatch):
     monkeypatch.delenv("CONTACTFEM_PRESET", raising=False)
     paper, fast = Path(default_outdir("paper")), Path(default_outdir("fast"))
     assert paper.name == "figures" and fast == paper / "fast"
-    assert Path(default_outdir()) == fast                      # the default preset is fast
+    assert Path(default_outdir()) == fast  # the default preset is fast
     monkeypatch.setenv("CONTACTFEM_PRESET", "paper")
     assert Path(default_outdir()) == paper
     monkeypatch.setenv("CONTACTFEM_FIGURES", "/tmp/elsewhere")
@@ -105,19 +139,36 @@ LAWS = Path(__file__).parent / "data" / "lying_laws.py"
 @pytest.mark.slow
 def test_sweep_of_a_law_files_fields_writes_a_row_per_value(tmp_path, capsys):
     out = tmp_path / "s.csv"
-    assert main(["sweep", "rolling_ring", "--friction", f"{LAWS}:OwnFields", "--set", "law.mu=0.1,0.2,0.3",
-                 "--set", "t_end=0.2", "--out", str(out)]) == 0
+    assert (
+        main(
+            [
+                "sweep",
+                "rolling_ring",
+                "--friction",
+                f"{LAWS}:OwnFields",
+                "--set",
+                "law.mu=0.1,0.2,0.3",
+                "--set",
+                "t_end=0.2",
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
     rows = list(csv.DictReader(out.open()))
     assert len(rows) == 3 and all(r["error"] == "" for r in rows)
     assert [r["param.law.mu"] for r in rows] == ["0.1", "0.2", "0.3"]
-    assert len({r["x_end"] for r in rows}) == 3                     # three laws, three results
-    assert "t_end" not in rows[0] and rows[0]["param.t_end"] == "0.2"       # a swept parameter once, as param.
+    assert len({r["x_end"] for r in rows}) == 3  # three laws, three results
+    assert "t_end" not in rows[0] and rows[0]["param.t_end"] == "0.2"  # a swept parameter once, as param.
 
 
 @pytest.mark.slow
 def test_sweep_points_equal_runs_of_the_same_law(tmp_path, capsys):
     out = tmp_path / "s.json"
-    assert main(["sweep", "block", "--friction", f"{LAWS}:OwnFields", "--set", "law.mu=0.3,0.4", "--out", str(out)]) == 0
+    assert (
+        main(["sweep", "block", "--friction", f"{LAWS}:OwnFields", "--set", "law.mu=0.3,0.4", "--out", str(out)]) == 0
+    )
     rows = json.loads(out.read_text())
     from contactfem.lab.lawfile import load_class
     from contactfem.scenes import run_scene
@@ -125,7 +176,10 @@ def test_sweep_points_equal_runs_of_the_same_law(tmp_path, capsys):
     own = load_class(f"{LAWS}:OwnFields")
     for row, mu in zip(rows, (0.3, 0.4)):
         res = run_scene("block", "fast", friction=own(mu=mu))
-        assert row["total_tangential"] == res["total_tangential"] and row["newton_iterations_total"] == res["newton_iterations_total"]
+        assert (
+            row["total_tangential"] == res["total_tangential"]
+            and row["newton_iterations_total"] == res["newton_iterations_total"]
+        )
 
 
 def test_sweep_needs_values_and_fails_when_a_run_fails(tmp_path, capsys):
@@ -135,13 +189,26 @@ def test_sweep_needs_values_and_fails_when_a_run_fails(tmp_path, capsys):
     assert main(["sweep", "block", "--set", "maxit=1,40", "--out", str(out)]) == 1
     err = capsys.readouterr().err.strip().splitlines()
     assert err == ["contactfem: sweep: 1 of 2 points failed (the table's error column says why)"]
-    rows = list(csv.DictReader(out.open()))                   # the table is written all the same
+    rows = list(csv.DictReader(out.open()))  # the table is written all the same
     assert [r["error"] != "" for r in rows] == [True, False]
 
 
 def test_sweep_refuses_a_law_that_lies_before_any_run(tmp_path, capsys):
-    assert main(["sweep", "block", "--friction", f"{LAWS}:NaNAbove", "--set", "law.p_bad=1e6,50",
-                 "--out", str(tmp_path / "s.csv")]) == 2
+    assert (
+        main(
+            [
+                "sweep",
+                "block",
+                "--friction",
+                f"{LAWS}:NaNAbove",
+                "--set",
+                "law.p_bad=1e6,50",
+                "--out",
+                str(tmp_path / "s.csv"),
+            ]
+        )
+        == 2
+    )
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "NaNAbove.slip_bound returned NaN or inf: Y = nan" in err[0]
     assert not (tmp_path / "s.csv").exists()
@@ -155,19 +222,39 @@ def test_ctrl_c_during_a_parallel_sweep_is_one_line(tmp_path, delay):
     table holds exactly the points the line says were done (none: no table)."""
     ready = tmp_path / "ready"
     env = dict(os.environ, CONTACTFEM_READY_FILE=str(ready))
-    p = subprocess.Popen([sys.executable, "-m", "contactfem", "sweep", "block", "--set", "c_N=1e5,2e5,3e5,4e5,5e5,6e5",
-                          "--set", "nx=40", "--jobs", "2", "--out", "s.csv"], cwd=tmp_path, env=env, text=True,
-                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True,
-                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))   # as from a terminal
+    p = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "contactfem",
+            "sweep",
+            "block",
+            "--set",
+            "c_N=1e5,2e5,3e5,4e5,5e5,6e5",
+            "--set",
+            "nx=40",
+            "--jobs",
+            "2",
+            "--out",
+            "s.csv",
+        ],
+        cwd=tmp_path,
+        env=env,
+        text=True,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        start_new_session=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )  # as from a terminal
     t0 = time.monotonic()
     while p.poll() is None and not ready.exists() and time.monotonic() - t0 < 120:
         time.sleep(0.002)
     time.sleep(delay)
     if p.poll() is None:
-        os.killpg(p.pid, signal.SIGINT)                         # as Ctrl-C in a terminal: the whole group
+        os.killpg(p.pid, signal.SIGINT)  # as Ctrl-C in a terminal: the whole group
     out, err = p.communicate(timeout=300)
     assert "Traceback" not in err, err
-    if p.returncode == 0:                                       # finished before the signal
+    if p.returncode == 0:  # finished before the signal
         return
     assert p.returncode == 130, err
     lines = err.strip().splitlines()

@@ -14,9 +14,11 @@ def test_readme_table_is_figures_summary():
     readme = S.table_lines((REPO / "README.md").read_text(), prefix="figures/")
     written = S.table_lines((REPO / "figures" / "summary.md").read_text())
     assert readme, "README.md has no table between " + S.START + " and " + S.END
-    assert readme == written, ("README.md and figures/summary.md disagree: regenerate with "
-                               "`contactfem figures --only summary --preset paper` and copy it with "
-                               "`python -m contactfem.plots.summary`")
+    assert readme == written, (
+        "README.md and figures/summary.md disagree: regenerate with "
+        "`contactfem figures --only summary --preset paper` and copy it with "
+        "`python -m contactfem.plots.summary`"
+    )
 
 
 def test_summary_has_one_row_per_example():
@@ -28,9 +30,12 @@ def test_summary_has_one_row_per_example():
 
 def test_ours_is_computed_from_the_figures_data():
     # change the figures' data: the row changes with it (nothing typed)
-    data = {"fig07_block_conical_stresses": dict(n_slip=7, equilibrium_error=3e-13, total_normal=-123.0,
-                                                 total_tangential=45.0),
-            "table1_block_newton_residuals": dict(conical=[171.37, 3.2, 4e-12], parabolic=[171.37] + [1.0] * 6)}
+    data = {
+        "fig07_block_conical_stresses": dict(
+            n_slip=7, equilibrium_error=3e-13, total_normal=-123.0, total_tangential=45.0
+        ),
+        "table1_block_newton_residuals": dict(conical=[171.37, 3.2, 4e-12], parabolic=[171.37] + [1.0] * 6),
+    }
     row = S.row_table1("paper", data.get)
     assert "conical 3 (7 nodes slip), parabolic 7" in row[3] and "first 171.37" in row[3]
     assert "(123 down, 45 along)" in S.row_block_equilibrium("paper", data.get)[3]
@@ -43,7 +48,8 @@ def test_readme_table_is_the_committed_figures_data():
     readme = S.table_lines((REPO / "README.md").read_text(), prefix="figures/")
     assert readme == S.summary_table("paper", S.committed(REPO / "figures")), (
         "README.md's table is not what figures/*.json hold: regenerate with `contactfem figures --preset paper` "
-        "and copy it with `python -m contactfem.plots.summary`")
+        "and copy it with `python -m contactfem.plots.summary`"
+    )
 
 
 def test_update_readme_round_trip(tmp_path):

@@ -13,13 +13,13 @@ from pathlib import Path
 
 import pytest
 
-pytestmark = pytest.mark.slow      # end-to-end: command lines and processes (the fast tier leaves them out)
+pytestmark = pytest.mark.slow  # end-to-end: command lines and processes (the fast tier leaves them out)
 
 # Coulomb with mu, and two faults: os._exit(7) above the pressure p_exit; and, for the run whose
 # mu is `victim`, its process id in the file $FRAGILE_MARK and a pause of $FRAGILE_PAUSE seconds in
 # every call of the run (a run slow enough to be killed from outside while it runs; not in the
 # probe of the law file, which calls it with three values).
-FRAGILE = '''
+FRAGILE = """
 import os
 import time
 from dataclasses import dataclass
@@ -45,7 +45,7 @@ class Fragile:
         if np.any(p > self.p_exit):
             os._exit(7)
         return self.mu * p, self.mu + 0 * p, 0 * p
-'''
+"""
 
 MUS = ["0.5", "0.55", "0.6", "0.65"]
 
@@ -62,9 +62,15 @@ def sweep(tmp_path, *args, pause=None, out="s.csv"):
     env = dict(os.environ, FRAGILE_MARK=str(tmp_path / "mark"))
     if pause is not None:
         env["FRAGILE_PAUSE"] = str(pause)
-    return subprocess.Popen([sys.executable, "-m", "contactfem", "sweep", "block", "--no-check", *args, "--out", out],
-                            cwd=tmp_path, env=env, text=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            start_new_session=True)
+    return subprocess.Popen(
+        [sys.executable, "-m", "contactfem", "sweep", "block", "--no-check", *args, "--out", out],
+        cwd=tmp_path,
+        env=env,
+        text=True,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        start_new_session=True,
+    )
 
 
 def finish(p, within):
@@ -132,19 +138,30 @@ def gone(pid, within=5.0):
 
 
 def test_a_worker_killed_twice_mid_sweep_is_a_failed_row_and_every_other_point_completes(tmp_path, law):
-    p = sweep(tmp_path, "--friction", law, "--set", f"law.mu={','.join(MUS)}", "--set", "law.victim=0.55",
-              "--jobs", "2", pause=0.2)
+    p = sweep(
+        tmp_path,
+        "--friction",
+        law,
+        "--set",
+        f"law.mu={','.join(MUS)}",
+        "--set",
+        "law.victim=0.55",
+        "--jobs",
+        "2",
+        pause=0.2,
+    )
     first = victim_pid(tmp_path)
-    os.kill(first, signal.SIGKILL)                      # as the out-of-memory killer does
-    second = victim_pid(tmp_path, other_than={first})   # the point again, on a fresh worker
+    os.kill(first, signal.SIGKILL)  # as the out-of-memory killer does
+    second = victim_pid(tmp_path, other_than={first})  # the point again, on a fresh worker
     os.kill(second, signal.SIGKILL)
     out, err = finish(p, 60)
     assert p.returncode == 1, err
     table = {r["param.law.mu"]: r for r in rows(tmp_path / "s.csv")}
     assert sorted(table) == sorted(MUS)
     assert table["0.55"]["error"] == "worker died: signal 9"
-    assert all(table[mu]["error"] == "" and float(table[mu]["newton_iterations_total"]) >= 1
-               for mu in MUS if mu != "0.55")
+    assert all(
+        table[mu]["error"] == "" and float(table[mu]["newton_iterations_total"]) >= 1 for mu in MUS if mu != "0.55"
+    )
     assert "4 points: 3 done, 1 failed, 0 left" in out
     assert "failed: law.mu=0.55" in out and "worker died: signal 9" in out
     assert err.strip().splitlines() == ["contactfem: sweep: 1 of 4 points failed (the table's error column says why)"]
@@ -155,26 +172,48 @@ def test_a_law_that_ends_its_process_fails_its_point_only(tmp_path, law):
     800 that only p_y = 300 reaches (the runs' largest pressures: about 620, 710 and 910);
     the lines it prints are the README's."""
     readme = (Path(__file__).parents[1] / "README.md").read_text().splitlines()
-    at = next(i for i, line in enumerate(readme) if line.startswith("$ contactfem sweep block --no-check --friction "
-                                                                      "fragile.py:Fragile"))
-    argv = readme[at][len("$ contactfem "):].split()
-    shown = readme[at + 1: readme.index("```", at)]
-    p = subprocess.run([sys.executable, "-m", "contactfem", *argv], cwd=tmp_path, capture_output=True, text=True,
-                       timeout=60)
+    at = next(
+        i
+        for i, line in enumerate(readme)
+        if line.startswith("$ contactfem sweep block --no-check --friction fragile.py:Fragile")
+    )
+    argv = readme[at][len("$ contactfem ") :].split()
+    shown = readme[at + 1 : readme.index("```", at)]
+    p = subprocess.run(
+        [sys.executable, "-m", "contactfem", *argv], cwd=tmp_path, capture_output=True, text=True, timeout=60
+    )
     assert p.returncode == 1, p.stderr
     assert p.stdout.splitlines() == shown
     table = {r["param.p_y"]: r for r in rows(tmp_path / "sweep.csv")}
     assert table["300"]["error"] == "worker exited with code 7"
     assert table["100"]["error"] == table["200"]["error"] == ""
-    assert float(table["200"]["total_normal"]) == pytest.approx(-800, rel=1e-6)     # p_y x width
+    assert float(table["200"]["total_normal"]) == pytest.approx(-800, rel=1e-6)  # p_y x width
 
 
 def test_a_law_that_ends_the_process_checking_it_is_one_line(tmp_path, law):
     """Without --no-check the law is checked over the scene's range (in a worker process):
     the sweep stops before the first run, in one line naming the law."""
-    p = subprocess.run([sys.executable, "-m", "contactfem", "sweep", "block", "--friction", law, "--set",
-                        "law.p_exit=800", "--set", "p_y=100,200,300", "--out", "s.csv"], cwd=tmp_path,
-                       capture_output=True, text=True, timeout=60)
+    p = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "contactfem",
+            "sweep",
+            "block",
+            "--friction",
+            law,
+            "--set",
+            "law.p_exit=800",
+            "--set",
+            "p_y=100,200,300",
+            "--out",
+            "s.csv",
+        ],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     lines = p.stderr.strip().splitlines()
     assert p.returncode == 2 and len(lines) == 1, p.stderr
     assert "--friction" in lines[0] and "ended the process" in lines[0] and "worker exited with code 7" in lines[0]
@@ -186,8 +225,18 @@ def test_sigterm_and_ctrl_c_while_a_dead_workers_point_runs_again(tmp_path, law,
     """The victim's worker killed, its point running again (slowly) on a fresh worker, the
     other points done: the signal ends the sweep within seconds with the documented exit
     code, the table of the points done on disk, and no worker left."""
-    p = sweep(tmp_path, "--friction", law, "--set", f"law.mu={','.join(MUS)}", "--set", "law.victim=0.5",
-              "--jobs", "2", pause=30)
+    p = sweep(
+        tmp_path,
+        "--friction",
+        law,
+        "--set",
+        f"law.mu={','.join(MUS)}",
+        "--set",
+        "law.victim=0.5",
+        "--jobs",
+        "2",
+        pause=30,
+    )
     first = victim_pid(tmp_path)
     os.kill(first, signal.SIGKILL)
     second = victim_pid(tmp_path, other_than={first})
@@ -195,7 +244,7 @@ def test_sigterm_and_ctrl_c_while_a_dead_workers_point_runs_again(tmp_path, law,
     workers = children(p.pid)
     assert second in workers
     t0 = time.monotonic()
-    os.kill(p.pid, sig)                                 # the sweep's process alone
+    os.kill(p.pid, sig)  # the sweep's process alone
     out, err = finish(p, 30)
     assert time.monotonic() - t0 < 10
     assert p.returncode == code, err
@@ -203,7 +252,8 @@ def test_sigterm_and_ctrl_c_while_a_dead_workers_point_runs_again(tmp_path, law,
     if sig == signal.SIGINT:
         assert err.strip().splitlines() == [
             "contactfem: interrupted during the sweep; s.csv holds the points done (3 done, 0 failed, 1 left: "
-            "--resume runs the rest)"]
+            "--resume runs the rest)"
+        ]
     table = rows(tmp_path / "s.csv")
     assert table == done and sorted(r["param.law.mu"] for r in table) == MUS[1:]
     assert all(r["error"] == "" for r in table)
@@ -228,13 +278,14 @@ def test_resume_after_the_sweep_was_killed_runs_the_missing_points_only(tmp_path
     assert p.returncode == 0, err
     assert "4 points: 4 done (2 kept from the table), 0 failed, 0 left" in out
     after = rows(tmp_path / "s.csv")
-    assert after[:2] == before                         # kept as they were, wall times included
+    assert after[:2] == before  # kept as they were, wall times included
     p = sweep(tmp_path, *grid, out="fresh.csv")
     finish(p, 60)
     fresh = rows(tmp_path / "fresh.csv")
     drop = ("wall_time_s",)
-    assert [{k: v for k, v in r.items() if k not in drop} for r in after] == \
-        [{k: v for k, v in r.items() if k not in drop} for r in fresh]
+    assert [{k: v for k, v in r.items() if k not in drop} for r in after] == [
+        {k: v for k, v in r.items() if k not in drop} for r in fresh
+    ]
     assert len({r["code_version"] for r in after}) == 1 and after[0]["code_version"].startswith("0.")
 
 
@@ -258,9 +309,25 @@ def test_resume_runs_again_the_failed_points_and_those_of_other_code(tmp_path, l
 def test_an_unreachable_scheduler_is_one_line_at_once(tmp_path):
     pytest.importorskip("dask.distributed")
     t0 = time.monotonic()
-    p = subprocess.run([sys.executable, "-m", "contactfem", "sweep", "block", "--set", "p_y=100,200", "--scheduler",
-                        "tcp://127.0.0.1:1", "--out", "s.csv"], cwd=tmp_path, capture_output=True, text=True,
-                       timeout=60)
+    p = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "contactfem",
+            "sweep",
+            "block",
+            "--set",
+            "p_y=100,200",
+            "--scheduler",
+            "tcp://127.0.0.1:1",
+            "--out",
+            "s.csv",
+        ],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert time.monotonic() - t0 < 20
     lines = p.stderr.strip().splitlines()
     assert p.returncode == 2 and len(lines) == 1, p.stderr
@@ -278,33 +345,74 @@ def cluster(tmp_path, monkeypatch):
     monkeypatch.setenv("FRAGILE_MARK", str(tmp_path / "mark"))
     monkeypatch.setenv("FRAGILE_PAUSE", "0.2")
     with dask.config.set({"distributed.scheduler.allowed-failures": 1}):
-        with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
-                                      silence_logs=50) as c:
+        with distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None, silence_logs=50
+        ) as c:
             yield c
 
 
 @pytest.mark.slow
 def test_a_dask_worker_killed_mid_sweep_the_sweep_completes(tmp_path, law, cluster):
-    p = subprocess.Popen([sys.executable, "-m", "contactfem", "sweep", "block", "--no-check", "--friction", law,
-                          "--set", f"law.mu={','.join(MUS)}", "--set", "law.victim=0.55", "--scheduler",
-                          cluster.scheduler_address, "--out", "s.csv"], cwd=tmp_path, text=True,
-                         stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    p = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "contactfem",
+            "sweep",
+            "block",
+            "--no-check",
+            "--friction",
+            law,
+            "--set",
+            f"law.mu={','.join(MUS)}",
+            "--set",
+            "law.victim=0.55",
+            "--scheduler",
+            cluster.scheduler_address,
+            "--out",
+            "s.csv",
+        ],
+        cwd=tmp_path,
+        text=True,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
     first = victim_pid(tmp_path, within=120)
-    os.kill(first, signal.SIGKILL)                      # a real worker process, mid-run
+    os.kill(first, signal.SIGKILL)  # a real worker process, mid-run
     out, err = finish(p, 180)
     assert p.returncode == 0, err
     table = {r["param.law.mu"]: r for r in rows(tmp_path / "s.csv")}
     assert sorted(table) == sorted(MUS) and all(r["error"] == "" for r in table.values())
-    assert int((tmp_path / "mark").read_text()) != first          # the point ran again elsewhere
+    assert int((tmp_path / "mark").read_text()) != first  # the point ran again elsewhere
     assert "4 points: 4 done, 0 failed, 0 left" in out
 
 
 @pytest.mark.slow
 def test_a_point_that_keeps_killing_its_dask_workers_is_a_failed_row(tmp_path, law, cluster):
-    p = subprocess.Popen([sys.executable, "-m", "contactfem", "sweep", "block", "--no-check", "--friction", law,
-                          "--set", "law.p_exit=800", "--set", "p_y=100,200,300", "--scheduler",
-                          cluster.scheduler_address, "--out", "s.csv"], cwd=tmp_path, text=True,
-                         stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    p = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "contactfem",
+            "sweep",
+            "block",
+            "--no-check",
+            "--friction",
+            law,
+            "--set",
+            "law.p_exit=800",
+            "--set",
+            "p_y=100,200,300",
+            "--scheduler",
+            cluster.scheduler_address,
+            "--out",
+            "s.csv",
+        ],
+        cwd=tmp_path,
+        text=True,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
     out, err = finish(p, 180)
     assert p.returncode == 1, err
     table = {r["param.p_y"]: r for r in rows(tmp_path / "s.csv")}
@@ -332,8 +440,20 @@ def test_a_table_interrupted_while_it_is_written_keeps_the_last_complete_one(tmp
 
 
 def test_a_run_over_the_time_limit_is_a_failed_row(tmp_path, law):
-    p = sweep(tmp_path, "--friction", law, "--set", "law.mu=0.5,0.55", "--set", "law.victim=0.5", "--jobs", "2",
-              "--time-limit", "8", pause=60)
+    p = sweep(
+        tmp_path,
+        "--friction",
+        law,
+        "--set",
+        "law.mu=0.5,0.55",
+        "--set",
+        "law.victim=0.5",
+        "--jobs",
+        "2",
+        "--time-limit",
+        "8",
+        pause=60,
+    )
     out, err = finish(p, 60)
     assert p.returncode == 1, err
     table = {r["param.law.mu"]: r for r in rows(tmp_path / "s.csv")}
@@ -341,11 +461,14 @@ def test_a_run_over_the_time_limit_is_a_failed_row(tmp_path, law):
     assert "2 points: 1 done, 1 failed, 0 left" in out
 
 
-@pytest.mark.parametrize("argv,pattern", [
-    (["--time-limit", "0"], "parameter time-limit = 0 is out of range"),
-    (["--time-limit", "5", "--scheduler", "tcp://127.0.0.1:1"], "--time-limit applies to local workers"),
-    (["--scheduler", "no scheduler"], "--scheduler no scheduler: "),
-])
+@pytest.mark.parametrize(
+    "argv,pattern",
+    [
+        (["--time-limit", "0"], "parameter time-limit = 0 is out of range"),
+        (["--time-limit", "5", "--scheduler", "tcp://127.0.0.1:1"], "--time-limit applies to local workers"),
+        (["--scheduler", "no scheduler"], "--scheduler no scheduler: "),
+    ],
+)
 def test_bad_limits_and_addresses_are_one_line(tmp_path, capsys, argv, pattern):
     pytest.importorskip("dask.distributed")
     from contactfem.cli import main
@@ -365,10 +488,12 @@ def test_a_json_table_resumes_too(tmp_path):
     from contactfem.lab.sweep import Table
 
     same = dict(scene="block", preset="fast", laws="", code_version="v1")
-    earlier = [dict(same, error="", x=1, **{"param.p_y": "100"}),
-               dict(same, error="worker died: signal 9", **{"param.p_y": "200"}),
-               dict(same, error="", x=3, **{"param.p_y": "300", "code_version": "v0"}),
-               dict(same, error="", x=9, **{"param.p_y": "900"})]
+    earlier = [
+        dict(same, error="", x=1, **{"param.p_y": "100"}),
+        dict(same, error="worker died: signal 9", **{"param.p_y": "200"}),
+        dict(same, error="", x=3, **{"param.p_y": "300", "code_version": "v0"}),
+        dict(same, error="", x=9, **{"param.p_y": "900"}),
+    ]
     path = tmp_path / "t.json"
     path.write_text(json.dumps(earlier))
     table = Table(path, resume=True)

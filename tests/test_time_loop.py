@@ -2,6 +2,7 @@
 Its schedules (fixed steps or an adaptive rule, with the halving of failed steps and growth)
 are what the scenes need; a scene records and stops by iterating, so no scene keeps a time
 loop of its own."""
+
 import ast
 import io
 import math
@@ -43,8 +44,10 @@ def test_no_scene_keeps_its_own_time_loop(path):
 
 def test_the_grep_finds_a_private_loop(tmp_path):
     bad = tmp_path / "bad.py"
-    bad.write_text("def run(stepper, u):\n    t = 0.0\n    while t < 1.0:\n        t += 0.1\n"
-                   "    for k in range(3):\n        u = stepper.step(k, u, u, u)[0]\n    return u\n")
+    bad.write_text(
+        "def run(stepper, u):\n    t = 0.0\n    while t < 1.0:\n        t += 0.1\n"
+        "    for k in range(3):\n        u = stepper.step(k, u, u, u)[0]\n    return u\n"
+    )
     assert [line for line, _ in private_loops(bad)] == [3, 5]
 
 
@@ -62,12 +65,14 @@ class Spring:
 
     def start(self, u, t=0.0):
         from contactfem.solver.system import SystemState
+
         return SystemState()
 
     def evaluate(self, u, t, dt=None, u0=None, mass_coefficient=0.0, phases=None, *, state):
         import scipy.sparse as sp
 
         from contactfem.solver import Evaluation
+
         return Evaluation(self.k * u - t, sp.csr_matrix([[self.k]]), (), np.array([t]), state)
 
     def energies(self, u, v, evaluation, dt=None, state=None):
@@ -91,17 +96,19 @@ class FailingStatic(Static):
 def test_adaptive_rule_cutback_growth():
     """A rule asks for 0.25; the step ending at 0.5 fails at full size and is halved;
     with growth = 1 the halved size is kept, with growth = 2 it doubles back."""
-    for growth, expected in ((1.0, [0.25, 0.125, 0.125, 0.125, 0.125, 0.125, 0.125]),
-                             (2.0, [0.25, 0.125, 0.25, 0.25, 0.125])):
+    for growth, expected in (
+        (1.0, [0.25, 0.125, 0.125, 0.125, 0.125, 0.125, 0.125]),
+        (2.0, [0.25, 0.125, 0.25, 0.25, 0.125]),
+    ):
         sys = Spring(fail=lambda t1, dt: abs(t1 - 0.5) < 1e-12 and dt > 0.2)
         schedule = Adaptive(lambda rec: 0.25, t_end=1.0, dt=0.25, growth=growth, max_cuts=3)
         recs = list(march(FailingStatic(sys), schedule, 0.0, np.zeros(1)))
         dts = [r.dt for r in recs[1:]]
-        assert np.allclose(dts, expected[:len(dts)]) and recs[-1].t == pytest.approx(1.0)
-        assert len(sys.commits) == len(recs) - 1                 # committed once per accepted step
+        assert np.allclose(dts, expected[: len(dts)]) and recs[-1].t == pytest.approx(1.0)
+        assert len(sys.commits) == len(recs) - 1  # committed once per accepted step
         assert (recs[0].k, recs[0].dt, recs[0].cuts) == (0, 0.0, 0) and recs[2].cuts == 1
         assert recs[2].failures and "no convergence" in recs[2].failures[0]
-        assert np.allclose(recs[-1].u, 0.5)                      # k u = t at t = 1
+        assert np.allclose(recs[-1].u, 0.5)  # k u = t at t = 1
 
 
 def test_the_scene_stops_by_leaving_the_loop_and_min_dt_ends_the_cuts():
@@ -113,19 +120,32 @@ def test_the_scene_stops_by_leaving_the_loop_and_min_dt_ends_the_cuts():
     assert recs[-1].t == pytest.approx(0.5) and len(recs) == 6
     sys = Spring(fail=lambda t1, dt: True)
     with pytest.raises(NewtonError) as err:
-        list(march(FailingStatic(sys), Adaptive(lambda rec: 0.5, t_end=1.0, dt=0.5, max_cuts=10, min_dt=0.1),
-                   0.0, np.zeros(1)))
-    assert err.value.record.k == 0                               # the last record before the failure
+        list(
+            march(
+                FailingStatic(sys),
+                Adaptive(lambda rec: 0.5, t_end=1.0, dt=0.5, max_cuts=10, min_dt=0.1),
+                0.0,
+                np.zeros(1),
+            )
+        )
+    assert err.value.record.k == 0  # the last record before the failure
     with pytest.raises(NewtonError) as err:
         integrate(FailingStatic(sys), 0.0, np.zeros(1), t_end=1.0, dt=0.5, cutback=True, max_cuts=10, min_dt=0.1)
-    assert len(err.value.partial.t) == 1                         # 0.5, 0.25, 0.125 failed; 0.0625 < min_dt
+    assert len(err.value.partial.t) == 1  # 0.5, 0.25, 0.125 failed; 0.0625 < min_dt
 
 
 def test_progress_bar_follows_the_records():
     from contactfem.io import ProgressBar
+
     out = io.StringIO()
-    integrate(Static(Spring()), 0.0, np.zeros(1), n_steps=4, dt=0.25,
-              progress=lambda t0, t1, label: ProgressBar(t0=t0, t_end=t1, label=label, stream=out))
+    integrate(
+        Static(Spring()),
+        0.0,
+        np.zeros(1),
+        n_steps=4,
+        dt=0.25,
+        progress=lambda t0, t1, label: ProgressBar(t0=t0, t_end=t1, label=label, stream=out),
+    )
     assert "100%" in out.getvalue() and out.getvalue().endswith("\n")
 
 
@@ -136,7 +156,7 @@ def test_fixed_steps_snap_to_the_grid_and_cover_a_halved_step():
     recs = list(march(FailingStatic(sys), Steps(0.1, n_steps=3, max_cuts=2), 0.0, np.zeros(1)))
     assert np.allclose([r.dt for r in recs[1:]], [0.1, 0.05, 0.05, 0.1])
     assert np.allclose([r.t for r in recs], [0.0, 0.1, 0.15, 0.2, 0.3], rtol=0, atol=1e-15)
-    assert recs[3].t == 2 * 0.1 and recs[4].t == 3 * 0.1           # the grid t0 + k dt, exactly
+    assert recs[3].t == 2 * 0.1 and recs[4].t == 3 * 0.1  # the grid t0 + k dt, exactly
     assert [r.cuts for r in recs] == [0, 0, 1, 0, 0]
 
 
@@ -160,6 +180,7 @@ def test_fixed_steps_to_t_end_take_exactly_the_steps_that_fit(dt, t_end):
 @pytest.mark.slow
 def test_run_cork_progress_shows_a_bar(capsys):
     from contactfem.cli import main
+
     assert main(["run", "cork", "--progress", "--set", "t_end=0.0004", "--set", "n_press=2"]) == 0
     err = capsys.readouterr().err
     assert "cork: press fit [" in err and "cork: pop [" in err and "100%" in err
@@ -172,6 +193,7 @@ def test_a_run_that_ends_before_t_end_finishes_its_bar_and_says_why(capsys, tmp_
     import json
 
     from contactfem.cli import main
+
     assert main(["run", "cork", "--progress", "--json", str(tmp_path / "cork.json")]) == 0
     err = capsys.readouterr().err
     last = [ln for ln in err.replace("\r", "\n").splitlines() if ln.startswith("cork: pop [")][-1]
@@ -181,6 +203,7 @@ def test_a_run_that_ends_before_t_end_finishes_its_bar_and_says_why(capsys, tmp_
 
 def test_progress_bar_finish_draws_the_whole_bar_with_the_reason():
     from contactfem.io import ProgressBar
+
     out = io.StringIO()
     bar = ProgressBar(t0=0.0, t_end=1.0, label="x", stream=out)
     bar(0.25)

@@ -2,6 +2,7 @@
 mypy of the test extra ([tool.mypy] in pyproject.toml): the Protocols of its interfaces.py files
 declare every member the code reads of a law, contact, body, load or stepper. And the library
 neither forwards attributes (``__getattr__`` on an object) nor replaces Python's builtins."""
+
 import os
 import re
 import subprocess
@@ -21,8 +22,13 @@ def test_the_core_type_checks(tmp_path):
         if os.environ.get("CI"):
             raise
         pytest.skip("mypy is not installed (pip install -e '.[test]')")
-    run = subprocess.run([sys.executable, "-m", "mypy", "--cache-dir", str(tmp_path / "cache")], cwd=REPO,
-                         capture_output=True, text=True, timeout=600)
+    run = subprocess.run(
+        [sys.executable, "-m", "mypy", "--cache-dir", str(tmp_path / "cache")],
+        cwd=REPO,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     assert run.returncode == 0, run.stdout[-4000:] + run.stderr[-2000:]
     assert "no issues found" in run.stdout
 
@@ -30,8 +36,11 @@ def test_the_core_type_checks(tmp_path):
 def offenders(text):
     """(line number, line) of an object's ``__getattr__`` (a module's PEP 562 lazy import is
     not one: it loads a name once) or a use of ``builtins``."""
-    return [(n, line.strip()) for n, line in enumerate(text.splitlines(), 1)
-            if re.search(r"\bbuiltins\b", line) or re.match(r"\s+def __getattr__\(self", line)]
+    return [
+        (n, line.strip())
+        for n, line in enumerate(text.splitlines(), 1)
+        if re.search(r"\bbuiltins\b", line) or re.match(r"\s+def __getattr__\(self", line)
+    ]
 
 
 # The grader's sandbox is the one place that must do both: it gives a submission a copy of the
@@ -41,9 +50,12 @@ SANDBOX = ("contactfem/lab/course/sandbox.py", "contactfem/lab/course/grade.py")
 
 
 def test_no_attribute_forwarding_and_no_swapped_builtins():
-    found = [f"{path.relative_to(REPO)}:{n}: {line}" for path in sorted((REPO / "contactfem").rglob("*.py"))
-             if path.relative_to(REPO).as_posix() not in SANDBOX
-             for n, line in offenders(path.read_text())]
+    found = [
+        f"{path.relative_to(REPO)}:{n}: {line}"
+        for path in sorted((REPO / "contactfem").rglob("*.py"))
+        if path.relative_to(REPO).as_posix() not in SANDBOX
+        for n, line in offenders(path.read_text())
+    ]
     assert not found, "\n".join(found)
 
 

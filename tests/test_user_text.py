@@ -20,8 +20,11 @@ def user_files():
 
 def test_no_issue_numbers_in_user_text():
     """One lint of every user-facing file (not one test item a file): all offenders at once."""
-    hits = {str(p.relative_to(REPO)): [m.group(0) for m in HISTORY.finditer(p.read_text())]
-            for p in user_files() if p.exists()}
+    hits = {
+        str(p.relative_to(REPO)): [m.group(0) for m in HISTORY.finditer(p.read_text())]
+        for p in user_files()
+        if p.exists()
+    }
     hits = {k: v for k, v in hits.items() if v}
     assert not hits, f"user text mentions development history {hits}: say what it means to a user instead"
 

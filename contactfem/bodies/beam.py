@@ -44,6 +44,7 @@ import numpy as np
 from ..contact.placement import start_of
 from .interfaces import MASS_MATRICES
 
+
 def _check(name, value, low, low_open=True):
     """Raise ValueError unless value is a finite number > low (>= low if not low_open)."""
     try:
@@ -106,8 +107,23 @@ class Beam:
     mass_matrix     the mass the System uses: "lumped" (default) or "consistent" (``mass``)
     """
 
-    def __init__(self, X, closed, E, A, I, rho, G=None, nu=0.0, kappa_s=5 / 6,
-                 name="beam", plastic=None, integration=1, rotary_inertia=True, mass_matrix="lumped"):
+    def __init__(
+        self,
+        X,
+        closed,
+        E,
+        A,
+        I,
+        rho,
+        G=None,
+        nu=0.0,
+        kappa_s=5 / 6,
+        name="beam",
+        plastic=None,
+        integration=1,
+        rotary_inertia=True,
+        mass_matrix="lumped",
+    ):
         X = np.asarray(X, dtype=float)
         if X.ndim != 2 or X.shape[1] != 2 or not np.all(np.isfinite(X)):
             raise ValueError(f"parameter X must be a finite (nn, 2) array, got shape {X.shape}")
@@ -145,22 +161,22 @@ class Beam:
 
         self.ndof = 3 * nn
         self.xdofs = 3 * np.arange(nn)[:, None] + np.array([0, 1])
-        self.edofs = np.column_stack([3 * self.conn[:, 0] + k for k in range(3)]
-                                     + [3 * self.conn[:, 1] + k for k in range(3)])
+        self.edofs = np.column_stack(
+            [3 * self.conn[:, 0] + k for k in range(3)] + [3 * self.conn[:, 1] + k for k in range(3)]
+        )
         # COO indices of the element matrices, fixed: entry 6 i + j of every element, entry by entry
         self._rows = np.repeat(self.edofs.T, 6, axis=0).ravel()
         self._cols = np.concatenate([self.edofs.T] * 6).ravel()
-        self._edofs_T = self.edofs.T.ravel()                      # the element dofs, dof by dof
+        self._edofs_T = self.edofs.T.ravel()  # the element dofs, dof by dof
         self.ne = ne
-        self._dX = chord                                          # X_b - X_a per element
+        self._dX = chord  # X_b - X_a per element
 
         self.S0, self.eta = None, None
         if plastic is not None:
             unknown = set(plastic) - {"N0", "Q0", "M0", "eta"}
             if unknown:
                 raise ValueError(f"parameter plastic has unknown keys {sorted(unknown)}: allowed N0, Q0, M0, eta")
-            self.S0 = np.array([_check(k, plastic.get(k, d), 0.0)
-                                for k, d in (("N0", 1.0), ("Q0", 0.5), ("M0", 0.25))])
+            self.S0 = np.array([_check(k, plastic.get(k, d), 0.0) for k, d in (("N0", 1.0), ("Q0", 0.5), ("M0", 0.25))])
             self.eta = _check("eta", plastic.get("eta", 0.1), 0.0)
         if integration not in (1, 2):
             raise ValueError(f"parameter integration = {integration!r} is not allowed: one of 1|2")
@@ -171,14 +187,16 @@ class Beam:
         # (its state, from ``start`` and ``commit``): rows k ne .. (k+1) ne - 1 belong to point k
         self._ep0 = np.zeros((len(self.points) * ne, 3))
         self._ep0.flags.writeable = False
-        self._g = None                  # the constants of internal_coo (``_gauss``), made on first use
-        self._mass = None               # the lumped mass, made on first use
+        self._g = None  # the constants of internal_coo (``_gauss``), made on first use
+        self._mass = None  # the lumped mass, made on first use
         self.rotary_inertia = bool(rotary_inertia)
         if mass_matrix not in MASS_MATRICES:
-            raise ValueError(f"parameter mass_matrix = {mass_matrix!r} is not allowed: one of {'|'.join(MASS_MATRICES)}")
+            raise ValueError(
+                f"parameter mass_matrix = {mass_matrix!r} is not allowed: one of {'|'.join(MASS_MATRICES)}"
+            )
         self.mass_matrix = mass_matrix
 
-    quadratic_energy = False        # the strains are nonlinear in u (finite rotations)
+    quadratic_energy = False  # the strains are nonlinear in u (finite rotations)
 
     @property
     def hyperelastic(self):
@@ -226,7 +244,7 @@ class Beam:
         q[np.arange(6), np.arange(1, 7)] += 1j * step
         out = self._step_forces(q0[:, None, :], q, g)
         F = np.bincount(e.ravel(), out[:, 0].real.ravel(), minlength=self.ndof)
-        Ke = out[:, 1:].imag / step                               # (6, 6, m): d F_i / d q_j
+        Ke = out[:, 1:].imag / step  # (6, 6, m): d F_i / d q_j
         rows = np.broadcast_to(e[:, None, :], Ke.shape).ravel()
         cols = np.broadcast_to(e[None, :, :], Ke.shape).ravel()
         return F, rows, cols, Ke.ravel()
@@ -237,7 +255,7 @@ class Beam:
         the middle axes broadcast)."""
         Na, Nb, invL = g["Na"], g["Nb"], g["invL"]
         dX = g["dX"].reshape((2,) + (1,) * (q1.ndim - 2) + (-1,))
-        a0 = (dX + q0[3:5] - q0[0:2]) * invL                      # x' at the start and the end
+        a0 = (dX + q0[3:5] - q0[0:2]) * invL  # x' at the start and the end
         a1 = (dX + q1[3:5] - q1[0:2]) * invL
         th0 = g["theta0"] + Na * q0[2] + Nb * q0[5]
         th1 = g["theta0"] + Na * q1[2] + Nb * q1[5]
@@ -249,7 +267,7 @@ class Beam:
 
         (e0, y0), (e1, y1) = gamma(a0, th0), gamma(a1, th1)
         N, Q = 0.5 * D[0] * (e0 + e1), 0.5 * D[1] * (y0 + y1)
-        dA, dB = q1[2] - q0[2], q1[5] - q0[5]                   # the nodes' Delta theta
+        dA, dB = q1[2] - q0[2], q1[5] - q0[5]  # the nodes' Delta theta
         M = 0.5 * D[2] * (q0[5] - q0[2] + q1[5] - q1[2]) * invL
         pA, pB = 2.0 * np.tan(0.5 * dA), 2.0 * np.tan(0.5 * dB)  # their phi
         dth = th1 - th0
@@ -257,7 +275,7 @@ class Beam:
         ch = np.cos(0.5 * dth)
         v = np.array([ch * (N * np.cos(tm) - Q * np.sin(tm)), ch * (N * np.sin(tm) + Q * np.cos(tm))])
         am = 0.5 * (a0 + a1)
-        m = v[1] * am[0] - v[0] * am[1]                          # v . J a_mid
+        m = v[1] * am[0] - v[0] * am[1]  # v . J a_mid
         delta = pB - pA
         pbar = Na * pA + Nb * pB
         small = np.abs(np.real(delta)) < 1e-6
@@ -268,8 +286,9 @@ class Beam:
         k = np.where(small, 1.0 / (1.0 + 0.0625 * (pA + pB) ** 2), (dB - dA) / safe)
         Mk = M * k * invL
         w = g["wL0"]
-        return w * np.array([-v[0] * invL, -v[1] * invL, -Na * m - h * m - Mk,
-                             v[0] * invL, v[1] * invL, -Nb * m + h * m + Mk])
+        return w * np.array(
+            [-v[0] * invL, -v[1] * invL, -Na * m - h * m - Mk, v[0] * invL, v[1] * invL, -Nb * m + h * m + Mk]
+        )
 
     # ---- kinematics ----------------------------------------------------------------
     def positions(self, u):
@@ -281,15 +300,15 @@ class Beam:
         (ne, 3), and t, n of the total angle there."""
         U = np.asarray(u, float).reshape(-1, 3)
         a, b = self.conn.T
-        xp = (self._dX + U[b, :2] - U[a, :2]) / self.L0[:, None]          # x'
+        xp = (self._dX + U[b, :2] - U[a, :2]) / self.L0[:, None]  # x'
         phi = self.theta0 + 0.5 * (1 - xi) * U[a, 2] + 0.5 * (1 + xi) * U[b, 2]
         cos, sin = np.cos(phi), np.sin(phi)
         t = np.stack([cos, sin], axis=1)
         n = np.stack([-sin, cos], axis=1)
         E = np.empty((len(phi), 3))
-        E[:, 0] = xp[:, 0] * cos + xp[:, 1] * sin - 1.0                   # eps = x' . t - 1
-        E[:, 1] = -xp[:, 0] * sin + xp[:, 1] * cos                        # gam = x' . n
-        E[:, 2] = (U[b, 2] - U[a, 2]) / self.L0                           # kap = theta'
+        E[:, 0] = xp[:, 0] * cos + xp[:, 1] * sin - 1.0  # eps = x' . t - 1
+        E[:, 1] = -xp[:, 0] * sin + xp[:, 1] * cos  # gam = x' . n
+        E[:, 2] = (U[b, 2] - U[a, 2]) / self.L0  # kap = theta'
         return E, t, n
 
     def resultants(self, u, xi=0.0, k=0, E=None, dt=None, state=None):
@@ -299,7 +318,7 @@ class Beam:
         if E is None:
             E = self.strains(u, xi)[0]
         ne = len(self.L0)
-        return return_map(E, self._ep(state)[k * ne:(k + 1) * ne], self.D, self.S0, self.eta, self._dt(dt))
+        return return_map(E, self._ep(state)[k * ne : (k + 1) * ne], self.D, self.S0, self.eta, self._dt(dt))
 
     def _ep(self, state):
         """The committed plastic strains: the state, or the initial (zero) ones for None."""
@@ -352,52 +371,52 @@ class Beam:
         eps, gam = E[0], E[1]
         N, Q, M = S[0], S[1], S[2]
         C_N, C_Q, C_M = C[0], C[1], C[2]
-        e1 = 1 + eps                                             # x'.t
+        e1 = 1 + eps  # x'.t
         m = len(eps)
         # residual w L0 B^T S, one row of re per element dof (u_a, theta_a, u_b, theta_b)
         re = np.empty((6, m))
-        np.multiply(g["wiL"], N * t + Q * n, out=re[3:5])        # x': N t + Q n (times 1/L0 at b)
-        np.negative(re[3:5], out=re[0:2])                        # (times -1/L0 at a)
-        h = N * gam - Q * e1                                     # theta: (N gam - Q (1 + eps)) p
+        np.multiply(g["wiL"], N * t + Q * n, out=re[3:5])  # x': N t + Q n (times 1/L0 at b)
+        np.negative(re[3:5], out=re[0:2])  # (times -1/L0 at a)
+        h = N * gam - Q * e1  # theta: (N gam - Q (1 + eps)) p
         wM = g["wiL"] * M
         re[2], re[5] = g["wNa"] * h - wM, g["wNb"] * h + wM
         # tangent: the ten distinct entries of w L0 K_e (docstring)
-        U = np.empty((20, m))                                    # the ten entries, then their negatives
-        tt = np.empty((3, m))                                    # t t^T: (c c, c s, s s)
+        U = np.empty((20, m))  # the ten entries, then their negatives
+        tt = np.empty((3, m))  # t t^T: (c c, c s, s s)
         np.multiply(t, t[0], out=tt[0:2])
         np.multiply(t[1], t[1], out=tt[2])
-        nn = tt[::-1] * g["flip"]                                # n n^T: (s s, -c s, c c)
+        nn = tt[::-1] * g["flip"]  # n n^T: (s s, -c s, c c)
         np.multiply(g["wiL2"], C_N * tt + C_Q * nn, out=U[0:3])  # x'x' (times 1/L0^2)
         a1, a2 = C_N * gam - Q, N - C_Q * e1
-        v = a1 * t + a2 * n                                      # v = (C_N gam - Q) t + (N - C_Q (1 + eps)) n
-        np.multiply(g["wiLN"], v, out=U[3:7].reshape(2, 2, m))   # x' theta_a, x' theta_b (times 1/L0)
-        alpha = gam * a1 - e1 * a2                               # = C_N gam^2 + C_Q (1 + eps)^2 - N (1 + eps) - Q gam
-        np.multiply(g["wNN"], alpha, out=U[7:10])                # theta theta: alpha p p^T
-        U[7:10] += g["wiL2pm"] * C_M                             #   + C_M / L0^2 [[1, -1], [-1, 1]]
-        if len(self.points) > 1:                                 # two points: sum them per element (rows
-            ne = self.ne                                         # e and ne + e), before K_e is spread out
+        v = a1 * t + a2 * n  # v = (C_N gam - Q) t + (N - C_Q (1 + eps)) n
+        np.multiply(g["wiLN"], v, out=U[3:7].reshape(2, 2, m))  # x' theta_a, x' theta_b (times 1/L0)
+        alpha = gam * a1 - e1 * a2  # = C_N gam^2 + C_Q (1 + eps)^2 - N (1 + eps) - Q gam
+        np.multiply(g["wNN"], alpha, out=U[7:10])  # theta theta: alpha p p^T
+        U[7:10] += g["wiL2pm"] * C_M  #   + C_M / L0^2 [[1, -1], [-1, 1]]
+        if len(self.points) > 1:  # two points: sum them per element (rows
+            ne = self.ne  # e and ne + e), before K_e is spread out
             re, U = re[:, :ne] + re[:, ne:], U[:, :ne] + U[:, ne:]
         np.negative(U[:10], out=U[10:])
-        Ke = U[g["entry"]]                                       # (36, ne): entry 6 i + j of each element
+        Ke = U[g["entry"]]  # (36, ne): entry 6 i + j of each element
         R = np.bincount(self._edofs_T, re.ravel(), minlength=self.ndof)
         return R, self._rows, self._cols, Ke.ravel()
 
     def _row_strains(self, u, g):
         """The strains E = (eps, gam, kap) (3, m) and t = (cos, sin), n = (-sin, cos) of the angle
         phi (each (2, m)) at every row of ``_gauss`` (all integration points of all elements)."""
-        q = np.asarray(u, float)[g["edofs"]]                     # (6, m): u_a, theta_a, u_b, theta_b per row
-        x = (g["dX"] + q[3:5] - q[0:2]) * g["invL2"]             # x', both components at once
+        q = np.asarray(u, float)[g["edofs"]]  # (6, m): u_a, theta_a, u_b, theta_b per row
+        x = (g["dX"] + q[3:5] - q[0:2]) * g["invL2"]  # x', both components at once
         phi = g["theta0"] + g["Na"] * q[2] + g["Nb"] * q[5]
         t = np.empty((2, len(phi)))
         np.cos(phi, out=t[0])
         np.sin(phi, out=t[1])
-        n = t[::-1] * g["turn"]                                  # n = e3 x t = (-sin, cos)
+        n = t[::-1] * g["turn"]  # n = e3 x t = (-sin, cos)
         xt, xn = x * t, x * n
         E = np.empty((3, len(phi)))
-        np.add(xt[0], xt[1], out=E[0])                           # eps = x' . t - 1
+        np.add(xt[0], xt[1], out=E[0])  # eps = x' . t - 1
         E[0] -= 1.0
-        np.add(xn[0], xn[1], out=E[1])                           # gam = x' . n
-        np.multiply(q[5] - q[2], g["invL"], out=E[2])            # kap = theta'
+        np.add(xn[0], xn[1], out=E[1])  # gam = x' . n
+        np.multiply(q[5] - q[2], g["invL"], out=E[2])  # kap = theta'
         return E, t, n
 
     def _resultants(self, E, g, dt, state=None):
@@ -421,10 +440,10 @@ class Beam:
             ne, k = len(self.L0), len(self.points)
             xi = np.repeat([x for x, _ in self.points], ne)
             weight = np.repeat([w for _, w in self.points], ne)
-            tile = lambda a: np.concatenate([a] * k)                # noqa: E731
+            tile = lambda a: np.concatenate([a] * k)  # noqa: E731
             Na, Nb, invL, wL0 = 0.5 * (1 - xi), 0.5 * (1 + xi), tile(1 / self.L0), weight * tile(self.L0)
             # w L0 K_e[i, j] = sign * U[entry] (internal_coo): dofs 0, 1 (u_a), 2 (theta_a), 3, 4 (u_b), 5 (theta_b)
-            side = {0: -1.0, 1: -1.0, 3: 1.0, 4: 1.0}               # dx'/du = -1/L0 at a, 1/L0 at b
+            side = {0: -1.0, 1: -1.0, 3: 1.0, 4: 1.0}  # dx'/du = -1/L0 at a, 1/L0 at b
             xx = {(0, 0): 0, (0, 1): 1, (1, 0): 1, (1, 1): 2}
             entry, sign = np.zeros(36, dtype=int), np.ones(36)
             for i in range(6):
@@ -438,17 +457,30 @@ class Beam:
                         entry[6 * i + j] = {(2, 2): 7, (2, 5): 8, (5, 2): 8, (5, 5): 9}[(i, j)]
             # C order: the rows of the element dofs q = u[edofs] (u_x of node a, ...) and of the
             # chords are contiguous, so every product over a row runs on contiguous memory
-            self._g = dict(edofs=np.ascontiguousarray(np.concatenate([self.edofs.T] * k, axis=1)),
-                           dX=np.ascontiguousarray(np.concatenate([self._dX.T] * k, axis=1)),
-                           invL=invL, invL2=np.array([invL, invL]), Dm=self.D[:, None] * np.ones((3, len(xi))),
-                           D2=2 * self.D[:, None], theta0=tile(self.theta0), Na=Na, Nb=Nb, wL0=wL0,
-                           wiL=wL0 * invL, wiL2=wL0 * invL * invL, wNa=wL0 * Na, wNb=wL0 * Nb,
-                           wiLN=np.array([wL0 * invL * Na, wL0 * invL * Nb])[:, None, :],
-                           wNN=np.array([wL0 * Na * Na, wL0 * Na * Nb, wL0 * Nb * Nb]),
-                           wiL2pm=wL0 * invL * invL * np.array([[1.0], [-1.0], [1.0]]),
-                           flip=np.array([[1.0], [-1.0], [1.0]]), turn=np.array([[-1.0], [1.0]]),
-                           entry=np.where(sign < 0, entry + 10, entry),
-                           D=self.D[:, None], S0=None if self.S0 is None else self.S0[:, None])
+            self._g = dict(
+                edofs=np.ascontiguousarray(np.concatenate([self.edofs.T] * k, axis=1)),
+                dX=np.ascontiguousarray(np.concatenate([self._dX.T] * k, axis=1)),
+                invL=invL,
+                invL2=np.array([invL, invL]),
+                Dm=self.D[:, None] * np.ones((3, len(xi))),
+                D2=2 * self.D[:, None],
+                theta0=tile(self.theta0),
+                Na=Na,
+                Nb=Nb,
+                wL0=wL0,
+                wiL=wL0 * invL,
+                wiL2=wL0 * invL * invL,
+                wNa=wL0 * Na,
+                wNb=wL0 * Nb,
+                wiLN=np.array([wL0 * invL * Na, wL0 * invL * Nb])[:, None, :],
+                wNN=np.array([wL0 * Na * Na, wL0 * Na * Nb, wL0 * Nb * Nb]),
+                wiL2pm=wL0 * invL * invL * np.array([[1.0], [-1.0], [1.0]]),
+                flip=np.array([[1.0], [-1.0], [1.0]]),
+                turn=np.array([[-1.0], [1.0]]),
+                entry=np.where(sign < 0, entry + 10, entry),
+                D=self.D[:, None],
+                S0=None if self.S0 is None else self.S0[:, None],
+            )
         return self._g
 
     def strain_energy(self, u, dt=None, state=None):
@@ -468,7 +500,9 @@ class Beam:
         strains (None if elastic). The beam keeps nothing."""
         if self.S0 is None:
             return None
-        return np.concatenate([self.resultants(u, xi, k, dt=dt, state=state)[2] for k, (xi, _) in enumerate(self.points)])
+        return np.concatenate(
+            [self.resultants(u, xi, k, dt=dt, state=state)[2] for k, (xi, _) in enumerate(self.points)]
+        )
 
     @property
     def mesh(self):
@@ -503,9 +537,10 @@ class Beam:
                 rows += [i, i, j, j]
                 cols += [i, j, i, j]
                 vals += [2 * e, e, e, 2 * e]
-            return coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                              shape=(self.ndof, self.ndof)).tocsr()
-        if self._mass is None:                     # computed once, then reused
+            return coo_matrix(
+                (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(self.ndof, self.ndof)
+            ).tocsr()
+        if self._mass is None:  # computed once, then reused
             length = np.bincount(self.conn.ravel(), np.repeat(0.5 * self.L0, 2), minlength=self.X.shape[0])
             J = self.I * length if self.rotary_inertia else 0.0 * length
             self._mass = (self.rho * np.column_stack([self.A * length, self.A * length, J])).ravel()
@@ -551,7 +586,7 @@ class BeamGravity:
         if g.shape != (2,) or not np.all(np.isfinite(g)):
             raise ValueError(f"parameter g must be a finite number or 2-vector, got {g!r}")
         self.beam, self.g = beam, g
-        self._P = (None, None)              # (where, triplets): P made for one place of the beam
+        self._P = (None, None)  # (where, triplets): P made for one place of the beam
 
     def start(self, u, t=0.0, offsets=None):
         """A dead load has no state."""

@@ -22,10 +22,20 @@ so that one pair of weak forms serves all cases (principle of virtual work):
 with dV = thickness dA (plane) or 2 pi R dA (axisymmetric). The linear material
 uses the same forms with F = I + grad u and P = C : eps (small strain).
 """
+
 import numpy as np
-from skfem import (Basis, BilinearForm, ElementQuad1, ElementTriP1,
-                   ElementVector, Functional, LinearForm, MeshQuad, MeshTri,
-                   asm)
+from skfem import (
+    Basis,
+    BilinearForm,
+    ElementQuad1,
+    ElementTriP1,
+    ElementVector,
+    Functional,
+    LinearForm,
+    MeshQuad,
+    MeshTri,
+    asm,
+)
 
 from .interfaces import MASS_MATRICES
 from .materials import MATERIAL_FUNCTIONS, MATERIALS, _eye
@@ -47,13 +57,16 @@ def degenerate_guard(make, mesh):
         if "Jacobian" not in str(err):
             raise
         size = float(np.ptp(mesh.p, axis=1).max()) if mesh.p.size else 0.0
-        raise InvertedElementError(f"the mesh is degenerate in floating point (zero Jacobian determinant; "
-                                   f"mesh size {size:.3g}): lengths too small or too large") from None
+        raise InvertedElementError(
+            f"the mesh is degenerate in floating point (zero Jacobian determinant; "
+            f"mesh size {size:.3g}): lengths too small or too large"
+        ) from None
 
 
 # ---------------------------------------------------------------------------
 # Weak forms. w.axi (bool) and w.thickness are scalars passed to asm.
 # ---------------------------------------------------------------------------
+
 
 def _weight(w):
     """Volume element factor: 2 pi r (axisymmetric) or the thickness (plane)."""
@@ -68,7 +81,7 @@ def _hoop(v, w):
 @LinearForm
 def _internal_form(v, w):
     """Virtual work of the stresses: P : grad v + P_33 v_r / r."""
-    P = np.asarray(w.P)     # plain array: indexing a DiscreteField copies all of it
+    P = np.asarray(w.P)  # plain array: indexing a DiscreteField copies all of it
     work = np.einsum("ij...,ij...->...", P[:2, :2], v.grad) + P[2, 2] * _hoop(v, w)
     return work * _weight(w)
 
@@ -76,14 +89,17 @@ def _internal_form(v, w):
 @BilinearForm
 def _tangent_form(u, v, w):
     """Linearised virtual work: grad v : A : grad du (+ hoop couplings)."""
-    A = np.asarray(w.A)     # plain array: indexing a DiscreteField copies all of it (8x slower)
+    A = np.asarray(w.A)  # plain array: indexing a DiscreteField copies all of it (8x slower)
     k = np.einsum("ijkl...,ij...,kl...->...", A[:2, :2, :2, :2], v.grad, u.grad)
-    if not w.axi:           # plane: no hoop terms
+    if not w.axi:  # plane: no hoop terms
         return k * w.thickness
     hu, hv = _hoop(u, w), _hoop(v, w)
-    k = (k + np.einsum("ij...,ij...->...", A[:2, :2, 2, 2], v.grad) * hu
-         + np.einsum("kl...,kl...->...", A[2, 2, :2, :2], u.grad) * hv
-         + A[2, 2, 2, 2] * hu * hv)
+    k = (
+        k
+        + np.einsum("ij...,ij...->...", A[:2, :2, 2, 2], v.grad) * hu
+        + np.einsum("kl...,kl...->...", A[2, 2, :2, :2], u.grad) * hv
+        + A[2, 2, 2, 2] * hu * hv
+    )
     return k * _weight(w)
 
 
@@ -96,7 +112,7 @@ def _linear_form(u, v, w):
     gu, gv = u.grad, v.grad
     tr_u, tr_v = gu[0, 0] + gu[1, 1], gv[0, 0] + gv[1, 1]
     eps_eps = gu[0, 0] * gv[0, 0] + gu[1, 1] * gv[1, 1] + 0.5 * (gu[0, 1] + gu[1, 0]) * (gv[0, 1] + gv[1, 0])
-    if w.axi:               # the hoop strain in the trace and in eps : eps
+    if w.axi:  # the hoop strain in the trace and in eps : eps
         hu, hv = _hoop(u, w), _hoop(v, w)
         tr_u, tr_v, eps_eps = tr_u + hu, tr_v + hv, eps_eps + hu * hv
     return (w.lam * tr_u * tr_v + 2.0 * w.mu * eps_eps) * _weight(w)
@@ -117,6 +133,7 @@ def _energy_form(w):
 # ---------------------------------------------------------------------------
 # Boundary helper
 # ---------------------------------------------------------------------------
+
 
 def boundary_loop(mesh):
     """Node indices of the boundary of a 2D scikit-fem mesh, in order around it (the outer
@@ -154,6 +171,7 @@ def oriented_facets(mesh, facets):
 # The body
 # ---------------------------------------------------------------------------
 
+
 class Continuum:
     """A 2D continuum body (see module docstring); implements the body interface.
 
@@ -163,8 +181,9 @@ class Continuum:
     "lumped" (row sums, diagonal) or "consistent" (``mass(consistent=True)``).
     """
 
-    def __init__(self, mesh, E, nu, rho, kind="plane_strain", material="linear",
-                 name="body", thickness=1.0, mass_matrix="lumped"):
+    def __init__(
+        self, mesh, E, nu, rho, kind="plane_strain", material="linear", name="body", thickness=1.0, mass_matrix="lumped"
+    ):
         if not E > 0:
             raise ValueError(f"E must be > 0, got {E}")
         if not -1.0 < nu < 0.5:
@@ -178,7 +197,9 @@ class Continuum:
         if material not in MATERIALS:
             raise ValueError(f"material must be one of {MATERIALS}, got {material!r}")
         if mass_matrix not in MASS_MATRICES:
-            raise ValueError(f"parameter mass_matrix = {mass_matrix!r} is not allowed: one of {'|'.join(MASS_MATRICES)}")
+            raise ValueError(
+                f"parameter mass_matrix = {mass_matrix!r} is not allowed: one of {'|'.join(MASS_MATRICES)}"
+            )
         if kind == "plane_stress" and material != "linear":
             raise ValueError(f"material must be 'linear' for kind='plane_stress', got {material!r}")
         if isinstance(mesh, MeshQuad):
@@ -194,7 +215,7 @@ class Continuum:
         self.E, self.nu, self.rho = float(E), float(nu), float(rho)
         self.mu = E / (2.0 * (1.0 + nu))
         self.lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
-        if kind == "plane_stress":                      # sigma_33 = 0 eliminated
+        if kind == "plane_stress":  # sigma_33 = 0 eliminated
             self.lam = 2.0 * self.lam * self.mu / (self.lam + 2.0 * self.mu)
         self.axi = kind == "axisymmetric"
         self.thickness = 1.0 if self.axi else float(thickness)
@@ -207,8 +228,8 @@ class Continuum:
         self._K_linear = None
         self.mass_matrix = mass_matrix  # the mass the System uses: lumped (diagonal) or consistent
         self._mass = None
-        self._M = None                  # the consistent mass matrix (made on first use)
-        self._coo = None                # (indptr, indices, rows) of the last tangent's pattern
+        self._M = None  # the consistent mass matrix (made on first use)
+        self._coo = None  # (indptr, indices, rows) of the last tangent's pattern
 
     # -- kinematics and constitutive update at the quadrature points --------
 
@@ -239,7 +260,8 @@ class Continuum:
         if np.any(J <= 0.0) or not np.all(np.isfinite(J)):
             e = np.unique(np.nonzero(~(J > 0.0))[0])
             raise InvertedElementError(
-                f"element volume non-positive (det F <= 0) in body {self.name!r}, elements {e[:10]}")
+                f"element volume non-positive (det F <= 0) in body {self.name!r}, elements {e[:10]}"
+            )
         return F
 
     # -- body interface ----------------------------------------------------
@@ -260,10 +282,11 @@ class Continuum:
         assembly gives the same pattern at every call), so that the System places them once."""
         R, K = self.internal(u)
         last = self._coo
-        if last is None or not (last[0] is K.indptr or (np.array_equal(last[0], K.indptr)
-                                                        and np.array_equal(last[1], K.indices))):
+        if last is None or not (
+            last[0] is K.indptr or (np.array_equal(last[0], K.indptr) and np.array_equal(last[1], K.indices))
+        ):
             last = self._coo = (K.indptr, K.indices, np.repeat(np.arange(K.shape[0]), np.diff(K.indptr)))
-        if K.format == "csc":          # columns by columns: (rows, cols) = (indices, the column of each)
+        if K.format == "csc":  # columns by columns: (rows, cols) = (indices, the column of each)
             return R, last[1], last[2], K.data
         return R, last[2], last[1], K.data
 
@@ -305,7 +328,7 @@ class Continuum:
             if self._M is None:
                 self._M = asm(_mass_form, self.basis, rho=self.rho, **self._params()).tocsr()
             return self._M.copy()
-        if self._mass is None and self.rho == 0.0:       # quasi-static body: nothing to integrate
+        if self._mass is None and self.rho == 0.0:  # quasi-static body: nothing to integrate
             self._mass = np.zeros(self.ndof)
         if self._mass is None:
             self._mass = np.asarray(self.mass(consistent=True).sum(axis=1)).ravel()
@@ -329,7 +352,7 @@ class Continuum:
         inside out, or folded) where a ratio is <= 0; a small-strain (linear) run that
         inverts elements is outside the range of its own model."""
         u = np.asarray(u, dtype=float)
-        t = self.mesh.t.T                                       # (nel, corners), one orientation
+        t = self.mesh.t.T  # (nel, corners), one orientation
 
         def corners(x):
             q = x[t]
@@ -337,14 +360,14 @@ class Continuum:
             e_prev = np.roll(q, 1, axis=1) - q
             return e_next[..., 0] * e_prev[..., 1] - e_next[..., 1] * e_prev[..., 0]
 
-        x = self.X + u[offset + self.xdofs]          # u: the body's vector, or a System's with its offset
+        x = self.X + u[offset + self.xdofs]  # u: the body's vector, or a System's with its offset
         return corners(x) / corners(self.X)
 
     def inverted_elements(self, u, offset=0):
         """Indices of the elements with a non-positive det J somewhere (corner_jacobian_ratios)."""
         return np.flatnonzero(np.min(self.corner_jacobian_ratios(u, offset), axis=1) <= 0.0)
 
-    rotation_dofs = np.zeros(0, dtype=int)      # no angles among the unknowns
+    rotation_dofs = np.zeros(0, dtype=int)  # no angles among the unknowns
 
     def discrete_gradient(self, u0, u1):
         """The internal force of an energy-consistent step u0 -> u1 and its tangent dF/du1,
@@ -380,7 +403,7 @@ class Continuum:
         """Current (signed) area of every element in the plane (shoelace formula over its
         nodes, counter-clockwise): > 0 for a valid element, <= 0 for an inverted one."""
         x = self.X + np.asarray(u)[self.xdofs]
-        q = x[self.mesh.t.T]                            # (nel, nodes, 2)
+        q = x[self.mesh.t.T]  # (nel, nodes, 2)
         xs, ys = q[..., 0], q[..., 1]
         return 0.5 * np.sum(xs * np.roll(ys, -1, axis=1) - np.roll(xs, -1, axis=1) * ys, axis=1)
 

@@ -24,6 +24,7 @@ Sci 6, 1996): F = R(u_mid) + c w, with w the increment without its rigid transla
 that F has no resultant; it may have a moment (the correction's, of the order of the energy
 mismatch it removes). The linear continuum (c = 0: R(u_mid)) and a body of one's own.
 """
+
 import numpy as np
 
 from .materials import _eye
@@ -42,16 +43,18 @@ def cayley(d, rotations):
     x = dq[rotations]
     if np.any(~(np.abs(x) < np.pi)):
         i = int(np.argmax(~(np.abs(x) < np.pi)))
-        raise FloatingPointError(f"an angle turns by {x[i]:.3g} rad in one step at dof {int(rotations[i])}: the "
-                                 "Cayley update allows less than pi (a smaller dt)")
+        raise FloatingPointError(
+            f"an angle turns by {x[i]:.3g} rad in one step at dof {int(rotations[i])}: the "
+            "Cayley update allows less than pi (a smaller dt)"
+        )
     h = 0.5 * x
     phi = 2.0 * np.tan(h)
     dq[rotations] = phi
     D[rotations] = 1.0 + 0.25 * phi * phi
     small = np.abs(x) < 1e-2
     hs = np.where(small, 1.0, h)
-    chord[rotations] = np.where(small, 1.0 - x * x / 12.0 - x ** 4 / 720.0 - x ** 6 / 30240.0, hs / np.tan(hs))
-    dchord = np.where(small, -x / 6.0 - x ** 3 / 180.0 - x ** 5 / 5040.0, 0.5 / np.tan(hs) - 0.5 * hs / np.sin(hs) ** 2)
+    chord[rotations] = np.where(small, 1.0 - x * x / 12.0 - x**4 / 720.0 - x**6 / 30240.0, hs / np.tan(hs))
+    dchord = np.where(small, -x / 6.0 - x**3 / 180.0 - x**5 / 5040.0, 0.5 / np.tan(hs) - 0.5 * hs / np.sin(hs) ** 2)
     return dq, D, chord, dchord
 
 
@@ -69,7 +72,7 @@ def gonzalez(body, u0, u1, modes):
     correction for a quadratic W (the midpoint rule is exact: gap = 0 up to the rounding of
     R = K u, a sum of large cancelling terms when the body moves rigidly), nor where the gap
     is at the rounding of W."""
-    import scipy.sparse as sp     # (imported here: listing the scenes loads no scipy)
+    import scipy.sparse as sp  # (imported here: listing the scenes loads no scipy)
 
     um = 0.5 * (u0 + u1)
     R, K = body.internal(um)
@@ -77,7 +80,7 @@ def gonzalez(body, u0, u1, modes):
     W0, W1 = body.strain_energy(u0), body.strain_energy(u1)
     A = modes
     AtA_inv = np.linalg.inv(A.T @ A)
-    w = d - A @ (AtA_inv @ (A.T @ d))                    # d without its rigid translation
+    w = d - A @ (AtA_inv @ (A.T @ d))  # d without its rigid translation
     gap = W1 - W0 - R @ d
     ww = w @ w
     use = not body.quadratic_energy and ww > 0 and abs(gap) > 1e-13 * (abs(W0) + abs(W1))
@@ -115,7 +118,7 @@ def algorithmic_stress(material, F0, F1, lam, mu, W0=None):
     I = _eye(F0)
     E0 = 0.5 * (np.einsum("ki...,kj...->ij...", F0, F0) - I)
     E1 = 0.5 * (np.einsum("ki...,kj...->ij...", F1, F1) - I)
-    C = E0 + E1 + I                                           # C_mid = 2 E_mid + I
+    C = E0 + E1 + I  # C_mid = 2 E_mid + I
     # U = sqrt(C): the 2x2 in-plane block (B + sqrt(det B) I) / sqrt(tr B + 2 sqrt(det B)), U_33 = sqrt(C_33)
     s = np.sqrt(C[0, 0] * C[1, 1] - C[0, 1] * C[1, 0])
     t = np.sqrt(C[0, 0] + C[1, 1] + 2.0 * s)
@@ -128,7 +131,7 @@ def algorithmic_stress(material, F0, F1, lam, mu, W0=None):
     Ui[0, 0], Ui[1, 1], Ui[0, 1], Ui[1, 0] = U[1, 1] / det, U[0, 0] / det, -U[0, 1] / det, -U[1, 0] / det
     Ui[2, 2] = 1.0 / U[2, 2]
     S = np.einsum("ik...,kj...->ij...", Ui, P_mid)
-    S = 0.5 * (S + S.transpose(1, 0, *range(2, S.ndim)))     # symmetric (to rounding already)
+    S = 0.5 * (S + S.transpose(1, 0, *range(2, S.ndim)))  # symmetric (to rounding already)
     dE = E1 - E0
     nn = np.einsum("ij...,ij...->...", dE, dE)
     if W0 is None:

@@ -11,6 +11,7 @@ viscoplastic beam's plastic strains, a gas pressure's value) is their ``state``,
 ``start`` gives the first, ``commit`` returns the next, the System carries it (its
 SystemState, solver/system.py) and passes it to every call that needs it.
 """
+
 from typing import Protocol, runtime_checkable
 
 import numpy as np
@@ -24,13 +25,13 @@ class Body(Protocol):
     """A body (see contactfem.bodies): node positions, unknowns, mass, internal forces."""
 
     name: str
-    X: np.ndarray               # (nn, 2) reference positions of the nodes that can touch
+    X: np.ndarray  # (nn, 2) reference positions of the nodes that can touch
     ndof: int
-    xdofs: np.ndarray           # (nn, 2) local dof numbers of each node's (u_x, u_y)
-    hyperelastic: bool          # a stored energy and no history (energy-consistent stepping needs it)
-    quadratic_energy: bool      # W(u) quadratic (a linear body): the midpoint rule is energy-exact for it
-    mass_matrix: str            # the mass the System uses: "lumped" or "consistent" (MASS_MATRICES)
-    rotation_dofs: np.ndarray   # local dofs that are angles (a beam's theta; none for a continuum)
+    xdofs: np.ndarray  # (nn, 2) local dof numbers of each node's (u_x, u_y)
+    hyperelastic: bool  # a stored energy and no history (energy-consistent stepping needs it)
+    quadratic_energy: bool  # W(u) quadratic (a linear body): the midpoint rule is energy-exact for it
+    mass_matrix: str  # the mass the System uses: "lumped" or "consistent" (MASS_MATRICES)
+    rotation_dofs: np.ndarray  # local dofs that are angles (a beam's theta; none for a continuum)
 
     def mass(self, consistent: bool = False):
         """The lumped (diagonal) mass, (ndof,); with ``consistent=True`` the consistent mass as a

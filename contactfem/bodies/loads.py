@@ -12,6 +12,7 @@ without one).
 Axisymmetric bodies integrate over the full ring (2 pi r), plane bodies over
 the thickness, exactly as in ``Continuum``.
 """
+
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -59,9 +60,9 @@ class _Load:
 
     def assemble(self, u_global, t, state=None, offsets=None):
         off, n = start_of(self.body, offsets), self.body.ndof
-        P_local, rows, cols, vals = self._local(np.asarray(u_global)[off:off + n], t, state)
+        P_local, rows, cols, vals = self._local(np.asarray(u_global)[off : off + n], t, state)
         P = np.zeros(len(u_global))
-        P[off:off + n] = P_local
+        P[off : off + n] = P_local
         return P, rows + off, cols + off, vals
 
     def total_force(self, u_global, t, state=None, offsets=None):
@@ -117,8 +118,7 @@ class Pressure(_Load):
     """
 
     # d nL / d(u_ax, u_ay, u_bx, u_by), nL = (-(y_b - y_a), x_b - x_a)
-    _dnL = np.array([[0.0, 1.0, 0.0, -1.0],
-                     [-1.0, 0.0, 1.0, 0.0]])
+    _dnL = np.array([[0.0, 1.0, 0.0, -1.0], [-1.0, 0.0, 1.0, 0.0]])
 
     def __init__(self, body, boundary_name, p, follower=False):
         super().__init__(body)
@@ -126,8 +126,8 @@ class Pressure(_Load):
         facets = body.boundary_facets(boundary_name)
         if self.follower:
             ab = oriented_facets(body.mesh, facets)
-            self._dofs = body.xdofs[ab].reshape(-1, 4)    # [a_x, a_y, b_x, b_y] per facet
-            self._X = body.X[ab].reshape(-1, 4)          # reference (X_a, Y_a, X_b, Y_b)
+            self._dofs = body.xdofs[ab].reshape(-1, 4)  # [a_x, a_y, b_x, b_y] per facet
+            self._X = body.X[ab].reshape(-1, 4)  # reference (X_a, Y_a, X_b, Y_b)
         else:
             fb = FacetBasis(body.mesh, body.element, facets=facets)
             self._unit = asm(_unit_pressure, fb, axi=body.axi, thickness=body.thickness)
@@ -140,7 +140,7 @@ class Pressure(_Load):
         p = self._value(t, state)
         if not self.follower:
             return p * self._unit, *_EMPTY
-        x = self._X + u[self._dofs]             # current (x_a, y_a, x_b, y_b), (nf, 4)
+        x = self._X + u[self._dofs]  # current (x_a, y_a, x_b, y_b), (nf, 4)
         nL = np.column_stack([-(x[:, 3] - x[:, 1]), x[:, 2] - x[:, 0]])
         if self.body.axi:
             ra, rb = x[:, 0], x[:, 2]
@@ -149,9 +149,10 @@ class Pressure(_Load):
         else:
             c = np.full((len(x), 2), 0.5 * self.body.thickness)
             dc = np.zeros((2, 4))
-        f = -p * np.concatenate([c[:, 0:1] * nL, c[:, 1:2] * nL], axis=1)     # (nf, 4)
-        K = np.concatenate([c[:, i, None, None] * self._dnL + nL[:, :, None] * dc[i]
-                            for i in (0, 1)], axis=1) * -p                   # (nf, 4, 4)
+        f = -p * np.concatenate([c[:, 0:1] * nL, c[:, 1:2] * nL], axis=1)  # (nf, 4)
+        K = (
+            np.concatenate([c[:, i, None, None] * self._dnL + nL[:, :, None] * dc[i] for i in (0, 1)], axis=1) * -p
+        )  # (nf, 4, 4)
         P = np.zeros(self.body.ndof)
         np.add.at(P, self._dofs, f)
         rows = np.repeat(self._dofs, 4, axis=1).ravel()
@@ -174,6 +175,7 @@ class GasState:
     """What the gas column remembers (GasPressure): the swept volume S0 of the initial state,
     the number k of pressures set, the value set from the last converged state, whether the
     gas has escaped and when."""
+
     S0: float
     k: int = 0
     value: float = 0.0
@@ -264,7 +266,7 @@ class OverhangPressure:
         for i in range(len(nodes) - 1):
             xa, xb = x[i], x[i + 1]
             L = xb - xa
-            for lo, hi in ((xa, min(xb, x0)), (max(xa, x1), xb)):       # loaded sub-intervals
+            for lo, hi in ((xa, min(xb, x0)), (max(xa, x1), xb)):  # loaded sub-intervals
                 if hi > lo:
                     # int_lo^hi (xb - s)/L ds and int_lo^hi (s - xa)/L ds
                     f[i] += ((xb - lo) ** 2 - (xb - hi) ** 2) / (2 * L)
@@ -283,6 +285,6 @@ class OverhangPressure:
     def assemble(self, u_global, t, state=None, offsets=None):
         P = np.zeros(len(u_global))
         off = start_of(self.body, offsets)
-        P[off:off + self.body.ndof] = self.local
+        P[off : off + self.body.ndof] = self.local
         e = np.zeros(0, dtype=int)
         return P, e, e, np.zeros(0)

@@ -4,6 +4,7 @@ density W, first Piola-Kirchhoff stress P and material tangent A = dP/dF (None w
 ``tangent=False``: energy and stress only) (Holzapfel,
 Nonlinear Solid Mechanics, ch. 6; Wriggers, Nonlinear FEM, ch. 3-4). Plain numpy: the
 forms of continuum.py integrate them with scikit-fem."""
+
 import numpy as np
 
 MATERIALS = ("linear", "svk", "neohooke")
@@ -17,8 +18,7 @@ def _eye(F):
 def _isotropic_tangent(lam, mu, shape):
     """C_ijkl = lam d_ij d_kl + mu (d_ik d_jl + d_il d_jk), broadcast to shape."""
     d = np.eye(3)
-    C = (lam * np.einsum("ij,kl->ijkl", d, d)
-         + mu * (np.einsum("ik,jl->ijkl", d, d) + np.einsum("il,jk->ijkl", d, d)))
+    C = lam * np.einsum("ij,kl->ijkl", d, d) + mu * (np.einsum("ik,jl->ijkl", d, d) + np.einsum("il,jk->ijkl", d, d))
     return np.broadcast_to(C.reshape(C.shape + (1,) * len(shape)), C.shape + tuple(shape))  # a view, no copy
 
 
@@ -47,10 +47,12 @@ def saint_venant_kirchhoff(F, lam, mu, tangent=True):
     if not tangent:
         return W, P, None
     FFt = np.einsum("ik...,jk...->ij...", F, F)
-    A = (np.einsum("ik,jl...->ijkl...", np.eye(3), S)
-         + lam * np.einsum("ij...,kl...->ijkl...", F, F)
-         + mu * np.einsum("ik...,jl->ijkl...", FFt, np.eye(3))
-         + mu * np.einsum("il...,kj...->ijkl...", F, F))
+    A = (
+        np.einsum("ik,jl...->ijkl...", np.eye(3), S)
+        + lam * np.einsum("ij...,kl...->ijkl...", F, F)
+        + mu * np.einsum("ik...,jl->ijkl...", FFt, np.eye(3))
+        + mu * np.einsum("il...,kj...->ijkl...", F, F)
+    )
     return W, P, A
 
 
@@ -60,7 +62,7 @@ def neo_hooke(F, lam, mu, tangent=True):
     P = mu (F - F^-T) + lam ln J F^-T,
     A_iJkL = mu d_ik d_JL + (mu - lam ln J) Fi_Li Fi_Jk + lam Fi_Ji Fi_Lk  (Fi = F^-1).
     """
-    Fm = np.moveaxis(F, (0, 1), (-2, -1))           # (..., 3, 3) for numpy.linalg
+    Fm = np.moveaxis(F, (0, 1), (-2, -1))  # (..., 3, 3) for numpy.linalg
     J = np.linalg.det(Fm)
     Fi = np.moveaxis(np.linalg.inv(Fm), (-2, -1), (0, 1))
     FiT = Fi.transpose(1, 0, 2, 3)
@@ -71,12 +73,12 @@ def neo_hooke(F, lam, mu, tangent=True):
     if not tangent:
         return W, P, None
     d = np.eye(3)
-    A = (mu * np.einsum("ik,jl,...->ijkl...", d, d, np.ones(J.shape))
-         + (mu - lam * lnJ) * np.einsum("li...,jk...->ijkl...", Fi, Fi)
-         + lam * np.einsum("ji...,lk...->ijkl...", Fi, Fi))
+    A = (
+        mu * np.einsum("ik,jl,...->ijkl...", d, d, np.ones(J.shape))
+        + (mu - lam * lnJ) * np.einsum("li...,jk...->ijkl...", Fi, Fi)
+        + lam * np.einsum("ji...,lk...->ijkl...", Fi, Fi)
+    )
     return W, P, A
 
 
-MATERIAL_FUNCTIONS = {"linear": linear_elastic,
-                      "svk": saint_venant_kirchhoff,
-                      "neohooke": neo_hooke}
+MATERIAL_FUNCTIONS = {"linear": linear_elastic, "svk": saint_venant_kirchhoff, "neohooke": neo_hooke}

@@ -12,12 +12,14 @@ def block_mesh(width, height, nx, ny):
 
     mesh = MeshQuad.init_tensor(np.linspace(0.0, width, nx + 1), np.linspace(0.0, height, ny + 1))
     tx, ty = 1e-9 * width, 1e-9 * height
-    return mesh.with_boundaries({
-        "bottom": lambda x: x[1] < ty,
-        "top": lambda x: x[1] > height - ty,
-        "left": lambda x: x[0] < tx,
-        "right": lambda x: x[0] > width - tx,
-    })
+    return mesh.with_boundaries(
+        {
+            "bottom": lambda x: x[1] < ty,
+            "top": lambda x: x[1] > height - ty,
+            "left": lambda x: x[0] < tx,
+            "right": lambda x: x[0] > width - tx,
+        }
+    )
 
 
 def stretching(n, k):
@@ -53,7 +55,7 @@ def quarter_disk(R, n_el, k):
     from skfem import MeshQuad
 
     xi = stretching(n_el, k)
-    XI, ETA = np.meshgrid(xi, xi, indexing="ij")               # (n+1, n+1)
+    XI, ETA = np.meshgrid(xi, xi, indexing="ij")  # (n+1, n+1)
 
     def arc(theta):
         return R * np.stack([np.cos(theta), np.sin(theta)])
@@ -63,8 +65,12 @@ def quarter_disk(R, n_el, k):
     left = np.stack([0.0 * ETA, -R + ETA * R])
     right = arc(-np.pi / 4 + ETA * np.pi / 4)
     P00, P10, P01, P11 = arc(-np.pi / 2), arc(-np.pi / 4), np.zeros(2), arc(0.0)
-    corners = ((1 - XI) * (1 - ETA))[None] * P00[:, None, None] + (XI * (1 - ETA))[None] * P10[:, None, None] \
-        + ((1 - XI) * ETA)[None] * P01[:, None, None] + (XI * ETA)[None] * P11[:, None, None]
+    corners = (
+        ((1 - XI) * (1 - ETA))[None] * P00[:, None, None]
+        + (XI * (1 - ETA))[None] * P10[:, None, None]
+        + ((1 - XI) * ETA)[None] * P01[:, None, None]
+        + (XI * ETA)[None] * P11[:, None, None]
+    )
     x = (1 - ETA) * bottom + ETA * top + (1 - XI) * left + XI * right - corners
     p = x.reshape(2, -1)
     idx = np.arange((n_el + 1) ** 2).reshape(n_el + 1, n_el + 1)
@@ -75,11 +81,13 @@ def quarter_disk(R, n_el, k):
     if np.mean(area) < 0:
         t = t[::-1]
     tol = 1e-9 * R
-    return MeshQuad(p, t).with_boundaries({
-        "symmetry": lambda x: np.abs(x[0]) < tol,
-        "top": lambda x: np.abs(x[1]) < tol,
-        "arc": lambda x: (np.abs(x[0]) > tol) & (np.abs(x[1]) > tol),
-    })
+    return MeshQuad(p, t).with_boundaries(
+        {
+            "symmetry": lambda x: np.abs(x[0]) < tol,
+            "top": lambda x: np.abs(x[1]) < tol,
+            "arc": lambda x: (np.abs(x[0]) > tol) & (np.abs(x[1]) > tol),
+        }
+    )
 
 
 def cork_radius(z, R_tip, R_cork, L_taper):
@@ -95,12 +103,14 @@ def cork_mesh(R_tip, R_cork, L_taper, length, n_r, n_z):
 
     mesh = MeshQuad.init_tensor(np.linspace(0.0, 1.0, n_r + 1), np.linspace(0.0, length, n_z + 1))
     tr, tz = 1e-9, 1e-9 * length
-    mesh = mesh.with_boundaries({
-        "axis": lambda x: x[0] < tr,
-        "outer": lambda x: x[0] > 1.0 - tr,
-        "bottom": lambda x: x[1] < tz,
-        "top": lambda x: x[1] > length - tz,
-    })
+    mesh = mesh.with_boundaries(
+        {
+            "axis": lambda x: x[0] < tr,
+            "outer": lambda x: x[0] > 1.0 - tr,
+            "bottom": lambda x: x[1] < tz,
+            "top": lambda x: x[1] > length - tz,
+        }
+    )
     p = mesh.p.copy()
     p[0] = p[0] * cork_radius(p[1], R_tip, R_cork, L_taper)
     return MeshQuad(p, mesh.t, _boundaries=mesh.boundaries)

@@ -34,6 +34,7 @@ the nodes on x = x_c of the continuum half annulus. Its mass is half the ring's;
 rigid-body measures refer to the full (mirrored) ring: centre x = x_c, centre
 velocity (0, v_y), spin 0.
 """
+
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -90,7 +91,7 @@ def annulus_mesh(R_in, R_out, n_el, n_radial, center=(0.0, 0.0), half=False):
     I1 = (I + 1) % n_ang
     t = np.vstack([J * n_ang + I, (J + 1) * n_ang + I, (J + 1) * n_ang + I1, J * n_ang + I1])
     mesh = MeshQuad(p, t)
-    rad = lambda x: np.hypot(x[0] - c[0], x[1] - c[1])     # noqa: E731
+    rad = lambda x: np.hypot(x[0] - c[0], x[1] - c[1])  # noqa: E731
     tol = 1e-6 * (R_out - R_in)
     bnd = {"outer": lambda x: rad(x) > R_out - tol, "inner": lambda x: rad(x) < R_in + tol}
     if half:
@@ -106,6 +107,7 @@ class RingModel:
     contact_nodes  (nc,) body node indices of the contact surface, counter-clockwise
     offset         contact offset for NodeToSegment: h/2 (beam), 0 (continuum)
     """
+
     body: object
     kind: str
     R: float
@@ -134,7 +136,7 @@ class RingModel:
         """The body's local part of u (a global vector whose dofs start with the ring's, as in
         the ring scenes, is accepted too; or a stack of them, one a row)."""
         u = np.asarray(u, float)
-        return u[..., :self.body.ndof]
+        return u[..., : self.body.ndof]
 
     def positions(self, u):
         """Current positions of all nodes (beam: centreline nodes), (nn, 2) (a stack of u:
@@ -201,9 +203,9 @@ class RingModel:
             return L, Ic
         M = b.mass(consistent=True).tocsr()
         x = b.xdofs[:, 0]
-        Mt = M[x][:, x]                                # the same block for u_x and u_y
+        Mt = M[x][:, x]  # the same block for u_x and u_y
 
-        def Mx(a):                                     # M_t a over the node axis, a (..., nn)
+        def Mx(a):  # M_t a over the node axis, a (..., nn)
             return (Mt @ a.T).T
 
         L = np.sum(r[..., 0] * Mx(w[..., 1]) - r[..., 1] * Mx(w[..., 0]), axis=-1)
@@ -309,9 +311,25 @@ class RingModel:
         return int(np.argmin(self.outline(u)[: len(self.contact_nodes), 1]))
 
 
-def make_ring(kind="beam", R=1.0, thickness=0.1, n_el=32, E=1.0, nu=0.0, rho=1.0,
-              center=(0.0, 0.0), n_radial=2, plastic=None, width=1.0, half=False,
-              name="ring", material="svk", integration=1, rotary_inertia=True, mass_matrix="lumped"):
+def make_ring(
+    kind="beam",
+    R=1.0,
+    thickness=0.1,
+    n_el=32,
+    E=1.0,
+    nu=0.0,
+    rho=1.0,
+    center=(0.0, 0.0),
+    n_radial=2,
+    plastic=None,
+    width=1.0,
+    half=False,
+    name="ring",
+    material="svk",
+    integration=1,
+    rotary_inertia=True,
+    mass_matrix="lumped",
+):
     """Build a beam or continuum ring (see the module docstring); returns a RingModel.
 
     R          mean radius > 0;  thickness h in (0, 2R): radial wall thickness
@@ -347,9 +365,20 @@ def make_ring(kind="beam", R=1.0, thickness=0.1, n_el=32, E=1.0, nu=0.0, rho=1.0
             X = center + R * np.column_stack([np.cos(a), np.sin(a)])
         else:
             X = ring_nodes(R, n_el, center)
-        body = Beam(X, closed=not half, E=E, A=h * b, I=b * h**3 / 12, rho=rho, nu=nu,
-                    name=name, plastic=plastic, integration=integration, rotary_inertia=rotary_inertia,
-                    mass_matrix=mass_matrix)
+        body = Beam(
+            X,
+            closed=not half,
+            E=E,
+            A=h * b,
+            I=b * h**3 / 12,
+            rho=rho,
+            nu=nu,
+            name=name,
+            plastic=plastic,
+            integration=integration,
+            rotary_inertia=rotary_inertia,
+            mass_matrix=mass_matrix,
+        )
         return RingModel(body, kind, R, h, b, center, bool(half), np.arange(X.shape[0]), 0.5 * h)
 
     if plastic is not None:
@@ -357,10 +386,19 @@ def make_ring(kind="beam", R=1.0, thickness=0.1, n_el=32, E=1.0, nu=0.0, rho=1.0
     n_radial = _count("n_radial", n_radial, 1)
     if material not in ("svk", "neohooke"):
         raise ValueError(f"parameter material = {material!r} is not allowed: one of svk|neohooke")
-    from .continuum import Continuum      # scikit-fem is loaded when a continuum ring is built
+    from .continuum import Continuum  # scikit-fem is loaded when a continuum ring is built
 
     mesh, n_ang = annulus_mesh(R - h / 2, R + h / 2, n_el, n_radial, center, half)
-    body = Continuum(mesh, E=E, nu=nu, rho=rho, kind="plane_strain", material=material,
-                     name=name, thickness=b, mass_matrix=mass_matrix)
+    body = Continuum(
+        mesh,
+        E=E,
+        nu=nu,
+        rho=rho,
+        kind="plane_strain",
+        material=material,
+        name=name,
+        thickness=b,
+        mass_matrix=mass_matrix,
+    )
     outer = n_radial * n_ang + np.arange(n_ang)
     return RingModel(body, kind, R, h, b, center, bool(half), outer, 0.0)

@@ -8,6 +8,22 @@ from .masters import BodySurface, RigidArc, RigidComposite, RigidLine, RigidPoly
 from .state import ContactHistory, ContactState
 from ..laws.return_map import OPEN, SLIP, STICK
 
-__all__ = ["NodeToSegment", "tributary_lengths", "RigidLine", "RigidPolyline", "RigidArc", "RigidComposite",
-           "BodySurface", "ContactHistory", "ContactState", "contact_element", "normal_element", "to_coo",
-           "segment_geometry", "segment_variations", "OPEN", "STICK", "SLIP"]
+__all__ = [
+    "NodeToSegment",
+    "tributary_lengths",
+    "RigidLine",
+    "RigidPolyline",
+    "RigidArc",
+    "RigidComposite",
+    "BodySurface",
+    "ContactHistory",
+    "ContactState",
+    "contact_element",
+    "normal_element",
+    "to_coo",
+    "segment_geometry",
+    "segment_variations",
+    "OPEN",
+    "STICK",
+    "SLIP",
+]

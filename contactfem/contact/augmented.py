@@ -36,6 +36,7 @@ outer iteration is exactly the penalty step); lam_N carries over from the last s
 multipliers are part of the history (AugmentedHistory), a value: ``update_multipliers``
 returns the history with the new ones, and the contact keeps nothing.
 """
+
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -57,6 +58,7 @@ def augments_normal(law):
 class AugmentedHistory(ContactHistory):
     """A ContactHistory with the multipliers the next solve holds fixed: lam_N (normal, 0 when
     the normal law is not augmented) and lam_T (tangential), per slave node."""
+
     lam_N: np.ndarray | None = None
     lam_T: np.ndarray | None = None
 

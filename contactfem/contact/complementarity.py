@@ -59,11 +59,15 @@ def check_laws(normal, friction, where):
     c_N becomes the complementarity parameter, and a slip bound of the pressure alone
     (module docstring). Anything else: one ValueError naming the law and ``where``."""
     if not (isinstance(normal, PowerLaw) and normal.m == 1.0):
-        raise ValueError(f"{where}: enforcement = lagrange enforces g_N >= 0 exactly and takes the penalty law "
-                         f"PowerLaw(m = 1) only (its c_N becomes a complementarity parameter); got {normal!r}")
+        raise ValueError(
+            f"{where}: enforcement = lagrange enforces g_N >= 0 exactly and takes the penalty law "
+            f"PowerLaw(m = 1) only (its c_N becomes a complementarity parameter); got {normal!r}"
+        )
     if friction is not None and not isinstance(friction, LAGRANGE_FRICTION):
-        raise ValueError(f"{where}: enforcement = lagrange takes Coulomb or ParabolicSlip friction (a slip bound of "
-                         f"the pressure alone); got {type(friction).__name__}")
+        raise ValueError(
+            f"{where}: enforcement = lagrange takes Coulomb or ParabolicSlip friction (a slip bound of "
+            f"the pressure alone); got {type(friction).__name__}"
+        )
 
 
 def normal_complementarity(t_N, g_N, c_N, eligible=True):
@@ -71,7 +75,7 @@ def normal_complementarity(t_N, g_N, c_N, eligible=True):
     conditions in place of the penalty law of eq 4; ``eligible``: nodes that can touch at
     all (a node no master faces is open whatever its gap)."""
     p = -t_N
-    g = np.where(eligible, g_N, 0.0)                  # (an uncovered mortar node has g_N = inf)
+    g = np.where(eligible, g_N, 0.0)  # (an uncovered mortar node has g_N = inf)
     xi = np.where(eligible, p - c_N * g, -np.inf)
     closed = xi >= 0.0
     C = np.where(closed, c_N * g, p)

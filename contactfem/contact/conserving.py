@@ -89,8 +89,11 @@ def discrete_gradient(f0, f1, df_m, df_1, d2f_m, d, P=None):
     safe = np.where(use, ww, 1.0)
     c = np.where(use, G / safe, 0.0)
     dG = df_1 - df_m - 0.5 * np.einsum("ijk,ik->ij", d2f_m, d)
-    D = 0.5 * d2f_m + np.where(use, 1.0 / safe, 0.0)[:, None, None] * outer(w, dG) \
+    D = (
+        0.5 * d2f_m
+        + np.where(use, 1.0 / safe, 0.0)[:, None, None] * outer(w, dG)
         + c[:, None, None] * (P[None] - 2.0 * outer(w, w) / safe[:, None, None])
+    )
     return df_m + c[:, None] * w, D
 
 
@@ -104,7 +107,7 @@ def secant(law, g0, g1):
     P0, P1 = law.energy(g0), law.energy(g1)
     t1, dt1 = law.traction(g1)
     phi = (P1 - P0) / safe
-    dphi = (t1 * dg - (P1 - P0)) / safe ** 2
+    dphi = (t1 * dg - (P1 - P0)) / safe**2
     tm, dtm = law.traction(0.5 * (g0 + g1))
     return np.where(small, tm, phi), np.where(small, 0.5 * dtm, dphi)
 
@@ -125,7 +128,7 @@ def conserving_force(contact, u0, u1, t, h, e1, fr, offsets=None):
     g0 = np.where(on, e0["g_N"], 1.0)
     g1 = np.where(on, e1["g_N"], 1.0)
     phi, dphi = secant(contact.normal, g0, g1)
-    P = None if contact.master.rigid else translations(d.shape[1])   # a deformable master: no resultant
+    P = None if contact.master.rigid else translations(d.shape[1])  # a deformable master: no resultant
     gN, DgN = discrete_gradient(e0["g_N"], e1["g_N"], em["dg_N"], e1["dg_N"], em["d2g_N"], d, P)
     R = (w * phi)[:, None] * gN
     K = w[:, None, None] * (outer(gN, dphi[:, None] * e1["dg_N"]) + phi[:, None, None] * DgN)
@@ -137,16 +140,17 @@ def conserving_force(contact, u0, u1, t, h, e1, fr, offsets=None):
         r = e1["r"]
         act = e1["active"]
         t1 = np.where(act, fr["t_T"], 0.0)
-        dS = r * (e1["travel"] - e0["travel"])              # slip increment after touching
+        dS = r * (e1["travel"] - e0["travel"])  # slip increment after touching
         jump = t1 - t_bar
         small = np.abs(dS) <= 1e-12 * (1.0 + np.abs(e1["travel"]))
-        ratio = np.where(small, 1.0, jump / (c_T * np.where(small, 1.0, dS)))   # 1 in stick
-        tau = np.where(act, t1 - 0.5 * jump * ratio, 0.0)   # = t1 - (t1 - t_bar)^2 / (2 c_T dS)
+        ratio = np.where(small, 1.0, jump / (c_T * np.where(small, 1.0, dS)))  # 1 in stick
+        tau = np.where(act, t1 - 0.5 * jump * ratio, 0.0)  # = t1 - (t1 - t_bar)^2 / (2 c_T dS)
         dt1 = fr["c_T_s"][:, None] * e1["ddg_T"] + fr["c_N_s"][:, None] * e1["dg_N"]
-        dtau = np.where(act[:, None], (1.0 - ratio)[:, None] * dt1 + (0.5 * c_T * ratio ** 2)[:, None] * e1["ddg_T"], 0.0)
-        dr = e1["dr"][:, None] * e1["dg_N"]                  # dr/du of the closing-step factor
+        dtau = np.where(act[:, None], (1.0 - ratio)[:, None] * dt1 + (0.5 * c_T * ratio**2)[:, None] * e1["ddg_T"], 0.0)
+        dr = e1["dr"][:, None] * e1["dg_N"]  # dr/du of the closing-step factor
         R = R + (w * tau * r)[:, None] * sB
-        K = K + w[:, None, None] * (r[:, None, None] * outer(sB, dtau) + tau[:, None, None] * outer(sB, dr)
-                                    + (tau * r)[:, None, None] * DsB)
+        K = K + w[:, None, None] * (
+            r[:, None, None] * outer(sB, dtau) + tau[:, None, None] * outer(sB, dr) + (tau * r)[:, None, None] * DsB
+        )
         work_T = w * tau * dS
     return R[on], K[on], on, np.where(on, work_T, 0.0)

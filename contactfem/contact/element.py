@@ -68,7 +68,7 @@ def coo_indices(dofs):
     (nc, k) go, entry by entry (row-major in each element)."""
     k = dofs.shape[1]
     rows = np.repeat(dofs, k, axis=1).ravel()
-    cols = np.concatenate([dofs] * k, axis=1).ravel()          # np.tile(dofs, (1, k)), without its overhead
+    cols = np.concatenate([dofs] * k, axis=1).ravel()  # np.tile(dofs, (1, k)), without its overhead
     return rows, cols
 
 

@@ -88,17 +88,32 @@ class NodeToSegment:
               slip increment of a closing node is the whole travel of the step
     """
 
-    unknowns = 0                            # no unknowns of its own (contact/interfaces.py)
+    unknowns = 0  # no unknowns of its own (contact/interfaces.py)
 
-    def __init__(self, slave, nodes, master, *, normal, friction=None, weights=1.0, offset=0.0, name="contact",
-                 tangent="consistent", integration="standard", closing_step=True):
+    def __init__(
+        self,
+        slave,
+        nodes,
+        master,
+        *,
+        normal,
+        friction=None,
+        weights=1.0,
+        offset=0.0,
+        name="contact",
+        tangent="consistent",
+        integration="standard",
+        closing_step=True,
+    ):
         if tangent not in TANGENTS:
             raise ValueError(f"parameter tangent = {tangent!r} is not allowed: one of {'|'.join(TANGENTS)}")
         if integration not in INTEGRATIONS:
             raise ValueError(f"parameter integration = {integration!r} is not allowed: one of {'|'.join(INTEGRATIONS)}")
         if integration == "energy_consistent" and not hasattr(normal, "energy"):
-            raise ValueError(f"contact {name!r}: energy-consistent integration needs a normal law with a potential "
-                             "(an energy method)")
+            raise ValueError(
+                f"contact {name!r}: energy-consistent integration needs a normal law with a potential "
+                "(an energy method)"
+            )
         self.slave, self.master, self.normal, self.friction, self.name = slave, master, normal, friction, name
         self.tangent, self.integration = tangent, integration
         if not isinstance(closing_step, bool):
@@ -111,11 +126,11 @@ class NodeToSegment:
         self.offset = float(offset)
         self._law = None if friction is None else as_friction_law(friction)
         self.c_T = 0.0 if self._law is None else self._law.c_T
-        self._wear = self._law is not None and self._law.n_state > 0   # gap_offset(z) may move the surface
-        self._straight = bool(getattr(master, "straight", False))      # zero second variations (masters.py)
+        self._wear = self._law is not None and self._law.n_state > 0  # gap_offset(z) may move the surface
+        self._straight = bool(getattr(master, "straight", False))  # zero second variations (masters.py)
         self._has_energy = hasattr(normal, "energy")
-        self._X_s = self.slave.X[self.nodes]                          # the slaves' reference positions
-        self.evaluations = 0                # how often evaluate() ran (instrumentation)
+        self._X_s = self.slave.X[self.nodes]  # the slaves' reference positions
+        self.evaluations = 0  # how often evaluate() ran (instrumentation)
 
     def with_closing_step(self, closing_step):
         """A new contact of the same configuration with the closing step on (True) or off
@@ -184,14 +199,14 @@ class NodeToSegment:
         touching = active.any()
         if touching:
             t_N, dt_N = self.normal.traction(np.where(active, g_N, 1.0))
-        else:                                               # every node open (a body in flight): a normal
-            t_N = dt_N = zeros(nc)                          # law's t_N is 0 when open (read-only)
+        else:  # every node open (a body in flight): a normal
+            t_N = dt_N = zeros(nc)  # law's t_N is 0 when open (read-only)
         slave_dofs = self.slave_dofs(offsets)
         dofs = np.concatenate([slave_dofs, k["master_dofs"]], axis=1) if k["master_dofs"].size else slave_dofs
         travel = k["s"] - h.s_bar
-        r, dr, dg_T, ddg_T = ones(nc), zeros(nc), travel, k["ds"]   # r = 1: Delta g_T = travel (read-only)
+        r, dr, dg_T, ddg_T = ones(nc), zeros(nc), travel, k["ds"]  # r = 1: Delta g_T = travel (read-only)
         closing = (active & (h.g_bar > 0.0)).nonzero()[0] if self.closing_step and touching else ()
-        if len(closing):                                    # the closing step (module docstring), at those nodes
+        if len(closing):  # the closing step (module docstring), at those nodes
             c, gb, g = closing, h.g_bar[closing], g_N[closing]
             r, dr = np.ones(nc), np.zeros(nc)
             r[c] = -g / (gb - g)
@@ -199,8 +214,21 @@ class NodeToSegment:
             dg_T = r * travel
             ddg_T = k["ds"].copy()
             ddg_T[c] = r[c, None] * k["ds"][c] + (travel[c] * dr[c])[:, None] * k["dg_N"][c]
-        return dict(k, x_s=x_s, g_N=g_N, g_raw=g_raw, active=active, t_N=t_N, dt_N=dt_N, dg_T=dg_T,
-                    travel=travel, r=r, dr=dr, ddg_T=ddg_T, dofs=dofs)
+        return dict(
+            k,
+            x_s=x_s,
+            g_N=g_N,
+            g_raw=g_raw,
+            active=active,
+            t_N=t_N,
+            dt_N=dt_N,
+            dg_T=dg_T,
+            travel=travel,
+            r=r,
+            dr=dr,
+            ddg_T=ddg_T,
+            dofs=dofs,
+        )
 
     # -- friction (eqs 40-48) -----------------------------------------------------------
     def predictor(self, h):
@@ -211,22 +239,29 @@ class NodeToSegment:
         """t_T, c_T^s, c_N^s and the return map's record at the kinematics k: frictionless,
         the return map of eqs 40-48, or a phase of the staggered algorithm (tangents.Phase)."""
         nc = len(k["g_N"])
-        zero = zeros(nc)                                   # read-only
+        zero = zeros(nc)  # read-only
         if self._law is None:
             slip = np.where(k["t_N"] < 0.0, STICK, OPEN)
             return dict(t_T=zero, c_T_s=zero, c_N_s=zero, slip=slip, lam=zero, q=h.q_bar, z=h.z_bar)
-        in_flight = not (k["t_N"] < 0.0).any()             # every node open: the return map's answer,
-        if in_flight and phase is None and (dt is not None or not self._law.needs_dt):   # without calling it
+        in_flight = not (k["t_N"] < 0.0).any()  # every node open: the return map's answer,
+        if in_flight and phase is None and (dt is not None or not self._law.needs_dt):  # without calling it
             return dict(t_T=zero, c_T_s=zero, c_N_s=zero, slip=zeros(nc, int), lam=zero, q=h.q_bar, z=h.z_bar)
-        if phase is not None and phase.kind == "normal":   # stick about the frozen state
+        if phase is not None and phase.kind == "normal":  # stick about the frozen state
             slip = np.where(k["t_N"] < 0.0, STICK, OPEN)
-            return dict(t_T=phase.t_T + self.c_T * (k["s"] - phase.s), c_T_s=np.full(nc, self.c_T), c_N_s=zero,
-                        slip=slip, lam=zero, q=h.q_bar, z=h.z_bar, ddg_T=k["ds"])
-        if phase is not None:                              # friction phase: the pressure frozen
+            return dict(
+                t_T=phase.t_T + self.c_T * (k["s"] - phase.s),
+                c_T_s=np.full(nc, self.c_T),
+                c_N_s=zero,
+                slip=slip,
+                lam=zero,
+                q=h.q_bar,
+                z=h.z_bar,
+                ddg_T=k["ds"],
+            )
+        if phase is not None:  # friction phase: the pressure frozen
             fr = return_map(self._law, -phase.p, zero, k["dg_T"], self.predictor(h), h.q_bar, z_bar=h.z_bar, dt=dt)
         else:
-            fr = return_map(self._law, k["t_N"], k["dt_N"], k["dg_T"], self.predictor(h), h.q_bar,
-                            z_bar=h.z_bar, dt=dt)
+            fr = return_map(self._law, k["t_N"], k["dt_N"], k["dg_T"], self.predictor(h), h.q_bar, z_bar=h.z_bar, dt=dt)
         return dict(t_T=fr.t_T, c_T_s=fr.c_T_s, c_N_s=fr.c_N_s, slip=fr.state, lam=fr.lam, q=fr.q, z=fr.z)
 
     # -- one evaluation ------------------------------------------------------------------
@@ -238,8 +273,10 @@ class NodeToSegment:
         the contact as it is. ``offsets``: where the bodies' dofs start in u (placement.py)."""
         h = history
         if not isinstance(h, ContactHistory):
-            raise ValueError(f"contact {self.name!r}: history must be a ContactHistory (from start(u) or "
-                             f"commit(state)), got {type(h).__name__}")
+            raise ValueError(
+                f"contact {self.name!r}: history must be a ContactHistory (from start(u) or "
+                f"commit(state)), got {type(h).__name__}"
+            )
         self.evaluations += 1
         k = self.kinematics(u, t, h, offsets)
         fr = self.friction_state(k, h, dt, phase)
@@ -250,18 +287,44 @@ class NodeToSegment:
             R, K, on, work_T = conserving_force(self, u0, u, t, h, k, fr, offsets)
             element_dofs = k["dofs"][on]
         else:
-            on = k["active"].nonzero()[0]                  # the pairs in contact, by index
+            on = k["active"].nonzero()[0]  # the pairs in contact, by index
             element_dofs = k["dofs"][on]
             if on.size:
                 R, K = self.element(k, fr, on)
-            else:                                          # none in contact (a body in flight): no element
+            else:  # none in contact (a body in flight): no element
                 m = element_dofs.shape[1]
                 R, K = np.zeros((0, m)), np.zeros((0, m, m))
-        return ContactState(contact=self, history=h, u=u, t=t, offsets=offsets, x_s=k["x_s"], g_N=k["g_N"], g_raw=k["g_raw"], s=k["s"],
-                            s_next=k.get("s_next", k["s"]), n=k["n"], tangent=k["t"], seg=k["seg"],
-                            inside=k["inside"], active=k["active"], r=k["r"], t_N=k["t_N"], dt_N=k["dt_N"],
-                            t_T=fr["t_T"], c_T_s=fr["c_T_s"], c_N_s=fr["c_N_s"], slip=fr["slip"], lam=fr["lam"],
-                            q=fr["q"], z=fr["z"], R=R, K=K, element_dofs=element_dofs, work_T=work_T)
+        return ContactState(
+            contact=self,
+            history=h,
+            u=u,
+            t=t,
+            offsets=offsets,
+            x_s=k["x_s"],
+            g_N=k["g_N"],
+            g_raw=k["g_raw"],
+            s=k["s"],
+            s_next=k.get("s_next", k["s"]),
+            n=k["n"],
+            tangent=k["t"],
+            seg=k["seg"],
+            inside=k["inside"],
+            active=k["active"],
+            r=k["r"],
+            t_N=k["t_N"],
+            dt_N=k["dt_N"],
+            t_T=fr["t_T"],
+            c_T_s=fr["c_T_s"],
+            c_N_s=fr["c_N_s"],
+            slip=fr["slip"],
+            lam=fr["lam"],
+            q=fr["q"],
+            z=fr["z"],
+            R=R,
+            K=K,
+            element_dofs=element_dofs,
+            work_T=work_T,
+        )
 
     def element(self, k, fr, on):
         """The element residuals and tangents (eqs 28, 33, 39, 49-50) of the pairs `on` (a mask
@@ -274,10 +337,21 @@ class NodeToSegment:
             R, K = normal_element(w, k["t_N"][on], k["dt_N"][on], k["dg_N"][on], d2g_N)
         else:
             ddg_T = fr.get("ddg_T", k["ddg_T"])
-            ddg_T = None if ddg_T is k["ds"] else ddg_T[on]          # None: d(Delta g_T) = ds
+            ddg_T = None if ddg_T is k["ds"] else ddg_T[on]  # None: d(Delta g_T) = ds
             c_N_s = fr["c_N_s"][on] if self.tangent != "frozen" else np.zeros(len(w))
-            R, K = contact_element(w, k["t_N"][on], k["dt_N"][on], fr["t_T"][on], fr["c_T_s"][on], c_N_s,
-                                   k["dg_N"][on], d2g_N, k["ds"][on], d2s, ddg_T)
+            R, K = contact_element(
+                w,
+                k["t_N"][on],
+                k["dt_N"][on],
+                fr["t_T"][on],
+                fr["c_T_s"][on],
+                c_N_s,
+                k["dg_N"][on],
+                d2g_N,
+                k["ds"][on],
+                d2s,
+                ddg_T,
+            )
         if self.tangent == "symmetric":
             K = 0.5 * (K + K.transpose(0, 2, 1))
         return R, K

@@ -4,6 +4,7 @@ The solver never asks what an object can do (no ``hasattr``): a master and a con
 exactly these members. ``typing.Protocol`` classes: any object with these members is one
 (no inheritance needed), and ``isinstance(x, Contact)`` checks the members are there.
 """
+
 from typing import Protocol, runtime_checkable
 
 import numpy as np
@@ -15,10 +16,11 @@ class Master(Protocol):
     deformable body's boundary (BodySurface)."""
 
     rigid: bool
-    straight: bool          # second variations of g_N and s zero everywhere (a rigid line or polyline)
+    straight: bool  # second variations of g_N and s zero everywhere (a rigid line or polyline)
 
-    def locate(self, x_s: np.ndarray, s_bar: np.ndarray, u: np.ndarray, t=None, ref=None,
-               offsets: dict | None = None) -> dict:
+    def locate(
+        self, x_s: np.ndarray, s_bar: np.ndarray, u: np.ndarray, t=None, ref=None, offsets: dict | None = None
+    ) -> dict:
         """The kinematics of each slave with its closest master segment (masters.py): g_N, s,
         dg_N, ds, d2g_N, d2s, master_dofs, inside, seg (and s_next)."""
 
@@ -43,14 +45,23 @@ class Contact(Protocol):
     give their rows of the residual and the tangent like any other."""
 
     name: str
-    integration: str            # "standard" | "energy_consistent"
-    unknowns: int               # unknowns of its own (0: only the bodies' dofs)
+    integration: str  # "standard" | "energy_consistent"
+    unknowns: int  # unknowns of its own (0: only the bodies' dofs)
 
     def start(self, u: np.ndarray, t: float = 0.0, *, offsets: dict | None = None) -> object:
         """The history at the initial state u (a value)."""
 
-    def evaluate(self, u: np.ndarray, t: float = 0.0, dt: float | None = None, u0: np.ndarray | None = None,
-                 phase: object = None, *, history: object, offsets: dict | None = None) -> object:
+    def evaluate(
+        self,
+        u: np.ndarray,
+        t: float = 0.0,
+        dt: float | None = None,
+        u0: np.ndarray | None = None,
+        phase: object = None,
+        *,
+        history: object,
+        offsets: dict | None = None,
+    ) -> object:
         """The contact's state at the trial u of the step (t - dt, t] that starts from u0, with
         the committed ``history``."""
 
@@ -64,11 +75,11 @@ class NodeToSegmentContact(Contact, Protocol):
     contact that made them, besides the Contact protocol: where the slaves are, the weights
     and stick stiffness of its energies, and the functions of its laws."""
 
-    slave: object               # the slave body (contactfem.bodies.interfaces.Body)
-    nodes: np.ndarray           # (nc,) slave node numbers
+    slave: object  # the slave body (contactfem.bodies.interfaces.Body)
+    nodes: np.ndarray  # (nc,) slave node numbers
     master: Master
-    weights: np.ndarray         # (nc,) per-slave weights of the tractions
-    c_T: float                  # stick stiffness of the friction law (0: frictionless)
+    weights: np.ndarray  # (nc,) per-slave weights of the tractions
+    c_T: float  # stick stiffness of the friction law (0: frictionless)
 
     def pattern(self, dofs: np.ndarray) -> tuple:
         """(rows, cols) of the element tangents at the pairs' dofs (m, k)."""

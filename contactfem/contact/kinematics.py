@@ -22,14 +22,14 @@ def segment_geometry(x_s, x_1, x_2):
 
     Raises ValueError for a degenerate (zero-length) segment."""
     a = x_2 - x_1
-    l = np.linalg.norm(a, axis=-1)                                 # eq (18)
+    l = np.linalg.norm(a, axis=-1)  # eq (18)
     if np.any(~(l > 1e-14 * (1.0 + np.abs(x_1).max(initial=0.0)))):
         raise ValueError("master segment has zero length (degenerate segment): its two nodes coincide")
     t = a / l[:, None]
     n = e3_cross(t)
     d = x_s - x_1
-    g_N = np.einsum("ij,ij->i", d, n)                             # eq (17)
-    alpha = np.einsum("ij,ij->i", d, t) / l                       # eq (19)
+    g_N = np.einsum("ij,ij->i", d, n)  # eq (17)
+    alpha = np.einsum("ij,ij->i", d, t) / l  # eq (19)
     return l, t, n, g_N, alpha
 
 
@@ -64,8 +64,11 @@ def segment_variations(x_s, x_1, x_2):
     dg_N = N_s
     d2g_N = -((outer(N_0, T_s) + outer(T_s, N_0)) / l[:, None, None] + (g_N / l**2)[:, None, None] * outer(N_0, N_0))
     dalpha = (T_s + r * N_0) / l[:, None]
-    B = (outer(N_s, N_0) + outer(N_0, N_s)) - (outer(T_s, T_0) + outer(T_0, T_s)) \
+    B = (
+        (outer(N_s, N_0) + outer(N_0, N_s))
+        - (outer(T_s, T_0) + outer(T_0, T_s))
         - 2.0 * r[:, :, None] * (outer(N_0, T_0) + outer(T_0, N_0))
+    )
     d2alpha = B / (l**2)[:, None, None]
     return dict(l=l, t=t, n=n, g_N=g_N, alpha=alpha, dg_N=dg_N, d2g_N=d2g_N, dalpha=dalpha, d2alpha=d2alpha)
 
@@ -82,13 +85,13 @@ def line_variations(x_s, point, normal):
     every call (``line_frame``: made once per line and number of slaves, read-only)."""
     normal = np.asarray(normal, dtype=float)
     d = x_s - point
-    if normal.ndim == 1:                                            # one line: the same n and t for all
+    if normal.ndim == 1:  # one line: the same n and t for all
         nt, n, t, z2 = line_frame(float(normal[0]), float(normal[1]), len(d))
-        g_N, s = (d @ nt).T                                         # (x_s - point).n, (x_s - point).t
+        g_N, s = (d @ nt).T  # (x_s - point).n, (x_s - point).t
     else:
         n, t = np.empty_like(d), np.empty_like(d)
         n[:] = normal
-        t[:, 0], t[:, 1] = n[:, 1], -n[:, 0]                        # e3 x t = n
+        t[:, 0], t[:, 1] = n[:, 1], -n[:, 0]  # e3 x t = n
         g_N, s = np.einsum("ij,ij->i", d, n), np.einsum("ij,ij->i", d, t)
         z2 = np.zeros((len(d), 2, 2))
     return dict(t=t, n=n, g_N=g_N, s=s, dg_N=n, d2g_N=z2, ds=t, d2s=z2)
@@ -129,5 +132,14 @@ def arc_variations(x_s, center, R, inside, theta_ref):
     I = np.eye(2)[None]
     hess_r = (I - outer(e_r, e_r)) / r[:, None, None]
     hess_th = -(outer(e_r, e_th) + outer(e_th, e_r)) / (r**2)[:, None, None]
-    return dict(t=e_th, n=sigma * e_r, g_N=sigma * (r - R), s=R * theta, theta=theta,
-                dg_N=sigma * e_r, d2g_N=sigma * hess_r, ds=R * e_th / r[:, None], d2s=R * hess_th)
+    return dict(
+        t=e_th,
+        n=sigma * e_r,
+        g_N=sigma * (r - R),
+        s=R * theta,
+        theta=theta,
+        dg_N=sigma * e_r,
+        d2g_N=sigma * hess_r,
+        ds=R * e_th / r[:, None],
+        d2s=R * hess_th,
+    )

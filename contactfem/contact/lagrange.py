@@ -66,8 +66,9 @@ def multipliers(contact, u, offsets=None):
     """t_N, t_T (nc,) of the contact from the global u, and their global dofs (where the
     System's ``offsets`` place them: placement.py)."""
     if not placed(contact, offsets):
-        raise ValueError(f"contact {contact.name!r} owns unknowns (Lagrange multipliers): put it in a System, "
-                         "which places them")
+        raise ValueError(
+            f"contact {contact.name!r} owns unknowns (Lagrange multipliers): put it in a System, which places them"
+        )
     nc = len(contact.nodes)
     dN = start_of(contact, offsets) + np.arange(nc)
     dT = dN + nc if contact.friction is not None else np.zeros(0, int)
@@ -83,13 +84,33 @@ def conditions(contact, t_N, t_T, g_N, dg_T, eligible):
     nc = len(t_N)
     zero = np.zeros(nc)
     if contact.friction is None:
-        slip = np.where(xi >= 0.0, 1, 0)                      # STICK (closed) or OPEN
-        return dict(C_N=C_N, C_T=zero[:0], dN_t=dN_t, dN_g=dN_g, dT_t=zero, dT_tN=zero, dT_g=zero, dT_dg=zero,
-                    slip=slip, closed=xi >= 0.0)
+        slip = np.where(xi >= 0.0, 1, 0)  # STICK (closed) or OPEN
+        return dict(
+            C_N=C_N,
+            C_T=zero[:0],
+            dN_t=dN_t,
+            dN_g=dN_g,
+            dT_t=zero,
+            dT_tN=zero,
+            dT_g=zero,
+            dT_dg=zero,
+            slip=slip,
+            closed=xi >= 0.0,
+        )
     C_T, dT_t, dT_dg, dT_xi, slip = friction_complementarity(contact.friction, t_T, dg_T, xi, contact.c_T_ncp)
     # xi = -t_N - c_N g_N
-    return dict(C_N=C_N, C_T=C_T, dN_t=dN_t, dN_g=dN_g, dT_t=dT_t, dT_tN=-dT_xi, dT_g=-contact.c_N * dT_xi,
-                dT_dg=dT_dg, slip=slip, closed=xi >= 0.0)
+    return dict(
+        C_N=C_N,
+        C_T=C_T,
+        dN_t=dN_t,
+        dN_g=dN_g,
+        dT_t=dT_t,
+        dT_tN=-dT_xi,
+        dT_g=-contact.c_N * dT_xi,
+        dT_dg=dT_dg,
+        slip=slip,
+        closed=xi >= 0.0,
+    )
 
 
 @dataclass(frozen=True, eq=False)
@@ -98,6 +119,7 @@ class LagrangeState(ContactState):
     the closed set of the complementarity function, ``slip`` OPEN/STICK/SLIP; ``lam`` the
     slip |Delta g_T| of slipping nodes. The complementarity rows: C (the scaled C_N, C_T at
     ``ncp_dofs``) and the triplets ``ncp_coo`` of the multipliers' columns and rows."""
+
     C: np.ndarray | None = None
     ncp_dofs: np.ndarray | None = None
     ncp_coo: tuple = ()
@@ -125,8 +147,10 @@ class LagrangeNodeToSegment(NodeToSegment):
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
         if self.integration != "standard" or self.tangent != "consistent":
-            raise ValueError(f"contact {self.name!r}: enforcement = lagrange takes tangent = consistent and "
-                             f"integration = standard (got {self.tangent}, {self.integration})")
+            raise ValueError(
+                f"contact {self.name!r}: enforcement = lagrange takes tangent = consistent and "
+                f"integration = standard (got {self.tangent}, {self.integration})"
+            )
         _lagrange_checks(self)
 
     def evaluate(self, u, t=0.0, dt=None, u0=None, phase=None, *, history, offsets=None):
@@ -138,34 +162,66 @@ class LagrangeNodeToSegment(NodeToSegment):
         k = self.kinematics(u, t, h, offsets)
         t_N, t_T, dN, dT = multipliers(self, u, offsets)
         on = k["inside"]
-        dg_T = k["s"] - h.s_bar                              # eq 20, no closing-step factor (module docstring)
+        dg_T = k["s"] - h.s_bar  # eq 20, no closing-step factor (module docstring)
         cond = conditions(self, t_N, t_T, k["g_N"], dg_T, on)
         nc, w = len(t_N), self.weights
         # the bodies' rows: eq 28 with the multipliers, its geometric tangent (eqs 33, 39 without moduli)
         zero = np.zeros(np.count_nonzero(on))
-        R, K = contact_element(w[on], t_N[on], zero, t_T[on], zero, zero, k["dg_N"][on], k["d2g_N"][on],
-                               k["ds"][on], k["d2s"][on])
-        dofs, j = k["dofs"][on], np.flatnonzero(on)           # the pairs' dofs (m of them each)
+        R, K = contact_element(
+            w[on], t_N[on], zero, t_T[on], zero, zero, k["dg_N"][on], k["d2g_N"][on], k["ds"][on], k["d2s"][on]
+        )
+        dofs, j = k["dofs"][on], np.flatnonzero(on)  # the pairs' dofs (m of them each)
         m = dofs.shape[1]
         W = w[on][:, None]
-        coo = [(dofs.ravel(), np.repeat(dN[j], m), (W * k["dg_N"][on]).ravel()),       # dR/dt_N = w dg_N
-               (dN, dN, w * cond["dN_t"]),                                              # w dC_N/dt_N
-               (np.repeat(dN[j], m), dofs.ravel(), (W * cond["dN_g"][on, None] * k["dg_N"][on]).ravel())]
+        coo = [
+            (dofs.ravel(), np.repeat(dN[j], m), (W * k["dg_N"][on]).ravel()),  # dR/dt_N = w dg_N
+            (dN, dN, w * cond["dN_t"]),  # w dC_N/dt_N
+            (np.repeat(dN[j], m), dofs.ravel(), (W * cond["dN_g"][on, None] * k["dg_N"][on]).ravel()),
+        ]
         C = [w * cond["C_N"]]
         if self.friction is not None:
             dC_du = cond["dT_g"][on, None] * k["dg_N"][on] + cond["dT_dg"][on, None] * k["ds"][on]
-            coo += [(dofs.ravel(), np.repeat(dT[j], m), (W * k["ds"][on]).ravel()),      # dR/dt_T = w ds
-                    (dT, dT, w * cond["dT_t"]), (dT, dN, w * cond["dT_tN"]),
-                    (np.repeat(dT[j], m), dofs.ravel(), (W * dC_du).ravel())]
+            coo += [
+                (dofs.ravel(), np.repeat(dT[j], m), (W * k["ds"][on]).ravel()),  # dR/dt_T = w ds
+                (dT, dT, w * cond["dT_t"]),
+                (dT, dN, w * cond["dT_tN"]),
+                (np.repeat(dT[j], m), dofs.ravel(), (W * dC_du).ravel()),
+            ]
             C.append(w * cond["C_T"])
         lam = np.where(cond["slip"] == SLIP, np.abs(dg_T), 0.0)
         return LagrangeState(
-            contact=self, history=h, u=u, t=t, offsets=offsets, x_s=k["x_s"], g_N=k["g_N"], g_raw=k["g_raw"], s=k["s"],
-            s_next=k.get("s_next", k["s"]), n=k["n"], tangent=k["t"], seg=k["seg"], inside=on,
-            active=cond["closed"], r=np.ones(nc), t_N=t_N, dt_N=np.zeros(nc), t_T=t_T, c_T_s=np.zeros(nc),
-            c_N_s=np.zeros(nc), slip=cond["slip"], lam=lam, q=h.q_bar + lam, z=h.z_bar, R=R, K=K,
-            element_dofs=dofs, C=np.concatenate(C), ncp_dofs=np.concatenate([dN, dT]),
-            ncp_coo=tuple(np.concatenate(a) for a in zip(*coo)))
+            contact=self,
+            history=h,
+            u=u,
+            t=t,
+            offsets=offsets,
+            x_s=k["x_s"],
+            g_N=k["g_N"],
+            g_raw=k["g_raw"],
+            s=k["s"],
+            s_next=k.get("s_next", k["s"]),
+            n=k["n"],
+            tangent=k["t"],
+            seg=k["seg"],
+            inside=on,
+            active=cond["closed"],
+            r=np.ones(nc),
+            t_N=t_N,
+            dt_N=np.zeros(nc),
+            t_T=t_T,
+            c_T_s=np.zeros(nc),
+            c_N_s=np.zeros(nc),
+            slip=cond["slip"],
+            lam=lam,
+            q=h.q_bar + lam,
+            z=h.z_bar,
+            R=R,
+            K=K,
+            element_dofs=dofs,
+            C=np.concatenate(C),
+            ncp_dofs=np.concatenate([dN, dT]),
+            ncp_coo=tuple(np.concatenate(a) for a in zip(*coo)),
+        )
 
 
 class LagrangeMortar(MortarContact):
@@ -195,13 +251,16 @@ class LagrangeMortar(MortarContact):
         t_N, t_T, dN, dT = multipliers(self, u, offsets)
         cond = conditions(self, t_N, t_T, k["g_N"], k["dg_T"], k["covered"])
         s, ns = self.row_weights, len(t_N)
-        g = np.concatenate([self.slave_dofs(offsets).ravel(), self.master_dofs(offsets).ravel()])   # interface -> global (-1: rigid)
+        g = np.concatenate(
+            [self.slave_dofs(offsets).ravel(), self.master_dofs(offsets).ravel()]
+        )  # interface -> global (-1: rigid)
         zero = np.zeros(ns)
         # the bodies' rows: R = sum_j t_N,j f_N,j + t_T,j f_T,j and its geometric tangent (no moduli)
-        R_i, (r, c, v) = contact_forces(mi, t_N, zero, k["offset"], slip,
-                                        _Tractions(t_T, zero, zero) if slip is not None else None, h.w)
+        R_i, (r, c, v) = contact_forces(
+            mi, t_N, zero, k["offset"], slip, _Tractions(t_T, zero, zero) if slip is not None else None, h.w
+        )
         coo = [(g[r], g[c], v)]
-        F = [(_pair_rows(mi.f_N, mi.pairs, ns, len(g)), dN)]            # dR/dt_N = F_N^T, dR/dt_T = F_T^T
+        F = [(_pair_rows(mi.f_N, mi.pairs, ns, len(g)), dN)]  # dR/dt_N = F_N^T, dR/dt_T = F_T^T
         # the multipliers' rows: s C with dC/du through dg_N and d Delta g_T = dg~_T / w_bar
         D_u = [sparse.diags(s * cond["dN_g"]) @ k["dg_N"]]
         coo += [(dN, dN, s * cond["dN_t"])]
@@ -224,13 +283,36 @@ class LagrangeMortar(MortarContact):
         np.add.at(R, g[g >= 0], R_i[g >= 0])
         R[np.concatenate([dN, dT])] += np.concatenate(C)
         lam = np.where(cond["slip"] == SLIP, np.abs(k["dg_T"]), 0.0)
-        history = MortarHistory(t_T=np.where(cond["closed"], t_T, 0.0), q=h.q + lam, z=h.z, pairs=mi.pairs, D=mi.D,
-                                M=mi.M, w=mi.w, x=k["x"])
-        return MortarState(t=t, dt=dt, nodes=self.nodes, X=self.slave.X[self.nodes], x=k["xs"], g_N=k["g_N"],
-                           t_N=t_N, dt_N=zero, t_T=t_T, c_T_s=zero, c_N_s=zero, lam=lam, q=h.q + lam, z=h.z,
-                           state=cond["slip"], weights=mi.w, dg_T=k["dg_T"], R=R, rows=rows[keep], cols=cols[keep],
-                           vals=vals[keep], history=history, integrals=mi, energy=0.0,
-                           dissipation=float(np.sum(h.w * 0.5 * (h.t_T + t_T) * lam * np.sign(t_T))))
+        history = MortarHistory(
+            t_T=np.where(cond["closed"], t_T, 0.0), q=h.q + lam, z=h.z, pairs=mi.pairs, D=mi.D, M=mi.M, w=mi.w, x=k["x"]
+        )
+        return MortarState(
+            t=t,
+            dt=dt,
+            nodes=self.nodes,
+            X=self.slave.X[self.nodes],
+            x=k["xs"],
+            g_N=k["g_N"],
+            t_N=t_N,
+            dt_N=zero,
+            t_T=t_T,
+            c_T_s=zero,
+            c_N_s=zero,
+            lam=lam,
+            q=h.q + lam,
+            z=h.z,
+            state=cond["slip"],
+            weights=mi.w,
+            dg_T=k["dg_T"],
+            R=R,
+            rows=rows[keep],
+            cols=cols[keep],
+            vals=vals[keep],
+            history=history,
+            integrals=mi,
+            energy=0.0,
+            dissipation=float(np.sum(h.w * 0.5 * (h.t_T + t_T) * lam * np.sign(t_T))),
+        )
 
 
 @dataclass(frozen=True)
@@ -238,4 +320,3 @@ class _Tractions:
     t_T: np.ndarray
     c_T_s: np.ndarray
     c_N_s: np.ndarray
-

@@ -81,7 +81,7 @@ class RigidLine:
     towards the slave body (the rigid foundation of Secs 5.1-5.3)."""
 
     rigid = True
-    straight = True         # the second variations of g_N and s vanish (line_variations)
+    straight = True  # the second variations of g_N and s vanish (line_variations)
 
     def __init__(self, point=(0.0, 0.0), normal=(0.0, 1.0)):
         nrm = np.asarray(normal, dtype=float)
@@ -109,7 +109,7 @@ class RigidPolyline:
     with x_1, x_2 fixed: only the slave rows of eqs (25)-(38) remain."""
 
     rigid = True
-    straight = True         # the second variations of g_N and s vanish (line_variations)
+    straight = True  # the second variations of g_N and s vanish (line_variations)
 
     def __init__(self, points):
         self.points = _check_points(points, "points")
@@ -203,11 +203,20 @@ class BodySurface:
         l_bar = np.linalg.norm(x_bar[j + 1] - x_bar[j], axis=1)
         S_bar = _arc_lengths(x_bar)
         dofs = self.dofs(offsets)
-        return dict(g_N=k["g_N"], s=S_bar[j] + k["alpha"] * l_bar, t=k["t"], n=k["n"],
-                    dg_N=k["dg_N"], d2g_N=k["d2g_N"],
-                    ds=l_bar[:, None] * k["dalpha"], d2s=l_bar[:, None, None] * k["d2alpha"],
-                    master_dofs=np.concatenate([dofs[j], dofs[j + 1]], axis=1), inside=inside, seg=j,
-                    s_next=_arc_lengths(P)[j] + k["alpha"] * k["l"])
+        return dict(
+            g_N=k["g_N"],
+            s=S_bar[j] + k["alpha"] * l_bar,
+            t=k["t"],
+            n=k["n"],
+            dg_N=k["dg_N"],
+            d2g_N=k["d2g_N"],
+            ds=l_bar[:, None] * k["dalpha"],
+            d2s=l_bar[:, None, None] * k["d2alpha"],
+            master_dofs=np.concatenate([dofs[j], dofs[j + 1]], axis=1),
+            inside=inside,
+            seg=j,
+            s_next=_arc_lengths(P)[j] + k["alpha"] * k["l"],
+        )
 
     def outline(self, u=None, offsets=None):
         return self.body.X[self.nodes] if u is None else self.positions(u, offsets)
@@ -255,8 +264,9 @@ class RigidComposite:
                 c, R, th0, th1 = np.asarray(p[1], float), float(p[2]), float(p[3]), float(p[4])
                 if not R > 0 or th0 == th1:
                     raise ValueError("an arc piece of a composite master needs R > 0 and theta0 != theta1")
-                self.pieces.append(dict(kind="arc", c=c, R=R, th0=th0, th1=th1, length=R * abs(th1 - th0),
-                                        cw=th1 < th0))
+                self.pieces.append(
+                    dict(kind="arc", c=c, R=R, th0=th0, th1=th1, length=R * abs(th1 - th0), cw=th1 < th0)
+                )
             else:
                 raise ValueError(f"piece kind {kind!r} is not allowed: one of line|arc")
         self.S = np.concatenate([[0.0], np.cumsum([p["length"] for p in self.pieces])])
@@ -288,7 +298,7 @@ class RigidComposite:
             return k, k["s"]
         c = p["c"] + offset
         k = arc_variations(x_s, c, p["R"], not p["cw"], np.full(nc, 0.5 * (p["th0"] + p["th1"])))
-        if p["cw"]:                        # travelled clockwise: t = -e_theta, s = R (theta0 - theta)
+        if p["cw"]:  # travelled clockwise: t = -e_theta, s = R (theta0 - theta)
             k = dict(k, t=-k["t"], ds=-k["ds"], d2s=-k["d2s"])
             return k, p["R"] * p["th0"] - k["s"]
         return k, k["s"] - p["R"] * p["th0"]
@@ -301,7 +311,7 @@ class RigidComposite:
         for i in range(m):
             k, s_loc = self._piece(i, x_s, offset)
             local.append((k, s_loc))
-        for i in reversed(range(m - 1)):         # a joint belongs to the line beside it
+        for i in reversed(range(m - 1)):  # a joint belongs to the line beside it
             L_i = self.pieces[i]["length"]
             before_end = local[i][1] <= L_i if self.pieces[i]["kind"] == "line" else local[i][1] < L_i
             own = np.where(before_end, i, own)
@@ -349,7 +359,12 @@ def bottle_neck(R_neck, L_neck, r_mouth, z_low=-10.0, shift=0.0, motion=None):
     mouth. ``shift``: a fixed radial translation; ``motion(t) -> (dr, dz)``: a prescribed one
     (the press fit moves the neck inwards)."""
     r_top = R_neck + r_mouth + 6.0
-    return RigidComposite([("line", (R_neck, z_low), (R_neck, L_neck)),
-                           ("arc", (R_neck + r_mouth, L_neck), r_mouth, np.pi, np.pi / 2),
-                           ("line", (R_neck + r_mouth, L_neck + r_mouth), (r_top, L_neck + r_mouth))],
-                          offset=(shift, 0.0), motion=motion)
+    return RigidComposite(
+        [
+            ("line", (R_neck, z_low), (R_neck, L_neck)),
+            ("arc", (R_neck + r_mouth, L_neck), r_mouth, np.pi, np.pi / 2),
+            ("line", (R_neck + r_mouth, L_neck + r_mouth), (r_top, L_neck + r_mouth)),
+        ],
+        offset=(shift, 0.0),
+        motion=motion,
+    )

@@ -128,7 +128,7 @@ class Pairs:
         s = np.asarray(slave_segments, dtype=int)
         m = np.asarray(master_segments, dtype=int)
         nodes = np.stack([s, s + 1], axis=1)
-        both = np.concatenate([nodes, np.stack([m, m + 1], axis=1) + ns], axis=1)    # interface nodes a, b, c, d
+        both = np.concatenate([nodes, np.stack([m, m + 1], axis=1) + ns], axis=1)  # interface nodes a, b, c, d
         dofs = np.stack([2 * both, 2 * both + 1], axis=2).reshape(len(s), 8)
         return Pairs(s, m, nodes, dofs)
 
@@ -190,11 +190,11 @@ def pair_integrals(geo, lo, hi):
     M = [[0.0, 0.0], [0.0, 0.0]]
     g = [0.0, 0.0]
     for zeta, omega in zip(GAUSS_POINTS, GAUSS_WEIGHTS):
-        xi = lo + (hi - lo) * zeta                            # the Gauss point on the overlap
-        dGamma = geo["l"] * (hi - lo) * omega                 # l dxi
+        xi = lo + (hi - lo) * zeta  # the Gauss point on the overlap
+        dGamma = geo["l"] * (hi - lo) * omega  # l dxi
         g_xi, eta = gap_at(geo, xi)
-        N_s = (1.0 - xi, xi)                                  # slave shape functions = Phi_j
-        N_m = (1.0 - eta, eta)                                # master shape functions at eta(xi)
+        N_s = (1.0 - xi, xi)  # slave shape functions = Phi_j
+        N_m = (1.0 - eta, eta)  # master shape functions at eta(xi)
         for i in range(2):
             g[i] = N_s[i] * g_xi * dGamma + g[i]
             for k in range(2):
@@ -212,8 +212,16 @@ def virtual_work_vectors(D, M, ex, ey):
     (np, 2, 8, 8), which carry Delta D, Delta M and Delta e."""
     values, grads = [], []
     for i in range(2):
-        parts = [D[i][0] * ex, D[i][0] * ey, D[i][1] * ex, D[i][1] * ey,
-                 -M[i][0] * ex, -M[i][0] * ey, -M[i][1] * ex, -M[i][1] * ey]
+        parts = [
+            D[i][0] * ex,
+            D[i][0] * ey,
+            D[i][1] * ex,
+            D[i][1] * ey,
+            -M[i][0] * ex,
+            -M[i][0] * ey,
+            -M[i][1] * ex,
+            -M[i][1] * ey,
+        ]
         values.append(np.stack([f.val for f in parts], axis=1))
         grads.append(np.stack([f.grad for f in parts], axis=1))
     return np.stack(values, axis=1), np.stack(grads, axis=1)
@@ -231,7 +239,7 @@ def mortar_integrals(xs, xm, pairs, unbounded=False):
     geo = pair_geometry(*pairs.positions(xs, xm))
     lo, hi = overlap(geo["xi_c"], geo["xi_d"], unbounded)
     D, M, g = pair_integrals(geo, lo, hi)
-    w = [D[i][0] + D[i][1] for i in range(2)]                 # int N_i = int N_i (N_a + N_b)
+    w = [D[i][0] + D[i][1] for i in range(2)]  # int N_i = int N_i (N_a + N_b)
     minus_f_N, minus_df_N = virtual_work_vectors(D, M, geo["nx"], geo["ny"])
     f_T, df_T = virtual_work_vectors(D, M, geo["tx"], geo["ty"])
     w_val, dw = _nodal(w, pairs, ns, n)
@@ -258,7 +266,7 @@ def mortar_matrices(mi, nm):
     """The assembled mortar matrices D (ns, ns) and M (ns, nm), sparse (for reporting and
     checks; the residual uses the pairs' virtual-work vectors)."""
     p, ns = mi.pairs, len(mi.w)
-    rows = np.repeat(p.nodes, 2, axis=1).ravel()                  # node of i for (p, i, k)
+    rows = np.repeat(p.nodes, 2, axis=1).ravel()  # node of i for (p, i, k)
     D = sparse.csr_matrix((mi.D.ravel(), (rows, np.tile(p.nodes, (1, 2)).ravel())), shape=(ns, ns))
     master_nodes = np.stack([p.master, p.master + 1], axis=1)
     M = sparse.csr_matrix((mi.M.ravel(), (rows, np.tile(master_nodes, (1, 2)).ravel())), shape=(ns, nm))
@@ -298,15 +306,17 @@ def penalty_tractions(normal, friction, g_N, dg_T, t_T_bar, q_bar, z_bar=None, d
     average gaps (eq 4: t_N = -c_N <-g_N> for the penalty), zero at open nodes; then the
     return map (eqs 40-48) on the nodal slip increments. friction None: frictionless.
     Returns (t_N, dt_N, FrictionState)."""
-    closed = g_N < 0.0                                            # +inf (uncovered) is open
+    closed = g_N < 0.0  # +inf (uncovered) is open
     t_N, dt_N = normal.traction(np.where(closed, g_N, 1.0))
     t_N, dt_N = np.where(closed, t_N, 0.0), np.where(closed, dt_N, 0.0)
     bad = ~np.isfinite(t_N) | ~np.isfinite(dt_N) | (t_N > 0.0)
     if np.any(bad):
         j = int(np.flatnonzero(bad)[0])
-        raise NormalLawError(f"normal law {type(normal).__name__}.traction returned t_N = {t_N[j]!r}, "
-                             f"dt_N = {dt_N[j]!r} at slave node {j} (g_N = {g_N[j]!r}): a contact traction "
-                             "must be finite and <= 0")
+        raise NormalLawError(
+            f"normal law {type(normal).__name__}.traction returned t_N = {t_N[j]!r}, "
+            f"dt_N = {dt_N[j]!r} at slave node {j} (g_N = {g_N[j]!r}): a contact traction "
+            "must be finite and <= 0"
+        )
     law = FRICTIONLESS if friction is None else as_friction_law(friction)
     slip = np.zeros_like(g_N) if friction is None else dg_T
     fr = return_map(law, t_N, dt_N, slip, t_T_bar, q_bar, z_bar=z_bar, dt=dt)
@@ -346,8 +356,11 @@ def contact_forces(mi, t_N, dt_N, offset=0.0, slip=None, friction=None, w_bar=No
         blocks = blocks + sum(friction.t_T[p.nodes[:, i], None, None] * mi.df_T[:, i] for i in range(2))
     K = K.tocoo()
     rows, cols, vals = to_coo(p.dofs, blocks) if len(p) else (np.zeros(0, int),) * 2 + (np.zeros(0),)
-    return np.asarray(R).ravel(), (np.concatenate([rows, K.row]), np.concatenate([cols, K.col]),
-                                   np.concatenate([vals, K.data]))
+    return np.asarray(R).ravel(), (
+        np.concatenate([rows, K.row]),
+        np.concatenate([cols, K.col]),
+        np.concatenate([vals, K.data]),
+    )
 
 
 def linearised(mi, x):
@@ -358,8 +371,9 @@ def linearised(mi, x):
     p, ns = mi.pairs, len(mi.w)
     n = mi.dg.shape[1]
     F_N = _pair_rows(mi.f_N, p, ns, n)
-    return replace(mi, g=F_N @ x, dg=F_N, dw=sparse.csr_matrix((ns, n)), df_N=np.zeros_like(mi.df_N),
-                   df_T=np.zeros_like(mi.df_T))
+    return replace(
+        mi, g=F_N @ x, dg=F_N, dw=sparse.csr_matrix((ns, n)), df_N=np.zeros_like(mi.df_N), df_T=np.zeros_like(mi.df_T)
+    )
 
 
 def linear_slip(mi, x, x_bar):

@@ -18,8 +18,17 @@ import numpy as np
 
 from .masters import BodySurface, RigidLine, RigidPolyline
 from .placement import start_of
-from .mortar import (Pairs, contact_forces, linear_slip, linearised, mortar_integrals, nodal_gap, penalty_tractions,
-                     slip_increment, weighted_slip)
+from .mortar import (
+    Pairs,
+    contact_forces,
+    linear_slip,
+    linearised,
+    mortar_integrals,
+    nodal_gap,
+    penalty_tractions,
+    slip_increment,
+    weighted_slip,
+)
 from .segmentation import candidate_pairs
 from ..laws.protocol import as_friction_law
 from ..laws.return_map import SLIP, STATE_NAMES
@@ -44,7 +53,7 @@ class MortarHistory:
     D: np.ndarray
     M: np.ndarray
     w: np.ndarray
-    x: np.ndarray | None = None        # the interface positions (slave, master) of the converged state
+    x: np.ndarray | None = None  # the interface positions (slave, master) of the converged state
 
 
 @dataclass(frozen=True)
@@ -126,8 +135,17 @@ class MortarState:
     def report(self):
         """Per slave node: reference and current position, average gap, tractions, nodal
         force measures f = w t (the weights are the covered lengths), state names."""
-        return dict(X=self.X, x=self.x, g_N=self.g_N, t_N=self.t_N, t_T=self.t_T, f_N=self.weights * self.t_N,
-                    f_T=self.weights * self.t_T, state=STATE_NAMES[self.state], weights=self.weights)
+        return dict(
+            X=self.X,
+            x=self.x,
+            g_N=self.g_N,
+            t_N=self.t_N,
+            t_T=self.t_T,
+            f_N=self.weights * self.t_N,
+            f_T=self.weights * self.t_T,
+            state=STATE_NAMES[self.state],
+            weights=self.weights,
+        )
 
 
 class MortarContact:
@@ -155,11 +173,22 @@ class MortarContact:
                  test holds to round-off. Scenes choose it from their material.
     """
 
-    integration = "standard"          # (no energy-consistent variant)
-    unknowns = 0                      # penalty: no unknowns of its own (contact/interfaces.py)
+    integration = "standard"  # (no energy-consistent variant)
+    unknowns = 0  # penalty: no unknowns of its own (contact/interfaces.py)
 
-    def __init__(self, slave_body, slave_nodes, master, *, normal, friction=None, offset=0.0, search=np.inf,
-                 kinematics="finite", name="mortar"):
+    def __init__(
+        self,
+        slave_body,
+        slave_nodes,
+        master,
+        *,
+        normal,
+        friction=None,
+        offset=0.0,
+        search=np.inf,
+        kinematics="finite",
+        name="mortar",
+    ):
         if kinematics not in KINEMATICS:
             raise ValueError(f"parameter kinematics = {kinematics!r} is not allowed: one of {'|'.join(KINEMATICS)}")
         self.kinematics = kinematics
@@ -170,8 +199,10 @@ class MortarContact:
         if np.any(np.linalg.norm(np.diff(slave_body.X[self.nodes], axis=0), axis=1) <= 0.0):
             raise ValueError("parameter slave_nodes has a zero-length segment: two consecutive nodes coincide")
         if not isinstance(master, (BodySurface, RigidPolyline, RigidLine)):
-            raise ValueError(f"parameter master must be a BodySurface, RigidPolyline or RigidLine for mortar "
-                             f"contact, got {type(master).__name__} (approximate a curved obstacle by a RigidPolyline)")
+            raise ValueError(
+                f"parameter master must be a BodySurface, RigidPolyline or RigidLine for mortar "
+                f"contact, got {type(master).__name__} (approximate a curved obstacle by a RigidPolyline)"
+            )
         if not (np.isfinite(search) or search == np.inf) or not search > 0:
             raise ValueError(f"parameter search = {search!r} is out of range: allowed (0, inf]")
         offset = np.asarray(offset, dtype=float)
@@ -181,8 +212,8 @@ class MortarContact:
         self.search = float(search)
         self.unbounded = isinstance(master, RigidLine)
         self._law = None if friction is None else as_friction_law(friction)
-        self._reference = None              # small kinematics: the integrals of the reference configuration
-        self.evaluations = 0                # a counter for the benchmarks (not part of any result)
+        self._reference = None  # small kinematics: the integrals of the reference configuration
+        self.evaluations = 0  # a counter for the benchmarks (not part of any result)
 
     # -- where the interface's unknowns are ----------------------------------------
     def slave_dofs(self, offsets=None):
@@ -197,7 +228,7 @@ class MortarContact:
         return np.full((len(self._master_points()), 2), -1)
 
     def _master_points(self):
-        if isinstance(self.master, RigidLine):            # two points of the line, n = e3 x t
+        if isinstance(self.master, RigidLine):  # two points of the line, n = e3 x t
             n = self.master.normal
             return np.array([self.master.point, self.master.point + np.array([n[1], -n[0]])])
         return self.master.points
@@ -220,8 +251,16 @@ class MortarContact:
         mi = self._integrals(xs, xm) if self.kinematics == "finite" else self._reference
         ns = len(self.nodes)
         z = self._law.initial_state(ns) if self._law is not None else np.zeros((ns, 0))
-        return MortarHistory(t_T=np.zeros(ns), q=np.zeros(ns), z=z, pairs=mi.pairs, D=mi.D, M=mi.M,
-                             w=mi.w, x=np.concatenate([xs.ravel(), xm.ravel()]))
+        return MortarHistory(
+            t_T=np.zeros(ns),
+            q=np.zeros(ns),
+            z=z,
+            pairs=mi.pairs,
+            D=mi.D,
+            M=mi.M,
+            w=mi.w,
+            x=np.concatenate([xs.ravel(), xm.ravel()]),
+        )
 
     def kinematics_at(self, u, h, offsets=None):
         """Segmentation, mortar integrals, nodal gaps and slip increments at u with the
@@ -233,15 +272,13 @@ class MortarContact:
         mi = self._integrals(xs, xm) if self.kinematics == "finite" else linearised(self._reference, x)
         offset = self.offset
         if self._law is not None and self._law.n_state:
-            offset = offset - self._law.gap_offset(h.z)           # a worn surface: the gap opens
+            offset = offset - self._law.gap_offset(h.z)  # a worn surface: the gap opens
         g_N, covered, dg_N = nodal_gap(mi, offset)
         slip, dg_T = None, np.zeros(len(self.nodes))
         if self.friction is not None:
-            slip = (weighted_slip(xs, xm, h.pairs, h.D, h.M) if self.kinematics == "finite"
-                    else linear_slip(mi, x, h.x))
+            slip = weighted_slip(xs, xm, h.pairs, h.D, h.M) if self.kinematics == "finite" else linear_slip(mi, x, h.x)
             dg_T, _ = slip_increment(slip, h.w)
-        return dict(xs=xs, xm=xm, x=x, mi=mi, offset=offset, g_N=g_N, covered=covered, dg_N=dg_N, slip=slip,
-                    dg_T=dg_T)
+        return dict(xs=xs, xm=xm, x=x, mi=mi, offset=offset, g_N=g_N, covered=covered, dg_N=dg_N, slip=slip, dg_T=dg_T)
 
     def evaluate(self, u, t=0.0, dt=None, u0=None, phase=None, *, history, offsets=None):
         """Everything at u with the committed ``history``: segmentation, mortar integrals,
@@ -251,25 +288,50 @@ class MortarContact:
         h = self._check(phase, history)
         k = self.kinematics_at(u, h, offsets)
         mi, slip, g_N, dg_T = k["mi"], k["slip"], k["g_N"], k["dg_T"]
-        t_N, dt_N, fr = penalty_tractions(self.normal, self.friction, g_N, dg_T, h.t_T, h.q,
-                                          z_bar=h.z if self._law is not None else None, dt=dt)
+        t_N, dt_N, fr = penalty_tractions(
+            self.normal, self.friction, g_N, dg_T, h.t_T, h.q, z_bar=h.z if self._law is not None else None, dt=dt
+        )
         R_i, (r, c, v) = contact_forces(mi, t_N, dt_N, k["offset"], slip, fr if slip is not None else None, h.w)
         R, rows, cols, vals = self._to_global(R_i, r, c, v, len(u), offsets)
         z = fr.z if (self._law is not None and fr.z is not None) else h.z
         history = MortarHistory(t_T=fr.t_T, q=fr.q, z=z, pairs=mi.pairs, D=mi.D, M=mi.M, w=mi.w, x=k["x"])
-        return MortarState(t=t, dt=dt, nodes=self.nodes, X=self.slave.X[self.nodes], x=k["xs"], g_N=g_N, t_N=t_N,
-                           dt_N=dt_N, t_T=fr.t_T, c_T_s=fr.c_T_s, c_N_s=fr.c_N_s, lam=fr.lam, q=fr.q, z=z,
-                           state=fr.state, weights=mi.w, dg_T=dg_T, R=R, rows=rows, cols=cols, vals=vals,
-                           history=history, integrals=mi, energy=self._energy(g_N, mi.w, fr.t_T),
-                           dissipation=float(np.sum(h.w * 0.5 * (h.t_T + fr.t_T) * fr.lam * np.sign(fr.t_T))))
+        return MortarState(
+            t=t,
+            dt=dt,
+            nodes=self.nodes,
+            X=self.slave.X[self.nodes],
+            x=k["xs"],
+            g_N=g_N,
+            t_N=t_N,
+            dt_N=dt_N,
+            t_T=fr.t_T,
+            c_T_s=fr.c_T_s,
+            c_N_s=fr.c_N_s,
+            lam=fr.lam,
+            q=fr.q,
+            z=z,
+            state=fr.state,
+            weights=mi.w,
+            dg_T=dg_T,
+            R=R,
+            rows=rows,
+            cols=cols,
+            vals=vals,
+            history=history,
+            integrals=mi,
+            energy=self._energy(g_N, mi.w, fr.t_T),
+            dissipation=float(np.sum(h.w * 0.5 * (h.t_T + fr.t_T) * fr.lam * np.sign(fr.t_T))),
+        )
 
     def _check(self, phase, history):
         """The committed history, after the checks every evaluation makes; counts the evaluation."""
         if phase is not None:
             raise ValueError(f"{self.name}: mortar contact has no staggered phases (phase={phase!r})")
         if not isinstance(history, MortarHistory):
-            raise ValueError(f"{self.name}: history must be a MortarHistory (from start(u) or commit(state)), "
-                             f"got {type(history).__name__}")
+            raise ValueError(
+                f"{self.name}: history must be a MortarHistory (from start(u) or commit(state)), "
+                f"got {type(history).__name__}"
+            )
         self.evaluations += 1
         return history
 

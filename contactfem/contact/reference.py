@@ -29,21 +29,21 @@ from ..laws.return_map import OPEN, SLIP, STICK
 def pair_geometry(x_s, x_1, x_2):
     """Eqs (17)-(19): length l, unit tangent t, normal n, gap g_N and natural coordinate alpha."""
     x_s, x_1, x_2 = (np.asarray(x, dtype=float) for x in (x_s, x_1, x_2))
-    l = math.hypot(x_2[0] - x_1[0], x_2[1] - x_1[1])               # eq (18): l = ||x_2 - x_1||
-    t = (x_2 - x_1) / l                                            # eq (18)
-    n = np.array([-t[1], t[0]])                                    # eq (18): n = e_3 x t
-    g_N = (x_s - x_1) @ n                                          # eq (17)
-    alpha = (x_s - x_1) @ t / l                                    # eq (19)
+    l = math.hypot(x_2[0] - x_1[0], x_2[1] - x_1[1])  # eq (18): l = ||x_2 - x_1||
+    t = (x_2 - x_1) / l  # eq (18)
+    n = np.array([-t[1], t[0]])  # eq (18): n = e_3 x t
+    g_N = (x_s - x_1) @ n  # eq (17)
+    alpha = (x_s - x_1) @ t / l  # eq (19)
     return l, t, n, g_N, alpha
 
 
 def pair_vectors(t, n, alpha):
     """Eqs (25)-(26): the 6-vectors N_s, N_0, T_s, T_0 of one pair."""
     zero = np.zeros(2)
-    N_s = np.concatenate([n, -(1.0 - alpha) * n, -alpha * n])      # eq (25)
-    N_0 = np.concatenate([zero, -n, n])                            # eq (25)
-    T_s = np.concatenate([t, -(1.0 - alpha) * t, -alpha * t])      # eq (26)
-    T_0 = np.concatenate([zero, -t, t])                            # eq (26)
+    N_s = np.concatenate([n, -(1.0 - alpha) * n, -alpha * n])  # eq (25)
+    N_0 = np.concatenate([zero, -n, n])  # eq (25)
+    T_s = np.concatenate([t, -(1.0 - alpha) * t, -alpha * t])  # eq (26)
+    T_0 = np.concatenate([zero, -t, t])  # eq (26)
     return N_s, N_0, T_s, T_0
 
 
@@ -55,19 +55,38 @@ def pair_variations(x_s, x_1, x_2, l_bar=None, S_bar=0.0):
     l, t, n, g_N, alpha = pair_geometry(x_s, x_1, x_2)
     l_bar = l if l_bar is None else l_bar
     N_s, N_0, T_s, T_0 = pair_vectors(t, n, alpha)
-    a = T_s + (g_N / l) * N_0                          # the bracket of eq (27)
-    dg_N = N_s                                         # eq (27): delta g_N = N_s . delta v_c
-    dg_T = (l_bar / l) * a                             # eq (27): delta g_T = (l_bar/l)(T_s + g_N/l N_0) . delta v_c
-    d2g_N = -((np.outer(N_0, T_s) + np.outer(T_s, N_0)) / l
-              + (g_N / l**2) * np.outer(N_0, N_0))     # eqs (31)-(32): Delta delta g_N = dv^T d2g_N Dv
-    A = np.outer(a, a)                                 # eq (36); eq (35): Delta g_T delta g_T = dv^T (l_bar/l)^2 A Dv
-    B = (np.outer(N_s, N_0) + np.outer(N_0, N_s)) \
-        - (np.outer(T_s, T_0) + np.outer(T_0, T_s)) \
-        - 2.0 * (g_N / l) * (np.outer(N_0, T_0) + np.outer(T_0, N_0))   # eq (38)
-    d2g_T = (l_bar / l**2) * B                         # eq (37): Delta delta alpha = dv^T (B / l^2) Dv, times l_bar
-    return dict(l=l, l_bar=l_bar, t=t, n=n, g_N=g_N, alpha=alpha, s=S_bar + alpha * l_bar,
-                N_s=N_s, N_0=N_0, T_s=T_s, T_0=T_0, A=A, B=B,
-                dg_N=dg_N, dg_T=dg_T, d2g_N=d2g_N, d2g_T=d2g_T)
+    a = T_s + (g_N / l) * N_0  # the bracket of eq (27)
+    dg_N = N_s  # eq (27): delta g_N = N_s . delta v_c
+    dg_T = (l_bar / l) * a  # eq (27): delta g_T = (l_bar/l)(T_s + g_N/l N_0) . delta v_c
+    d2g_N = -(
+        (np.outer(N_0, T_s) + np.outer(T_s, N_0)) / l + (g_N / l**2) * np.outer(N_0, N_0)
+    )  # eqs (31)-(32): Delta delta g_N = dv^T d2g_N Dv
+    A = np.outer(a, a)  # eq (36); eq (35): Delta g_T delta g_T = dv^T (l_bar/l)^2 A Dv
+    B = (
+        (np.outer(N_s, N_0) + np.outer(N_0, N_s))
+        - (np.outer(T_s, T_0) + np.outer(T_0, T_s))
+        - 2.0 * (g_N / l) * (np.outer(N_0, T_0) + np.outer(T_0, N_0))
+    )  # eq (38)
+    d2g_T = (l_bar / l**2) * B  # eq (37): Delta delta alpha = dv^T (B / l^2) Dv, times l_bar
+    return dict(
+        l=l,
+        l_bar=l_bar,
+        t=t,
+        n=n,
+        g_N=g_N,
+        alpha=alpha,
+        s=S_bar + alpha * l_bar,
+        N_s=N_s,
+        N_0=N_0,
+        T_s=T_s,
+        T_0=T_0,
+        A=A,
+        B=B,
+        dg_N=dg_N,
+        dg_T=dg_T,
+        d2g_N=d2g_N,
+        d2g_T=d2g_T,
+    )
 
 
 def slave_rows(v):
@@ -108,9 +127,16 @@ def arc_pair(x_s, center, R, sigma, theta_ref, theta_0=0.0, direction=1.0, S=0.0
     theta = theta_ref + math.remainder(math.atan2(d[1], d[0]) - theta_ref, 2.0 * math.pi)
     hess_r = (np.eye(2) - np.outer(e_r, e_r)) / r
     hess_th = -(np.outer(e_r, e_th) + np.outer(e_th, e_r)) / r**2
-    return dict(g_N=sigma * (r - R), dg_N=sigma * e_r, d2g_N=sigma * hess_r,
-                s=S + direction * R * (theta - theta_0), dg_T=direction * R * e_th / r,
-                d2g_T=direction * R * hess_th, r=r, theta=theta)
+    return dict(
+        g_N=sigma * (r - R),
+        dg_N=sigma * e_r,
+        d2g_N=sigma * hess_r,
+        s=S + direction * R * (theta - theta_0),
+        dg_T=direction * R * e_th / r,
+        d2g_T=direction * R * hess_th,
+        r=r,
+        theta=theta,
+    )
 
 
 def power_law(g_N, c_N, m=1.0):
@@ -130,23 +156,23 @@ def return_map(c_T, alpha, beta, n, t_N, dt_N, Dg_T, t_T_bar):
     c_T and 0 while sticking), the slip multiplier lam, which makes the slip increment
     Delta g_T^s = lam sign(t_T) with Delta g_N^s = 0 (eqs 41, 45), and the state (OPEN,
     STICK, SLIP)."""
-    if not t_N < 0.0:                                   # open: no traction, nothing to integrate
+    if not t_N < 0.0:  # open: no traction, nothing to integrate
         return dict(t_T=0.0, c_T_s=0.0, c_N_s=0.0, lam=0.0, state=OPEN)
-    p = -t_N                                            # |t_N|
-    Y = alpha * p**n + beta * p                         # eq (10): f = ||t_T|| - Y
-    t_tr = t_T_bar + c_T * Dg_T                         # eq (42): elastic predictor (t_T = c_T g_T^e, eq 5)
-    f_tr = abs(t_tr) - Y                                # eq (40): f(t_N, t_tr)
-    if f_tr <= 0.0:                                     # stick: the trial is the answer, dt_T/dg_T = c_T (eq 39)
+    p = -t_N  # |t_N|
+    Y = alpha * p**n + beta * p  # eq (10): f = ||t_T|| - Y
+    t_tr = t_T_bar + c_T * Dg_T  # eq (42): elastic predictor (t_T = c_T g_T^e, eq 5)
+    f_tr = abs(t_tr) - Y  # eq (40): f(t_N, t_tr)
+    if f_tr <= 0.0:  # stick: the trial is the answer, dt_T/dg_T = c_T (eq 39)
         return dict(t_T=t_tr, c_T_s=c_T, c_N_s=0.0, lam=0.0, state=STICK)
     sign = 1.0 if t_tr > 0.0 else -1.0
-    lam = (abs(t_tr) - Y) / c_T                         # eq (44): f(t_N, t_T) = |t_tr| - c_T lam - Y = 0, for lam
-    t_T = t_tr - c_T * lam * sign                       # eq (43): t_T = t_tr - c_T lam sign(t_tr) = Y sign(t_tr)
+    lam = (abs(t_tr) - Y) / c_T  # eq (44): f(t_N, t_T) = |t_tr| - c_T lam - Y = 0, for lam
+    t_T = t_tr - c_T * lam * sign  # eq (43): t_T = t_tr - c_T lam sign(t_tr) = Y sign(t_tr)
     # eqs (41), (45): the slip Delta g_T^s = lam sign(t_T), Delta g_N^s = 0 (non-associated, eq 14).
     # eqs (46)-(48): t_T = sign(t_tr) Y(|t_N|) on the slip surface; sign(t_tr) is fixed near a slipping
     # state, so t_T does not change with Delta g_T, and changes with g_N through |t_N| = -t_N(g_N):
-    c_T_s = 0.0                                         # eq (47): dt_T/dg_T = c_T dY/dlam / (c_T + dY/dlam), dY/dlam = 0
-    dY_dp = alpha * n * p ** (n - 1.0) + beta           # dY/d|t_N| (unbounded at first touch when n < 1)
-    c_N_s = sign * dY_dp * (-dt_N)                      # eq (48): sign(t_tr) dY/d|t_N| d|t_N|/dg_N (= -dt_N)
+    c_T_s = 0.0  # eq (47): dt_T/dg_T = c_T dY/dlam / (c_T + dY/dlam), dY/dlam = 0
+    dY_dp = alpha * n * p ** (n - 1.0) + beta  # dY/d|t_N| (unbounded at first touch when n < 1)
+    c_N_s = sign * dY_dp * (-dt_N)  # eq (48): sign(t_tr) dY/d|t_N| d|t_N|/dg_N (= -dt_N)
     return dict(t_T=t_T, c_T_s=c_T_s, c_N_s=c_N_s, lam=lam, state=SLIP)
 
 
@@ -160,7 +186,7 @@ def closing_step(g_bar, g_N, s, s_bar, dg_N, dg_T):
     if not (g_bar > 0.0 and g_N < 0.0):
         return s - s_bar, dg_T
     r = -g_N / (g_bar - g_N)
-    dr = -g_bar / (g_bar - g_N) ** 2                    # dr/dg_N
+    dr = -g_bar / (g_bar - g_N) ** 2  # dr/dg_N
     return r * (s - s_bar), r * dg_T + (s - s_bar) * dr * dg_N
 
 
@@ -180,18 +206,19 @@ def segment_element(v, w, t_N, dt_N, fr, ddg_T=None, rigid=False):
     a = T_s + (g_N / l) * N_0
     R_c, K = np.zeros(6), np.zeros((6, 6))
     if fr["state"] != OPEN:
-        R_c = t_N * N_s + t_T * (l_bar / l) * a                                # eq (28)
-        K_N = dt_N * np.outer(N_s, N_s) \
-            - t_N * ((np.outer(N_0, T_s) + np.outer(T_s, N_0)) / l + (g_N / l**2) * np.outer(N_0, N_0))  # eq (33)
-        if ddg_T is not None and len(ddg_T) == 2:                               # a rigid master's slave rows
+        R_c = t_N * N_s + t_T * (l_bar / l) * a  # eq (28)
+        K_N = dt_N * np.outer(N_s, N_s) - t_N * (
+            (np.outer(N_0, T_s) + np.outer(T_s, N_0)) / l + (g_N / l**2) * np.outer(N_0, N_0)
+        )  # eq (33)
+        if ddg_T is not None and len(ddg_T) == 2:  # a rigid master's slave rows
             ddg_T = np.concatenate([ddg_T, np.zeros(4)])
         AA = (l_bar / l) ** 2 * A if ddg_T is None else (l_bar / l) * np.outer(a, ddg_T)
         if fr["state"] == STICK:
-            c_T = c_T_s                                                        # return_map gives c_T^s = c_T
-            K_T = c_T * AA + t_T * (l_bar / l**2) * B                          # eq (39)
+            c_T = c_T_s  # return_map gives c_T^s = c_T
+            K_T = c_T * AA + t_T * (l_bar / l**2) * B  # eq (39)
         else:
-            C = (l_bar / l) * np.outer(a, N_s)                                 # eq (50), non-symmetric
-            K_T = c_T_s * AA + t_T * (l_bar / l**2) * B + c_N_s * C            # eq (49)
+            C = (l_bar / l) * np.outer(a, N_s)  # eq (50), non-symmetric
+            K_T = c_T_s * AA + t_T * (l_bar / l**2) * B + c_N_s * C  # eq (49)
         K = K_N + K_T
     R_c, K = w * R_c, w * K
     return (slave_rows(R_c), slave_rows(K)) if rigid else (R_c, K)
@@ -206,9 +233,9 @@ def obstacle_element(k, w, t_N, dt_N, fr, ddg_T=None):
     ddg_T = dg_T if ddg_T is None else ddg_T
     if fr["state"] == OPEN:
         return np.zeros(2), np.zeros((2, 2))
-    R_c = t_N * dg_N + fr["t_T"] * dg_T                                        # eq (28)
-    K_N = dt_N * np.outer(dg_N, dg_N) + t_N * d2g_N                            # eq (33)
-    K_T = fr["c_T_s"] * np.outer(dg_T, ddg_T) + fr["t_T"] * d2g_T              # eq (39)
+    R_c = t_N * dg_N + fr["t_T"] * dg_T  # eq (28)
+    K_N = dt_N * np.outer(dg_N, dg_N) + t_N * d2g_N  # eq (33)
+    K_T = fr["c_T_s"] * np.outer(dg_T, ddg_T) + fr["t_T"] * d2g_T  # eq (39)
     if fr["state"] == SLIP:
-        K_T = K_T + fr["c_N_s"] * np.outer(dg_T, dg_N)                         # eqs (49)-(50)
+        K_T = K_T + fr["c_N_s"] * np.outer(dg_T, dg_N)  # eqs (49)-(50)
     return w * R_c, w * (K_N + K_T)

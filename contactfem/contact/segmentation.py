@@ -73,7 +73,7 @@ def candidate_pairs(xs, xm, unbounded=False, search=np.inf):
     Returns (slave_segment, master_segment), index arrays of equal length."""
     l, t, n = segment_frames(xs, "slave")
     _, _, n_m = segment_frames(xm, "master")
-    d_c = xm[None, :-1, :] - xs[:-1, None, :]                  # (slave seg, master seg, 2)
+    d_c = xm[None, :-1, :] - xs[:-1, None, :]  # (slave seg, master seg, 2)
     d_d = xm[None, 1:, :] - xs[:-1, None, :]
     xi_c = np.einsum("ekx,ex->ek", d_c, t) / l[:, None]
     xi_d = np.einsum("ekx,ex->ek", d_d, t) / l[:, None]
@@ -108,13 +108,14 @@ def pair_geometry(xa, xb, xc, xd):
     ex, ey = bx - ax, by - ay
     l = (ex * ex + ey * ey).sqrt()
     tx, ty = ex / l, ey / l
-    nx, ny = -ty, tx                                           # n = e3 x t, out of the slave
+    nx, ny = -ty, tx  # n = e3 x t, out of the slave
     xi_c = ((cx - ax) * tx + (cy - ay) * ty) / l
     g_c = (cx - ax) * nx + (cy - ay) * ny
     xi_d = ((dx - ax) * tx + (dy - ay) * ty) / l
     g_d = (dx - ax) * nx + (dy - ay) * ny
-    return dict(l=l, tx=tx, ty=ty, nx=nx, ny=ny, xi_c=xi_c, g_c=g_c, xi_d=xi_d, g_d=g_d,
-                v=(ax, ay, bx, by, cx, cy, dx, dy))
+    return dict(
+        l=l, tx=tx, ty=ty, nx=nx, ny=ny, xi_c=xi_c, g_c=g_c, xi_d=xi_d, g_d=g_d, v=(ax, ay, bx, by, cx, cy, dx, dy)
+    )
 
 
 def overlap(xi_c, xi_d, unbounded=False):

@@ -30,6 +30,7 @@ class ContactHistory:
     master   what the master remembers: a deformable master's converged node positions
              (its metric l_bar of eq 20), None for a rigid one
     """
+
     s_bar: np.ndarray
     g_bar: np.ndarray
     t_T_bar: np.ndarray
@@ -50,15 +51,16 @@ class ContactState:
     Element (eqs 28, 33, 39, 49-50): R (m, k) and K (m, k, k) at the global dofs ``element_dofs``
     (m, k) of the m pairs that carry a force.
     """
-    contact: object                 # the contact that made it (laws, weights, master: read only)
-    history: ContactHistory         # the history it was evaluated against
-    u: np.ndarray                   # the trial displacement (never modified afterwards)
+
+    contact: object  # the contact that made it (laws, weights, master: read only)
+    history: ContactHistory  # the history it was evaluated against
+    u: np.ndarray  # the trial displacement (never modified afterwards)
     t: float
     x_s: np.ndarray
     g_N: np.ndarray
-    g_raw: np.ndarray               # g_N without the friction law's gap offset (wear)
+    g_raw: np.ndarray  # g_N without the friction law's gap offset (wear)
     s: np.ndarray
-    s_next: np.ndarray              # s in the metric of this configuration (the next s_bar)
+    s_next: np.ndarray  # s in the metric of this configuration (the next s_bar)
     n: np.ndarray
     tangent: np.ndarray
     seg: np.ndarray
@@ -77,14 +79,14 @@ class ContactState:
     R: np.ndarray
     K: np.ndarray
     element_dofs: np.ndarray
-    work_T: np.ndarray | None = None       # energy-consistent: the friction force's work over the step
-    offsets: object = None                 # where the bodies' dofs start in u (a System's: placement.py)
+    work_T: np.ndarray | None = None  # energy-consistent: the friction force's work over the step
+    offsets: object = None  # where the bodies' dofs start in u (a System's: placement.py)
 
     # -- assembly ---------------------------------------------------------------------
     def scatter(self, ndof):
         """The global contact residual R_c (ndof,) and the tangent's COO triplets."""
         dofs = self.element_dofs
-        if not dofs.size:                       # no pair carries a force
+        if not dofs.size:  # no pair carries a force
             empty = np.zeros(0, dtype=int)
             return np.zeros(ndof), empty, empty, np.zeros(0)
         R_c = np.bincount(dofs.ravel(), self.R.ravel(), minlength=ndof)
@@ -99,8 +101,14 @@ class ContactState:
         c = self.contact
         z = self.z
         g = self.g_raw + c.gap_offset(z)
-        return ContactHistory(s_bar=self.s_next, g_bar=g, t_T_bar=np.where(self.active, self.t_T, 0.0),
-                              q_bar=self.q, z_bar=z, master=c.master.reference(self.u, self.offsets))
+        return ContactHistory(
+            s_bar=self.s_next,
+            g_bar=g,
+            t_T_bar=np.where(self.active, self.t_T, 0.0),
+            q_bar=self.q,
+            z_bar=z,
+            master=c.master.reference(self.u, self.offsets),
+        )
 
     @cached_property
     def energy(self):
@@ -109,7 +117,7 @@ class ContactState:
         c = self.contact
         W = c.normal_energy(np.where(self.active, self.g_N, 1.0))
         if c.c_T > 0.0:
-            W = W + self.t_T ** 2 / (2.0 * c.c_T)
+            W = W + self.t_T**2 / (2.0 * c.c_T)
         return float((c.weights * W).sum())
 
     @cached_property
@@ -126,16 +134,27 @@ class ContactState:
             return 0.0
         t_bar = self.history.t_T_bar
         if self.work_T is not None:
-            dW = c.weights * (np.where(self.active, self.t_T, 0.0) ** 2 - t_bar ** 2) / (2.0 * c.c_T)
+            dW = c.weights * (np.where(self.active, self.t_T, 0.0) ** 2 - t_bar**2) / (2.0 * c.c_T)
             return float(self.work_T.sum() - dW.sum())
         return float((c.weights * 0.5 * (t_bar + self.t_T) * self.lam * np.sign(self.t_T)).sum())
 
     def report(self):
         """Per slave node: reference and current position, gap, tractions, nodal forces, state."""
         c = self.contact
-        return dict(X=c.slave.X[c.nodes], x=self.x_s, g_N=self.g_N, t_N=self.t_N, t_T=self.t_T,
-                    f_N=c.weights * self.t_N, f_T=c.weights * self.t_T, n=self.n, t=self.tangent,
-                    state=STATE_NAMES[self.slip], seg=self.seg, weights=c.weights)
+        return dict(
+            X=c.slave.X[c.nodes],
+            x=self.x_s,
+            g_N=self.g_N,
+            t_N=self.t_N,
+            t_T=self.t_T,
+            f_N=c.weights * self.t_N,
+            f_T=c.weights * self.t_T,
+            n=self.n,
+            t=self.tangent,
+            state=STATE_NAMES[self.slip],
+            seg=self.seg,
+            weights=c.weights,
+        )
 
     @property
     def dg_T(self):

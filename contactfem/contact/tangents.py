@@ -13,6 +13,7 @@ and the phases of the staggered (two-step) algorithm of Sec. 2.2 (solver/stagger
     normal      the friction state frozen: stick about it, t_T = t_T* + c_T (s - s*)
     friction    the normal pressure p* = |t_N| frozen in the return mapping (c_N^s = 0)
 """
+
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,6 +26,7 @@ PHASES = ("normal", "friction")
 class Phase:
     """A phase of the staggered algorithm with the quantities it freezes (per slave node):
     t_T* and s* (normal phase), p* = |t_N| (friction phase); zero at open nodes."""
+
     kind: str
     t_T: np.ndarray
     s: np.ndarray

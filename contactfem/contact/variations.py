@@ -28,7 +28,7 @@ class Jet:
     val: np.ndarray
     grad: np.ndarray
 
-    __array_ufunc__ = None          # array * jet: numpy defers to Jet.__rmul__
+    __array_ufunc__ = None  # array * jet: numpy defers to Jet.__rmul__
 
     @staticmethod
     def variables(v):
@@ -59,7 +59,7 @@ class Jet:
         return self._lift(other) - self
 
     def __mul__(self, other):
-        if not isinstance(other, Jet):                       # a constant factor
+        if not isinstance(other, Jet):  # a constant factor
             c = np.asarray(other, dtype=float)
             return Jet(self.val * c, self.grad * c[..., None])
         # product rule: Delta(fg) = Delta f g + f Delta g

@@ -24,8 +24,9 @@ def _polylines(frame):
     return out
 
 
-def animate_outlines(frames, path, times=None, obstacles=(), closed=False, fps=20, title="",
-                     xlim=None, ylim=None, dpi=80, marks=None):
+def animate_outlines(
+    frames, path, times=None, obstacles=(), closed=False, fps=20, title="", xlim=None, ylim=None, dpi=80, marks=None
+):
     """Draw the polylines of each frame (bodies' outlines, a beam's centreline) and save
     an animation to `path` (.gif or .mp4). `obstacles` are fixed polylines (rigid masters:
     RigidLine.outline(extent), RigidPolyline.outline(), RigidArc.outline()). `closed`
@@ -68,7 +69,7 @@ def animate_outlines(frames, path, times=None, obstacles=(), closed=False, fps=2
     ax.set_ylim(ylim or (lo[1] - pad, hi[1] + pad))
     for o in obstacles:
         ax.plot(o[:, 0], o[:, 1], color="0.3", lw=2)
-        if len(o) == 2 and abs(o[0, 1] - o[1, 1]) < 1e-12 * (1 + abs(o[0, 1])):   # a floor: hatch below it
+        if len(o) == 2 and abs(o[0, 1] - o[1, 1]) < 1e-12 * (1 + abs(o[0, 1])):  # a floor: hatch below it
             ax.fill_between(o[:, 0], o[:, 1], o[:, 1] - pad, color="0.85", hatch="///", edgecolor="0.6", lw=0)
     lines = [ax.plot([], [], "-", lw=1.5)[0] for _ in frames[0]]
     spokes = [ax.plot([], [], "-o", color="tab:red", lw=1.5, ms=3)[0] for _ in (marks[0] if marks else ())]

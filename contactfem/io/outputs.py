@@ -34,7 +34,9 @@ def check_output_path(path, what, suffixes):
     existing parent a folder where files can be created). Makes nothing (``make_parents``
     does, when the file is written)."""
     if not str(path).strip():
-        raise ValueError(f"{what}: empty file name; give a file name{' ending in ' + ' or '.join(suffixes) if suffixes else ''}")
+        raise ValueError(
+            f"{what}: empty file name; give a file name{' ending in ' + ' or '.join(suffixes) if suffixes else ''}"
+        )
     p = Path(path)
     if suffixes and p.suffix.lower() not in suffixes:
         raise ValueError(f"{what} {path}: the file name must end in {' or '.join(suffixes)}")
@@ -71,7 +73,7 @@ def _writable_ancestor(p, what, path):
         raise ValueError(f"{what} {path}: {parent} is a file, not a folder")
     if not os.access(parent, os.W_OK | os.X_OK):
         raise ValueError(f"{what} {path}: cannot write in {parent} (permission denied)")
-    _probe(parent, what, path)                  # (a special file system may refuse what access allows)
+    _probe(parent, what, path)  # (a special file system may refuse what access allows)
     return parent
 
 
@@ -93,7 +95,7 @@ def _probe(folder, what, path):
         try:
             open(probe, "xb").close()
         finally:
-            probe.unlink(missing_ok=True)        # also when a Ctrl-C comes between the two
+            probe.unlink(missing_ok=True)  # also when a Ctrl-C comes between the two
     except OSError as err:
         raise ValueError(f"{what} {path}: cannot write in {folder} ({err.strerror or err})") from None
 
@@ -104,9 +106,9 @@ class Outputs:
     the block ends with an exception (Ctrl-C included)."""
 
     def __init__(self):
-        self.paths = {}          # option -> target Path
-        self.temps = {}          # option -> temporary Path
-        self.made = []           # folders made for the outputs (removed again if nothing is written)
+        self.paths = {}  # option -> target Path
+        self.temps = {}  # option -> temporary Path
+        self.made = []  # folders made for the outputs (removed again if nothing is written)
         self.committed = False
 
     def add(self, what, path, suffixes=()):
@@ -147,7 +149,7 @@ class Outputs:
                 t.unlink(missing_ok=True)
             except OSError:
                 pass
-        for folder in reversed(self.made):      # innermost first; only if still empty
+        for folder in reversed(self.made):  # innermost first; only if still empty
             try:
                 folder.rmdir()
             except OSError:

@@ -33,13 +33,16 @@ def _pad3(x):
 
 def write_pvd(path, files, times):
     """The ParaView collection: one <DataSet timestep=...> per file (paths relative to the .pvd)."""
-    from xml.sax.saxutils import quoteattr    # (pulls in urllib: ~0.1 s, only when writing)
+    from xml.sax.saxutils import quoteattr  # (pulls in urllib: ~0.1 s, only when writing)
 
     path = Path(path)
-    rows = "\n".join(f'    <DataSet timestep="{float(t)!r}" part="0" file={quoteattr(Path(f).name)}/>'
-                     for f, t in zip(files, times))
-    path.write_text('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n  <Collection>\n'
-                    f"{rows}\n  </Collection>\n</VTKFile>\n")
+    rows = "\n".join(
+        f'    <DataSet timestep="{float(t)!r}" part="0" file={quoteattr(Path(f).name)}/>' for f, t in zip(files, times)
+    )
+    path.write_text(
+        '<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n  <Collection>\n'
+        f"{rows}\n  </Collection>\n</VTKFile>\n"
+    )
     return str(path)
 
 
@@ -61,7 +64,9 @@ def export_series(points, cells, times, path, point_data=None, cell_data=None):
     points = list(points)
     times = np.asarray(times, dtype=float).ravel()
     if len(points) != len(times) or len(points) == 0:
-        raise ValueError(f"parameter times must give one time per snapshot: {len(times)} times, {len(points)} snapshots")
+        raise ValueError(
+            f"parameter times must give one time per snapshot: {len(times)} times, {len(points)} snapshots"
+        )
     point_data = point_data or {}
     cell_data = cell_data or {}
     for name, series in list(point_data.items()) + list(cell_data.items()):
@@ -70,9 +75,12 @@ def export_series(points, cells, times, path, point_data=None, cell_data=None):
     path.parent.mkdir(parents=True, exist_ok=True)
     files = []
     for k, x in enumerate(points):
-        mesh = meshio.Mesh(_pad3(x), cells,
-                           point_data={n: np.asarray(s[k], dtype=float) for n, s in point_data.items()},
-                           cell_data={n: [np.asarray(s[k], dtype=float)] for n, s in cell_data.items()})
+        mesh = meshio.Mesh(
+            _pad3(x),
+            cells,
+            point_data={n: np.asarray(s[k], dtype=float) for n, s in point_data.items()},
+            cell_data={n: [np.asarray(s[k], dtype=float)] for n, s in cell_data.items()},
+        )
         f = path.with_name(f"{path.stem}_{k:04d}.vtu")
         meshio.write(f, mesh)
         files.append(str(f))

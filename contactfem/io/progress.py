@@ -43,11 +43,11 @@ class _AutoBar(_Fields, auto_tqdm):
 
 
 def _bar(stream, **options):
-    if stream is not None:                    # a stream asked for: the text bar on it
+    if stream is not None:  # a stream asked for: the text bar on it
         return _TextBar(file=stream, **options)
     try:
         return _AutoBar(file=sys.stderr, **options)
-    except ImportError:                       # Jupyter without ipywidgets: tqdm cannot draw its widget
+    except ImportError:  # Jupyter without ipywidgets: tqdm cannot draw its widget
         return _TextBar(file=sys.stderr, **options)
 
 
@@ -65,9 +65,15 @@ class ProgressBar:
         self.total, self.t0, self.t_end = total, float(t0), t_end
         self.n, self.t = 0, float(t0)
         self.closed = False
-        self._bar = _bar(stream, total=total if total is not None else 1.0, desc=f"{label} " if label else "",
-                         mininterval=float(interval), miniters=1, ascii=".#",
-                         bar_format=FORMAT.replace("{bar}", f"{{bar:{int(width)}}}"))
+        self._bar = _bar(
+            stream,
+            total=total if total is not None else 1.0,
+            desc=f"{label} " if label else "",
+            mininterval=float(interval),
+            miniters=1,
+            ascii=".#",
+            bar_format=FORMAT.replace("{bar}", f"{{bar:{int(width)}}}"),
+        )
         self._bar.where = f"step 0/{total}" if total is not None else f"t = {self.t:.4g}"
 
     def _to(self, done, force=False):

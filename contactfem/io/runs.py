@@ -45,7 +45,7 @@ def _encode(obj, where, arrays):
     if isinstance(obj, np.ndarray):
         if obj.dtype == object:
             return _encode(obj.tolist(), where, arrays)
-        if arrays is not None:                     # npz: store natively, reference by key
+        if arrays is not None:  # npz: store natively, reference by key
             key = f"a{len(arrays)}"
             arrays[key] = obj
             return {_TAG: key}
@@ -85,7 +85,7 @@ class _Foreign(Exception):
     """Raised inside load_run for a file that is not a saved run; turned into ValueError."""
 
 
-_DTYPE_KINDS = "biufcU"          # numbers, booleans and text: never Python objects
+_DTYPE_KINDS = "biufcU"  # numbers, booleans and text: never Python objects
 
 
 def _tagged(obj, arrays):
@@ -120,7 +120,7 @@ def _decode(obj, arrays, to_arrays):
 
 def _one_line(err):
     text = " ".join(str(err).split()) or type(err).__name__
-    if "pickle" in text.lower():                   # numpy's advice to allow pickles is unsafe: never pass it on
+    if "pickle" in text.lower():  # numpy's advice to allow pickles is unsafe: never pass it on
         text = "it holds Python objects (pickled data), which load_run does not read"
     return text[:200]
 
@@ -165,9 +165,8 @@ def load_run(path, arrays=True):
         raise ValueError(f"{path} is not a saved contactfem run: {err}") from None
     except PermissionError:
         raise
-    except Exception as err:          # a damaged file fails anywhere inside zipfile, zlib, numpy or json
-        raise ValueError(f"{path} is not a readable contactfem run (corrupt or truncated?): "
-                         f"{_one_line(err)}") from None
+    except Exception as err:  # a damaged file fails anywhere inside zipfile, zlib, numpy or json
+        raise ValueError(f"{path} is not a readable contactfem run (corrupt or truncated?): {_one_line(err)}") from None
 
 
 def _load(path, to_arrays):
@@ -193,7 +192,7 @@ def _load(path, to_arrays):
         if not isinstance(doc.get("results"), dict):
             raise _Foreign("it has no results")
         return _decode(doc["results"], stored, to_arrays)
-    if path.suffix == ".json" and "scene" in doc:            # written by `contactfem run --json`
+    if path.suffix == ".json" and "scene" in doc:  # written by `contactfem run --json`
         return _decode(doc, stored, to_arrays)
     raise _Foreign("it has neither a 'format' (save_run) nor a 'scene' (contactfem run --json) entry")
 
@@ -201,10 +200,10 @@ def _load(path, to_arrays):
 class Recorder:
     """Keeps snapshots (t, u, v) of every `every`-th call, e.g. of the records of a march:
 
-        rec = Recorder(every=5)
-        for r in march(stepper, Steps(dt, n_steps=200), 0.0, u0, v0):
-            rec(r.t, r.u, r.v)
-        rec.t, rec.u            # arrays (n_snap,), (n_snap, ndof)
+    rec = Recorder(every=5)
+    for r in march(stepper, Steps(dt, n_steps=200), 0.0, u0, v0):
+        rec(r.t, r.u, r.v)
+    rec.t, rec.u            # arrays (n_snap,), (n_snap, ndof)
     """
 
     def __init__(self, every=1):
@@ -238,8 +237,22 @@ class Recorder:
 
 
 # what describes how a run went rather than what it computed: not compared
-RUN_KEYS = ("wall_time_s", "import_time_s", "linear_algebra", "ordering", "unknowns", "band_kl", "band_ku",
-            "residual_evaluations", "contact_evaluations", "scene", "preset", "parameters", "accuracy", "stepping")
+RUN_KEYS = (
+    "wall_time_s",
+    "import_time_s",
+    "linear_algebra",
+    "ordering",
+    "unknowns",
+    "band_kl",
+    "band_ku",
+    "residual_evaluations",
+    "contact_evaluations",
+    "scene",
+    "preset",
+    "parameters",
+    "accuracy",
+    "stepping",
+)
 
 
 def compare_runs(mine, ref, skip=RUN_KEYS):
@@ -267,10 +280,14 @@ def compare_runs(mine, ref, skip=RUN_KEYS):
             return None
         if b is None:
             return None
-        if isinstance(b, str):                          # text (a node's state): equal or not
+        if isinstance(b, str):  # text (a node's state): equal or not
             return note(0.0 if a == b else np.inf, key)
-        if isinstance(b, (list, tuple)) and b and any(isinstance(x, (dict, list, tuple, str)) or x is None for x in b) \
-                and not _rectangular(b):
+        if (
+            isinstance(b, (list, tuple))
+            and b
+            and any(isinstance(x, (dict, list, tuple, str)) or x is None for x in b)
+            and not _rectangular(b)
+        ):
             if not isinstance(a, (list, tuple)) or len(a) != len(b):
                 return note(np.inf, key)
             for i, (x, y) in enumerate(zip(a, b)):
@@ -280,7 +297,7 @@ def compare_runs(mine, ref, skip=RUN_KEYS):
             A, B = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
         except (TypeError, ValueError):
             return None
-        if A.size == 0 and B.size == 0:                 # nothing in either ([] and an empty (0, 2) array)
+        if A.size == 0 and B.size == 0:  # nothing in either ([] and an empty (0, 2) array)
             return None
         if A.shape != B.shape:
             return note(np.inf, key)
@@ -331,8 +348,13 @@ def _state_to_plain(obj, where, types):
         name = type(obj).__name__
         if types.get(name) is not type(obj):
             raise TypeError(f"record state {where} is a {name}, which save_record cannot save")
-        return {_STATE: name, **{f.name: _state_to_plain(getattr(obj, f.name), f"{where}.{f.name}", types)
-                                 for f in dataclasses.fields(obj)}}
+        return {
+            _STATE: name,
+            **{
+                f.name: _state_to_plain(getattr(obj, f.name), f"{where}.{f.name}", types)
+                for f in dataclasses.fields(obj)
+            },
+        }
     if isinstance(obj, tuple):
         return {_STATE: "tuple", "items": [_state_to_plain(v, f"{where}[{i}]", types) for i, v in enumerate(obj)]}
     return obj
@@ -355,14 +377,26 @@ def save_record(record, path):
     its step's local error and share) to `path` (.json or .npz, as save_run). Returns the path as
     a string."""
     ev, result = record.evaluation, record.result
-    G = result.G if result is not None else ev.G          # the prescribed-dof part: the reactions
-    doc = dict(k=int(record.k), t=float(record.t), dt=float(record.dt), u=record.u, v=record.v, a=record.a,
-               energy={k: float(v) for k, v in record.energy.items()}, cuts=int(record.cuts),
-               failures=list(record.failures), G=np.asarray(G), P=np.asarray(ev.P) if ev.P is not None else None,
-               iterations=int(record.iterations), residuals=[float(r) for r in record.residuals],
-               state=_state_to_plain(record.state, "state", _state_types()),
-               # a run at a tolerance sizes its next step from these (solver/schedule.py)
-               local_error=getattr(result, "local_error", None), error_share=getattr(result, "error_share", None))
+    G = result.G if result is not None else ev.G  # the prescribed-dof part: the reactions
+    doc = dict(
+        k=int(record.k),
+        t=float(record.t),
+        dt=float(record.dt),
+        u=record.u,
+        v=record.v,
+        a=record.a,
+        energy={k: float(v) for k, v in record.energy.items()},
+        cuts=int(record.cuts),
+        failures=list(record.failures),
+        G=np.asarray(G),
+        P=np.asarray(ev.P) if ev.P is not None else None,
+        iterations=int(record.iterations),
+        residuals=[float(r) for r in record.residuals],
+        state=_state_to_plain(record.state, "state", _state_types()),
+        # a run at a tolerance sizes its next step from these (solver/schedule.py)
+        local_error=getattr(result, "local_error", None),
+        error_share=getattr(result, "error_share", None),
+    )
     return save_run({"record": doc}, path)
 
 
@@ -380,9 +414,30 @@ def load_record(path):
     r = doc["record"]
     state = _state_from_plain(r["state"], _state_types())
     ev = Evaluation(G=r["G"], K=None, contacts=(), P=r["P"], state=state)
-    result = (NewtonResult(u=r["u"], residuals=list(r["residuals"]), iterations=int(r["iterations"]), G=r["G"],
-                           evaluation=ev, local_error=r.get("local_error"), error_share=r.get("error_share"))
-              if r["k"] > 0 else None)
-    return Record(k=int(r["k"]), t=float(r["t"]), dt=float(r["dt"]), u=r["u"], v=r["v"], a=r["a"], evaluation=ev,
-                  energy=dict(r["energy"]), result=result, cuts=int(r["cuts"]), failures=tuple(r["failures"]),
-                  state=state)
+    result = (
+        NewtonResult(
+            u=r["u"],
+            residuals=list(r["residuals"]),
+            iterations=int(r["iterations"]),
+            G=r["G"],
+            evaluation=ev,
+            local_error=r.get("local_error"),
+            error_share=r.get("error_share"),
+        )
+        if r["k"] > 0
+        else None
+    )
+    return Record(
+        k=int(r["k"]),
+        t=float(r["t"]),
+        dt=float(r["dt"]),
+        u=r["u"],
+        v=r["v"],
+        a=r["a"],
+        evaluation=ev,
+        energy=dict(r["energy"]),
+        result=result,
+        cuts=int(r["cuts"]),
+        failures=tuple(r["failures"]),
+        state=state,
+    )

@@ -38,13 +38,14 @@ from collections import deque
 from dataclasses import dataclass
 from multiprocessing.connection import wait
 
-_POLL_S = 1.0            # the longest the batch waits without looking at every worker
+_POLL_S = 1.0  # the longest the batch waits without looking at every worker
 
 
 @dataclass(frozen=True)
 class Outcome:
     """How one task ended: ``value`` is ``fn(*args)``'s return value when ``ok``, else None
     and ``reason`` says why; ``attempts`` counts the workers it ran on."""
+
     key: object
     ok: bool
     value: object
@@ -72,7 +73,7 @@ def run_batch(fn, tasks, *, jobs=1, timeout=None, retries=1, memory_limit=None, 
         raise ValueError(f"run_batch: timeout = {timeout!r} must be a number of seconds > 0 (or None)")
     if memory_limit is not None and not memory_limit > 0:
         raise ValueError(f"run_batch: memory_limit = {memory_limit!r} must be a number of bytes > 0 (or None)")
-    todo = deque((key, tuple(args), 0) for key, args in tasks)      # (key, args, attempts so far)
+    todo = deque((key, tuple(args), 0) for key, args in tasks)  # (key, args, attempts so far)
     return _batch(fn, todo, jobs, timeout, retries, memory_limit, initializer)
 
 
@@ -83,7 +84,7 @@ def _batch(fn, todo, jobs, timeout, retries, memory_limit, initializer):
     finished = False
     try:
         while todo or any(w.task for w in workers):
-            for w in workers:                                 # idle workers first, then new ones
+            for w in workers:  # idle workers first, then new ones
                 if w.task is None and w.alive() and todo:
                     w.give(todo.popleft(), todo)
             while todo and len(workers) < jobs:
@@ -95,7 +96,7 @@ def _batch(fn, todo, jobs, timeout, retries, memory_limit, initializer):
             wait([w.conn for w in busy] + [w.proc.sentinel for w in workers], wait_s)
             for w in list(workers):
                 answer = w.answer()
-                if answer is not None:                        # the task ended in the worker
+                if answer is not None:  # the task ended in the worker
                     key, _, attempts = w.task
                     w.task = None
                     ok, value = answer
@@ -108,19 +109,19 @@ def _batch(fn, todo, jobs, timeout, retries, memory_limit, initializer):
                     continue
                 if w.alive():
                     continue
-                w.stop(workers)                               # dead: its task (if any) runs again
+                w.stop(workers)  # dead: its task (if any) runs again
                 if w.task is not None:
                     key, args, attempts = w.task
-                    if attempts + 1 <= retries:                   # on a fresh worker, not an idle one
+                    if attempts + 1 <= retries:  # on a fresh worker, not an idle one
                         _Worker(ctx, fn, initializer, memory_limit, workers).give((key, args, attempts + 1), todo)
                     else:
                         yield Outcome(key, False, None, _death(w.proc.exitcode), attempts + 1)
         finished = True
     finally:
-        if finished:                                          # idle workers end on their own
+        if finished:  # idle workers end on their own
             for w in workers:
                 w.close()
-        for w in workers:                                     # everything else at once
+        for w in workers:  # everything else at once
             w.kill()
         for w in list(workers):
             w.stop(workers)
@@ -137,7 +138,7 @@ def _describe(exc):
     return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
 
 
-_LIVE = set()            # every worker started and not yet reaped, for the exit of the interpreter
+_LIVE = set()  # every worker started and not yet reaped, for the exit of the interpreter
 
 
 @atexit.register
@@ -151,16 +152,17 @@ class _Worker:
 
     def __init__(self, ctx, fn, initializer, memory_limit, workers):
         self.conn, child_end = ctx.Pipe()
-        self.proc = ctx.Process(target=_work, args=(child_end, fn, initializer, memory_limit, os.getpid()),
-                                name="contactfem-batch-worker")
+        self.proc = ctx.Process(
+            target=_work, args=(child_end, fn, initializer, memory_limit, os.getpid()), name="contactfem-batch-worker"
+        )
         self.task = None
         self.started = None
-        with _signals_held():              # no Ctrl-C between the fork and the worker's own handlers,
-            self.proc.start()              # and the worker is known before one can be raised here
+        with _signals_held():  # no Ctrl-C between the fork and the worker's own handlers,
+            self.proc.start()  # and the worker is known before one can be raised here
             workers.append(self)
             _LIVE.add(self)
             try:
-                os.setpgid(self.proc.pid, self.proc.pid)      # its own group (the worker sets it too)
+                os.setpgid(self.proc.pid, self.proc.pid)  # its own group (the worker sets it too)
             except (AttributeError, OSError):
                 pass
         child_end.close()
@@ -168,7 +170,7 @@ class _Worker:
     def give(self, task, todo):
         try:
             self.conn.send(task[1])
-        except OSError:                    # died before its task: the task waits for another worker
+        except OSError:  # died before its task: the task waits for another worker
             todo.appendleft(task)
             return
         self.task, self.started = task, time.monotonic()
@@ -181,9 +183,9 @@ class _Worker:
             if not self.conn.poll():
                 return None
             return self.conn.recv()
-        except (EOFError, OSError):        # the worker died, with or before its answer
+        except (EOFError, OSError):  # the worker died, with or before its answer
             return None
-        except Exception as exc:           # an answer that cannot be unpickled here
+        except Exception as exc:  # an answer that cannot be unpickled here
             return False, f"error: the value cannot be read back: {_describe(exc)}"
 
     def alive(self):
@@ -249,7 +251,7 @@ def _work(conn, fn, initializer, memory_limit, parent):
     if initializer is not None:
         try:
             initializer()
-        except Exception as exc:           # every task of this worker says so
+        except Exception as exc:  # every task of this worker says so
             broken = f"error: initializer: {_describe(exc)}"
     while True:
         try:
@@ -269,7 +271,7 @@ def _work(conn, fn, initializer, memory_limit, parent):
             conn.send(answer)
         except (EOFError, OSError):
             return
-        except Exception as exc:           # a value that cannot be pickled
+        except Exception as exc:  # a value that cannot be pickled
             conn.send((False, f"error: the value cannot be sent back: {_describe(exc)}"))
 
 

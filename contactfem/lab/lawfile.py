@@ -40,8 +40,15 @@ def shipped_laws():
     from .. import laws
 
     out = {"friction": {}, "normal": {}}
-    for cls in (laws.Coulomb, laws.ParabolicSlip, laws.SlipHardening, laws.Frictionless, laws.Stribeck,
-                laws.DieterichRuina, laws.ArchardWear):
+    for cls in (
+        laws.Coulomb,
+        laws.ParabolicSlip,
+        laws.SlipHardening,
+        laws.Frictionless,
+        laws.Stribeck,
+        laws.DieterichRuina,
+        laws.ArchardWear,
+    ):
         out["friction"][_snake(cls.__name__)] = cls
     for cls in (laws.PowerLaw, laws.ExponentialLaw):
         out["normal"][_snake(cls.__name__)] = cls
@@ -69,8 +76,12 @@ def _check_kind(cls, option, where):
     if have is None:
         need = "slip_bound(p, q) and a stick stiffness c_T" if want == "friction" else "traction(g_N)"
         raise ValueError(f"{where}: {cls.__name__} is not a {want} law (a {want} law has {need})")
-    raise ValueError(f"{where}: {cls.__name__} is a {have} law (it has "
-                     f"{'slip_bound' if have == 'friction' else 'traction'}): give it with --{have}, not {option}")
+    raise ValueError(
+        f"{where}: {cls.__name__} is a {have} law (it has "
+        f"{'slip_bound' if have == 'friction' else 'traction'}): give it with --{have}, not {option}"
+    )
+
+
 _counter = itertools.count()
 
 
@@ -110,12 +121,15 @@ def load_class(spec, option="--friction"):
     else:
         kinds = shipped_laws()
         key = _snake(spec) if not spec.islower() else spec.lower()
-        found = {k: v[key] for k, v in kinds.items() if key in v} or \
-            {k: c for k, v in kinds.items() for n, c in v.items() if n.replace("_", "") == spec.lower().replace("_", "")}
+        found = {k: v[key] for k, v in kinds.items() if key in v} or {
+            k: c for k, v in kinds.items() for n, c in v.items() if n.replace("_", "") == spec.lower().replace("_", "")
+        }
         if not found:
             names = "; ".join(f"{k}: {', '.join(v)}" for k, v in kinds.items())
-            raise ValueError(f"{option} {spec}: not a shipped law ({names}), a law file FILE.py:CLASS or a module "
-                             "path package.module:CLASS")
+            raise ValueError(
+                f"{option} {spec}: not a shipped law ({names}), a law file FILE.py:CLASS or a module "
+                "path package.module:CLASS"
+            )
         cls = next(iter(found.values()))
     _check_kind(cls, option, f"{option} {spec}")
     return cls
@@ -128,7 +142,7 @@ def _from_module(module, name, option, spec):
         raise ValueError(f"{option} expects FILE.py:CLASS or package.module:CLASS, got class name {name!r}")
     try:
         mod = importlib.import_module(module)
-    except (Exception, SystemExit) as err:            # noqa: BLE001 (anything in the user's module, even exit)
+    except (Exception, SystemExit) as err:  # noqa: BLE001 (anything in the user's module, even exit)
         raise ValueError(f"{option} {spec}: cannot import {module} ({_cause(err)})") from None
     cls = getattr(mod, name, None)
     if cls is None or not isinstance(cls, type):
@@ -147,21 +161,28 @@ def _from_file(file, name, option):
     if mspec is None:
         raise ValueError(f"{option}: law file {file} is not a Python file")
     module = importlib.util.module_from_spec(mspec)
-    sys.modules[mod_name] = module                     # dataclasses look the module up
+    sys.modules[mod_name] = module  # dataclasses look the module up
     try:
         mspec.loader.exec_module(module)
-    except SystemExit as err:                         # sys.exit() in the file: bad input, not our exit
+    except SystemExit as err:  # sys.exit() in the file: bad input, not our exit
         sys.modules.pop(mod_name, None)
-        raise ValueError(f"{_where(path, err)}: the law file calls sys.exit({err.code!r}) when it is imported; a law "
-                         "file only defines its law") from None
-    except Exception as err:                          # noqa: BLE001 (anything in the user's file)
+        raise ValueError(
+            f"{_where(path, err)}: the law file calls sys.exit({err.code!r}) when it is imported; a law "
+            "file only defines its law"
+        ) from None
+    except Exception as err:  # noqa: BLE001 (anything in the user's file)
         sys.modules.pop(mod_name, None)
         raise ValueError(f"{_where(path, err)}: {_cause(err)}") from None
     cls = getattr(module, name, None)
     if cls is None or not isinstance(cls, type):
-        found = sorted(k for k, v in vars(module).items()                 # the law classes it holds
-                       if isinstance(v, type) and (hasattr(v, "traction") or hasattr(v, "slip_bound")))
-        raise ValueError(f"law file {path.name} has no class {name}" + (f" (it defines: {', '.join(found)})" if found else ""))
+        found = sorted(
+            k
+            for k, v in vars(module).items()  # the law classes it holds
+            if isinstance(v, type) and (hasattr(v, "traction") or hasattr(v, "slip_bound"))
+        )
+        raise ValueError(
+            f"law file {path.name} has no class {name}" + (f" (it defines: {', '.join(found)})" if found else "")
+        )
     cls._contactfem_file = str(file)
     return cls
 
@@ -170,7 +191,11 @@ def _convert(value, field):
     """A --set text to the field's type (float unless the annotation says otherwise)."""
     if not isinstance(value, str):
         return value
-    t = field.type if isinstance(field.type, type) else {"int": int, "bool": bool, "str": str}.get(str(field.type), float)
+    t = (
+        field.type
+        if isinstance(field.type, type)
+        else {"int": int, "bool": bool, "str": str}.get(str(field.type), float)
+    )
     if t is bool:
         s = value.lower()
         if s in ("true", "1", "yes"):
@@ -194,38 +219,47 @@ def make_law(cls, values=None, scene_params=None, option="--friction", notes=Non
     values = dict(values or {})
     path = Path(getattr(cls, "_contactfem_file", "")).resolve() if getattr(cls, "_contactfem_file", None) else None
     if not dataclasses.is_dataclass(cls):
-        raise ValueError(f"{option}: {cls.__name__} is not a dataclass: write the law as @dataclass(frozen=True) "
-                         "so that its parameters can be set with --set law.NAME=VALUE")
+        raise ValueError(
+            f"{option}: {cls.__name__} is not a dataclass: write the law as @dataclass(frozen=True) "
+            "so that its parameters can be set with --set law.NAME=VALUE"
+        )
     fields = {f.name: f for f in dataclasses.fields(cls) if f.init}
     unknown = sorted(set(values) - set(fields))
     if unknown:
-        raise ValueError(f"unknown law parameter law.{unknown[0]} for {cls.__name__}: known are {', '.join(fields) or '(none)'}")
+        raise ValueError(
+            f"unknown law parameter law.{unknown[0]} for {cls.__name__}: known are {', '.join(fields) or '(none)'}"
+        )
     kwargs, from_scene = {}, []
     for name, f in fields.items():
         if name in values:
             kwargs[name] = _convert(values[name], f)
         elif f.default is not dataclasses.MISSING or f.default_factory is not dataclasses.MISSING:
-            continue                                  # the law's own default
+            continue  # the law's own default
         elif scene_params and name in scene_params:
             kwargs[name] = scene_params[name]
             from_scene.append(name)
         else:
             known = f" (the scene's parameters of this law: {', '.join(scene_params)})" if scene_params else ""
-            raise ValueError(f"law parameter {name} of {cls.__name__} has no default and the scene has no parameter "
-                             f"{name} for it{known}: give --set law.{name}=VALUE")
+            raise ValueError(
+                f"law parameter {name} of {cls.__name__} has no default and the scene has no parameter "
+                f"{name} for it{known}: give --set law.{name}=VALUE"
+            )
     try:
         law = cls(**kwargs)
     except ValueError as err:
         raise ValueError(f"{cls.__name__}: {' '.join(str(err).split())}") from None
-    except Exception as err:                          # noqa: BLE001
+    except Exception as err:  # noqa: BLE001
         where = _where(path, err) if path else cls.__name__
         raise ValueError(f"{where}: {_cause(err)}") from None
     probe(law, path, option)
     if from_scene and notes is not None:
-        shown = ", ".join(f"{k} = {kwargs[k]:g}" if isinstance(kwargs[k], float) else f"{k} = {kwargs[k]}"
-                          for k in from_scene)
-        notes.append(f"{option.lstrip('-')} law {cls.__name__}: {shown} from the scene's parameters (fields without "
-                     "a default; --set law.NAME=VALUE sets them)")
+        shown = ", ".join(
+            f"{k} = {kwargs[k]:g}" if isinstance(kwargs[k], float) else f"{k} = {kwargs[k]}" for k in from_scene
+        )
+        notes.append(
+            f"{option.lstrip('-')} law {cls.__name__}: {shown} from the scene's parameters (fields without "
+            "a default; --set law.NAME=VALUE sets them)"
+        )
     return law
 
 
@@ -244,7 +278,7 @@ def probe(law, path=None, option="--friction"):
                 L = FrictionLaw(law)
                 z = L.evolve(L.initial_state(3), p, 0.1 * p, 1.0)[0]
                 L.slip_bound(p, 0.1 * p, 0.1 * p, z)
-    except Exception as err:                          # noqa: BLE001
+    except Exception as err:  # noqa: BLE001
         where = _where(path, err) if path else type(law).__name__
         cause = str(err) if isinstance(err, LawError) else _cause(err)
         if isinstance(err, LawError) and path is not None:
@@ -276,22 +310,31 @@ def laws_from_options(friction=None, normal=None, law_sets=None, scene_params=No
     law_sets = law_sets or {"law": {}, "friction": {}, "normal": {}}
     specs = {"friction": friction, "normal": normal}
     classes = {k: load_class(s, f"--{k}") for k, s in specs.items() if s is not None}
-    fields = {k: {f.name for f in dataclasses.fields(c)} if dataclasses.is_dataclass(c) else set()
-              for k, c in classes.items()}
+    fields = {
+        k: {f.name for f in dataclasses.fields(c)} if dataclasses.is_dataclass(c) else set() for k, c in classes.items()
+    }
     values = {k: dict(law_sets.get(k, {})) for k in KINDS}
     for k in KINDS:
         if values[k] and k not in classes:
-            raise ValueError(f"--set {k}.{next(iter(values[k]))} needs --{k} (a law file FILE.py:CLASS, a module "
-                             "path or a shipped law)")
+            raise ValueError(
+                f"--set {k}.{next(iter(values[k]))} needs --{k} (a law file FILE.py:CLASS, a module "
+                "path or a shipped law)"
+            )
     for name, value in law_sets.get("law", {}).items():
         owners = [k for k in classes if name in fields[k]]
         if not classes:
-            raise ValueError(f"--set law.{name} needs --friction or --normal (a law file FILE.py:CLASS, a module "
-                             "path or a shipped law)")
+            raise ValueError(
+                f"--set law.{name} needs --friction or --normal (a law file FILE.py:CLASS, a module "
+                "path or a shipped law)"
+            )
         if len(owners) > 1:
-            raise ValueError(f"--set law.{name}: both laws have a parameter {name}: write friction.{name} or normal.{name}")
+            raise ValueError(
+                f"--set law.{name}: both laws have a parameter {name}: write friction.{name} or normal.{name}"
+            )
         values[owners[0] if owners else next(iter(classes))][name] = value
     scene_params = scene_params or {}
     per_kind = set(scene_params) <= set(KINDS) and all(isinstance(v, dict) for v in scene_params.values())
-    return {k: make_law(c, values[k], scene_params.get(k, {}) if per_kind else scene_params, f"--{k}", notes)
-            for k, c in classes.items()}
+    return {
+        k: make_law(c, values[k], scene_params.get(k, {}) if per_kind else scene_params, f"--{k}", notes)
+        for k, c in classes.items()
+    }

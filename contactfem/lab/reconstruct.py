@@ -65,7 +65,7 @@ from pathlib import Path
 
 import numpy as np
 
-PAPER_FIRST_RESIDUAL = 171.3709            # Table 1, 0.1713709e3, 7 printed digits
+PAPER_FIRST_RESIDUAL = 171.3709  # Table 1, 0.1713709e3, 7 printed digits
 RESIDUAL_FLOOR = 1e-3
 # The physical screen of the block's readings. The paper's foundation is rigid; the penalty c_N
 # stands in for it, and its penetration is the error of that stand-in. Under the paper's loads
@@ -106,11 +106,12 @@ def block_first_residual(width, height, nx, ny, p_normal, p_tangential):
     return float(np.hypot(top, side))
 
 
-MESHES = ((8, 25), (10, 20), (20, 10), (25, 8), (40, 5), (50, 4))   # nx x ny = 200, >= 5 contact nodes
+MESHES = ((8, 25), (10, 20), (20, 10), (25, 8), (40, 5), (50, 4))  # nx x ny = 200, >= 5 contact nodes
 
 
-def block_geometries(tol=0.01, step=0.25, size=(0.5, 10.0), meshes=MESHES, mu=0.5, block_aspect=3.0,
-                     element_aspect=4.0):
+def block_geometries(
+    tol=0.01, step=0.25, size=(0.5, 10.0), meshes=MESHES, mu=0.5, block_aspect=3.0, element_aspect=4.0
+):
     """Stage A: (nx, ny, W, H, p_y, p_x, first residual) with the first residual within
     ``tol`` of the paper's and an equilibrium possible (p_x H < mu p_y W), sorted by the
     distance to the printed value. A *block* (not a strip: W / H and H / W at most
@@ -160,10 +161,18 @@ def _block_case(params):
     except (NewtonError, FloatingPointError, np.linalg.LinAlgError) as exc:
         return dict(converged=False, error=str(exc).splitlines()[0][:120])
     c = r["contact"]
-    return dict(converged=True, residuals=[float(x) for x in r["newton_residuals"]], n_slip=r["n_slip"],
-                n_stick=r["n_stick"], n_open=r["n_open"], t_N=np.asarray(c["t_N"]).tolist(),
-                t_T=np.asarray(c["t_T"]).tolist(), max_penetration=r["max_penetration"],
-                inverted_elements=r["inverted_elements"], min_jacobian_ratio=r["min_jacobian_ratio"])
+    return dict(
+        converged=True,
+        residuals=[float(x) for x in r["newton_residuals"]],
+        n_slip=r["n_slip"],
+        n_stick=r["n_stick"],
+        n_open=r["n_open"],
+        t_N=np.asarray(c["t_N"]).tolist(),
+        t_T=np.asarray(c["t_T"]).tolist(),
+        max_penetration=r["max_penetration"],
+        inverted_elements=r["inverted_elements"],
+        min_jacobian_ratio=r["min_jacobian_ratio"],
+    )
 
 
 def block_case_outcome(case, height):
@@ -206,12 +215,23 @@ def score_block(reading, conical, parabolic):
         "conical_slips": bool(conical.get("converged") and conical["n_slip"] > 0),
         "fig8_remark": frac == 1.0,
     }
-    d = (residual_distance(conical.get("residuals"), PAPER_TABLE1["conical"])
-         + residual_distance(parabolic.get("residuals"), PAPER_TABLE1["parabolic"]))
-    return dict(reading, first_residual=r0, n_conical=n_con, n_parabolic=n_par,
-                n_slip_conical=conical.get("n_slip"), fig8_fraction=frac, fig8_min_reduction=red,
-                residuals_conical=conical.get("residuals"), residuals_parabolic=parabolic.get("residuals"),
-                facts=facts, n_facts=int(sum(facts.values())), distance=d)
+    d = residual_distance(conical.get("residuals"), PAPER_TABLE1["conical"]) + residual_distance(
+        parabolic.get("residuals"), PAPER_TABLE1["parabolic"]
+    )
+    return dict(
+        reading,
+        first_residual=r0,
+        n_conical=n_con,
+        n_parabolic=n_par,
+        n_slip_conical=conical.get("n_slip"),
+        fig8_fraction=frac,
+        fig8_min_reduction=red,
+        residuals_conical=conical.get("residuals"),
+        residuals_parabolic=parabolic.get("residuals"),
+        facts=facts,
+        n_facts=int(sum(facts.values())),
+        distance=d,
+    )
 
 
 BLOCK_KEYS = ("nx", "ny", "width", "height", "p_y", "p_x", "p_x_face", "free_end_nodes", "c_N", "penalty", "plane")
@@ -265,12 +285,14 @@ def evaluate_block(reading, solve):
         outcomes[law] = block_case_outcome(cases[law], reading["height"])
     row = score_block(reading, cases["conical"], cases["parabolic"])
     pen = [c["max_penetration"] for c in cases.values() if c.get("converged")]
-    row.update(outcome=reading_outcome(outcomes.values()), outcome_conical=outcomes["conical"],
-               outcome_parabolic=outcomes["parabolic"],
-               max_penetration_ratio=max(pen) / reading["height"] if pen else None,
-               inverted_elements=max((c["inverted_elements"] for c in cases.values() if c.get("converged")),
-                                     default=None),
-               errors={law: c["error"] for law, c in cases.items() if "error" in c})
+    row.update(
+        outcome=reading_outcome(outcomes.values()),
+        outcome_conical=outcomes["conical"],
+        outcome_parabolic=outcomes["parabolic"],
+        max_penetration_ratio=max(pen) / reading["height"] if pen else None,
+        inverted_elements=max((c["inverted_elements"] for c in cases.values() if c.get("converged")), default=None),
+        errors={law: c["error"] for law, c in cases.items() if "error" in c},
+    )
     return row
 
 
@@ -279,14 +301,16 @@ def rank(rows, kinds=OUTCOMES, eligible=None):
     facts met first, then the distance; the converged readings that are not eligible next,
     unranked (rank None), in the same order; every other reading after them, unranked, by
     outcome. Sets 'rank'."""
+
     def ok(r):
         return r.get("outcome", "converged") == "converged"
 
-    order = lambda r: (-r["n_facts"], r["distance"])                      # noqa: E731
+    order = lambda r: (-r["n_facts"], r["distance"])  # noqa: E731
     ranked = sorted((r for r in rows if ok(r) and (eligible is None or eligible(r))), key=order)
     shown = sorted((r for r in rows if ok(r) and eligible is not None and not eligible(r)), key=order)
-    rest = sorted((r for r in rows if not ok(r)),
-                  key=lambda r: (kinds.index(r["outcome"]), -r["n_facts"], r["distance"]))
+    rest = sorted(
+        (r for r in rows if not ok(r)), key=lambda r: (kinds.index(r["outcome"]), -r["n_facts"], r["distance"])
+    )
     for i, r in enumerate(ranked, 1):
         r["rank"] = i
     for r in shown + rest:
@@ -318,25 +342,32 @@ def reconstruct_block(quick=False, cache=True, progress=None):
     paper = block_paper_reading()
     if quick:
         geos = [g for g in geos if (g["nx"], g["width"], g["height"]) == (paper["nx"], paper["width"], paper["height"])]
-    readings = [dict(g, p_x_face=face, free_end_nodes=k, c_N=c_N, penalty=unit, plane=plane)
-                for g in geos for face in ("right", "left") for k in (1, 2)
-                for c_N in (1e2, 1e4, 1e6) for unit in ("per_node", "per_length") for plane in ("strain", "stress")]
+    readings = [
+        dict(g, p_x_face=face, free_end_nodes=k, c_N=c_N, penalty=unit, plane=plane)
+        for g in geos
+        for face in ("right", "left")
+        for k in (1, 2)
+        for c_N in (1e2, 1e4, 1e6)
+        for unit in ("per_node", "per_length")
+        for plane in ("strain", "stress")
+    ]
     if quick:
         readings.append(paper)
     rows = evaluate_all(readings, evaluate_block, solve, progress)
-    if not quick:                      # stage C around the best of stage B
+    if not quick:  # stage C around the best of stage B
         seen = {json.dumps({k: r[k] for k in BLOCK_KEYS}, sort_keys=True) for r in rows}
         extra = []
-        for best in [r for r in rank(rows) if r["rank"]][:12]:    # the 12 best admissible readings
+        for best in [r for r in rank(rows) if r["rank"]][:12]:  # the 12 best admissible readings
             for c_N, plane in itertools.product((1e3, 1e5), ("strain", "stress")):
-                rd = {k: best[k] for k in BLOCK_KEYS} | dict(c_N=c_N, plane=plane,
-                                                              first_residual=best["first_residual"])
+                rd = {k: best[k] for k in BLOCK_KEYS} | dict(
+                    c_N=c_N, plane=plane, first_residual=best["first_residual"]
+                )
                 key = json.dumps({k: rd[k] for k in BLOCK_KEYS}, sort_keys=True)
                 if key not in seen:
                     seen.add(key)
                     extra.append(rd)
         if json.dumps({k: paper[k] for k in BLOCK_KEYS}, sort_keys=True) not in seen:
-            extra.append(paper)        # the scene's defaults are always among the readings
+            extra.append(paper)  # the scene's defaults are always among the readings
         rows += evaluate_all(extra, evaluate_block, solve)
     return rank(rows), geos
 
@@ -361,9 +392,11 @@ def block_table(rows, top=25):
     counts = outcome_counts(rows)
     rows = [r for r in rows if r["rank"]]
     facts = list(rows[0]["facts"]) if rows else []
-    head = (f"{'rank':>4} {'mesh':>6} {'W':>5} {'H':>5} {'face':>5} {'free':>4} {'c_N':>6} {'unit':>10} "
-            f"{'plane':>6} {'||G0||':>8} {'con':>3} {'par':>3} {'slip':>4} {'fig8':>5} {'facts':>5} {'dist':>6}"
-            "  conical residuals | parabolic residuals")
+    head = (
+        f"{'rank':>4} {'mesh':>6} {'W':>5} {'H':>5} {'face':>5} {'free':>4} {'c_N':>6} {'unit':>10} "
+        f"{'plane':>6} {'||G0||':>8} {'con':>3} {'par':>3} {'slip':>4} {'fig8':>5} {'facts':>5} {'dist':>6}"
+        "  conical residuals | parabolic residuals"
+    )
     lines = [head, "-" * len(head)]
     for i, r in enumerate(rows[:top], 1):
         lines.append(
@@ -371,18 +404,25 @@ def block_table(rows, top=25):
             f"{r['free_end_nodes']:4d} {r['c_N']:6.0e} {r['penalty']:>10} {r['plane']:>6} {r['first_residual']:8.3f} "
             f"{r['n_conical'] or '-':>3} {r['n_parabolic'] or '-':>3} {r['n_slip_conical'] or 0:4d} "
             f"{r['fig8_fraction']:5.2f} {r['n_facts']:3d}/{len(facts)} {r['distance']:6.2f}  "
-            f"{_fmt_res(r['residuals_conical'])} | {_fmt_res(r['residuals_parabolic'])}")
-    lines.append("facts: " + ", ".join(facts) + "; dist: RMS |log10(ours/paper)| of both residual histories "
-                 f"(floored at {RESIDUAL_FLOOR:g})")
+            f"{_fmt_res(r['residuals_conical'])} | {_fmt_res(r['residuals_parabolic'])}"
+        )
+    lines.append(
+        "facts: " + ", ".join(facts) + "; dist: RMS |log10(ours/paper)| of both residual histories "
+        f"(floored at {RESIDUAL_FLOOR:g})"
+    )
     lines.append(outcome_line(counts, f"penetration above {PENETRATION_FRACTION:.0%} of the block's height"))
     return "\n".join(lines)
 
 
 def outcome_line(counts, penetration):
     """One line: how many readings ended in each outcome; only converged ones are ranked."""
-    words = dict(converged="converged and admissible (ranked)", no_equilibrium="no static equilibrium",
-                 no_convergence="no convergence", rejected_penetration=f"rejected: {penetration}",
-                 rejected_inverted="rejected: inverted elements")
+    words = dict(
+        converged="converged and admissible (ranked)",
+        no_equilibrium="no static equilibrium",
+        no_convergence="no convergence",
+        rejected_penetration=f"rejected: {penetration}",
+        rejected_inverted="rejected: inverted elements",
+    )
     return "outcomes: " + "; ".join(f"{counts[o]} {words[o]}" for o in OUTCOMES)
 
 
@@ -417,10 +457,19 @@ SLOPING_OUTCOMES = ("converged", "no_convergence", "no_rebound", "rejected_energ
 # paper states these.
 SLOPING_TEXT = dict(mass_matrix="lumped", contact_integration="standard")
 SLOPING_AGAINST_TEXT = dict(mass_matrix="consistent", contact_integration="energy_consistent")
-SLOPING_KEYS = ("integration", "rotary_inertia", "contact_at", "penalty", "c_N", "gap0", "mass_matrix",
-                "contact_integration")
-SLOPING_PAPER_READING = dict(integration="2", rotary_inertia=True, contact_at="outer", penalty="per_node",
-                             c_N=50.0, gap0=0.05, **SLOPING_TEXT)
+SLOPING_KEYS = (
+    "integration",
+    "rotary_inertia",
+    "contact_at",
+    "penalty",
+    "c_N",
+    "gap0",
+    "mass_matrix",
+    "contact_integration",
+)
+SLOPING_PAPER_READING = dict(
+    integration="2", rotary_inertia=True, contact_at="outer", penalty="per_node", c_N=50.0, gap0=0.05, **SLOPING_TEXT
+)
 # the ring leaves the plane before t = 7 in every reading tried; after that it flies freely (no
 # gravity) and its centre-of-mass velocity is constant, so 80 steps (t = 8) give the rebound of
 # the paper's 200; a run still in contact at t = 8 is repeated with the paper's 200 steps
@@ -435,10 +484,18 @@ def _sloping_case(params):
         r = _quiet_run(SCENE, params)
     except (NewtonError, FloatingPointError, np.linalg.LinAlgError) as exc:
         return dict(converged=False, error=str(exc).splitlines()[0][:120])
-    return dict(converged=True, vx=r["rebound_vx"], vy=r["rebound_vy"], angle=r["rebound_angle_deg"],
-                spin=r["rebound_spin"], rebounded=r["rebounded"], t_separation=r["t_separation"],
-                steps=params["n_steps"], energy_gain=r["energy_total_max_rel_increase_per_step"],
-                energy_final=r["energy_total_final_rel"])
+    return dict(
+        converged=True,
+        vx=r["rebound_vx"],
+        vy=r["rebound_vy"],
+        angle=r["rebound_angle_deg"],
+        spin=r["rebound_spin"],
+        rebounded=r["rebounded"],
+        t_separation=r["t_separation"],
+        steps=params["n_steps"],
+        energy_gain=r["energy_total_max_rel_increase_per_step"],
+        energy_final=r["energy_total_final_rel"],
+    )
 
 
 def sloping_case_outcome(case):
@@ -480,20 +537,25 @@ def evaluate_sloping(reading, solve):
             e = (abs(ours) - paper[q]) / (TABLE2_VELOCITY_TOL * paper[q])
             facts[f"{variant}_{q}"] = bool(abs(e) <= 1.0)
             errs.append(e)
-        for q in ("angle",):                       # shown, not scored (see TABLE2_SCORED)
+        for q in ("angle",):  # shown, not scored (see TABLE2_SCORED)
             ours = row[f"{variant}_{q}"]
-            row[f"{variant}_angle_within"] = None if ours is None else bool(
-                abs(ours - paper["angle_deg"]) <= TABLE2_ANGLE_TOL_DEG)
+            row[f"{variant}_angle_within"] = (
+                None if ours is None else bool(abs(ours - paper["angle_deg"]) <= TABLE2_ANGLE_TOL_DEG)
+            )
         row[f"{variant}_spin"] = case.get("spin")
         row[f"{variant}_energy_gain"] = case.get("energy_gain")
-        row[f"{variant}_energy_final"] = case.get("energy_final")       # E(end) / E0
+        row[f"{variant}_energy_final"] = case.get("energy_final")  # E(end) / E0
     against = [k for k, v in SLOPING_TEXT.items() if reading.get(k, v) != v]
     row.update(follows_text=not against, against_text=against)
-    row.update(facts=facts, n_facts=int(sum(facts.values())),
-               # RMS of the three scored errors in units of their tolerance (<= 1: all within)
-               distance=float(np.sqrt(np.mean(np.square(errs)))),
-               outcome=reading_outcome(outcomes.values(), SLOPING_OUTCOMES),
-               outcome_frictionless=outcomes["frictionless"], outcome_frictional=outcomes["frictional"])
+    row.update(
+        facts=facts,
+        n_facts=int(sum(facts.values())),
+        # RMS of the three scored errors in units of their tolerance (<= 1: all within)
+        distance=float(np.sqrt(np.mean(np.square(errs)))),
+        outcome=reading_outcome(outcomes.values(), SLOPING_OUTCOMES),
+        outcome_frictionless=outcomes["frictionless"],
+        outcome_frictional=outcomes["frictional"],
+    )
     return row
 
 
@@ -505,12 +567,15 @@ def sloping_impact_readings(quick=False):
     presets paper (gap0 0.05) and midpoint. quick: those two and the paper preset without
     rotary inertia."""
     base = SLOPING_PAPER_READING
-    presets = [base, dict(base, integration="1")]            # presets paper and midpoint
+    presets = [base, dict(base, integration="1")]  # presets paper and midpoint
     if quick:
         return presets + [dict(base, rotary_inertia=False)]
-    return [dict(integration=i, rotary_inertia=j, contact_at=c, penalty=p, c_N=50.0, gap0=g, **SLOPING_TEXT)
-            for i, j, c, p, g in itertools.product(("1", "2"), (True, False), ("outer", "axis"),
-                                                   ("per_node", "per_length"), (0.0, 0.25))] + presets
+    return [
+        dict(integration=i, rotary_inertia=j, contact_at=c, penalty=p, c_N=50.0, gap0=g, **SLOPING_TEXT)
+        for i, j, c, p, g in itertools.product(
+            ("1", "2"), (True, False), ("outer", "axis"), ("per_node", "per_length"), (0.0, 0.25)
+        )
+    ] + presets
 
 
 def against_text_readings(bases):
@@ -564,46 +629,66 @@ def sloping_table(rows, top=25):
     every = rows
     rows = [r for r in rows if r["rank"]]
     fl, fr = PAPER_TABLE2["frictionless"], PAPER_TABLE2["frictional"]
-    f = lambda x, w=5, d=2: "  -  ".rjust(w) if x is None else f"{x:{w}.{d}f}"   # noqa: E731
+    f = lambda x, w=5, d=2: "  -  ".rjust(w) if x is None else f"{x:{w}.{d}f}"  # noqa: E731
     n = len(TABLE2_SCORED)
-    head = (f"{'rank':>4} {'int':>3} {'rot':>3} {'at':>5} {'penalty':>10} {'c_N':>5} {'gap0':>5} | "
-            f"{'vx':>5} {'vy':>5} {'angle':>5} | {'vx':>5} {'vy':>5} {'angle':>5} {'facts':>5} {'dist':>5}")
-    lines = [" " * 42 + "| frictionless       | frictional", head, "-" * len(head),
-             f"{'paper':>42} | {f(fl['vx'])} {f(fl['vy'])} {f(fl['angle_deg'], 5, 1)} | "
-             f"{f(fr['vx'])} {f(fr['vy'])} {f(fr['angle_deg'], 5, 1)}"]
+    head = (
+        f"{'rank':>4} {'int':>3} {'rot':>3} {'at':>5} {'penalty':>10} {'c_N':>5} {'gap0':>5} | "
+        f"{'vx':>5} {'vy':>5} {'angle':>5} | {'vx':>5} {'vy':>5} {'angle':>5} {'facts':>5} {'dist':>5}"
+    )
+    lines = [
+        " " * 42 + "| frictionless       | frictional",
+        head,
+        "-" * len(head),
+        f"{'paper':>42} | {f(fl['vx'])} {f(fl['vy'])} {f(fl['angle_deg'], 5, 1)} | "
+        f"{f(fr['vx'])} {f(fr['vy'])} {f(fr['angle_deg'], 5, 1)}",
+    ]
     for i, r in enumerate(rows[:top], 1):
         lines.append(
             f"{i:4d} {r['integration']:>3} {'yes' if r['rotary_inertia'] else 'no':>3} {r['contact_at']:>5} "
             f"{r['penalty']:>10} {r['c_N']:5g} {r['gap0']:5.2f} | {f(r['frictionless_vx'])} {f(r['frictionless_vy'])} "
             f"{f(r['frictionless_angle'], 5, 1)} | {f(r['frictional_vx'])} {f(r['frictional_vy'])} "
-            f"{f(r['frictional_angle'], 5, 1)} {r['n_facts']:3d}/{n} {r['distance']:5.2f}")
-    lines.append(f"facts: the {n} independent numbers of Table 2 that a reading can miss (frictionless v_y, "
-                 f"frictional v_x and v_y) within {TABLE2_VELOCITY_TOL:.0%}; frictionless v_x = 2 holds on any "
-                 "frictionless plane and the angles are atan(v_x / v_y): shown, not counted; dist: RMS of the "
-                 "scored errors in units of that tolerance")
+            f"{f(r['frictional_angle'], 5, 1)} {r['n_facts']:3d}/{n} {r['distance']:5.2f}"
+        )
+    lines.append(
+        f"facts: the {n} independent numbers of Table 2 that a reading can miss (frictionless v_y, "
+        f"frictional v_x and v_y) within {TABLE2_VELOCITY_TOL:.0%}; frictionless v_x = 2 holds on any "
+        "frictionless plane and the angles are atan(v_x / v_y): shown, not counted; dist: RMS of the "
+        "scored errors in units of that tolerance"
+    )
     shown = [r for r in every if r["outcome"] == "converged" and not r["follows_text"]]
     if shown:
-        lines += ["", "Against the paper's text (it states " + ", ".join(f"{k} = {v}" for k, v in SLOPING_TEXT.items())
-                  + "): the energy kept through the impact; not ranked. E: the energy at the end / E0; "
-                  "change: against the same reading with the text's mass and integration.",
-                  f"{'int':>3} {'rot':>3} {'at':>5} {'penalty':>10} {'c_N':>5} {'mass':>10} {'integration':>17} | "
-                  f"{'vx':>5} {'vy':>5} {'angle':>5} {'E':>5} | {'vx':>5} {'vy':>5} {'angle':>5} {'E':>5} "
-                  f"{'facts':>5} | change: frictionless vy, angle; frictional vx, vy, angle"]
+        lines += [
+            "",
+            "Against the paper's text (it states "
+            + ", ".join(f"{k} = {v}" for k, v in SLOPING_TEXT.items())
+            + "): the energy kept through the impact; not ranked. E: the energy at the end / E0; "
+            "change: against the same reading with the text's mass and integration.",
+            f"{'int':>3} {'rot':>3} {'at':>5} {'penalty':>10} {'c_N':>5} {'mass':>10} {'integration':>17} | "
+            f"{'vx':>5} {'vy':>5} {'angle':>5} {'E':>5} | {'vx':>5} {'vy':>5} {'angle':>5} {'E':>5} "
+            f"{'facts':>5} | change: frictionless vy, angle; frictional vx, vy, angle",
+        ]
         for r in shown:
             b = text_base(r, every)
-            d = ("-" if b is None else
-                 f"{r['frictionless_vy'] - b['frictionless_vy']:+.2f}, {r['frictionless_angle'] - b['frictionless_angle']:+.1f}; "
-                 f"{r['frictional_vx'] - b['frictional_vx']:+.2f}, {r['frictional_vy'] - b['frictional_vy']:+.2f}, "
-                 f"{r['frictional_angle'] - b['frictional_angle']:+.1f}")
+            d = (
+                "-"
+                if b is None
+                else f"{r['frictionless_vy'] - b['frictionless_vy']:+.2f}, {r['frictionless_angle'] - b['frictionless_angle']:+.1f}; "
+                f"{r['frictional_vx'] - b['frictional_vx']:+.2f}, {r['frictional_vy'] - b['frictional_vy']:+.2f}, "
+                f"{r['frictional_angle'] - b['frictional_angle']:+.1f}"
+            )
             lines.append(
                 f"{r['integration']:>3} {'yes' if r['rotary_inertia'] else 'no':>3} {r['contact_at']:>5} "
                 f"{r['penalty']:>10} {r['c_N']:5g} {r['mass_matrix']:>10} {r['contact_integration']:>17} | "
                 f"{f(r['frictionless_vx'])} {f(r['frictionless_vy'])} {f(r['frictionless_angle'], 5, 1)} "
                 f"{f(r['frictionless_energy_final'])} | {f(r['frictional_vx'])} {f(r['frictional_vy'])} "
-                f"{f(r['frictional_angle'], 5, 1)} {f(r['frictional_energy_final'])} {r['n_facts']:3d}/{n} | {d}")
-    words = dict(converged="converged and admissible (ranked if it follows the text)", no_convergence="no convergence",
-                 no_rebound="no rebound within the paper's 200 steps",
-                 rejected_energy_gain=f"rejected: energy gained in a step (> {ENERGY_GAIN_TOL:g} E0)")
+                f"{f(r['frictional_angle'], 5, 1)} {f(r['frictional_energy_final'])} {r['n_facts']:3d}/{n} | {d}"
+            )
+    words = dict(
+        converged="converged and admissible (ranked if it follows the text)",
+        no_convergence="no convergence",
+        no_rebound="no rebound within the paper's 200 steps",
+        rejected_energy_gain=f"rejected: energy gained in a step (> {ENERGY_GAIN_TOL:g} E0)",
+    )
     lines.append("outcomes: " + "; ".join(f"{counts[o]} {words[o]}" for o in SLOPING_OUTCOMES))
     return "\n".join(lines)
 
@@ -616,6 +701,7 @@ def _progress(label):
     def show(i, n):
         if sys.stderr.isatty():
             print(f"\r{label}: {i}/{n} readings", end="\n" if i == n else "", file=sys.stderr, flush=True)
+
     return show
 
 
@@ -649,37 +735,61 @@ def main(scene, quick=False, top=25, json_path=None, cache=True):
     if scene == "block":
         rows, geos = reconstruct_block(quick=quick, cache=cache, progress=_progress("block"))
         g = block_geometries()
-        print(f"Block (Sec. 5.1): {len(g)} geometries within 1 % of the printed first residual "
-              f"{PAPER_FIRST_RESIDUAL} (closest: {g[0]['first_residual']:.4f} at W = {g[0]['width']}, "
-              f"H = {g[0]['height']}, {g[0]['nx']} x {g[0]['ny']}; none reaches the printed digits); "
-              f"{len(rows)} readings of {len(geos)} of them run{' (quick profile)' if quick else ''}.")
+        print(
+            f"Block (Sec. 5.1): {len(g)} geometries within 1 % of the printed first residual "
+            f"{PAPER_FIRST_RESIDUAL} (closest: {g[0]['first_residual']:.4f} at W = {g[0]['width']}, "
+            f"H = {g[0]['height']}, {g[0]['nx']} x {g[0]['ny']}; none reaches the printed digits); "
+            f"{len(rows)} readings of {len(geos)} of them run{' (quick profile)' if quick else ''}."
+        )
         print(block_table(rows, top))
         pull = pulled_reading(rows)
         best = rows[0] if rows and rows[0]["rank"] else None
         if best is not None:
             pushes = (best["p_x_face"] == "right") != (best["p_x"] > 0)
-            print(f"The best reading {'pushes' if pushes else 'pulls'} the block (load on its {best['p_x_face']} "
-                  "side; the paper says 'pulled'). " + (
-                      f"The best pulling reading ranks {pull['rank']} with {pull['n_facts']} of "
-                      f"{len(pull['facts'])} facts (distance {pull['distance']:.2f})." if pull is not None
-                      else "No pulling reading is admissible."))
-        out = dict(scene="block", quick=quick, outcomes=outcome_counts(rows),
-                   criteria=dict(penetration_fraction_of_height=PENETRATION_FRACTION,
-                                 inverted="an element with det J <= 0 at a corner of the deformed mesh",
-                                 no_equilibrium="|p_x| H above the friction capacity (scenes.block_params.friction_capacity)"),
-                   best_pulled_rank=pull["rank"] if pull is not None else None, readings=rows)
+            print(
+                f"The best reading {'pushes' if pushes else 'pulls'} the block (load on its {best['p_x_face']} "
+                "side; the paper says 'pulled'). "
+                + (
+                    f"The best pulling reading ranks {pull['rank']} with {pull['n_facts']} of "
+                    f"{len(pull['facts'])} facts (distance {pull['distance']:.2f})."
+                    if pull is not None
+                    else "No pulling reading is admissible."
+                )
+            )
+        out = dict(
+            scene="block",
+            quick=quick,
+            outcomes=outcome_counts(rows),
+            criteria=dict(
+                penetration_fraction_of_height=PENETRATION_FRACTION,
+                inverted="an element with det J <= 0 at a corner of the deformed mesh",
+                no_equilibrium="|p_x| H above the friction capacity (scenes.block_params.friction_capacity)",
+            ),
+            best_pulled_rank=pull["rank"] if pull is not None else None,
+            readings=rows,
+        )
     elif scene == "sloping_impact":
         rows = reconstruct_sloping_impact(quick=quick, cache=cache, progress=_progress("sloping_impact"))
-        print(f"Sloping impact (Sec. 5.3): {len(rows)} readings run{' (quick profile)' if quick else ''}, "
-              "16 elements, dt = 0.1, 200 steps (the paper's); lumped mass and Newmark 0.7 / 0.4 (the paper's) "
-              "unless a reading says otherwise.")
+        print(
+            f"Sloping impact (Sec. 5.3): {len(rows)} readings run{' (quick profile)' if quick else ''}, "
+            "16 elements, dt = 0.1, 200 steps (the paper's); lumped mass and Newmark 0.7 / 0.4 (the paper's) "
+            "unless a reading says otherwise."
+        )
         print(sloping_table(rows, top))
-        out = dict(scene="sloping_impact", quick=quick, outcomes=outcome_counts(rows, SLOPING_OUTCOMES),
-                   criteria=dict(energy_gain_per_step=ENERGY_GAIN_TOL, velocity_tolerance=TABLE2_VELOCITY_TOL,
-                                 scored=[f"{v}_{q}" for v, q in TABLE2_SCORED],
-                                 ranked="converged readings that keep what the paper states: "
-                                        + ", ".join(f"{k} = {v}" for k, v in SLOPING_TEXT.items())),
-                   text=SLOPING_TEXT, readings=rows)
+        out = dict(
+            scene="sloping_impact",
+            quick=quick,
+            outcomes=outcome_counts(rows, SLOPING_OUTCOMES),
+            criteria=dict(
+                energy_gain_per_step=ENERGY_GAIN_TOL,
+                velocity_tolerance=TABLE2_VELOCITY_TOL,
+                scored=[f"{v}_{q}" for v, q in TABLE2_SCORED],
+                ranked="converged readings that keep what the paper states: "
+                + ", ".join(f"{k} = {v}" for k, v in SLOPING_TEXT.items()),
+            ),
+            text=SLOPING_TEXT,
+            readings=rows,
+        )
     else:
         raise ValueError(f"parameter scene = {scene!r} is not allowed: one of block|sloping_impact")
     if json_path is not None:

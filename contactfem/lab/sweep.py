@@ -73,7 +73,7 @@ def _one(scene, preset, point, friction=None, normal=None):
         res = run_scene(scene, preset, overrides, check=False, **laws)
         row = {k: v for k, v in res.items() if not isinstance(v, (list, dict)) and k not in point}
         row["error"] = ""
-    except Exception as exc:   # a failed point is a row of the table, not the end of the sweep
+    except Exception as exc:  # a failed point is a row of the table, not the end of the sweep
         row = {"error": f"{type(exc).__name__}: {' '.join(str(exc).split())}"}
     row.update({f"param.{k}": v for k, v in point.items()})
     return row
@@ -84,7 +84,7 @@ def laws_text(friction=None, normal=None):
     return " ".join(f"--{k} {v}" for k, v in (("friction", friction), ("normal", normal)) if v)
 
 
-LIBRARY = ("clock.py", "laws", "contact", "bodies", "solver", "scenes")   # the sources a run uses
+LIBRARY = ("clock.py", "laws", "contact", "bodies", "solver", "scenes")  # the sources a run uses
 
 
 def code_version(friction=None, normal=None, scene=None):
@@ -112,8 +112,7 @@ def code_version(friction=None, normal=None, scene=None):
     return f"{contactfem.__version__}+{h.hexdigest()[:12]}"
 
 
-def plan(scene, grid, preset="fast", jobs=1, scheduler=None, friction=None, normal=None, check=True,
-         force=False):
+def plan(scene, grid, preset="fast", jobs=1, scheduler=None, friction=None, normal=None, check=True, force=False):
     """The points of the grid (dicts NAME -> value), every one validated (ValueError, one line):
     its parameters, its laws, unless ``check`` is False the laws over the range the scene meets,
     and unless ``force`` its size against the limits of `contactfem run` (resources.LIMITS),
@@ -123,7 +122,7 @@ def plan(scene, grid, preset="fast", jobs=1, scheduler=None, friction=None, norm
     sc = get_scene(scene)
     points = [dict(zip(grid, combo)) for combo in itertools.product(*grid.values())]
     largest = None
-    for p in points:               # validate every point before starting anything
+    for p in points:  # validate every point before starting anything
         overrides, laws = build_laws(scene, preset, p, friction, normal)
         params = sc.resolve(preset, overrides)
         est = check_resources(sc, params, force)
@@ -133,15 +132,28 @@ def plan(scene, grid, preset="fast", jobs=1, scheduler=None, friction=None, norm
             sc.preflight(params, laws)
     together = 1 if scheduler else min(jobs, len(points))
     if not force and largest is not None and together * largest["memory_bytes"] > LIMITS["memory_bytes"]:
-        raise ValueError(f"{sc.name}: {together} runs at once (--jobs {jobs}), the largest needing "
-                         f"{describe(largest)}, would need about {together * largest['memory_bytes'] / 1e9:.2g} GB "
-                         f"together: above the limit of {LIMITS['memory_bytes'] / 1e9:.2g} GB (lower --jobs, "
-                         "or add --force to run it anyway)")
+        raise ValueError(
+            f"{sc.name}: {together} runs at once (--jobs {jobs}), the largest needing "
+            f"{describe(largest)}, would need about {together * largest['memory_bytes'] / 1e9:.2g} GB "
+            f"together: above the limit of {LIMITS['memory_bytes'] / 1e9:.2g} GB (lower --jobs, "
+            "or add --force to run it anyway)"
+        )
     return points
 
 
-def sweep(scene, grid, preset="fast", jobs=1, scheduler=None, friction=None, normal=None, check=True,
-          force=False, table=None, timeout=None):
+def sweep(
+    scene,
+    grid,
+    preset="fast",
+    jobs=1,
+    scheduler=None,
+    friction=None,
+    normal=None,
+    check=True,
+    force=False,
+    table=None,
+    timeout=None,
+):
     """Run `scene` at every point of the grid (parameters and law fields law.NAME, with the
     laws named by ``friction`` / ``normal`` as on the command line); returns the list of row
     dicts, in the grid's order. Every point is validated first (``plan``). ``table``: a Table
@@ -149,21 +161,26 @@ def sweep(scene, grid, preset="fast", jobs=1, scheduler=None, friction=None, nor
     ``resume`` the rows it already holds); ``timeout``: seconds a local run may take before it
     is stopped and recorded as failed."""
     args = (scene, grid, preset, jobs, scheduler, friction, normal, check, force)
-    points, version = _guarded(_prepare, args, laws_text(friction, normal)) \
-        if friction is not None or normal is not None else _prepare(*args)
+    points, version = (
+        _guarded(_prepare, args, laws_text(friction, normal))
+        if friction is not None or normal is not None
+        else _prepare(*args)
+    )
     table = Table() if table is None else table
     same = dict(scene=get_scene(scene).name, preset=preset, laws=laws_text(friction, normal), code_version=version)
     todo = table.start(points, same)
     tasks = [(i, (scene, preset, points[i], friction, normal)) for i in todo]
     runs = _on_dask(scheduler, tasks) if scheduler else _local(tasks, jobs, timeout)
-    with closing(runs):            # an exception here (Ctrl-C, SIGTERM) stops the workers at once
+    with closing(runs):  # an exception here (Ctrl-C, SIGTERM) stops the workers at once
         for i, row in runs:
             table.add(i, row)
     return table.grid_rows()
 
 
 def _prepare(scene, grid, preset, jobs, scheduler, friction, normal, check, force):
-    return plan(scene, grid, preset, jobs, scheduler, friction, normal, check, force), code_version(friction, normal, scene)
+    return plan(scene, grid, preset, jobs, scheduler, friction, normal, check, force), code_version(
+        friction, normal, scene
+    )
 
 
 def _guarded(fn, args, laws):
@@ -173,8 +190,10 @@ def _guarded(fn, args, laws):
 
     (outcome,) = run_batch(_capture, [(None, (fn, *args))], retries=0)
     if not outcome.ok:
-        raise ValueError(f"{laws}: the law's code ended the process that loaded and checked it ({outcome.reason}); "
-                         "with --no-check its check over the scene's range is skipped")
+        raise ValueError(
+            f"{laws}: the law's code ended the process that loaded and checked it ({outcome.reason}); "
+            "with --no-check its check over the scene's range is skipped"
+        )
     ok, value = outcome.value
     if not ok:
         raise value
@@ -184,7 +203,7 @@ def _guarded(fn, args, laws):
 def _capture(fn, *args):
     try:
         return True, fn(*args)
-    except Exception as exc:       # raised again in the sweep's process
+    except Exception as exc:  # raised again in the sweep's process
         return False, exc
 
 
@@ -238,25 +257,30 @@ def connect(address, timeout=10):
         scheme, location = parse_address(address)
         host, port = parse_host_port(location) if scheme in ("tcp", "tls") else (None, None)
     except (ValueError, TypeError) as err:
-        raise ValueError(f"--scheduler {address}: not the address of a Dask scheduler, such as "
-                         f"tcp://HOST:8786 ({_short(err)})") from None
+        raise ValueError(
+            f"--scheduler {address}: not the address of a Dask scheduler, such as tcp://HOST:8786 ({_short(err)})"
+        ) from None
     if host is not None:
         try:
             socket.create_connection((host, port), timeout=timeout).close()
             ident = asyncio.run(_identity(address, timeout))
         except OSError as err:
-            raise ValueError(f"--scheduler {address}: no Dask scheduler answers at {host}:{port} "
-                             f"({err.strerror or _short(err)})") from None
-        except Exception as err:      # noqa: BLE001 (whatever listens there, its answer)
-            raise ValueError(f"--scheduler {address}: what answers there is not a Dask scheduler "
-                             f"({type(err).__name__}: {_short(err)[:120]})") from None
+            raise ValueError(
+                f"--scheduler {address}: no Dask scheduler answers at {host}:{port} ({err.strerror or _short(err)})"
+            ) from None
+        except Exception as err:  # noqa: BLE001 (whatever listens there, its answer)
+            raise ValueError(
+                f"--scheduler {address}: what answers there is not a Dask scheduler "
+                f"({type(err).__name__}: {_short(err)[:120]})"
+            ) from None
         if not isinstance(ident, dict) or ident.get("type") != "Scheduler":
             raise ValueError(f"--scheduler {address}: what answers there is not a Dask scheduler")
     try:
         return Client(address, timeout=timeout, set_as_default=False)
-    except Exception as err:          # noqa: BLE001
-        raise ValueError(f"--scheduler {address}: no Dask scheduler answers there "
-                         f"({type(err).__name__}: {_short(err)[:120]})") from None
+    except Exception as err:  # noqa: BLE001
+        raise ValueError(
+            f"--scheduler {address}: no Dask scheduler answers there ({type(err).__name__}: {_short(err)[:120]})"
+        ) from None
 
 
 async def _identity(address, timeout):
@@ -291,10 +315,10 @@ class Table:
         self.path = Path(path) if path is not None else None
         self.earlier = read_table(self.path) if resume and self.path is not None and self.path.exists() else []
         self.points = []
-        self.rows = {}             # grid index -> row of this sweep (or kept from the file)
-        self.stale = {}            # grid index -> the file's row of that point, until its new row comes
-        self.others = []           # the file's rows of points outside this grid
-        self.kept = 0              # points not run again (resume)
+        self.rows = {}  # grid index -> row of this sweep (or kept from the file)
+        self.stale = {}  # grid index -> the file's row of that point, until its new row comes
+        self.others = []  # the file's rows of points outside this grid
+        self.kept = 0  # points not run again (resume)
         self.same = {}
         self.written = None
 
@@ -306,8 +330,11 @@ class Table:
             i = index.get(_key(row))
             if i is None:
                 self.others.append(row)
-            elif i not in self.rows and not row.get("error") and \
-                    all(str(row.get(k, "")) == str(v) for k, v in self.same.items()):
+            elif (
+                i not in self.rows
+                and not row.get("error")
+                and all(str(row.get(k, "")) == str(v) for k, v in self.same.items())
+            ):
                 self.rows[i] = row
             else:
                 self.stale.setdefault(i, row)
@@ -345,7 +372,7 @@ class Table:
 
         from ..io.outputs import make_parents
 
-        make_parents(self.path)                # the folders --out names, made when the table is first written
+        make_parents(self.path)  # the folders --out names, made when the table is first written
         temp = self.path.with_name(f".{self.path.stem}.{secrets.token_hex(4)}.part{self.path.suffix}")
         try:
             write_table(self.all_rows(), temp)
@@ -372,8 +399,9 @@ def read_table(path):
         with open(path, newline="") as fh:
             return list(csv.DictReader(fh))
     except (OSError, ValueError, csv.Error, UnicodeDecodeError) as err:
-        raise ValueError(f"--out {path}: cannot resume from it, it is not a sweep's table "
-                         f"({' '.join(str(err).split())})") from None
+        raise ValueError(
+            f"--out {path}: cannot resume from it, it is not a sweep's table ({' '.join(str(err).split())})"
+        ) from None
 
 
 def write_table(rows, path):

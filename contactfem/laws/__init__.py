@@ -12,7 +12,28 @@ from .rate_state import ArchardWear, DieterichRuina, Stribeck
 from .return_map import OPEN, SLIP, STICK, FrictionState, ReturnMapError, return_map
 from .check import LawReport, check_law
 
-__all__ = ["PowerLaw", "ExponentialLaw", "ParabolicSlip", "Coulomb", "SlipHardening", "Frictionless",
-           "Stribeck", "DieterichRuina", "ArchardWear", "FrictionLaw", "NormalLawView", "as_friction_law",
-           "as_normal_law", "LawError", "LawValueError",
-           "return_map", "FrictionState", "ReturnMapError", "OPEN", "STICK", "SLIP", "check_law", "LawReport"]
+__all__ = [
+    "PowerLaw",
+    "ExponentialLaw",
+    "ParabolicSlip",
+    "Coulomb",
+    "SlipHardening",
+    "Frictionless",
+    "Stribeck",
+    "DieterichRuina",
+    "ArchardWear",
+    "FrictionLaw",
+    "NormalLawView",
+    "as_friction_law",
+    "as_normal_law",
+    "LawError",
+    "LawValueError",
+    "return_map",
+    "FrictionState",
+    "ReturnMapError",
+    "OPEN",
+    "STICK",
+    "SLIP",
+    "check_law",
+    "LawReport",
+]

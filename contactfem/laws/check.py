@@ -31,9 +31,10 @@ class LawReport:
     """What check_law found: ``checks``, a list of (ok, sentence); ``ok`` if all hold.
     ``errors``: the failed checks a run would stop on (the protocol, values no law may
     return); ``warnings``: the other failed checks (derivatives, the return mapping)."""
+
     law: object
-    checks: list = field(default_factory=list)   # (ok, sentence)
-    fatal: set = field(default_factory=set)      # indices of checks a run would stop on
+    checks: list = field(default_factory=list)  # (ok, sentence)
+    fatal: set = field(default_factory=set)  # indices of checks a run would stop on
 
     @property
     def ok(self):
@@ -91,16 +92,20 @@ def _check_derivatives(rep, L, p, q, v, z, lam, dt, rtol):
     one sentence per wrong derivative, naming it."""
     Y, Y_p, Y_q, Y_v, Y_z = L.slip_bound(p, q, v, z)
     where = {"p": p, "q": q, "v": v} if L.rate else {"p": p, "q": q}
-    checks = [("dY/dp", Y_p, p, lambda x: L.slip_bound(x, q, v, z)[0]),
-              ("dY/dq", Y_q, q, lambda x: L.slip_bound(p, x, v, z)[0])]
+    checks = [
+        ("dY/dp", Y_p, p, lambda x: L.slip_bound(x, q, v, z)[0]),
+        ("dY/dq", Y_q, q, lambda x: L.slip_bound(p, x, v, z)[0]),
+    ]
     if L.arity >= 3:
         checks.append(("dY/dv", Y_v, v, lambda x: L.slip_bound(p, q, x, z)[0]))
     if L.arity >= 4:
         for c in range(L.n_state):
+
             def f(x, c=c):
                 zz = z.copy()
                 zz[:, c] = x
                 return L.slip_bound(p, q, v, zz)[0]
+
             checks.append((f"dY/dz[{c}]" if L.n_state > 1 else "dY/dz", Y_z[:, c], z[:, c], f))
     if L.n_state and hasattr(L.law, "evolve"):
         zb = z
@@ -115,23 +120,37 @@ def _check_derivatives(rep, L, p, q, v, z, lam, dt, rtol):
         h = 1e-6 * np.maximum(np.abs(x), 1e-2 * xs if xs > 0 else 1.0)
         fd, kink = _fd_nonneg(fun, x, h)
         ok_pts = ~kink & np.isfinite(fd)
-        noise = 100 * np.finfo(float).eps * (np.abs(fun(x)) + np.max(np.abs(Y))) / h    # round-off of the differences
+        noise = 100 * np.finfo(float).eps * (np.abs(fun(x)) + np.max(np.abs(Y))) / h  # round-off of the differences
         err = np.maximum(np.abs(an - fd) - noise, 0.0) / (np.abs(fd) + np.abs(an) + 1e-300)
         err = np.where(ok_pts, err, 0.0)
         i = int(np.argmax(err))
         if err[i] >= rtol:
             how = "computed by complex step" if name in L.computed else "returned by the law"
-            hint = (" -- the complex step needs slip_bound to be complex-analytic: np.abs, np.sign, np.maximum,"
+            hint = (
+                (
+                    " -- the complex step needs slip_bound to be complex-analytic: np.abs, np.sign, np.maximum,"
                     " comparisons and np.where on the argument break it (use np.sqrt(x * x) for |x|, or return"
-                    " the derivative yourself)") if name in L.computed else ""
-            rep.add(False, "", f"{name} does not match finite differences: worst relative error {err[i]:.2e} at "
-                               f"{_where(where, i)} ({how}: {an[i]:.6g}, finite differences: {fd[i]:.6g}){hint}")
+                    " the derivative yourself)"
+                )
+                if name in L.computed
+                else ""
+            )
+            rep.add(
+                False,
+                "",
+                f"{name} does not match finite differences: worst relative error {err[i]:.2e} at "
+                f"{_where(where, i)} ({how}: {an[i]:.6g}, finite differences: {fd[i]:.6g}){hint}",
+            )
         else:
             good.append(name)
             worst_all = max(worst_all, float(err[i]))
     if good:
         verb = "agrees" if len(good) == 1 else "agree"
-        rep.add(True, f"{', '.join(good)} {verb} with finite differences (worst relative error beyond round-off {worst_all:.1e})", "")
+        rep.add(
+            True,
+            f"{', '.join(good)} {verb} with finite differences (worst relative error beyond round-off {worst_all:.1e})",
+            "",
+        )
 
 
 def _grid(p_max, q_max, v_max, rate, n_p=31):
@@ -161,7 +180,7 @@ def _values(rep, L, p_max, q_max, v_max, dt):
     try:
         Z = _states(L, P, q_max, dt, np.random.default_rng(1))
         out = L.slip_bound(P, Q, V, Z)
-        L._guard_slip_bound([P, Q, V, Z], out)          # (a shipped law's adapter does not guard)
+        L._guard_slip_bound([P, Q, V, Z], out)  # (a shipped law's adapter does not guard)
     except LawError as err:
         rep.add(False, "", str(err), fatal=True)
         return False
@@ -172,7 +191,7 @@ def _values(rep, L, p_max, q_max, v_max, dt):
 
 def check_friction_law(law, normal=None, scale=1.0, rtol=1e-5, dt=1.0, p_max=None, q_max=None, v_max=None):
     """check_law for a friction law (see check_law for the keywords)."""
-    with np.errstate(all="ignore"):       # the report says what is wrong; no numpy warnings
+    with np.errstate(all="ignore"):  # the report says what is wrong; no numpy warnings
         return _check_friction_law(law, normal, scale, rtol, dt, p_max, q_max, v_max)
 
 
@@ -183,7 +202,7 @@ def _check_friction_law(law, normal, scale, rtol, dt, p_max, q_max, v_max):
     except LawError as err:
         rep.add(False, "", str(err), fatal=True)
         return rep
-    L.trusted = False                          # check a shipped law like any other
+    L.trusted = False  # check a shipped law like any other
     rep.add(True, f"stick stiffness c_T = {L.c_T:g} > 0", "", fatal=True)
     p_max = 1e4 * scale if p_max is None else float(p_max)
     q_max = 10.0 * scale if q_max is None else float(q_max)
@@ -196,7 +215,7 @@ def _check_friction_law(law, normal, scale, rtol, dt, p_max, q_max, v_max):
     p = np.repeat(np.geomspace(1e-6, 1.0, 5) * p_max, 8)
     n = len(p)
     t_N = -p
-    try:      # a normal stiffness dt_N/dg_N for the modulus dt_T/dg_N (any positive one serves)
+    try:  # a normal stiffness dt_N/dg_N for the modulus dt_T/dg_N (any positive one serves)
         dt_N = np.abs(NormalLawView(normal).traction(-p / (10.0 * scale))[1])
     except LawError:
         dt_N = np.zeros(n)
@@ -228,7 +247,7 @@ def _check_friction_law(law, normal, scale, rtol, dt, p_max, q_max, v_max):
     c_T = L.c_T
     z0 = L.evolve(z_bar, p, 0.0 * p, dt)[0]
     Y0 = L.slip_bound(p, q_bar, 0.0 * p, z0)[0]
-    t_bar = t_bar * Y0   # start inside the slip surface
+    t_bar = t_bar * Y0  # start inside the slip surface
     worst_f, worst_tan, min_diss, states = 0.0, 0.0, np.inf, set()
 
     def rm(t_N, dt_N, dg):
@@ -242,7 +261,7 @@ def _check_friction_law(law, normal, scale, rtol, dt, p_max, q_max, v_max):
             states |= set(np.unique(fr.state).tolist())
             Y = L.slip_bound(p, fr.q, fr.v, fr.z)[0]
             f = np.abs(fr.t_T) - Y
-            scale_f = np.maximum(1.0, Y)     # the return map's tolerance: 1e-12 max(1, |t_tr|)
+            scale_f = np.maximum(1.0, Y)  # the return map's tolerance: 1e-12 max(1, |t_tr|)
             slip = fr.state == SLIP
             stick = fr.state == STICK
             if np.any(slip):
@@ -255,10 +274,10 @@ def _check_friction_law(law, normal, scale, rtol, dt, p_max, q_max, v_max):
                 worst_f = max(worst_f, np.max(np.maximum(f[stick], 0.0) / scale_f[stick]))
             min_diss = min(min_diss, float(np.min(fr.dissipation)))
             # tangents by central differences in the slip increment and in the gap
-            h_g = 1e-7 * (np.abs(dg) + (np.abs(t_bar) + Y0) / c_T)       # round-off: relative to t_T, not dg
+            h_g = 1e-7 * (np.abs(dg) + (np.abs(t_bar) + Y0) / c_T)  # round-off: relative to t_T, not dg
             d_T_fd = _fd(lambda x: rm(t_N, dt_N, x).t_T, dg, h_g)
             h_p = 1e-7 * p
-            d_N_fd = _fd(lambda x: rm(-x, dt_N, dg).t_T, p, h_p) * -dt_N     # dt_T/dg_N = dt_T/dp dp/dg_N
+            d_N_fd = _fd(lambda x: rm(-x, dt_N, dg).t_T, p, h_p) * -dt_N  # dt_T/dg_N = dt_T/dp dp/dg_N
             # skip points where the finite difference straddles the stick/slip kink
             same = np.ones(n, bool)
             for a, b in ((dg + h_g, p), (dg - h_g, p), (dg, p + h_p), (dg, p - h_p)):
@@ -266,20 +285,32 @@ def _check_friction_law(law, normal, scale, rtol, dt, p_max, q_max, v_max):
             for an, fd in ((fr.c_T_s, d_T_fd), (fr.c_N_s, d_N_fd)):
                 rel = np.abs(an - fd) / (np.abs(fd) + np.abs(an) + 1e-3 * c_T)
                 worst_tan = max(worst_tan, float(np.max(np.where(same, rel, 0.0))))
-    except LawValueError as err:          # a value no law may return, within the range
+    except LawValueError as err:  # a value no law may return, within the range
         rep.add(False, "", str(err), fatal=True)
         return rep
     except (LawError, FloatingPointError, ValueError) as err:
         rep.add(False, "", f"the return mapping fails with this law: {err}")
         return rep
-    rep.add(worst_f < 1e-8, f"the return mapping lands on the slip surface when slipping and stays inside when sticking (worst |f|/Y = {worst_f:.1e})",
-            f"the return mapping misses the slip surface: worst |f|/Y = {worst_f:.2e} (should be < 1e-8)")
-    rep.add(min_diss >= -1e-12, "dissipation lambda |t_T| >= 0 in every slip step",
-            f"negative dissipation {min_diss:.3e}: the slip works against the traction")
-    rep.add(worst_tan < rtol, f"the moduli dt_T/dg_T and dt_T/dg_N match finite differences (worst relative error {worst_tan:.1e})",
-            f"the moduli do not match finite differences: worst relative error {worst_tan:.2e} (needs < {rtol:g})")
-    rep.add({STICK, SLIP} <= states, "both stick and slip were exercised",
-            "the test grid never produced both stick and slip: is the slip bound sensible?")
+    rep.add(
+        worst_f < 1e-8,
+        f"the return mapping lands on the slip surface when slipping and stays inside when sticking (worst |f|/Y = {worst_f:.1e})",
+        f"the return mapping misses the slip surface: worst |f|/Y = {worst_f:.2e} (should be < 1e-8)",
+    )
+    rep.add(
+        min_diss >= -1e-12,
+        "dissipation lambda |t_T| >= 0 in every slip step",
+        f"negative dissipation {min_diss:.3e}: the slip works against the traction",
+    )
+    rep.add(
+        worst_tan < rtol,
+        f"the moduli dt_T/dg_T and dt_T/dg_N match finite differences (worst relative error {worst_tan:.1e})",
+        f"the moduli do not match finite differences: worst relative error {worst_tan:.2e} (needs < {rtol:g})",
+    )
+    rep.add(
+        {STICK, SLIP} <= states,
+        "both stick and slip were exercised",
+        "the test grid never produced both stick and slip: is the slip bound sensible?",
+    )
     return rep
 
 
@@ -293,7 +324,7 @@ def check_normal_law(law, scale=1.0, rtol=1e-6, g_max=None):
         except LawError as err:
             rep.add(False, "", str(err), fatal=True)
             return rep
-        N.trusted = False                      # check a shipped law's values too
+        N.trusted = False  # check a shipped law's values too
         try:
             g_open = g_max * np.array([1e-9, 1e-6, 0.1, 1.0])
             t_o, d_o = N.traction(g_open)
@@ -302,36 +333,51 @@ def check_normal_law(law, scale=1.0, rtol=1e-6, g_max=None):
         except LawError as err:
             rep.add(False, "", str(err), fatal=True)
             return rep
-        rep.add(True, f"traction and stiffness are finite, t_N <= 0, for g_N in [{-g_max:.3g}, {g_max:.3g}]", "",
-                fatal=True)
-        rep.add(np.all(t_o == 0) and np.all(d_o == 0), "no traction and no stiffness while the gap is open (g_N > 0)",
-                "the law gives a traction or stiffness for an open gap g_N > 0")
-        rep.add(np.all(t_N < 0), "contact traction is compressive (t_N < 0 for g_N < 0)",
-                "the contact traction must be negative (compressive) when g_N < 0, it is zero somewhere")
-        rep.add(np.all(dt_N >= 0), "stiffness dt_N/dg_N >= 0 (more penetration, more pressure)",
-                "dt_N/dg_N must be non-negative")
+        rep.add(
+            True, f"traction and stiffness are finite, t_N <= 0, for g_N in [{-g_max:.3g}, {g_max:.3g}]", "", fatal=True
+        )
+        rep.add(
+            np.all(t_o == 0) and np.all(d_o == 0),
+            "no traction and no stiffness while the gap is open (g_N > 0)",
+            "the law gives a traction or stiffness for an open gap g_N > 0",
+        )
+        rep.add(
+            np.all(t_N < 0),
+            "contact traction is compressive (t_N < 0 for g_N < 0)",
+            "the contact traction must be negative (compressive) when g_N < 0, it is zero somewhere",
+        )
+        rep.add(
+            np.all(dt_N >= 0),
+            "stiffness dt_N/dg_N >= 0 (more penetration, more pressure)",
+            "dt_N/dg_N must be non-negative",
+        )
         gs = g[g < -1e-4 * g_max]
         h = 1e-7 * np.abs(gs)
-        try:      # relative errors, with a floor of 1e-9 of the largest value (round-off near g_N = 0)
+        try:  # relative errors, with a floor of 1e-9 of the largest value (round-off near g_N = 0)
             ts, ds = N.traction(gs)
             fd = (N.traction(gs + h)[0] - N.traction(gs - h)[0]) / (2 * h)
             rel = np.abs(fd - ds) / (np.abs(ds) + np.abs(fd) + 1e-9 * np.max(np.abs(ds)) + 1e-300)
             i = int(np.argmax(rel))
-            rep.add(rel[i] < 1e-5, f"dt_N/dg_N matches finite differences (worst relative error {rel[i]:.1e})",
-                    f"dt_N/dg_N does not match finite differences: worst relative error {rel[i]:.2e} at g_N = "
-                    f"{gs[i]:.3g} (returned {ds[i]:.6g}, finite differences {fd[i]:.6g})")
+            rep.add(
+                rel[i] < 1e-5,
+                f"dt_N/dg_N matches finite differences (worst relative error {rel[i]:.1e})",
+                f"dt_N/dg_N does not match finite differences: worst relative error {rel[i]:.2e} at g_N = "
+                f"{gs[i]:.3g} (returned {ds[i]:.6g}, finite differences {fd[i]:.6g})",
+            )
             if not N.has_energy:
                 rep.add(True, "no energy(g_N) (only contact_integration = energy_consistent needs the potential)", "")
             else:
                 W0 = N.energy(np.zeros(1))[0]
-                hW = 1e-4 * np.abs(gs)        # a wider step: an energy is often a difference of larger terms
+                hW = 1e-4 * np.abs(gs)  # a wider step: an energy is often a difference of larger terms
                 fdW = (N.energy(gs + hW) - N.energy(gs - hW)) / (2 * hW)
                 errW = np.abs(fdW - ts) / (np.abs(ts) + np.abs(fdW) + 1e-9 * np.max(np.abs(ts)) + 1e-300)
                 j = int(np.argmax(errW))
-                rep.add(errW[j] < 1e-5 and W0 == 0.0,
-                        f"energy W(0) = 0 and dW/dg_N = t_N (worst relative error {errW[j]:.1e})",
-                        f"energy: W(0) = {W0:.3g} must be 0 and dW/dg_N = t_N: worst relative error {errW[j]:.2e} at "
-                        f"g_N = {gs[j]:.3g} (t_N {ts[j]:.6g}, finite differences of W {fdW[j]:.6g})")
+                rep.add(
+                    errW[j] < 1e-5 and W0 == 0.0,
+                    f"energy W(0) = 0 and dW/dg_N = t_N (worst relative error {errW[j]:.1e})",
+                    f"energy: W(0) = {W0:.3g} must be 0 and dW/dg_N = t_N: worst relative error {errW[j]:.2e} at "
+                    f"g_N = {gs[j]:.3g} (t_N {ts[j]:.6g}, finite differences of W {fdW[j]:.6g})",
+                )
         except LawError as err:
             rep.add(False, "", str(err), fatal=True)
     return rep
@@ -361,11 +407,14 @@ def check_law(law, **kw):
         return check_friction_law(law, **kw)
     if hasattr(law, "traction"):
         return check_normal_law(law, **kw)
-    raise TypeError(f"check_law: {type(law).__name__} is not a law: a normal law has traction(g_N), "
-                    "a friction law c_T and slip_bound(p, q)")
+    raise TypeError(
+        f"check_law: {type(law).__name__} is not a law: a normal law has traction(g_N), "
+        "a friction law c_T and slip_bound(p, q)"
+    )
 
 
 # -- pre-flight: what a run checks of a law object before solving --------------------------
+
 
 def _concave_envelope(x, y, x0):
     """The least concave majorant of the samples (x, y) (x increasing) at x0."""
@@ -373,7 +422,7 @@ def _concave_envelope(x, y, x0):
     for pt in zip(x, y):
         while len(hull) >= 2:
             (x1, y1), (x2, y2) = hull[-2], hull[-1]
-            if (x2 - x1) * (pt[1] - y1) - (y2 - y1) * (pt[0] - x1) >= 0:    # hull[-1] below the chord
+            if (x2 - x1) * (pt[1] - y1) - (y2 - y1) * (pt[0] - x1) >= 0:  # hull[-1] below the chord
                 hull.pop()
             else:
                 break
@@ -427,19 +476,31 @@ def preflight(friction=None, normal=None, p=1.0, q=1.0, v=1.0, dt=1.0, g=1.0, ho
                 rep = check_friction_law(friction, normal=normal, dt=dt, p_max=p, q_max=q, v_max=v)
                 if rep.errors:
                     raise LawError(f"friction law {rep.errors[0]}")
-                warnings += [f"friction law {type(friction).__name__}: {s}" for s in rep.warnings
-                             if "both stick and slip" not in s]
+                warnings += [
+                    f"friction law {type(friction).__name__}: {s}"
+                    for s in rep.warnings
+                    if "both stick and slip" not in s
+                ]
             if hold is not None:
                 try:
                     cap = hold_capacity(L, hold["T"], hold["N"], hold["L"], hold["w_min"], q, v, dt)
                 except LawError as err:
                     raise LawError(f"friction law {err}") from None
                 if hold["T"] > cap * (1.0 + HOLD_MARGIN):
-                    raise LawError(f"no static equilibrium: the tangential load {hold['T']:.4g} exceeds the largest "
-                                   f"friction force {cap:.4g} the friction law {L.name} can carry under the normal load "
-                                   f"{hold['N']:.4g}; lower the tangential load or raise the friction")
+                    raise LawError(
+                        f"no static equilibrium: the tangential load {hold['T']:.4g} exceeds the largest "
+                        f"friction force {cap:.4g} the friction law {L.name} can carry under the normal load "
+                        f"{hold['N']:.4g}; lower the tangential load or raise the friction"
+                    )
     return warnings
 
 
-__all__ = ["LawReport", "check_law", "check_friction_law", "check_normal_law", "preflight", "hold_capacity",
-           "explain_call_error"]
+__all__ = [
+    "LawReport",
+    "check_law",
+    "check_friction_law",
+    "check_normal_law",
+    "preflight",
+    "hold_capacity",
+    "explain_call_error",
+]

@@ -43,9 +43,12 @@ class ParabolicSlip:
     def slip_bound(self, p, q):
         p = np.asarray(p, dtype=float)
         on = p > 0.0
-        if on.all():               # every node pressed (the return map's call): no masking needed
-            return (self.alpha * p**self.n + self.beta * p, self.alpha * self.n * p ** (self.n - 1.0) + self.beta,
-                    np.zeros(p.shape))
+        if on.all():  # every node pressed (the return map's call): no masking needed
+            return (
+                self.alpha * p**self.n + self.beta * p,
+                self.alpha * self.n * p ** (self.n - 1.0) + self.beta,
+                np.zeros(p.shape),
+            )
         pp = np.where(on, p, 1.0)  # avoid 0**(n-1); masked below
         Y = np.where(on, self.alpha * pp**self.n + self.beta * p, 0.0)
         dY_dp = np.where(on, self.alpha * self.n * pp ** (self.n - 1.0) + self.beta, 0.0)

@@ -5,6 +5,7 @@ with slip rates and internal variables, is spelled out in protocol.py).
 student's own, usually a frozen dataclass). The contact calls laws only through the adapters
 of protocol.py, which read these members and check what they return.
 """
+
 from typing import Protocol, runtime_checkable
 
 import numpy as np

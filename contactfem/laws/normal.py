@@ -34,7 +34,7 @@ class PowerLaw:
         g_N = np.asarray(g_N, dtype=float)
         closed = g_N < 0.0
         a = np.where(closed, -g_N, 0.0)  # approach, >= 0
-        if self.m == 1.0:                # the penalty: a**1 = a and a**0 = 1, the same numbers without powers
+        if self.m == 1.0:  # the penalty: a**1 = a and a**0 = 1, the same numbers without powers
             return -self.c_N * a, np.where(closed, self.c_N * 1.0, 0.0)
         t_N = -self.c_N * a**self.m
         dt_N = np.where(closed, self.c_N * self.m * a ** (self.m - 1.0), 0.0)

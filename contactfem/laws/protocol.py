@@ -63,17 +63,28 @@ from .friction import Coulomb, Frictionless, ParabolicSlip, SlipHardening
 from .normal import ExponentialLaw, PowerLaw
 from .rate_state import ArchardWear, DieterichRuina, Stribeck
 
-try:                                           # numpy >= 1.25
+try:  # numpy >= 1.25
     from numpy.exceptions import ComplexWarning
-except ImportError:                            # pragma: no cover
+except ImportError:  # pragma: no cover
     from numpy import ComplexWarning  # type: ignore[attr-defined,no-redef]
 
-H_CS = 1e-30                                   # complex step
+H_CS = 1e-30  # complex step
 ARG_NAMES = ("p", "q", "v", "z")
 # the shipped law classes themselves: their adapters skip the guards (module docstring); a class
 # is trusted by what it is, never by the name of the module that defines it
-SHIPPED_LAWS = frozenset({PowerLaw, ExponentialLaw, ParabolicSlip, Coulomb, SlipHardening, Frictionless, Stribeck,
-                          DieterichRuina, ArchardWear})
+SHIPPED_LAWS = frozenset(
+    {
+        PowerLaw,
+        ExponentialLaw,
+        ParabolicSlip,
+        Coulomb,
+        SlipHardening,
+        Frictionless,
+        Stribeck,
+        DieterichRuina,
+        ArchardWear,
+    }
+)
 
 
 class LawError(ValueError):
@@ -90,11 +101,15 @@ def explain_call_error(what, err):
     """One sentence for an exception raised inside a law's method called with arrays."""
     msg = str(err)
     if isinstance(err, TypeError) and any(k in msg for k in ("length-1", "size-1", "0-dimensional", "convert")):
-        return (f"{what} fails on arrays ({msg}): it is called with one value per contact node, so use numpy "
-                "functions (np.tanh, not math.tanh) and np.where instead of if/else on the values")
+        return (
+            f"{what} fails on arrays ({msg}): it is called with one value per contact node, so use numpy "
+            "functions (np.tanh, not math.tanh) and np.where instead of if/else on the values"
+        )
     if isinstance(err, ValueError) and "truth value" in msg:
-        return (f"{what} uses if/else on its arguments ({msg}): it is called with one value per contact node, "
-                "so use np.where(condition, a, b)")
+        return (
+            f"{what} uses if/else on its arguments ({msg}): it is called with one value per contact node, "
+            "so use np.where(condition, a, b)"
+        )
     return f"{what} raised {type(err).__name__}: {' '.join(msg.split())}"
 
 
@@ -129,9 +144,11 @@ def _real(value, what, where=lambda i: ""):
     if np.any(bad):
         i = np.unravel_index(int(np.argmax(bad)), a.shape) if a.ndim else ()
         at = where(i[0] if len(i) == 1 else 0)
-        raise LawValueError(f"{what} is complex, {_num(a[i])}{' at ' + at if at else ''}: a law returns real numbers "
-                            "at real arguments (a square root or a fractional power of a negative number? "
-                            "clip it with np.maximum(x, 0) first)")
+        raise LawValueError(
+            f"{what} is complex, {_num(a[i])}{' at ' + at if at else ''}: a law returns real numbers "
+            "at real arguments (a square root or a fractional power of a negative number? "
+            "clip it with np.maximum(x, 0) first)"
+        )
     return np.real(a)
 
 
@@ -153,10 +170,13 @@ def slip_bound_arity(law):
     fun = getattr(law, "slip_bound", None)
     if fun is None or not callable(fun):
         if callable(getattr(law, "traction", None)):
-            raise LawError(f"{_name(law)} is a normal law (it has traction(g_N), no slip_bound): give it as the "
-                           "normal law (--normal, normal=), not as the friction law")
-        raise LawError(f"{_name(law)} has no method slip_bound(p, q): a friction law needs one "
-                       "(and a stick stiffness c_T)")
+            raise LawError(
+                f"{_name(law)} is a normal law (it has traction(g_N), no slip_bound): give it as the "
+                "normal law (--normal, normal=), not as the friction law"
+            )
+        raise LawError(
+            f"{_name(law)} has no method slip_bound(p, q): a friction law needs one (and a stick stiffness c_T)"
+        )
     try:
         sig = inspect.signature(fun)
     except (TypeError, ValueError):
@@ -165,23 +185,25 @@ def slip_bound_arity(law):
     if any(p.kind == p.VAR_POSITIONAL for p in sig.parameters.values()):
         return 4
     if len(pos) < 2:
-        raise LawError(f"{_name(law)}.slip_bound takes {len(pos)} argument(s); it must take (p, q), "
-                       "(p, q, v) for a rate-dependent law or (p, q, v, z) for a law with internal variables")
+        raise LawError(
+            f"{_name(law)}.slip_bound takes {len(pos)} argument(s); it must take (p, q), "
+            "(p, q, v) for a rate-dependent law or (p, q, v, z) for a law with internal variables"
+        )
     return min(len(pos), 4)
 
 
 def _as_array(value, shape, what):
     if type(value) is np.ndarray and value.shape == shape and value.dtype == np.float64:
-        return value                           # the common case, nothing to check (a return map calls this often)
+        return value  # the common case, nothing to check (a return map calls this often)
     try:
         a = np.asarray(value)
-    except Exception as err:                   # noqa: BLE001 (anything a law returns)
+    except Exception as err:  # noqa: BLE001 (anything a law returns)
         raise LawValueError(f"{what} is not an array of numbers ({err})") from None
     if a.dtype == object or not (np.issubdtype(a.dtype, np.number) or a.dtype == bool):
         raise LawValueError(f"{what} is not an array of numbers (got {type(value).__name__})")
-    if a.shape == shape or a.ndim == 0:               # one value per node, or one for all
+    if a.shape == shape or a.ndim == 0:  # one value per node, or one for all
         return np.broadcast_to(a, shape)
-    if len(shape) == 2 and shape[1] == 1 and a.shape == shape[:1]:     # one internal variable, as (n,)
+    if len(shape) == 2 and shape[1] == 1 and a.shape == shape[:1]:  # one internal variable, as (n,)
         return a.reshape(shape)
     raise LawValueError(f"{what} has shape {a.shape}, expected {shape} (one value per contact node)")
 
@@ -232,11 +254,14 @@ class FrictionLaw:
         try:
             self.c_T = float(law.c_T)
         except (TypeError, ValueError):
-            raise LawError(f"{self.name}.c_T = {law.c_T!r} is not a number: the stick stiffness (eq 5) must be "
-                           "a finite number > 0") from None
+            raise LawError(
+                f"{self.name}.c_T = {law.c_T!r} is not a number: the stick stiffness (eq 5) must be a finite number > 0"
+            ) from None
         if not (math.isfinite(self.c_T) and (self.c_T > 0 or (self.trusted and self.c_T == 0))):
-            raise LawError(f"{self.name}.c_T = {self.c_T:g} is out of range: the stick stiffness (eq 5) must be a "
-                           "finite number > 0")
+            raise LawError(
+                f"{self.name}.c_T = {self.c_T:g} is out of range: the stick stiffness (eq 5) must be a "
+                "finite number > 0"
+            )
         check_fields(law)
         k = getattr(law, "n_state", 0)
         try:
@@ -249,7 +274,7 @@ class FrictionLaw:
         self.rate = self.arity >= 3
         self.stateful = self.n_state > 0
         self.supplied, self.computed = set(), set()
-        self.check_values = True               # False: only the protocol (shapes, numbers), not the values
+        self.check_values = True  # False: only the protocol (shapes, numbers), not the values
         self._has_evolve = self.n_state > 0 and hasattr(law, "evolve")
         self._has_offset = self.n_state > 0 and hasattr(law, "gap_offset")
 
@@ -264,7 +289,9 @@ class FrictionLaw:
             if a is not None:
                 a = np.asarray(a)
                 val = a[i] if a.ndim else a
-                parts.append(f"{name} = " + (_num(val) if np.ndim(val) == 0 else "[" + ", ".join(_num(x) for x in val) + "]"))
+                parts.append(
+                    f"{name} = " + (_num(val) if np.ndim(val) == 0 else "[" + ", ".join(_num(x) for x in val) + "]")
+                )
         for name, a in more.items():
             a = np.asarray(a)
             parts.append(f"{name} = {_num(a[i] if a.ndim else a)}")
@@ -279,8 +306,10 @@ class FrictionLaw:
             z = np.array(_as_array(z, (n, self.n_state), f"{self.name}.initial_state({n})"), dtype=float)
             if not self.trusted and self.check_values and not _all_finite([z]):
                 i = int(np.argmin(_rows_finite(z)))
-                raise LawValueError(f"{self.name}.initial_state({n}) returned NaN or inf: z = "
-                                    f"[{', '.join(_num(x) for x in z[i])}] at node {i}")
+                raise LawValueError(
+                    f"{self.name}.initial_state({n}) returned NaN or inf: z = "
+                    f"[{', '.join(_num(x) for x in z[i])}] at node {i}"
+                )
         else:
             z = np.zeros((n, self.n_state))
         return z
@@ -296,8 +325,9 @@ class FrictionLaw:
             bad = ~np.isfinite(g) & ok
             if np.any(bad):
                 i = int(np.argmax(bad))
-                raise LawValueError(f"{self.name}.gap_offset returned NaN or inf: {_num(g[i])} at "
-                                    f"{self._where(z=z, i=i)}")
+                raise LawValueError(
+                    f"{self.name}.gap_offset returned NaN or inf: {_num(g[i])} at {self._where(z=z, i=i)}"
+                )
         return g
 
     def _guarded_call(self, method, fn, what):
@@ -311,7 +341,7 @@ class FrictionLaw:
     # -- the slip bound -----------------------------------------------------
     def _call(self, args, what):
         try:
-            return self.law.slip_bound(*args[:self.arity])
+            return self.law.slip_bound(*args[: self.arity])
         except (LawError, ComplexWarning):
             raise
         except (Exception, SystemExit) as err:  # noqa: BLE001 (a student's law may raise anything, even exit)
@@ -322,9 +352,11 @@ class FrictionLaw:
         expect = 1 + self.arity
         if isinstance(out, (tuple, list)):
             if len(out) != expect:
-                names = ", ".join(["Y"] + [f"dY/d{a}" for a in ARG_NAMES[:self.arity]])
-                raise LawValueError(f"{self.name}.slip_bound({', '.join(ARG_NAMES[:self.arity])}) returned "
-                                    f"{len(out)} values: it must return Y alone or the {expect} values ({names})")
+                names = ", ".join(["Y"] + [f"dY/d{a}" for a in ARG_NAMES[: self.arity]])
+                raise LawValueError(
+                    f"{self.name}.slip_bound({', '.join(ARG_NAMES[: self.arity])}) returned "
+                    f"{len(out)} values: it must return Y alone or the {expect} values ({names})"
+                )
             return out[0], list(out[1:])
         return out, [None] * self.arity
 
@@ -345,10 +377,12 @@ class FrictionLaw:
                 raise LawValueError(
                     f"{self.name}.slip_bound leaves out dY/d{ARG_NAMES[j]}, which is then computed by complex step, "
                     "but the law casts its arguments to float (e.g. np.asarray(p, dtype=float)): write np.asarray(p) "
-                    "or return the derivative") from None
+                    "or return the derivative"
+                ) from None
             except LawError as err:
-                raise LawValueError(f"{err} (while computing dY/d{ARG_NAMES[j]} by complex step: return it "
-                                    "yourself)") from None
+                raise LawValueError(
+                    f"{err} (while computing dY/d{ARG_NAMES[j]} by complex step: return it yourself)"
+                ) from None
         Y, _ = self._split(out, n)
         Y = _as_array(Y, (n,), f"{self.name}.slip_bound: Y")
         return np.imag(Y) / H_CS
@@ -372,18 +406,18 @@ class FrictionLaw:
         k = self.n_state
         z = np.zeros((n, k)) if z is None else as_shape(z, (n, k))
         args = [p, q, v, z]
-        if self.trusted:                       # a shipped law returns Y and every derivative, exact
-            out = self.law.slip_bound(*args[:self.arity])
+        if self.trusted:  # a shipped law returns Y and every derivative, exact
+            out = self.law.slip_bound(*args[: self.arity])
             if self.arity == 4:
                 return out
-            rest = (np.zeros(n), np.zeros((n, k)))[self.arity - 2:]
+            rest = (np.zeros(n), np.zeros((n, k)))[self.arity - 2 :]
             return (*out, *rest)
         Y, ders = self._split(self._call(args, ""), n)
-        at = lambda i: self._where(p, q, v, z, i)          # noqa: E731
+        at = lambda i: self._where(p, q, v, z, i)  # noqa: E731
         Y = _real(Y, f"{self.name}.slip_bound: Y", at)
         self._one_for_all(Y, args, n)
         Y = np.array(_as_array(Y, (n,), f"{self.name}.slip_bound: Y"), dtype=float)
-        if any(d is None for d in ders):        # Y first: the missing derivatives are computed from it
+        if any(d is None for d in ders):  # Y first: the missing derivatives are computed from it
             self._guard_slip_bound(args, (Y,))
         res = []
         for j in range(4):
@@ -398,8 +432,9 @@ class FrictionLaw:
                 res.append(np.array(_as_array(d, shape, f"{self.name}.slip_bound: {name}"), dtype=float))
                 self.supplied.add(name)
             elif j == 3:
-                res.append(np.stack([self._complex_step(args, 3, n, c) for c in range(k)], axis=1)
-                           if k else np.zeros((n, 0)))
+                res.append(
+                    np.stack([self._complex_step(args, 3, n, c) for c in range(k)], axis=1) if k else np.zeros((n, 0))
+                )
                 self.computed.add(name)
             else:
                 res.append(self._complex_step(args, j, n))
@@ -413,8 +448,8 @@ class FrictionLaw:
         their values (``mu * np.mean(p)``): Y must be one value per node, each from that node's own
         arguments. One number that does not change with them (a constant Y) is one for every node."""
         if n < 2 or np.ndim(Y) != 0 or np.asarray(Y).dtype.kind not in "biuf":
-            return                             # (not a number: _as_array says so)
-        moved = [np.array(a, dtype=float) for a in args]     # the first node's arguments moved
+            return  # (not a number: _as_array says so)
+        moved = [np.array(a, dtype=float) for a in args]  # the first node's arguments moved
         moved[0][0] = 2.0 * moved[0][0] + 1.0
         for a in moved[1:]:
             if a.size:
@@ -425,35 +460,40 @@ class FrictionLaw:
             return
         Y2 = np.asarray(Y2)
         if Y2.ndim == 0 and Y2.dtype.kind in "biufc" and not np.array_equal(Y2, np.asarray(Y), equal_nan=True):
-            names = ", ".join(ARG_NAMES[:self.arity])
+            names = ", ".join(ARG_NAMES[: self.arity])
             raise LawValueError(
                 f"{self.name}.slip_bound returned one number for all {n} contact nodes (shape ()), and it changes "
                 f"with the values at one node: it must return one value per node, shape ({n},), each from that "
-                f"node's own {names} (e.g. mu * p, not mu * np.mean(p))")
+                f"node's own {names} (e.g. mu * p, not mu * np.mean(p))"
+            )
 
     def _guard_slip_bound(self, args, out):
         """LawValueError at the first node where the law returned NaN/inf or Y < 0 (nodes whose
         arguments are themselves not finite excepted: there the solver has failed, not the law)."""
         Y = out[0]
-        out = out[:1 + self.arity]
+        out = out[: 1 + self.arity]
         if not self.check_values or not Y.size or (Y.min() >= 0.0 and _all_finite(out)):
-            return                             # (the minimum is NaN, not >= 0, if a value is NaN)
+            return  # (the minimum is NaN, not >= 0, if a value is NaN)
         p, q, v, z = args
         ok = _rows_finite(p, q, v, z)
-        names = ["Y"] + [f"dY/d{a}" for a in ARG_NAMES[:self.arity]]
+        names = ["Y"] + [f"dY/d{a}" for a in ARG_NAMES[: self.arity]]
         for name, a in zip(names, out):
             bad = ~_rows_finite(a) & ok
             if np.any(bad):
                 i = int(np.argmax(bad))
                 val = a[i] if a.ndim == 1 else "[" + ", ".join(_num(x) for x in a[i]) + "]"
                 how = " (computed by complex step)" if name in self.computed else ""
-                raise LawValueError(f"{self.name}.slip_bound returned NaN or inf: {name}{how} = "
-                                    f"{_num(val) if a.ndim == 1 else val} at {self._where(p, q, v, z, i)}")
+                raise LawValueError(
+                    f"{self.name}.slip_bound returned NaN or inf: {name}{how} = "
+                    f"{_num(val) if a.ndim == 1 else val} at {self._where(p, q, v, z, i)}"
+                )
         bad = (Y < 0.0) & ok
         if np.any(bad):
             i = int(np.argmax(bad))
-            raise LawValueError(f"{self.name}.slip_bound returned a negative slip bound: Y = {_num(Y[i])} at "
-                                f"{self._where(p, q, v, z, i)} (Y, the largest tangential traction, must be >= 0)")
+            raise LawValueError(
+                f"{self.name}.slip_bound returned a negative slip bound: Y = {_num(Y[i])} at "
+                f"{self._where(p, q, v, z, i)} (Y, the largest tangential traction, must be >= 0)"
+            )
 
     # -- the state evolution -------------------------------------------------
     def _evolve_call(self, z_bar, p, lam, dt):
@@ -475,8 +515,9 @@ class FrictionLaw:
         out = self._evolve_call(z_bar, p, lam, dt)
         if isinstance(out, (tuple, list)):
             if len(out) != 3:
-                raise LawValueError(f"{self.name}.evolve returned {len(out)} values: it must return z alone or "
-                                    "(z, dz/dp, dz/dlam)")
+                raise LawValueError(
+                    f"{self.name}.evolve returned {len(out)} values: it must return z alone or (z, dz/dp, dz/dlam)"
+                )
             z, dz_p, dz_lam = out
         else:
             z, dz_p, dz_lam = out, None, None
@@ -484,8 +525,12 @@ class FrictionLaw:
         res = []
         for name, d, x in (("dz/dp", dz_p, 1), ("dz/dlam", dz_lam, 2)):
             if d is not None:
-                res.append(np.array(_as_array(_real(d, f"{self.name}.evolve: {name}"), (n, k),
-                                              f"{self.name}.evolve: {name}"), dtype=float))
+                res.append(
+                    np.array(
+                        _as_array(_real(d, f"{self.name}.evolve: {name}"), (n, k), f"{self.name}.evolve: {name}"),
+                        dtype=float,
+                    )
+                )
                 self.supplied.add(name)
                 continue
             a = [z_bar, np.asarray(p, dtype=float), np.asarray(lam, dtype=float), dt]
@@ -495,8 +540,10 @@ class FrictionLaw:
                 try:
                     o = self._evolve_call(*a)
                 except ComplexWarning:
-                    raise LawValueError(f"{self.name}.evolve leaves out {name}, which is then computed by complex "
-                                        "step, but it casts its arguments to float: return the derivative") from None
+                    raise LawValueError(
+                        f"{self.name}.evolve leaves out {name}, which is then computed by complex "
+                        "step, but it casts its arguments to float: return the derivative"
+                    ) from None
             zc = o[0] if isinstance(o, (tuple, list)) else o
             res.append(np.imag(_as_array(zc, (n, k), f"{self.name}.evolve: z")) / H_CS)
             self.computed.add(name)
@@ -510,10 +557,12 @@ class FrictionLaw:
                 if np.any(bad):
                     i = int(np.argmax(bad))
                     how = " (computed by complex step)" if name in self.computed else ""
-                    raise LawValueError(f"{self.name}.evolve returned NaN or inf: {name}{how} = "
-                                        f"[{', '.join(_num(x) for x in a[i])}] at z_bar = "
-                                        f"[{', '.join(_num(x) for x in zb[i])}], p = {_num(p_[i])}, "
-                                        f"lam = {_num(lam_[i])}, dt = {_num(dt)}")
+                    raise LawValueError(
+                        f"{self.name}.evolve returned NaN or inf: {name}{how} = "
+                        f"[{', '.join(_num(x) for x in a[i])}] at z_bar = "
+                        f"[{', '.join(_num(x) for x in zb[i])}], p = {_num(p_[i])}, "
+                        f"lam = {_num(lam_[i])}, dt = {_num(dt)}"
+                    )
         return out
 
 
@@ -539,21 +588,26 @@ class NormalLawView:
         self.trusted = is_shipped(law)
         if not callable(getattr(law, "traction", None)):
             if callable(getattr(law, "slip_bound", None)):
-                raise LawError(f"{self.name} is a friction law (it has slip_bound, no traction): give it as the "
-                               "friction law (--friction, friction=), not as the normal law")
-            raise LawError(f"{self.name} has no method traction(g_N): a normal law needs one, returning "
-                           "(t_N, dt_N/dg_N)")
+                raise LawError(
+                    f"{self.name} is a friction law (it has slip_bound, no traction): give it as the "
+                    "friction law (--friction, friction=), not as the normal law"
+                )
+            raise LawError(
+                f"{self.name} has no method traction(g_N): a normal law needs one, returning (t_N, dt_N/dg_N)"
+            )
         check_fields(law)
         self.has_energy = callable(getattr(law, "energy", None))
-        self.check_values = True               # False: only the protocol (shapes, numbers), not the values
+        self.check_values = True  # False: only the protocol (shapes, numbers), not the values
 
     @property
     def energy(self):
         """The law's potential, ``energy(g_N) -> W`` (checked); an AttributeError that says so for a
         law without one (so ``hasattr(view, "energy")`` is False)."""
         if not self.has_energy:
-            raise AttributeError(f"{self.name} has no method energy(g_N): this use needs the law's potential W, "
-                                 "dW/dg_N = t_N (e.g. c_N (-g_N)^(m+1) / (m+1) for eq 4)")
+            raise AttributeError(
+                f"{self.name} has no method energy(g_N): this use needs the law's potential W, "
+                "dW/dg_N = t_N (e.g. c_N (-g_N)^(m+1) / (m+1) for eq 4)"
+            )
         return self._energy
 
     def _call(self, method, g):
@@ -573,24 +627,37 @@ class NormalLawView:
         out = self._call("traction", g)
         if not (isinstance(out, (tuple, list)) and len(out) == 2):
             got = f"{len(out)} values" if isinstance(out, (tuple, list)) else "one value"
-            raise LawValueError(f"{self.name}.traction(g_N) returned {got}: it must return the two values "
-                                "(t_N, dt_N/dg_N)")
-        at = lambda i: f"g_N = {_num(g.ravel()[i])}" if g.size else ""       # noqa: E731
-        t, dt = (np.array(_as_array(_real(a, f"{self.name}.traction: {w}", at), g.shape, f"{self.name}.traction: {w}"),
-                          dtype=float) for a, w in zip(out, ("t_N", "dt_N/dg_N")))
-        if self.check_values and t.size and not (_all_finite((t, dt)) and (t.max() <= 0.0 or not np.any((t > 0.0) & (g < 0.0)))):
+            raise LawValueError(
+                f"{self.name}.traction(g_N) returned {got}: it must return the two values (t_N, dt_N/dg_N)"
+            )
+        at = lambda i: f"g_N = {_num(g.ravel()[i])}" if g.size else ""  # noqa: E731
+        t, dt = (
+            np.array(
+                _as_array(_real(a, f"{self.name}.traction: {w}", at), g.shape, f"{self.name}.traction: {w}"),
+                dtype=float,
+            )
+            for a, w in zip(out, ("t_N", "dt_N/dg_N"))
+        )
+        if (
+            self.check_values
+            and t.size
+            and not (_all_finite((t, dt)) and (t.max() <= 0.0 or not np.any((t > 0.0) & (g < 0.0))))
+        ):
             ok = np.isfinite(g)
             for name, a in (("t_N", t), ("dt_N/dg_N", dt)):
                 bad = ~np.isfinite(a) & ok
                 if np.any(bad):
                     i = np.unravel_index(int(np.argmax(bad)), a.shape)
-                    raise LawValueError(f"{self.name}.traction returned NaN or inf: {name} = {_num(a[i])} at "
-                                        f"g_N = {_num(g[i])}")
+                    raise LawValueError(
+                        f"{self.name}.traction returned NaN or inf: {name} = {_num(a[i])} at g_N = {_num(g[i])}"
+                    )
             bad = (t > 0.0) & (g < 0.0)
             if np.any(bad):
                 i = np.unravel_index(int(np.argmax(bad)), t.shape)
-                raise LawValueError(f"{self.name}.traction returned a tensile traction: t_N = {_num(t[i])} > 0 at "
-                                    f"g_N = {_num(g[i])} (in contact, g_N < 0, t_N must be <= 0: compressive)")
+                raise LawValueError(
+                    f"{self.name}.traction returned a tensile traction: t_N = {_num(t[i])} > 0 at "
+                    f"g_N = {_num(g[i])} (in contact, g_N < 0, t_N must be <= 0: compressive)"
+                )
         return t, dt
 
     def _energy(self, g_N):
@@ -620,5 +687,5 @@ def describe(law):
 
     law = getattr(law, "law", law) if isinstance(law, (FrictionLaw, NormalLawView)) else law
     cls = type(law)
-    fields = ({f.name: getattr(law, f.name) for f in dataclasses.fields(law)} if dataclasses.is_dataclass(law) else {})
+    fields = {f.name: getattr(law, f.name) for f in dataclasses.fields(law)} if dataclasses.is_dataclass(law) else {}
     return {"class": cls.__name__, "file": getattr(cls, "_contactfem_file", None), "fields": fields}

@@ -49,8 +49,8 @@ class Stribeck:
     def coefficient(self, v):
         """mu(v) and dmu/dv."""
         v = np.asarray(v, dtype=float)
-        x = v / self.v_s                                   # >= 0
-        e = np.exp(-x ** self.delta)
+        x = v / self.v_s  # >= 0
+        e = np.exp(-(x**self.delta))
         d_e = -self.delta * x ** (self.delta - 1.0) * e / self.v_s
         return self.mu_d + (self.mu_s - self.mu_d) * e + self.mu_v * v, (self.mu_s - self.mu_d) * d_e + self.mu_v
 

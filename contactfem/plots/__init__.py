@@ -12,15 +12,17 @@ import pkgutil
 from functools import lru_cache
 from pathlib import Path
 
-REGISTRY = {}   # file stem -> (paper label, function)
+REGISTRY = {}  # file stem -> (paper label, function)
 
 
 def figure(stem, label):
     """Register a function drawing the paper's figure/table `label` into `stem`.*"""
+
     def deco(fn):
         REGISTRY[stem] = (label, fn)
         fn.figure_stem = stem
         return fn
+
     return deco
 
 
@@ -87,8 +89,9 @@ def stored(fn):
 
     def call(*args, **kwargs):
         return kept(fn, source_hash(), args, kwargs)
+
     call.__wrapped__ = fn
-    call.kept = lambda *args, **kwargs: kept.check_call_in_cache(fn, source_hash(), args, kwargs)   # on disk?
+    call.kept = lambda *args, **kwargs: kept.check_call_in_cache(fn, source_hash(), args, kwargs)  # on disk?
     return call
 
 
@@ -132,7 +135,7 @@ def savefig(fig, outdir, stem):
 
 
 def fitted_words(r, to, width=95):
-    """"FITTED to <to>: name = value, ..." from a run's JSON ``fitted`` (the values the scan lost
+    """ "FITTED to <to>: name = value, ..." from a run's JSON ``fitted`` (the values the scan lost
     that a study chose so the result lands near the paper's), wrapped to ``width``; "" for a run
     without fitted values. Figures that show a fitted reading put it in their title."""
     import textwrap
@@ -140,7 +143,7 @@ def fitted_words(r, to, width=95):
     fitted = r.get("fitted") or {}
     if not fitted:
         return ""
-    fmt = lambda v: f"{v:g}" if isinstance(v, float) else str(v)          # noqa: E731
+    fmt = lambda v: f"{v:g}" if isinstance(v, float) else str(v)  # noqa: E731
     text = f"FITTED to {to}: " + ", ".join(f"{k} = {fmt(v)}" for k, v in fitted.items())
     return "\n".join(textwrap.wrap(text, width))
 

@@ -59,21 +59,30 @@ def fig06(preset="fast", outdir=None, law="conical", params=None, body=None, rec
     fig, axes = plt.subplots(1, 2, figsize=(12, 5.2))
     ax = axes[0]
     draw_mesh(ax, X, t, edgecolors="k", linewidths=0.6)
-    for xi in np.linspace(0, W, 9):                               # pressure p_y on the top
+    for xi in np.linspace(0, W, 9):  # pressure p_y on the top
         ax.annotate("", (xi, H), (xi, H + 0.5), arrowprops=dict(arrowstyle="->", color="tab:green"))
-    right = P["p_x_face"] == "right"                          # traction p_x on a lateral side
+    right = P["p_x_face"] == "right"  # traction p_x on a lateral side
     x0 = W if right else 0.0
     for yi in np.linspace(0, H, 8):
         tail = (x0, yi) if right else (x0 - 0.5, yi)
         ax.annotate("", (tail[0] + 0.5, yi), tail, arrowprops=dict(arrowstyle="->", color="tab:purple"))
     ax.text(W / 2, H + 0.6, f"p_y = {P['p_y']:g}", ha="center", color="tab:green")
-    ax.text(W + 0.55 if right else -0.55, H / 2, f"p_x = {P['p_x']:g}", va="center",
-            ha="left" if right else "right", color="tab:purple")
+    ax.text(
+        W + 0.55 if right else -0.55,
+        H / 2,
+        f"p_x = {P['p_x']:g}",
+        va="center",
+        ha="left" if right else "right",
+        color="tab:purple",
+    )
     Xs = rep["X"]
     ax.plot(Xs[:, 0], Xs[:, 1], "o", ms=4, color="tab:orange", label=f"contact nodes ({len(Xs)})")
     fitted = " (FITTED to Table 1)" if preset in ("fast", "paper") else ""
-    ax.set_title(f"system and discretisation: {P['nx']} x {P['ny']} quads, width {W:g},\n"
-                 f"height {H:g}, plane {P['plane']}{fitted}", fontsize=9)
+    ax.set_title(
+        f"system and discretisation: {P['nx']} x {P['ny']} quads, width {W:g},\n"
+        f"height {H:g}, plane {P['plane']}{fitted}",
+        fontsize=9,
+    )
     ax.legend(loc="lower left", fontsize=8)
     ax = axes[1]
     draw_mesh(ax, X, t, edgecolors="0.8", linewidths=0.5)
@@ -82,10 +91,18 @@ def fig06(preset="fast", outdir=None, law="conical", params=None, body=None, rec
         sel = rep["state"] == state
         if sel.any():
             ax.plot(rep["x"][sel, 0], rep["x"][sel, 1], "o", ms=4, color=color, label=state)
-    data = dict(law=law, X=X, x=x, max_displacement=float(np.linalg.norm(u[body.xdofs], axis=1).max()),
-                contact=dict(X=Xs, x=rep["x"], state=[str(v) for v in rep["state"]]))
-    ax.set_title(f"deformed ({law} law), displacements at true scale (x1):\nmax |u| = "
-                 f"{data['max_displacement']:.2f}; grey: undeformed", fontsize=9)
+    data = dict(
+        law=law,
+        X=X,
+        x=x,
+        max_displacement=float(np.linalg.norm(u[body.xdofs], axis=1).max()),
+        contact=dict(X=Xs, x=rep["x"], state=[str(v) for v in rep["state"]]),
+    )
+    ax.set_title(
+        f"deformed ({law} law), displacements at true scale (x1):\nmax |u| = "
+        f"{data['max_displacement']:.2f}; grey: undeformed",
+        fontsize=9,
+    )
     ax.legend(loc="lower left", fontsize=8)
     for ax in axes:
         ax.axhline(0.0, color="k", lw=2.5)
@@ -104,8 +121,10 @@ STRESS_KEYS = ("total_normal", "total_tangential", "equilibrium_error", "n_slip"
 def stress_data(r):
     """What Figs 7 and 8 draw of a block run: STRESS_KEYS and the contact side's x, t_N, t_T,
     slip bound and states."""
-    return dict({k: r.get(k) for k in STRESS_KEYS},
-                contact={k: r["contact"][k] for k in ("x", "t_N", "t_T", "slip_bound", "state")})
+    return dict(
+        {k: r.get(k) for k in STRESS_KEYS},
+        contact={k: r["contact"][k] for k in ("x", "t_N", "t_T", "slip_bound", "state")},
+    )
 
 
 def draw_stresses(ax, r, label="", style="-", faint=False):
@@ -145,12 +164,17 @@ def fig07(preset="fast", outdir=None, r=None):
     P = r["parameters"]
     fig, ax = plt.subplots(figsize=(7.5, 5))
     draw_stresses(ax, r, "(conical)")
-    _stress_axes(ax, "Fig 7: stresses on the contact area, conical slip surface "
-                     f"(n = 1, alpha + beta = {P['alpha'] + P['beta']:g})\n"
-                     f"sum |t_N| w = {-r['total_normal']:.6g}, sum t_T w = {r['total_tangential']:.6g}; "
-                     + slip_words(r) + _fitted_line(r))
-    return save_figure(fig, Path(outdir or default_outdir(preset)) / "fig07_block_conical_stresses.png",
-                       stress_data(r), P)
+    _stress_axes(
+        ax,
+        "Fig 7: stresses on the contact area, conical slip surface "
+        f"(n = 1, alpha + beta = {P['alpha'] + P['beta']:g})\n"
+        f"sum |t_N| w = {-r['total_normal']:.6g}, sum t_T w = {r['total_tangential']:.6g}; "
+        + slip_words(r)
+        + _fitted_line(r),
+    )
+    return save_figure(
+        fig, Path(outdir or default_outdir(preset)) / "fig07_block_conical_stresses.png", stress_data(r), P
+    )
 
 
 @figure("fig08_block_parabolic_stresses", "Fig 8")
@@ -164,11 +188,18 @@ def fig08(preset="fast", outdir=None, r=None, conical=None):
     draw_stresses(ax, rc, "conical", style=":", faint=True)
     draw_stresses(ax, r, "(parabolic)")
     P = r["parameters"]
-    _stress_axes(ax, "Fig 8: stresses on the contact area, parabolic slip surface "
-                     f"(n = {P['n']:g}, alpha = {P['alpha']:g}, beta = {P['beta']:g})\n"
-                     f"{slip_words(r)}; grey: the conical case (Fig 7)" + _fitted_line(r))
-    return save_figure(fig, Path(outdir or default_outdir(preset)) / "fig08_block_parabolic_stresses.png",
-                       dict(stress_data(r), conical=stress_data(rc)), P)
+    _stress_axes(
+        ax,
+        "Fig 8: stresses on the contact area, parabolic slip surface "
+        f"(n = {P['n']:g}, alpha = {P['alpha']:g}, beta = {P['beta']:g})\n"
+        f"{slip_words(r)}; grey: the conical case (Fig 7)" + _fitted_line(r),
+    )
+    return save_figure(
+        fig,
+        Path(outdir or default_outdir(preset)) / "fig08_block_parabolic_stresses.png",
+        dict(stress_data(r), conical=stress_data(rc)),
+        P,
+    )
 
 
 def fig8_reading_data(preset="fast", other="fig8"):
@@ -182,17 +213,25 @@ def fig8_reading_data(preset="fast", other="fig8"):
         c, p = runs["conical"]["contact"], runs["parabolic"]["contact"]
         frac, red, n_top = fig8_remark(c["t_N"], c["t_T"], p["t_T"])
         data["readings"][name] = dict(
-            fig8_fraction=frac, fig8_min_reduction=red, fig8_nodes=n_top,
+            fig8_fraction=frac,
+            fig8_min_reduction=red,
+            fig8_nodes=n_top,
             **{law: dict(n_slip=r["n_slip"], newton_residuals=r["newton_residuals"]) for law, r in runs.items()},
-            x=c["x"], t_N_conical=c["t_N"], t_T_conical=c["t_T"], t_T_parabolic=p["t_T"])
+            x=c["x"],
+            t_N_conical=c["t_N"],
+            t_T_conical=c["t_T"],
+            t_T_parabolic=p["t_T"],
+        )
         params[name] = {k: v for k, v in runs["conical"]["parameters"].items() if k != "law"}
     return data, params
 
 
 def _reading_words(P):
-    return (f"{P['width']:g} x {P['height']:g}, {P['nx']} x {P['ny']}, p_x on the {P['p_x_face']} side, "
-            f"{P['free_end_nodes']} free end node{'s' if P['free_end_nodes'] > 1 else ''}, c_N = {P['c_N']:g} "
-            f"{P['penalty'].replace('_', ' ')}, plane {P['plane']}")
+    return (
+        f"{P['width']:g} x {P['height']:g}, {P['nx']} x {P['ny']}, p_x on the {P['p_x_face']} side, "
+        f"{P['free_end_nodes']} free end node{'s' if P['free_end_nodes'] > 1 else ''}, c_N = {P['c_N']:g} "
+        f"{P['penalty'].replace('_', ' ')}, plane {P['plane']}"
+    )
 
 
 @figure("fig08b_block_fig8_readings", "Fig 8")
@@ -215,22 +254,28 @@ def fig08b(preset="fast", outdir=None, other="fig8"):
         for xi in x[top]:
             ax.axvspan(xi - 0.04, xi + 0.04, color="gold", alpha=0.35, lw=0)
         holds = d["fig8_fraction"] == 1.0
-        ax.set_title(f"preset {name}: {_reading_words(P)}\nthe {d['fig8_nodes']} nodes of highest conical pressure "
-                     f"(shaded): parabolic |t_T| lower\nby at least {100 * data['fig8_drop']:g} % at "
-                     f"{round(d['fig8_fraction'] * d['fig8_nodes'])} of them, smallest reduction "
-                     f"{100 * d['fig8_min_reduction']:+.1f} %\nremark {'SHOWN' if holds else 'not shown'}; Newton: "
-                     f"conical {len(d['conical']['newton_residuals'])}, parabolic "
-                     f"{len(d['parabolic']['newton_residuals'])} residuals (Table 1: "
-                     f"{len(PAPER_TABLE1['conical'])}, {len(PAPER_TABLE1['parabolic'])}); nodes slipping: conical "
-                     f"{d['conical']['n_slip']}, parabolic {d['parabolic']['n_slip']}", fontsize=8)
+        ax.set_title(
+            f"preset {name}: {_reading_words(P)}\nthe {d['fig8_nodes']} nodes of highest conical pressure "
+            f"(shaded): parabolic |t_T| lower\nby at least {100 * data['fig8_drop']:g} % at "
+            f"{round(d['fig8_fraction'] * d['fig8_nodes'])} of them, smallest reduction "
+            f"{100 * d['fig8_min_reduction']:+.1f} %\nremark {'SHOWN' if holds else 'not shown'}; Newton: "
+            f"conical {len(d['conical']['newton_residuals'])}, parabolic "
+            f"{len(d['parabolic']['newton_residuals'])} residuals (Table 1: "
+            f"{len(PAPER_TABLE1['conical'])}, {len(PAPER_TABLE1['parabolic'])}); nodes slipping: conical "
+            f"{d['conical']['n_slip']}, parabolic {d['parabolic']['n_slip']}",
+            fontsize=8,
+        )
         ax.set_xlabel("x-coordinate (reference)")
         ax.set_ylabel("contact stress (force / length)")
         ax.set_ylim(0, None)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7)
-    fig.suptitle("Fig 8's remark, 'a considerable reduction of the frictional stress in the region of higher "
-                 "normal pressure', on two readings of the values the scan lost\n(neither is the paper's: the preset "
-                 "FITTED to Table 1, preset fig8 the study's best-ranked reading that shows the remark)", fontsize=10)
+    fig.suptitle(
+        "Fig 8's remark, 'a considerable reduction of the frictional stress in the region of higher "
+        "normal pressure', on two readings of the values the scan lost\n(neither is the paper's: the preset "
+        "FITTED to Table 1, preset fig8 the study's best-ranked reading that shows the remark)",
+        fontsize=10,
+    )
     fig.tight_layout()
     outdir = outdir or default_outdir(preset)
     return save_figure(fig, Path(outdir) / "fig08b_block_fig8_readings.png", data, params)
@@ -254,12 +299,14 @@ def residual_histories(preset="fast", results=None):
     Coulomb case with the tangent without the c_N^s coupling ('frozen'). ``results``:
     block results by law ("conical", ...) to take instead of the scene's runs."""
     given = results or {}
-    pick = lambda law: given.get(law) or result(preset, law=law)     # noqa: E731
+    pick = lambda law: given.get(law) or result(preset, law=law)  # noqa: E731
     out = {law: pick(law)["newton_residuals"] for law in ("conical", "parabolic", "coulomb")}
     out["coulomb, frozen tangent"] = result(preset, law="coulomb", tangent="frozen")["newton_residuals"]
     out["verdict"] = {key: describe_newton(hist, True) for key, hist in out.items()}
     try:
-        out["coulomb, symmetric tangent"] = result(preset, law="coulomb", tangent="symmetric", maxit=12)["newton_residuals"]
+        out["coulomb, symmetric tangent"] = result(preset, law="coulomb", tangent="symmetric", maxit=12)[
+            "newton_residuals"
+        ]
         out["verdict"]["coulomb, symmetric tangent"] = describe_newton(out["coulomb, symmetric tangent"], True)
     except NewtonError as err:
         out["coulomb, symmetric tangent"] = err.history
@@ -271,6 +318,7 @@ def residual_histories(preset="fast", results=None):
 
 def table1_markdown(hist):
     """Table 1 as markdown: the paper's values beside ours (linear solves = rows - 1)."""
+
     def cell(values, k, law=None):
         if k >= len(values):
             return ""
@@ -278,30 +326,40 @@ def table1_markdown(hist):
         if law and k in PAPER_TABLE1_UNCERTAIN.get(law, ()):
             text += " (scan?)"
         return text
+
     n = max(len(PAPER_TABLE1["parabolic"]), len(hist["conical"]), len(hist["parabolic"]), len(hist["coulomb"]))
     P = hist["parameters"]
-    lines = ["# Table 1: norm of the residual ||G|| per Newton iteration, whole load in one step",
-             "",
-             f"Block of Sec. 5.1: E = {P['E']:g}, nu = {P['nu']:g}, c_T = {P['c_T']:g} ({P['penalty']}) from the scan; "
-             f"FITTED to this table (the scan lost them; `contactfem reconstruct block`): width {P['width']:g}, "
-             f"height {P['height']:g}, {P['nx']} x {P['ny']} quads, p_x on the {P['p_x_face']} side, "
-             f"{P['free_end_nodes']} free end nodes, c_N = {P['c_N']:g}, plane {P['plane']}. Iteration 1 is the "
-             "initial state u = 0: its residual is the nodal load vector (top pressure and side traction; the "
-             "contact forces at g_N0 = -1e-12 are ~1e-8); no uniform mesh reproduces the printed first value. "
-             "(scan?): exponent garbled in the scan, value uncertain.",
-             "",
-             f"| iteration | paper conical | ours conical | paper parabolic | ours parabolic | ours Coulomb mu = {P['mu']:g} |",
-             "|---:|---:|---:|---:|---:|---:|"]
+    lines = [
+        "# Table 1: norm of the residual ||G|| per Newton iteration, whole load in one step",
+        "",
+        f"Block of Sec. 5.1: E = {P['E']:g}, nu = {P['nu']:g}, c_T = {P['c_T']:g} ({P['penalty']}) from the scan; "
+        f"FITTED to this table (the scan lost them; `contactfem reconstruct block`): width {P['width']:g}, "
+        f"height {P['height']:g}, {P['nx']} x {P['ny']} quads, p_x on the {P['p_x_face']} side, "
+        f"{P['free_end_nodes']} free end nodes, c_N = {P['c_N']:g}, plane {P['plane']}. Iteration 1 is the "
+        "initial state u = 0: its residual is the nodal load vector (top pressure and side traction; the "
+        "contact forces at g_N0 = -1e-12 are ~1e-8); no uniform mesh reproduces the printed first value. "
+        "(scan?): exponent garbled in the scan, value uncertain.",
+        "",
+        f"| iteration | paper conical | ours conical | paper parabolic | ours parabolic | ours Coulomb mu = {P['mu']:g} |",
+        "|---:|---:|---:|---:|---:|---:|",
+    ]
     for k in range(n):
-        lines.append(f"| {k + 1} | {cell(PAPER_TABLE1['conical'], k, 'conical')} | {cell(hist['conical'], k)} | "
-                     f"{cell(PAPER_TABLE1['parabolic'], k, 'parabolic')} | {cell(hist['parabolic'], k)} | "
-                     f"{cell(hist['coulomb'], k)} |")
-    lines += ["", f"Linear solves: paper conical {len(PAPER_TABLE1['conical']) - 1}, "
-              f"parabolic {len(PAPER_TABLE1['parabolic']) - 1}; ours conical "
-              f"{len(hist['conical']) - 1}, parabolic {len(hist['parabolic']) - 1}, Coulomb {len(hist['coulomb']) - 1}; "
-              f"Coulomb with the tangent without the c_N^s coupling (frozen): {len(hist['coulomb, frozen tangent']) - 1}; "
-              f"with the symmetrised tangent: {hist['verdict']['coulomb, symmetric tangent']}; residuals "
-              + ", ".join(f"{v:.2e}" for v in hist["coulomb, symmetric tangent"][:6]) + ", ...", ""]
+        lines.append(
+            f"| {k + 1} | {cell(PAPER_TABLE1['conical'], k, 'conical')} | {cell(hist['conical'], k)} | "
+            f"{cell(PAPER_TABLE1['parabolic'], k, 'parabolic')} | {cell(hist['parabolic'], k)} | "
+            f"{cell(hist['coulomb'], k)} |"
+        )
+    lines += [
+        "",
+        f"Linear solves: paper conical {len(PAPER_TABLE1['conical']) - 1}, "
+        f"parabolic {len(PAPER_TABLE1['parabolic']) - 1}; ours conical "
+        f"{len(hist['conical']) - 1}, parabolic {len(hist['parabolic']) - 1}, Coulomb {len(hist['coulomb']) - 1}; "
+        f"Coulomb with the tangent without the c_N^s coupling (frozen): {len(hist['coulomb, frozen tangent']) - 1}; "
+        f"with the symmetrised tangent: {hist['verdict']['coulomb, symmetric tangent']}; residuals "
+        + ", ".join(f"{v:.2e}" for v in hist["coulomb, symmetric tangent"][:6])
+        + ", ...",
+        "",
+    ]
     return "\n".join(lines)
 
 
@@ -324,20 +382,40 @@ def table1(preset="fast", outdir=None, results=None):
         ax.semilogy(k, paper, ":", color=color, lw=1)
         ax.semilogy(k[ok], paper[ok], "s", mfc="none", color=color, label=f"paper, {law}")
         if (~ok).any():
-            ax.semilogy(k[~ok], paper[~ok], "s", mfc="none", color=color, alpha=0.4,
-                        label=f"paper, {law}: exponent uncertain (scan?)")
+            ax.semilogy(
+                k[~ok],
+                paper[~ok],
+                "s",
+                mfc="none",
+                color=color,
+                alpha=0.4,
+                label=f"paper, {law}: exponent uncertain (scan?)",
+            )
         ours = hist[law]
-        ax.semilogy(np.arange(1, len(ours) + 1), ours, "-o", color=color,
-                    label=f"ours{' (FITTED reading)' if hist['fitted'] else ''}, {law}")
+        ax.semilogy(
+            np.arange(1, len(ours) + 1),
+            ours,
+            "-o",
+            color=color,
+            label=f"ours{' (FITTED reading)' if hist['fitted'] else ''}, {law}",
+        )
     for key, style in (("coulomb", "-^"), ("coulomb, frozen tangent", "--v")):
         ours = hist[key]
-        ax.semilogy(np.arange(1, len(ours) + 1), ours, style, color="tab:green" if key == "coulomb" else "0.5",
-                    label=f"ours, {key} (mu = {hist['parameters']['mu']:g})")
+        ax.semilogy(
+            np.arange(1, len(ours) + 1),
+            ours,
+            style,
+            color="tab:green" if key == "coulomb" else "0.5",
+            label=f"ours, {key} (mu = {hist['parameters']['mu']:g})",
+        )
     ax.set_xlabel("iteration (1 = initial state)")
     ax.set_ylabel("||G||")
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=7)
-    ax.set_title("Table 1: residual norm per Newton iteration, whole load in one step"
-                 + _fitted_line(dict(fitted=hist["fitted"])), fontsize=9)
+    ax.set_title(
+        "Table 1: residual norm per Newton iteration, whole load in one step"
+        + _fitted_line(dict(fitted=hist["fitted"])),
+        fontsize=9,
+    )
     data = {k: v for k, v in hist.items() if k != "parameters"}
     return [str(md), *save_figure(fig, Path(outdir) / "table1_block_newton_residuals.png", data, hist["parameters"])]

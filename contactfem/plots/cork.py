@@ -17,7 +17,6 @@ scene. The problem is axisymmetric (x = r, y = z); the drawings mirror the merid
 axis to show the whole cork and both sides of the neck.
 """
 
-
 import json
 import os
 from pathlib import Path
@@ -30,8 +29,16 @@ from . import cached_run, default_outdir, figure, pyplot, stored
 from .data import save_figure, write_data
 
 # the cork run's headline numbers, in the data of each of Figs 14-17 (the summary's row reads them)
-CORK_KEYS = ("exited", "exit_time_ms", "exit_velocity_m_s", "press_fit_normal_force_N", "press_fit_calibrated",
-             "breakaway_pressure_static_MPa", "applied_pressure_MPa", "breakaway_margin_MPa")
+CORK_KEYS = (
+    "exited",
+    "exit_time_ms",
+    "exit_velocity_m_s",
+    "press_fit_normal_force_N",
+    "press_fit_calibrated",
+    "breakaway_pressure_static_MPa",
+    "applied_pressure_MPa",
+    "breakaway_margin_MPa",
+)
 
 
 def cork_data(r, *keys):
@@ -52,8 +59,7 @@ def _geometry(params):
     from ..bodies.meshes import cork_mesh
 
     P = params
-    mesh = cork_mesh(P["R_tip"], P["R_cork"], P["L_neck"], P["L_neck"] + P["r_mouth"] + P["L_head"],
-                     P["n_r"], P["n_z"])
+    mesh = cork_mesh(P["R_tip"], P["R_cork"], P["L_neck"], P["L_neck"] + P["r_mouth"] + P["L_head"], P["n_r"], P["n_z"])
     neck = bottle_neck(P["R_neck"], P["L_neck"], P["r_mouth"], z_low=-P["gas_column"])
     return mesh, neck
 
@@ -72,7 +78,7 @@ def draw_neck(ax, neck, gas_column=None):
     for sign in (1.0, -1.0):
         ax.plot(sign * P[:, 0], P[:, 1], color="0.25", lw=2.0)
     if gas_column is not None:
-        R_neck = P[0, 0]                             # the wall's radius: the neck's first point
+        R_neck = P[0, 0]  # the wall's radius: the neck's first point
         ax.fill_between([-R_neck, R_neck], -gas_column, 0.0, color="#cfe3f5", zorder=0)
 
 
@@ -87,15 +93,24 @@ def fig14_cork_mesh(preset="fast", outdir=None, r=None):
     draw_neck(axes[1], neck, r["parameters"]["gas_column"])
     draw_mesh(axes[1], mesh, np.asarray(r["snapshots_x"][0]))
     fitted = "fitted through R_tip" if r.get("press_fit_calibrated") else "R_tip not the fitted value"
-    axes[1].set_title(f"pressed in: normal force {r['press_fit_normal_force_N']:.0f} N (paper ~2500 N)\n"
-                      f"{fitted}; static breakaway margin {r['breakaway_margin_MPa']:+.3f} MPa", fontsize=10)
+    axes[1].set_title(
+        f"pressed in: normal force {r['press_fit_normal_force_N']:.0f} N (paper ~2500 N)\n"
+        f"{fitted}; static breakaway margin {r['breakaway_margin_MPa']:+.3f} MPa",
+        fontsize=10,
+    )
     for ax in axes:
         ax.set_aspect("equal")
         ax.set_xlabel("r (mm)")
     axes[0].set_ylabel("z (mm)")
     fig.suptitle(f"Fig 14: the cork (axisymmetric, the meridian mirrored; R_tip = {r['parameters']['R_tip']:g} mm)")
-    return _save(fig, r, outdir, preset, "fig14_cork_mesh",
-                 dict(cork_data(r, "n_elements"), x_free=mesh.p.T, x_pressed=r["snapshots_x"][0]))
+    return _save(
+        fig,
+        r,
+        outdir,
+        preset,
+        "fig14_cork_mesh",
+        dict(cork_data(r, "n_elements"), x_free=mesh.p.T, x_pressed=r["snapshots_x"][0]),
+    )
 
 
 @figure("fig15_cork_configurations", "Fig 15")
@@ -115,10 +130,18 @@ def fig15_cork_configurations(preset="fast", outdir=None, r=None):
         ax.set_ylim(-4, top + 2)
         ax.set_xticks([])
     v = r["exit_velocity_m_s"]
-    fig.suptitle("Fig 15: the cork leaving the bottle"
-                 + (f"; exit velocity {v:.1f} m/s (paper ~28 m/s)" if v is not None else "; it did not leave"))
-    return _save(fig, r, outdir, preset, "fig15_cork_configurations",
-                 cork_data(r, "snapshot_times_ms", "snapshot_paper_times_ms", "snapshots_x"))
+    fig.suptitle(
+        "Fig 15: the cork leaving the bottle"
+        + (f"; exit velocity {v:.1f} m/s (paper ~28 m/s)" if v is not None else "; it did not leave")
+    )
+    return _save(
+        fig,
+        r,
+        outdir,
+        preset,
+        "fig15_cork_configurations",
+        cork_data(r, "snapshot_times_ms", "snapshot_paper_times_ms", "snapshots_x"),
+    )
 
 
 @figure("fig16_cork_pressure", "Fig 16")
@@ -132,15 +155,25 @@ def fig16_cork_pressure(preset="fast", outdir=None, r=None):
     P = r["parameters"]
     p0 = P["p_step"] * P["n_ramp"]
     L, gas = P["L_neck"], P["gas_column"]
-    ax.axhline(p0 * gas / (gas + L), color="C3", ls=":", lw=1,
-               label=f"Boyle at {L:g} mm travel: {p0:g} * {gas:g}/{gas + L:g} = {p0 * gas / (gas + L):.3g} MPa")
+    ax.axhline(
+        p0 * gas / (gas + L),
+        color="C3",
+        ls=":",
+        lw=1,
+        label=f"Boyle at {L:g} mm travel: {p0:g} * {gas:g}/{gas + L:g} = {p0 * gas / (gas + L):.3g} MPa",
+    )
     ax.set_xlabel("time (ms)")
     ax.set_ylabel("p (MPa)")
     ax.set_title("Fig 16: the pressure on the cork")
     ax.legend(fontsize=8)
-    return _save(fig, r, outdir, preset, "fig16_cork_pressure",
-                 dict(cork_data(r, "gas_release_time_ms", "time_ms", "pressure_MPa"),
-                      boyle_pressure_MPa=p0 * gas / (gas + L)))
+    return _save(
+        fig,
+        r,
+        outdir,
+        preset,
+        "fig16_cork_pressure",
+        dict(cork_data(r, "gas_release_time_ms", "time_ms", "pressure_MPa"), boyle_pressure_MPa=p0 * gas / (gas + L)),
+    )
 
 
 @figure("fig17_cork_displacement", "Fig 17")
@@ -156,8 +189,14 @@ def fig17_cork_displacement(preset="fast", outdir=None, r=None):
     ax.set_ylabel("axial displacement (mm)")
     ax.set_title("Fig 17: the displacement of the cork")
     ax.legend(fontsize=8)
-    return _save(fig, r, outdir, preset, "fig17_cork_displacement",
-                 cork_data(r, "time_ms", "displacement_bottom_mm", "displacement_cm_mm", "displacement_top_mm"))
+    return _save(
+        fig,
+        r,
+        outdir,
+        preset,
+        "fig17_cork_displacement",
+        cork_data(r, "time_ms", "displacement_bottom_mm", "displacement_cm_mm", "displacement_top_mm"),
+    )
 
 
 # The sensitivity study of lecture 08: one reconstructed datum changed at a time, each
@@ -169,18 +208,22 @@ SENSITIVITY = (
     ("rho = 2.4e-10 (240 kg/m^3, lighter)", {"rho": 2.4e-10}),
     ("R_tip = 10.5 mm (less taper)", {"R_tip": 10.5}),
 )
-P0_STEPS = (8, 9)      # n_ramp: p0 = 0.8 MPa (paper) and 0.9 MPa
+P0_STEPS = (8, 9)  # n_ramp: p0 = 0.8 MPa (paper) and 0.9 MPa
 
 
 def _case(preset, over):
     """Exit velocity (m/s), 'stays in', or 'solver failed: ...' for one run."""
     try:
         r = result(preset, **over)
-    except Exception as err:                        # a NewtonError is a row of the table, not hidden
+    except Exception as err:  # a NewtonError is a row of the table, not hidden
         return dict(v=f"solver failed ({type(err).__name__})", F=None, p=None, exit_velocity_m_s=None)
     v = f"{r['exit_velocity_m_s']:.1f}" if r["exited"] else "stays in"
-    return dict(v=v, F=r["press_fit_normal_force_N"], p=r["breakaway_pressure_MPa"],
-                exit_velocity_m_s=r["exit_velocity_m_s"] if r["exited"] else None)
+    return dict(
+        v=v,
+        F=r["press_fit_normal_force_N"],
+        p=r["breakaway_pressure_MPa"],
+        exit_velocity_m_s=r["exit_velocity_m_s"] if r["exited"] else None,
+    )
 
 
 def sensitivity_runs(preset="fast", cases=SENSITIVITY, jobs=2):
@@ -203,7 +246,7 @@ def sensitivity_rows(preset="fast", cases=SENSITIVITY, jobs=2, runs=None):
     out = runs or sensitivity_runs(preset, cases, jobs)
     rows = []
     for i, (label, _) in enumerate(cases):
-        res = out[i * len(P0_STEPS):(i + 1) * len(P0_STEPS)]
+        res = out[i * len(P0_STEPS) : (i + 1) * len(P0_STEPS)]
         F = next((x["F"] for x in res if x["F"] is not None), None)
         rows.append((label, F, [x["v"] for x in res]))
     return rows
@@ -229,9 +272,20 @@ def table_cork_sensitivity(preset="fast", outdir=None):
     path.parent.mkdir(parents=True, exist_ok=True)
     runs = sensitivity_runs(preset)
     path.write_text(sensitivity_markdown(sensitivity_rows(preset, runs=runs), preset))
-    data = dict(preset=preset, runs=[dict(case=x["case"], overrides=x["overrides"], exit_velocity_m_s=x["exit_velocity_m_s"],
-                                          outcome=x["v"], press_fit_normal_force_N=x["F"],
-                                          breakaway_pressure_MPa=x["p"]) for x in runs])
+    data = dict(
+        preset=preset,
+        runs=[
+            dict(
+                case=x["case"],
+                overrides=x["overrides"],
+                exit_velocity_m_s=x["exit_velocity_m_s"],
+                outcome=x["v"],
+                press_fit_normal_force_N=x["F"],
+                breakaway_pressure_MPa=x["p"],
+            )
+            for x in runs
+        ],
+    )
     parameters = dict(get_scene("cork").resolve(preset), cases=dict(SENSITIVITY), n_ramp=P0_STEPS)
     return [str(path), write_data(path.with_suffix(".json"), data, parameters)]
 
@@ -242,12 +296,18 @@ def table_cork_sensitivity(preset="fast", outdir=None):
 # made at a few points. The runs use the fast preset: the paper's mesh and press fit (the same
 # margin) with coarser steps around the exit. CONTACTFEM_SLOW=1: the full grid.
 KNIFE_PRESET = "fast"
-KNIFE_GRID = dict(mu=(0.095, 0.1, 0.105), R_tip=(10.0, 10.05, 10.1),
-                  runs=((0.095, 10.0), (0.1, 10.0), (0.105, 10.0), (0.1, 10.05), (0.1, 10.1)),
-                  p0=(0.78, 0.8, 0.84))
-KNIFE_GRID_SLOW = dict(mu=(0.09, 0.095, 0.0975, 0.1, 0.1025, 0.105, 0.11),
-                       R_tip=(10.0, 10.025, 10.05, 10.1, 10.15, 10.2),
-                       runs="all", p0=(0.72, 0.76, 0.78, 0.79, 0.8, 0.82, 0.84, 0.88))
+KNIFE_GRID = dict(
+    mu=(0.095, 0.1, 0.105),
+    R_tip=(10.0, 10.05, 10.1),
+    runs=((0.095, 10.0), (0.1, 10.0), (0.105, 10.0), (0.1, 10.05), (0.1, 10.1)),
+    p0=(0.78, 0.8, 0.84),
+)
+KNIFE_GRID_SLOW = dict(
+    mu=(0.09, 0.095, 0.0975, 0.1, 0.1025, 0.105, 0.11),
+    R_tip=(10.0, 10.025, 10.05, 10.1, 10.15, 10.2),
+    runs="all",
+    p0=(0.72, 0.76, 0.78, 0.79, 0.8, 0.82, 0.84, 0.88),
+)
 
 
 def knife_grid():
@@ -261,7 +321,7 @@ def _margin_case(preset, over):
 
     try:
         return dict(over, **stored(press_fit_only)(get_scene("cork").resolve(preset, over)), error=None)
-    except Exception as err:                        # a failed press fit is a point of the figure, not hidden
+    except Exception as err:  # a failed press fit is a point of the figure, not hidden
         return dict(over, breakaway_margin_MPa=None, error=type(err).__name__)
 
 
@@ -271,8 +331,14 @@ def _run_case(preset, over):
         r = result(preset, **over)
     except Exception as err:
         return dict(over, exited=None, v=None, margin=None, error=type(err).__name__)
-    return dict(over, exited=bool(r["exited"]), v=r["exit_velocity_m_s"], margin=r["breakaway_margin_MPa"],
-                force=r["press_fit_normal_force_N"], error=None)
+    return dict(
+        over,
+        exited=bool(r["exited"]),
+        v=r["exit_velocity_m_s"],
+        margin=r["breakaway_margin_MPa"],
+        force=r["press_fit_normal_force_N"],
+        error=None,
+    )
 
 
 def knife_edge_data(preset=KNIFE_PRESET, grid=None, jobs=2):
@@ -280,8 +346,9 @@ def knife_edge_data(preset=KNIFE_PRESET, grid=None, jobs=2):
     p0 (n_ramp = 8, p_step = p0 / 8) at the fitted mu, R_tip. Returns dict(field, runs, p0, preset)."""
     g = grid or knife_grid()
     field = [dict(mu=m, R_tip=R) for m in g["mu"] for R in g["R_tip"]]
-    runs = [dict(mu=m, R_tip=R) for m, R in (g["runs"] if g["runs"] != "all" else
-                                             [(f["mu"], f["R_tip"]) for f in field])]
+    runs = [
+        dict(mu=m, R_tip=R) for m, R in (g["runs"] if g["runs"] != "all" else [(f["mu"], f["R_tip"]) for f in field])
+    ]
     line = [dict(p_step=p0 / 8.0, n_ramp=8) for p0 in g["p0"]]
     todo = [(_margin_case, o) for o in field] + [(_run_case, o) for o in runs + line]
     try:
@@ -291,9 +358,9 @@ def knife_edge_data(preset=KNIFE_PRESET, grid=None, jobs=2):
     else:
         out = Parallel(n_jobs=jobs)(delayed(fn)(preset, o) for fn, o in todo)
     nf, nr = len(field), len(runs)
-    for o in out[nf + nr:]:
+    for o in out[nf + nr :]:
         o["p0"] = o["p_step"] * o["n_ramp"]
-    return dict(field=out[:nf], runs=out[nf:nf + nr], p0=out[nf + nr:], preset=preset)
+    return dict(field=out[:nf], runs=out[nf : nf + nr], p0=out[nf + nr :], preset=preset)
 
 
 @figure("cork_knife_edge", "Sec 5.5")
@@ -335,8 +402,11 @@ def cork_knife_edge(preset="fast", outdir=None, data=None):
     ax.set_xlabel("friction coefficient mu (paper: 0.1)")
     ax.set_ylabel("R_tip (mm); 10 fitted to the paper's ~2500 N")
     n_out = sum(1 for o in d["runs"] if o["exited"])
-    ax.set_title(f"p0 = 0.8 MPa: the cork leaves in {n_out} of {len(d['runs'])} runs; black line: margin 0\n"
-                 "(static breakaway = applied pressure); square: the fitted point", fontsize=9)
+    ax.set_title(
+        f"p0 = 0.8 MPa: the cork leaves in {n_out} of {len(d['runs'])} runs; black line: margin 0\n"
+        "(static breakaway = applied pressure); square: the fitted point",
+        fontsize=9,
+    )
     line = sorted(d["p0"], key=lambda o: o["p0"])
     ok = [o for o in line if o["error"] is None]
     ap.plot([o["p0"] for o in ok], [o["v"] if o["exited"] else 0.0 for o in ok], "o:", color="tab:green", lw=0.8)
@@ -348,20 +418,32 @@ def cork_knife_edge(preset="fast", outdir=None, data=None):
             ap.annotate("solver failed", (o["p0"], 0.0), fontsize=8, xytext=(0, 16), textcoords="offset points")
     static = [o["p0"] - o["margin"] for o in ok]
     if static:
-        ap.axvline(np.mean(static), color="k", ls="--", lw=1,
-                   label=f"static breakaway mu N / (pi R^2) = {np.mean(static):.3f} MPa")
+        ap.axvline(
+            np.mean(static),
+            color="k",
+            ls="--",
+            lw=1,
+            label=f"static breakaway mu N / (pi R^2) = {np.mean(static):.3f} MPa",
+        )
     ap.axhline(28.0, color="0.5", ls=":", lw=1, label="paper: ~28 m/s at 0.8 MPa")
     ap.set_xlabel("applied pressure p0 (MPa); mu = 0.1, R_tip = 10 mm")
     ap.set_ylabel("exit velocity (m/s); 0: stays in")
     ap.legend(fontsize=8, loc="center right")
     ap.set_title("over the applied pressure", fontsize=9)
-    fig.suptitle(f"The cork's knife edge (preset {d['preset']}: the paper's mesh and press fit). "
-                 "The press-fit force is fitted through R_tip", fontsize=10)
+    fig.suptitle(
+        f"The cork's knife edge (preset {d['preset']}: the paper's mesh and press fit). "
+        "The press-fit force is fitted through R_tip",
+        fontsize=10,
+    )
     fig.tight_layout()
     from ..scenes import get_scene
 
-    return save_figure(fig, Path(outdir or default_outdir(preset)) / "cork_knife_edge.png", d,
-                       dict(get_scene("cork").resolve(d["preset"]), grid=knife_grid()))
+    return save_figure(
+        fig,
+        Path(outdir or default_outdir(preset)) / "cork_knife_edge.png",
+        d,
+        dict(get_scene("cork").resolve(d["preset"]), grid=knife_grid()),
+    )
 
 
 # The exit time. The paper reports the exit "between 2.6 and 2.7 ms"; what moves ours? The
@@ -374,7 +456,7 @@ def cork_knife_edge(preset="fast", outdir=None, data=None):
 # the press fit refined eightfold, one refined time step; CONTACTFEM_SLOW=1: every case.
 EXIT_PRESET = "paper"
 _ON, _OFF = (True, True), (False, False)
-_RAMP = 1e-4          # s: the paper's ramp, 8 steps of 0.1 MPa every 0.1 ms, kept when dt is refined
+_RAMP = 1e-4  # s: the paper's ramp, 8 steps of 0.1 MPa every 0.1 ms, kept when dt is refined
 _STEP = "time step in the neck (ramp kept)"
 EXIT_CASES_QUICK = (
     # group, label, scene overrides, (closing step in the press fit, in the pop), ramp step (s)
@@ -388,17 +470,24 @@ EXIT_CASES_QUICK = (
 )
 EXIT_CASES_SLOW = EXIT_CASES_QUICK + (
     ("closing step", "closing step in the pop only", {}, (False, True), None),
-    *(("press-fit increments", f"n_press = {n}", {"n_press": n}, rule, None)
-      for n in (40, 80) for rule in (_ON, _OFF)),
+    *(("press-fit increments", f"n_press = {n}", {"n_press": n}, rule, None) for n in (40, 80) for rule in (_ON, _OFF)),
     *((_STEP, f"dt = {dt:g} s", {"dt": dt}, rule, _RAMP) for dt in (5e-5, 1.25e-5) for rule in (_ON, _OFF)),
-    *((_STEP, f"dt = 2.5e-05 s, n_press = {n}", {"dt": 2.5e-5, "n_press": n}, rule, _RAMP)
-      for n in (40, 80) for rule in (_ON, _OFF)),
-    *(("steps near the exit", f"{k} = {v:g}", {k: v}, rule, None)
-      for k, v in (("dt_fine", 2.5e-6), ("dt_fine", 1e-5), ("travel_max", 0.25), ("travel_max", 1.0))
-      for rule in (_ON, _OFF)),
+    *(
+        (_STEP, f"dt = 2.5e-05 s, n_press = {n}", {"dt": 2.5e-5, "n_press": n}, rule, _RAMP)
+        for n in (40, 80)
+        for rule in (_ON, _OFF)
+    ),
+    *(
+        ("steps near the exit", f"{k} = {v:g}", {k: v}, rule, None)
+        for k, v in (("dt_fine", 2.5e-6), ("dt_fine", 1e-5), ("travel_max", 0.25), ("travel_max", 1.0))
+        for rule in (_ON, _OFF)
+    ),
     *(("stick stiffness", f"c_T = {c:g}", {"c_T": c}, rule, None) for c in (5.0, 20.0) for rule in (_ON, _OFF)),
-    *(("breakaway margin", f"{k} = {v:g}", {k: v}, rule, None)
-      for k, v in (("mu", 0.098), ("mu", 0.102), ("R_tip", 10.02)) for rule in (_ON, _OFF)),
+    *(
+        ("breakaway margin", f"{k} = {v:g}", {k: v}, rule, None)
+        for k, v in (("mu", 0.098), ("mu", 0.102), ("R_tip", 10.02))
+        for rule in (_ON, _OFF)
+    ),
 )
 
 
@@ -418,31 +507,52 @@ def exit_case(case, preset=EXIT_PRESET):
     from ..scenes.cork_stages import pop, press_fit, stage_systems
 
     group, label, over, (fit_rule, pop_rule), ramp = case
-    row = dict(group=group, label=label, overrides=dict(over), closing_step_press_fit=fit_rule,
-               closing_step_pop=pop_rule, ramp_step_s=ramp)
+    row = dict(
+        group=group,
+        label=label,
+        overrides=dict(over),
+        closing_step_press_fit=fit_rule,
+        closing_step_pop=pop_rule,
+        ramp_step_s=ramp,
+    )
     try:
         P = get_scene("cork").resolve(preset, over)
         model = build(P)
         if ramp is not None:
             model.parts["gas"].dt_ramp = ramp
         contacts = model.parts["contacts"]
-        model = replace(model, systems=stage_systems(model.parts, P, contacts=(
-            [c.with_closing_step(fit_rule) for c in contacts], [c.with_closing_step(pop_rule) for c in contacts])))
+        model = replace(
+            model,
+            systems=stage_systems(
+                model.parts,
+                P,
+                contacts=(
+                    [c.with_closing_step(fit_rule) for c in contacts],
+                    [c.with_closing_step(pop_rule) for c in contacts],
+                ),
+            ),
+        )
         fit_last, _ = press_fit(model, P)
         records, pressures, exit_time, gas = pop(model, P, fit_last.u, histories=fit_last.state.contacts)
-    except Exception as err:                        # a failed run is a row of the study, not hidden
+    except Exception as err:  # a failed run is a row of the study, not hidden
         return dict(row, exited=None, error=f"{type(err).__name__}: {str(err).splitlines()[0][:100]}")
     exited = bool(gas.released and records[-1].contacts[0].n_active == 0)
     h = history(model, dict(records=records, pressures=pressures))
     t_ramp = P["n_ramp"] * (ramp or P["dt"])
     after = np.flatnonzero(h["t"] > t_ramp * (1 + 1e-9))
     k = after[np.argmin(h["v_cm"][after])]
-    return dict(row, exited=exited, error=None,
-                exit_time_ms=exit_time * 1e3 if exited else None,
-                exit_velocity_m_s=float(h["v_cm"][-1]) if exited else None,
-                press_fit_normal_force_N=contact_forces(fit_last.contacts)["normal"],
-                v_min_after_ramp_m_s=float(h["v_cm"][k]), t_v_min_ms=float(h["t"][k] * 1e3),
-                steps=int(len(h["t"]) - 1), newton_failures=sum(len(rec.failures) for rec in records))
+    return dict(
+        row,
+        exited=exited,
+        error=None,
+        exit_time_ms=exit_time * 1e3 if exited else None,
+        exit_velocity_m_s=float(h["v_cm"][-1]) if exited else None,
+        press_fit_normal_force_N=contact_forces(fit_last.contacts)["normal"],
+        v_min_after_ramp_m_s=float(h["v_cm"][k]),
+        t_v_min_ms=float(h["t"][k] * 1e3),
+        steps=int(len(h["t"]) - 1),
+        newton_failures=sum(len(rec.failures) for rec in records),
+    )
 
 
 def stored_exit_case(case, preset=EXIT_PRESET):
@@ -484,6 +594,7 @@ def exit_time_summary(d):
 
     def find(label, rl):
         return next((r for r in rows if r["label"] == label and rule(r) == rl), None)
+
     on, off = find("paper preset", _ON), find("without the closing step", _OFF)
     fit_only = find("closing step in the press fit only", (True, False))
     n_max = max(r["overrides"]["n_press"] for r in rows if r["group"] == "press-fit increments")
@@ -491,51 +602,70 @@ def exit_time_summary(d):
     refined = [r for r in rows if r["group"] == _STEP and "n_press" not in r["overrides"]]
     dt_min = min(r["overrides"]["dt"] for r in refined)
     fine = {name: find(f"dt = {dt_min:g} s", rl)["exit_time_ms"] for name, rl in (("with", _ON), ("without", _OFF))}
-    return dict(exit_ms=on["exit_time_ms"], exit_velocity_m_s=on["exit_velocity_m_s"],
-                exit_without_ms=off["exit_time_ms"], shift_ms=on["exit_time_ms"] - off["exit_time_ms"],
-                pop_rule_shift_ms=fit_only["exit_time_ms"] - on["exit_time_ms"],
-                n_press=paper["n_press"], n_press_refined=n_max,
-                press_fit_refined_ms=fit, dt_paper_s=paper["dt"], dt_refined_s=dt_min,
-                refined_ms=fine, paper_window_ms=(2.6, 2.7))
+    return dict(
+        exit_ms=on["exit_time_ms"],
+        exit_velocity_m_s=on["exit_velocity_m_s"],
+        exit_without_ms=off["exit_time_ms"],
+        shift_ms=on["exit_time_ms"] - off["exit_time_ms"],
+        pop_rule_shift_ms=fit_only["exit_time_ms"] - on["exit_time_ms"],
+        n_press=paper["n_press"],
+        n_press_refined=n_max,
+        press_fit_refined_ms=fit,
+        dt_paper_s=paper["dt"],
+        dt_refined_s=dt_min,
+        refined_ms=fine,
+        paper_window_ms=(2.6, 2.7),
+    )
 
 
 def exit_time_markdown(d):
     s = exit_time_summary(d)
     fit, ref = s["press_fit_refined_ms"], s["refined_ms"]
-    lines = ["# The cork's exit time: the closing step and the discretisation (paper preset)", "",
-             "Written by `contactfem figures --only cork_exit` (contactfem/plots/cork.py) with "
-             + ("every case (CONTACTFEM_SLOW=1)." if d["slow"] else "the quick profile (CONTACTFEM_SLOW=1: every case).")
-             + " The paper: exit between 2.6 and 2.7 ms at about 28 m/s.", "",
-             f"- At the paper's time step in the neck ({s['dt_paper_s']:g} s) and the preset's {s['n_press']} press-fit "
-             f"increments the cork leaves at {s['exit_ms']:.3f} ms with the closing step, at "
-             f"{s['exit_without_ms']:.3f} ms without it ({s['shift_ms']:+.3f} ms).",
-             f"- The rule acts through the press fit: with the closing step in the press fit only, the exit "
-             f"moves by {s['pop_rule_shift_ms']:+.1e} ms.",
-             f"- With the press fit refined to {s['n_press_refined']} increments both rules give {fit['with']:.3f} and "
-             f"{fit['without']:.3f} ms: the closing step is {abs(s['exit_ms'] - fit['with']):.3f} ms from that with "
-             f"{s['n_press']} increments, the rule without it {abs(s['exit_without_ms'] - fit['without']):.3f} ms "
-             "(it loads the stick springs of the nodes that touch during an increment with the travel "
-             "made before touching, an error of the increment's size).",
-             f"- With the time step in the neck refined to {s['dt_refined_s']:g} s (the pressure ramp kept at 8 x 0.1 ms) "
-             f"both rules give {ref['with']:.3f} and {ref['without']:.3f} ms: the paper's step leaves a "
-             f"time-discretisation error of {s['exit_ms'] - ref['with']:+.3f} ms in the stall after the ramp.",
-             "- The slowest speed after the ramp is that stall: the gas expands (Boyle), its pressure falls "
-             "below the static breakaway, the cork slows down; how far it slows sets the exit time.", "",
-             "| group | case | closing step (press fit, pop) | exit (ms) | exit velocity (m/s) | "
-             "slowest after the ramp (m/s, at ms) | press-fit force (N) | steps |",
-             "|---|---|---|---:|---:|---:|---:|---:|"]
+    lines = [
+        "# The cork's exit time: the closing step and the discretisation (paper preset)",
+        "",
+        "Written by `contactfem figures --only cork_exit` (contactfem/plots/cork.py) with "
+        + ("every case (CONTACTFEM_SLOW=1)." if d["slow"] else "the quick profile (CONTACTFEM_SLOW=1: every case).")
+        + " The paper: exit between 2.6 and 2.7 ms at about 28 m/s.",
+        "",
+        f"- At the paper's time step in the neck ({s['dt_paper_s']:g} s) and the preset's {s['n_press']} press-fit "
+        f"increments the cork leaves at {s['exit_ms']:.3f} ms with the closing step, at "
+        f"{s['exit_without_ms']:.3f} ms without it ({s['shift_ms']:+.3f} ms).",
+        f"- The rule acts through the press fit: with the closing step in the press fit only, the exit "
+        f"moves by {s['pop_rule_shift_ms']:+.1e} ms.",
+        f"- With the press fit refined to {s['n_press_refined']} increments both rules give {fit['with']:.3f} and "
+        f"{fit['without']:.3f} ms: the closing step is {abs(s['exit_ms'] - fit['with']):.3f} ms from that with "
+        f"{s['n_press']} increments, the rule without it {abs(s['exit_without_ms'] - fit['without']):.3f} ms "
+        "(it loads the stick springs of the nodes that touch during an increment with the travel "
+        "made before touching, an error of the increment's size).",
+        f"- With the time step in the neck refined to {s['dt_refined_s']:g} s (the pressure ramp kept at 8 x 0.1 ms) "
+        f"both rules give {ref['with']:.3f} and {ref['without']:.3f} ms: the paper's step leaves a "
+        f"time-discretisation error of {s['exit_ms'] - ref['with']:+.3f} ms in the stall after the ramp.",
+        "- The slowest speed after the ramp is that stall: the gas expands (Boyle), its pressure falls "
+        "below the static breakaway, the cork slows down; how far it slows sets the exit time.",
+        "",
+        "| group | case | closing step (press fit, pop) | exit (ms) | exit velocity (m/s) | "
+        "slowest after the ramp (m/s, at ms) | press-fit force (N) | steps |",
+        "|---|---|---|---:|---:|---:|---:|---:|",
+    ]
     onoff = {True: "on", False: "off"}
     for r in d["cases"]:
         if r["error"]:
             tail = f"| {r['error']} | | | | |"
         elif r["exited"]:
-            tail = (f"| {r['exit_time_ms']:.3f} | {r['exit_velocity_m_s']:.2f} | {r['v_min_after_ramp_m_s']:.2f} at "
-                    f"{r['t_v_min_ms']:.2f} | {r['press_fit_normal_force_N']:.1f} | {r['steps']} |")
+            tail = (
+                f"| {r['exit_time_ms']:.3f} | {r['exit_velocity_m_s']:.2f} | {r['v_min_after_ramp_m_s']:.2f} at "
+                f"{r['t_v_min_ms']:.2f} | {r['press_fit_normal_force_N']:.1f} | {r['steps']} |"
+            )
         else:
-            tail = (f"| stays in | - | {r['v_min_after_ramp_m_s']:.2f} at {r['t_v_min_ms']:.2f} | "
-                    f"{r['press_fit_normal_force_N']:.1f} | {r['steps']} |")
-        lines.append(f"| {r['group']} | {r['label']} | {onoff[r['closing_step_press_fit']]}, "
-                     f"{onoff[r['closing_step_pop']]} " + tail)
+            tail = (
+                f"| stays in | - | {r['v_min_after_ramp_m_s']:.2f} at {r['t_v_min_ms']:.2f} | "
+                f"{r['press_fit_normal_force_N']:.1f} | {r['steps']} |"
+            )
+        lines.append(
+            f"| {r['group']} | {r['label']} | {onoff[r['closing_step_press_fit']]}, "
+            f"{onoff[r['closing_step_pop']]} " + tail
+        )
     return "\n".join(lines) + "\n"
 
 
@@ -563,8 +693,13 @@ def cork_exit_time(preset="fast", outdir=None, data=None):
             ax.plot(r["exit_time_ms"], y, ls="none", **style)
         else:
             ax.plot(t_max + 0.1, y, ls="none", **dict(style, marker=">"))
-            ax.annotate("stays in" if r["error"] is None else "failed", (t_max + 0.1, y), fontsize=7,
-                        xytext=(6, -3), textcoords="offset points")
+            ax.annotate(
+                "stays in" if r["error"] is None else "failed",
+                (t_max + 0.1, y),
+                fontsize=7,
+                xytext=(6, -3),
+                textcoords="offset points",
+            )
     ax.plot([], [], "o", color="tab:blue", label="closing step in the press fit (the code)")
     ax.plot([], [], "o", color="tab:orange", mfc="none", label="without it in the press fit")
     ax.set_yticks(range(len(labels)))
@@ -574,10 +709,13 @@ def cork_exit_time(preset="fast", outdir=None, data=None):
     ax.set_xlim(t_min, t_max + 0.3)
     ax.grid(axis="x", alpha=0.3)
     ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
-    ax.set_title(f"The cork's exit time (paper preset): {s['exit_ms']:.2f} ms with the closing step, "
-                 f"{s['exit_without_ms']:.2f} without; with the press fit refined\n({s['n_press_refined']} "
-                 f"increments) both give {s['press_fit_refined_ms']['with']:.2f} ms, with the time step in the neck "
-                 f"refined ({s['dt_refined_s']:g} s) {s['refined_ms']['with']:.2f} ms", fontsize=9)
+    ax.set_title(
+        f"The cork's exit time (paper preset): {s['exit_ms']:.2f} ms with the closing step, "
+        f"{s['exit_without_ms']:.2f} without; with the press fit refined\n({s['n_press_refined']} "
+        f"increments) both give {s['press_fit_refined_ms']['with']:.2f} ms, with the time step in the neck "
+        f"refined ({s['dt_refined_s']:g} s) {s['refined_ms']['with']:.2f} ms",
+        fontsize=9,
+    )
     fig.tight_layout()
     out = Path(outdir or default_outdir(EXIT_PRESET))
     out.mkdir(parents=True, exist_ok=True)

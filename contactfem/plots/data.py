@@ -68,8 +68,12 @@ def figure_record(stem, data, parameters):
     clash = [k for k in data if k in RESERVED]
     if clash:
         raise ValueError(f"figure data of {stem} uses the reserved key(s) {', '.join(clash)}")
-    return dict(figure=stem, code_version=code_version(), parameters=jsonable(parameters or {}),
-                **jsonable(dict(data), where=stem))
+    return dict(
+        figure=stem,
+        code_version=code_version(),
+        parameters=jsonable(parameters or {}),
+        **jsonable(dict(data), where=stem),
+    )
 
 
 def write_data(path_json, data, parameters):
@@ -145,8 +149,12 @@ def _compare(a, b, where, rtol, scale, out):
         s = _scale(a + b) if scale is None else scale
         for i, (x, y) in enumerate(zip(a, b)):
             _compare(x, y, f"{where}[{i}]", rtol, s, out)
-    elif (isinstance(a, (int, float)) and isinstance(b, (int, float))
-          and not isinstance(a, bool) and not isinstance(b, bool)):
+    elif (
+        isinstance(a, (int, float))
+        and isinstance(b, (int, float))
+        and not isinstance(a, bool)
+        and not isinstance(b, bool)
+    ):
         if _number_differs(a, b, rtol, scale or 0.0):
             out.append(f"{where}: {a!r} in the file, {b!r} from the run")
     elif a != b:

@@ -10,7 +10,6 @@ the centre against time. Panel (b) stops when the centre is back at its starting
 Each draws a result it is given (``r=``: a lecture's own time loop) or runs the scene.
 """
 
-
 from pathlib import Path
 
 import numpy as np
@@ -19,8 +18,21 @@ from . import cached_run, default_outdir, figure, pyplot
 from .data import save_figure
 
 # what Figs 12-13 show of a run: the outcome (headline) and the drawn series
-FUNNEL_KEYS = ("variant", "stuck", "v_c_final", "max_deformation", "y_c_start", "y_c_min", "t_y_c_min", "t", "y_c",
-               "v_c", "outline_t", "outlines", "wall")
+FUNNEL_KEYS = (
+    "variant",
+    "stuck",
+    "v_c_final",
+    "max_deformation",
+    "y_c_start",
+    "y_c_min",
+    "t_y_c_min",
+    "t",
+    "y_c",
+    "v_c",
+    "outline_t",
+    "outlines",
+    "wall",
+)
 
 
 def funnel_data(r):
@@ -40,7 +52,7 @@ def draw_funnel(r, title):
     plt = pyplot()
     fig, axes = plt.subplots(1, 3, figsize=(13, 5.2), gridspec_kw=dict(width_ratios=[1, 1, 1.1]))
     wall = np.asarray(r["wall"])
-    both = np.vstack([wall, wall[::-1] * [-1, 1]])          # left wall, vertex, mirrored right wall
+    both = np.vstack([wall, wall[::-1] * [-1, 1]])  # left wall, vertex, mirrored right wall
     outlines, times = np.asarray(r["outlines"]), np.asarray(r["outline_t"])
     top = wall[:, 1].max()
     t_low = r["t_y_c_min"]
@@ -48,9 +60,10 @@ def draw_funnel(r, title):
     t, y_c = np.asarray(r["t"]), np.asarray(r["y_c"])
     back = np.flatnonzero((t > t_low) & (y_c >= r["y_c_start"]))
     t_end = t[back[0]] if back.size else t[-1]
-    for ax, part, label in ((axes[0], times <= t_low + 1e-9, "(a) falling in"),
-                            (axes[1], (times >= t_low - 1e-9) & (times <= t_end + 1e-9),
-                             "(b) after the deepest point")):
+    for ax, part, label in (
+        (axes[0], times <= t_low + 1e-9, "(a) falling in"),
+        (axes[1], (times >= t_low - 1e-9) & (times <= t_end + 1e-9), "(b) after the deepest point"),
+    ):
         sel = np.flatnonzero(part & (outlines[:, :, 1].min(axis=1) < top))
         colors = plt.cm.viridis(np.linspace(0, 0.9, max(len(sel), 1)))
         for c, k in zip(colors, sel):
@@ -79,16 +92,23 @@ def draw_funnel(r, title):
 @figure("fig12_funnel_frictionless", "Fig 12")
 def fig12(preset="fast", outdir=None, r=None):
     r = r or result("frictionless", preset)
-    fig = draw_funnel(r, f"Fig 12: ring falling into a funnel, frictionless (funnel wall at "
-                         f"{r['parameters']['phi_deg']:g} deg from the vertical: chosen)")
-    return save_figure(fig, Path(outdir or default_outdir(preset)) / "fig12_funnel_frictionless.png", funnel_data(r),
-                       r["parameters"])
+    fig = draw_funnel(
+        r,
+        f"Fig 12: ring falling into a funnel, frictionless (funnel wall at "
+        f"{r['parameters']['phi_deg']:g} deg from the vertical: chosen)",
+    )
+    return save_figure(
+        fig, Path(outdir or default_outdir(preset)) / "fig12_funnel_frictionless.png", funnel_data(r), r["parameters"]
+    )
 
 
 @figure("fig13_funnel_frictional", "Fig 13")
 def fig13(preset="fast", outdir=None, r=None):
     r = r or result("frictional", preset)
     p = r["parameters"]
-    fig = draw_funnel(r, f"Fig 13: ring falling into a funnel, frictional eq (10): n = {p['n']:g}, "
-                         f"alpha = {p['alpha']:g}, beta = {p['beta']:g} (wall at {p['phi_deg']:g} deg: chosen)")
+    fig = draw_funnel(
+        r,
+        f"Fig 13: ring falling into a funnel, frictional eq (10): n = {p['n']:g}, "
+        f"alpha = {p['alpha']:g}, beta = {p['beta']:g} (wall at {p['phi_deg']:g} deg: chosen)",
+    )
     return save_figure(fig, Path(outdir or default_outdir(preset)) / "fig13_funnel_frictional.png", funnel_data(r), p)

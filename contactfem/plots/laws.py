@@ -26,6 +26,7 @@ def _save(fig, outdir, preset, stem, data, parameters):
 
 # -- formulas of Sec. 2 used only by the figures ------------------------------
 
+
 def true_contact_area_ratio(p_over_H, n):
     """Eq (3) (Tabor, Kragelski): A_r / A = (|t_N| / (A H))^n, with p_over_H = |t_N| / (A H)
     the nominal pressure over the hardness H; n in [2/3, 1] (2/3: elastic spherical
@@ -94,14 +95,19 @@ def associated_direction(law, t_N, t_T):
 
 # -- the figures ----------------------------------------------------------------
 
+
 @figure("fig01_true_contact_area", "Fig 1")
 def fig01_true_contact_area(preset="fast", outdir=None):
     """Fig 1: true contact area ratio vs dimensionless pressure, eq (3), log-log."""
     plt = pyplot()
     p = np.geomspace(1e-4, 1.0, 200)
     fig, ax = plt.subplots(figsize=(5.0, 4.0))
-    ns = ((2 / 3, "n = 2/3 (elastic, Tabor)"), (0.8, "n = 0.8"), (0.9, "n = 0.9 (Kragelski, elastic)"),
-          (1.0, "n = 1 (plastic, Meyer)"))
+    ns = (
+        (2 / 3, "n = 2/3 (elastic, Tabor)"),
+        (0.8, "n = 0.8"),
+        (0.9, "n = 0.9 (Kragelski, elastic)"),
+        (1.0, "n = 1 (plastic, Meyer)"),
+    )
     data = dict(p_over_H=p, area_ratio={label: true_contact_area_ratio(p, n) for n, label in ns})
     for n, label in ns:
         ax.loglog(p, data["area_ratio"][label], label=label)
@@ -130,24 +136,38 @@ def fig02_force_vs_microdisplacement(preset="fast", outdir=None):
     g = fig02_history() * g_stick
     fig, ax = plt.subplots(figsize=(5.5, 4.0))
     data = dict(g_T_over_g_stick=g / g_stick, t_T_over_mu_p={})
-    for law, label in ((Coulomb(c_T=c_T, mu=mu), "Coulomb, eq (11)"),
-                       (SlipHardening(c_T=c_T, mu=mu, h=5.0), "slip hardening, h = 5"),
-                       (SlipHardening(c_T=c_T, mu=mu, h=-5.0), "slip softening, h = -5")):
+    for law, label in (
+        (Coulomb(c_T=c_T, mu=mu), "Coulomb, eq (11)"),
+        (SlipHardening(c_T=c_T, mu=mu, h=5.0), "slip hardening, h = 5"),
+        (SlipHardening(c_T=c_T, mu=mu, h=-5.0), "slip softening, h = -5"),
+    ):
         t_T, state, _ = drive_slip_history(law, p, g)
         data["t_T_over_mu_p"][label] = t_T / (mu * p)
         ax.plot(g / g_stick, t_T / (mu * p), label=label)
     ax.axhline(1.0, color="0.6", lw=0.8, ls=":")
     ax.axhline(-1.0, color="0.6", lw=0.8, ls=":")
-    ax.annotate("zone 1: stick\n$t_T = c_T\\, g_T$ (eq 5)", xy=(0.5, 0.5), xytext=(0.9, 0.15),
-                arrowprops=dict(arrowstyle="->"), fontsize=8)
-    ax.annotate("zone 2: sliding\n$|t_T| = Y(|t_N|, q)$", xy=(2.2, 1.0), xytext=(1.6, 0.45),
-                arrowprops=dict(arrowstyle="->"), fontsize=8)
+    ax.annotate(
+        "zone 1: stick\n$t_T = c_T\\, g_T$ (eq 5)",
+        xy=(0.5, 0.5),
+        xytext=(0.9, 0.15),
+        arrowprops=dict(arrowstyle="->"),
+        fontsize=8,
+    )
+    ax.annotate(
+        "zone 2: sliding\n$|t_T| = Y(|t_N|, q)$",
+        xy=(2.2, 1.0),
+        xytext=(1.6, 0.45),
+        arrowprops=dict(arrowstyle="->"),
+        fontsize=8,
+    )
     ax.set_xlabel(r"micro-displacement $g_T / (\mu |t_N| / c_T)$")
     ax.set_ylabel(r"tangential force $t_T / (\mu |t_N|)$")
     ax.set_title("Fig 2: tangential force vs micro-displacement")
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="lower right")
-    return _save(fig, outdir, preset, "fig02_force_vs_microdisplacement", data, dict(c_T=c_T, mu=mu, p=p, h=[5.0, -5.0]))
+    return _save(
+        fig, outdir, preset, "fig02_force_vs_microdisplacement", data, dict(c_T=c_T, mu=mu, p=p, h=[5.0, -5.0])
+    )
 
 
 @figure("fig03_shear_vs_normal", "Fig 3")
@@ -159,8 +179,11 @@ def fig03_shear_vs_normal(preset="fast", outdir=None):
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(11.0, 4.2), layout="constrained")
     H, tau_0, beta = 1.0, 0.1, 0.2
     p_r = np.linspace(0.02, 1.0, 200) * H
-    data = dict(p_r_over_H=p_r / H, tau_over_H=junction_shear_strength(p_r, tau_0, beta) / H,
-                mu=friction_coefficient(p_r, tau_0, beta))
+    data = dict(
+        p_r_over_H=p_r / H,
+        tau_over_H=junction_shear_strength(p_r, tau_0, beta) / H,
+        mu=friction_coefficient(p_r, tau_0, beta),
+    )
     a1.plot(p_r / H, junction_shear_strength(p_r, tau_0, beta) / H, label=r"$\tau = \tau_0 + \beta p_r$ (eq 6)")
     a1.set_xlabel(r"real pressure $p_r / H$")
     a1.set_ylabel(r"shear strength $\tau / H$")
@@ -184,8 +207,14 @@ def fig03_shear_vs_normal(preset="fast", outdir=None):
     a2.legend(fontsize=8)
     fig.suptitle("Fig 3: shear vs normal stress")
     data["t_N_abs"] = p
-    return _save(fig, outdir, preset, "fig03_shear_vs_normal", data,
-                 dict(H=H, tau_0=tau_0, beta_junction=beta, alpha=alpha, beta=beta2, n=[1.0, 0.8, 0.5]))
+    return _save(
+        fig,
+        outdir,
+        preset,
+        "fig03_shear_vs_normal",
+        data,
+        dict(H=H, tau_0=tau_0, beta_junction=beta, alpha=alpha, beta=beta2, n=[1.0, 0.8, 0.5]),
+    )
 
 
 def fig04_geometry(law, t_N, t_T_trial):
@@ -198,9 +227,13 @@ def fig04_geometry(law, t_N, t_T_trial):
     d2 = (-p - t_N) ** 2 + (np.sign(t_T_trial) * Y - t_T_trial) ** 2
     k = int(np.argmin(d2))
     closest = np.array([-p[k], np.sign(t_T_trial) * Y[k]])
-    return dict(trial=np.array([t_N, t_T_trial]), nonassociated=np.array([t_N, fr.t_T[0]]),
-                state=int(fr.state[0]), closest=closest,
-                associated=associated_direction(law, np.array([closest[0]]), np.array([closest[1]]))[0])
+    return dict(
+        trial=np.array([t_N, t_T_trial]),
+        nonassociated=np.array([t_N, fr.t_T[0]]),
+        state=int(fr.state[0]),
+        closest=closest,
+        associated=associated_direction(law, np.array([closest[0]]), np.array([closest[1]]))[0],
+    )
 
 
 @figure("fig04_parabolic_slip_surface", "Fig 4")
@@ -226,13 +259,23 @@ def fig04_parabolic_slip_surface(preset="fast", outdir=None):
     ax.annotate("trial $t_T^{tr}$ (eq 42)", tr, xytext=(tr[0] + 0.12, tr[1] + 0.1), fontsize=8)
     ax.annotate("", xy=na, xytext=tr, arrowprops=dict(arrowstyle="->", color="C3", lw=2))
     ax.plot(*na, "o", color="C3")
-    ax.annotate("non-associated return\nalong $t_T$ (eq 14): $\\Delta g_N^s = 0$", na,
-                xytext=(na[0] + 0.12, na[1] + 0.35), fontsize=8, color="C3")
+    ax.annotate(
+        "non-associated return\nalong $t_T$ (eq 14): $\\Delta g_N^s = 0$",
+        na,
+        xytext=(na[0] + 0.12, na[1] + 0.35),
+        fontsize=8,
+        color="C3",
+    )
     ax.plot([tr[0], cl[0]], [tr[1], cl[1]], ":", color="C2")
     ax.annotate("", xy=cl + 0.8 * d, xytext=cl, arrowprops=dict(arrowstyle="->", color="C2", lw=2))
     ax.plot(*cl, "o", color="C2")
-    ax.annotate("associated $\\partial f/\\partial t$ (eq 13):\nnormal part, uplift", cl + 0.8 * d,
-                xytext=(-3.9, 2.15), fontsize=8, color="C2")
+    ax.annotate(
+        "associated $\\partial f/\\partial t$ (eq 13):\nnormal part, uplift",
+        cl + 0.8 * d,
+        xytext=(-3.9, 2.15),
+        fontsize=8,
+        color="C2",
+    )
     ax.axhline(0, color="k", lw=0.5)
     ax.axvline(0, color="k", lw=0.5)
     ax.set_xlim(-4.0, 0.6)
@@ -241,6 +284,11 @@ def fig04_parabolic_slip_surface(preset="fast", outdir=None):
     ax.set_ylabel(r"tangential traction $t_T$")
     ax.set_title(rf"Fig 4: parabolic slip surface, $\alpha = {law.alpha:g}$, $\beta = {law.beta:g}$")
     ax.legend(fontsize=7, loc="lower left")
-    return _save(fig, outdir, preset, "fig04_parabolic_slip_surface", dict(g, t_N_abs=p, slip_bound=Y, coulomb=Yc),
-                 dict(c_T=law.c_T, alpha=law.alpha, beta=law.beta, n=law.n, mu_coulomb=coul.mu, t_N=-2.0,
-                      t_T_trial=1.9))
+    return _save(
+        fig,
+        outdir,
+        preset,
+        "fig04_parabolic_slip_surface",
+        dict(g, t_N_abs=p, slip_bound=Y, coulomb=Yc),
+        dict(c_T=law.c_T, alpha=law.alpha, beta=law.beta, n=law.n, mu_coulomb=coul.mu, t_N=-2.0, t_T_trial=1.9),
+    )

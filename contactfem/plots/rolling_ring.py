@@ -12,7 +12,6 @@ Exact: the rigid thin hoop (scenes.rings.rigid_ring_exact): x* = 229.4 cm,
 v* = 150 cm/s, and x(2 s) = 376.5 cm.
 """
 
-
 from pathlib import Path
 
 import numpy as np
@@ -48,12 +47,17 @@ def convergence_study(preset="fast"):
 
     xj, vj = errs(joint)
     xs, vs = errs(steps)
-    return dict(n_el=np.array([n for n, _ in joint_refinement(preset)]),
-                dt_joint=np.array([dt for _, dt in joint_refinement(preset)]),
-                x_err_joint=xj, v_err_joint=vj,
-                dt_step=np.array(step_refinement(preset)), x_err_step=xs, v_err_step=vs,
-                iterations_joint=np.array([r["newton_iterations_total"] for r in joint]),
-                iterations_step=np.array([r["newton_iterations_total"] for r in steps]))
+    return dict(
+        n_el=np.array([n for n, _ in joint_refinement(preset)]),
+        dt_joint=np.array([dt for _, dt in joint_refinement(preset)]),
+        x_err_joint=xj,
+        v_err_joint=vj,
+        dt_step=np.array(step_refinement(preset)),
+        x_err_step=xs,
+        v_err_step=vs,
+        iterations_joint=np.array([r["newton_iterations_total"] for r in joint]),
+        iterations_step=np.array([r["newton_iterations_total"] for r in steps]),
+    )
 
 
 def slip_after_rolling(r):
@@ -66,10 +70,35 @@ def slip_after_rolling(r):
 
 
 # what Fig 9 shows of a run: its headline numbers (the run's own keys) and the drawn series
-FIG09_KEYS = ("kind", "rolled", "t_roll", "x_roll", "v_final", "omega_final", "x_end", "t_star_exact", "x_roll_exact",
-              "v_final_exact", "x_end_exact", "exact_mu", "rolling_radius", "t", "x_c", "y_c", "vx_c", "omega",
-              "slip_velocity", "vx_exact", "omega_exact", "outline_t", "outlines", "outline_vc", "outline_omega",
-              "outline_node_y", "outline_node_vx")
+FIG09_KEYS = (
+    "kind",
+    "rolled",
+    "t_roll",
+    "x_roll",
+    "v_final",
+    "omega_final",
+    "x_end",
+    "t_star_exact",
+    "x_roll_exact",
+    "v_final_exact",
+    "x_end_exact",
+    "exact_mu",
+    "rolling_radius",
+    "t",
+    "x_c",
+    "y_c",
+    "vx_c",
+    "omega",
+    "slip_velocity",
+    "vx_exact",
+    "omega_exact",
+    "outline_t",
+    "outlines",
+    "outline_vc",
+    "outline_omega",
+    "outline_node_y",
+    "outline_node_vx",
+)
 
 
 def fig09_data(r):
@@ -91,19 +120,19 @@ def draw_rolling(r, title):
     colors = plt.cm.viridis(np.linspace(0, 0.9, len(outlines)))
     for k, (P, t, c) in enumerate(zip(outlines, times, colors)):
         ax.plot(P[:, 0], P[:, 1], color=c, lw=1.0)
-        ax.text(P[:, 0].mean(), P[:, 1].max() + (3 if k % 2 == 0 else 11), f"{t:g} s",
-                ha="center", fontsize=7, color=c)
+        ax.text(P[:, 0].mean(), P[:, 1].max() + (3 if k % 2 == 0 else 11), f"{t:g} s", ha="center", fontsize=7, color=c)
     # velocity profiles as arrows on the vertical diameter (the paper's Fig 9), every 0.5 s
     a, prm = r["rolling_radius"], r["parameters"]
-    scale = 0.1                                            # cm of arrow per cm/s
+    scale = 0.1  # cm of arrow per cm/s
     for P, t, c, vc, om in zip(outlines, times, colors, r["outline_vc"], r["outline_omega"]):
         if abs(t / 0.5 - round(t / 0.5)) > 1e-6:
             continue
         xc, yc = P[:, 0].mean(), 0.5 * (P[:, 1].max() + P[:, 1].min())
         hh = yc + a * np.linspace(-1, 1, 5)
-        vx = vc[0] - om * (hh - yc)                        # rigid-body profile v + omega e3 x r
-        ax.quiver(np.full(5, xc), hh, scale * vx, np.zeros(5), angles="xy", scale_units="xy", scale=1,
-                  color=c, width=0.0025)
+        vx = vc[0] - om * (hh - yc)  # rigid-body profile v + omega e3 x r
+        ax.quiver(
+            np.full(5, xc), hh, scale * vx, np.zeros(5), angles="xy", scale_units="xy", scale=1, color=c, width=0.0025
+        )
         ax.plot([xc, xc], [hh[0], hh[-1]], color=c, lw=0.6)
     t = np.asarray(r["t"])
     ax.plot(r["x_c"], r["y_c"], "k:", lw=0.8)
@@ -112,20 +141,33 @@ def draw_rolling(r, title):
     ax.axhline(0.0, color="k", lw=1.0)
     if r["rolled"]:
         ax.plot([r["x_roll"]], [0], "r^", ms=10, label=f"rolling starts, computed x = {r['x_roll']:.1f} cm")
-    closed = r.get("x_roll_exact") is not None          # None: a friction law without a closed form
+    closed = r.get("x_roll_exact") is not None  # None: a friction law without a closed form
     if closed:
-        ax.plot([r["x_roll_exact"]], [0], "kv", ms=10, mfc="none",
-                label=f"exact (rigid thin ring) x* = {r['x_roll_exact']:.1f} cm")
-    ax.plot([r["x_end"]], [r["y_c"][-1]], "r+", ms=10,
-            label=f"centre at {t[-1]:g} s: {r['x_end']:.1f} cm" + (f" (exact {r['x_end_exact']:.1f})" if closed else ""))
+        ax.plot(
+            [r["x_roll_exact"]],
+            [0],
+            "kv",
+            ms=10,
+            mfc="none",
+            label=f"exact (rigid thin ring) x* = {r['x_roll_exact']:.1f} cm",
+        )
+    ax.plot(
+        [r["x_end"]],
+        [r["y_c"][-1]],
+        "r+",
+        ms=10,
+        label=f"centre at {t[-1]:g} s: {r['x_end']:.1f} cm" + (f" (exact {r['x_end_exact']:.1f})" if closed else ""),
+    )
     ax.set_xlim(x_lo, x_hi)
     ax.set_ylim(-8, outlines[:, :, 1].max() + 18)
     ax.set_aspect("equal")
     ax.set_xlabel("x [cm]")
     ax.set_ylabel("y [cm]")
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), fontsize=8, ncol=3)
-    ax.set_title(title + "\narrows: horizontal velocity on the vertical diameter "
-                 f"({1 / scale:g} cm/s per cm of arrow)", fontsize=10)
+    ax.set_title(
+        title + f"\narrows: horizontal velocity on the vertical diameter ({1 / scale:g} cm/s per cm of arrow)",
+        fontsize=10,
+    )
 
     # velocity profiles: horizontal velocity of the contact nodes against their height
     pick = np.unique(np.searchsorted(times, [0.0, 0.5, r["t_roll"] or 1.0, times[-1]]).clip(0, len(times) - 1))
@@ -135,10 +177,9 @@ def draw_rolling(r, title):
         ap.plot(vx, y, ".", color=c, ms=3)
         yc = np.mean(y)
         hh = np.linspace(yc - a, yc + a, 3)
-        if r.get("exact_mu") is not None:           # the rigid ring's profile (Coulomb friction)
+        if r.get("exact_mu") is not None:  # the rigid ring's profile (Coulomb friction)
             ex = rigid_ring_exact(prm["v0"], r["exact_mu"], prm["g"], prm["R"], t=[times[i]])
-            ap.plot(ex["v"][0] - ex["omega"][0] * (hh - yc), hh, "--", color=c, lw=1,
-                    label=f"t = {times[i]:.2f} s")
+            ap.plot(ex["v"][0] - ex["omega"][0] * (hh - yc), hh, "--", color=c, lw=1, label=f"t = {times[i]:.2f} s")
     ap.axvline(0.0, color="k", lw=0.6)
     ap.set_xlabel("horizontal velocity v_x [cm/s] (dots: nodes; dashed: rigid ring)")
     ap.set_ylabel("height y [cm]")
@@ -146,7 +187,9 @@ def draw_rolling(r, title):
     ap.grid(alpha=0.3)
     if r["rolled"]:
         s_late = slip_after_rolling(r)
-        verdict = f"once rolling, the contact point slips at most {s_late:.2g} cm/s ({100 * s_late / prm['v0']:.1g} % of v0)"
+        verdict = (
+            f"once rolling, the contact point slips at most {s_late:.2g} cm/s ({100 * s_late / prm['v0']:.1g} % of v0)"
+        )
     else:
         verdict = "the ring did not start rolling"
     ap.set_title("velocity profiles across the ring; " + verdict, fontsize=9)
@@ -174,9 +217,13 @@ def fig09(preset="fast", outdir=None, r=None, **overrides):
     with ``overrides``."""
     r = r or result(preset, **overrides)
     p, d = r["parameters"], fig09_data(r)
-    title = (f"Fig 9: ring sliding then rolling ({d['kind']}, {p['n_el']} elements, dt = {p['dt']:g} s, "
-             f"mu = {p['mu']:g}); v_final = {d['v_final']:.1f} cm/s (exact {d['v_final_exact']:.0f})")
-    stem = "fig09_rolling_ring" + ("" if not overrides else "_" + "_".join(f"{k}{v}" for k, v in sorted(overrides.items())))
+    title = (
+        f"Fig 9: ring sliding then rolling ({d['kind']}, {p['n_el']} elements, dt = {p['dt']:g} s, "
+        f"mu = {p['mu']:g}); v_final = {d['v_final']:.1f} cm/s (exact {d['v_final_exact']:.0f})"
+    )
+    stem = "fig09_rolling_ring" + (
+        "" if not overrides else "_" + "_".join(f"{k}{v}" for k, v in sorted(overrides.items()))
+    )
     fig = draw_rolling(dict(r, **d), title)
     return save_figure(fig, Path(outdir or default_outdir(preset)) / f"{stem}.png", d, p)
 
@@ -207,9 +254,21 @@ def fig09b(preset="fast", outdir=None):
     a2.invert_xaxis()
     a2.grid(alpha=0.3, which="both")
     a2.legend(fontsize=8)
-    fig.suptitle("Rolling ring: error of the start of rolling x_roll and of the rolling speed v_final; at dt = "
-                 f"{d[0]:g} s on 120 elements |v_final error| = {abs(c['v_err_step'][0]):.3f}", fontsize=10)
+    fig.suptitle(
+        "Rolling ring: error of the start of rolling x_roll and of the rolling speed v_final; at dt = "
+        f"{d[0]:g} s on 120 elements |v_final error| = {abs(c['v_err_step'][0]):.3f}",
+        fontsize=10,
+    )
     fig.tight_layout()
-    return save_figure(fig, Path(outdir or default_outdir(preset)) / "fig09b_rolling_ring_convergence.png", c,
-                       dict(result(preset)["parameters"], joint_n_el=c["n_el"], joint_dt=c["dt_joint"],
-                            step_n_el=120, step_dt=c["dt_step"]))
+    return save_figure(
+        fig,
+        Path(outdir or default_outdir(preset)) / "fig09b_rolling_ring_convergence.png",
+        c,
+        dict(
+            result(preset)["parameters"],
+            joint_n_el=c["n_el"],
+            joint_dt=c["dt_joint"],
+            step_n_el=120,
+            step_dt=c["dt_step"],
+        ),
+    )

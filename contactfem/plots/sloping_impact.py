@@ -12,7 +12,6 @@ Each draws a result it is given (``r=``, ``results=``: a lecture's own time loop
 the scene.
 """
 
-
 from pathlib import Path
 
 import numpy as np
@@ -23,9 +22,24 @@ from . import cached_run, default_outdir, figure, fitted_words, pyplot
 from .data import save_figure, write_data
 
 # what Figs 10-11b show of a run: the rebound (headline) and the drawn series
-IMPACT_KEYS = ("variant", "rebound_vx", "rebound_vy", "rebound_angle_deg", "rebound_spin", "fitted", "t", "x_c", "y_c",
-               "outline_t", "outlines", "energy_kinetic", "energy_strain", "energy_contact", "energy_dissipation",
-               "energy_total")
+IMPACT_KEYS = (
+    "variant",
+    "rebound_vx",
+    "rebound_vy",
+    "rebound_angle_deg",
+    "rebound_spin",
+    "fitted",
+    "t",
+    "x_c",
+    "y_c",
+    "outline_t",
+    "outlines",
+    "energy_kinetic",
+    "energy_strain",
+    "energy_contact",
+    "energy_dissipation",
+    "energy_total",
+)
 
 
 def impact_data(r):
@@ -61,13 +75,20 @@ def draw_impact(r, title):
     ax.set_xlabel("x")
     ax.set_ylabel("y")
     fitted = fitted_words(r, "Table 2")
-    ax.set_title(f"{title}\nrebound v = ({r['rebound_vx']:.2f}, {r['rebound_vy']:.2f}), "
-                 f"angle {r['rebound_angle_deg']:.1f} deg from the normal, spin {r['rebound_spin']:.3f}; "
-                 "labels: time" + (f"\n{fitted} (points per beam element)" if fitted else ""), fontsize=9)
+    ax.set_title(
+        f"{title}\nrebound v = ({r['rebound_vx']:.2f}, {r['rebound_vy']:.2f}), "
+        f"angle {r['rebound_angle_deg']:.1f} deg from the normal, spin {r['rebound_spin']:.3f}; "
+        "labels: time" + (f"\n{fitted} (points per beam element)" if fitted else ""),
+        fontsize=9,
+    )
     ax.legend(loc="upper left", fontsize=8)
     t = np.asarray(r["t"])
-    for key, label in (("energy_kinetic", "kinetic"), ("energy_strain", "strain"),
-                       ("energy_contact", "contact"), ("energy_dissipation", "frictional dissipation")):
+    for key, label in (
+        ("energy_kinetic", "kinetic"),
+        ("energy_strain", "strain"),
+        ("energy_contact", "contact"),
+        ("energy_dissipation", "frictional dissipation"),
+    ):
         ae.plot(t, r[key], label=label)
     ae.plot(t, r["energy_total"], "k", lw=2, label="kinetic + strain + contact")
     ae.set_xlabel("t")
@@ -83,8 +104,7 @@ def fig10(preset="fast", outdir=None, r=None):
     r = r or result("frictionless", preset)
     p = r["parameters"]
     newmark = "/".join(map(format, newmark_of(p)))
-    fig = draw_impact(r, f"Fig 10: sloping impact, frictionless contact (Newmark {newmark}, "
-                         f"dt = {p['dt']:g})")
+    fig = draw_impact(r, f"Fig 10: sloping impact, frictionless contact (Newmark {newmark}, dt = {p['dt']:g})")
     return _save(fig, r, outdir, preset, "fig10_sloping_impact_frictionless")
 
 
@@ -92,8 +112,11 @@ def fig10(preset="fast", outdir=None, r=None):
 def fig11a(preset="fast", outdir=None, r=None):
     r = r or result("frictional", preset)
     p = r["parameters"]
-    fig = draw_impact(r, f"Fig 11a: sloping impact, frictional contact (eq 10: n = {p['n']:g}, alpha = {p['alpha']:g}, "
-                         f"beta = {p['beta']:g})")
+    fig = draw_impact(
+        r,
+        f"Fig 11a: sloping impact, frictional contact (eq 10: n = {p['n']:g}, alpha = {p['alpha']:g}, "
+        f"beta = {p['beta']:g})",
+    )
     return _save(fig, r, outdir, preset, "fig11a_sloping_impact_frictional")
 
 
@@ -101,8 +124,9 @@ def fig11a(preset="fast", outdir=None, r=None):
 def fig11b(preset="fast", outdir=None, r=None):
     r = r or result("viscoplastic", preset)
     eta = r["parameters"]["eta"]
-    fig = draw_impact(r, "Fig 11b: frictional contact, viscoplastic ring (N0 = 1, Q0 = 0.5, M0 = 0.25; "
-                         f"eta = {eta:g} chosen)")
+    fig = draw_impact(
+        r, f"Fig 11b: frictional contact, viscoplastic ring (N0 = 1, Q0 = 0.5, M0 = 0.25; eta = {eta:g} chosen)"
+    )
     return _save(fig, r, outdir, preset, "fig11b_sloping_impact_viscoplastic")
 
 
@@ -115,11 +139,23 @@ def table2_rows(preset="fast", refined_n_el=32, results=None):
         r = (results or {}).get(variant) or result(variant, preset)
         f = result(variant, preset, n_el=refined_n_el)
         p = PAPER_TABLE2.get(variant)
-        rows.append(dict(variant=variant, vx=r["rebound_vx"], vy=r["rebound_vy"], angle=r["rebound_angle_deg"],
-                         spin=r["rebound_spin"], n_el=r["parameters"]["n_el"],
-                         vx_ref=f["rebound_vx"], vy_ref=f["rebound_vy"], angle_ref=f["rebound_angle_deg"],
-                         n_el_ref=refined_n_el, paper_vx=p["vx"] if p else None, paper_vy=p["vy"] if p else None,
-                         paper_angle=p["angle_deg"] if p else None))
+        rows.append(
+            dict(
+                variant=variant,
+                vx=r["rebound_vx"],
+                vy=r["rebound_vy"],
+                angle=r["rebound_angle_deg"],
+                spin=r["rebound_spin"],
+                n_el=r["parameters"]["n_el"],
+                vx_ref=f["rebound_vx"],
+                vy_ref=f["rebound_vy"],
+                angle_ref=f["rebound_angle_deg"],
+                n_el_ref=refined_n_el,
+                paper_vx=p["vx"] if p else None,
+                paper_vy=p["vy"] if p else None,
+                paper_angle=p["angle_deg"] if p else None,
+            )
+        )
     return rows
 
 
@@ -130,12 +166,35 @@ def _fmt(x, f="{:.2f}"):
 def table2_cells(rows):
     """Table 2's header and rows of cells, formatted as the markdown and the image print them."""
     n_ref = rows[0]["n_el_ref"]
-    head = ["contact", "ours v_x", "ours v_y", "ours angle", "ours spin",
-            f"{n_ref} el. v_x", f"{n_ref} el. v_y", f"{n_ref} el. angle",
-            "paper v_x", "paper v_y", "paper angle"]
-    body = [[r["variant"], _fmt(r["vx"]), _fmt(r["vy"]), _fmt(r["angle"], "{:.1f}"), _fmt(r["spin"], "{:.3f}"),
-             _fmt(r["vx_ref"]), _fmt(r["vy_ref"]), _fmt(r["angle_ref"], "{:.1f}"),
-             _fmt(r["paper_vx"]), _fmt(r["paper_vy"]), _fmt(r["paper_angle"], "{:.0f}")] for r in rows]
+    head = [
+        "contact",
+        "ours v_x",
+        "ours v_y",
+        "ours angle",
+        "ours spin",
+        f"{n_ref} el. v_x",
+        f"{n_ref} el. v_y",
+        f"{n_ref} el. angle",
+        "paper v_x",
+        "paper v_y",
+        "paper angle",
+    ]
+    body = [
+        [
+            r["variant"],
+            _fmt(r["vx"]),
+            _fmt(r["vy"]),
+            _fmt(r["angle"], "{:.1f}"),
+            _fmt(r["spin"], "{:.3f}"),
+            _fmt(r["vx_ref"]),
+            _fmt(r["vy_ref"]),
+            _fmt(r["angle_ref"], "{:.1f}"),
+            _fmt(r["paper_vx"]),
+            _fmt(r["paper_vy"]),
+            _fmt(r["paper_angle"], "{:.0f}"),
+        ]
+        for r in rows
+    ]
     return head, body
 
 
@@ -144,23 +203,34 @@ def table2_markdown(preset="fast", refined_n_el=32, results=None):
     variant -> result for the columns "ours")."""
     rows = table2_rows(preset, refined_n_el, results)
     given = results or {}
-    ours = lambda v: given.get(v) or result(v, preset)      # noqa: E731
+    ours = lambda v: given.get(v) or result(v, preset)  # noqa: E731
     head, body = table2_cells(rows)
     n_el = rows[0]["n_el"]
     P = ours("frictionless")["parameters"]
-    lines = ["# Table 2: rebound of the ring after the sloping impact (Sec. 5.3)", "",
-             f"Centre-of-mass velocity after rebound and angle of reflection from the normal, "
-             f"atan(|v_x|/|v_y|) in degrees. 'ours': the paper's mesh ({n_el} beam elements), "
-             f"Newmark {'/'.join(map(format, newmark_of(P)))}, dt = {P['dt']:g}, {P['n_steps']} steps; "
-             f"'{refined_n_el} el.': the same on a refined ring. "
-             "The paper gives no viscoplastic row (it reports a lower bounce). Spin: angular velocity "
-             "about the centre of mass after rebound (counter-clockwise positive). Beam integration: "
-             + "; ".join(f"{v} {ours(v).get('integration_points', 1)} point(s)"
-                         for v in ("frictionless", "frictional", "viscoplastic"))
-             + (" (2 points FITTED to this table: `contactfem reconstruct sloping_impact`; the scan does not "
-                "say; the viscoplastic ring keeps the midpoint rule)"
-                if ours("frictionless").get("fitted") else "") + ".", "",
-             "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    lines = [
+        "# Table 2: rebound of the ring after the sloping impact (Sec. 5.3)",
+        "",
+        f"Centre-of-mass velocity after rebound and angle of reflection from the normal, "
+        f"atan(|v_x|/|v_y|) in degrees. 'ours': the paper's mesh ({n_el} beam elements), "
+        f"Newmark {'/'.join(map(format, newmark_of(P)))}, dt = {P['dt']:g}, {P['n_steps']} steps; "
+        f"'{refined_n_el} el.': the same on a refined ring. "
+        "The paper gives no viscoplastic row (it reports a lower bounce). Spin: angular velocity "
+        "about the centre of mass after rebound (counter-clockwise positive). Beam integration: "
+        + "; ".join(
+            f"{v} {ours(v).get('integration_points', 1)} point(s)"
+            for v in ("frictionless", "frictional", "viscoplastic")
+        )
+        + (
+            " (2 points FITTED to this table: `contactfem reconstruct sloping_impact`; the scan does not "
+            "say; the viscoplastic ring keeps the midpoint rule)"
+            if ours("frictionless").get("fitted")
+            else ""
+        )
+        + ".",
+        "",
+        "| " + " | ".join(head) + " |",
+        "|" + "---|" * len(head),
+    ]
     lines += ["| " + " | ".join(b) + " |" for b in body]
     return "\n".join(lines) + "\n"
 
@@ -170,7 +240,7 @@ def table2(preset="fast", outdir=None, refined_n_el=32, results=None):
     """Table 2 (.md and .png); ``results``: variant -> result for the columns "ours"."""
     rows = table2_rows(preset, refined_n_el, results)
     given = results or {}
-    ours = lambda v: given.get(v) or result(v, preset)      # noqa: E731
+    ours = lambda v: given.get(v) or result(v, preset)  # noqa: E731
     n_el = rows[0]["n_el"]
     head, body = table2_cells(rows)
     out = outdir or default_outdir(preset)
@@ -186,12 +256,20 @@ def table2(preset="fast", outdir=None, refined_n_el=32, results=None):
     tab.set_fontsize(8)
     tab.scale(1.0, 1.5)
     fitted = fitted_words(ours("frictionless"), "this table")
-    ax.set_title(f"Table 2: rebound after the sloping impact, ours ({n_el} and {refined_n_el} elements) vs paper"
-                 + (f"\nours, frictionless and frictional rows: {fitted} (points per beam element)" if fitted else ""),
-                 fontsize=9)
-    return [str(md), *save_figure(fig, Path(out) / "table2_sloping_impact.png",
-                                  dict(rows=rows, fitted=ours("frictionless").get("fitted")),
-                                  ours("frictionless")["parameters"])]
+    ax.set_title(
+        f"Table 2: rebound after the sloping impact, ours ({n_el} and {refined_n_el} elements) vs paper"
+        + (f"\nours, frictionless and frictional rows: {fitted} (points per beam element)" if fitted else ""),
+        fontsize=9,
+    )
+    return [
+        str(md),
+        *save_figure(
+            fig,
+            Path(out) / "table2_sloping_impact.png",
+            dict(rows=rows, fitted=ours("frictionless").get("fitted")),
+            ours("frictionless")["parameters"],
+        ),
+    ]
 
 
 # The discretisation study of lecture 06: the one-point ring (integration = 1) of the paper's run,
@@ -205,8 +283,11 @@ DISCRETISATION = (
     ("32, 0.025, 1/2 / 1/4", dict(n_el=32, dt=0.025, n_steps=800, **AVERAGE), ("frictionless", "frictional")),
     ("128, 0.0125, 0.7/0.4", dict(n_el=128, dt=0.0125, n_steps=1600), ("frictionless", "frictional")),
     ("128, 0.0125, 1/2 / 1/4", dict(n_el=128, dt=0.0125, n_steps=1600, **AVERAGE), ("frictionless", "frictional")),
-    ("continuum ring 64 x 2, 0.025, 1/2 / 1/4", dict(kind="continuum", n_el=64, dt=0.025, n_steps=800, **AVERAGE),
-     ("frictionless",)),
+    (
+        "continuum ring 64 x 2, 0.025, 1/2 / 1/4",
+        dict(kind="continuum", n_el=64, dt=0.025, n_steps=800, **AVERAGE),
+        ("frictionless",),
+    ),
 )
 
 
@@ -222,30 +303,41 @@ def discretisation_rows(preset="fast", quick=False):
             kw = dict(over) if over.get("kind") == "continuum" else dict(over, integration="1")
             r = result(v, preset, **kw)
             E = np.asarray(r["energy_total"])
-            row[v] = dict(vx=r["rebound_vx"], vy=r["rebound_vy"], angle=r["rebound_angle_deg"],
-                          energy_left=float(E[-1] / E[0]))
+            row[v] = dict(
+                vx=r["rebound_vx"], vy=r["rebound_vy"], angle=r["rebound_angle_deg"], energy_left=float(E[-1] / E[0])
+            )
         rows.append(row)
     return rows
 
 
 def discretisation_markdown(rows):
     """The study as a markdown table (what figures/table_sloping_impact_discretisation.md holds)."""
+
     def frictionless(row):
         r = row.get("frictionless")
         return ("", "") if r is None else (f"{r['vy']:.2f}, {r['angle']:.1f} deg", f"{r['energy_left']:.3f}")
 
     def frictional(row):
         r = row.get("frictional")
-        return ("", "") if r is None else (f"{r['vx']:.2f}, {r['vy']:.2f}, {r['angle']:.1f} deg",
-                                           f"{r['energy_left']:.3f}")
-    lines = ["# The sloping impact against its discretisation (lecture 06)", "",
-             "The one-point beam ring of the paper's run (integration = 1), frictionless and frictional, refined in "
-             "the mesh (elements), the step (dt) and the integrator (Newmark delta / beta) up to t = 20. Rebound "
-             "velocity of the centre of mass and the angle of reflection from the normal; E_end / E_0: the "
-             "mechanical energy left at the end. Paper, Table 2: frictionless (2, 1.7), 50 deg; frictional "
-             "(1.2, 1.7), 35 deg.", "",
-             "| elements, dt, Newmark | frictionless v_y, angle | frictionless E_end / E_0 | frictional v_x, v_y, "
-             "angle | frictional E_end / E_0 |", "|---|---|---|---|---|"]
+        return (
+            ("", "")
+            if r is None
+            else (f"{r['vx']:.2f}, {r['vy']:.2f}, {r['angle']:.1f} deg", f"{r['energy_left']:.3f}")
+        )
+
+    lines = [
+        "# The sloping impact against its discretisation (lecture 06)",
+        "",
+        "The one-point beam ring of the paper's run (integration = 1), frictionless and frictional, refined in "
+        "the mesh (elements), the step (dt) and the integrator (Newmark delta / beta) up to t = 20. Rebound "
+        "velocity of the centre of mass and the angle of reflection from the normal; E_end / E_0: the "
+        "mechanical energy left at the end. Paper, Table 2: frictionless (2, 1.7), 50 deg; frictional "
+        "(1.2, 1.7), 35 deg.",
+        "",
+        "| elements, dt, Newmark | frictionless v_y, angle | frictionless E_end / E_0 | frictional v_x, v_y, "
+        "angle | frictional E_end / E_0 |",
+        "|---|---|---|---|---|",
+    ]
     for row in rows:
         lines.append("| " + " | ".join([row["label"], *frictionless(row), *frictional(row)]) + " |")
     return "\n".join(lines) + "\n"
@@ -263,5 +355,11 @@ def table_sloping_impact_discretisation(preset="fast", outdir=None, rows=None):
     md = out / "table_sloping_impact_discretisation.md"
     md.write_text(discretisation_markdown(rows))
     base = get_scene("sloping_impact").resolve(preset, {"variant": "frictionless"})
-    return [str(md), write_data(out / "table_sloping_impact_discretisation.json", dict(preset=preset, rows=rows),
-                                dict(base, rows=[row["overrides"] for row in rows]))]
+    return [
+        str(md),
+        write_data(
+            out / "table_sloping_impact_discretisation.json",
+            dict(preset=preset, rows=rows),
+            dict(base, rows=[row["overrides"] for row in rows]),
+        ),
+    ]

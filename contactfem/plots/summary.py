@@ -54,22 +54,31 @@ def fresh(preset):
         from .cork import EXIT_CASES_QUICK, cached_exit_case
 
         return dict(cases=[cached_exit_case(c) for c in EXIT_CASES_QUICK if c[4] is not None])
+
     makers = {
         "fig07_block_conical_stresses": lambda: with_parameters(block.stress_data(blk("conical")), blk("conical")),
         "fig08_block_parabolic_stresses": lambda: with_parameters(
-            dict(block.stress_data(blk("parabolic")), conical=block.stress_data(blk("conical"))), blk("parabolic")),
+            dict(block.stress_data(blk("parabolic")), conical=block.stress_data(blk("conical"))), blk("parabolic")
+        ),
         "table1_block_newton_residuals": lambda: block.residual_histories(preset),
-        "fig09_rolling_ring": lambda: with_parameters(rolling_ring.fig09_data(cached_run("rolling_ring", preset)),
-                                                      cached_run("rolling_ring", preset)),
+        "fig09_rolling_ring": lambda: with_parameters(
+            rolling_ring.fig09_data(cached_run("rolling_ring", preset)), cached_run("rolling_ring", preset)
+        ),
         "fig10_sloping_impact_frictionless": lambda: with_parameters(
-            sloping_impact.impact_data(ring("sloping_impact", "frictionless")), ring("sloping_impact", "frictionless")),
+            sloping_impact.impact_data(ring("sloping_impact", "frictionless")), ring("sloping_impact", "frictionless")
+        ),
         "fig11a_sloping_impact_frictional": lambda: with_parameters(
-            sloping_impact.impact_data(ring("sloping_impact", "frictional")), ring("sloping_impact", "frictional")),
-        "fig12_funnel_frictionless": lambda: with_parameters(funnel.funnel_data(ring("funnel", "frictionless")),
-                                                             ring("funnel", "frictionless")),
-        "fig13_funnel_frictional": lambda: with_parameters(funnel.funnel_data(ring("funnel", "frictional")),
-                                                           ring("funnel", "frictional")),
-        "fig14_cork_mesh": lambda: with_parameters(cork.cork_data(cached_run("cork", preset)), cached_run("cork", preset)),
+            sloping_impact.impact_data(ring("sloping_impact", "frictional")), ring("sloping_impact", "frictional")
+        ),
+        "fig12_funnel_frictionless": lambda: with_parameters(
+            funnel.funnel_data(ring("funnel", "frictionless")), ring("funnel", "frictionless")
+        ),
+        "fig13_funnel_frictional": lambda: with_parameters(
+            funnel.funnel_data(ring("funnel", "frictional")), ring("funnel", "frictional")
+        ),
+        "fig14_cork_mesh": lambda: with_parameters(
+            cork.cork_data(cached_run("cork", preset)), cached_run("cork", preset)
+        ),
         "cork_exit_time": exit_rows,
     }
     return lru_cache(maxsize=None)(lambda stem: makers[stem]())
@@ -77,27 +86,39 @@ def fresh(preset):
 
 def committed(folder):
     """record(stem): the data of figure ``stem`` as written in ``folder``/stem.json."""
+
     @lru_cache(maxsize=None)
     def record(stem):
         return json.loads((Path(folder) / f"{stem}.json").read_text())
+
     return record
 
 
 def row_laws(preset, record=None):
-    return ("Figs 1-4", "interface laws, slip surface, return-mapping geometry", "-", "-",
-            _links(("1", "fig01_true_contact_area.png"), ("2", "fig02_force_vs_microdisplacement.png"),
-                   ("3", "fig03_shear_vs_normal.png"), ("4", "fig04_parabolic_slip_surface.png")))
+    return (
+        "Figs 1-4",
+        "interface laws, slip surface, return-mapping geometry",
+        "-",
+        "-",
+        _links(
+            ("1", "fig01_true_contact_area.png"),
+            ("2", "fig02_force_vs_microdisplacement.png"),
+            ("3", "fig03_shear_vs_normal.png"),
+            ("4", "fig04_parabolic_slip_surface.png"),
+        ),
+    )
 
 
 def row_block_equilibrium(preset, record=None):
     r = (record or fresh(preset))("fig07_block_conical_stresses")
-    ours = (f"equilibrium to {r['equilibrium_error']:.0e} ({-r['total_normal']:.0f} down, "
-            f"{r['total_tangential']:.0f} along)")
+    ours = (
+        f"equilibrium to {r['equilibrium_error']:.0e} ({-r['total_normal']:.0f} down, "
+        f"{r['total_tangential']:.0f} along)"
+    )
     what = "block on a rough foundation, whole load in one step"
     if r.get("fitted"):
         what += " (" + ", ".join(r["fitted"]) + " FITTED to Table 1)"
-    return ("Sec. 5.1, Fig 6", what, "-", ours,
-            _links(("6", "fig06_block_mesh_deformed.png")))
+    return ("Sec. 5.1, Fig 6", what, "-", ours, _links(("6", "fig06_block_mesh_deformed.png")))
 
 
 def fig8_remark(preset, record=None):
@@ -109,67 +130,102 @@ def fig8_remark(preset, record=None):
     top = p >= np.quantile(p[p > 0], 0.75) if np.any(p > 0) else np.zeros_like(p, bool)
     tp, tc = (np.abs(np.asarray(r["contact"]["t_T"]))[top] for r in (par, con))
     change = (tp - tc) / np.where(tc > 0, tc, np.inf)
-    return dict(n_top=int(top.sum()), change_min=float(change.min(initial=0.0)),
-                change_max=float(change.max(initial=0.0)), n_slip_parabolic=par["n_slip"],
-                n_slip_conical=con["n_slip"])
+    return dict(
+        n_top=int(top.sum()),
+        change_min=float(change.min(initial=0.0)),
+        change_max=float(change.max(initial=0.0)),
+        n_slip_parabolic=par["n_slip"],
+        n_slip_conical=con["n_slip"],
+    )
 
 
 def row_block_stresses(preset, record=None):
     f = fig8_remark(preset, record)
-    ours = (f"at the {f['n_top']} nodes of highest pressure (top quartile) the parabolic friction stress "
-            f"differs from the conical by {100 * f['change_min']:+.0f} % to {100 * f['change_max']:+.0f} %; nodes slipping: "
-            f"conical {f['n_slip_conical']}, parabolic {f['n_slip_parabolic']}")
-    return ("Figs 7-8", "contact stresses, conical and parabolic slip surface",
-            "parabolic lowers friction where pressure is high", ours,
-            _links(("7", "fig07_block_conical_stresses.png"), ("8", "fig08_block_parabolic_stresses.png")))
+    ours = (
+        f"at the {f['n_top']} nodes of highest pressure (top quartile) the parabolic friction stress "
+        f"differs from the conical by {100 * f['change_min']:+.0f} % to {100 * f['change_max']:+.0f} %; nodes slipping: "
+        f"conical {f['n_slip_conical']}, parabolic {f['n_slip_parabolic']}"
+    )
+    return (
+        "Figs 7-8",
+        "contact stresses, conical and parabolic slip surface",
+        "parabolic lowers friction where pressure is high",
+        ours,
+        _links(("7", "fig07_block_conical_stresses.png"), ("8", "fig08_block_parabolic_stresses.png")),
+    )
 
 
 def row_table1(preset, record=None):
     record = record or fresh(preset)
     c, t = record("fig07_block_conical_stresses"), record("table1_block_newton_residuals")
     rc, rp = t["conical"], t["parabolic"]
-    ours = (f"conical {len(rc)} ({c['n_slip']} nodes slip), parabolic {len(rp)}; "
-            f"first {rc[0]:.2f}; last {rc[-1]:.0e} and {rp[-1]:.0e}")
-    return ("Table 1", "residual norms of Newton, one load step" + (" (reading FITTED to this table)" if c.get("fitted") else ""),
-            f"conical {len(PAPER_TABLE1['conical'])} residuals, parabolic {len(PAPER_TABLE1['parabolic'])}; "
-            f"first {PAPER_TABLE1['conical'][0]:.2f}", ours,
-            _links(("table", "table1_block_newton_residuals.md")))
+    ours = (
+        f"conical {len(rc)} ({c['n_slip']} nodes slip), parabolic {len(rp)}; "
+        f"first {rc[0]:.2f}; last {rc[-1]:.0e} and {rp[-1]:.0e}"
+    )
+    return (
+        "Table 1",
+        "residual norms of Newton, one load step" + (" (reading FITTED to this table)" if c.get("fitted") else ""),
+        f"conical {len(PAPER_TABLE1['conical'])} residuals, parabolic {len(PAPER_TABLE1['parabolic'])}; "
+        f"first {PAPER_TABLE1['conical'][0]:.2f}",
+        ours,
+        _links(("table", "table1_block_newton_residuals.md")),
+    )
 
 
 def row_rolling_ring(preset, record=None):
     r = (record or fresh(preset))("fig09_rolling_ring")
     x_roll = "did not roll" if not r["rolled"] else f"x_roll = {r['x_roll']:.1f} cm"
     ours = f"{x_roll}, x(2 s) = {r['x_end']:.1f} cm, v = {r['v_final']:.1f} cm/s"
-    return ("Sec. 5.2, Fig 9", "ring sliding, then rolling (exact: rigid thin ring)",
-            "rolling at x = 23x (229), later 382 (376), 149 (150) cm/s", ours,
-            _links(("9", "fig09_rolling_ring.png"), ("conv.", "fig09b_rolling_ring_convergence.png")))
+    return (
+        "Sec. 5.2, Fig 9",
+        "ring sliding, then rolling (exact: rigid thin ring)",
+        "rolling at x = 23x (229), later 382 (376), 149 (150) cm/s",
+        ours,
+        _links(("9", "fig09_rolling_ring.png"), ("conv.", "fig09b_rolling_ring_convergence.png")),
+    )
 
 
 def row_sloping_impact(preset, record=None):
     record = record or fresh(preset)
     parts = []
-    for variant, stem in (("frictionless", "fig10_sloping_impact_frictionless"),
-                          ("frictional", "fig11a_sloping_impact_frictional")):
+    for variant, stem in (
+        ("frictionless", "fig10_sloping_impact_frictionless"),
+        ("frictional", "fig11a_sloping_impact_frictional"),
+    ):
         r = record(stem)
         parts.append(f"{variant} ({r['rebound_vx']:.2f}, {r['rebound_vy']:.2f}), {r['rebound_angle_deg']:.1f} deg")
     n_el = record("fig10_sloping_impact_frictionless")["parameters"]["n_el"]
     ours = "; ".join(parts) + f" ({n_el} elements)"
     fitted = record("fig10_sloping_impact_frictionless").get("fitted") or {}
-    what = "sloping impact, rebound" + (f" (beam integration FITTED to this table: {fitted['integration']} points)"
-                                        if "integration" in fitted else "")
-    return ("Sec. 5.3, Table 2", what,
-            "frictionless (2, 1.7), 50 deg; frictional (1.2, 1.7), 35 deg", ours,
-            _links(("10", "fig10_sloping_impact_frictionless.png"), ("11a", "fig11a_sloping_impact_frictional.png"),
-                   ("11b", "fig11b_sloping_impact_viscoplastic.png"), ("table", "table2_sloping_impact.md")))
+    what = "sloping impact, rebound" + (
+        f" (beam integration FITTED to this table: {fitted['integration']} points)" if "integration" in fitted else ""
+    )
+    return (
+        "Sec. 5.3, Table 2",
+        what,
+        "frictionless (2, 1.7), 50 deg; frictional (1.2, 1.7), 35 deg",
+        ours,
+        _links(
+            ("10", "fig10_sloping_impact_frictionless.png"),
+            ("11a", "fig11a_sloping_impact_frictional.png"),
+            ("11b", "fig11b_sloping_impact_viscoplastic.png"),
+            ("table", "table2_sloping_impact.md"),
+        ),
+    )
 
 
 def row_funnel(preset, record=None):
     record = record or fresh(preset)
     f, g = record("fig12_funnel_frictionless"), record("fig13_funnel_frictional")
     phi = f["parameters"]["phi_deg"]
-    return ("Sec. 5.4, Figs 12-13", f"ring into a funnel (angle chosen: {phi:g} deg)",
-            "frictionless rebounds, frictional sticks", f"{f['verdict']}; {g['verdict']}",
-            _links(("12", "fig12_funnel_frictionless.png"), ("13", "fig13_funnel_frictional.png")))
+    return (
+        "Sec. 5.4, Figs 12-13",
+        f"ring into a funnel (angle chosen: {phi:g} deg)",
+        "frictionless rebounds, frictional sticks",
+        f"{f['verdict']}; {g['verdict']}",
+        _links(("12", "fig12_funnel_frictionless.png"), ("13", "fig13_funnel_frictional.png")),
+    )
 
 
 def cork_refined_exit(preset, record=None):
@@ -180,7 +236,7 @@ def cork_refined_exit(preset, record=None):
 
     cases = [c for c in EXIT_CASES_QUICK if c[4] is not None]
     rows = (record or fresh(preset))("cork_exit_time")["cases"]
-    key = lambda g, label, fit, pop: (g, label, bool(fit), bool(pop))           # noqa: E731
+    key = lambda g, label, fit, pop: (g, label, bool(fit), bool(pop))  # noqa: E731
     by_key = {key(r["group"], r["label"], r["closing_step_press_fit"], r["closing_step_pop"]): r for r in rows}
     return [by_key[key(c[0], c[1], *c[3])] for c in cases], cases[0][2]["dt"]
 
@@ -188,26 +244,40 @@ def cork_refined_exit(preset, record=None):
 def row_cork(preset, record=None):
     record = record or fresh(preset)
     r = record("fig14_cork_mesh")
-    exit_text = (f"exit {r['exit_time_ms']:.2f} ms at {r['exit_velocity_m_s']:.1f} m/s" if r["exited"]
-                 else "the cork stays in")
+    exit_text = (
+        f"exit {r['exit_time_ms']:.2f} ms at {r['exit_velocity_m_s']:.1f} m/s" if r["exited"] else "the cork stays in"
+    )
     if r["exited"] and preset == "paper":
         fine, dt = cork_refined_exit(preset, record)
         t = [f["exit_time_ms"] for f in fine if f["exited"]]
         if len(t) == len(fine):
-            rules = ("with or without the closing step" if f"{min(t):.2f}" == f"{max(t):.2f}"
-                     else f"{min(t):.2f}-{max(t):.2f} ms over the closing-step rules")
+            rules = (
+                "with or without the closing step"
+                if f"{min(t):.2f}" == f"{max(t):.2f}"
+                else f"{min(t):.2f}-{max(t):.2f} ms over the closing-step rules"
+            )
             exit_text += f" ({t[0]:.2f} ms with the step in the neck refined to {dt:g} s, {rules})"
     ours = f"{r['press_fit_normal_force_N']:.0f} N"
     if r["press_fit_calibrated"]:
         ours += " (fitted: R_tip chosen to give ~2500 N)"
-    ours += (f", {exit_text}; static breakaway {r['breakaway_pressure_static_MPa']:.3f} MPa against "
-             f"{r['applied_pressure_MPa']:g} applied (margin {r['breakaway_margin_MPa']:+.3f} MPa)")
-    return ("Sec. 5.5, Figs 14-17", "champagne cork (dimensions reconstructed; the press fit is calibrated "
-            "through R_tip)", "press fit ~2500 N, exit ~2.6-2.7 ms at ~28 m/s", ours,
-            _links(("14", "fig14_cork_mesh.png"), ("15", "fig15_cork_configurations.png"),
-                   ("16", "fig16_cork_pressure.png"), ("17", "fig17_cork_displacement.png"),
-                   ("knife edge", "cork_knife_edge.png"),
-                   ("exit time", "cork_exit_time.md")))
+    ours += (
+        f", {exit_text}; static breakaway {r['breakaway_pressure_static_MPa']:.3f} MPa against "
+        f"{r['applied_pressure_MPa']:g} applied (margin {r['breakaway_margin_MPa']:+.3f} MPa)"
+    )
+    return (
+        "Sec. 5.5, Figs 14-17",
+        "champagne cork (dimensions reconstructed; the press fit is calibrated through R_tip)",
+        "press fit ~2500 N, exit ~2.6-2.7 ms at ~28 m/s",
+        ours,
+        _links(
+            ("14", "fig14_cork_mesh.png"),
+            ("15", "fig15_cork_configurations.png"),
+            ("16", "fig16_cork_pressure.png"),
+            ("17", "fig17_cork_displacement.png"),
+            ("knife edge", "cork_knife_edge.png"),
+            ("exit time", "cork_exit_time.md"),
+        ),
+    )
 
 
 # row function -> the scenes (and variants) it runs
@@ -236,10 +306,17 @@ def summary_table(preset="paper", record=None):
 
 
 def summary_markdown(preset="paper", record=None):
-    return "\n".join(["# The paper's examples: ours beside the paper's", "",
-                      f"Written by `contactfem figures --preset {preset}` (contactfem/plots/summary.py): "
-                      "every value in the column 'ours' is computed by the run behind the figures.", "",
-                      *summary_table(preset, record), ""])
+    return "\n".join(
+        [
+            "# The paper's examples: ours beside the paper's",
+            "",
+            f"Written by `contactfem figures --preset {preset}` (contactfem/plots/summary.py): "
+            "every value in the column 'ours' is computed by the run behind the figures.",
+            "",
+            *summary_table(preset, record),
+            "",
+        ]
+    )
 
 
 def table_lines(text, prefix=""):
@@ -274,8 +351,10 @@ if __name__ == "__main__":
     import argparse
 
     repo = Path(__file__).resolve().parents[2]
-    cli = argparse.ArgumentParser(prog="python -m contactfem.plots.summary",
-                                  description="Copy the table of figures/summary.md into the README, between its markers.")
+    cli = argparse.ArgumentParser(
+        prog="python -m contactfem.plots.summary",
+        description="Copy the table of figures/summary.md into the README, between its markers.",
+    )
     cli.add_argument("readme", nargs="?", default=repo / "README.md")
     cli.add_argument("summary_md", nargs="?", default=repo / "figures" / "summary.md")
     args = cli.parse_args()

@@ -36,8 +36,10 @@ def get_scene(name):
         from pathlib import Path
 
         if not Path(name).expanduser().is_file():
-            raise ValueError(f"unknown scene {str(name)!r}: no scene file there (a path to a .py file that defines "
-                             f"SCENE); known are {', '.join(all_scenes())}")
+            raise ValueError(
+                f"unknown scene {str(name)!r}: no scene file there (a path to a .py file that defines "
+                f"SCENE); known are {', '.join(all_scenes())}"
+            )
         return load_scene_file(name)
     if isinstance(name, str) and name.isidentifier() and not name.startswith("_") and name != "base":
         module = f"{__name__}.{name}"
@@ -68,8 +70,17 @@ def check_laws(scene, laws, overrides=None):
         raise ValueError(f"{err}; scenes with a {kind} law: {', '.join(others)}") from None
 
 
-def run_scene(name, preset="fast", overrides=None, progress=None, friction=None, normal=None,
-              linear_algebra=None, instrument=None, check=True):
+def run_scene(
+    name,
+    preset="fast",
+    overrides=None,
+    progress=None,
+    friction=None,
+    normal=None,
+    linear_algebra=None,
+    instrument=None,
+    check=True,
+):
     """Run a scene and return its JSON-able results with the parameters used, the run's own wall
     time, Newton iteration count and the linear algebra of its Systems (``linear_algebra``:
     dense|banded|sparse, joined by + if they differ; ``ordering``; ``unknowns``, the largest
@@ -101,8 +112,10 @@ def run_scene(name, preset="fast", overrides=None, progress=None, friction=None,
     scene = get_scene(name)
     overrides = check_overrides(overrides)
     if progress is not None and not callable(progress):
-        raise TypeError(f"parameter progress must be None or a callable progress(t0, t_end, label) (e.g. "
-                        f"contactfem.io.progress_bar), got {type(progress).__name__} {progress!r}")
+        raise TypeError(
+            f"parameter progress must be None or a callable progress(t0, t_end, label) (e.g. "
+            f"contactfem.io.progress_bar), got {type(progress).__name__} {progress!r}"
+        )
     laws = {k: v for k, v in (("friction", friction), ("normal", normal)) if v is not None}
     check_laws(scene, laws, overrides)
     params = scene.resolve(preset, overrides)
@@ -111,10 +124,16 @@ def run_scene(name, preset="fast", overrides=None, progress=None, friction=None,
     if check:
         for note in scene.preflight(params, laws):
             warnings.warn(note, UserWarning, stacklevel=2)
-    if normal is not None:                          # every call into it checked (contactfem.laws.protocol)
+    if normal is not None:  # every call into it checked (contactfem.laws.protocol)
         normal = as_normal_law(normal)
-    results = scene.run(params, normal=normal, friction=friction, progress=progress,
-                        linear_algebra=linear_algebra or "auto", instrument=instrument)
+    results = scene.run(
+        params,
+        normal=normal,
+        friction=friction,
+        progress=progress,
+        linear_algebra=linear_algebra or "auto",
+        instrument=instrument,
+    )
     for kind, law in laws.items():
         results[f"{kind}_law"] = describe(law)
     if "friction" in laws and scene.law_choice is not None and "variant" in results:
@@ -127,4 +146,18 @@ def run_scene(name, preset="fast", overrides=None, progress=None, friction=None,
     return jsonable(results)
 
 
-__all__ = ["Limit", "Model", "Param", "Scene", "SceneError", "Stage", "all_scenes", "is_scene_file", "get_scene", "run_scene", "check_laws", "jsonable", "simulate"]
+__all__ = [
+    "Limit",
+    "Model",
+    "Param",
+    "Scene",
+    "SceneError",
+    "Stage",
+    "all_scenes",
+    "is_scene_file",
+    "get_scene",
+    "run_scene",
+    "check_laws",
+    "jsonable",
+    "simulate",
+]

@@ -27,6 +27,7 @@ The indicators that apply to a run (``collect``), from its records and the model
 and a scene adds its own (``reference``): its closed-form references in every regime its
 ranges allow, each error measure covering every contact surface.
 """
+
 import sys
 import warnings
 
@@ -41,34 +42,44 @@ def indicator(value, threshold, what, source, upper=True):
     """One indicator: ok when value <= threshold (``upper``) or value >= threshold."""
     value, threshold = float(value), float(threshold)
     ok = value <= threshold if upper else value >= threshold
-    return dict(value=value, threshold=threshold, ok=bool(ok), what=what, source=source,
-                bound="at most" if upper else "at least")
+    return dict(
+        value=value,
+        threshold=threshold,
+        ok=bool(ok),
+        what=what,
+        source=source,
+        bound="at most" if upper else "at least",
+    )
 
 
-EQUILIBRIUM = 1e-6          # solver.newton.ROUNDOFF_RTOL: what Newton accepts when round-off stops it
-PENETRATION_ELEMENT = 0.1   # ANSYS's default penetration tolerance (FTOLN): 0.1 of the underlying element
-PENETRATION_BODY = 0.01     # 1 % of the body's size: the contact changes the body's geometry visibly
-ENERGY_GAIN = 0.01          # a gain of 1 % is no Newton tolerance's share (1e-6 at most)
-ENERGY_LOSS = 0.30          # measured: the paper's sloping impact loses 22 % to Newmark's damping (delta = 0.7)
-IMPACT_STEPS = 5            # measured: the presets resolve their impacts with >= 23 steps; dt = 1 on the
-                            # sloping impact with 3
-PENALTY_STEPS = 4.0         # dt sqrt(k/m): Newmark's (and the energy-consistent midpoint rule's) period error passes
-                            # 25 % above 2 rad a step; the presets' impacts stay below 4 (the paper's sloping
-                            # impact: 3.6); the bar, midpoint rule at courant 10 (14.1): rebound 11 % off unflagged
+EQUILIBRIUM = 1e-6  # solver.newton.ROUNDOFF_RTOL: what Newton accepts when round-off stops it
+PENETRATION_ELEMENT = 0.1  # ANSYS's default penetration tolerance (FTOLN): 0.1 of the underlying element
+PENETRATION_BODY = 0.01  # 1 % of the body's size: the contact changes the body's geometry visibly
+ENERGY_GAIN = 0.01  # a gain of 1 % is no Newton tolerance's share (1e-6 at most)
+ENERGY_LOSS = 0.30  # measured: the paper's sloping impact loses 22 % to Newmark's damping (delta = 0.7)
+IMPACT_STEPS = 5  # measured: the presets resolve their impacts with >= 23 steps; dt = 1 on the
+# sloping impact with 3
+PENALTY_STEPS = 4.0  # dt sqrt(k/m): Newmark's (and the energy-consistent midpoint rule's) period error passes
+# 25 % above 2 rad a step; the presets' impacts stay below 4 (the paper's sloping
+# impact: 3.6); the bar, midpoint rule at courant 10 (14.1): rebound 11 % off unflagged
 # the verification scenes' closed forms (their own error measures, each covering every contact surface)
-HERTZ_TOL = 0.05            # hertz a, p0: node-to-segment 0.05 % at the presets; mortar on the rigid plane 2 % (fast)
+HERTZ_TOL = 0.05  # hertz a, p0: node-to-segment 0.05 % at the presets; mortar on the rigid plane 2 % (fast)
 HERTZ_SOURCE = "node-to-segment: 0.05 % at the presets; mortar on the rigid plane: a few percent (README)"
-PRESSURE_TOL = 0.2          # patch: <= 0.052 at the presets (paper, one pass); node-to-segment at 11|5, 17|3: 1.0, 3.8
-V_FINAL_TOL = 0.1           # rolling ring: the elastic ring against the rigid hoop, 6 % at the fast preset
-MESH_HEIGHT = 4             # block: elements through its height; measured, the largest displacement against
-MESH_HEIGHT_SOURCE = ("measured: with 4 the block's largest displacement is within 5 % of 32 at nx = 3, 10, 25 "
-                      "(2: 15 %, 11 %, 4.5 % off; 1: 26 %, 14 %, 2.4 %)")
-FACETS = 0.8                # rad, one element of a ring: 8 elements around it (2 pi / 8 = 0.785); measured, the
-FACETS_SOURCE = ("measured: the sloping impact's rebound v_y with 3 to 6 elements around the ring is 20-57 % off "
-                 "the 16-element ring's, with 8 within 6 %")
-X_END_TOL = 0.05            # rolling ring x_end: 2.1 % at the fast preset, within 1 % refined; c_N = 1e5 at dt 0.02: 6.9 %
-ERROR_BUDGET = 2.0          # a step is kept with up to twice its share of the error (solver/schedule.py)
-LOCAL_ERROR = 0.30          # measured: the presets stay below 0.25 (the paper's sloping impact); dt = 1: 0.82
+PRESSURE_TOL = 0.2  # patch: <= 0.052 at the presets (paper, one pass); node-to-segment at 11|5, 17|3: 1.0, 3.8
+V_FINAL_TOL = 0.1  # rolling ring: the elastic ring against the rigid hoop, 6 % at the fast preset
+MESH_HEIGHT = 4  # block: elements through its height; measured, the largest displacement against
+MESH_HEIGHT_SOURCE = (
+    "measured: with 4 the block's largest displacement is within 5 % of 32 at nx = 3, 10, 25 "
+    "(2: 15 %, 11 %, 4.5 % off; 1: 26 %, 14 %, 2.4 %)"
+)
+FACETS = 0.8  # rad, one element of a ring: 8 elements around it (2 pi / 8 = 0.785); measured, the
+FACETS_SOURCE = (
+    "measured: the sloping impact's rebound v_y with 3 to 6 elements around the ring is 20-57 % off "
+    "the 16-element ring's, with 8 within 6 %"
+)
+X_END_TOL = 0.05  # rolling ring x_end: 2.1 % at the fast preset, within 1 % refined; c_N = 1e5 at dt 0.02: 6.9 %
+ERROR_BUDGET = 2.0  # a step is kept with up to twice its share of the error (solver/schedule.py)
+LOCAL_ERROR = 0.30  # measured: the presets stay below 0.25 (the paper's sloping impact); dt = 1: 0.82
 
 
 def references(errors, threshold, source):
@@ -88,51 +99,80 @@ def hertz_half_width(x, f):
 def collect(model, params, records, results):
     """The generic indicators of a run (module docstring), as a dict name -> indicator."""
     out = {}
-    if isinstance(records, dict):                 # a scene of several stages (the cork): their records in turn
+    if isinstance(records, dict):  # a scene of several stages (the cork): their records in turn
         records = [r for part in records.values() if isinstance(part, list) for r in part if hasattr(r, "result")]
     steps = [r for r in records[1:] if r.result is not None]
     ratios = [getattr(r.result, "residual_ratio", 0.0) for r in steps]
     if ratios:
-        out["equilibrium"] = indicator(max(ratios), EQUILIBRIUM, "largest converged residual / the step's force scale",
-                                       "Newton's round-off tolerance (solver.newton.ROUNDOFF_RTOL); its own is 1e-8")
+        out["equilibrium"] = indicator(
+            max(ratios),
+            EQUILIBRIUM,
+            "largest converged residual / the step's force scale",
+            "Newton's round-off tolerance (solver.newton.ROUNDOFF_RTOL); its own is 1e-8",
+        )
     sizes = model.sizes
-    deepest = _deepest(records[1:] or records)      # (a scene's initial guess may overlap on purpose: hertz)
+    deepest = _deepest(records[1:] or records)  # (a scene's initial guess may overlap on purpose: hertz)
     if deepest is not None and sizes.get("element"):
-        out["penetration"] = indicator(deepest / sizes["element"], PENETRATION_ELEMENT,
-                                       f"largest penetration / local element size ({sizes['element']:.3g})",
-                                       "ANSYS's default penetration tolerance: 0.1 of the underlying element")
+        out["penetration"] = indicator(
+            deepest / sizes["element"],
+            PENETRATION_ELEMENT,
+            f"largest penetration / local element size ({sizes['element']:.3g})",
+            "ANSYS's default penetration tolerance: 0.1 of the underlying element",
+        )
     if deepest is not None and sizes.get("body"):
-        out["penetration_body"] = indicator(deepest / sizes["body"], PENETRATION_BODY,
-                                            f"largest penetration / the body's size ({sizes['body']:.3g})",
-                                            "chosen: 1 % of the body changes its geometry visibly")
+        out["penetration_body"] = indicator(
+            deepest / sizes["body"],
+            PENETRATION_BODY,
+            f"largest penetration / the body's size ({sizes['body']:.3g})",
+            "chosen: 1 % of the body changes its geometry visibly",
+        )
     if sizes.get("radius") and sizes.get("element"):
-        out["facets"] = indicator(sizes["element"] / sizes["radius"], FACETS, "the angle one element of the ring "
-                                  "spans [rad] (its length over the radius)", FACETS_SOURCE)
+        out["facets"] = indicator(
+            sizes["element"] / sizes["radius"],
+            FACETS,
+            "the angle one element of the ring spans [rad] (its length over the radius)",
+            FACETS_SOURCE,
+        )
     err = results.get("energy_error")
     if isinstance(err, float):
-        out["energy_gain"] = indicator(max(err, 0.0), ENERGY_GAIN, "energy gained over the run / initial energy "
-                                       "(dissipation and the loads' work counted)",
-                                       "a gain above 1 % is the integrator's, not Newton's (1e-6 at most)")
-    if isinstance(err, float) and not model.plastic:    # plastic work is no integrator's loss
-        out["energy_loss"] = indicator(max(-err, 0.0), ENERGY_LOSS, "energy lost to the integrator / initial energy "
-                                       "(friction's dissipation counted apart)",
-                                       "measured: the paper's sloping impact loses 22 % to Newmark's damping")
+        out["energy_gain"] = indicator(
+            max(err, 0.0),
+            ENERGY_GAIN,
+            "energy gained over the run / initial energy (dissipation and the loads' work counted)",
+            "a gain above 1 % is the integrator's, not Newton's (1e-6 at most)",
+        )
+    if isinstance(err, float) and not model.plastic:  # plastic work is no integrator's loss
+        out["energy_loss"] = indicator(
+            max(-err, 0.0),
+            ENERGY_LOSS,
+            "energy lost to the integrator / initial energy (friction's dissipation counted apart)",
+            "measured: the paper's sloping impact loses 22 % to Newmark's damping",
+        )
     if model.rebound and steps:
-        out["separated"] = indicator(float(_touching(records[-1])), 0.0, "in contact at the run's end (1: the impact "
-                                     "is not over, the rebound it reports is read mid-impact)",
-                                     "the scene's rebound quantities are read after the body has left the obstacle")
-    shares = [(r.result.local_error, r.result.error_share) for r in steps
-              if getattr(r.result, "error_share", None) is not None]
-    if shares:                                                 # a run at a tolerance
+        out["separated"] = indicator(
+            float(_touching(records[-1])),
+            0.0,
+            "in contact at the run's end (1: the impact is not over, the rebound it reports is read mid-impact)",
+            "the scene's rebound quantities are read after the body has left the obstacle",
+        )
+    shares = [
+        (r.result.local_error, r.result.error_share)
+        for r in steps
+        if getattr(r.result, "error_share", None) is not None
+    ]
+    if shares:  # a run at a tolerance
         out["error_budget"] = indicator(
-            sum(e for e, _ in shares) / sum(s for _, s in shares), ERROR_BUDGET,
+            sum(e for e, _ in shares) / sum(s for _, s in shares),
+            ERROR_BUDGET,
             "the run's own estimate of its time-stepping error / the error its tolerance allows (its steps' local "
             f"error estimates over their shares, summed; {100 * at_floor(steps):.0f} % of the run's time in steps kept "
-            "at the floor dt TOL with more than twice their share)", "a step is kept with up to twice its share; "
+            "at the floor dt TOL with more than twice their share)",
+            "a step is kept with up to twice its share; "
             "beyond: steps at the floor dt TOL where the estimate asked for smaller ones, and the tolerance is not "
-            "assured")
+            "assured",
+        )
     stepper = getattr(model.stage, "stepper", None)
-    stepper = getattr(stepper, "stepper", stepper)            # Uzawa's inner stepper
+    stepper = getattr(stepper, "stepper", stepper)  # Uzawa's inner stepper
     if bool(steps) and getattr(stepper, "dynamic", False):
         beta = getattr(stepper, "beta", 0.25 if type(stepper).__name__ == "EnergyConsistent" else None)
         out.update(_time_resolution(model, records, beta))
@@ -164,26 +204,38 @@ def _time_resolution(model, records, beta):
         if f and start is None:
             start = k
         elif not f and start is not None:
-            episodes.append(k - start)                  # steps with contact, touch-down to lift-off
+            episodes.append(k - start)  # steps with contact, touch-down to lift-off
             start = None
-    if not episodes:                                   # no impact (a resting contact): neither applies
+    if not episodes:  # no impact (a resting contact): neither applies
         return out
-    out["impact_steps"] = indicator(max(episodes), IMPACT_STEPS, "steps that resolve the longest impact (touch-down "
-                                    "to lift-off)", "measured: the presets resolve their impacts with >= 23 steps",
-                                    upper=False)
-    stiff = _penalty_frequency(model, records) if beta is not None else None    # Newmark's and the midpoint rule's
+    out["impact_steps"] = indicator(
+        max(episodes),
+        IMPACT_STEPS,
+        "steps that resolve the longest impact (touch-down to lift-off)",
+        "measured: the presets resolve their impacts with >= 23 steps",
+        upper=False,
+    )
+    stiff = _penalty_frequency(model, records) if beta is not None else None  # Newmark's and the midpoint rule's
     if stiff is not None:
         dt = max(r.dt for r in records[1:])
-        out["penalty_steps"] = indicator(dt * stiff, PENALTY_STEPS, "dt sqrt(k / m), k the contact stiffness and m the "
-                                         "mass at the stiffest contact node", "the period error of Newmark's and the "
-                                         "midpoint rule's passes 25 % above 2; the presets' impacts stay below 4")
+        out["penalty_steps"] = indicator(
+            dt * stiff,
+            PENALTY_STEPS,
+            "dt sqrt(k / m), k the contact stiffness and m the mass at the stiffest contact node",
+            "the period error of Newmark's and the "
+            "midpoint rule's passes 25 % above 2; the presets' impacts stay below 4",
+        )
     if beta is not None and len(records) > 2:
         pairs = list(zip(records, records[1:]))
-        e = max(float(np.max(np.abs(b.a - a.a))) * b.dt ** 2 * abs(beta - 1.0 / 6.0) for a, b in pairs)
+        e = max(float(np.max(np.abs(b.a - a.a))) * b.dt**2 * abs(beta - 1.0 / 6.0) for a, b in pairs)
         du = max(float(np.max(np.abs(b.u - a.u))) for a, b in pairs)
         if du > 0:
-            out["local_error"] = indicator(e / du, LOCAL_ERROR, "Zienkiewicz-Xie local error dt^2 |beta - 1/6| "
-                                           "|a+ - a| / the largest increment", "measured: the presets stay below 0.25")
+            out["local_error"] = indicator(
+                e / du,
+                LOCAL_ERROR,
+                "Zienkiewicz-Xie local error dt^2 |beta - 1/6| |a+ - a| / the largest increment",
+                "measured: the presets stay below 0.25",
+            )
     return out
 
 
@@ -217,20 +269,30 @@ def stepping(params, records):
     """How a run stepped (``stepping``): the mode (fixed, or at the tolerance params['accuracy']), the
     integrator, the steps taken, the smallest and the largest step, and at_floor."""
     from .time_integration import integrator_of
-    if isinstance(records, dict):                 # a scene of several stages (the cork): its dynamic one
+
+    if isinstance(records, dict):  # a scene of several stages (the cork): its dynamic one
         records = records["records"]
     dts = [r.dt for r in records[1:]]
     tol = params.get("accuracy") or 0.0
-    return dict(mode="adaptive" if tol else "fixed", accuracy=tol or None, integrator=integrator_of(params),
-                steps=len(dts), dt_min=min(dts, default=None), dt_max=max(dts, default=None),
-                at_floor=at_floor(records[1:]) if tol else None)
+    return dict(
+        mode="adaptive" if tol else "fixed",
+        accuracy=tol or None,
+        integrator=integrator_of(params),
+        steps=len(dts),
+        dt_min=min(dts, default=None),
+        dt_max=max(dts, default=None),
+        at_floor=at_floor(records[1:]) if tol else None,
+    )
 
 
 def at_floor(steps):
     """The fraction of a run's time in steps kept with more than twice their share of the error (above
     the floor dt TOL, schedule.py rejects them: the estimate asked for less); None for fixed steps."""
-    shared = [(r.dt, r.result.local_error > 2.0 * r.result.error_share) for r in steps
-              if getattr(r.result, "error_share", None) is not None]
+    shared = [
+        (r.dt, r.result.local_error > 2.0 * r.result.error_share)
+        for r in steps
+        if getattr(r.result, "error_share", None) is not None
+    ]
     total = sum(dt for dt, _ in shared)
     return (float(sum(dt for dt, over in shared if over) / total) if total > 0 else 0.0) if shared else None
 
@@ -238,13 +300,22 @@ def at_floor(steps):
 def warn(accuracy, stacklevel=2):
     """One AccuracyWarning per indicator past its threshold (the same run twice warns twice: no
     registry remembers a line), pointing where warnings.warn(stacklevel) would; returns the lines."""
-    lines = [f"accuracy: {name} = {ind['value']:.3g}, {ind['bound']} {ind['threshold']:.3g} wanted ({ind['what']}; "
-             f"threshold: {ind['source']})" for name, ind in accuracy.items()
-             if isinstance(ind, dict) and not ind.get("ok", True)]
+    lines = [
+        f"accuracy: {name} = {ind['value']:.3g}, {ind['bound']} {ind['threshold']:.3g} wanted ({ind['what']}; "
+        f"threshold: {ind['source']})"
+        for name, ind in accuracy.items()
+        if isinstance(ind, dict) and not ind.get("ok", True)
+    ]
     frame = sys._getframe(1)
     for _ in range(stacklevel - 2):
         frame = frame.f_back or frame
     for line in lines:
-        warnings.warn_explicit(line, AccuracyWarning, frame.f_code.co_filename, frame.f_lineno,
-                               module=frame.f_globals.get("__name__"), registry=None)
+        warnings.warn_explicit(
+            line,
+            AccuracyWarning,
+            frame.f_code.co_filename,
+            frame.f_lineno,
+            module=frame.f_globals.get("__name__"),
+            registry=None,
+        )
     return lines

@@ -72,22 +72,30 @@ def bar_exact(L, E, rho, v0):
 
 def check(params):
     if params["integrator"] == "central_difference" and params["contact_integration"] == "energy_consistent":
-        raise ValueError("parameter contact_integration = 'energy_consistent' is implicit: "
-                         "use it with integrator = newmark")
+        raise ValueError(
+            "parameter contact_integration = 'energy_consistent' is implicit: use it with integrator = newmark"
+        )
     enforcement.check(params)
     if params["integrator"] == "central_difference" and params["accuracy"]:
-        raise ValueError(f"parameter accuracy = {params['accuracy']} needs an implicit stepper (its local error "
-                         "estimate): use it with integrator = newmark")
+        raise ValueError(
+            f"parameter accuracy = {params['accuracy']} needs an implicit stepper (its local error "
+            "estimate): use it with integrator = newmark"
+        )
     if params["enforcement"] != "penalty" and params["accuracy"]:
-        raise ValueError(f"parameter accuracy = {params['accuracy']} is offered with enforcement = penalty only "
-                         "(the multipliers' iterations are not tried at the adaptive mode's small first steps)")
+        raise ValueError(
+            f"parameter accuracy = {params['accuracy']} is offered with enforcement = penalty only "
+            "(the multipliers' iterations are not tried at the adaptive mode's small first steps)"
+        )
     if params["integrator"] == "central_difference" and params["enforcement"] != "penalty":
-        raise ValueError(f"parameter enforcement = {params['enforcement']} needs an implicit solve: use it with "
-                         "integrator = newmark")
+        raise ValueError(
+            f"parameter enforcement = {params['enforcement']} needs an implicit solve: use it with integrator = newmark"
+        )
     if params["contact_integration"] == "energy_consistent" and (
-            params["enforcement"] != "penalty" or params["contact_discretization"] != "node_to_segment"):
-        raise ValueError("parameter contact_integration = energy_consistent is offered with the penalty "
-                         "node-to-segment contact only")
+        params["enforcement"] != "penalty" or params["contact_discretization"] != "node_to_segment"
+    ):
+        raise ValueError(
+            "parameter contact_integration = energy_consistent is offered with the penalty node-to-segment contact only"
+        )
 
 
 def build(params, *, normal=None, friction=None, system_options=None):
@@ -105,9 +113,17 @@ def build(params, *, normal=None, friction=None, system_options=None):
     nodes = nodes[np.argsort(body.X[nodes, 1])]
     w = tributary_lengths(body.X[nodes])
     c_N = params["c_N_factor"] * params["E"] / (L / n)
-    contact = enforcement.interface(params, body, nodes, RigidLine((0.0, 0.0), (1.0, 0.0)),
-                                    normal=normal or PowerLaw(c_N, 1.0), friction=friction, weights=w, name="wall",
-                                    integration=time_integration.contact_integration(params))
+    contact = enforcement.interface(
+        params,
+        body,
+        nodes,
+        RigidLine((0.0, 0.0), (1.0, 0.0)),
+        normal=normal or PowerLaw(c_N, 1.0),
+        friction=friction,
+        weights=w,
+        name="wall",
+        integration=time_integration.contact_integration(params),
+    )
     system = System([body], [contact], **(system_options or {}))
     v0, ex = params["v0"], bar_exact(L, params["E"], params["rho"], params["v0"])
     dt = params["courant"] * (L / n) / ex["c"]
@@ -118,16 +134,21 @@ def build(params, *, normal=None, friction=None, system_options=None):
     else:
         F_scale = ex["stress"] * H
         stepper = time_integration.make_stepper(params, system, atol=1e-9 * F_scale, maxit=30)
-    stepper = enforcement.wrap(params, stepper, [contact], length=L / n)     # gap_violation: penetration / h_x
+    stepper = enforcement.wrap(params, stepper, [contact], length=L / n)  # gap_violation: penetration / h_x
     v0_vec = np.zeros(system.ndof)
     v0_vec[body.xdofs[:, 0]] = -v0
     # accuracy: the errors of the rebound velocity (speed v0) are made while the bar touches, 2 L / c
-    stepper, schedule = time_integration.plan(params, stepper, dt=dt, t_end=t_end, speed=v0, duration=ex["duration"],
-                                              max_cuts=0 if explicit else 4)
+    stepper, schedule = time_integration.plan(
+        params, stepper, dt=dt, t_end=t_end, speed=v0, duration=ex["duration"], max_cuts=0 if explicit else 4
+    )
     stage = Stage(stepper, schedule, np.zeros(system.ndof), v0_vec, name="bar_impact")
-    return Model(systems=(system,), stage=stage, sizes=dict(element=L / n, body=L),     # the accuracy indicators' lengths
-                 rebound=True,                # the accuracy's `separated`: the rebound is read after the impact
-                 parts=dict(body=body, contact=contact, nodes=nodes, w=w, c_N=c_N, dt=dt))
+    return Model(
+        systems=(system,),
+        stage=stage,
+        sizes=dict(element=L / n, body=L),  # the accuracy indicators' lengths
+        rebound=True,  # the accuracy's `separated`: the rebound is read after the impact
+        parts=dict(body=body, contact=contact, nodes=nodes, w=w, c_N=c_N, dt=dt),
+    )
 
 
 def measure(m, params, records):
@@ -155,22 +176,43 @@ def measure(m, params, records):
     E_tot = hist.kinetic + hist.strain + hist.contact
     E0 = E_tot[0]
     return dict(
-        duration=duration, duration_exact=ex["duration"], error_duration=(duration - ex["duration"]) / ex["duration"],
-        stress_peak=float(stress.max()), stress_mean=float(stress[mid].mean()) if np.any(mid) else float(stress.max()),
+        duration=duration,
+        duration_exact=ex["duration"],
+        error_duration=(duration - ex["duration"]) / ex["duration"],
+        stress_peak=float(stress.max()),
+        stress_mean=float(stress[mid].mean()) if np.any(mid) else float(stress.max()),
         stress_exact=ex["stress"],
         error_stress_mean=(float(stress[mid].mean()) - ex["stress"]) / ex["stress"] if np.any(mid) else 0.0,
-        rebound_velocity=v_after, rebound_velocity_exact=ex["rebound_velocity"],
+        rebound_velocity=v_after,
+        rebound_velocity_exact=ex["rebound_velocity"],
         error_rebound=(v_after - v0) / v0,
-        energy_initial=E0, energy_final=float(E_tot[-1]),
-        energy_error=float((E_tot[-1] - E0) / E0), energy_error_max=float(np.max(np.abs(E_tot - E0)) / E0),
-        wave_speed=ex["c"], dt=dt, c_N=m.parts["c_N"], n_steps=int(len(t) - 1),
-        time=t, contact_stress=stress, energy_total=E_tot,
+        energy_initial=E0,
+        energy_final=float(E_tot[-1]),
+        energy_error=float((E_tot[-1] - E0) / E0),
+        energy_error_max=float(np.max(np.abs(E_tot - E0)) / E0),
+        wave_speed=ex["c"],
+        dt=dt,
+        c_N=m.parts["c_N"],
+        n_steps=int(len(t) - 1),
+        time=t,
+        contact_stress=stress,
+        energy_total=E_tot,
         newton_iterations_total=int(np.sum(hist.iterations)),
-        accuracy=references(dict(duration=(duration - ex["duration"]) / ex["duration"],
-                                 rebound_velocity=(v_after - ex["rebound_velocity"]) / ex["rebound_velocity"]),
-                            CLOSED_FORM_TOL, CLOSED_FORM_SOURCE),
-        **enforcement.report(params, records, max(enforcement.penetration(rec.contacts[0]) for rec in records),
-                             L / params["n_el"], "the element length h_x (largest penetration of the run)"),
+        accuracy=references(
+            dict(
+                duration=(duration - ex["duration"]) / ex["duration"],
+                rebound_velocity=(v_after - ex["rebound_velocity"]) / ex["rebound_velocity"],
+            ),
+            CLOSED_FORM_TOL,
+            CLOSED_FORM_SOURCE,
+        ),
+        **enforcement.report(
+            params,
+            records,
+            max(enforcement.penetration(rec.contacts[0]) for rec in records),
+            L / params["n_el"],
+            "the element length h_x (largest penetration of the run)",
+        ),
     )
 
 
@@ -178,13 +220,16 @@ def measure(m, params, records):
 # duration and 1.8 % in rebound velocity, the paper's (100) 1.0 % and 1.2 %; the duration's error falls
 # as 1 / n_el (4 elements: 25 %, 10: 10 %, 20: 7.5 %) and grows as the penalty softens (c_N x 0.1: 20 %)
 CLOSED_FORM_TOL = 0.05
-CLOSED_FORM_SOURCE = ("5 %, the extremes grid's criterion; measured: 40 elements 3.8 % (duration) and 1.8 % "
-                      "(rebound), 100 elements 1.0 % and 1.2 %, 20 elements 7.5 %, c_N x 0.1 20 %")
+CLOSED_FORM_SOURCE = (
+    "5 %, the extremes grid's criterion; measured: 40 elements 3.8 % (duration) and 1.8 % "
+    "(rebound), 100 elements 1.0 % and 1.2 %, 20 elements 7.5 %, c_N x 0.1 20 %"
+)
 
 
 def law_range(params):
     """Normal law only: probed down to a penetration of the bar's height."""
     return dict(g=params["h"])
+
 
 SCENE = Scene(
     name="bar_impact",
@@ -198,12 +243,23 @@ SCENE = Scene(
         Param("gap", 0.0, "mm", 0.0, None, doc="initial distance to the wall"),
         Param("n_el", 100, "", 2, 100000, doc="elements along the bar"),
         Param("courant", 1.0, "", 0.0, None, low_open=True, doc="Courant number c dt / h (sets dt)"),
-        Param("c_N_factor", 1.0, "", 0.0, None, low_open=True,
-              doc="penalty per unit length c_N = c_N_factor E / h_x (eq 4, m = 1); chosen: 1, a penalty "
-                  "as stiff as one element; much stiffer penalties chatter under the trapezoidal rule"),
-        Param("integrator", "newmark", choices=("newmark", "central_difference"),
-              doc="implicit Newmark (delta, beta_newmark) or explicit central differences (stable for "
-                  "courant < 1; no Newton, no cutback)"),
+        Param(
+            "c_N_factor",
+            1.0,
+            "",
+            0.0,
+            None,
+            low_open=True,
+            doc="penalty per unit length c_N = c_N_factor E / h_x (eq 4, m = 1); chosen: 1, a penalty "
+            "as stiff as one element; much stiffer penalties chatter under the trapezoidal rule",
+        ),
+        Param(
+            "integrator",
+            "newmark",
+            choices=("newmark", "central_difference"),
+            doc="implicit Newmark (delta, beta_newmark) or explicit central differences (stable for "
+            "courant < 1; no Newton, no cutback)",
+        ),
         *time_integration.newmark_params(0.5, 0.25, "chosen, average acceleration"),
         Param("t_end", 1.5, "2L/c", 0.0, None, low_open=True, doc="simulated time in units of 2 L / c"),
         time_integration.CONTACT_INTEGRATION_PARAM,
@@ -214,11 +270,20 @@ SCENE = Scene(
     measure=measure,
     check=check,
     presets={"fast": {"n_el": 40}, "paper": {"n_el": 100}},
-    size=lambda p: dict(elements=p["n_el"], unknowns=4 * (p["n_el"] + 1),
-                        steps=(2 * p["t_end"] + p["gap"] / p["L"] * (p["E"] / p["rho"]) ** 0.5 / p["v0"])
-                        * p["n_el"] / p["courant"]),
-    reports=("duration", "duration_exact", "stress_mean", "stress_peak", "stress_exact",
-             "rebound_velocity", "energy_error"),
+    size=lambda p: dict(
+        elements=p["n_el"],
+        unknowns=4 * (p["n_el"] + 1),
+        steps=(2 * p["t_end"] + p["gap"] / p["L"] * (p["E"] / p["rho"]) ** 0.5 / p["v0"]) * p["n_el"] / p["courant"],
+    ),
+    reports=(
+        "duration",
+        "duration_exact",
+        "stress_mean",
+        "stress_peak",
+        "stress_exact",
+        "rebound_velocity",
+        "energy_error",
+    ),
     laws=("normal",),
     law_params={"normal": ("c_N_factor",)},
     law_range=law_range,

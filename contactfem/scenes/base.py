@@ -23,9 +23,11 @@ from .params import Limit, Param, check_overrides, parse_all  # noqa: F401  (sce
 from .resources import check_resources, describe  # noqa: F401  (the command line takes them from here)
 
 PENALTIES = ("per_length", "per_node")
-PENALTY_DOC = ("unit of c_N and c_T: per_length = tractions per unit gap and per unit length of the contact "
-               "boundary (nodal weights = tributary lengths; per unit area of an axisymmetric surface), "
-               "per_node = nodal stiffnesses (weights 1)")
+PENALTY_DOC = (
+    "unit of c_N and c_T: per_length = tractions per unit gap and per unit length of the contact "
+    "boundary (nodal weights = tributary lengths; per unit area of an axisymmetric surface), "
+    "per_node = nodal stiffnesses (weights 1)"
+)
 
 
 def simulate(model, params=None, progress=None):
@@ -50,21 +52,22 @@ def run(scene, params, normal=None, friction=None, progress=None, linear_algebra
     from ..clock import imports_timed
     from .accuracy import collect, stepping, warn
 
-    with imports_timed() as imported:              # modules loaded on first use: not the run's time
+    with imports_timed() as imported:  # modules loaded on first use: not the run's time
         t0 = time.perf_counter()
         options = dict(linear_algebra=linear_algebra, instrument=instrument)
         model = scene.build(params, normal=normal, friction=friction, system_options=options)
         if not isinstance(model, Model):
-            raise TypeError(f"scene {scene.name}, build: returned {type(model).__name__}, not a Model "
-                            "(contactfem.scenes.Model)")
+            raise TypeError(
+                f"scene {scene.name}, build: returned {type(model).__name__}, not a Model (contactfem.scenes.Model)"
+            )
         records = (scene.simulate or simulate)(model, params, progress)
         results = dict(scene.measure(model, params, records))
         wall = time.perf_counter() - t0
     systems = model.systems
-    if "accuracy" in params:                    # how the run stepped: fixed, or at a tolerance
+    if "accuracy" in params:  # how the run stepped: fixed, or at a tolerance
         results["stepping"] = stepping(params, records)
     accuracy = collect(model, params, records, results)
-    accuracy.update(results.pop("accuracy", None) or {})     # the scene's own (its references)
+    accuracy.update(results.pop("accuracy", None) or {})  # the scene's own (its references)
     results["accuracy"] = accuracy
     warn(accuracy, stacklevel=3)
     results["wall_time_s"] = wall - imported[0]
@@ -72,12 +75,14 @@ def run(scene, params, normal=None, friction=None, progress=None, linear_algebra
     results["ordering"] = "+".join(dict.fromkeys(s.ordering for s in systems)) or None
     results["unknowns"] = max((s.ndof for s in systems), default=None)
     bands = [s.band for s in systems if s.band is not None]
-    results["band_kl"] = max((kl for kl, _ in bands), default=None)     # banded: the widest band
+    results["band_kl"] = max((kl for kl, _ in bands), default=None)  # banded: the widest band
     results["band_ku"] = max((ku for _, ku in bands), default=None)
     results["residual_evaluations"] = int(sum(s.evaluations for s in systems))
     contacts = {id(c): c for s in systems for c in s.contacts}
     results["contact_evaluations"] = int(sum(c.evaluations for c in contacts.values()))
-    results.setdefault("newton_iterations_total", int(sum(getattr(r, "iterations", 0) for r in records)))  # if not counted
+    results.setdefault(
+        "newton_iterations_total", int(sum(getattr(r, "iterations", 0) for r in records))
+    )  # if not counted
     return results
 
 
@@ -86,25 +91,32 @@ class Scene:
     name: str
     title: str
     params: tuple
-    build: Callable                               # (params, *, normal, friction, system_options) -> Model
-    measure: Callable                             # (model, params, records) -> results dict
-    simulate: Callable | None = None              # (model, params, progress) -> records; default: the model's stage
-    presets: dict = field(default_factory=dict)   # preset name -> {param: value}
-    reports: tuple = ()                           # names of the main results, for `show`
-    check: Callable[[dict], None] | None = None   # cross-parameter checks (ValueError), before any run
-    size: Callable[[dict], dict] | None = None    # {"elements", "unknowns", "steps"} from the parameters
-    outlines: bool = False                        # records body outlines (run --gif can animate them)
-    notes: str = ""                               # what `show` says after the parameters (data read/fitted)
+    build: Callable  # (params, *, normal, friction, system_options) -> Model
+    measure: Callable  # (model, params, records) -> results dict
+    simulate: Callable | None = None  # (model, params, progress) -> records; default: the model's stage
+    presets: dict = field(default_factory=dict)  # preset name -> {param: value}
+    reports: tuple = ()  # names of the main results, for `show`
+    check: Callable[[dict], None] | None = None  # cross-parameter checks (ValueError), before any run
+    size: Callable[[dict], dict] | None = None  # {"elements", "unknowns", "steps"} from the parameters
+    outlines: bool = False  # records body outlines (run --gif can animate them)
+    notes: str = ""  # what `show` says after the parameters (data read/fitted)
     # The interface laws (a law object given to run_scene, or --friction / --normal, replaces the scene's own):
-    laws: tuple = ()                              # the kinds of law the scene's contact has: "normal", "friction"
-    law_params: dict = field(default_factory=dict)   # kind -> the parameters that build the scene's law of that kind
-    law_choice: tuple | None = None               # (parameter, values): those values of it choose the friction law
+    laws: tuple = ()  # the kinds of law the scene's contact has: "normal", "friction"
+    law_params: dict = field(default_factory=dict)  # kind -> the parameters that build the scene's law of that kind
+    law_choice: tuple | None = None  # (parameter, values): those values of it choose the friction law
     law_range: Callable[[dict], dict] | None = None  # the range a law meets (LAW_RANGE_KEYS), for the pre-flight
 
     def run(self, params, normal=None, friction=None, progress=None, linear_algebra="auto", instrument=None):
         """Build, simulate and measure (module function ``run``)."""
-        return run(self, params, normal=normal, friction=friction, progress=progress, linear_algebra=linear_algebra,
-                   instrument=instrument)
+        return run(
+            self,
+            params,
+            normal=normal,
+            friction=friction,
+            progress=progress,
+            linear_algebra=linear_algebra,
+            instrument=instrument,
+        )
 
     def param(self, name):
         for p in self.params:
@@ -124,18 +136,22 @@ class Scene:
         for k, v in overrides.items():
             if k not in known:
                 head, dot, field = str(k).partition(".")
-                if dot and head in ("law", "friction", "normal"):   # the command line's --set law.X, from Python
-                    raise ValueError(f"unknown parameter {k!r} for scene {self.name}: from Python a law's fields are "
-                                     f"set on the law object itself, e.g. friction=Coulomb(c_T, mu) "
-                                     f"or dataclasses.replace(law, {field}=...)")
+                if dot and head in ("law", "friction", "normal"):  # the command line's --set law.X, from Python
+                    raise ValueError(
+                        f"unknown parameter {k!r} for scene {self.name}: from Python a law's fields are "
+                        f"set on the law object itself, e.g. friction=Coulomb(c_T, mu) "
+                        f"or dataclasses.replace(law, {field}=...)"
+                    )
                 raise ValueError(f"unknown parameter {k!r} for scene {self.name}: known are {', '.join(known)}")
             values[k] = v
         values = parse_all(self.params, values)  # each value, then the ranges from other parameters
-        for k in overrides:                       # a value the resolved variant would silently ignore
+        for k in overrides:  # a value the resolved variant would silently ignore
             if not known[k].applies(values):
                 now = ", ".join(f"{o}={values[o]}" for o, _ in known[k].when)
-                raise ValueError(f"parameter {k} does not apply to {self.name} with {now}: "
-                                 f"it is used only with {known[k].when_text()}")
+                raise ValueError(
+                    f"parameter {k} does not apply to {self.name} with {now}: "
+                    f"it is used only with {known[k].when_text()}"
+                )
         if self.check is not None:
             self.check(values)
         return values
@@ -145,8 +161,11 @@ class Scene:
         for kind, names in self.law_params.items():
             if name in names:
                 return kind
-        if self.law_choice is not None and name == self.law_choice[0] and \
-                (value is None or str(value) in map(str, self.law_choice[1])):
+        if (
+            self.law_choice is not None
+            and name == self.law_choice[0]
+            and (value is None or str(value) in map(str, self.law_choice[1]))
+        ):
             return "friction"
         return None
 
@@ -159,8 +178,9 @@ class Scene:
         for kind, law in laws.items():
             if kind not in self.laws:
                 what = "is frictionless" if kind == "friction" else "has no normal law"
-                raise ValueError(f"scene {self.name} has no {kind} law (its contact {what}): a {kind} law does "
-                                 "not apply to it")
+                raise ValueError(
+                    f"scene {self.name} has no {kind} law (its contact {what}): a {kind} law does not apply to it"
+                )
         for k, v in (overrides or {}).items():
             kind = self.law_param_kind(k, v)
             if kind is None or kind not in laws:
@@ -169,13 +189,19 @@ class Scene:
             cls = law if isinstance(law, type) else type(law)
             name = cls.__name__
             if self.law_choice is not None and k == self.law_choice[0]:
-                raise ValueError(f"parameter {k} = {v} chooses the scene's {kind} law, which the {kind} law {name} "
-                                 f"replaces: leave {k} out")
+                raise ValueError(
+                    f"parameter {k} = {v} chooses the scene's {kind} law, which the {kind} law {name} "
+                    f"replaces: leave {k} out"
+                )
             fields = [f.name for f in dataclasses.fields(cls)] if dataclasses.is_dataclass(cls) else []
-            fix = (f"set {name}'s own field instead: --set law.{k}={v} (or {name}({k}={v}))" if k in fields else
-                   f"{name} has no field {k} (its fields: {', '.join(fields) or 'none'})")
-            raise ValueError(f"parameter {k} builds the scene's {kind} law, which the {kind} law {name} replaces: "
-                             + fix)
+            fix = (
+                f"set {name}'s own field instead: --set law.{k}={v} (or {name}({k}={v}))"
+                if k in fields
+                else f"{name} has no field {k} (its fields: {', '.join(fields) or 'none'})"
+            )
+            raise ValueError(
+                f"parameter {k} builds the scene's {kind} law, which the {kind} law {name} replaces: " + fix
+            )
 
     def variant_of(self, params, friction=None):
         """The variant a run reports: the law_choice parameter's value; with a friction law
@@ -225,7 +251,7 @@ def jsonable(obj, where="result"):
         return [jsonable(v, where) for v in obj]
     if isinstance(obj, np.ndarray):
         if obj.dtype.kind in "biu" or (obj.dtype.kind == "f" and np.isfinite(obj).all()):
-            return obj.tolist()                   # numbers, every one finite: Python's ints and floats
+            return obj.tolist()  # numbers, every one finite: Python's ints and floats
         return jsonable(obj.tolist(), where)
     if isinstance(obj, (np.bool_,)):
         return bool(obj)
@@ -234,7 +260,9 @@ def jsonable(obj, where="result"):
     if isinstance(obj, (float, np.floating)):
         f = float(obj)
         if not np.isfinite(f):
-            raise FloatingPointError(f"the run gave a non-finite result ({where} = {f}); refusing to report it "
-                                     "(parameters near the limits of floating point?)")
+            raise FloatingPointError(
+                f"the run gave a non-finite result ({where} = {f}); refusing to report it "
+                "(parameters near the limits of floating point?)"
+            )
         return f
     return obj

@@ -56,33 +56,59 @@ def build(params, *, normal=None, friction=None, system_options=None):
 
     W, H = params["width"], params["height"]
     mesh = block_mesh(W, H, params["nx"], params["ny"])
-    body = Continuum(mesh, E=params["E"], nu=params["nu"], rho=0.0, kind="plane_" + params["plane"],
-                     material=params["material"], name="block")
+    body = Continuum(
+        mesh,
+        E=params["E"],
+        nu=params["nu"],
+        rho=0.0,
+        kind="plane_" + params["plane"],
+        material=params["material"],
+        name="block",
+    )
     bottom = body.boundary_nodes("bottom")
-    bottom = bottom[np.argsort(body.X[bottom, 0])]          # left to right
+    bottom = bottom[np.argsort(body.X[bottom, 0])]  # left to right
     k = params["free_end_nodes"]
     assert 0 < 2 * k < len(bottom) - 1, "free_end_nodes leaves no contact node (its Param's limit)"
-    weights = tributary_lengths(body.X[bottom])[k:-k]        # tractions per unit length of the bottom
-    slaves = bottom[k:-k]                                   # the first and last element never touch
-    contact = enforcement.interface(params, body, slaves, RigidLine((0.0, 0.0), (0.0, 1.0)),
-                                    normal=normal or PowerLaw(c_N=params["c_N"] * per_length(params), m=params["m"]),
-                                    friction=friction or friction_law(params), weights=weights,
-                                    offset=-params["g_N0"], name="foundation", tangent=params["tangent"],
-                                    material=params["material"])
+    weights = tributary_lengths(body.X[bottom])[k:-k]  # tractions per unit length of the bottom
+    slaves = bottom[k:-k]  # the first and last element never touch
+    contact = enforcement.interface(
+        params,
+        body,
+        slaves,
+        RigidLine((0.0, 0.0), (0.0, 1.0)),
+        normal=normal or PowerLaw(c_N=params["c_N"] * per_length(params), m=params["m"]),
+        friction=friction or friction_law(params),
+        weights=weights,
+        offset=-params["g_N0"],
+        name="foundation",
+        tangent=params["tangent"],
+        material=params["material"],
+    )
     p_y, p_x = params["p_y"], params["p_x"]
-    loads = [Pressure(body, "top", lambda t: p_y * t),                # dead loads, ramped over the
-             Traction(body, params["p_x_face"], lambda t: (p_x * t, 0.0))]   # pseudo-time t in [0, 1]
+    loads = [
+        Pressure(body, "top", lambda t: p_y * t),  # dead loads, ramped over the
+        Traction(body, params["p_x_face"], lambda t: (p_x * t, 0.0)),
+    ]  # pseudo-time t in [0, 1]
     system = System([body], [contact], loads, **(system_options or {}))
     n = params["n_steps"]
-    h = params["width"] / params["nx"]                        # gap_violation: penetration / element size
+    h = params["width"] / params["nx"]  # gap_violation: penetration / element size
     stepper = Static(system, atol=params["atol"], rtol=params["rtol"], maxit=params["maxit"])
-    stepper = enforcement.wrap(dict(params, enforcement=params.get("enforcement", "penalty")), stepper,
-                               [contact], length=h)
-    stage = Stage(stepper, Steps(1.0 / n, n_steps=n), np.zeros(system.ndof), name="block",
-                  label=lambda k, t1, dt: f"block, load step {k} of {n}")
-    return Model(systems=(system,), stage=stage,
-                 sizes=dict(element=min(h, params["height"] / params["ny"]), body=min(params["width"], params["height"])),
-                 parts=dict(body=body, contact=contact, loads=loads, slaves=slaves, stepper=stepper, element_size=h))
+    stepper = enforcement.wrap(
+        dict(params, enforcement=params.get("enforcement", "penalty")), stepper, [contact], length=h
+    )
+    stage = Stage(
+        stepper,
+        Steps(1.0 / n, n_steps=n),
+        np.zeros(system.ndof),
+        name="block",
+        label=lambda k, t1, dt: f"block, load step {k} of {n}",
+    )
+    return Model(
+        systems=(system,),
+        stage=stage,
+        sizes=dict(element=min(h, params["height"] / params["ny"]), body=min(params["width"], params["height"])),
+        parts=dict(body=body, contact=contact, loads=loads, slaves=slaves, stepper=stepper, element_size=h),
+    )
 
 
 def converged(model, records):
@@ -92,8 +118,15 @@ def converged(model, records):
     last = records[-1]
     state = last.contacts[0]
     Y = FrictionLaw(model.parts["contact"].friction).slip_bound(-state.t_N, state.q, state.lam / last.dt, state.z)[0]
-    return dict(u=last.u, result=last.result, results=[r.result for r in records[1:]], report=state.report(),
-                R_c=state.scatter(len(last.u))[0], slip_bound=Y, state=state)
+    return dict(
+        u=last.u,
+        result=last.result,
+        results=[r.result for r in records[1:]],
+        report=state.report(),
+        R_c=state.scatter(len(last.u))[0],
+        slip_bound=Y,
+        state=state,
+    )
 
 
 def solve(params, *, friction=None, normal=None, progress=None, system_options=None):
@@ -123,20 +156,20 @@ def measure(model, params, records):
     s = dict(model.parts, **converged(model, records))
     body, rep, res = s["body"], s["report"], s["result"]
     dofs = body.xdofs
-    total_normal = float(s["R_c"][dofs[:, 1]].sum())          # = sum w t_N (signed, < 0 compressive)
-    total_tangential = float(s["R_c"][dofs[:, 0]].sum())      # = sum w t_T
+    total_normal = float(s["R_c"][dofs[:, 1]].sum())  # = sum w t_N (signed, < 0 compressive)
+    total_tangential = float(s["R_c"][dofs[:, 0]].sum())  # = sum w t_T
     W, H = params["width"], params["height"]
     applied_normal, applied_tangential = -params["p_y"] * W, params["p_x"] * H
-    Y = s["slip_bound"]                                       # of the law in use, after the step
-    excess = np.abs(rep["t_T"]) - Y                           # <= 0 everywhere, = 0 on slipping nodes
+    Y = s["slip_bound"]  # of the law in use, after the step
+    excess = np.abs(rep["t_T"]) - Y  # <= 0 everywhere, = 0 on slipping nodes
     slipping = rep["state"] == "slip"
     top, side = load_norms(body, s["loads"])
     u = s["u"]
     iterations = [r.iterations for r in s["results"]]
     return {
-        "newton_residuals": list(res.residuals),                     # of the (last) load step
+        "newton_residuals": list(res.residuals),  # of the (last) load step
         "newton_residuals_per_step": [list(r.residuals) for r in s["results"]],
-        "iterations": int(sum(iterations)),                          # linear solves
+        "iterations": int(sum(iterations)),  # linear solves
         "newton_iterations_total": int(sum(iterations)),
         "total_normal": total_normal,
         "total_tangential": total_tangential,
@@ -155,19 +188,33 @@ def measure(model, params, records):
         # a displacement far outside the small-strain model
         "min_jacobian_ratio": float(np.min(body.corner_jacobian_ratios(u))),
         "inverted_elements": int(body.inverted_elements(u).size),
-        "contact": {"x": rep["X"][:, 0], "x_current": rep["x"][:, 0], "t_N": rep["t_N"], "t_T": rep["t_T"],
-                    "state": [str(v) for v in rep["state"]], "g_N": rep["g_N"], "slip_bound": Y,
-                    "weights": rep["weights"]},
+        "contact": {
+            "x": rep["X"][:, 0],
+            "x_current": rep["x"][:, 0],
+            "t_N": rep["t_N"],
+            "t_T": rep["t_T"],
+            "state": [str(v) for v in rep["state"]],
+            "g_N": rep["g_N"],
+            "slip_bound": Y,
+            "weights": rep["weights"],
+        },
         "paper_table1": PAPER_TABLE1.get(params["law"], []),
-        "accuracy": {"mesh_height": indicator(params["ny"], MESH_HEIGHT, "elements through the block's height "
-                                              "(bilinear quads: too few bend too stiffly)", MESH_HEIGHT_SOURCE,
-                                              upper=False)},
+        "accuracy": {
+            "mesh_height": indicator(
+                params["ny"],
+                MESH_HEIGHT,
+                "elements through the block's height (bilinear quads: too few bend too stiffly)",
+                MESH_HEIGHT_SOURCE,
+                upper=False,
+            )
+        },
         # the scan lost these; their values (the defaults) are fitted to Table 1 by `contactfem reconstruct block`
         "fitted": {k: params[k] for k in FITTED},
         "fitted_to": "Table 1 (first residual, number and pattern of the residuals, conical slip); "
-                     "see contactfem reconstruct block",
-        **enforcement.report(params, records, enforcement.penetration(s["state"]), s["element_size"],
-                             "the element size width / nx"),
+        "see contactfem reconstruct block",
+        **enforcement.report(
+            params, records, enforcement.penetration(s["state"]), s["element_size"], "the element size width / nx"
+        ),
     }
 
 
@@ -179,24 +226,53 @@ SCENE = Scene(
     measure=measure,
     # fast = paper: the paper's 200 elements are already small. canonical: the reading used before the
     # reconstruction study (no node slips with the conical law)
-    presets={"fast": {}, "paper": {},
-             "canonical": {"width": 4.0, "height": 3.5, "nx": 20, "ny": 10, "p_x_face": "right", "c_T": 5.0e4,
-                           "plane": "strain"},
-             # the best-ranked reading of `contactfem reconstruct block` that shows Fig 8's remark (none
-             # that shows it has Table 1's conical residuals and slip): Fig 8 of it beside the preset's
-             "fig8": {"width": 4.0, "height": 3.0, "nx": 25, "ny": 8, "p_x_face": "right", "free_end_nodes": 1,
-                      "c_N": 1.0e6, "penalty": "per_node", "plane": "strain"}},
-    notes=("Read from the scan: E, nu, p_y = 200, p_x = 60, 200 elements, c_T = 1e4, m, the laws, one load step.\n"
-           "FITTED to Table 1 (the scan lost them; contactfem reconstruct block ranks every reading): width 4, "
-           "height 3.25, 25 x 8 elements, p_x on the left side (it pushes the block: this CONTRADICTS the "
-           "paper's text, whose block is pulled; the readings that pull meet fewer of Table 1's facts), "
-           "free_end_nodes 2, c_N 1e5 per length, "
-           "penalty per_length, plane stress. First residual 171.88 (paper 171.37, +0.30 %: no uniform mesh "
-           "reaches the printed digits); conical 4 residuals with slip, parabolic 7 (paper 4 and 7). "
-           "Fig 8's remark is shown by no reading that meets Table 1's conical facts (4 residuals, nodes "
-           "slipping); preset fig8, a reading without them, shows it."),
-    reports=("newton_residuals", "iterations", "total_normal", "total_tangential", "equilibrium_error",
-             "n_stick", "n_slip", "contact"),
+    presets={
+        "fast": {},
+        "paper": {},
+        "canonical": {
+            "width": 4.0,
+            "height": 3.5,
+            "nx": 20,
+            "ny": 10,
+            "p_x_face": "right",
+            "c_T": 5.0e4,
+            "plane": "strain",
+        },
+        # the best-ranked reading of `contactfem reconstruct block` that shows Fig 8's remark (none
+        # that shows it has Table 1's conical residuals and slip): Fig 8 of it beside the preset's
+        "fig8": {
+            "width": 4.0,
+            "height": 3.0,
+            "nx": 25,
+            "ny": 8,
+            "p_x_face": "right",
+            "free_end_nodes": 1,
+            "c_N": 1.0e6,
+            "penalty": "per_node",
+            "plane": "strain",
+        },
+    },
+    notes=(
+        "Read from the scan: E, nu, p_y = 200, p_x = 60, 200 elements, c_T = 1e4, m, the laws, one load step.\n"
+        "FITTED to Table 1 (the scan lost them; contactfem reconstruct block ranks every reading): width 4, "
+        "height 3.25, 25 x 8 elements, p_x on the left side (it pushes the block: this CONTRADICTS the "
+        "paper's text, whose block is pulled; the readings that pull meet fewer of Table 1's facts), "
+        "free_end_nodes 2, c_N 1e5 per length, "
+        "penalty per_length, plane stress. First residual 171.88 (paper 171.37, +0.30 %: no uniform mesh "
+        "reaches the printed digits); conical 4 residuals with slip, parabolic 7 (paper 4 and 7). "
+        "Fig 8's remark is shown by no reading that meets Table 1's conical facts (4 residuals, nodes "
+        "slipping); preset fig8, a reading without them, shows it."
+    ),
+    reports=(
+        "newton_residuals",
+        "iterations",
+        "total_normal",
+        "total_tangential",
+        "equilibrium_error",
+        "n_stick",
+        "n_slip",
+        "contact",
+    ),
     check=check,
     size=size,
     laws=("normal", "friction"),

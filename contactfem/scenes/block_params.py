@@ -40,8 +40,7 @@ from .base import PENALTIES, PENALTY_DOC, Limit, Param
 # the conical law's 3rd and 4th entries (NOTES.md, "scan?"): listed in UNCERTAIN.
 PAPER_TABLE1 = {
     "conical": [0.1713709e3, 0.1196315e2, 0.3218561e1, 0.4368441e-11],
-    "parabolic": [0.1713709e3, 0.2446232e2, 0.1265767e2, 0.5389606e1, 0.1306383e1,
-                  0.1098278e-5, 0.4359430e-11],
+    "parabolic": [0.1713709e3, 0.2446232e2, 0.1265767e2, 0.5389606e1, 0.1306383e1, 0.1098278e-5, 0.4359430e-11],
 }
 PAPER_TABLE1_UNCERTAIN = {"conical": (2, 3), "parabolic": ()}
 
@@ -50,64 +49,158 @@ LAWS = ("conical", "parabolic", "coulomb")
 FITTED = ("width", "height", "nx", "ny", "p_x_face", "free_end_nodes", "c_N", "penalty", "plane")
 
 PARAMS = (
-    Param("law", "conical", choices=LAWS,
-          doc="slip surface: conical (eq 10, n = 1: Coulomb with mu = alpha + beta), "
-              "parabolic (eq 10 with exponent n) or coulomb (eq 11 with mu)"),
-    Param("plane", "stress", choices=("strain", "stress"),
-          doc="plane strain or plane stress (the scan does not say; stress FITTED to Table 1; plane stress "
-              "needs material = linear)"),
-    Param("material", "linear", choices=MATERIALS,
-          doc="bulk material: small-strain linear (as Oden & Pires), St Venant-Kirchhoff or neo-Hooke"),
-    Param("tangent", "consistent", choices=TANGENTS,
-          doc="contact tangent given to Newton: consistent (eqs 39, 49-50), symmetric ((K+K^T)/2), "
-              "frozen (without the c_N^s C coupling of eq 49)"),
+    Param(
+        "law",
+        "conical",
+        choices=LAWS,
+        doc="slip surface: conical (eq 10, n = 1: Coulomb with mu = alpha + beta), "
+        "parabolic (eq 10 with exponent n) or coulomb (eq 11 with mu)",
+    ),
+    Param(
+        "plane",
+        "stress",
+        choices=("strain", "stress"),
+        doc="plane strain or plane stress (the scan does not say; stress FITTED to Table 1; plane stress "
+        "needs material = linear)",
+    ),
+    Param(
+        "material",
+        "linear",
+        choices=MATERIALS,
+        doc="bulk material: small-strain linear (as Oden & Pires), St Venant-Kirchhoff or neo-Hooke",
+    ),
+    Param(
+        "tangent",
+        "consistent",
+        choices=TANGENTS,
+        doc="contact tangent given to Newton: consistent (eqs 39, 49-50), symmetric ((K+K^T)/2), "
+        "frozen (without the c_N^s C coupling of eq 49)",
+    ),
     Param("E", 1000.0, "F/L^2", 0.0, low_open=True, doc="Young's modulus (paper)"),
     Param("nu", 0.3, "", -1.0, 0.5, low_open=True, high_open=True, doc="Poisson's ratio (paper)"),
-    Param("width", 4.0, "L", 0.0, low_open=True,
-          doc="block width. FITTED to Table 1 (the scan lost it; contactfem reconstruct block)"),
-    Param("height", 3.25, "L", 0.0, low_open=True,
-          doc="block height. FITTED to Table 1 (the scan lost it; contactfem reconstruct block)"),
-    Param("free_end_nodes", 2, "", 1,
-          doc="bottom nodes at each end kept out of contact (paper: 'the first and the last element'; 2 = both "
-              "nodes of each end element, FITTED against 1 = the end node only); at least one bottom node "
-              "stays in contact",
-          limit=Limit(("nx",), lambda v: (None, (v["nx"] - 1) // 2), "[1, (nx - 1) // 2]")),
+    Param(
+        "width",
+        4.0,
+        "L",
+        0.0,
+        low_open=True,
+        doc="block width. FITTED to Table 1 (the scan lost it; contactfem reconstruct block)",
+    ),
+    Param(
+        "height",
+        3.25,
+        "L",
+        0.0,
+        low_open=True,
+        doc="block height. FITTED to Table 1 (the scan lost it; contactfem reconstruct block)",
+    ),
+    Param(
+        "free_end_nodes",
+        2,
+        "",
+        1,
+        doc="bottom nodes at each end kept out of contact (paper: 'the first and the last element'; 2 = both "
+        "nodes of each end element, FITTED against 1 = the end node only); at least one bottom node "
+        "stays in contact",
+        limit=Limit(("nx",), lambda v: (None, (v["nx"] - 1) // 2), "[1, (nx - 1) // 2]"),
+    ),
     Param("nx", 25, "", 3, 400, doc="elements along the width (paper: 200 elements in all; 25 x 8 FITTED)"),
     Param("ny", 8, "", 1, 400, doc="elements along the height (paper: 200 elements in all; 25 x 8 FITTED)"),
     Param("p_y", 200.0, "F/L", 0.0, doc="downward pressure on the top (paper: p_y = 200 per unit length)"),
-    Param("p_x", 60.0, "F/L", doc="tangential traction along +x on the side p_x_face (paper: p_x = 60 per unit length)"),
-    Param("p_x_face", "left", choices=("right", "left"),
-          doc="lateral side carrying p_x (the scan: 'one of its lateral sides'; left FITTED to Table 1); with "
-              "p_x > 0 the right side is pulled, the left side pushed (the fitted left side contradicts the "
-              "paper's 'pulled')"),
-    Param("c_N", 1.0e5, "F/L^2", 0.0, low_open=True,
-          doc="normal penalty per unit length (eq 4). The scan lost it (it reads 'lo*', 10^2 if '*' is a garbled "
-              "superscript 2); 1e5 FITTED to Table 1 (contactfem reconstruct block). The largest penetration, "
-              "|t_N| / c_N (eq 4) at the corner where the pressure peaks (the run reports max_penetration), stays "
-              "below 2 % of the block's elastic settlement p_y height / E"),
-    Param("penalty", "per_length", choices=PENALTIES,
-          doc=PENALTY_DOC + " (here converted to per length by the bottom element length width/nx; the scan "
-              "gives no unit; per_length FITTED)"),
+    Param(
+        "p_x", 60.0, "F/L", doc="tangential traction along +x on the side p_x_face (paper: p_x = 60 per unit length)"
+    ),
+    Param(
+        "p_x_face",
+        "left",
+        choices=("right", "left"),
+        doc="lateral side carrying p_x (the scan: 'one of its lateral sides'; left FITTED to Table 1); with "
+        "p_x > 0 the right side is pulled, the left side pushed (the fitted left side contradicts the "
+        "paper's 'pulled')",
+    ),
+    Param(
+        "c_N",
+        1.0e5,
+        "F/L^2",
+        0.0,
+        low_open=True,
+        doc="normal penalty per unit length (eq 4). The scan lost it (it reads 'lo*', 10^2 if '*' is a garbled "
+        "superscript 2); 1e5 FITTED to Table 1 (contactfem reconstruct block). The largest penetration, "
+        "|t_N| / c_N (eq 4) at the corner where the pressure peaks (the run reports max_penetration), stays "
+        "below 2 % of the block's elastic settlement p_y height / E",
+    ),
+    Param(
+        "penalty",
+        "per_length",
+        choices=PENALTIES,
+        doc=PENALTY_DOC + " (here converted to per length by the bottom element length width/nx; the scan "
+        "gives no unit; per_length FITTED)",
+    ),
     Param("m", 1.0, "", 1.0, doc="exponent of the normal law (eq 4); m = 1 is the penalty method (paper)"),
-    Param("c_T", 1.0e4, "F/L^2", 0.0, low_open=True,
-          doc="stick stiffness (eq 5), paper: c_T = 10^4; read per unit length (per node: FITTED against it)"),
-    Param("alpha", 0.2, "", 0.0, doc="eq 10 (paper: 0.2; conical: alpha + beta = 0.5)",
-          when=(("law", ("conical", "parabolic")),)),
+    Param(
+        "c_T",
+        1.0e4,
+        "F/L^2",
+        0.0,
+        low_open=True,
+        doc="stick stiffness (eq 5), paper: c_T = 10^4; read per unit length (per node: FITTED against it)",
+    ),
+    Param(
+        "alpha",
+        0.2,
+        "",
+        0.0,
+        doc="eq 10 (paper: 0.2; conical: alpha + beta = 0.5)",
+        when=(("law", ("conical", "parabolic")),),
+    ),
     Param("beta", 0.3, "", 0.0, doc="eq 10 (paper: 0.3)", when=(("law", ("conical", "parabolic")),)),
-    Param("n", 0.5, "", 0.0, 1.0, low_open=True, doc="exponent of the parabolic slip surface (paper: 0.5); "
-                                                      "the conical law has n = 1",
-          when=(("law", ("parabolic",)),)),
-    Param("mu", 0.3, "", 0.0, doc="Coulomb coefficient for law=coulomb (ours, not the paper's: 0.3, a wide slip zone)",
-          when=(("law", ("coulomb",)),)),
-    Param("g_N0", -1.0e-12, "L", -1e-3, 0.0, high_open=True,
-          doc="initial gap of the bottom nodes. Chosen: a touch (-1e-12) so the first Newton iterate has "
-              "contact stiffness (at g_N = 0 the contact is inactive and the tangent singular)"),
-    Param("n_steps", 1, "", 1, 1000,
-          doc="load steps of a pseudo-time ramp (the paper: the whole load in ONE step). Note: with the "
-              "finite-strain materials the paper's loads (compressive strain ~20%, dead top load near the block's "
-              "shear-buckling load) invert elements; they converge up to about p_y = 50, p_x = 15"),
-    Param("rtol", 1e-10, "", 0.0, 1e-3, low_open=True,
-          doc="Newton: largest residual <= atol + rtol * the step's force scale (loads, reactions, contact forces; tighter than the solver's 1e-8: the block's tables read the residuals to 1e-10)"),
+    Param(
+        "n",
+        0.5,
+        "",
+        0.0,
+        1.0,
+        low_open=True,
+        doc="exponent of the parabolic slip surface (paper: 0.5); the conical law has n = 1",
+        when=(("law", ("parabolic",)),),
+    ),
+    Param(
+        "mu",
+        0.3,
+        "",
+        0.0,
+        doc="Coulomb coefficient for law=coulomb (ours, not the paper's: 0.3, a wide slip zone)",
+        when=(("law", ("coulomb",)),),
+    ),
+    Param(
+        "g_N0",
+        -1.0e-12,
+        "L",
+        -1e-3,
+        0.0,
+        high_open=True,
+        doc="initial gap of the bottom nodes. Chosen: a touch (-1e-12) so the first Newton iterate has "
+        "contact stiffness (at g_N = 0 the contact is inactive and the tangent singular)",
+    ),
+    Param(
+        "n_steps",
+        1,
+        "",
+        1,
+        1000,
+        doc="load steps of a pseudo-time ramp (the paper: the whole load in ONE step). Note: with the "
+        "finite-strain materials the paper's loads (compressive strain ~20%, dead top load near the block's "
+        "shear-buckling load) invert elements; they converge up to about p_y = 50, p_x = 15",
+    ),
+    Param(
+        "rtol",
+        1e-10,
+        "",
+        0.0,
+        1e-3,
+        low_open=True,
+        doc="Newton: largest residual <= atol + rtol * the step's force scale (loads, reactions, contact forces; tighter than the solver's 1e-8: the block's tables read the residuals to 1e-10)",
+    ),
     Param("atol", 1e-12, "F", 0.0, doc="Newton absolute tolerance (a floor for a step without forces)"),
     Param("maxit", 40, "", 1, 500, doc="Newton: maximal number of linear solves"),
     *enforcement.ENFORCEMENT_PARAMS,
@@ -128,9 +221,13 @@ def friction_capacity(params):
     if params["law"] == "coulomb":
         return params["mu"] * N, f"mu p_y width with mu = {params['mu']:g}"
     if params["law"] == "conical":
-        return (params["alpha"] + params["beta"]) * N, f"(alpha + beta) p_y width = {params['alpha'] + params['beta']:g} p_y width"
+        return (
+            params["alpha"] + params["beta"]
+        ) * N, f"(alpha + beta) p_y width = {params['alpha'] + params['beta']:g} p_y width"
     L, n = contact_length(params), params["n"]
-    return params["alpha"] * L ** (1 - n) * N ** n + params["beta"] * N, "alpha L^(1-n) (p_y width)^n + beta p_y width, at most"
+    return params["alpha"] * L ** (1 - n) * N**n + params[
+        "beta"
+    ] * N, "alpha L^(1-n) (p_y width)^n + beta p_y width, at most"
 
 
 def check(params):
@@ -138,14 +235,18 @@ def check(params):
     stress), and the static problem must have a solution (the block is held by friction alone)."""
     enforcement.check(params)
     if params["plane"] == "stress" and params["material"] != "linear":
-        raise ValueError(f"parameter material = {params['material']} needs plane = strain (plane stress is "
-                         "small-strain only: material = linear)")
-    if params["material"] == "linear":           # dead loads: the applied forces are known beforehand
+        raise ValueError(
+            f"parameter material = {params['material']} needs plane = strain (plane stress is "
+            "small-strain only: material = linear)"
+        )
+    if params["material"] == "linear":  # dead loads: the applied forces are known beforehand
         T = abs(params["p_x"]) * params["height"]
         cap, how = friction_capacity(params)
         if T > cap * (1 + 1e-9):
-            raise ValueError(f"no static equilibrium: the tangential load |p_x| height = {T:.4g} exceeds the friction "
-                             f"capacity {cap:.4g} ({how}, law = {params['law']}); lower p_x or raise the friction")
+            raise ValueError(
+                f"no static equilibrium: the tangential load |p_x| height = {T:.4g} exceeds the friction "
+                f"capacity {cap:.4g} ({how}, law = {params['law']}); lower p_x or raise the friction"
+            )
 
 
 def size(params):
@@ -201,6 +302,9 @@ def law_range(params):
     w = params["width"] / params["nx"]
     N = params["p_y"] * params["width"]
     dt = 1.0 / params["n_steps"]
-    hold = (dict(T=abs(params["p_x"]) * params["height"], N=N, L=contact_length(params), w_min=w)
-            if params["material"] == "linear" else None)
+    hold = (
+        dict(T=abs(params["p_x"]) * params["height"], N=N, L=contact_length(params), w_min=w)
+        if params["material"] == "linear"
+        else None
+    )
     return dict(p=N / w, q=params["height"], v=params["height"] / dt, dt=dt, g=params["height"], hold=hold)

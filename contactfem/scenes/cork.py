@@ -64,61 +64,136 @@ from .cork_stages import press_fit_only, simulate, stage_systems  # noqa: F401 (
 PARAMS = (
     Param("E", 10.0, "MPa", 0.0, low_open=True, doc="Young's modulus (paper)"),
     Param("nu", 0.25, "", -1.0, 0.5, low_open=True, high_open=True, doc="Poisson's ratio (paper)"),
-    Param("rho", 3.5e-10, "N s^2/mm^4", 0.0, low_open=True,
-          doc="density. Chosen: scan lost the exponent of 3.5e-?; -10 (350 kg/m^3) gives a 7 g cork"),
-    Param("c_N", 100.0, "N/mm^3", 0.0, low_open=True,
-          doc="normal penalty (eq 4, m = 1; paper: 100 'N/mm'), per unit area with penalty=per_length"),
+    Param(
+        "rho",
+        3.5e-10,
+        "N s^2/mm^4",
+        0.0,
+        low_open=True,
+        doc="density. Chosen: scan lost the exponent of 3.5e-?; -10 (350 kg/m^3) gives a 7 g cork",
+    ),
+    Param(
+        "c_N",
+        100.0,
+        "N/mm^3",
+        0.0,
+        low_open=True,
+        doc="normal penalty (eq 4, m = 1; paper: 100 'N/mm'), per unit area with penalty=per_length",
+    ),
     Param("m", 1.0, "", 1.0, doc="exponent of the normal law (paper: 1, penalty)"),
     Param("c_T", 10.0, "N/mm^3", 0.0, low_open=True, doc="stick stiffness (eq 5; paper: 10 'N/mm')"),
     Param("mu", 0.1, "", 0.0, doc="friction coefficient at zero slip (paper: alpha + beta = 0.1, n = 1)"),
     Param("h", 0.001, "1/mm", doc="slip hardening mu = mu_0 + h q, q the accumulated slip (paper: 0.001)"),
-    Param("penalty", "per_length", choices=PENALTIES,
-          doc=PENALTY_DOC + ". Chosen: per_length, c_N per unit area of the neck (w = 2 pi R_neck * tributary "
-              "length): per node, c_N = 100 N/mm would need the whole interference as penetration"),
+    Param(
+        "penalty",
+        "per_length",
+        choices=PENALTIES,
+        doc=PENALTY_DOC + ". Chosen: per_length, c_N per unit area of the neck (w = 2 pi R_neck * tributary "
+        "length): per node, c_N = 100 N/mm would need the whole interference as penetration",
+    ),
     Param("R_neck", 10.0, "mm", 0.0, low_open=True, doc="inner radius of the neck (paper)"),
-    Param("R_cork", 12.0, "mm", 0.0, low_open=True, doc="radius of the free cork (paper: maximum radius 12): "
-          "above R_neck (a press fit)", limit=Limit(("R_neck",), lambda v: (v["R_neck"], None), "(R_neck, inf)")),
-    Param("R_tip", R_TIP_FITTED, "mm", limit=Limit(("R_neck", "R_cork"), lambda v: (v["R_neck"], v["R_cork"]),
-                                                   "[R_neck, R_cork]"),
-          doc="radius of the cork's bottom: the shaft is conical from R_tip to R_cork at the mouth. Fitted: "
-              "scan lost the shape; 10 (the shaft's tip fits the neck) gives the paper's ~2500 N press-fit "
-              "force (press_fit_calibrated), a cylinder (R_tip = 12) twice that, which 0.8 MPa could not push "
-              "out; 10.1 and the cork stays in (breakaway_margin_MPa < 0)"),
-    Param("L_neck", 24.0, "mm", 0.0, low_open=True,
-          doc="cork length in the straight neck = travel to the exit. Chosen: scan lost it; 30/54 * 0.8 "
-              "MPa before the exit (paper) gives 54 - 30 = 24 mm"),
-    Param("r_mouth", 2.0, "mm", 0.0, low_open=True,
-          doc="radius of the rounded mouth. Chosen: scan lost it; R_cork - R_neck, so the lip ends at r = 12"),
-    Param("L_head", 22.0, "mm", 0.0, low_open=True,
-          doc="cork length above the mouth. Chosen: scan lost it; 24 + 2 + 22 = 48 mm, the length of a "
-              "standard champagne cork (it sets the cork's mass: see the sensitivity table of lecture 08)"),
+    Param(
+        "R_cork",
+        12.0,
+        "mm",
+        0.0,
+        low_open=True,
+        doc="radius of the free cork (paper: maximum radius 12): above R_neck (a press fit)",
+        limit=Limit(("R_neck",), lambda v: (v["R_neck"], None), "(R_neck, inf)"),
+    ),
+    Param(
+        "R_tip",
+        R_TIP_FITTED,
+        "mm",
+        limit=Limit(("R_neck", "R_cork"), lambda v: (v["R_neck"], v["R_cork"]), "[R_neck, R_cork]"),
+        doc="radius of the cork's bottom: the shaft is conical from R_tip to R_cork at the mouth. Fitted: "
+        "scan lost the shape; 10 (the shaft's tip fits the neck) gives the paper's ~2500 N press-fit "
+        "force (press_fit_calibrated), a cylinder (R_tip = 12) twice that, which 0.8 MPa could not push "
+        "out; 10.1 and the cork stays in (breakaway_margin_MPa < 0)",
+    ),
+    Param(
+        "L_neck",
+        24.0,
+        "mm",
+        0.0,
+        low_open=True,
+        doc="cork length in the straight neck = travel to the exit. Chosen: scan lost it; 30/54 * 0.8 "
+        "MPa before the exit (paper) gives 54 - 30 = 24 mm",
+    ),
+    Param(
+        "r_mouth",
+        2.0,
+        "mm",
+        0.0,
+        low_open=True,
+        doc="radius of the rounded mouth. Chosen: scan lost it; R_cork - R_neck, so the lip ends at r = 12",
+    ),
+    Param(
+        "L_head",
+        22.0,
+        "mm",
+        0.0,
+        low_open=True,
+        doc="cork length above the mouth. Chosen: scan lost it; 24 + 2 + 22 = 48 mm, the length of a "
+        "standard champagne cork (it sets the cork's mass: see the sensitivity table of lecture 08)",
+    ),
     Param("gas_column", 30.0, "mm", 0.0, low_open=True, doc="height of the gas column under the cork (paper)"),
     Param("n_r", 6, "", 1, 100, doc="elements across the radius (6 x 19 = 114, the paper's count)"),
     Param("n_z", 19, "", 3, 400, doc="elements along the axis"),
     Param("n_press", 20, "", 1, 1000, doc="static increments of the press fit (stage 1)"),
-    Param("z_hold", 2.0 / 3.0, "", 0.0, 1.0,
-          doc="stage 1 holds the axis node nearest to z = z_hold * L_neck axially. Chosen: 2/3, the centroid "
-              "of the contact pressure that grows along the conical shaft, so the hold's reaction stays small"),
+    Param(
+        "z_hold",
+        2.0 / 3.0,
+        "",
+        0.0,
+        1.0,
+        doc="stage 1 holds the axis node nearest to z = z_hold * L_neck axially. Chosen: 2/3, the centroid "
+        "of the contact pressure that grows along the conical shaft, so the hold's reaction stays small",
+    ),
     Param("p_step", 0.1, "MPa", 0.0, low_open=True, doc="pressure increment per ramp step (paper: 0.1)"),
     Param("n_ramp", 8, "", 1, 100, doc="ramp steps (paper: 8, to 0.8 MPa), then Boyle's law"),
     Param("dt", 1.0e-4, "s", 0.0, low_open=True, doc="time step in the neck (paper: 1e-4)"),
     time_integration.ACCURACY_PARAM,
     Param("dt_fine", 5.0e-6, "s", 0.0, low_open=True, doc="time step around the exit (paper: 5e-6)"),
-    Param("exit_zone", 2.0, "mm", 0.0,
-          doc="dt_fine once the cork bottom is closer than this to the mouth. Chosen: one mouth radius"),
+    Param(
+        "exit_zone",
+        2.0,
+        "mm",
+        0.0,
+        doc="dt_fine once the cork bottom is closer than this to the mouth. Chosen: one mouth radius",
+    ),
     Param("t_after", 3.0e-4, "s", 0.0, doc="dt_fine for this long after the gas release (paper: 3-4e-4 s)"),
-    Param("travel_max", 0.5, "mm", 0.0, low_open=True,
-          doc="largest axial travel per step (adaptive dt). Chosen: a quarter of an element"),
+    Param(
+        "travel_max",
+        0.5,
+        "mm",
+        0.0,
+        low_open=True,
+        doc="largest axial travel per step (adaptive dt). Chosen: a quarter of an element",
+    ),
     Param("t_end", 4.0e-3, "s", 0.0, low_open=True, doc="latest end of the run (paper: Fig 15 up to 3 ms)"),
     Param("t_flight", 4.0e-4, "s", 0.0, doc="the run stops this long after the exit (paper: 3.0 - 2.65 ms)"),
     *newmark_params(0.7, 0.4, "paper"),
     Param("max_cuts", 6, "", 0, 20, doc="step halvings allowed when Newton fails"),
-    Param("atol", 1e-8, "N", 0.0, doc="Newton absolute tolerance (a floor for a step without forces; the breakaway "
-          "step is a knife edge: the paper preset exits at 2.71 ms with 1e-6 or 1e-10 N, at 2.86 ms with 1e-8 N, "
-          "as the refined runs)"),
-    Param("rtol", 1e-9, "", 0.0, 1e-3, low_open=True,
-          doc="Newton: largest residual <= atol + rtol * the step's force scale (loads, reactions, contact forces, "
-              "inertia)"),
+    Param(
+        "atol",
+        1e-8,
+        "N",
+        0.0,
+        doc="Newton absolute tolerance (a floor for a step without forces; the breakaway "
+        "step is a knife edge: the paper preset exits at 2.71 ms with 1e-6 or 1e-10 N, at 2.86 ms with 1e-8 N, "
+        "as the refined runs)",
+    ),
+    Param(
+        "rtol",
+        1e-9,
+        "",
+        0.0,
+        1e-3,
+        low_open=True,
+        doc="Newton: largest residual <= atol + rtol * the step's force scale (loads, reactions, contact forces, "
+        "inertia)",
+    ),
     Param("maxit", 30, "", 1, 500, doc="Newton: maximal number of linear solves per step"),
 )
 
@@ -135,23 +210,40 @@ def build(params, *, normal=None, friction=None, system_options=None):
     length = P["L_neck"] + P["r_mouth"] + P["L_head"]
     mesh = cork_mesh(P["R_tip"], P["R_cork"], P["L_neck"], length, P["n_r"], P["n_z"])
     cork = Continuum(mesh, P["E"], P["nu"], P["rho"], kind="axisymmetric", material="neohooke", name="cork")
-    shift0 = P["R_cork"] - P["R_neck"]                  # the press fit moves the neck in from r = R_cork
+    shift0 = P["R_cork"] - P["R_neck"]  # the press fit moves the neck in from r = R_cork
     neck = bottle_neck(P["R_neck"], P["L_neck"], P["r_mouth"], motion=lambda t: (shift0 * (1.0 - t), 0.0))
-    side = cork.boundary_nodes("outer")[::-1]        # bottom corner first, upwards
+    side = cork.boundary_nodes("outer")[::-1]  # bottom corner first, upwards
     Z = cork.X[side]
     w = 2.0 * np.pi * P["R_neck"] * tributary_lengths(Z) if P["penalty"] == "per_length" else np.ones(len(side))
-    contact = NodeToSegment(cork, side, neck, normal=normal or PowerLaw(P["c_N"], P["m"]),
-                            friction=friction or SlipHardening(c_T=P["c_T"], mu=P["mu"], h=P["h"]), weights=w,
-                            name="neck")
+    contact = NodeToSegment(
+        cork,
+        side,
+        neck,
+        normal=normal or PowerLaw(P["c_N"], P["m"]),
+        friction=friction or SlipHardening(c_T=P["c_T"], mu=P["mu"], h=P["h"]),
+        weights=w,
+        name="neck",
+    )
     axis = cork.boundary_nodes("axis")
     bottom = cork.boundary_nodes("bottom")
-    gas = GasPressure(cork, "bottom", bottom, np.pi * P["R_neck"]**2, P["gas_column"], P["p_step"], P["n_ramp"],
-                      P["dt"], P["L_neck"])
-    element = min(float(np.min(np.diff(np.sort(Z[:, 1])))), P["R_neck"] / P["n_r"])   # along the side, across
+    gas = GasPressure(
+        cork,
+        "bottom",
+        bottom,
+        np.pi * P["R_neck"] ** 2,
+        P["gas_column"],
+        P["p_step"],
+        P["n_ramp"],
+        P["dt"],
+        P["L_neck"],
+    )
+    element = min(float(np.min(np.diff(np.sort(Z[:, 1])))), P["R_neck"] / P["n_r"])  # along the side, across
     parts = dict(cork=cork, neck=neck, contacts=[contact], gas=gas, axis=axis, side=side, bottom=bottom, length=length)
-    return Model(systems=stage_systems(parts, P, system_options),      # the press fit's, the pop's (cork_stages.py)
-                 sizes=dict(element=element, body=P["R_neck"]),        # the accuracy indicators' lengths
-                 parts=parts)
+    return Model(
+        systems=stage_systems(parts, P, system_options),  # the press fit's, the pop's (cork_stages.py)
+        sizes=dict(element=element, body=P["R_neck"]),  # the accuracy indicators' lengths
+        parts=parts,
+    )
 
 
 def law_range(P):
@@ -164,8 +256,14 @@ def law_range(P):
     length = P["L_neck"] + P["r_mouth"] + P["L_head"]
     W = P["p_step"] * P["n_ramp"] * np.pi * P["R_neck"] ** 2 * (P["L_neck"] + P["r_mouth"])
     M = P["rho"] * np.pi * P["R_cork"] ** 2 * length
-    return dict(p=2.0 * P["c_N"] * a ** P["m"], q=2.0 * length, v=2.0 * float(np.sqrt(2.0 * W / M)),
-                dt=min(P["dt"], P["dt_fine"]), g=2.0 * a)
+    return dict(
+        p=2.0 * P["c_N"] * a ** P["m"],
+        q=2.0 * length,
+        v=2.0 * float(np.sqrt(2.0 * W / M)),
+        dt=min(P["dt"], P["dt_fine"]),
+        g=2.0 * a,
+    )
+
 
 SCENE = Scene(
     name="cork",
@@ -181,12 +279,22 @@ SCENE = Scene(
         "fast": dict(n_press=8, dt_fine=2e-5, t_after=1e-4, travel_max=1.0),
     },
     # steps: the press fit, then at most t_end / dt_fine (the adaptive step never goes below dt_fine)
-    size=lambda p: dict(elements=p["n_r"] * p["n_z"], unknowns=2 * (p["n_r"] + 1) * (p["n_z"] + 1),
-                        steps=p["n_press"] + p["t_end"] / p["dt_fine"]),
+    size=lambda p: dict(
+        elements=p["n_r"] * p["n_z"],
+        unknowns=2 * (p["n_r"] + 1) * (p["n_z"] + 1),
+        steps=p["n_press"] + p["t_end"] / p["dt_fine"],
+    ),
     outlines=True,
-    reports=("exit_velocity_m_s", "exit_time_ms", "breakaway_pressure_MPa", "breakaway_margin_MPa",
-             "press_fit_calibrated", "press_fit_normal_force_N",
-             "max_penetration_ratio", "newton_iterations_total"),
+    reports=(
+        "exit_velocity_m_s",
+        "exit_time_ms",
+        "breakaway_pressure_MPa",
+        "breakaway_margin_MPa",
+        "press_fit_calibrated",
+        "press_fit_normal_force_N",
+        "max_penetration_ratio",
+        "newton_iterations_total",
+    ),
     laws=("normal", "friction"),
     law_params={"friction": ("c_T", "mu", "h"), "normal": ("c_N", "m")},
     law_range=law_range,

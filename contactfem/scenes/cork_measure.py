@@ -16,11 +16,17 @@ and the fast one, which differ only in time stepping and press-fit increments).
 import numpy as np
 
 # The paper's numbers (Sec. 5.5) the run is compared with.
-PAPER = dict(exit_velocity_m_s=28.0, press_fit_normal_force_N=2500.0, sliding_force_N=250.0,
-             breakaway_pressure_MPa=0.8, pressure_before_exit_MPa=0.56,
-             snapshot_times_ms=(0.0, 0.8, 1.0, 1.5, 2.0, 2.6, 2.7, 3.0), exit_time_ms=2.65)
-R_TIP_FITTED = 10.0     # mm: chosen so that the press fit gives the paper's ~2500 N (fitted, not predicted)
-V_BREAK = 1.0           # m/s: the cork "slides" (not just creeps) once its centre of mass is this fast
+PAPER = dict(
+    exit_velocity_m_s=28.0,
+    press_fit_normal_force_N=2500.0,
+    sliding_force_N=250.0,
+    breakaway_pressure_MPa=0.8,
+    pressure_before_exit_MPa=0.56,
+    snapshot_times_ms=(0.0, 0.8, 1.0, 1.5, 2.0, 2.6, 2.7, 3.0),
+    exit_time_ms=2.65,
+)
+R_TIP_FITTED = 10.0  # mm: chosen so that the press fit gives the paper's ~2500 N (fitted, not predicted)
+V_BREAK = 1.0  # m/s: the cork "slides" (not just creeps) once its centre of mass is this fast
 
 
 def contact_forces(states):
@@ -38,8 +44,7 @@ def contact_forces(states):
             min_gap = min(min_gap, float(np.min(rep["g_N"][on])))
         touching |= set(st.contact.nodes[on].tolist())
         slipping |= set(st.contact.nodes[rep["state"] == "slip"].tolist())
-    return dict(normal=normal, tangential=tangential, min_gap=min_gap, n_active=len(touching),
-                n_slip=len(slipping))
+    return dict(normal=normal, tangential=tangential, min_gap=min_gap, n_active=len(touching), n_slip=len(slipping))
 
 
 def centre_of_mass_velocity(body, v, offset=0):
@@ -55,20 +60,34 @@ def history(model, out):
     the smallest gap, the smallest element area ratio, iterations, cuts, energies."""
     cork, gas, records = model.parts["cork"], model.parts["gas"], out["records"]
     u0 = records[0].u
-    uz = cork.xdofs[:, 1]                             # the cork is its Systems' only body: offset 0
+    uz = cork.xdofs[:, 1]  # the cork is its Systems' only body: offset 0
     centre = model.parts["bottom"][np.argmin(cork.X[model.parts["bottom"], 0])]
     top = model.parts["axis"][np.argmax(cork.X[model.parts["axis"], 1])]
     M, A0 = cork.mass()[cork.xdofs[:, 1]], cork.element_areas(np.zeros(cork.ndof))
     rows = []
     for rec in records:
         f = contact_forces(rec.contacts)
-        rows.append(dict(t=rec.t, dt=rec.dt, volume=gas.volume(rec.u, rec.state.loads[0]), u_bottom=rec.u[uz[centre]] - u0[uz[centre]],
-                         u_top=rec.u[uz[top]] - u0[uz[top]], u_cm=float(np.sum(M * (rec.u - u0)[uz]) / np.sum(M)),
-                         v_cm=centre_of_mass_velocity(cork, rec.v) / 1e3, normal_force=f["normal"],
-                         friction_force=f["tangential"], n_contact=f["n_active"], n_slip=f["n_slip"],
-                         min_gap=f["min_gap"], min_area_ratio=float(np.min(cork.element_areas(rec.u) / A0)),
-                         iterations=rec.iterations, cuts=rec.cuts, kinetic=rec.energy["kinetic"],
-                         strain=rec.energy["strain"]))
+        rows.append(
+            dict(
+                t=rec.t,
+                dt=rec.dt,
+                volume=gas.volume(rec.u, rec.state.loads[0]),
+                u_bottom=rec.u[uz[centre]] - u0[uz[centre]],
+                u_top=rec.u[uz[top]] - u0[uz[top]],
+                u_cm=float(np.sum(M * (rec.u - u0)[uz]) / np.sum(M)),
+                v_cm=centre_of_mass_velocity(cork, rec.v) / 1e3,
+                normal_force=f["normal"],
+                friction_force=f["tangential"],
+                n_contact=f["n_active"],
+                n_slip=f["n_slip"],
+                min_gap=f["min_gap"],
+                min_area_ratio=float(np.min(cork.element_areas(rec.u) / A0)),
+                iterations=rec.iterations,
+                cuts=rec.cuts,
+                kinetic=rec.energy["kinetic"],
+                strain=rec.energy["strain"],
+            )
+        )
     H = {k: np.array([r[k] for r in rows]) for k in rows[0]}
     H["p"] = out["pressures"]
     return H
@@ -116,7 +135,7 @@ def measure(model, P, out):
     snaps = snapshot_times(t_ramp, out["exit_time"], h["t"][-1])
     idx = [int(np.argmin(np.abs(h["t"] - ts))) for ts in snaps]
     cork, states = model.parts["cork"], [rec.u for rec in out["records"]]
-    loop = boundary_loop(cork.mesh)                                  # outlines for animations
+    loop = boundary_loop(cork.mesh)  # outlines for animations
     frames = np.unique(np.linspace(0, len(h["t"]) - 1, 80).astype(int))
     failures = [f for rec in out["records"] for f in rec.failures]
     return dict(
@@ -129,10 +148,12 @@ def measure(model, P, out):
         sliding_force_N=float(np.max(h["friction_force"])),
         **static_breakaway(P, fit["normal"]),
         press_fit_calibrated=bool(P["R_tip"] == R_TIP_FITTED),
-        press_fit_calibration=("R_tip fitted so that the press-fit normal force is near the paper's ~2500 N: "
-                               "the force is a calibration, not a prediction"
-                               if P["R_tip"] == R_TIP_FITTED else "R_tip set by the user: the press fit is not "
-                               "the calibrated one"),
+        press_fit_calibration=(
+            "R_tip fitted so that the press-fit normal force is near the paper's ~2500 N: "
+            "the force is a calibration, not a prediction"
+            if P["R_tip"] == R_TIP_FITTED
+            else "R_tip set by the user: the press fit is not the calibrated one"
+        ),
         press_fit_normal_force_N=fit["normal"],
         press_fit_friction_force_N=fit["tangential"],
         press_fit_contact_nodes=fit["n_active"],
@@ -140,17 +161,25 @@ def measure(model, P, out):
         max_penetration_mm=max_pen,
         max_penetration_ratio=max_pen / P["R_neck"],
         min_element_area_ratio=min(fit["min_area_ratio"], float(np.min(h["min_area_ratio"]))),
-        cork_mass_g=float(np.sum(cork.mass()[cork.xdofs[:, 1]]) * 1e6),     # N s^2/mm = 1e6 g
+        cork_mass_g=float(np.sum(cork.mass()[cork.xdofs[:, 1]]) * 1e6),  # N s^2/mm = 1e6 g
         n_elements=int(cork.mesh.t.shape[1]),
         n_steps=int(len(h["t"]) - 1),
         newton_iterations_total=int(fit["iterations"] + np.sum(h["iterations"])),
         newton_failures=int(fit["failures"] + len(failures)),
         newton_failure_log=failures,
-        time_ms=h["t"] * 1e3, dt_s=h["dt"], pressure_MPa=h["p"],
-        displacement_bottom_mm=h["u_bottom"], displacement_top_mm=h["u_top"], displacement_cm_mm=h["u_cm"],
-        velocity_cm_m_s=h["v_cm"], normal_force_N=h["normal_force"], friction_force_N=h["friction_force"],
-        contact_nodes=h["n_contact"], gas_volume_mm3=h["volume"],
-        snapshot_times_ms=h["t"][idx] * 1e3, snapshot_paper_times_ms=list(PAPER["snapshot_times_ms"]),
+        time_ms=h["t"] * 1e3,
+        dt_s=h["dt"],
+        pressure_MPa=h["p"],
+        displacement_bottom_mm=h["u_bottom"],
+        displacement_top_mm=h["u_top"],
+        displacement_cm_mm=h["u_cm"],
+        velocity_cm_m_s=h["v_cm"],
+        normal_force_N=h["normal_force"],
+        friction_force_N=h["friction_force"],
+        contact_nodes=h["n_contact"],
+        gas_volume_mm3=h["volume"],
+        snapshot_times_ms=h["t"][idx] * 1e3,
+        snapshot_paper_times_ms=list(PAPER["snapshot_times_ms"]),
         snapshots_x=[(cork.X + states[k][cork.xdofs]).tolist() for k in idx],
         outlines=[cork.X[loop] + states[k][cork.xdofs[loop]] for k in frames],
         outline_t=h["t"][frames],

@@ -39,6 +39,7 @@ from ..solver.schedule import at_tolerance
 from .cork_measure import R_TIP_FITTED, centre_of_mass_velocity, contact_forces, static_breakaway
 from .time_integration import newmark_of
 
+
 def _newton_options(P):
     return dict(atol=P["atol"], rtol=P["rtol"], maxit=P["maxit"])
 
@@ -58,7 +59,7 @@ def stage_systems(parts, P, system_options=None, contacts=None):
     hold = _hold(cork, axis, P)
     fixed = [Dirichlet(cork, cork.xdofs[axis, 0], 0.0), Dirichlet(cork, [cork.xdofs[hold, 1]], 0.0)]
     fit = System([cork], fit_contacts, [], fixed, **options)
-    rest = neck.without_motion()                             # the press fit is done: the neck stays at r = R_neck
+    rest = neck.without_motion()  # the press fit is done: the neck stays at r = R_neck
     moved = [c.with_master(rest) if c.master is neck else c for c in pop_contacts]
     pop = System([cork], moved, [parts["gas"]], [Dirichlet(cork, cork.xdofs[axis, 0], 0.0)], **options)
     return fit, pop
@@ -73,15 +74,32 @@ def press_fit(model, P, progress=None):
     cork, system = model.parts["cork"], model.systems[0]
     hold = _hold(cork, model.parts["axis"], P)
     ds = 1.0 / P["n_press"]
-    schedule = Adaptive(lambda rec: ds, t_end=1.0, dt=ds, growth=1.0, max_cuts=P["max_cuts"],
-                        min_dt=ds / 2 ** P["max_cuts"])
-    records = list(watch(march(Static(system, **_newton_options(P)), schedule, 0.0, np.zeros(system.ndof),
-                               label=lambda k, t1, h: f"press fit {t1:.3f}"), progress, 0.0, 1.0, "cork: press fit"))
+    schedule = Adaptive(
+        lambda rec: ds, t_end=1.0, dt=ds, growth=1.0, max_cuts=P["max_cuts"], min_dt=ds / 2 ** P["max_cuts"]
+    )
+    records = list(
+        watch(
+            march(
+                Static(system, **_newton_options(P)),
+                schedule,
+                0.0,
+                np.zeros(system.ndof),
+                label=lambda k, t1, h: f"press fit {t1:.3f}",
+            ),
+            progress,
+            0.0,
+            1.0,
+            "cork: press fit",
+        )
+    )
     last = records[-1]
     # the axial hold's reaction: released at the start of stage 2 (the dynamic run absorbs this
     # small imbalance; it is reported, not hidden)
-    return last, dict(iterations=int(sum(r.iterations for r in records)), failures=int(sum(r.cuts for r in records)),
-                      hold_reaction=float(last.result.G[cork.xdofs[hold, 1]]))
+    return last, dict(
+        iterations=int(sum(r.iterations for r in records)),
+        failures=int(sum(r.cuts for r in records)),
+        hold_reaction=float(last.result.G[cork.xdofs[hold, 1]]),
+    )
 
 
 def choose_dt(P, t, gap_to_mouth, released_at, v_cm):
@@ -93,7 +111,7 @@ def choose_dt(P, t, gap_to_mouth, released_at, v_cm):
         return P["dt_fine"]
     dt = P["dt"]
     if abs(v_cm) > 0:
-        dt = min(dt, P["travel_max"] / (1e3 * abs(v_cm)))     # v_cm in m/s = 1e3 mm/s
+        dt = min(dt, P["travel_max"] / (1e3 * abs(v_cm)))  # v_cm in m/s = 1e3 mm/s
     return max(dt, P["dt_fine"])
 
 
@@ -135,19 +153,19 @@ def pop(model, P, u0, progress=None, histories=None):
     cork, gas, system = model.parts["cork"], model.parts["gas"], model.systems[1]
     t_ramp = P["n_ramp"] * P["dt"]
     state = system.start(u0, 0.0)
-    if histories is not None:                                # the contacts go on from the press fit
+    if histories is not None:  # the contacts go on from the press fit
         state = replace(state, contacts=tuple(histories))
 
-    delta, beta = newmark_of(P)                              # (the trapezoidal rule at a tolerance)
+    delta, beta = newmark_of(P)  # (the trapezoidal rule at a tolerance)
     stepper = Newmark(system, delta=delta, beta=beta, **_newton_options(P))
     tol = P.get("accuracy") or 0.0
     rule, rejections = None, 0
-    if tol:        # steps from the local error estimate: the exit velocity's errors (its scale: speed_scale) add up
-        stepper, rule, rejections = at_tolerance(stepper, tol, speed_scale(P), P["t_end"], P["dt"])   # over t_end
+    if tol:  # steps from the local error estimate: the exit velocity's errors (its scale: speed_scale) add up
+        stepper, rule, rejections = at_tolerance(stepper, tol, speed_scale(P), P["t_end"], P["dt"])  # over t_end
 
-    def dt_rule(rec):                                        # rec.state: the gas after the step
+    def dt_rule(rec):  # rec.state: the gas after the step
         v_cm = centre_of_mass_velocity(cork, rec.v) / 1e3 if rec.k else 0.0
-        if rule is not None:                                 # travel_max still holds, and the gas's lag
+        if rule is not None:  # travel_max still holds, and the gas's lag
             h = min(rule(rec), gas_lag_step(P, gas, rec, tol))
             h = min(h, P["travel_max"] / (1e3 * abs(v_cm))) if v_cm else h
         else:
@@ -157,27 +175,38 @@ def pop(model, P, u0, progress=None, histories=None):
     # the press fit is a static state: start at rest with a0 = 0 (M^-1 G would put the hold's
     # reaction on one light axis node as a spurious acceleration spike)
     zero = np.zeros(system.ndof)
-    schedule = Adaptive(dt_rule, t_end=P["t_end"], dt=P["dt"], max_cuts=P["max_cuts"] + rejections,
-                        growth=2.0 if tol else None)
+    schedule = Adaptive(
+        dt_rule, t_end=P["t_end"], dt=P["dt"], max_cuts=P["max_cuts"] + rejections, growth=2.0 if tol else None
+    )
     records, pressures, exit_time, touching, acting = [], [], None, None, None
     bar = progress(0.0, P["t_end"], "cork: pop") if progress is not None else None
     try:
-        for rec in march(stepper, schedule, 0.0, u0.copy(), zero, a0=zero, state=state,
-                         label=lambda k, t1, h: f"cork t = {t1 * 1e3:.5f} ms, dt = {h:.2e}"):
+        for rec in march(
+            stepper,
+            schedule,
+            0.0,
+            u0.copy(),
+            zero,
+            a0=zero,
+            state=state,
+            label=lambda k, t1, h: f"cork t = {t1 * 1e3:.5f} ms, dt = {h:.2e}",
+        ):
             if bar is not None:
                 bar(rec.t, rec.u, rec.v, rec.a)
             records.append(rec)
-            pressures.append(gas.pressure(rec.t, acting) if rec.k else 0.0)   # the gas the step was taken with
+            pressures.append(gas.pressure(rec.t, acting) if rec.k else 0.0)  # the gas the step was taken with
             n_contact = sum(st.n_active for st in rec.contacts)
             if rec.k and acting.released and n_contact == 0 and (exit_time is None or touching):
-                exit_time = rec.t                            # the last time the contact opened
+                exit_time = rec.t  # the last time the contact opened
             touching = n_contact > 0
             if exit_time is not None and rec.t >= exit_time + P["t_flight"] * (1 - 1e-9):
-                if hasattr(bar, "finish"):                   # done before t_end: the bar says why
-                    bar.finish(f"the cork left at {exit_time * 1e3:.3f} ms; the run stops t_flight = "
-                               f"{P['t_flight'] * 1e3:g} ms later")
-                break                                        # t_flight after the exit: stop
-            acting = rec.state.loads[0]                      # explicit coupling: the next step's pressure
+                if hasattr(bar, "finish"):  # done before t_end: the bar says why
+                    bar.finish(
+                        f"the cork left at {exit_time * 1e3:.3f} ms; the run stops t_flight = "
+                        f"{P['t_flight'] * 1e3:g} ms later"
+                    )
+                break  # t_flight after the exit: stop
+            acting = rec.state.loads[0]  # explicit coupling: the next step's pressure
     finally:
         if hasattr(bar, "close"):
             bar.close()
@@ -193,8 +222,15 @@ def simulate(model, P, progress=None):
     fit["min_area_ratio"] = float(np.min(areas(fit_last.u) / areas(0 * fit_last.u)))
     records, pressures, exit_time, gas = pop(model, P, fit_last.u, progress, fit_last.state.contacts)
     exited = bool(gas.released and records[-1].contacts[0].n_active == 0)
-    return dict(fit_last=fit_last, fit=fit, records=records, pressures=pressures, exited=exited,
-                exit_time=exit_time if exited else None, released_at=gas.released_at)
+    return dict(
+        fit_last=fit_last,
+        fit=fit,
+        records=records,
+        pressures=pressures,
+        exited=exited,
+        exit_time=exit_time if exited else None,
+        released_at=gas.released_at,
+    )
 
 
 def press_fit_only(params):
@@ -205,5 +241,8 @@ def press_fit_only(params):
     model = build(params)
     last, fit = press_fit(model, params)
     fit.update(contact_forces(last.contacts))
-    return dict(static_breakaway(params, fit["normal"]), press_fit_normal_force_N=fit["normal"],
-                press_fit_calibrated=bool(params["R_tip"] == R_TIP_FITTED))
+    return dict(
+        static_breakaway(params, fit["normal"]),
+        press_fit_normal_force_N=fit["normal"],
+        press_fit_calibrated=bool(params["R_tip"] == R_TIP_FITTED),
+    )

@@ -70,7 +70,7 @@ def exec_file(path, what):
     stat = path.stat()
     key = hashlib.sha1(f"{path}:{stat.st_mtime_ns}:{stat.st_size}".encode()).hexdigest()[:12]
     mod_name = f"contactfem_{what.replace(' ', '_')}_{key}_{path.stem}"
-    if mod_name in sys.modules:                     # the same file, unchanged: loaded once a process
+    if mod_name in sys.modules:  # the same file, unchanged: loaded once a process
         return sys.modules[mod_name]
     spec = importlib.util.spec_from_file_location(mod_name, path)
     if spec is None or spec.loader is None:
@@ -79,7 +79,7 @@ def exec_file(path, what):
     sys.modules[mod_name] = module
     try:
         spec.loader.exec_module(module)
-    except (Exception, SystemExit) as err:            # noqa: BLE001 (anything in the user's file)
+    except (Exception, SystemExit) as err:  # noqa: BLE001 (anything in the user's file)
         sys.modules.pop(mod_name, None)
         line = _line_in(path, err)
         raise ValueError(f"{what} {path.name}" + (f", line {line}" if line else "") + f": {_cause(err)}") from None
@@ -95,13 +95,14 @@ def _guarded(fn, path, role):
         try:
             return fn(*args, **kwargs)
         except (NewtonError, LawValueError, FloatingPointError, SceneError):
-            raise                                   # the run's own outcome, as in a shipped scene
+            raise  # the run's own outcome, as in a shipped scene
         except ValueError as err:
-            if role == "check":                     # a cross-parameter check: bad input (exit 2)
+            if role == "check":  # a cross-parameter check: bad input (exit 2)
                 raise ValueError(f"scene {path.stem}: {' '.join(str(err).split())}") from None
             raise _error(err, path, role) from None
-        except (Exception, SystemExit) as err:        # noqa: BLE001
+        except (Exception, SystemExit) as err:  # noqa: BLE001
             raise _error(err, path, role) from None
+
     return call
 
 
@@ -114,12 +115,17 @@ def _checked_build(build, path, own_simulate):
     def call(params, **kwargs):
         model = build(params, **kwargs)
         if not isinstance(model, Model):
-            raise SceneError(f"scene file {path.name}, build: returned {type(model).__name__}, not a Model: "
-                             "return Model(systems=(system,), stage=Stage(...), parts=dict(...))")
+            raise SceneError(
+                f"scene file {path.name}, build: returned {type(model).__name__}, not a Model: "
+                "return Model(systems=(system,), stage=Stage(...), parts=dict(...))"
+            )
         if model.stage is None and not own_simulate:
-            raise SceneError(f"scene file {path.name}, build: the Model has no stage (the time loop's Stage) "
-                             "and the Scene no simulate of its own")
+            raise SceneError(
+                f"scene file {path.name}, build: the Model has no stage (the time loop's Stage) "
+                "and the Scene no simulate of its own"
+            )
         return model
+
     return call
 
 
@@ -129,6 +135,7 @@ def _checked_measure(measure, path):
         if not isinstance(out, dict):
             raise SceneError(f"scene file {path.name}, measure: returned {type(out).__name__}, not a dict of results")
         return out
+
     return call
 
 
@@ -141,8 +148,11 @@ def load_scene_file(path):
     if not isinstance(scene, Scene):
         found = "" if scene is None else f" (SCENE is a {type(scene).__name__})"
         raise ValueError(f"scene file {path.name} defines no SCENE = Scene(...){found}: see contactfem.scenes.Scene")
-    guarded = {role: _guarded(getattr(scene, role), path, role)
-               for role in ("check", "size", "law_range", "simulate") if getattr(scene, role) is not None}
+    guarded = {
+        role: _guarded(getattr(scene, role), path, role)
+        for role in ("check", "size", "law_range", "simulate")
+        if getattr(scene, role) is not None
+    }
     build = _guarded(_checked_build(scene.build, path, scene.simulate is not None), path, "build")
     measure = _guarded(_checked_measure(scene.measure, path), path, "measure")
     return replace(scene, build=build, measure=measure, **guarded)

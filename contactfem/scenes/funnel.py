@@ -56,25 +56,53 @@ def build(params, *, normal=None, friction=None, system_options=None):
     (a friction law given makes the run frictional)."""
     R, h = params["R"], params["thickness"]
     phi = np.radians(params["phi_deg"])
-    yc0 = (R + h / 2) / np.sin(phi) + params["gap0"]      # wall distance of the centre = R + h/2 + gap
-    ring = make_ring(kind=params["kind"], R=R, thickness=h, width=params["width"], n_el=params["n_el"],
-                     E=params["E"], nu=params["nu"], rho=params["rho"], center=(0.0, yc0), half=True,
-                     name="half ring", mass_matrix=params["mass_matrix"])
+    yc0 = (R + h / 2) / np.sin(phi) + params["gap0"]  # wall distance of the centre = R + h/2 + gap
+    ring = make_ring(
+        kind=params["kind"],
+        R=R,
+        thickness=h,
+        width=params["width"],
+        n_el=params["n_el"],
+        E=params["E"],
+        nu=params["nu"],
+        rho=params["rho"],
+        center=(0.0, yc0),
+        half=True,
+        name="half ring",
+        mass_matrix=params["mass_matrix"],
+    )
     wall = RigidPolyline(funnel_wall(params["phi_deg"], params["wall_length"]))
     if friction is None and params["variant"] == "frictional":
         friction = ParabolicSlip(params["c_T"], params["alpha"], params["beta"], params["n"])
-    contact = NodeToSegment(ring.body, ring.contact_nodes, wall, normal=normal or PowerLaw(params["c_N"], params["m"]),
-                            friction=friction, weights=1.0, offset=ring.offset, name="funnel",
-                            integration=time_integration.contact_integration(params))
+    contact = NodeToSegment(
+        ring.body,
+        ring.contact_nodes,
+        wall,
+        normal=normal or PowerLaw(params["c_N"], params["m"]),
+        friction=friction,
+        weights=1.0,
+        offset=ring.offset,
+        name="funnel",
+        integration=time_integration.contact_integration(params),
+    )
     symmetry = Dirichlet(ring.body, ring.symmetry_dofs(), 0.0)
     system = System([ring.body], [contact], fixed=[symmetry], **(system_options or {}))
     stepper = time_integration.make_stepper(params, system, atol=1e-10, maxit=30)
-    stage = Stage(stepper, Steps(params["dt"], n_steps=params["n_steps"], max_cuts=6), np.zeros(ring.body.ndof),
-                  ring.initial_velocity((0.0, -params["v0"])), name="funnel")
-    return Model(systems=(system,), stage=stage, sizes=dict(element=np.pi * R / params["n_el"], body=2.0 * R, radius=R),
-                 parts=dict(ring=ring, wall=wall, contact=contact))
-                # the accuracy indicators' lengths (n_el on the half ring):
-                # a beam element's size is its length (the thickness is its section's)
+    stage = Stage(
+        stepper,
+        Steps(params["dt"], n_steps=params["n_steps"], max_cuts=6),
+        np.zeros(ring.body.ndof),
+        ring.initial_velocity((0.0, -params["v0"])),
+        name="funnel",
+    )
+    return Model(
+        systems=(system,),
+        stage=stage,
+        sizes=dict(element=np.pi * R / params["n_el"], body=2.0 * R, radius=R),
+        parts=dict(ring=ring, wall=wall, contact=contact),
+    )
+    # the accuracy indicators' lengths (n_el on the half ring):
+    # a beam element's size is its length (the thickness is its section's)
 
 
 def radial_deviation(ring, u, center):
@@ -87,37 +115,53 @@ def radial_deviation(ring, u, center):
 def measure(m, params, records):
     ring = m.parts["ring"]
     hist = History.of(records)
-    rec = ring_history(ring, records, measures=dict(
-        deformation=lambda u, v: radial_deviation(ring, u, ring.center_of_mass(u))))
+    rec = ring_history(
+        ring, records, measures=dict(deformation=lambda u, v: radial_deviation(ring, u, ring.center_of_mass(u)))
+    )
     shots = snapshot_indices(rec["t"], every=params["outline_every"])
-    t, y_c, v_c = rec["t"], rec["x_c"][:, 1], rec["v_c"][:, 1]   # the mirrored ring: centre on x = 0
+    t, y_c, v_c = rec["t"], rec["x_c"][:, 1], rec["v_c"][:, 1]  # the mirrored ring: centre on x = 0
     n_contact = np.asarray(rec["n_contact"])
-    k0 = len(t) - max(2, len(t) // 4)                           # the last quarter of the run
+    k0 = len(t) - max(2, len(t) // 4)  # the last quarter of the run
     T_win = t[-1] - t[k0]
     mean_v_window = float((y_c[-1] - y_c[k0]) / T_win)
     in_contact_window = bool(np.all(n_contact[k0:] > 0))
     stuck = in_contact_window and abs(mean_v_window) < 0.02 * params["v0"]
     k_low = int(np.argmin(y_c))
-    rep = records[-1].contacts[0].report()                      # the interface at the end of the run
+    rep = records[-1].contacts[0].report()  # the interface at the end of the run
     on = rep["state"] != "open"
     contact_final = dict(x=rep["x"][on], t_N=rep["t_N"][on], t_T=rep["t_T"][on], state=rep["state"][on].tolist())
     mech = hist.kinetic + hist.strain + hist.contact
     return dict(
-        variant=params["variant"], stuck=bool(stuck),
-        mean_v_c_last_quarter=mean_v_window, in_contact_last_quarter=in_contact_window,
-        t=t, x_c=np.zeros_like(t), y_c=y_c, v_c=v_c,
-        n_contact_nodes=n_contact, n_slip_nodes=np.asarray(rec["n_slip"]),
-        deformation=np.asarray(rec["deformation"]), max_deformation=float(np.max(rec["deformation"])),
-        y_c_min=float(y_c[k_low]), t_y_c_min=float(t[k_low]), y_c_start=float(y_c[0]),
-        v_c_final=float(v_c[-1]), y_c_final=float(y_c[-1]),
-        slipping_nodes_final=int(rec["n_slip"][-1]), contact_nodes_final=int(n_contact[-1]),
+        variant=params["variant"],
+        stuck=bool(stuck),
+        mean_v_c_last_quarter=mean_v_window,
+        in_contact_last_quarter=in_contact_window,
+        t=t,
+        x_c=np.zeros_like(t),
+        y_c=y_c,
+        v_c=v_c,
+        n_contact_nodes=n_contact,
+        n_slip_nodes=np.asarray(rec["n_slip"]),
+        deformation=np.asarray(rec["deformation"]),
+        max_deformation=float(np.max(rec["deformation"])),
+        y_c_min=float(y_c[k_low]),
+        t_y_c_min=float(t[k_low]),
+        y_c_start=float(y_c[0]),
+        v_c_final=float(v_c[-1]),
+        y_c_final=float(y_c[-1]),
+        slipping_nodes_final=int(rec["n_slip"][-1]),
+        contact_nodes_final=int(n_contact[-1]),
         contact_final=contact_final,
         energy_error=time_integration.energy_error(hist)[0],
-        energy_kinetic=hist.kinetic, energy_strain=hist.strain, energy_contact=hist.contact,
-        energy_dissipation=hist.dissipation, energy_total=mech,
-        outlines=np.array([ring.outline(records[k].u, mirror=True) for k in shots]), outline_t=t[shots],
+        energy_kinetic=hist.kinetic,
+        energy_strain=hist.strain,
+        energy_contact=hist.contact,
+        energy_dissipation=hist.dissipation,
+        energy_total=mech,
+        outlines=np.array([ring.outline(records[k].u, mirror=True) for k in shots]),
+        outline_t=t[shots],
         wall=m.parts["wall"].points,
-        obstacles=[m.parts["wall"].points, m.parts["wall"].points * [-1.0, 1.0]],     # the wall and its mirror image
+        obstacles=[m.parts["wall"].points, m.parts["wall"].points * [-1.0, 1.0]],  # the wall and its mirror image
         newton_iterations_total=int(np.sum(hist.iterations)),
         step_cuts_total=int(np.sum(hist.cuts)),
     )
@@ -129,33 +173,90 @@ def law_range(params):
     distance the ring can travel, slip rates up to twice its initial speed."""
     M = params["rho"] * np.pi * params["R"] * params["thickness"] * params["width"]
     E = 0.5 * M * params["v0"] ** 2
-    return dict(p=penalty_pressure(E, params["c_N"], params["m"]), q=params["v0"] * params["n_steps"] * params["dt"],
-                v=2.0 * params["v0"], dt=params["dt"], g=params["thickness"])
+    return dict(
+        p=penalty_pressure(E, params["c_N"], params["m"]),
+        q=params["v0"] * params["n_steps"] * params["dt"],
+        v=2.0 * params["v0"],
+        dt=params["dt"],
+        g=params["thickness"],
+    )
+
 
 SCENE = Scene(
     name="funnel",
     title="Fall of an elastic ring into a rigid funnel, half ring by symmetry (Sec. 5.4, Figs 12-13)",
     params=(
-        Param("variant", "frictionless", choices=VARIANTS,
-              doc="frictionless (Fig 12: rebounds) or frictional eq (10) (Fig 13: sticks)"),
-        *RING_PARAMS,                      # "the same ring as in Sec. 5.3" (half of it, by symmetry)
+        Param(
+            "variant",
+            "frictionless",
+            choices=VARIANTS,
+            doc="frictionless (Fig 12: rebounds) or frictional eq (10) (Fig 13: sticks)",
+        ),
+        *RING_PARAMS,  # "the same ring as in Sec. 5.3" (half of it, by symmetry)
         Param("n_el", 30, "", 2, 2000, doc="elements on the half ring (paper: 30 beam elements)"),
         Param("v0", 4.0, "L/T", 0.0, None, low_open=True, doc="initial downward speed (paper)"),
-        Param("phi_deg", 20.0, "deg", 0.0, 90.0, low_open=True, high_open=True,
-              doc="funnel wall angle from the vertical (chosen: scan lost it; 20 deg sticks with friction "
-                  "because tan(phi) = 0.36 < mu_eff of eq (10) at the light pressures, and rebounds without)"),
+        Param(
+            "phi_deg",
+            20.0,
+            "deg",
+            0.0,
+            90.0,
+            low_open=True,
+            high_open=True,
+            doc="funnel wall angle from the vertical (chosen: scan lost it; 20 deg sticks with friction "
+            "because tan(phi) = 0.36 < mu_eff of eq (10) at the light pressures, and rebounds without)",
+        ),
         Param("wall_length", 45.0, "L", 0.0, None, low_open=True, doc="length of the funnel wall (chosen)"),
         Param("gap0", 0.2, "L", 0.0, None, doc="initial clearance of the outer surface from the wall (chosen)"),
         Param("c_N", 10.0, "F/L", 0.0, None, low_open=True, doc="normal penalty, nodal stiffness, eq (4) (paper)"),
         Param("m", 1.0, "", 1.0, None, doc="exponent of the normal law eq (4) (paper)"),
-        Param("c_T", 5.0, "F/L", 0.0, None, low_open=True, doc="tangential stick stiffness, nodal, eq (5) (paper)",
-              when=(("variant", ("frictional",)),)),
-        Param("n", 0.75, "", 0.0, 1.0, low_open=True, doc="exponent of the slip surface eq (10) (paper)", when=(("variant", ("frictional",)),)),
-        Param("alpha", 0.3, "F^(1-n)", 0.0, None, doc="alpha of the slip surface eq (10) (paper)", when=(("variant", ("frictional",)),)),
-        Param("beta", 0.1, "", 0.0, None, doc="beta of the slip surface eq (10) (paper)", when=(("variant", ("frictional",)),)),
+        Param(
+            "c_T",
+            5.0,
+            "F/L",
+            0.0,
+            None,
+            low_open=True,
+            doc="tangential stick stiffness, nodal, eq (5) (paper)",
+            when=(("variant", ("frictional",)),),
+        ),
+        Param(
+            "n",
+            0.75,
+            "",
+            0.0,
+            1.0,
+            low_open=True,
+            doc="exponent of the slip surface eq (10) (paper)",
+            when=(("variant", ("frictional",)),),
+        ),
+        Param(
+            "alpha",
+            0.3,
+            "F^(1-n)",
+            0.0,
+            None,
+            doc="alpha of the slip surface eq (10) (paper)",
+            when=(("variant", ("frictional",)),),
+        ),
+        Param(
+            "beta",
+            0.1,
+            "",
+            0.0,
+            None,
+            doc="beta of the slip surface eq (10) (paper)",
+            when=(("variant", ("frictional",)),),
+        ),
         Param("dt", 0.1, "T", 0.0, None, low_open=True, doc="time step (paper)"),
-        Param("n_steps", 150, "", 4, 100000,
-              doc="number of steps (chosen: the scan gives none; 150 covers the impact and 7 s after it)"),
+        Param(
+            "n_steps",
+            150,
+            "",
+            4,
+            100000,
+            doc="number of steps (chosen: the scan gives none; 150 covers the impact and 7 s after it)",
+        ),
         *time_integration.newmark_params(0.7, 0.4, "chosen as in Sec. 5.3"),
         time_integration.CONTACT_INTEGRATION_PARAM,
         MASS_MATRIX_PARAM,
@@ -163,7 +264,7 @@ SCENE = Scene(
     ),
     build=build,
     measure=measure,
-    presets={"fast": {}, "paper": {}},   # 30 elements, 150 steps: about a second
+    presets={"fast": {}, "paper": {}},  # 30 elements, 150 steps: about a second
     reports=("stuck", "y_c_min", "v_c_final", "max_deformation", "newton_iterations_total"),
     size=lambda p: dict(ring_size(p, half=True), steps=p["n_steps"]),
     outlines=True,

@@ -69,12 +69,21 @@ def foundation(params, h, a):
 
     R = params["R"]
     mesh = graded_block_mesh(R, params["foundation_ratio"] * h, 2.5 * a, a)
-    body = Continuum(mesh, params["E_foundation"], params["nu"], 0.0, kind="plane_strain", material=params["material"],
-                     name="foundation")
+    body = Continuum(
+        mesh,
+        params["E_foundation"],
+        params["nu"],
+        0.0,
+        kind="plane_strain",
+        material=params["material"],
+        name="foundation",
+    )
     top = np.flatnonzero(np.abs(body.X[:, 1] + R) < 1e-9 * R)
-    top = top[np.argsort(body.X[top, 0])]                       # left to right: n = e3 x t = +y, out of it
-    fixed = [Dirichlet(body, body.xdofs[np.abs(body.X[:, 0]) < 1e-9 * R, 0], 0.0),
-             Dirichlet(body, body.xdofs[np.abs(body.X[:, 1] + 2 * R) < 1e-9 * R, 1], 0.0)]
+    top = top[np.argsort(body.X[top, 0])]  # left to right: n = e3 x t = +y, out of it
+    fixed = [
+        Dirichlet(body, body.xdofs[np.abs(body.X[:, 0]) < 1e-9 * R, 0], 0.0),
+        Dirichlet(body, body.xdofs[np.abs(body.X[:, 1] + 2 * R) < 1e-9 * R, 1], 0.0),
+    ]
     return body, BodySurface(body, top), fixed
 
 
@@ -110,19 +119,28 @@ def build(params, *, normal=None, friction=None, system_options=None):
     arc = body.X[:, 0] ** 2 + body.X[:, 1] ** 2 > (R * (1 - 1e-9)) ** 2
     near = arc & (body.X[:, 0] < min(0.7 * R, 4.0 * a_ex))
     nodes = np.flatnonzero(near)
-    nodes = nodes[np.argsort(body.X[nodes, 0])]                # chain from B outwards
+    nodes = nodes[np.argsort(body.X[nodes, 0])]  # chain from B outwards
     w = tributary_lengths(body.X[nodes])
     bodies, more_fixed, master = [body], [], RigidLine((0.0, -R), (0.0, 1.0))
     if elastic:
         found, master, more_fixed = foundation(params, body.X[nodes[1], 0], a_ex)
         bodies.append(found)
         if params.get("contact_discretization", "node_to_segment") == "node_to_segment":
-            w[1] += w[0]                                       # the slave on the symmetry line is left out
+            w[1] += w[0]  # the slave on the symmetry line is left out
             nodes, w = nodes[1:], w[1:]
     weights = w if params["penalty"] == "per_length" else 1.0
-    contact = enforcement.interface(params, body, nodes, master, normal=normal or PowerLaw(params["c_N"], 1.0),
-                                    friction=friction, weights=weights, name="plane", material=params["material"])
-    if contact.nodes[0] != nodes[0]:                           # mortar's chain runs the other way
+    contact = enforcement.interface(
+        params,
+        body,
+        nodes,
+        master,
+        normal=normal or PowerLaw(params["c_N"], 1.0),
+        friction=friction,
+        weights=weights,
+        name="plane",
+        material=params["material"],
+    )
+    if contact.nodes[0] != nodes[0]:  # mortar's chain runs the other way
         nodes, w = nodes[::-1], w[::-1]
     sym = np.flatnonzero(np.abs(body.X[:, 0]) < 1e-9 * R)
     fixed = [Dirichlet(body, body.xdofs[sym, 0], 0.0)] + more_fixed
@@ -132,13 +150,21 @@ def build(params, *, normal=None, friction=None, system_options=None):
     # initial guess: the rigid translation that overlaps the plane over |x| < a (a^2 / 2R),
     # so that the first tangent is not singular (the plane is the only vertical support)
     u0 = np.zeros(system.ndof)
-    u0[body.xdofs[:, 1]] = -a_ex**2 / (2.0 * R)
-    stepper = enforcement.wrap(params, Static(system, atol=1e-12 * P, maxit=40), [contact],   # (atol: a floor)
-                               length=a_ex)                  # gap_violation: penetration / a
+    u0[body.xdofs[:, 1]] = -(a_ex**2) / (2.0 * R)
+    stepper = enforcement.wrap(
+        params,
+        Static(system, atol=1e-12 * P, maxit=40),
+        [contact],  # (atol: a floor)
+        length=a_ex,
+    )  # gap_violation: penetration / a
     n = params["n_steps"]
     stage = Stage(stepper, Steps(1.0 / n, n_steps=n, max_cuts=6), u0, name="hertz")
-    return Model(systems=(system,), stage=stage, sizes=dict(element=float(np.min(w[w > 0])), body=R),
-                 parts=dict(body=body, contact=contact, nodes=nodes, w=w, a_exact=a_ex, p0_exact=p0_ex, grading_k=k))
+    return Model(
+        systems=(system,),
+        stage=stage,
+        sizes=dict(element=float(np.min(w[w > 0])), body=R),
+        parts=dict(body=body, contact=contact, nodes=nodes, w=w, a_exact=a_ex, p0_exact=p0_ex, grading_k=k),
+    )
 
 
 def oscillations(x, p, p_exact, a, p0):
@@ -148,10 +174,12 @@ def oscillations(x, p, p_exact, a, p0):
     the node-to-node oscillation about the closed form."""
     o = np.argsort(x)
     x, p, dev = x[o], p[o], (p - p_exact)[o]
-    inner = (x[1:] < 0.8 * a)
+    inner = x[1:] < 0.8 * a
     jump = np.abs(np.diff(p))[inner]
-    return dict(max_jump=float(np.max(jump, initial=0.0) / p0),
-                oscillation=float(np.max(np.abs(np.diff(dev))[inner], initial=0.0) / p0))
+    return dict(
+        max_jump=float(np.max(jump, initial=0.0) / p0),
+        oscillation=float(np.max(np.abs(np.diff(dev))[inner], initial=0.0) / p0),
+    )
 
 
 def check(params):
@@ -159,14 +187,18 @@ def check(params):
     enforcement.check(params)
     E_f = params["E_foundation"] if params.get("foundation", "rigid") == "elastic" else np.inf
     a = hertz_exact(params["P"], params["R"], params["E"], params["nu"], E_f, params["nu"])[0]
-    if not a < 0.5 * params["R"]:        # the graded mesh puts 1.5 a on the quarter arc; Hertz's theory a << R
-        raise ValueError(f"parameter P = {params['P']:g} gives Hertz's a = {a:.4g}, a/R = {a / params['R']:.2g}: "
-                         "Hertz's small-strain theory needs a/R < 0.5 (a << R): lower P or raise E")
-    per_length = params["c_N"] if params["penalty"] == "per_length" else 0.0   # (per_node: c_N / w is above it)
-    enforcement.check_roundoff(per_length, 2.0 * params["P"] / (np.pi * a), params["R"], " MPa")   # against p0
+    if not a < 0.5 * params["R"]:  # the graded mesh puts 1.5 a on the quarter arc; Hertz's theory a << R
+        raise ValueError(
+            f"parameter P = {params['P']:g} gives Hertz's a = {a:.4g}, a/R = {a / params['R']:.2g}: "
+            "Hertz's small-strain theory needs a/R < 0.5 (a << R): lower P or raise E"
+        )
+    per_length = params["c_N"] if params["penalty"] == "per_length" else 0.0  # (per_node: c_N / w is above it)
+    enforcement.check_roundoff(per_length, 2.0 * params["P"] / (np.pi * a), params["R"], " MPa")  # against p0
     if params["contact_discretization"] == "mortar" and params["penalty"] != "per_length":
-        raise ValueError("parameter penalty = per_node does not apply to contact_discretization = mortar (its "
-                         "tractions are per unit length): use penalty = per_length")
+        raise ValueError(
+            "parameter penalty = per_node does not apply to contact_discretization = mortar (its "
+            "tractions are per unit length): use penalty = per_length"
+        )
 
 
 def measure(m, params, records):
@@ -188,20 +220,35 @@ def measure(m, params, records):
     h_c = float(np.median(np.diff(np.sort(x))[: max(2, np.count_nonzero(in_contact))]))
     c_eff = params["c_N"] if params["penalty"] == "per_length" else params["c_N"] / w[in_contact]
     profile_exact = p0_ex * np.sqrt(np.clip(1 - (x / a_ex) ** 2, 0, None))
-    a_mom = hertz_half_width(x, -rep["f_N"])     # mortar's nodal tractions are smeared where the zone ends: its a
+    a_mom = hertz_half_width(x, -rep["f_N"])  # mortar's nodal tractions are smeared where the zone ends: its a
     a = a_mom if params["contact_discretization"] == "mortar" else a_fit
     return dict(
         **oscillations(x, p, profile_exact, a_ex, p0_ex),
-        a=a, p0=p0_max, p0_fit=p0_fit, a_exact=a_ex, p0_exact=m.parts["p0_exact"], a_fit=a_fit, a_moments=a_mom,
-        error_a=(a - a_ex) / a_ex, error_a_fit=(a_fit - a_ex) / a_ex, error_a_moments=(a_mom - a_ex) / a_ex,
-        error_p0=(p0_max - p0_ex) / p0_ex, error_p0_fit=(p0_fit - p0_ex) / p0_ex, accuracy=references(
-            dict(a=(a - a_ex) / a_ex, p0=(p0_max - p0_ex) / p0_ex), HERTZ_TOL, HERTZ_SOURCE),
-        contact_force=float(-rep["f_N"].sum()), half_load=P / 2.0,
-        n_quads=int(body.mesh.t.shape[1]), n_dofs=int(body.ndof),
-        n_contact_nodes=int(np.count_nonzero(in_contact)), h_contact=h_c,
+        a=a,
+        p0=p0_max,
+        p0_fit=p0_fit,
+        a_exact=a_ex,
+        p0_exact=m.parts["p0_exact"],
+        a_fit=a_fit,
+        a_moments=a_mom,
+        error_a=(a - a_ex) / a_ex,
+        error_a_fit=(a_fit - a_ex) / a_ex,
+        error_a_moments=(a_mom - a_ex) / a_ex,
+        error_p0=(p0_max - p0_ex) / p0_ex,
+        error_p0_fit=(p0_fit - p0_ex) / p0_ex,
+        accuracy=references(dict(a=(a - a_ex) / a_ex, p0=(p0_max - p0_ex) / p0_ex), HERTZ_TOL, HERTZ_SOURCE),
+        contact_force=float(-rep["f_N"].sum()),
+        half_load=P / 2.0,
+        n_quads=int(body.mesh.t.shape[1]),
+        n_dofs=int(body.ndof),
+        n_contact_nodes=int(np.count_nonzero(in_contact)),
+        h_contact=h_c,
         penetration_max=float(-rep["g_N"].min()),
-        c_N_per_length_min=float(np.min(c_eff)), c_N_per_length_max=float(np.max(c_eff)),
-        profile_x=x, profile_p=p, profile_p_exact=profile_exact,
+        c_N_per_length_min=float(np.min(c_eff)),
+        c_N_per_length_max=float(np.max(c_eff)),
+        profile_x=x,
+        profile_p=p,
+        profile_p_exact=profile_exact,
         newton_iterations_total=int(np.sum(hist.iterations)),
         newton_residuals=[list(r) for r in hist.residuals[1:]],
         **enforcement.report(params, records, enforcement.penetration(state), a_ex, "the exact contact half-width a"),
@@ -215,25 +262,74 @@ SCENE = Scene(
         Param("R", 10.0, "mm", 0.0, None, low_open=True, doc="cylinder radius"),
         Param("E", 2.0e5, "MPa", 0.0, None, low_open=True, doc="Young's modulus"),
         Param("nu", 0.3, "", -1.0, 0.5, low_open=True, high_open=True, doc="Poisson's ratio (plane strain)"),
-        Param("P", 2000.0, "N/mm", 0.0, None, low_open=True,
-              doc="line load per unit thickness (default: a/R = 0.034, small strain)"),
-        Param("material", "linear", "", choices=("linear", "svk", "neohooke"),
-              doc="linear (small strain, Hertz's setting) or finite strain"),
+        Param(
+            "P",
+            2000.0,
+            "N/mm",
+            0.0,
+            None,
+            low_open=True,
+            doc="line load per unit thickness (default: a/R = 0.034, small strain)",
+        ),
+        Param(
+            "material",
+            "linear",
+            "",
+            choices=("linear", "svk", "neohooke"),
+            doc="linear (small strain, Hertz's setting) or finite strain",
+        ),
         Param("n_el", 64, "", 4, 2000, doc="quads per side of the quarter disk (n_el^2 quads; 4: two loaded nodes)"),
-        Param("grading", 1.0, "", 0.0, 3.0,
-              doc="multiplies the sinh stretching that puts a third of the elements within 1.5 a (0: uniform)"),
-        Param("penalty", "per_length", "", choices=PENALTIES,
-              doc=PENALTY_DOC + " (c_N in MPa/mm per length, N/mm per node)"),
-        Param("c_N", 1.0e9, "MPa/mm or N/mm", 0.0, None, low_open=True,
-              doc="penalty stiffness (eq 4, m = 1); chosen: stiff enough that the penalty error is < 0.1 %"),
+        Param(
+            "grading",
+            1.0,
+            "",
+            0.0,
+            3.0,
+            doc="multiplies the sinh stretching that puts a third of the elements within 1.5 a (0: uniform)",
+        ),
+        Param(
+            "penalty",
+            "per_length",
+            "",
+            choices=PENALTIES,
+            doc=PENALTY_DOC + " (c_N in MPa/mm per length, N/mm per node)",
+        ),
+        Param(
+            "c_N",
+            1.0e9,
+            "MPa/mm or N/mm",
+            0.0,
+            None,
+            low_open=True,
+            doc="penalty stiffness (eq 4, m = 1); chosen: stiff enough that the penalty error is < 0.1 %",
+        ),
         Param("n_steps", 1, "", 1, 1000, doc="load steps (the whole load in one step by default)"),
-        Param("foundation", "rigid", "", choices=("rigid", "elastic"),
-              doc="rigid plane (Hertz's setting) or an elastic block of E_foundation with a non-matching mesh"),
-        Param("E_foundation", 2.0e5, "MPa", 0.0, None, low_open=True, doc="Young's modulus of the elastic foundation",
-              when=(("foundation", ("elastic",)),)),
-        Param("foundation_ratio", 1.37, "", 0.1, 10.0,
-              doc="foundation element size / the cylinder's contact element size (non-matching meshes: not 1)",
-              when=(("foundation", ("elastic",)),)),
+        Param(
+            "foundation",
+            "rigid",
+            "",
+            choices=("rigid", "elastic"),
+            doc="rigid plane (Hertz's setting) or an elastic block of E_foundation with a non-matching mesh",
+        ),
+        Param(
+            "E_foundation",
+            2.0e5,
+            "MPa",
+            0.0,
+            None,
+            low_open=True,
+            doc="Young's modulus of the elastic foundation",
+            when=(("foundation", ("elastic",)),),
+        ),
+        Param(
+            "foundation_ratio",
+            1.37,
+            "",
+            0.1,
+            10.0,
+            doc="foundation element size / the cylinder's contact element size (non-matching meshes: not 1)",
+            when=(("foundation", ("elastic",)),),
+        ),
         *enforcement.ENFORCEMENT_PARAMS,
     ),
     build=build,
@@ -242,9 +338,12 @@ SCENE = Scene(
     presets={"fast": {"n_el": 32}, "paper": {"n_el": 64}},
     reports=("a", "p0", "a_exact", "p0_exact", "error_a", "error_p0"),
     # the elastic foundation adds about as many elements as the cylinder (graded: 1.5 n_el^2 at most)
-    size=lambda p: dict(elements=p["n_el"] ** 2 * (2.5 if p["foundation"] == "elastic" else 1),
-                        unknowns=2 * (p["n_el"] + 1) ** 2 * (2.5 if p["foundation"] == "elastic" else 1),
-                        steps=p["n_steps"]),
-    laws=("normal",), law_params={"normal": ("c_N",)},
-    law_range=lambda params: dict(g=0.1 * params["R"]),    # the normal law probed to a tenth of R deep
+    size=lambda p: dict(
+        elements=p["n_el"] ** 2 * (2.5 if p["foundation"] == "elastic" else 1),
+        unknowns=2 * (p["n_el"] + 1) ** 2 * (2.5 if p["foundation"] == "elastic" else 1),
+        steps=p["n_steps"],
+    ),
+    laws=("normal",),
+    law_params={"normal": ("c_N",)},
+    law_range=lambda params: dict(g=0.1 * params["R"]),  # the normal law probed to a tenth of R deep
 )

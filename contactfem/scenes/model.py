@@ -11,6 +11,7 @@ import numpy as np
 class Stage:
     """One march of a scene (solver.march): the stepper, the schedule, the initial state,
     and how the progress bar and error messages name it."""
+
     stepper: object
     schedule: object
     u0: np.ndarray
@@ -30,6 +31,7 @@ class Model:
     energy by plasticity (``plastic``: no integrator's loss), the name progress shows, and the
     scene's own objects (``parts``: bodies, contacts, node sets, closed forms) for its
     ``measure`` and plots."""
+
     systems: tuple
     stage: Stage | None = None
     sizes: dict = field(default_factory=dict)

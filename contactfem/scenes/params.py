@@ -27,6 +27,7 @@ class Limit:
     """A range from other parameters: ``bounds(values) -> (low, high)`` (None: no bound beyond
     the parameter's own), the parameters it reads (``of``) and how ``show`` states it (``text``,
     e.g. "[1, (nx - 1) // 2]")."""
+
     of: tuple
     bounds: Callable[[dict], tuple]
     text: str
@@ -43,8 +44,8 @@ class Param:
     high_open: bool = False
     choices: tuple | None = None
     doc: str = ""
-    when: tuple = ()      # ((other_param, (values...)), ...): the parameter is used only then
-    limit: Limit | None = None   # a range from other parameters (checked by Scene.resolve)
+    when: tuple = ()  # ((other_param, (values...)), ...): the parameter is used only then
+    limit: Limit | None = None  # a range from other parameters (checked by Scene.resolve)
 
     def applies(self, values):
         """Whether the resolved `values` use this parameter (see `when`)."""
@@ -65,7 +66,11 @@ class Param:
         low, high = self.bounds(values)
         lo = "-inf" if low is None else f"{low:g}"
         hi = "inf" if high is None else f"{high:g}"
-        text = ("(" if self.low_open or low is None else "[") + f"{lo}, {hi}" + (")" if self.high_open or high is None else "]")
+        text = (
+            ("(" if self.low_open or low is None else "[")
+            + f"{lo}, {hi}"
+            + (")" if self.high_open or high is None else "]")
+        )
         if self.limit is not None:
             text += " for " + ", ".join(f"{k} = {values[k]:g}" for k in self.limit.of)
         return text
@@ -86,8 +91,9 @@ class Param:
             return
         v = values[self.name]
         low, high = self.bounds(values)
-        if (low is not None and (v <= low if self.low_open else v < low)) or \
-                (high is not None and (v >= high if self.high_open else v > high)):
+        if (low is not None and (v <= low if self.low_open else v < low)) or (
+            high is not None and (v >= high if self.high_open else v > high)
+        ):
             raise ValueError(f"parameter {self.name} = {v:g} is out of range: allowed {self.range_text(values)}")
 
     def parse(self, value):
@@ -114,7 +120,9 @@ class Param:
         except ValueError:
             if self.limit is None:
                 raise
-            raise ValueError(f"parameter {self.name} = {value!r} is out of range: allowed {self.range_text()}") from None
+            raise ValueError(
+                f"parameter {self.name} = {value!r} is out of range: allowed {self.range_text()}"
+            ) from None
         return number if isinstance(self.default, int) else v
 
     def _integer(self, value):
@@ -156,8 +164,10 @@ def check_overrides(overrides):
     if overrides is None:
         return {}
     if not isinstance(overrides, Mapping):
-        raise TypeError(f"parameter overrides must be a dict of parameter name -> value (e.g. {{'nx': 12}}), got "
-                        f"{type(overrides).__name__} {overrides!r}"[:200])
+        raise TypeError(
+            f"parameter overrides must be a dict of parameter name -> value (e.g. {{'nx': 12}}), got "
+            f"{type(overrides).__name__} {overrides!r}"[:200]
+        )
     bad = [k for k in overrides if not isinstance(k, str)]
     if bad:
         raise TypeError(f"parameter overrides: the names must be strings, got {bad[0]!r}")

@@ -78,8 +78,7 @@ def block(xs, y0, y1, ny, name, E, nu):
 
     mesh = MeshQuad.init_tensor(np.asarray(xs, dtype=float), np.linspace(y0, y1, ny + 1))
     tol = 1e-9 * (xs[-1] - xs[0])
-    mesh = mesh.with_boundaries({"bottom": lambda x: np.abs(x[1] - y0) < tol,
-                                 "top": lambda x: np.abs(x[1] - y1) < tol})
+    mesh = mesh.with_boundaries({"bottom": lambda x: np.abs(x[1] - y0) < tol, "top": lambda x: np.abs(x[1] - y1) < tol})
     return Continuum(mesh, E, nu, 0.0, kind="plane_strain", name=name)
 
 
@@ -97,12 +96,22 @@ def build(params, *, normal=None, friction=None, system_options=None):
         friction = Coulomb(c_T=params["c_N"], mu=params["mu"])
     passes = params["passes"] if params["contact_discretization"] == "node_to_segment" else 1
     half = 0.5 if passes == 2 else 1.0
-    top_lower = lower.boundary_nodes("top")           # outward normal +y (towards the upper block)
-    top_lower = top_lower[np.argsort(lower.X[top_lower, 0])]        # left to right: n = e3 x t = +y
-    bottom_upper = upper.boundary_nodes("bottom")     # outward normal -y (towards the lower block)
+    top_lower = lower.boundary_nodes("top")  # outward normal +y (towards the upper block)
+    top_lower = top_lower[np.argsort(lower.X[top_lower, 0])]  # left to right: n = e3 x t = +y
+    bottom_upper = upper.boundary_nodes("bottom")  # outward normal -y (towards the lower block)
     w_upper = tributary_lengths(upper.X[bottom_upper])
-    contacts = [enforcement.interface(params, upper, bottom_upper, BodySurface(lower, top_lower), normal=law,
-                                      friction=friction, weights=half * w_upper, name="upper_on_lower")]
+    contacts = [
+        enforcement.interface(
+            params,
+            upper,
+            bottom_upper,
+            BodySurface(lower, top_lower),
+            normal=law,
+            friction=friction,
+            weights=half * w_upper,
+            name="upper_on_lower",
+        )
+    ]
     if passes == 2:
         # the lower block's top nodes over [0, W]; each carries its tributary part of [0, W]
         inner = top_lower[(lower.X[top_lower, 0] > 0.0) & (lower.X[top_lower, 0] < W)]
@@ -111,8 +120,18 @@ def build(params, *, normal=None, friction=None, system_options=None):
         w = tributary_lengths(chain)
         w[1] += w[0]
         w[-2] += w[-1]
-        contacts.append(enforcement.interface(params, lower, inner, BodySurface(upper, bottom_upper), normal=law,
-                                              friction=friction, weights=half * w[1:-1], name="lower_on_upper"))
+        contacts.append(
+            enforcement.interface(
+                params,
+                lower,
+                inner,
+                BodySurface(upper, bottom_upper),
+                normal=law,
+                friction=friction,
+                weights=half * w[1:-1],
+                name="lower_on_upper",
+            )
+        )
 
     def node(body, x, y):
         return int(np.argmin(np.hypot(body.X[:, 0] - x, body.X[:, 1] - y)))
@@ -121,9 +140,11 @@ def build(params, *, normal=None, friction=None, system_options=None):
     # rollers under the lower block; one pin (u_x = 0) on each block against rigid sliding:
     # the homogeneous solution slides the blocks against each other by eps_xx e / 2, which a
     # frictionless interface allows without any reaction
-    fixed = [Dirichlet(lower, lower.xdofs[bottom, 1], 0.0),
-             Dirichlet(lower, lower.xdofs[node(lower, -0.5 * e, 0.0), 0], 0.0)]
-    if friction is None:                              # with friction the interface holds the upper block
+    fixed = [
+        Dirichlet(lower, lower.xdofs[bottom, 1], 0.0),
+        Dirichlet(lower, lower.xdofs[node(lower, -0.5 * e, 0.0), 0], 0.0),
+    ]
+    if friction is None:  # with friction the interface holds the upper block
         fixed.append(Dirichlet(upper, upper.xdofs[node(upper, 0.0, 2 * H), 0], 0.0))
     top_sorted = top_lower[np.argsort(lower.X[top_lower, 0])]
     loads = [Pressure(upper, "top", params["p"]), OverhangPressure(lower, top_sorted, params["p"], 0.0, W)]
@@ -133,11 +154,14 @@ def build(params, *, normal=None, friction=None, system_options=None):
     # penetration p / c_N, so the interface is active and the first tangent regular
     u0 = np.zeros(system.ndof)
     u0[system.global_dofs(upper, upper.xdofs[:, 1])] = -2.0 * p / params["c_N"]
-    stepper = Static(system, atol=1e-12 * p * params["W"], maxit=30)      # Newton's force test; atol: a floor
-    stepper = enforcement.wrap(params, stepper, contacts, length=H)     # gap_violation: penetration / H
-    return Model(systems=(system,), stage=Stage(stepper, Steps(1.0, n_steps=1), u0, name="patch"),
-                 sizes=dict(element=min(e, W / params["nx_upper"], H / params["ny"]), body=H),
-                 parts=dict(lower=lower, upper=upper, contacts=contacts, bottom_upper=bottom_upper, top_lower=top_sorted))
+    stepper = Static(system, atol=1e-12 * p * params["W"], maxit=30)  # Newton's force test; atol: a floor
+    stepper = enforcement.wrap(params, stepper, contacts, length=H)  # gap_violation: penetration / H
+    return Model(
+        systems=(system,),
+        stage=Stage(stepper, Steps(1.0, n_steps=1), u0, name="patch"),
+        sizes=dict(element=min(e, W / params["nx_upper"], H / params["ny"]), body=H),
+        parts=dict(lower=lower, upper=upper, contacts=contacts, bottom_upper=bottom_upper, top_lower=top_sorted),
+    )
 
 
 def measure(m, params, records):
@@ -147,9 +171,12 @@ def measure(m, params, records):
     u, states = records[-1].u, records[-1].contacts
 
     result = dict(newton_iterations_total=int(np.sum(hist.iterations)), passes=params["passes"])
-    result.update(enforcement.report(params, records, max(enforcement.penetration(st) for st in states), params["H"],
-                                     "the block height H"))
-    for c, st in zip(m.parts["contacts"], states):      # each pass's own traction law values
+    result.update(
+        enforcement.report(
+            params, records, max(enforcement.penetration(st) for st in states), params["H"], "the block height H"
+        )
+    )
+    for c, st in zip(m.parts["contacts"], states):  # each pass's own traction law values
         rep = st.report()
         result[f"{c.name}_x"] = rep["X"][:, 0]
         result[f"{c.name}_t_N"] = -rep["t_N"]
@@ -175,7 +202,7 @@ def measure(m, params, records):
     result["pressure_deviation_lower"] = float(np.max(np.abs(pressure_lower - p)) / p)
     result["pressure_deviation_max"] = max(result["pressure_deviation_upper"], result["pressure_deviation_lower"])
     result["load_carried"] = float(f.sum())
-    result["load_applied"] = p * params["W"]          # through the interface
+    result["load_applied"] = p * params["W"]  # through the interface
     s_dev = 0.0
     for body in (lower, upper):
         s = body.cauchy_stress(system.local(body, u))
@@ -183,10 +210,16 @@ def measure(m, params, records):
     result["stress_deviation_max"] = s_dev
     from .accuracy import PRESSURE_TOL, indicator
 
-    result["accuracy"] = dict(pressure_deviation=indicator(
-        result["pressure_deviation_max"], PRESSURE_TOL, "largest |interface pressure / p - 1| over both blocks' "
-        "interface nodes (the patch test's exact answer: p everywhere)", "measured: node-to-segment stays below 0.052 "
-        "on the presets (its load transfer's own error, the paper's method); mortar: 1e-11"))
+    result["accuracy"] = dict(
+        pressure_deviation=indicator(
+            result["pressure_deviation_max"],
+            PRESSURE_TOL,
+            "largest |interface pressure / p - 1| over both blocks' "
+            "interface nodes (the patch test's exact answer: p everywhere)",
+            "measured: node-to-segment stays below 0.052 "
+            "on the presets (its load transfer's own error, the paper's method); mortar: 1e-11",
+        )
+    )
     return result
 
 
@@ -207,10 +240,14 @@ def check(params):
     penalty (or Lagrange's steering c_N) that round-off can resolve."""
     enforcement.check(params)
     _, xs_lower, xs_upper = columns(params)
-    if params["contact_discretization"] == "node_to_segment" and \
-            np.min(np.abs(xs_upper[:, None] - xs_lower[None, :])) < 1e-6 * params["W"]:
-        raise ValueError("parameters nx_lower, nx_upper put a slave node exactly above a master node "
-                         "(node-to-segment switching is non-smooth there): choose nx_upper odd")
+    if (
+        params["contact_discretization"] == "node_to_segment"
+        and np.min(np.abs(xs_upper[:, None] - xs_lower[None, :])) < 1e-6 * params["W"]
+    ):
+        raise ValueError(
+            "parameters nx_lower, nx_upper put a slave node exactly above a master node "
+            "(node-to-segment switching is non-smooth there): choose nx_upper odd"
+        )
     enforcement.check_roundoff(params["c_N"], params["p"], max(params["W"], 2.0 * params["H"]))
     enforcement.check_steering(params, min(params["E"], params["E_upper"]) / params["H"], "E / H")
 
@@ -222,27 +259,56 @@ SCENE = Scene(
         Param("W", 1.0, "mm", 0.0, None, low_open=True, doc="block width"),
         Param("H", 0.5, "mm", 0.0, None, low_open=True, doc="height of each block"),
         Param("E", 1000.0, "MPa", 0.0, None, low_open=True, doc="Young's modulus (both blocks by default)"),
-        Param("E_upper", 1000.0, "MPa", 0.0, None, low_open=True,
-              doc="Young's modulus of the upper block (differs: the blocks slide against each other)"),
+        Param(
+            "E_upper",
+            1000.0,
+            "MPa",
+            0.0,
+            None,
+            low_open=True,
+            doc="Young's modulus of the upper block (differs: the blocks slide against each other)",
+        ),
         Param("nu", 0.3, "", -1.0, 0.5, low_open=True, high_open=True, doc="Poisson's ratio (plane strain)"),
         Param("p", 10.0, "MPa", 0.0, None, low_open=True, doc="pressure on the top of the upper block"),
         Param("nx_lower", 4, "", 1, 1000, doc="elements across the lower block"),
         Param("nx_upper", 7, "", 1, 1000, doc="elements across the upper block (non-matching)"),
         Param("ny", 2, "", 1, 1000, doc="elements through each block"),
-        Param("c_N", 1.0e6, "MPa/mm", 0.0, None, low_open=True,
-              doc="penalty per unit length (eq 4, m = 1); chosen: 1000 E / H"),
-        Param("passes", 1, "", choices=(1, 2), doc="1: one-pass node-to-segment; 2: two-pass, halved weights",
-              when=(("contact_discretization", ("node_to_segment",)),)),
-        Param("mu", 0.0, "", 0.0, None,
-              doc="Coulomb friction coefficient of the interface (eq 11, c_T = c_N); 0: frictionless"),
+        Param(
+            "c_N",
+            1.0e6,
+            "MPa/mm",
+            0.0,
+            None,
+            low_open=True,
+            doc="penalty per unit length (eq 4, m = 1); chosen: 1000 E / H",
+        ),
+        Param(
+            "passes",
+            1,
+            "",
+            choices=(1, 2),
+            doc="1: one-pass node-to-segment; 2: two-pass, halved weights",
+            when=(("contact_discretization", ("node_to_segment",)),),
+        ),
+        Param(
+            "mu",
+            0.0,
+            "",
+            0.0,
+            None,
+            doc="Coulomb friction coefficient of the interface (eq 11, c_T = c_N); 0: frictionless",
+        ),
         *enforcement.ENFORCEMENT_PARAMS,
     ),
     check=check,
     build=build,
     measure=measure,
     presets={"fast": {}, "paper": {"nx_lower": 8, "nx_upper": 13, "ny": 4}},
-    size=lambda p: dict(elements=(p["nx_lower"] + 1 + p["nx_upper"]) * p["ny"],
-                        unknowns=2 * (p["nx_lower"] + 3 + p["nx_upper"]) * (p["ny"] + 1), steps=1),
+    size=lambda p: dict(
+        elements=(p["nx_lower"] + 1 + p["nx_upper"]) * p["ny"],
+        unknowns=2 * (p["nx_lower"] + 3 + p["nx_upper"]) * (p["ny"] + 1),
+        steps=1,
+    ),
     reports=("pressure_deviation_max", "stress_deviation_max", "load_carried", "load_applied"),
     laws=("normal",),
     law_params={"normal": ("c_N",)},

@@ -12,8 +12,7 @@ def estimate(size, linear_algebra="auto"):
     small)."""
     est = {k: _count(v) for k, v in size.items()}
     n = max(est.get("unknowns", 0), 1)
-    memory = (MEMORY_BASE + MEMORY_PER_UNKNOWN * n * math.log2(max(n, 2))
-              + MEMORY_PER_STEP * est.get("steps", 0))
+    memory = MEMORY_BASE + MEMORY_PER_UNKNOWN * n * math.log2(max(n, 2)) + MEMORY_PER_STEP * est.get("steps", 0)
     if linear_algebra == "dense":
         memory += DENSE_BYTES * float(n) ** 2
     elif linear_algebra == "banded":
@@ -25,15 +24,15 @@ def estimate(size, linear_algebra="auto"):
 def _count(x):
     """A count from a float estimate: rounded up, overflow (inf, nan) as 1e18."""
     x = float(x)
-    return int(math.ceil(x - 1e-9)) if math.isfinite(x) and x < 1e18 else 10 ** 18
+    return int(math.ceil(x - 1e-9)) if math.isfinite(x) and x < 1e18 else 10**18
 
 
 # Resource model (Scene.estimate) and the limits that `contactfem run` enforces unless --force.
 # Calibrated on hertz (peak resident memory): 45,602 unknowns 312 MB, 181,202 unknowns 1.08 GB,
 # i.e. about 310 bytes per unknown and per log2(unknowns) (the LU fill grows like n log n).
-MEMORY_BASE = 100e6            # the interpreter with numpy, scipy and scikit-fem loaded
-MEMORY_PER_UNKNOWN = 310.0     # bytes per unknown and per log2(unknowns)
-MEMORY_PER_STEP = 2.0e3        # bytes per time step (recorded histories)
+MEMORY_BASE = 100e6  # the interpreter with numpy, scipy and scikit-fem loaded
+MEMORY_PER_UNKNOWN = 310.0  # bytes per unknown and per log2(unknowns)
+MEMORY_PER_STEP = 2.0e3  # bytes per time step (recorded histories)
 LIMITS = {"memory_bytes": 2e9, "unknowns": 1e6, "steps": 1e6}
 # A forced dense solve holds K (n x n doubles) and the copy LAPACK factorises: 16 bytes per entry.
 # A forced band LU holds n (2 kl + ku + 1) doubles; a 2-D mesh renumbered by reverse Cuthill-McKee
@@ -51,15 +50,18 @@ def check_resources(scene, params, force=False, linear_algebra="auto"):
         return est
     over = [k for k, lim in LIMITS.items() if est.get(k, 0) > lim]
     if over:
-        raise ValueError(f"{scene.name} would need {describe(est)}: above the limit of "
-                         + ", ".join(_fmt(k, LIMITS[k]) for k in over) + " (add --force to run it anyway)")
+        raise ValueError(
+            f"{scene.name} would need {describe(est)}: above the limit of "
+            + ", ".join(_fmt(k, LIMITS[k]) for k in over)
+            + " (add --force to run it anyway)"
+        )
     return est
 
 
 def _fmt(key, value):
     if key == "memory_bytes":
         return f"{value / 1e9:.2g} GB" if value >= 1e8 else f"{value / 1e6:.0f} MB"
-    return f"{value:,.0f} {key[:-1] if round(value) == 1 else key}"     # 1 step, 2 steps
+    return f"{value:,.0f} {key[:-1] if round(value) == 1 else key}"  # 1 step, 2 steps
 
 
 def describe(est):

@@ -18,21 +18,45 @@ from .base import Limit, Param
 
 # The mass matrix of every ring scene (the scan does not say which the paper used).
 MASS_MATRIX_PARAM = Param(
-    "mass_matrix", "lumped", choices=("lumped", "consistent"),
+    "mass_matrix",
+    "lumped",
+    choices=("lumped", "consistent"),
     doc="the ring's mass: lumped (diagonal, row sums; our default) or consistent (the P1 mass matrix of the "
-        "beam's translations and rotations, scikit-fem's mass form for the continuum); the scan does not say")
+    "beam's translations and rotations, scikit-fem's mass form for the continuum); the scan does not say",
+)
 
 # A ring's wall is thinner than its diameter: thickness in (0, 2 R) (the ring builders assert it).
 THICKNESS_LIMIT = Limit(("R",), lambda v: (None, 2.0 * v["R"]), "(0, 2 R)")
 
 # The ring of Sec. 5.3; Sec. 5.4 (the funnel) uses "the same ring".
 RING_PARAMS = (
-    Param("kind", "beam", choices=("beam", "continuum"),
-          doc="beam: the paper's finite-deformation beam; continuum: annulus of quads (plane strain, SVK)"),
-    Param("R", 10.0, "L", 0.0, None, low_open=True, doc="mean radius of the ring (paper, Sec. 5.3). The paper gives no "
-          "units: any consistent set of length L, time T, force F (mass M = F T^2 / L)"),
-    Param("thickness", 1.0, "L", 0.0, None, low_open=True, high_open=True, limit=THICKNESS_LIMIT,
-          doc="radial wall thickness h (paper: square section A = 1)"),
+    Param(
+        "kind",
+        "beam",
+        choices=("beam", "continuum"),
+        doc="beam: the paper's finite-deformation beam; continuum: annulus of quads (plane strain, SVK)",
+    ),
+    Param(
+        "R",
+        10.0,
+        "L",
+        0.0,
+        None,
+        low_open=True,
+        doc="mean radius of the ring (paper, Sec. 5.3). The paper gives no "
+        "units: any consistent set of length L, time T, force F (mass M = F T^2 / L)",
+    ),
+    Param(
+        "thickness",
+        1.0,
+        "L",
+        0.0,
+        None,
+        low_open=True,
+        high_open=True,
+        limit=THICKNESS_LIMIT,
+        doc="radial wall thickness h (paper: square section A = 1)",
+    ),
     Param("width", 1.0, "L", 0.0, None, low_open=True, doc="out-of-plane depth b (paper: square section A = 1)"),
     Param("E", 100.0, "F/L^2", 0.0, None, low_open=True, doc="Young's modulus (paper)"),
     Param("nu", 0.0, "", -1.0, 0.5, low_open=True, high_open=True, doc="Poisson's ratio (paper)"),
@@ -55,9 +79,13 @@ def ring_history(ring, records, measures=None):
     whole mirrored ring for a half ring), the spin omega, and from the record's first contact
     state the nodes in contact (n_contact) and slipping in the step (n_slip); ``measures``,
     name -> f(u, v), more numbers per record."""
-    U, V = np.array([r.u for r in records]), np.array([r.v for r in records])     # one record a row
-    out = dict(t=np.array([r.t for r in records]), x_c=ring.center_of_mass(U), v_c=ring.velocity_of_mass(V),
-               omega=ring.angular_velocity(U, V))
+    U, V = np.array([r.u for r in records]), np.array([r.v for r in records])  # one record a row
+    out = dict(
+        t=np.array([r.t for r in records]),
+        x_c=ring.center_of_mass(U),
+        v_c=ring.velocity_of_mass(V),
+        omega=ring.angular_velocity(U, V),
+    )
     if records and records[0].contacts:
         out["n_contact"] = np.array([int(np.count_nonzero(r.contacts[0].slip != OPEN)) for r in records])
         out["n_slip"] = np.array([int(np.count_nonzero(r.contacts[0].slip == SLIP)) for r in records])
@@ -96,13 +124,13 @@ def rigid_ring_exact(v0, mu, g, a, k2=None, t=None):
         raise ValueError(f"parameter k2 = {k2!r} is out of range: allowed (0, inf)")
     r = a * a / k2
     t_star = v0 / (mu * g * (1 + r))
-    x_star = v0 * t_star - 0.5 * mu * g * t_star ** 2
+    x_star = v0 * t_star - 0.5 * mu * g * t_star**2
     v_star = v0 - mu * g * t_star
     out = dict(t_star=t_star, x_star=x_star, v_star=v_star, omega_star=-v_star / a)
     if t is not None:
         t = np.asarray(t, float)
         ts = np.minimum(t, t_star)
-        out["x"] = v0 * ts - 0.5 * mu * g * ts ** 2 + v_star * np.maximum(t - t_star, 0.0)
+        out["x"] = v0 * ts - 0.5 * mu * g * ts**2 + v_star * np.maximum(t - t_star, 0.0)
         out["v"] = v0 - mu * g * ts
         out["omega"] = -mu * g * a * ts / k2
     return out
@@ -118,7 +146,7 @@ def detect_rolling(t, slip, v0, lo=0.1, hi=0.9, roll=0.02):
         return None
     k = below[0]
     sel = np.flatnonzero((slip[:k] > lo * v0) & (slip[:k] < hi * v0))
-    if sel.size < 2:                         # too few sliding samples: interpolate the crossing
+    if sel.size < 2:  # too few sliding samples: interpolate the crossing
         if k == 0:
             return float(t[0])
         s0, s1 = slip[k - 1], slip[k]
@@ -149,4 +177,4 @@ def penalty_pressure(energy, c_N, m=1.0, weight=1.0):
     weight `weight` stores all of `energy`: w c_N a^(m+1) / (m+1) = energy. A bound of the
     pressures of a run whose energy is `energy` (a scene's law_range)."""
     a = ((m + 1.0) * energy / (weight * c_N)) ** (1.0 / (m + 1.0))
-    return c_N * a ** m
+    return c_N * a**m

@@ -15,23 +15,38 @@ from .base import Param
 CONTACT_INTEGRATIONS = ("standard", "energy_consistent")
 
 CONTACT_INTEGRATION_PARAM = Param(
-    "contact_integration", "standard", choices=CONTACT_INTEGRATIONS,
+    "contact_integration",
+    "standard",
+    choices=CONTACT_INTEGRATIONS,
     doc="standard: Newmark with delta, beta_newmark (the paper; with an unresolved penalty the trapezoidal "
-        "rule gains energy at impact); energy_consistent: midpoint rule with discrete gradients of the "
-        "bodies' and the interface's energy (Armero-Petocz): a frictionless impact conserves energy whatever "
-        "c_N, dt and the phase at which contact begins; friction only dissipates (delta, beta_newmark unused)")
+    "rule gains energy at impact); energy_consistent: midpoint rule with discrete gradients of the "
+    "bodies' and the interface's energy (Armero-Petocz): a frictionless impact conserves energy whatever "
+    "c_N, dt and the phase at which contact begins; friction only dissipates (delta, beta_newmark unused)",
+)
 
 
 def newmark_params(delta, beta, source):
     """The Params delta and beta_newmark with the scene's defaults and Newmark's own ranges
     (solver.newmark: delta in [0.5, 1], beta in (0, 0.5]); ``source`` says where the defaults
     come from (e.g. "paper")."""
-    return (Param("delta", delta, "", **DELTA_RANGE,
-                  doc=f"Newmark delta, the usual gamma ({source}: {delta:g}; 0.5 with beta 0.25 conserves energy, "
-                      "below 0.5 every step amplifies; a run with accuracy > 0 uses 0.5)"),
-            Param("beta_newmark", beta, "", **BETA_RANGE,
-                  doc=f"Newmark beta ({source}: {beta:g}; stable for every step when beta >= (delta + 1/2)^2 / 4; "
-                      "a run with accuracy > 0 uses 0.25)"))
+    return (
+        Param(
+            "delta",
+            delta,
+            "",
+            **DELTA_RANGE,
+            doc=f"Newmark delta, the usual gamma ({source}: {delta:g}; 0.5 with beta 0.25 conserves energy, "
+            "below 0.5 every step amplifies; a run with accuracy > 0 uses 0.5)",
+        ),
+        Param(
+            "beta_newmark",
+            beta,
+            "",
+            **BETA_RANGE,
+            doc=f"Newmark beta ({source}: {beta:g}; stable for every step when beta >= (delta + 1/2)^2 / 4; "
+            "a run with accuracy > 0 uses 0.25)",
+        ),
+    )
 
 
 def contact_integration(params):
@@ -103,22 +118,29 @@ class Tolerance(Param):
         try:
             v = super().parse(value)
         except ValueError:
-            raise ValueError(f"parameter {self.name} = {value!r} is out of range: allowed {self.range_text()}") from None
+            raise ValueError(
+                f"parameter {self.name} = {value!r} is out of range: allowed {self.range_text()}"
+            ) from None
         if 0.0 < v < ACCURACY_MIN:
             raise ValueError(f"parameter {self.name} = {value!r} is out of range: allowed {self.range_text()}")
         return v
 
 
 ACCURACY_PARAM = Tolerance(
-    "accuracy", 0.0, "", 0.0, 0.1,
+    "accuracy",
+    0.0,
+    "",
+    0.0,
+    0.1,
     doc="0: fixed steps of dt (the default); TOL > 0: the steps are chosen from a local error estimate "
-        "(solver/schedule.py: each step's error in the velocities held at TOL speed dt / duration) so "
-        "that the headline quantities land within about TOL (relative) of the run refined in time; dt is then "
-        "the largest step, and Newmark is the trapezoidal rule (delta = 0.5, beta_newmark = 0.25: second order; "
-        "the damping of delta > 0.5 is an error of first order in dt); the run's error_budget indicator warns "
-        "where its own estimate passes twice what TOL allows. The penalty is not changed: in these scenes it "
-        "is the interface law of the model (the paper's eq 4, the bar's one-element stiffness), the reference "
-        "is the same model refined in time, and the penetration indicator says how deep it lets the bodies go")
+    "(solver/schedule.py: each step's error in the velocities held at TOL speed dt / duration) so "
+    "that the headline quantities land within about TOL (relative) of the run refined in time; dt is then "
+    "the largest step, and Newmark is the trapezoidal rule (delta = 0.5, beta_newmark = 0.25: second order; "
+    "the damping of delta > 0.5 is an error of first order in dt); the run's error_budget indicator warns "
+    "where its own estimate passes twice what TOL allows. The penalty is not changed: in these scenes it "
+    "is the interface law of the model (the paper's eq 4, the bar's one-element stiffness), the reference "
+    "is the same model refined in time, and the penetration indicator says how deep it lets the bodies go",
+)
 
 
 def plan(params, stepper, *, dt, speed, max_cuts, t_end=None, n_steps=None, duration=None, t0=0.0):
@@ -134,5 +156,11 @@ def plan(params, stepper, *, dt, speed, max_cuts, t_end=None, n_steps=None, dura
         return stepper, Steps(dt, n_steps=n_steps, t_end=None if n_steps else t_end, t0=t0, max_cuts=max_cuts)
     duration = duration or (n_steps * dt if n_steps else t_end - t0)
     estimated, rule, rejections = at_tolerance(stepper, tol, speed, duration, dt)
-    return estimated, Adaptive(rule, t_end=t0 + n_steps * dt if n_steps else t_end, dt=dt * tol, t0=t0,
-                               max_cuts=max_cuts + rejections, growth=2.0)
+    return estimated, Adaptive(
+        rule,
+        t_end=t0 + n_steps * dt if n_steps else t_end,
+        dt=dt * tol,
+        t0=t0,
+        max_cuts=max_cuts + rejections,
+        growth=2.0,
+    )

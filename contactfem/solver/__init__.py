@@ -21,12 +21,29 @@ Lagrangian's outer loop), staggered.py (the two-step algorithm of Sec. 2.2), int
 (what a stepper and a schedule are). A stepper's ``step`` never commits; the time loop commits
 only converged steps.
 """
+
 from .system import Dirichlet, Evaluation, System
 from .newton import NewtonError, NewtonResult, newton
 from .newmark import CentralDifference, Newmark, Static, initial_acceleration
 from .march import History, Record, integrate, march, watch
 from .schedule import Adaptive, Steps
 
-__all__ = ["Dirichlet", "Evaluation", "System", "NewtonError", "NewtonResult", "newton", "Newmark", "Static",
-           "CentralDifference", "History", "Record", "integrate", "march", "watch", "initial_acceleration",
-           "Adaptive", "Steps"]
+__all__ = [
+    "Dirichlet",
+    "Evaluation",
+    "System",
+    "NewtonError",
+    "NewtonResult",
+    "newton",
+    "Newmark",
+    "Static",
+    "CentralDifference",
+    "History",
+    "Record",
+    "integrate",
+    "march",
+    "watch",
+    "initial_acceleration",
+    "Adaptive",
+    "Steps",
+]

@@ -93,13 +93,13 @@ class TangentAssembler:
         self.n, self.requested = int(n), linear_algebra
         self.kind = choose_linear_algebra(self.n, linear_algebra)
         self.free = None if free is None or len(free) == self.n else np.asarray(free)
-        self.keys = None            # sparse: sorted pattern keys col * n + row
-        self.plan = None            # the BandPlan of the pattern (None where the band cannot be chosen)
-        self.banded_plan = None     # the plan of the last K solved banded
-        self.dissection = None      # the DissectionPlan of the pattern, where it is solved sparse and large
-        self.used = {}              # kind -> ordering, of every assembly so far
-        self._cache = {}            # key -> (rows, cols, positions) of a constant contribution
-        self.pattern_builds = 0     # how often the pattern was (re)computed
+        self.keys = None  # sparse: sorted pattern keys col * n + row
+        self.plan = None  # the BandPlan of the pattern (None where the band cannot be chosen)
+        self.banded_plan = None  # the plan of the last K solved banded
+        self.dissection = None  # the DissectionPlan of the pattern, where it is solved sparse and large
+        self.used = {}  # kind -> ordering, of every assembly so far
+        self._cache = {}  # key -> (rows, cols, positions) of a constant contribution
+        self.pattern_builds = 0  # how often the pattern was (re)computed
 
     # -- the pattern (sparse) ---------------------------------------------------------
     def _grow(self, keys):
@@ -108,36 +108,41 @@ class TangentAssembler:
         diag = np.arange(self.n) * (self.n + 1)
         old = diag if self.keys is None else self.keys
         merged = np.concatenate([old, np.asarray(keys, dtype=np.int64)])
-        order = np.argsort(merged, kind="stable")   # sorted runs (old keys, a body's CSR rows): near-linear
+        order = np.argsort(merged, kind="stable")  # sorted runs (old keys, a body's CSR rows): near-linear
         merged = merged[order]
-        first = np.empty(merged.size, dtype=bool)   # the first of each run of equal keys
+        first = np.empty(merged.size, dtype=bool)  # the first of each run of equal keys
         first[:1] = True
         np.not_equal(merged[1:], merged[:-1], out=first[1:])
         self.keys = merged[first]
-        self._ends = np.append(self.keys, -1)        # a position beyond the last key finds no key there
+        self._ends = np.append(self.keys, -1)  # a position beyond the last key finds no key there
         where = np.empty(merged.size, dtype=np.int64)
-        where[order] = np.cumsum(first) - 1         # each merged key's place in the pattern
+        where[order] = np.cumsum(first) - 1  # each merged key's place in the pattern
         from scipy.sparse import csc_matrix
 
-        indices = self.keys % self.n                                         # row of each entry
+        indices = self.keys % self.n  # row of each entry
         indptr = np.searchsorted(self.keys, np.arange(self.n + 1) * self.n)
         self._template = csc_matrix((np.zeros(self.keys.size), indices, indptr), shape=(self.n, self.n))
-        self.indices, self.indptr = self._template.indices, self._template.indptr   # scipy's index dtype
-        self.indices.flags.writeable = self.indptr.flags.writeable = False          # shared by every K
+        self.indices, self.indptr = self._template.indices, self._template.indptr  # scipy's index dtype
+        self.indices.flags.writeable = self.indptr.flags.writeable = False  # shared by every K
         self.diag_pos = np.searchsorted(self.keys, diag)
         n_free = self.n if self.free is None else len(self.free)
-        if self.requested == "banded" or (self.requested == "auto" and (n_free < BOUND_MIN or not band_too_wide(
-                self.indptr, self.indices, self.n, self.free, BANDED_WORK))):
+        if self.requested == "banded" or (
+            self.requested == "auto"
+            and (n_free < BOUND_MIN or not band_too_wide(self.indptr, self.indices, self.n, self.free, BANDED_WORK))
+        ):
             self.plan = BandPlan(self.indptr, self.indices, self.n, self.free)
-        else:                                       # no plan where the band cannot be chosen
+        else:  # no plan where the band cannot be chosen
             self.plan = None
         if self.requested in ("auto", "banded"):
             self.kind = choose_linear_algebra(self.n, self.requested, self.plan)
-        self.dissection = (DissectionPlan(self.indptr, self.indices, self.n, self.free)
-                           if self.kind == "sparse" and n_free >= DISSECTION_MIN else None)
+        self.dissection = (
+            DissectionPlan(self.indptr, self.indices, self.n, self.free)
+            if self.kind == "sparse" and n_free >= DISSECTION_MIN
+            else None
+        )
         self._cache.clear()
         self.pattern_builds += 1
-        return where[old.size:]
+        return where[old.size :]
 
     def _positions(self, rows, cols, offset, key):
         """Index of each (row + offset, col + offset) in the pattern, growing it if need be."""
@@ -147,7 +152,7 @@ class TangentAssembler:
                 return hit[2]
         keys = _keys(rows, cols, offset, self.n)
         pos = np.searchsorted(self.keys, keys)
-        if keys.size and (self._ends[pos] != keys).any():       # (_ends: keys and one beyond the last)
+        if keys.size and (self._ends[pos] != keys).any():  # (_ends: keys and one beyond the last)
             pos = self._grow(keys)
         if key is not None:
             self._cache[key] = (rows, cols, pos)
@@ -183,32 +188,35 @@ class TangentAssembler:
             self.used["dense"] = DENSE_ORDERING
             index = [self._flat(r, c, o, key) for r, c, _, o, key in blocks]
             vals = [v for _, _, v, _, _ in blocks]
-            if diagonal is not None:              # the diagonal last: summed after the blocks, as K + diag
+            if diagonal is not None:  # the diagonal last: summed after the blocks, as K + diag
                 index.append(self._flat(None, None, 0, "diagonal"))
                 vals.append(diagonal)
-            K = np.bincount(np.concatenate(index or [np.zeros(0, int)]), np.concatenate(vals or [np.zeros(0)]),
-                            minlength=n * n).reshape(n, n)
+            K = np.bincount(
+                np.concatenate(index or [np.zeros(0, int)]), np.concatenate(vals or [np.zeros(0)]), minlength=n * n
+            ).reshape(n, n)
             return K
-        if self.keys is None:                     # the first assembly: the whole pattern at once
+        if self.keys is None:  # the first assembly: the whole pattern at once
             keys = [_keys(r, c, o, n) for r, c, _, o, _ in blocks]
-            pos = np.split(self._grow(np.concatenate(keys + [np.zeros(0, np.int64)])),
-                           np.cumsum([k.size for k in keys])[:-1])
+            pos = np.split(
+                self._grow(np.concatenate(keys + [np.zeros(0, np.int64)])), np.cumsum([k.size for k in keys])[:-1]
+            )
             for (r, c, _, _, key), p in zip(blocks, pos):
                 if key is not None:
                     self._cache[key] = (r, c, p)
         else:
-            for _ in range(2):                    # a grown pattern voids positions found before it
+            for _ in range(2):  # a grown pattern voids positions found before it
                 builds = self.pattern_builds
                 pos = [self._positions(r, c, o, key) for r, c, _, o, key in blocks]
                 if self.pattern_builds == builds:
                     break
         vals = [v for _, _, v, _, _ in blocks]
-        if diagonal is not None:                  # the diagonal last: summed after the blocks, as K + diag
+        if diagonal is not None:  # the diagonal last: summed after the blocks, as K + diag
             pos.append(self.diag_pos)
             vals.append(diagonal)
-        data = np.bincount(np.concatenate(pos or [np.zeros(0, int)]), np.concatenate(vals or [np.zeros(0)]),
-                           minlength=self.keys.size)
-        K = shallow_copy(self._template)          # shares the pattern's index arrays (docstring)
+        data = np.bincount(
+            np.concatenate(pos or [np.zeros(0, int)]), np.concatenate(vals or [np.zeros(0)]), minlength=self.keys.size
+        )
+        K = shallow_copy(self._template)  # shares the pattern's index arrays (docstring)
         K.data = data
         if self.kind == "banded":
             K.band_plan = self.banded_plan = self.plan

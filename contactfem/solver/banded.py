@@ -67,11 +67,11 @@ def band_too_wide(indptr, indices, n, free=None, work=BANDED_WORK):
     free = np.arange(n) if free is None else np.asarray(free)
     if free.size < 2:
         return False
-    seen = np.ones(n, dtype=bool)                   # fixed dofs are never entered
+    seen = np.ones(n, dtype=bool)  # fixed dofs are never entered
     seen[free] = False
     frontier = free[:1]
     seen[frontier] = True
-    last = np.zeros(n, dtype=np.int64)              # to keep one of repeated neighbours
+    last = np.zeros(n, dtype=np.int64)  # to keep one of repeated neighbours
     reached, level, b = 1, 0, 0.0
     while frontier.size:
         start, count = indptr[frontier], indptr[frontier + 1] - indptr[frontier]
@@ -84,11 +84,11 @@ def band_too_wide(indptr, indices, n, free=None, work=BANDED_WORK):
         level += 1
         reached += frontier.size
         b = max(b, (reached - 1) / (2 * level))
-        if 2.0 * np.ceil(b) ** 2 > work:            # the bound only grows: no need to search on
+        if 2.0 * np.ceil(b) ** 2 > work:  # the bound only grows: no need to search on
             break
     if 2.0 * np.ceil(b) ** 2 <= work:
         return False
-    import scipy.sparse as sp                       # structural symmetry: the pattern equals its transpose
+    import scipy.sparse as sp  # structural symmetry: the pattern equals its transpose
 
     t = sp.csr_matrix((np.ones(len(indices)), indices, indptr), shape=(n, n)).tocsc()
     return bool(np.array_equal(t.indptr, indptr) and np.array_equal(t.indices, indices))
@@ -106,7 +106,7 @@ class BandPlan:
         rows = np.asarray(indices, dtype=np.int64)
         cols = np.repeat(np.arange(n), np.diff(indptr))
         if free is None:
-            self.take, m = None, n                             # every stored entry
+            self.take, m = None, n  # every stored entry
         else:
             local = np.full(n, -1)
             local[free] = np.arange(len(free))
@@ -147,8 +147,9 @@ class BandPlan:
         Raises RuntimeError on an exactly singular matrix (a zero pivot), like SuperLU."""
         band = np.zeros((self.n, self.ldab))
         band.ravel()[self.slot] = data if self.take is None else data[self.take]
-        _, _, x, info = lapack_dgbsv()(self.kl, self.ku, band.T, np.asarray(b, dtype=float)[self.perm],
-                                       overwrite_ab=True, overwrite_b=True)
+        _, _, x, info = lapack_dgbsv()(
+            self.kl, self.ku, band.T, np.asarray(b, dtype=float)[self.perm], overwrite_ab=True, overwrite_b=True
+        )
         if info > 0:
             raise RuntimeError(f"Factor is exactly singular (banded LU: zero pivot U({info}, {info}))")
         if info < 0:

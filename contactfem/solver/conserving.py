@@ -39,6 +39,7 @@ Newton's tangent is exact: 2 M D / dt^2 (D = d dq / d u_1, 1 + phi^2 / 4 on an a
 bodies' tangents of their discrete gradients, plus X times the contacts' and loads' tangents
 with the derivative of X on the diagonal.
 """
+
 import numpy as np
 
 from ..bodies.discrete_gradient import cayley
@@ -50,20 +51,26 @@ class EnergyConsistent:
     """Energy-consistent implicit stepper (module docstring) of a System whose contacts are
     built with ``integration="energy_consistent"`` and whose bodies are hyperelastic.
     ``newton_options`` go to ``newton``."""
+
     dynamic = True
 
     def __init__(self, system, **newton_options):
         self.system, self.newton_options = system, newton_options
-        self.rotations = np.concatenate([system.offset(b) + np.asarray(b.rotation_dofs, dtype=int)
-                                         for b in system.bodies] + [np.zeros(0, int)])
+        self.rotations = np.concatenate(
+            [system.offset(b) + np.asarray(b.rotation_dofs, dtype=int) for b in system.bodies] + [np.zeros(0, int)]
+        )
         for c in system.contacts:
             if c.integration != "energy_consistent":
-                raise ValueError(f"contact {c.name!r}: energy-consistent time stepping needs contacts built with "
-                                 "integration='energy_consistent'")
+                raise ValueError(
+                    f"contact {c.name!r}: energy-consistent time stepping needs contacts built with "
+                    "integration='energy_consistent'"
+                )
         for b in system.bodies:
             if not b.hyperelastic:
-                raise ValueError(f"body {b.name!r}: energy-consistent integration needs hyperelastic bodies "
-                                 "(use contact_integration=standard for the viscoplastic ring)")
+                raise ValueError(
+                    f"body {b.name!r}: energy-consistent integration needs hyperelastic bodies "
+                    "(use contact_integration=standard for the viscoplastic ring)"
+                )
 
     def _bodies(self, u0, u1):
         """Every body's discrete gradient (its ``discrete_gradient``) placed in the global vector,
@@ -86,11 +93,12 @@ class EnergyConsistent:
         assert dt > 0, "a step's size comes from its Schedule, which checks it"
         s = self.system
         t1, tm = t + dt, t + 0.5 * dt
-        M = s.mass()                        # lumped (a vector) or consistent (a sparse matrix)
-        c_mass = 2.0 / dt ** 2
+        M = s.mass()  # lumped (a vector) or consistent (a sparse matrix)
+        c_mass = 2.0 / dt**2
 
-        def inertia(D):                     # d (c_mass M (dq - dt v)) / d u1 = c_mass M diag(D)
+        def inertia(D):  # d (c_mass M (dq - dt v)) / d u1 = c_mass M diag(D)
             return sp.diags(c_mass * M * D) if isinstance(M, np.ndarray) else c_mass * (M @ sp.diags(D))
+
         rot = self.rotations
 
         def fun(u1):
@@ -107,7 +115,11 @@ class EnergyConsistent:
                 Rc, r, c, vv = cs.scatter(s.ndof)
                 states.append(cs)
                 Gc += Rc
-                rows_c.append(np.asarray(r, int)), cols_c.append(np.asarray(c, int)), vals_c.append(np.asarray(vv, float))
+                (
+                    rows_c.append(np.asarray(r, int)),
+                    cols_c.append(np.asarray(c, int)),
+                    vals_c.append(np.asarray(vv, float)),
+                )
             Pm = np.zeros(s.ndof)
             for load, ls in zip(s.loads, state.loads):
                 P, r, c, vv = load.assemble(um, tm, ls, offsets=s.offsets)
@@ -121,15 +133,23 @@ class EnergyConsistent:
             vals += [vv * chord[r] for r, vv in zip(rows_c, vals_c)] + [dchord * Gc[rot]]
             ma = s.mass_times(c_mass * (dq - dt * v))
             G += ma
-            K = sp.coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                              shape=(s.ndof, s.ndof)).tocsr() + inertia(D)
+            K = sp.coo_matrix(
+                (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(s.ndof, s.ndof)
+            ).tocsr() + inertia(D)
             return Evaluation(G, K, tuple(states), Pm, state, ma)
 
-        guess = s.apply_dirichlet(u + dt * v + 0.5 * dt ** 2 * a, t1)
-        result = newton(fun, guess, s.free_dofs, instrument=s.instrument, label=label or f"t = {t1:.6g}, dt = {dt:.3g}",
-                        start=u, **self.newton_options)
+        guess = s.apply_dirichlet(u + dt * v + 0.5 * dt**2 * a, t1)
+        result = newton(
+            fun,
+            guess,
+            s.free_dofs,
+            instrument=s.instrument,
+            label=label or f"t = {t1:.6g}, dt = {dt:.3g}",
+            start=u,
+            **self.newton_options,
+        )
         u1 = result.u
-        result.evaluation = result.evaluation._replace(P=s.external_force(u1, t1, state))   # the loads' work
+        result.evaluation = result.evaluation._replace(P=s.external_force(u1, t1, state))  # the loads' work
         v1 = 2.0 * cayley(u1 - u, rot)[0] / dt - v
         a1 = (v1 - v) / dt
         return u1, v1, a1, result

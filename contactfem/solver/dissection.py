@@ -26,7 +26,7 @@ import numpy as np
 
 from .banded import BandPlan
 
-DISSECTION_MIN = 10_000        # free unknowns from which the sparse path is renumbered by METIS
+DISSECTION_MIN = 10_000  # free unknowns from which the sparse path is renumbered by METIS
 
 
 def supervariables(indptr, indices, m):
@@ -34,16 +34,16 @@ def supervariables(indptr, indices, m):
     row indices sharing one (numbered in order of their first column); and its count."""
     count = np.diff(indptr)
     col = np.repeat(np.arange(m), count)
-    weight = np.random.default_rng(12345).random(m)         # a hash of each column's rows
+    weight = np.random.default_rng(12345).random(m)  # a hash of each column's rows
     h = np.bincount(col, weight[indices], minlength=m) + count
-    first = np.r_[True, h[1:] != h[:-1]]                    # merge only neighbouring columns
+    first = np.r_[True, h[1:] != h[:-1]]  # merge only neighbouring columns
     sv = np.cumsum(first) - 1
-    rep = np.flatnonzero(first)[sv]                         # each column's first column
+    rep = np.flatnonzero(first)[sv]  # each column's first column
     same = count == count[rep]
-    at = np.repeat(indptr[rep] - indptr[:-1], count) + np.arange(indices.size)   # the same place in rep's column
+    at = np.repeat(indptr[rep] - indptr[:-1], count) + np.arange(indices.size)  # the same place in rep's column
     check = same[col]
     same[col[check & (indices[np.where(check, at, 0)] != indices)]] = False
-    if not same.all():                                      # a hash collision (never seen): no merging
+    if not same.all():  # a hash collision (never seen): no merging
         sv = np.arange(m)
     return sv, int(sv[-1]) + 1 if m else 0
 
@@ -61,13 +61,13 @@ class DissectionPlan:
         cols = np.repeat(np.arange(n), np.diff(indptr))
         entry = np.arange(rows.size)
         m = n
-        if free is not None:             # the block: its entries keep the CSC order (free is ascending)
+        if free is not None:  # the block: its entries keep the CSC order (free is ascending)
             local = np.full(n, -1)
             local[free] = np.arange(len(free))
             inside = (local[rows] >= 0) & (local[cols] >= 0)
             entry, m = entry[inside], len(free)
             rows, cols = local[rows[inside]], local[cols[inside]]
-            if np.any(np.diff(free) <= 0):                       # free not ascending: back to CSC order
+            if np.any(np.diff(free) <= 0):  # free not ascending: back to CSC order
                 o = np.lexsort((rows, cols))
                 rows, cols, entry = rows[o], cols[o], entry[o]
         self.n = m
@@ -80,11 +80,12 @@ class DissectionPlan:
         edge = rep[rows] & rep[cols] & (rows != cols)
         a, c = sv[rows[edge]], sv[cols[edge]]
         graph = sp.csr_matrix((np.ones(2 * a.size), (np.r_[a, c], np.r_[c, a])), shape=(k, k))
-        order = pymetis.nested_dissection(pymetis.CSRAdjacency(graph.indptr, graph.indices),
-                                          vweights=np.bincount(sv, minlength=k))[0]
+        order = pymetis.nested_dissection(
+            pymetis.CSRAdjacency(graph.indptr, graph.indices), vweights=np.bincount(sv, minlength=k)
+        )[0]
         place = np.empty(k, dtype=np.int64)
         place[np.asarray(order)] = np.arange(k)
-        self.perm = np.lexsort((np.arange(m), place[sv]))        # new -> old: a supervariable's dofs together
+        self.perm = np.lexsort((np.arange(m), place[sv]))  # new -> old: a supervariable's dofs together
         new = np.empty(m, dtype=np.int64)
         new[self.perm] = np.arange(m)
         # the renumbered block's CSC arrays, and the stored entry each of its entries takes: its

@@ -12,11 +12,12 @@ and the steppers hand the instrument to Newton, which times its linear solves an
 Without an instrument (the default) nothing is timed. CPU time of the running thread:
 OpenBLAS's idle worker threads, spinning on another core after a library call, do not count.
 """
+
 import time
 from contextlib import nullcontext
 
 PARTS = ("bulk", "contact", "assembly", "solve", "newton")
-NOT_TIMED = nullcontext()          # what an uninstrumented part enters (reusable, does nothing)
+NOT_TIMED = nullcontext()  # what an uninstrumented part enters (reusable, does nothing)
 
 
 class Timings:
@@ -30,7 +31,7 @@ class Timings:
         self.seconds = dict.fromkeys(PARTS, 0.0)
         self.outside = dict.fromkeys(PARTS, 0.0)
         self.solves = 0
-        self._newton = 0                # depth of Newton solves in progress
+        self._newton = 0  # depth of Newton solves in progress
         self._parts = {name: _Part(self, name) for name in PARTS}
 
     def part(self, name):
@@ -49,7 +50,7 @@ class _Part:
     def __enter__(self):
         t = self.timings
         t._newton += self.name == "newton"
-        self.starts.append(t.clock())          # a stack: a part may be entered again inside itself
+        self.starts.append(t.clock())  # a stack: a part may be entered again inside itself
 
     def __exit__(self, *exc):
         t = self.timings

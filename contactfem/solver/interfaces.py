@@ -2,6 +2,7 @@
 
 ``typing.Protocol`` classes: any object with these members is one.
 """
+
 from typing import Protocol, runtime_checkable
 
 import numpy as np
@@ -11,11 +12,12 @@ import numpy as np
 class Stepper(Protocol):
     """One step of a time integrator (newmark.py, conserving.py, uzawa.py, staggered.py)."""
 
-    system: object              # the System it steps
-    dynamic: bool               # inertia (v, a) or quasi-static
+    system: object  # the System it steps
+    dynamic: bool  # inertia (v, a) or quasi-static
 
-    def step(self, t: float, u: np.ndarray, v: np.ndarray, a: np.ndarray, dt: float, label: str = "", *,
-             state: object) -> tuple:
+    def step(
+        self, t: float, u: np.ndarray, v: np.ndarray, a: np.ndarray, dt: float, label: str = "", *, state: object
+    ) -> tuple:
         """(u1, v1, a1, result) of the step of size dt from the converged (t, u, v, a) with the
         committed SystemState ``state``; commits nothing; ``result.evaluation`` is the System's
         converged evaluation, ``result.G`` the residual whose prescribed-dof part are the
@@ -27,18 +29,18 @@ class ImplicitStepper(Stepper, Protocol):
     """A stepper whose step equation others solve differently (the staggered algorithm,
     staggered.py, reads Newmark's constants; the Uzawa loop, uzawa.py, its Newton options)."""
 
-    beta: float                 # Newmark's beta (and delta): the step equation's constants
+    beta: float  # Newmark's beta (and delta): the step equation's constants
     delta: float
-    newton_options: dict        # atol, rtol, maxit, ... of its Newton solves
+    newton_options: dict  # atol, rtol, maxit, ... of its Newton solves
 
 
 @runtime_checkable
 class Schedule(Protocol):
     """The step sizes of a march (schedule.py)."""
 
-    dt: float                   # the size the initial state is evaluated with
+    dt: float  # the size the initial state is evaluated with
     t_end: float
-    n_steps: object             # int, or None when not known beforehand
+    n_steps: object  # int, or None when not known beforehand
 
     def next_dt(self, record) -> object:
         """The size of the step after this record, or None when the run is over."""

@@ -20,6 +20,7 @@ The schedule (schedule.py) decides the step sizes: fixed steps, or an adaptive r
 the last record, with the halving of a failed step; the scene decides when to stop, by
 leaving the loop. ``integrate`` collects a march into a ``History`` of arrays.
 """
+
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -43,6 +44,7 @@ class Record:
     state           the SystemState after the step (solver/system.py): what the next step
                     starts from
     """
+
     k: int
     t: float
     dt: float
@@ -93,7 +95,11 @@ def resume(stepper, schedule, record, *, label=None):
         while (dt := schedule.next_dt(rec)) is not None:
             cuts, failures = 0, []
             while True:
-                name = label(rec.k + 1, rec.t + dt, dt) if label else f"step {rec.k + 1}, t = {rec.t + dt:.6g}, dt = {dt:.3g}"
+                name = (
+                    label(rec.k + 1, rec.t + dt, dt)
+                    if label
+                    else f"step {rec.k + 1}, t = {rec.t + dt:.6g}, dt = {dt:.3g}"
+                )
                 try:
                     trial = stepper.step(rec.t, rec.u, rec.v, rec.a, dt, name, state=rec.state)
                     break
@@ -106,7 +112,7 @@ def resume(stepper, schedule, record, *, label=None):
                     dt, cuts = smaller, cuts + 1
             rec = accept(stepper.system, rec, schedule.end_time(rec.t, dt), dt, trial, cuts, failures)
             yield rec
-    except KeyboardInterrupt as interrupt:         # Ctrl-C: say where (the innermost loop names it)
+    except KeyboardInterrupt as interrupt:  # Ctrl-C: say where (the innermost loop names it)
         if not hasattr(interrupt, "step"):
             interrupt.t, interrupt.step, interrupt.n_steps = rec.t, rec.k + 1, schedule.n_steps
         raise
@@ -146,8 +152,20 @@ def accept(system, rec, t1, dt, trial, cuts=0, failures=()):
     if getattr(result, "carry", None) is not None:  # what the stepper hands to its next step
         state = replace(state, stepper=result.carry)
     energy = dict(system.energies(u1, v1, ev, dt, state), dissipation=dissipation, external_work=float(work))
-    return Record(k=rec.k + 1, t=t1, dt=dt, u=u1, v=v1, a=a1, evaluation=ev, energy=energy, result=result,
-                  cuts=cuts, failures=tuple(failures), state=state)
+    return Record(
+        k=rec.k + 1,
+        t=t1,
+        dt=dt,
+        u=u1,
+        v=v1,
+        a=a1,
+        evaluation=ev,
+        energy=energy,
+        result=result,
+        cuts=cuts,
+        failures=tuple(failures),
+        state=state,
+    )
 
 
 def acceleration(system, G):
@@ -188,6 +206,7 @@ def watch(records, progress, t0, t_end, name):
 class History:
     """A march collected into arrays (``integrate``): one entry per record, entry 0 the
     initial state. ``records`` keeps the records themselves."""
+
     t: np.ndarray | None = None
     dt: np.ndarray | None = None
     iterations: np.ndarray | None = None
@@ -222,8 +241,23 @@ class History:
         return h
 
 
-def integrate(stepper, t0, u0, v0=None, n_steps=None, t_end=None, *, dt, cutback=False, max_cuts=4, min_dt=None,
-              a0=None, progress=None, label=None, name=None):
+def integrate(
+    stepper,
+    t0,
+    u0,
+    v0=None,
+    n_steps=None,
+    t_end=None,
+    *,
+    dt,
+    cutback=False,
+    max_cuts=4,
+    min_dt=None,
+    a0=None,
+    progress=None,
+    label=None,
+    name=None,
+):
     """March over n_steps steps of dt, or up to t_end, and collect the records into a History
     (a convenience over ``march`` with a fixed schedule, ``Steps``). With ``cutback``, a step
     whose Newton fails is halved (up to ``max_cuts`` times, never below ``min_dt``) and the
@@ -232,8 +266,13 @@ def integrate(stepper, t0, u0, v0=None, n_steps=None, t_end=None, *, dt, cutback
     schedule = Steps(dt, n_steps=n_steps, t_end=t_end, t0=t0, max_cuts=max_cuts if cutback else 0, min_dt=min_dt)
     records = []
     try:
-        for rec in watch(march(stepper, schedule, t0, u0, v0, a0=a0, label=label), progress, t0, schedule.t_end,
-                         name or type(stepper).__name__):
+        for rec in watch(
+            march(stepper, schedule, t0, u0, v0, a0=a0, label=label),
+            progress,
+            t0,
+            schedule.t_end,
+            name or type(stepper).__name__,
+        ):
             records.append(rec)
     except NewtonError as err:
         err.partial = History.of(records) if records else None

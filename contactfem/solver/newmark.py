@@ -25,6 +25,7 @@ The unknowns a contact owns (Lagrange multipliers, system.py) are not motions: N
 starts them from their last converged values and they get no velocity or acceleration
 (``system.contact_dofs``; none in a penalty model, where nothing of this changes).
 """
+
 import warnings
 
 import numpy as np
@@ -53,18 +54,23 @@ class Newmark:
 
     ``newton_options`` (atol, rtol, ctol, maxit) are passed on to ``newton``.
     """
+
     dynamic = True
 
     def __init__(self, system, delta=0.7, beta=0.4, **newton_options):
         require("delta", delta, **DELTA_RANGE)
         require("beta", beta, **BETA_RANGE)
         if beta < (delta + 0.5) ** 2 / 4:
-            warnings.warn(f"Newmark delta={delta}, beta={beta} is not unconditionally stable "
-                          "(needs beta >= (delta + 1/2)^2 / 4)", stacklevel=2)
+            warnings.warn(
+                f"Newmark delta={delta}, beta={beta} is not unconditionally stable (needs beta >= (delta + 1/2)^2 / 4)",
+                stacklevel=2,
+            )
         for contact in system.contacts:
             if contact.integration != "standard":
-                raise ValueError(f"contact {contact.name!r} is built for {contact.integration} integration: "
-                                 "step it with EnergyConsistent, not Newmark")
+                raise ValueError(
+                    f"contact {contact.name!r} is built for {contact.integration} integration: "
+                    "step it with EnergyConsistent, not Newmark"
+                )
         self.system, self.delta, self.beta = system, delta, beta
         self.newton_options = newton_options
 
@@ -72,23 +78,30 @@ class Newmark:
         assert dt > 0, SIZE_CHECKED
         s, beta, delta = self.system, self.beta, self.delta
         t1 = t + dt
-        c = 1.0 / (beta * dt ** 2)
-        cM = c * s.mass()                     # the step's constants: c M and the predictor
-        lumped = isinstance(cM, np.ndarray)   # a diagonal (ndof,), else a sparse consistent M
-        u_pred = u + dt * v + dt ** 2 * (0.5 - beta) * a
+        c = 1.0 / (beta * dt**2)
+        cM = c * s.mass()  # the step's constants: c M and the predictor
+        lumped = isinstance(cM, np.ndarray)  # a diagonal (ndof,), else a sparse consistent M
+        u_pred = u + dt * v + dt**2 * (0.5 - beta) * a
 
-        def effective(u1):                    # eq 29 with a+ = c (u1 - u_pred); tangent K + c M
+        def effective(u1):  # eq 29 with a+ = c (u1 - u_pred); tangent K + c M
             ev = s.evaluate(u1, t1, dt, u, mass_coefficient=c, state=state)
             du = u1 - u_pred
             inertia = cM * du if lumped else cM @ du
             return ev._replace(G=ev.G + inertia, inertia=inertia)
 
         # initial guess: the acceleration stays a (u + dt v + dt^2 a / 2); multipliers as they were
-        guess = s.apply_dirichlet(u_pred + beta * dt ** 2 * a, t1)
+        guess = s.apply_dirichlet(u_pred + beta * dt**2 * a, t1)
         own = s.contact_dofs
         guess[own] = u[own]
-        result = newton(effective, guess, s.free_dofs, instrument=s.instrument, start=u,
-                        label=label or f"t = {t1:.6g}, dt = {dt:.3g}", **self.newton_options)
+        result = newton(
+            effective,
+            guess,
+            s.free_dofs,
+            instrument=s.instrument,
+            start=u,
+            label=label or f"t = {t1:.6g}, dt = {dt:.3g}",
+            **self.newton_options,
+        )
         u1 = result.u
         a1 = c * (u1 - u_pred)
         v1 = v + dt * ((1 - delta) * a + delta * a1)
@@ -101,6 +114,7 @@ class Static:
 
     ``dt`` of a step is the pseudo-time increment of load stepping; v and a are returned as 0.
     """
+
     dynamic = False
 
     def __init__(self, system, **newton_options):
@@ -109,9 +123,15 @@ class Static:
     def step(self, t, u, v, a, dt, label="", *, state):
         assert dt > 0, SIZE_CHECKED
         s, t1 = self.system, t + dt
-        result = newton(lambda w: s.evaluate(w, t1, dt, u, state=state), s.apply_dirichlet(u, t1),
-                        s.free_dofs, instrument=s.instrument, label=label or f"t = {t1:.6g}", start=u,
-                        **self.newton_options)
+        result = newton(
+            lambda w: s.evaluate(w, t1, dt, u, state=state),
+            s.apply_dirichlet(u, t1),
+            s.free_dofs,
+            instrument=s.instrument,
+            label=label or f"t = {t1:.6g}",
+            start=u,
+            **self.newton_options,
+        )
         zero = np.zeros(s.ndof)
         return result.u, zero, zero.copy(), result
 
@@ -126,6 +146,7 @@ class CentralDifference:
     Conditionally stable: dt < 2 / omega_max. Prescribed dofs: v+ = (u+ - u) / dt, a+ = 0.
     (The tangent is assembled but unused; fine for the small problems here.)
     """
+
     dynamic = True
 
     def __init__(self, system):
@@ -136,7 +157,7 @@ class CentralDifference:
     def step(self, t, u, v, a, dt, label="", *, state):
         assert dt > 0, SIZE_CHECKED
         s, t1 = self.system, t + dt
-        u1 = s.apply_dirichlet(u + dt * v + 0.5 * dt ** 2 * a, t1)
+        u1 = s.apply_dirichlet(u + dt * v + 0.5 * dt**2 * a, t1)
         ev = s.evaluate(u1, t1, dt, u, state=state)
         a1 = acceleration(s, ev.G)
         v1 = v + 0.5 * dt * (a + a1)
@@ -144,5 +165,9 @@ class CentralDifference:
         if not (np.all(np.isfinite(u1)) and np.all(np.isfinite(a1))):
             raise NewtonError(f"explicit step gave NaN/inf ({label or f't = {t1:.6g}'})", [], label)
         G = ev.G + s.mass_times(a1)
-        return u1, v1, a1, NewtonResult(u=u1, residuals=[], iterations=0, G=G, evaluation=ev._replace(G=G),
-                                        evaluations=1)
+        return (
+            u1,
+            v1,
+            a1,
+            NewtonResult(u=u1, residuals=[], iterations=0, G=G, evaluation=ev._replace(G=G), evaluations=1),
+        )

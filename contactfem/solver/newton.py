@@ -45,6 +45,7 @@ Failures raise NewtonError: maxit reached, NaN/inf residual or correction, singu
 tangent, or a FloatingPointError raised by fun (the bodies' InvertedElementError and
 the contact's ReturnMapError derive from it), so a driver can cut the step back.
 """
+
 import math
 from dataclasses import dataclass, field
 
@@ -57,7 +58,7 @@ from .instrument import timed
 # ordering of A^T + A fills in less than scipy's default COLAMD: 1.6-2x faster
 # factorisations from 1e3 to 1e5 unknowns (BENCHMARKS.md, `contactfem bench`).
 ORDERING = "MMD_AT_PLUS_A"
-DENSE_ORDERING = "natural (LAPACK LU, partial pivoting)"   # what a dense K gets
+DENSE_ORDERING = "natural (LAPACK LU, partial pivoting)"  # what a dense K gets
 
 
 def solve_free(K, b, free, all_free):
@@ -68,7 +69,7 @@ def solve_free(K, b, free, all_free):
         Kff = K if all_free else K[np.ix_(free, free)]
         try:
             return np.linalg.solve(Kff, b)
-        except np.linalg.LinAlgError as err:           # "Singular matrix"
+        except np.linalg.LinAlgError as err:  # "Singular matrix"
             raise RuntimeError(f"Factor is exactly singular ({err})") from None
     plan = getattr(K, "band_plan", None) or getattr(K, "dissection_plan", None)
     if plan is not None and plan.fits(K, None if all_free else free):
@@ -96,29 +97,29 @@ class NewtonError(RuntimeError):
 
 @dataclass
 class NewtonResult:
-    u: np.ndarray                                 # the converged solution
+    u: np.ndarray  # the converged solution
     residuals: list = field(default_factory=list)  # ||G|| of every iterate, first = initial guess
-    iterations: int = 0                           # number of linear solves
-    G: np.ndarray | None = None                          # full residual at u (its fixed-dof part = reactions)
-    evaluation: object = None                     # what fun returned at u (G, K, contact states, ...)
-    evaluations: int = 0                          # calls of fun (residuals + line-search trials)
-    force_scale: float = 0.0                      # F at u (module docstring)
-    residual_ratio: float = 0.0                   # (max |G_f| - atol)+ / F at u: what the test accepted above atol
-    correction_ratio: float = 0.0                 # the last correction / the step's increment (0 at k = 0)
-    ratios: list = field(default_factory=list)    # max |G_f| / F of every iterate
-    local_error: float | None = None              # a time stepper's estimate of the step's error (schedule.Estimated)
-    carry: object = None                          # what the stepper hands to its next step (SystemState.stepper)
-    error_share: float | None = None              # the error its share allows a step of its size (schedule.Estimated)
+    iterations: int = 0  # number of linear solves
+    G: np.ndarray | None = None  # full residual at u (its fixed-dof part = reactions)
+    evaluation: object = None  # what fun returned at u (G, K, contact states, ...)
+    evaluations: int = 0  # calls of fun (residuals + line-search trials)
+    force_scale: float = 0.0  # F at u (module docstring)
+    residual_ratio: float = 0.0  # (max |G_f| - atol)+ / F at u: what the test accepted above atol
+    correction_ratio: float = 0.0  # the last correction / the step's increment (0 at k = 0)
+    ratios: list = field(default_factory=list)  # max |G_f| / F of every iterate
+    local_error: float | None = None  # a time stepper's estimate of the step's error (schedule.Estimated)
+    carry: object = None  # what the stepper hands to its next step (SystemState.stepper)
+    error_share: float | None = None  # the error its share allows a step of its size (schedule.Estimated)
 
 
 # The default tolerances of the convergence test (module docstring; BENCHMARKS.md argues them)
-RTOL = 1e-8            # the largest residual over the step's force scale
-CTOL = 1e-6            # the largest correction over the step's largest increment
-ROUNDOFF = 1e3 * np.finfo(float).eps   # a correction below this times max |u| is at u's round-off
-ROUNDOFF_RTOL = 1e-6   # accepted when the corrections are at u's round-off: Newton can do no better
-NEGLIGIBLE = 1e-3      # a residual this far below its tolerance: the iterate's own error (K^-1 G) is negligible
-                       # whatever the last correction was; one more iteration could only flip a contact
-                       # node sitting at g_N = 0 (and cycle: a disc on a polyline wall did)
+RTOL = 1e-8  # the largest residual over the step's force scale
+CTOL = 1e-6  # the largest correction over the step's largest increment
+ROUNDOFF = 1e3 * np.finfo(float).eps  # a correction below this times max |u| is at u's round-off
+ROUNDOFF_RTOL = 1e-6  # accepted when the corrections are at u's round-off: Newton can do no better
+NEGLIGIBLE = 1e-3  # a residual this far below its tolerance: the iterate's own error (K^-1 G) is negligible
+# whatever the last correction was; one more iteration could only flip a contact
+# node sitting at g_N = 0 (and cycle: a disc on a polyline wall did)
 
 
 def force_scale(evaluation, free):
@@ -142,8 +143,9 @@ def force_scale(evaluation, free):
     return F
 
 
-def newton(fun, u0, free, atol=1e-12, rtol=RTOL, maxit=25, label="", line_search=0, instrument=None, ctol=CTOL,
-           start=None):
+def newton(
+    fun, u0, free, atol=1e-12, rtol=RTOL, maxit=25, label="", line_search=0, instrument=None, ctol=CTOL, start=None
+):
     """Full Newton method: K_ff du_f = -G_f, u_f += du_f, until converged.
 
     Parameters
@@ -187,7 +189,7 @@ def _newton(fun, u0, free, atol, rtol, maxit, label, line_search, instrument, ct
     all_free = len(free) == len(u) and bool((free == np.arange(len(u))).all())
     if int(line_search) != line_search or line_search < 0:
         raise ValueError(f"parameter line_search = {line_search} is out of range: allowed integers [0, inf)")
-    history, largest, ratios = [], [], []             # ||G_f||, max |G_f| and max |G_f| / F of every iterate
+    history, largest, ratios = [], [], []  # ||G_f||, max |G_f| and max |G_f| / F of every iterate
     calls = 0
     u_start = (u if start is None else np.asarray(start, dtype=float))[free]
     du, tol, F = None, atol, 0.0
@@ -197,17 +199,16 @@ def _newton(fun, u0, free, atol, rtol, maxit, label, line_search, instrument, ct
         calls += 1
         try:
             return fun(v)
-        except FloatingPointError as err:             # inverted element, failed return map
-            raise NewtonError(f"Newton: {type(err).__name__} at iteration {k}{where}: {err}",
-                              history, label) from err
+        except FloatingPointError as err:  # inverted element, failed return map
+            raise NewtonError(f"Newton: {type(err).__name__} at iteration {k}{where}: {err}", history, label) from err
 
-    evaluated = None                                  # fun's value at u from the line search
+    evaluated = None  # fun's value at u from the line search
     for k in range(maxit + 1):
         out = evaluated if evaluated is not None else evaluate(u, k)
         evaluated = None
         G = out[0]
         G_f = G if all_free else G[free]
-        r = math.sqrt(G_f.dot(G_f))                   # ||G_f|| (as np.linalg.norm computes it)
+        r = math.sqrt(G_f.dot(G_f))  # ||G_f|| (as np.linalg.norm computes it)
         if not math.isfinite(r):
             raise NewtonError(f"Newton: non-finite residual at iteration {k}{where}", history, label)
         history.append(r)
@@ -217,24 +218,31 @@ def _newton(fun, u0, free, atol, rtol, maxit, label, line_search, instrument, ct
         tol = atol + rtol * F
         ratios.append(r_max / F if F > 0 else (0.0 if r_max == 0 else math.inf))
         c_ratio = _correction(du, u[free], u_start)
-        stalled = _at_roundoff(du, u[free])           # the corrections no longer move u
+        stalled = _at_roundoff(du, u[free])  # the corrections no longer move u
         if r_max <= tol or (stalled and r_max <= atol + max(rtol, ROUNDOFF_RTOL) * F):
             if k == 0 or r_max <= atol or r_max <= NEGLIGIBLE * tol or c_ratio <= ctol or stalled:
-                return NewtonResult(u=u, residuals=history, iterations=k, G=G, evaluation=out, evaluations=calls,
-                                    force_scale=F, residual_ratio=max(r_max - atol, 0.0) / F if F > 0 else 0.0,
-                                    correction_ratio=c_ratio if k else 0.0, ratios=ratios)
+                return NewtonResult(
+                    u=u,
+                    residuals=history,
+                    iterations=k,
+                    G=G,
+                    evaluation=out,
+                    evaluations=calls,
+                    force_scale=F,
+                    residual_ratio=max(r_max - atol, 0.0) / F if F > 0 else 0.0,
+                    correction_ratio=c_ratio if k else 0.0,
+                    ratios=ratios,
+                )
         if k == maxit:
             break
         try:
             with timed(instrument, "solve"):
                 du = solve_free(out[1], -G_f, free, all_free)
-        except RuntimeError as err:                   # "Factor is exactly singular"
-            raise NewtonError(f"Newton: singular tangent at iteration {k}{where}: {err}",
-                              history, label) from err
+        except RuntimeError as err:  # "Factor is exactly singular"
+            raise NewtonError(f"Newton: singular tangent at iteration {k}{where}: {err}", history, label) from err
         # every value finite: du.du is, unless a value is not (or the sum overflows: then each is checked)
         if not (math.isfinite(du.dot(du)) or np.isfinite(du).all()):
-            raise NewtonError(f"Newton: non-finite correction at iteration {k}{where}",
-                              history, label)
+            raise NewtonError(f"Newton: non-finite correction at iteration {k}{where}", history, label)
         if line_search:
             step = 1.0
             for _ in range(int(line_search) + 1):
@@ -247,14 +255,18 @@ def _newton(fun, u0, free, atol, rtol, maxit, label, line_search, instrument, ct
                 step /= 2
             u = trial
         elif all_free:
-            u = u + du                                # a new iterate: the last evaluation keeps its own u
+            u = u + du  # a new iterate: the last evaluation keeps its own u
         else:
             u = u.copy()
             u[free] += du
 
     share = f" ({largest[-1] / F:.1e} of the step's force scale {F:.3g})" if F > 0 else ""
-    raise NewtonError(f"Newton: no convergence in {maxit} iterations{where}: largest residual {largest[-1]:.3g}"
-                      f"{share} against the tolerance {tol:.3g}{_stall(largest, tol)}", history, label)
+    raise NewtonError(
+        f"Newton: no convergence in {maxit} iterations{where}: largest residual {largest[-1]:.3g}"
+        f"{share} against the tolerance {tol:.3g}{_stall(largest, tol)}",
+        history,
+        label,
+    )
 
 
 def _correction(du, u_f, u_start):
@@ -279,10 +291,12 @@ def _stall(history, tol):
     factor 3, 5 or more of them) below 1e-3 of the first residual: Newton sits on the round-off of
     the residual (its corrections no longer move u), above the tolerance; else ''."""
     k = len(history)
-    while k > 0 and max(history[k - 1:]) <= 3.0 * min(history[k - 1:]):
+    while k > 0 and max(history[k - 1 :]) <= 3.0 * min(history[k - 1 :]):
         k -= 1
     tail = history[k:]
     if len(tail) < 5 or max(tail) > 1e-3 * history[0]:
         return ""
-    return (f"; it stalls near {float(np.median(tail)):.1e} from iteration {k} on: the round-off of this "
-            "system's residual (a penalty this stiff makes one round-off of a gap a force above the tolerance)")
+    return (
+        f"; it stalls near {float(np.median(tail)):.1e} from iteration {k} on: the round-off of this "
+        "system's residual (a penalty this stiff makes one round-off of a gap a force above the tolerance)"
+    )

@@ -10,6 +10,7 @@ Both halve a step whose Newton fails, up to ``max_cuts`` times and never below
 answers three questions: the size of the next step after a record (None: the run is
 over), the size after a failure, and the time a step ends at.
 """
+
 import math
 from dataclasses import replace
 from functools import partial
@@ -75,7 +76,7 @@ class Steps(_Cuts):
             return None
         target = self._target(rec.t)
         on_grid = rec.k == 0 or abs(rec.t - (target - self.dt)) <= self.SAME * self.dt or rec.t == self.t0
-        if not on_grid:                                 # within a halved step: go on with its size
+        if not on_grid:  # within a halved step: go on with its size
             return min(rec.dt, target - rec.t)
         return target - rec.t
 
@@ -87,7 +88,7 @@ class Steps(_Cuts):
         """As _Cuts.cut, and never below dt / 2^max_cuts of the schedule's dt: the rest of a halved
         step goes on with the smaller size, and its parts, cut again each with a fresh count, would
         otherwise halve without end (a run that crawls at 1e-11 of its step and never finishes)."""
-        if dt / 2 < self.dt / 2 ** self.max_cuts * (1 - 1e-9):
+        if dt / 2 < self.dt / 2**self.max_cuts * (1 - 1e-9):
             return None
         return super().cut(dt, cuts)
 
@@ -151,6 +152,7 @@ class Adaptive(_Cuts):
 # cannot see an event coming) is retried halved, as a step whose Newton fails (StepRejected), down
 # to the first step's size.
 
+
 def error_constant(stepper):
     """c of the first-difference estimate c dt |a+ - a| (the comment above), and the power of the
     error's ratio that gives the next step (1 for a first-order velocity update, 1/2 for a
@@ -161,8 +163,9 @@ def error_constant(stepper):
         return 1.0 / 12.0, 0.5
     delta, beta = getattr(stepper, "delta", None), getattr(stepper, "beta", None)
     if delta is None or beta is None:
-        raise ValueError(f"accuracy needs an implicit Newmark or the energy-consistent stepper, not "
-                         f"{type(stepper).__name__}")
+        raise ValueError(
+            f"accuracy needs an implicit Newmark or the energy-consistent stepper, not {type(stepper).__name__}"
+        )
     if abs(delta - 0.5) > 1e-12:
         return abs(delta - 0.5), 1.0
     return abs(beta - 1.0 / 6.0), 0.5
@@ -209,15 +212,19 @@ class Estimated:
         if self.power == 1.0 or before is None or before[0] is None:
             return self.c * dt * self.norm(a1 - a), handed
         s0, h0 = before
-        return dt ** 3 / 12.0 * self.norm((slope - s0) / (0.5 * (dt + h0))), handed
+        return dt**3 / 12.0 * self.norm((slope - s0) / (0.5 * (dt + h0))), handed
 
     def step(self, t, u, v, a, dt, label="", *, state):
         u1, v1, a1, result = self.stepper.step(t, u, v, a, dt, label, state=state)
         e, handed = self.estimate(a, a1, dt, getattr(state, "stepper", None))
         if self.share is not None and dt > self.floor * (1 + 1e-9) and e > 2.0 * self.share(dt):
             raise StepRejected(f"local error {e:.3g} is past twice its share {self.share(dt):.3g}", [], label)
-        return u1, v1, a1, replace(result, local_error=e, carry=handed,
-                                   error_share=None if self.share is None else self.share(dt))
+        return (
+            u1,
+            v1,
+            a1,
+            replace(result, local_error=e, carry=handed, error_share=None if self.share is None else self.share(dt)),
+        )
 
 
 def error_step(rec, tol, speed, duration, dt_first, dt_max, power=1.0):
@@ -242,8 +249,9 @@ def at_tolerance(stepper, tol, speed, duration, dt_max):
     dt_first = dt_max * tol
     share = partial(_share, tol * speed / duration)
     estimated = Estimated(stepper, share=share, floor=dt_first)
-    rule = partial(error_step, tol=tol, speed=speed, duration=duration, dt_first=dt_first, dt_max=dt_max,
-                   power=estimated.power)
+    rule = partial(
+        error_step, tol=tol, speed=speed, duration=duration, dt_first=dt_first, dt_max=dt_max, power=estimated.power
+    )
     return estimated, rule, int(math.ceil(math.log2(1.0 / tol)))
 
 

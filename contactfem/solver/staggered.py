@@ -35,6 +35,7 @@ consistent Newton's. A cycle limit raises NewtonError (never returns an unconver
 A phase is a value frozen from the full evaluation that starts it (contact/tangents.py,
 ``freeze``) and handed to every evaluation of the phase: the contacts are not wrapped.
 """
+
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -42,11 +43,13 @@ import numpy as np
 from ..contact.tangents import freeze
 from .newton import RTOL, NewtonError, force_scale, newton
 
+
 @dataclass
 class StaggeredResult:
     """Like NewtonResult; ``residuals`` are the full residual norms at the start and after
     each cycle, ``iterations`` all linear solves, ``phase_iterations`` the solves of each
     phase in order (normal, friction, normal, ...)."""
+
     u: np.ndarray
     residuals: list = field(default_factory=list)
     iterations: int = 0
@@ -57,8 +60,9 @@ class StaggeredResult:
     phase_iterations: list = field(default_factory=list)
 
 
-def staggered(fun, u0, free, atol=1e-12, rtol=RTOL, maxit=25, max_cycles=60, label="", instrument=None,
-              **newton_options):
+def staggered(
+    fun, u0, free, atol=1e-12, rtol=RTOL, maxit=25, max_cycles=60, label="", instrument=None, **newton_options
+):
     """The staggered iteration (module docstring) on fun(u, phases) -> the (effective)
     Evaluation of a System, ``phases`` one per contact (None: the full contacts).
 
@@ -72,9 +76,9 @@ def staggered(fun, u0, free, atol=1e-12, rtol=RTOL, maxit=25, max_cycles=60, lab
     u = np.array(u0, dtype=float)
     ev = fun(u, None)
     calls = 1
-    history = [float(np.linalg.norm(ev.G[free]))]        # ||G_f|| of every cycle, for reports
+    history = [float(np.linalg.norm(ev.G[free]))]  # ||G_f|| of every cycle, for reports
 
-    def tolerance(ev):                                     # newton's test: the full residual's force scale
+    def tolerance(ev):  # newton's test: the full residual's force scale
         return atol + rtol * force_scale(ev, free)
 
     def converged(ev):
@@ -83,18 +87,36 @@ def staggered(fun, u0, free, atol=1e-12, rtol=RTOL, maxit=25, max_cycles=60, lab
     solves, per_phase = 0, []
     for cycle in range(1, max_cycles + 1):
         if converged(ev):
-            return StaggeredResult(u=u, residuals=history, iterations=solves, G=ev.G, evaluation=ev,
-                                   evaluations=calls, cycles=cycle - 1, phase_iterations=per_phase)
+            return StaggeredResult(
+                u=u,
+                residuals=history,
+                iterations=solves,
+                G=ev.G,
+                evaluation=ev,
+                evaluations=calls,
+                cycles=cycle - 1,
+                phase_iterations=per_phase,
+            )
         for kind in ("normal", "friction"):
-            if kind == "friction":               # freeze from the full state at the end of the normal phase
+            if kind == "friction":  # freeze from the full state at the end of the normal phase
                 ev, calls = fun(u, None), calls + 1
             phases, tol = [freeze(state, kind) for state in ev.contacts], tolerance(ev)
             try:
-                res = newton(lambda w: fun(w, phases), u, free, atol=tol, rtol=0.0, maxit=maxit,
-                             label=f"{kind} phase{where}", instrument=instrument, **newton_options)
+                res = newton(
+                    lambda w: fun(w, phases),
+                    u,
+                    free,
+                    atol=tol,
+                    rtol=0.0,
+                    maxit=maxit,
+                    label=f"{kind} phase{where}",
+                    instrument=instrument,
+                    **newton_options,
+                )
             except NewtonError as err:
-                raise NewtonError(f"staggered: {kind} phase of cycle {cycle} failed{where}: {err}",
-                                  history, label) from err
+                raise NewtonError(
+                    f"staggered: {kind} phase of cycle {cycle} failed{where}: {err}", history, label
+                ) from err
             u, solves, calls = res.u, solves + res.iterations, calls + res.evaluations
             per_phase.append(res.iterations)
         ev, calls = fun(u, None), calls + 1
@@ -103,10 +125,22 @@ def staggered(fun, u0, free, atol=1e-12, rtol=RTOL, maxit=25, max_cycles=60, lab
             raise NewtonError(f"staggered: residual is NaN/inf after cycle {cycle}{where}", history, label)
         history.append(r)
     if converged(ev):
-        return StaggeredResult(u=u, residuals=history, iterations=solves, G=ev.G, evaluation=ev, evaluations=calls,
-                               cycles=max_cycles, phase_iterations=per_phase)
-    raise NewtonError(f"staggered: no convergence in {max_cycles} cycles{where}; full residuals "
-                      f"{', '.join(f'{x:.3e}' for x in history[-5:])} (last 5)", history, label)
+        return StaggeredResult(
+            u=u,
+            residuals=history,
+            iterations=solves,
+            G=ev.G,
+            evaluation=ev,
+            evaluations=calls,
+            cycles=max_cycles,
+            phase_iterations=per_phase,
+        )
+    raise NewtonError(
+        f"staggered: no convergence in {max_cycles} cycles{where}; full residuals "
+        f"{', '.join(f'{x:.3e}' for x in history[-5:])} (last 5)",
+        history,
+        label,
+    )
 
 
 class Staggered:
@@ -126,19 +160,25 @@ class Staggered:
         t1 = t + dt
         opts = dict(st.newton_options, instrument=s.instrument)
         if not self.dynamic:
-            res = staggered(lambda w, ph: s.evaluate(w, t1, dt, u, phases=ph, state=state), s.apply_dirichlet(u, t1),
-                            s.free_dofs, max_cycles=self.max_cycles, label=label, **opts)
+            res = staggered(
+                lambda w, ph: s.evaluate(w, t1, dt, u, phases=ph, state=state),
+                s.apply_dirichlet(u, t1),
+                s.free_dofs,
+                max_cycles=self.max_cycles,
+                label=label,
+                **opts,
+            )
             zero = np.zeros(s.ndof)
             return res.u, zero, zero.copy(), res
         beta, delta = st.beta, st.delta
-        c = 1.0 / (beta * dt ** 2)
-        u_pred = u + dt * v + dt ** 2 * (0.5 - beta) * a
+        c = 1.0 / (beta * dt**2)
+        u_pred = u + dt * v + dt**2 * (0.5 - beta) * a
 
-        def effective(u1, phases):                           # as Newmark.step
+        def effective(u1, phases):  # as Newmark.step
             ev = s.evaluate(u1, t1, dt, u, mass_coefficient=c, phases=phases, state=state)
             return ev._replace(G=ev.G + s.mass_times(c * (u1 - u_pred)))
 
-        guess = s.apply_dirichlet(u_pred + beta * dt ** 2 * a, t1)
+        guess = s.apply_dirichlet(u_pred + beta * dt**2 * a, t1)
         res = staggered(effective, guess, s.free_dofs, max_cycles=self.max_cycles, label=label, **opts)
         a1 = c * (res.u - u_pred)
         v1 = v + dt * ((1 - delta) * a + delta * a1)

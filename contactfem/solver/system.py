@@ -37,6 +37,7 @@ the contacts' states (contact/state.py) travel with it, and the SystemState it w
 with, so the converged one is what the time loop commits, records and reports
 (solver/march.py); nothing evaluates it again.
 """
+
 from dataclasses import dataclass
 from types import MappingProxyType
 from typing import NamedTuple
@@ -58,6 +59,7 @@ class SystemState:
     stepper   what the time stepper carries to its next step (None for most; a run at a
               tolerance: the last step's change of the accelerations, schedule.Estimated)
     """
+
     contacts: tuple = ()
     bodies: tuple = ()
     loads: tuple = ()
@@ -69,6 +71,7 @@ class Evaluation(NamedTuple):
     the SystemState it was evaluated with (a tuple, so ``G, K = evaluation[:2]`` reads as before);
     a time stepper's effective evaluation also carries the inertia M a it added to G (Newton's
     force scale reads it)."""
+
     G: np.ndarray
     K: object
     contacts: tuple = ()
@@ -94,8 +97,10 @@ class Dirichlet:
         value = self.value(t) if callable(self.value) else self.value
         value = np.asarray(value, dtype=float)
         if value.ndim > 0 and value.size != self.local_dofs.size:
-            raise ValueError(f"Dirichlet value must be a scalar or have {self.local_dofs.size} "
-                             f"entries (one per dof), got {value.size}")
+            raise ValueError(
+                f"Dirichlet value must be a scalar or have {self.local_dofs.size} "
+                f"entries (one per dof), got {value.size}"
+            )
         return np.broadcast_to(value.ravel() if value.ndim else value, self.local_dofs.shape)
 
 
@@ -149,19 +154,19 @@ class System:
             raise ValueError("bodies must contain at least one body")
 
         self._place()
-        self.contact_dofs = np.arange(self.body_ndof, self.ndof)   # massless, never prescribed
+        self.contact_dofs = np.arange(self.body_ndof, self.ndof)  # massless, never prescribed
 
         for d in self.fixed:
             if d.body not in self.bodies:
                 raise ValueError(f"Dirichlet condition on body {d.body.name!r}, which is not in bodies")
             if np.any(d.local_dofs < 0) or np.any(d.local_dofs >= d.body.ndof):
-                raise ValueError(f"Dirichlet local_dofs of body {d.body.name!r} must be in "
-                                 f"[0, {d.body.ndof - 1}]")
-        self.fixed_dofs = np.unique(np.concatenate(
-            [self.global_dofs(d.body, d.local_dofs) for d in self.fixed] + [np.zeros(0, int)]))
+                raise ValueError(f"Dirichlet local_dofs of body {d.body.name!r} must be in [0, {d.body.ndof - 1}]")
+        self.fixed_dofs = np.unique(
+            np.concatenate([self.global_dofs(d.body, d.local_dofs) for d in self.fixed] + [np.zeros(0, int)])
+        )
         self.free_dofs = np.setdiff1d(np.arange(self.ndof), self.fixed_dofs)
         self._mass = None
-        self._cM = (None, None)                 # (c, c M) of the last lumped effective tangent
+        self._cM = (None, None)  # (c, c M) of the last lumped effective tangent
         self._requested = linear_algebra
         self._tangent = TangentAssembler(self.ndof, linear_algebra, self.free_dofs)
         self.evaluations = 0
@@ -206,7 +211,7 @@ class System:
     def band(self):
         """(kl, ku), the half-bandwidths below and above the diagonal of K renumbered by reverse
         Cuthill-McKee, of the last K solved banded; None when no K was."""
-        plan = self._tangent.banded_plan                # of the last K solved banded
+        plan = self._tangent.banded_plan  # of the last K solved banded
         return (plan.kl, plan.ku) if plan is not None else None
 
     def offset(self, obj):
@@ -221,7 +226,7 @@ class System:
     def local(self, body, u):
         """The body's own part (a view) of a global vector."""
         off = self.offset(body)
-        return u[off:off + body.ndof]
+        return u[off : off + body.ndof]
 
     # -- Dirichlet conditions -------------------------------------------------
 
@@ -244,7 +249,7 @@ class System:
 
     @property
     def mass_matrix(self):
-        """"consistent" if a body's mass is (``body.mass_matrix``), else "lumped"."""
+        """ "consistent" if a body's mass is (``body.mass_matrix``), else "lumped"."""
         return "consistent" if any(b.mass_matrix == "consistent" for b in self.bodies) else "lumped"
 
     def mass(self):
@@ -253,18 +258,21 @@ class System:
         ``mass_times`` for M x, whichever it is."""
         if self._mass is None:
             if self.mass_matrix == "lumped":
-                self._mass = np.concatenate([np.asarray(b.mass(), dtype=float) for b in self.bodies]
-                                            + [np.zeros(self.ndof - self.body_ndof)])
+                self._mass = np.concatenate(
+                    [np.asarray(b.mass(), dtype=float) for b in self.bodies] + [np.zeros(self.ndof - self.body_ndof)]
+                )
             else:
                 import scipy.sparse as sp
 
-                blocks = [b.mass(consistent=True) if b.mass_matrix == "consistent" else sp.diags(b.mass())
-                          for b in self.bodies]
+                blocks = [
+                    b.mass(consistent=True) if b.mass_matrix == "consistent" else sp.diags(b.mass())
+                    for b in self.bodies
+                ]
                 if self.ndof > self.body_ndof:
                     blocks.append(sp.csr_matrix((self.ndof - self.body_ndof,) * 2))
                 self._mass = sp.block_diag(blocks, format="csr")
                 coo = self._mass.tocoo()
-                self._mass_coo = (coo.row, coo.col, coo.data)    # the same arrays at every assembly
+                self._mass_coo = (coo.row, coo.col, coo.data)  # the same arrays at every assembly
         return self._mass
 
     def mass_times(self, x):
@@ -288,11 +296,16 @@ class System:
     def _check_state(self, state):
         if not isinstance(state, SystemState):
             raise ValueError(f"state must be a SystemState (System.start or commit), got {type(state).__name__}")
-        if (len(state.contacts), len(state.bodies), len(state.loads)) != (len(self.contacts), len(self.bodies),
-                                                                           len(self.loads)):
-            raise ValueError(f"state has {len(state.contacts)} contacts, {len(state.bodies)} bodies and "
-                             f"{len(state.loads)} loads; the System {len(self.contacts)}, {len(self.bodies)} and "
-                             f"{len(self.loads)}")
+        if (len(state.contacts), len(state.bodies), len(state.loads)) != (
+            len(self.contacts),
+            len(self.bodies),
+            len(self.loads),
+        ):
+            raise ValueError(
+                f"state has {len(state.contacts)} contacts, {len(state.bodies)} bodies and "
+                f"{len(state.loads)} loads; the System {len(self.contacts)}, {len(self.bodies)} and "
+                f"{len(self.loads)}"
+            )
         return state
 
     def evaluate(self, u, t, dt=None, u0=None, mass_coefficient=0.0, phases=None, *, state):
@@ -313,32 +326,33 @@ class System:
         self._check_state(state)
         self.evaluations += 1
         G = np.zeros(self.ndof)
-        blocks = []                                    # (rows, cols, vals, offset, key)
+        blocks = []  # (rows, cols, vals, offset, key)
 
         with timed(self.instrument, "bulk"):
-            for body, bs in zip(self.bodies, state.bodies):   # block diagonal: internal forces
+            for body, bs in zip(self.bodies, state.bodies):  # block diagonal: internal forces
                 off = self.offsets[id(body)]
-                R, rows, cols, vals = body.internal_coo(u[off:off + body.ndof], dt, bs)
-                G[off:off + body.ndof] += R
+                R, rows, cols, vals = body.internal_coo(u[off : off + body.ndof], dt, bs)
+                G[off : off + body.ndof] += R
                 blocks.append((rows, cols, vals, off, body))
 
         states = []
         with timed(self.instrument, "contact"):
-            for i, (contact, h) in enumerate(zip(self.contacts, state.contacts)):   # eq 28 and its tangent
-                cs = contact.evaluate(u, t, dt, u0, None if phases is None else phases[i], history=h,
-                                      offsets=self.offsets)
+            for i, (contact, h) in enumerate(zip(self.contacts, state.contacts)):  # eq 28 and its tangent
+                cs = contact.evaluate(
+                    u, t, dt, u0, None if phases is None else phases[i], history=h, offsets=self.offsets
+                )
                 Rc, r, c, v = cs.scatter(self.ndof)
                 G += Rc
-                if len(v):                             # (a contact in flight adds no tangent entries)
-                    blocks.append((*_triplets(r, c, v), 0, contact))   # (r, c: the same arrays while
-                states.append(cs)                                        # its contact set stays)
+                if len(v):  # (a contact in flight adds no tangent entries)
+                    blocks.append((*_triplets(r, c, v), 0, contact))  # (r, c: the same arrays while
+                states.append(cs)  # its contact set stays)
 
         with timed(self.instrument, "assembly"):
             P = np.zeros(self.ndof)
-            for load, ls in zip(self.loads, state.loads):   # loads enter with a minus sign
+            for load, ls in zip(self.loads, state.loads):  # loads enter with a minus sign
                 Pl, r, c, v = load.assemble(u, t, ls, offsets=self.offsets)
                 P += Pl
-                if len(v):                             # (a dead load has no tangent)
+                if len(v):  # (a dead load has no tangent)
                     r, c, v = _triplets(r, c, v)
                     blocks.append((r, c, -v, 0, None))
             if self.loads:
@@ -346,11 +360,11 @@ class System:
             diagonal = None
             if mass_coefficient:
                 M = self.mass()
-                if isinstance(M, np.ndarray):                 # c M, made once for each c (a step's)
+                if isinstance(M, np.ndarray):  # c M, made once for each c (a step's)
                     if self._cM[0] != mass_coefficient:
                         self._cM = (mass_coefficient, mass_coefficient * M)
                     diagonal = self._cM[1]
-                else:                                  # consistent: one more constant block, c M
+                else:  # consistent: one more constant block, c M
                     r, c, v = self._mass_coo
                     blocks.append((r, c, mass_coefficient * v, 0, "mass"))
             K = self._tangent.assemble(blocks, diagonal)
@@ -368,9 +382,11 @@ class System:
         state, whatever ran before), so every run from the start is solved the same way."""
         u = np.asarray(u, dtype=float)
         self._tangent = TangentAssembler(self.ndof, self._requested, self.free_dofs)
-        return SystemState(contacts=tuple(c.start(u, t, offsets=self.offsets) for c in self.contacts),
-                           bodies=tuple(b.start(self.local(b, u).copy()) for b in self.bodies),
-                           loads=tuple(ld.start(u, t, offsets=self.offsets) for ld in self.loads))
+        return SystemState(
+            contacts=tuple(c.start(u, t, offsets=self.offsets) for c in self.contacts),
+            bodies=tuple(b.start(self.local(b, u).copy()) for b in self.bodies),
+            loads=tuple(ld.start(u, t, offsets=self.offsets) for ld in self.loads),
+        )
 
     def commit(self, evaluation, u, t, dt=None):
         """The SystemState after a converged step ending at (u, t) (``evaluation`` the converged
@@ -380,7 +396,8 @@ class System:
         return SystemState(
             contacts=tuple(c.commit(cs) for c, cs in zip(self.contacts, evaluation.contacts)),
             bodies=tuple(b.commit(self.local(b, u).copy(), dt, bs) for b, bs in zip(self.bodies, state.bodies)),
-            loads=tuple(ld.commit(u, t, ls, offsets=self.offsets) for ld, ls in zip(self.loads, state.loads)))
+            loads=tuple(ld.commit(u, t, ls, offsets=self.offsets) for ld, ls in zip(self.loads, state.loads)),
+        )
 
     # -- energies ------------------------------------------------------------------
     def energies(self, u, v, evaluation, dt=None, state=None):

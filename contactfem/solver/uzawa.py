@@ -27,6 +27,7 @@ is evaluated twice. The multipliers are part of the interfaces' histories (a val
 SystemState, contact/augmented.py): each update gives the next outer iteration a new state
 to solve with, and the time loop (march.py) commits the last one, as for any stepper.
 """
+
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -41,6 +42,7 @@ class UzawaResult:
     uzawa_iterations - 1 multiplier updates; ``newton_per_outer``: linear solves of each;
     ``violations``: the violation after each; ``gap_violations``: the largest penetration /
     length after each; ``gap_violation``: its last value (the converged state)."""
+
     u: np.ndarray
     residuals: list = field(default_factory=list)
     iterations: int = 0
@@ -53,9 +55,9 @@ class UzawaResult:
     violations: list = field(default_factory=list)
     gap_violation: float = 0.0
     gap_violations: list = field(default_factory=list)
-    local_error: float | None = None          # a time stepper's estimate of the step's error (schedule.Estimated)
-    carry: object = None                      # what the stepper hands to its next step (SystemState.stepper)
-    error_share: float | None = None          # the error its share allows a step of its size (schedule.Estimated)
+    local_error: float | None = None  # a time stepper's estimate of the step's error (schedule.Estimated)
+    carry: object = None  # what the stepper hands to its next step (SystemState.stepper)
+    error_share: float | None = None  # the error its share allows a step of its size (schedule.Estimated)
 
 
 class Uzawa:
@@ -85,18 +87,22 @@ class Uzawa:
         start = u
         residuals, per_outer, viols, gaps, calls = [], [], [], [], [0]
         for k in range(self.max_updates + 1):
-            u1, v1, a1, res = self.stepper.step(t, start, v, a, dt,
-                                                label=f"{label} (outer iteration {k + 1})" if label else "",
-                                                state=state)
+            u1, v1, a1, res = self.stepper.step(
+                t, start, v, a, dt, label=f"{label} (outer iteration {k + 1})" if label else "", state=state
+            )
             out = self._outer(k, u1, v1, a1, res, residuals, per_outer, viols, gaps, calls)
             if isinstance(out, tuple):
                 return out
-            state = out                       # the same step again, with the updated multipliers
+            state = out  # the same step again, with the updated multipliers
             if not self.dynamic:
-                start = u1                    # warm start of the next static solve
-        raise NewtonError(f"Uzawa: contact violation {viols[-1]:.3e} > uzawa_tol = {self.tol:.1e} after "
-                          f"{self.max_updates} multiplier updates ({label}); violations "
-                          f"{', '.join(f'{x:.2e}' for x in viols[-5:])} (last 5)", residuals, label)
+                start = u1  # warm start of the next static solve
+        raise NewtonError(
+            f"Uzawa: contact violation {viols[-1]:.3e} > uzawa_tol = {self.tol:.1e} after "
+            f"{self.max_updates} multiplier updates ({label}); violations "
+            f"{', '.join(f'{x:.2e}' for x in viols[-5:])} (last 5)",
+            residuals,
+            label,
+        )
 
     def _outer(self, k, u1, v1, a1, res, residuals, per_outer, viols, gaps, calls):
         """Book-keeping of outer iteration k: the step's result if converged, else the SystemState
@@ -111,12 +117,25 @@ class Uzawa:
         viols.append(viol)
         gaps.append(gap)
         if viol <= self.tol:
-            result = UzawaResult(u=u1, residuals=residuals, iterations=sum(per_outer), G=res.G,
-                                 evaluation=res.evaluation, evaluations=calls[0], uzawa_iterations=k + 1, updates=k,
-                                 newton_per_outer=per_outer, violations=viols, gap_violation=gap, gap_violations=list(gaps))
+            result = UzawaResult(
+                u=u1,
+                residuals=residuals,
+                iterations=sum(per_outer),
+                G=res.G,
+                evaluation=res.evaluation,
+                evaluations=calls[0],
+                uzawa_iterations=k + 1,
+                updates=k,
+                newton_per_outer=per_outer,
+                violations=viols,
+                gap_violation=gap,
+                gap_violations=list(gaps),
+            )
             return u1, v1, a1, result
         ours = set(map(id, self.contacts))
         ev = res.evaluation
-        histories = tuple(c.update_multipliers(st) if id(c) in ours else h
-                          for c, st, h in zip(self.system.contacts, ev.contacts, ev.state.contacts))
+        histories = tuple(
+            c.update_multipliers(st) if id(c) in ours else h
+            for c, st, h in zip(self.system.contacts, ev.contacts, ev.state.contacts)
+        )
         return replace(ev.state, contacts=histories)

@@ -29,14 +29,14 @@ nb_execution_raise_on_error = True
 nb_execution_show_tb = True
 nb_merge_streams = True
 myst_enable_extensions = ["dollarmath", "amsmath"]
-myst_dmath_double_inline = True     # $$...$$ inside a paragraph or list item, as Jupyter shows it
+myst_dmath_double_inline = True  # $$...$$ inside a paragraph or list item, as Jupyter shows it
 myst_heading_anchors = 3
 
 # -- API reference from the docstrings
 autodoc_default_options = {"members": True, "member-order": "bysource", "ignore-module-all": True}
 autodoc_typehints = "none"
 add_module_names = False
-nitpicky = True          # a reference that does not resolve (e.g. in the equation index) is an error
+nitpicky = True  # a reference that does not resolve (e.g. in the equation index) is an error
 # (type names in signatures outside contactfem, e.g. numpy's, are not documented here)
 nitpick_ignore_regex = [("py:class", r"(?!contactfem\.).*")]
 
@@ -51,18 +51,22 @@ def docstring_as_written(app, what, name, obj, options, lines):
 def setup(app):
     app.connect("autodoc-process-docstring", docstring_as_written)
 
+
 # -- MathJax 3 from the site itself (copied from the django-static-mathjax package)
 html_static_path = ["_static"]
 mathjax_path = "mathjax/tex-chtml.js"
 # Sphinx writes math as \( \) and \[ \]; a '$$' left in the page is a bug the browser check sees
 # and an undefined macro is an error (MathJax's default would print it in red and go on)
-mathjax3_config = {"tex": {"inlineMath": [["\\(", "\\)"]], "displayMath": [["\\[", "\\]"]],
-                           "packages": {"[-]": ["noundefined"]}}}
+mathjax3_config = {
+    "tex": {"inlineMath": [["\\(", "\\)"]], "displayMath": [["\\[", "\\]"]], "packages": {"[-]": ["noundefined"]}}
+}
 
 html_theme = "alabaster"
 html_title = "contactfem course"
-html_theme_options = {"description": "Large-deformation impact-contact with friction "
-                                     "(Wriggers, Vu Van & Stein 1990) on scikit-fem",
-                      "page_width": "1180px", "sidebar_width": "260px"}
+html_theme_options = {
+    "description": "Large-deformation impact-contact with friction (Wriggers, Vu Van & Stein 1990) on scikit-fem",
+    "page_width": "1180px",
+    "sidebar_width": "260px",
+}
 html_sidebars = {"**": ["about.html", "navigation.html", "relations.html", "searchbox.html"]}
 html_show_sourcelink = False

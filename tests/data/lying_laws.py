@@ -19,6 +19,7 @@ class NaNEverywhere:
 @dataclass(frozen=True)
 class NaNAbove:
     """Coulomb, but NaN above the pressure p_bad (a forgotten branch)."""
+
     c_T: float = 10.0
     mu: float = 0.3
     p_bad: float = 50.0
@@ -31,6 +32,7 @@ class NaNAbove:
 @dataclass(frozen=True)
 class NegativeAbove:
     """Coulomb, but Y = -mu p above p_bad (a sign error in one branch)."""
+
     c_T: float = 10.0
     mu: float = 0.3
     p_bad: float = 0.0
@@ -44,6 +46,7 @@ class NegativeAbove:
 class NaNWindow:
     """NaN for pressures strictly between lo and hi only: a law the quick probe of the law
     file (p = 0.5, 1, 2) does not catch, so that --no-check lets the run meet it."""
+
     c_T: float = 10.0
     mu: float = 0.3
     lo: float = 0.01
@@ -59,6 +62,7 @@ class OwnFields:
     """A slip bound hardening with the slip, Y = mu p (1 + delta q)^m: its fields m and
     delta share their names with the scenes' normal-law exponent and Newmark parameter,
     and keep their own defaults."""
+
     c_T: float = 10.0
     mu: float = 0.2
     m: float = 0.5
@@ -71,6 +75,7 @@ class OwnFields:
 @dataclass(frozen=True)
 class Tensile:
     """A normal law with the sign of t_N wrong beyond the depth d (it pulls)."""
+
     c_N: float = 10.0
     d: float = 0.05
 

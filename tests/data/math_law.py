@@ -9,4 +9,4 @@ class MathTanh:
 
     def slip_bound(self, p, q):
         th = math.tanh(p)
-        return self.mu * th, self.mu * (1 - th ** 2), 0.0
+        return self.mu * th, self.mu * (1 - th**2), 0.0

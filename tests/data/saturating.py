@@ -26,4 +26,4 @@ class Saturating:
 
     def slip_bound(self, p, q):
         th = np.tanh(np.asarray(p) / self.p0)
-        return self.mu0 * self.p0 * th, self.mu0 * (1 - th ** 2), 0 * th
+        return self.mu0 * self.p0 * th, self.mu0 * (1 - th**2), 0 * th

@@ -74,18 +74,31 @@ from .targets import targets_study
 from .work_precision import work_precision
 from .adaptive import adaptive_study
 
-STUDIES = {"tangents": tangent_study, "work_precision": work_precision, "cost": cost_study,
-           "targets": targets_study, "enforcement": enforcement_study, "speed": speed_study,
-           "semismooth": semismooth_study, "scaling": scaling_study, "extremes": extremes_study,
-           "adaptive": adaptive_study}
+STUDIES = {
+    "tangents": tangent_study,
+    "work_precision": work_precision,
+    "cost": cost_study,
+    "targets": targets_study,
+    "enforcement": enforcement_study,
+    "speed": speed_study,
+    "semismooth": semismooth_study,
+    "scaling": scaling_study,
+    "extremes": extremes_study,
+    "adaptive": adaptive_study,
+}
 
 
 def machine():
     import scipy
 
-    return dict(python=platform.python_version(), numpy=np.__version__, scipy=scipy.__version__,
-                cpus=os.cpu_count(), platform=platform.platform(),
-                load_average=list(os.getloadavg()) if hasattr(os, "getloadavg") else None)
+    return dict(
+        python=platform.python_version(),
+        numpy=np.__version__,
+        scipy=scipy.__version__,
+        cpus=os.cpu_count(),
+        platform=platform.platform(),
+        load_average=list(os.getloadavg()) if hasattr(os, "getloadavg") else None,
+    )
 
 
 def run_bench(quick=False, only=None, progress=print):
@@ -102,7 +115,26 @@ def run_bench(quick=False, only=None, progress=print):
     return jsonable(out)
 
 
-__all__ = ["run_bench", "STUDIES", "TARGETS", "PAPER_SCENES", "VARIANTS", "observed_order", "machine",
-           "write_markdown", "write_outputs", "tangent_study", "work_precision", "cost_study",
-           "iteration_cost", "targets_study", "enforcement_study", "speed_study", "semismooth_study",
-           "scaling_study", "plain_hertz", "extremes_study", "adaptive_study"]
+__all__ = [
+    "run_bench",
+    "STUDIES",
+    "TARGETS",
+    "PAPER_SCENES",
+    "VARIANTS",
+    "observed_order",
+    "machine",
+    "write_markdown",
+    "write_outputs",
+    "tangent_study",
+    "work_precision",
+    "cost_study",
+    "iteration_cost",
+    "targets_study",
+    "enforcement_study",
+    "speed_study",
+    "semismooth_study",
+    "scaling_study",
+    "plain_hertz",
+    "extremes_study",
+    "adaptive_study",
+]

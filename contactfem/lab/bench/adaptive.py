@@ -35,27 +35,47 @@ TRAPEZOIDAL = {"delta": time_integration.TRAPEZOIDAL["delta"], "beta_newmark": t
 # order), the headline quantities, the adaptive mode's overrides
 STUDY = {
     "bar_impact": dict(
-        preset="fast", fixed=lambda h: {"courant": h}, ladder=(2.0, 1.0, 0.5, 0.25, 0.125, 0.0625, 0.03125),
+        preset="fast",
+        fixed=lambda h: {"courant": h},
+        ladder=(2.0, 1.0, 0.5, 0.25, 0.125, 0.0625, 0.03125),
         step="courant",
-        trapezoidal=None, reference_with="preset", h_ref=0.0078125, order=2, keys=("duration", "rebound_velocity"),
-        adaptive={}),
+        trapezoidal=None,
+        reference_with="preset",
+        h_ref=0.0078125,
+        order=2,
+        keys=("duration", "rebound_velocity"),
+        adaptive={},
+    ),
     # the rebound is over by t = 3 (the ring leaves at ~2.5): 3 time units, not the paper's 20
     "sloping_impact": dict(
-        preset="fast", fixed=lambda h: {"dt": h, "n_steps": int(round(3.0 / h))},
+        preset="fast",
+        fixed=lambda h: {"dt": h, "n_steps": int(round(3.0 / h))},
         ladder=(0.1, 0.05, 0.025, 0.0125, 0.00625, 0.003125, 0.0015625, 0.00078125, 0.00015625, 0.000078125),
-        step="dt", trapezoidal=(0.025, 0.0125, 0.00625, 0.003125, 0.0015625, 0.00078125, 0.000390625),
-        reference_with="trapezoidal", h_ref=0.000390625 / 2, order=2, keys=("rebound_vx", "rebound_vy"),
-        adaptive={"n_steps": 30}),
+        step="dt",
+        trapezoidal=(0.025, 0.0125, 0.00625, 0.003125, 0.0015625, 0.00078125, 0.000390625),
+        reference_with="trapezoidal",
+        h_ref=0.000390625 / 2,
+        order=2,
+        keys=("rebound_vx", "rebound_vy"),
+        adaptive={"n_steps": 30},
+    ),
     # the paper's ring of 120 elements: the fast preset's 40-gon has no converged v_final (its rolling
     # speed is set by the energy each of its coarse touch-downs trades with the ring's vibrations:
     # fixed trapezoidal steps from 5e-3 to 7.8e-5 s scatter by 1.5 %, 146.3 to 148.5 cm/s); the 120-gon's
     # settles (the trapezoidal rule at 7.8e-5 and 3.9e-5 s: 149.874 and 149.905 cm/s, x_roll 229.5252
     # and 229.5259 cm)
     "rolling_ring": dict(
-        preset="paper", fixed=lambda h: {"dt": h},
-        ladder=(0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125, 0.00015625, 0.000078125), step="dt",
-        trapezoidal=(0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125, 0.00015625), reference_with="trapezoidal",
-        h_ref=0.0000390625, order=2, keys=("v_final", "x_roll"), adaptive={}),
+        preset="paper",
+        fixed=lambda h: {"dt": h},
+        ladder=(0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125, 0.00015625, 0.000078125),
+        step="dt",
+        trapezoidal=(0.01, 0.005, 0.0025, 0.00125, 0.000625, 0.0003125, 0.00015625),
+        reference_with="trapezoidal",
+        h_ref=0.0000390625,
+        order=2,
+        keys=("v_final", "x_roll"),
+        adaptive={},
+    ),
     # the cork's own schedule with dt_fine = h everywhere: from the start (exit_zone 1e3 mm: the whole
     # neck is "near the exit") and after the exit (a travel limit of 1e-9 mm). dt (1e-4 s) stays: it
     # sets the gas's ramp in time (a staircase the steps resolve, as a run at a tolerance does). A
@@ -66,11 +86,17 @@ STUDY = {
     # 6.25e-7, 3.125e-7 and 1.5625e-7 s: 28.0185, 27.9982, 27.9949, 27.9924 m/s; a reference from
     # 6.25e-7 s moves by 1.1e-3 and cannot judge 1e-3)
     "cork": dict(
-        preset="fast", fixed=lambda h: {"dt_fine": h, "exit_zone": 1e3, "travel_max": 1e-9},
+        preset="fast",
+        fixed=lambda h: {"dt_fine": h, "exit_zone": 1e3, "travel_max": 1e-9},
         ladder=(8e-5, 4e-5, 2e-5, 1e-5, 5e-6, 2.5e-6),
-        step="dt_fine", trapezoidal=(4e-5, 2e-5, 1e-5, 5e-6, 2.5e-6, 1.25e-6), reference_with="trapezoidal",
-        h_ref=1.5625e-7, order=1,
-        keys=("exit_velocity_m_s", "exit_time_ms"), adaptive={}),
+        step="dt_fine",
+        trapezoidal=(4e-5, 2e-5, 1e-5, 5e-6, 2.5e-6, 1.25e-6),
+        reference_with="trapezoidal",
+        h_ref=1.5625e-7,
+        order=1,
+        keys=("exit_velocity_m_s", "exit_time_ms"),
+        adaptive={},
+    ),
 }
 TOLERANCES = (1e-2, 1e-3)
 
@@ -88,18 +114,26 @@ def _run(scene, preset, over, keys):
 
 def _point(scene, preset, over, keys):
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore")            # a coarse run's indicators warn: its error is measured here
+        warnings.simplefilter("ignore")  # a coarse run's indicators warn: its error is measured here
         try:
             r, wall = timed(run_scene, scene, preset, over)
-        except Exception as err:                   # recorded, not hidden: a failed point is a result
+        except Exception as err:  # recorded, not hidden: a failed point is a result
             return dict(over, ok=False, failure=f"{type(err).__name__}: {str(err).splitlines()[0][:160]}")
     st = r["stepping"]
-    budget = r["accuracy"].get("error_budget")                # a run at a tolerance: its own estimate
-    return dict(over, ok=True, values={k: r.get(k) for k in keys},
-                error_budget=None if budget is None else budget["value"],
-                newton_iterations=int(r["newton_iterations_total"]),
-                residual_evaluations=int(r["residual_evaluations"]), wall_time_s=wall, steps=st["steps"],
-                dt_min=st["dt_min"], dt_max=st["dt_max"], mode=st["mode"])
+    budget = r["accuracy"].get("error_budget")  # a run at a tolerance: its own estimate
+    return dict(
+        over,
+        ok=True,
+        values={k: r.get(k) for k in keys},
+        error_budget=None if budget is None else budget["value"],
+        newton_iterations=int(r["newton_iterations_total"]),
+        residual_evaluations=int(r["residual_evaluations"]),
+        wall_time_s=wall,
+        steps=st["steps"],
+        dt_min=st["dt_min"],
+        dt_max=st["dt_max"],
+        mode=st["mode"],
+    )
 
 
 def _over(scene, h, trapezoidal=False):
@@ -160,7 +194,7 @@ def scene_study(scene, tolerances=TOLERANCES, ladder=None, h_ref=None):
     if not r["ok"]:
         return dict(reference=r, fixed=[], fixed_trapezoidal=[], adaptive=[])
     ref = r["values"]
-    own = (1, 2, 4) if s["order"] == 1 else (2,)       # (a second-order reference is its own run: error 0)
+    own = (1, 2, 4) if s["order"] == 1 else (2,)  # (a second-order reference is its own run: error 0)
     own = {m * r["h_ref"] for m in own}
     trap = s["reference_with"] == "trapezoidal"
 
@@ -172,9 +206,20 @@ def scene_study(scene, tolerances=TOLERANCES, ladder=None, h_ref=None):
     fixed_trapezoidal = ladder_points(s["trapezoidal"], True) if s["trapezoidal"] else []
     adaptive = [dict(_errors(adaptive_run(scene, tol), ref, keys), accuracy=tol) for tol in tolerances]
     adaptive = [dict(a, **matches(a, fixed, fixed_trapezoidal, r["change"])) for a in adaptive]
-    return dict(step=s["step"], keys=list(keys), preset=s["preset"], h_reference=r["h_ref"], reference=ref,
-                reference_with=s["reference_with"], reference_change=r["change"], reference_runs=r["runs"],
-                order=s["order"], fixed=fixed, fixed_trapezoidal=fixed_trapezoidal, adaptive=adaptive)
+    return dict(
+        step=s["step"],
+        keys=list(keys),
+        preset=s["preset"],
+        h_reference=r["h_ref"],
+        reference=ref,
+        reference_with=s["reference_with"],
+        reference_change=r["change"],
+        reference_runs=r["runs"],
+        order=s["order"],
+        fixed=fixed,
+        fixed_trapezoidal=fixed_trapezoidal,
+        adaptive=adaptive,
+    )
 
 
 def matching_fixed(fixed, error):
@@ -187,14 +232,19 @@ def matching_fixed(fixed, error):
     if error is None:
         return None
     match = None
-    for f in sorted(fixed, key=lambda f: f["h"]):           # finest first
-        if f.get("error") is None or not f["error"] <= error:   # (None or NaN: not within)
+    for f in sorted(fixed, key=lambda f: f["h"]):  # finest first
+        if f.get("error") is None or not f["error"] <= error:  # (None or NaN: not within)
             break
         match = f
     if match is None:
         return None
-    return dict(h=match["h"], error=match["error"], residual_evaluations=match["residual_evaluations"],
-                newton_iterations=match["newton_iterations"], wall_time_s=match["wall_time_s"])
+    return dict(
+        h=match["h"],
+        error=match["error"],
+        residual_evaluations=match["residual_evaluations"],
+        newton_iterations=match["newton_iterations"],
+        wall_time_s=match["wall_time_s"],
+    )
 
 
 def matches(a, fixed, fixed_trapezoidal, reference_change):
@@ -205,12 +255,23 @@ def matches(a, fixed, fixed_trapezoidal, reference_change):
     that stays within the tolerance itself (what a run at that tolerance could have cost; None
     where the reference moves by more than half the tolerance)."""
     error = None if a.get("error") is None else max(a["error"], reference_change)
-    at_tol = [] if reference_change > a["accuracy"] / 2 else [
-        dict(m, integrator=label) for label, m in (("preset", matching_fixed(fixed, a["accuracy"])),
-                                                   ("trapezoidal", matching_fixed(fixed_trapezoidal, a["accuracy"])))
-        if m]
-    return dict(fixed_match=matching_fixed(fixed, error), trapezoidal_match=matching_fixed(fixed_trapezoidal, error),
-                tolerance_match=min(at_tol, key=lambda m: m["residual_evaluations"]) if at_tol else None)
+    at_tol = (
+        []
+        if reference_change > a["accuracy"] / 2
+        else [
+            dict(m, integrator=label)
+            for label, m in (
+                ("preset", matching_fixed(fixed, a["accuracy"])),
+                ("trapezoidal", matching_fixed(fixed_trapezoidal, a["accuracy"])),
+            )
+            if m
+        ]
+    )
+    return dict(
+        fixed_match=matching_fixed(fixed, error),
+        trapezoidal_match=matching_fixed(fixed_trapezoidal, error),
+        tolerance_match=min(at_tol, key=lambda m: m["residual_evaluations"]) if at_tol else None,
+    )
 
 
 def adaptive_study(quick=False):

@@ -8,6 +8,7 @@ the augmented method meets it at any c_N, in outer (Uzawa) iterations whose numb
 as c_N falls. Counted: Newton linear solves (all outer iterations), outer iterations, wall
 time of the scene's run().
 """
+
 import time
 
 from ...scenes import get_scene, run_scene
@@ -20,11 +21,17 @@ def _point(scene, preset, over):
     t0 = time.perf_counter()
     try:
         r = run_scene(scene, preset, over)
-    except Exception as err:                     # a failed run is reported, not hidden
+    except Exception as err:  # a failed run is reported, not hidden
         return dict(ok=False, error=f"{type(err).__name__}: {err}"[:300], time_s=time.perf_counter() - t0)
-    return dict(ok=True, solves=int(sum(r["newton_per_outer"])), outer=int(r["uzawa_iterations"]),
-                gap_violation=r["gap_violation"], met=bool(r["gap_violation"] <= TARGET),
-                time_s=time.perf_counter() - t0, length=r["gap_violation_length_is"])
+    return dict(
+        ok=True,
+        solves=int(sum(r["newton_per_outer"])),
+        outer=int(r["uzawa_iterations"]),
+        gap_violation=r["gap_violation"],
+        met=bool(r["gap_violation"] <= TARGET),
+        time_s=time.perf_counter() - t0,
+        length=r["gap_violation_length_is"],
+    )
 
 
 def enforcement_study(quick=False):
@@ -49,20 +56,30 @@ def enforcement_study(quick=False):
 
 def enforcement_markdown(res):
     """The BENCHMARKS.md section of the study."""
-    L = ["## Enforcement: solves to a gap violation of 1e-8, penalty against augmented Lagrangian", "",
-         f"Gap violation = largest penetration / the scene's length; target {res['target']:g}; "
-         f"{res['preset']} presets. Penalty: one Newton solve per load step, its gap is what it is "
-         "(the c_N it would need for the target is extrapolated, gap * c_N constant). Augmented: "
-         "`enforcement=augmented uzawa_tol=1e-8`, Newton solves summed over the outer iterations.", "",
-         "| scene | c_N | penalty: solves | penalty: gap violation | penalty: c_N needed (extrapolated) | "
-         "augmented: solves | augmented: outer iterations | augmented: gap violation | augmented: time [s] |",
-         "|---|---|---|---|---|---|---|---|---|"]
+    L = [
+        "## Enforcement: solves to a gap violation of 1e-8, penalty against augmented Lagrangian",
+        "",
+        f"Gap violation = largest penetration / the scene's length; target {res['target']:g}; "
+        f"{res['preset']} presets. Penalty: one Newton solve per load step, its gap is what it is "
+        "(the c_N it would need for the target is extrapolated, gap * c_N constant). Augmented: "
+        "`enforcement=augmented uzawa_tol=1e-8`, Newton solves summed over the outer iterations.",
+        "",
+        "| scene | c_N | penalty: solves | penalty: gap violation | penalty: c_N needed (extrapolated) | "
+        "augmented: solves | augmented: outer iterations | augmented: gap violation | augmented: time [s] |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
     for scene, s in res["scenes"].items():
         for r in s["rows"]:
             p, a = r["penalty"], r["augmented"]
-            pen = (f"{p['solves']} | {p['gap_violation']:.1e} | {p['c_N_needed_extrapolated']:.1e}" if p["ok"]
-                   else "failed | - | -")
-            aug = (f"{a['solves']} | {a['outer']} | {a['gap_violation']:.1e} | {a['time_s']:.2f}" if a["ok"]
-                   else f"failed: {a['error'][:60]} | - | - | -")
+            pen = (
+                f"{p['solves']} | {p['gap_violation']:.1e} | {p['c_N_needed_extrapolated']:.1e}"
+                if p["ok"]
+                else "failed | - | -"
+            )
+            aug = (
+                f"{a['solves']} | {a['outer']} | {a['gap_violation']:.1e} | {a['time_s']:.2f}"
+                if a["ok"]
+                else f"failed: {a['error'][:60]} | - | - | -"
+            )
             L.append(f"| {scene} (length: {s['length']}) | {r['c_N']:.0e} | {pen} | {aug} |")
     return L + [""]

@@ -29,6 +29,7 @@ shortened where the headline quantity is decided early (argued at each scene). T
 the finest this bench affords, not the range's end (Hertz n_el = 2000 is four million quads).
 ``quick`` is the slice the test suite runs (seconds).
 """
+
 import signal
 import threading
 import time
@@ -38,97 +39,180 @@ from dataclasses import dataclass, field
 from ...scenes import get_scene, run_scene
 from ...scenes.accuracy import AccuracyWarning
 
-TOL = 0.05          # a headline quantity more than 5 % off its reference is wrong
-REFINE = 0.25       # the reference's step, times the scene's (the presets are first order at worst:
-                    # the reference's own error is a quarter of the preset's, which is below 5 %)
+TOL = 0.05  # a headline quantity more than 5 % off its reference is wrong
+REFINE = 0.25  # the reference's step, times the scene's (the presets are first order at worst:
+# the reference's own error is a quarter of the preset's, which is below 5 %)
 TIME_LIMIT = 240.0  # seconds one run may take before it counts as past its time limit
-C_N = (1e-4, 1e-2, 1.0, 1e2, 1e4, 1e9, 1e18)     # penalty factors on the static scenes
-C_N_DYN = (1e-4, 1e-2, 1.0, 1e4, 1e18)           # and on the dynamic ones, crossed with DT
-DT = (1.0, 10.0)                                  # step factors crossed with the penalty
-DT_ALONE = 0.1                                    # a step factor at the scene's penalty only, beside Spec.tiny
-NUMERICAL = {"c_N", "c_N_factor", "dt", "dt_fine", "courant", "n_steps", "t_end", "enforcement",
-             "contact_discretization", "contact_integration", "integrator", "passes", "n_el", "nx", "ny",
-             "nx_lower", "nx_upper", "n_r", "n_z", "uzawa_tol", "travel_max"}
+C_N = (1e-4, 1e-2, 1.0, 1e2, 1e4, 1e9, 1e18)  # penalty factors on the static scenes
+C_N_DYN = (1e-4, 1e-2, 1.0, 1e4, 1e18)  # and on the dynamic ones, crossed with DT
+DT = (1.0, 10.0)  # step factors crossed with the penalty
+DT_ALONE = 0.1  # a step factor at the scene's penalty only, beside Spec.tiny
+NUMERICAL = {
+    "c_N",
+    "c_N_factor",
+    "dt",
+    "dt_fine",
+    "courant",
+    "n_steps",
+    "t_end",
+    "enforcement",
+    "contact_discretization",
+    "contact_integration",
+    "integrator",
+    "passes",
+    "n_el",
+    "nx",
+    "ny",
+    "nx_lower",
+    "nx_upper",
+    "n_r",
+    "n_z",
+    "uzawa_tol",
+    "travel_max",
+}
 
 
 @dataclass(frozen=True)
 class Spec:
     """How a scene enters the grid."""
-    headlines: tuple                 # result keys compared with the reference
-    base: dict = field(default_factory=dict)       # overrides every run shares (a shortened end)
-    scale: dict = field(default_factory=dict)      # headline -> the absolute scale of a near-zero one
-    c_N: str = "c_N"                 # the penalty's parameter
-    dt: str = None                   # the step's parameter (None: static)
-    steps: float = None              # end time kept by n_steps = steps / dt (the scenes counted in steps)
-    mesh: tuple = ()                 # (coarsest overrides, finest overrides)
-    mu: tuple = ()                   # the overrides of mu = 0 and mu = 2
-    methods: tuple = ()              # enforcement / discretisation / integration overrides
-    exact: dict = None               # headline -> the result key of its closed form
+
+    headlines: tuple  # result keys compared with the reference
+    base: dict = field(default_factory=dict)  # overrides every run shares (a shortened end)
+    scale: dict = field(default_factory=dict)  # headline -> the absolute scale of a near-zero one
+    c_N: str = "c_N"  # the penalty's parameter
+    dt: str = None  # the step's parameter (None: static)
+    steps: float = None  # end time kept by n_steps = steps / dt (the scenes counted in steps)
+    mesh: tuple = ()  # (coarsest overrides, finest overrides)
+    mu: tuple = ()  # the overrides of mu = 0 and mu = 2
+    methods: tuple = ()  # enforcement / discretisation / integration overrides
+    exact: dict = None  # headline -> the result key of its closed form
     reference: dict = field(default_factory=dict)  # what the reference adds (the block: lagrange)
-    c_N_factors: tuple = None        # the penalty factors, where not C_N / C_N_DYN (the cork: cost)
-    physical: tuple = ()             # numerical elsewhere, part of the problem here (the block's nx)
-    tiny: tuple = (1e-3, {})         # the smallest step factor and what makes it affordable (shared by its reference)
-    ref_mesh: dict = field(default_factory=dict)   # the reference's mesh at least this fine (else the preset's)
+    c_N_factors: tuple = None  # the penalty factors, where not C_N / C_N_DYN (the cork: cost)
+    physical: tuple = ()  # numerical elsewhere, part of the problem here (the block's nx)
+    tiny: tuple = (1e-3, {})  # the smallest step factor and what makes it affordable (shared by its reference)
+    ref_mesh: dict = field(default_factory=dict)  # the reference's mesh at least this fine (else the preset's)
 
 
 SCENES = {
     # static, closed form: a and p0 against Hertz's, whatever the run's settings
-    "hertz": Spec(("a", "p0"), mesh=({"n_el": 4}, {"n_el": 128}), exact={"a": "a_exact", "p0": "p0_exact"},
-                  methods=({"contact_discretization": "mortar"}, {"enforcement": "augmented"},
-                           {"enforcement": "lagrange"}, {"enforcement": "lagrange", "contact_discretization": "mortar"},
-                           {"enforcement": "lagrange", "c_N": 1e5}, {"enforcement": "lagrange", "c_N": 1e27},
-                           {"enforcement": "augmented", "contact_discretization": "mortar"})),
+    "hertz": Spec(
+        ("a", "p0"),
+        mesh=({"n_el": 4}, {"n_el": 128}),
+        exact={"a": "a_exact", "p0": "p0_exact"},
+        methods=(
+            {"contact_discretization": "mortar"},
+            {"enforcement": "augmented"},
+            {"enforcement": "lagrange"},
+            {"enforcement": "lagrange", "contact_discretization": "mortar"},
+            {"enforcement": "lagrange", "c_N": 1e5},
+            {"enforcement": "lagrange", "c_N": 1e27},
+            {"enforcement": "augmented", "contact_discretization": "mortar"},
+        ),
+    ),
     # static: the largest displacement against the same block solved with Lagrange multipliers and 16
     # elements through its height; nx is the problem's own (the free ends are free_end_nodes of nx)
-    "block": Spec(("max_displacement",), mesh=({"nx": 3, "ny": 1}, {"nx": 3, "ny": 1, "free_end_nodes": 1},
-                                                {"nx": 100, "ny": 32}),
-                  mu=({"law": "coulomb", "mu": 0.0}, {"law": "coulomb", "mu": 2.0}),
-                  methods=({"contact_discretization": "mortar"}, {"enforcement": "augmented"},
-                           {"enforcement": "lagrange"}, {"law": "coulomb", "enforcement": "lagrange"}),
-                  reference={"enforcement": "lagrange"}, physical=("nx",), ref_mesh={"ny": 16}),
+    "block": Spec(
+        ("max_displacement",),
+        mesh=({"nx": 3, "ny": 1}, {"nx": 3, "ny": 1, "free_end_nodes": 1}, {"nx": 100, "ny": 32}),
+        mu=({"law": "coulomb", "mu": 0.0}, {"law": "coulomb", "mu": 2.0}),
+        methods=(
+            {"contact_discretization": "mortar"},
+            {"enforcement": "augmented"},
+            {"enforcement": "lagrange"},
+            {"law": "coulomb", "enforcement": "lagrange"},
+        ),
+        reference={"enforcement": "lagrange"},
+        physical=("nx",),
+        ref_mesh={"ny": 16},
+    ),
     # static, closed form: the uniform pressure on both blocks (pressure_deviation_max is the error)
-    "patch": Spec(("pressure",), mesh=({"nx_lower": 1, "nx_upper": 1, "ny": 1}, {"nx_lower": 11, "nx_upper": 5},
-                                       {"nx_lower": 17, "nx_upper": 3}, {"nx_lower": 64, "nx_upper": 117, "ny": 16}),
-                  mu=({"mu": 2.0},),
-                  methods=({"passes": 2}, {"contact_discretization": "mortar"}, {"enforcement": "augmented"},
-                           {"enforcement": "lagrange"}, {"enforcement": "lagrange", "contact_discretization": "mortar"},
-                           {"enforcement": "lagrange", "c_N": 1e10}, {"enforcement": "lagrange", "c_N": 1e24},
-                           {"contact_discretization": "mortar", "nx_lower": 17, "nx_upper": 3})),
+    "patch": Spec(
+        ("pressure",),
+        mesh=(
+            {"nx_lower": 1, "nx_upper": 1, "ny": 1},
+            {"nx_lower": 11, "nx_upper": 5},
+            {"nx_lower": 17, "nx_upper": 3},
+            {"nx_lower": 64, "nx_upper": 117, "ny": 16},
+        ),
+        mu=({"mu": 2.0},),
+        methods=(
+            {"passes": 2},
+            {"contact_discretization": "mortar"},
+            {"enforcement": "augmented"},
+            {"enforcement": "lagrange"},
+            {"enforcement": "lagrange", "contact_discretization": "mortar"},
+            {"enforcement": "lagrange", "c_N": 1e10},
+            {"enforcement": "lagrange", "c_N": 1e24},
+            {"contact_discretization": "mortar", "nx_lower": 17, "nx_upper": 3},
+        ),
+    ),
     # the rebound is over by t = 2.4 (the paper's step: contact from 0.1 to 2.4): end at 4; dt / 1000 ends at 3
-    "sloping_impact": Spec(("rebound_vx", "rebound_vy"), scale={"rebound_vx": 2.83, "rebound_vy": 2.83},
-                           tiny=(1e-3, {"n_steps": 30000}),
-                           dt="dt", steps=4.0, mesh=({"n_el": 3}, {"n_el": 400}),
-                           mu=({"variant": "frictional", "alpha": 0.0, "beta": 0.0},
-                               {"variant": "frictional", "alpha": 0.0, "beta": 2.0}),
-                           methods=({"contact_integration": "energy_consistent"},
-                                    {"contact_integration": "energy_consistent", "c_N": 5e5},
-                                    {"variant": "frictional"}, {"variant": "viscoplastic"},
-                                    {"kind": "continuum"})),
+    "sloping_impact": Spec(
+        ("rebound_vx", "rebound_vy"),
+        scale={"rebound_vx": 2.83, "rebound_vy": 2.83},
+        tiny=(1e-3, {"n_steps": 30000}),
+        dt="dt",
+        steps=4.0,
+        mesh=({"n_el": 3}, {"n_el": 400}),
+        mu=({"variant": "frictional", "alpha": 0.0, "beta": 0.0}, {"variant": "frictional", "alpha": 0.0, "beta": 2.0}),
+        methods=(
+            {"contact_integration": "energy_consistent"},
+            {"contact_integration": "energy_consistent", "c_N": 5e5},
+            {"variant": "frictional"},
+            {"variant": "viscoplastic"},
+            {"kind": "continuum"},
+        ),
+    ),
     # rolling starts near t = 1.02 s (mu = 0.15) and v_final is read after it: 1.5 s of the 2
     # dt / 1000: mu = 2 rolls from t = 0.076 s, so 0.2 s of it (10,000 steps) decides v_final
-    "rolling_ring": Spec(("v_final", "x_end"), base={"t_end": 1.5}, scale={"v_final": 300.0}, dt="dt",
-                         tiny=(1e-3, {"mu": 2.0, "t_end": 0.2}),
-                         mesh=({"n_el": 8}, {"n_el": 480}), mu=({"mu": 1e-9}, {"mu": 2.0}),
-                         methods=({"contact_integration": "energy_consistent"}, {"kind": "continuum"})),
+    "rolling_ring": Spec(
+        ("v_final", "x_end"),
+        base={"t_end": 1.5},
+        scale={"v_final": 300.0},
+        dt="dt",
+        tiny=(1e-3, {"mu": 2.0, "t_end": 0.2}),
+        mesh=({"n_el": 8}, {"n_el": 480}),
+        mu=({"mu": 1e-9}, {"mu": 2.0}),
+        methods=({"contact_integration": "energy_consistent"}, {"kind": "continuum"}),
+    ),
     # one impact: contact lasts 2L/c, the run ends at 1.5 of it (the preset)
     # courant / 1000 on 4 elements (12,000 steps; 40 elements would take 120,000)
-    "bar_impact": Spec(("duration", "rebound_velocity"), c_N="c_N_factor", dt="courant", tiny=(1e-3, {"n_el": 4}),
-                       mesh=({"n_el": 2}, {"n_el": 400}),
-                       methods=({"integrator": "central_difference", "courant": 0.5},
-                                {"contact_integration": "energy_consistent"}, {"contact_discretization": "mortar"},
-                                {"enforcement": "augmented"}, {"enforcement": "lagrange"},
-                                {"enforcement": "lagrange", "c_N_factor": 1e-4},
-                                {"enforcement": "lagrange", "c_N_factor": 1e18})),
+    "bar_impact": Spec(
+        ("duration", "rebound_velocity"),
+        c_N="c_N_factor",
+        dt="courant",
+        tiny=(1e-3, {"n_el": 4}),
+        mesh=({"n_el": 2}, {"n_el": 400}),
+        methods=(
+            {"integrator": "central_difference", "courant": 0.5},
+            {"contact_integration": "energy_consistent"},
+            {"contact_discretization": "mortar"},
+            {"enforcement": "augmented"},
+            {"enforcement": "lagrange"},
+            {"enforcement": "lagrange", "c_N_factor": 1e-4},
+            {"enforcement": "lagrange", "c_N_factor": 1e18},
+        ),
+    ),
     # the lowest point is reached at t = 4.4 and the ring has left the wall by 7: end at 8
     # dt / 100 (8,000 steps): dt / 1000 would take 80,000
-    "funnel": Spec(("y_c_min", "v_c_final"), scale={"v_c_final": 4.0}, dt="dt", steps=8.0, tiny=(1e-2, {}),
-                   mesh=({"n_el": 2}, {"n_el": 240}), mu=({"variant": "frictional", "alpha": 0.0, "beta": 0.0},
-                                                           {"variant": "frictional", "alpha": 0.0, "beta": 2.0}),
-                   methods=({"contact_integration": "energy_consistent"}, {"variant": "frictional"})),
+    "funnel": Spec(
+        ("y_c_min", "v_c_final"),
+        scale={"v_c_final": 4.0},
+        dt="dt",
+        steps=8.0,
+        tiny=(1e-2, {}),
+        mesh=({"n_el": 2}, {"n_el": 240}),
+        mu=({"variant": "frictional", "alpha": 0.0, "beta": 0.0}, {"variant": "frictional", "alpha": 0.0, "beta": 2.0}),
+        methods=({"contact_integration": "energy_consistent"}, {"variant": "frictional"}),
+    ),
     # 8 s a run at the fast preset: the penalty's ends, friction's and the coarse mesh only; its dt sets
     # the gas ramp (p_step a step), so the reference refines the pop's dt_fine and travel_max
-    "cork": Spec(("exit_velocity_m_s", "exit_time_ms"), mu=({"mu": 0.0}, {"mu": 2.0}),
-                 mesh=({"n_r": 1, "n_z": 3},), c_N_factors=(1e-4, 1e4)),
+    "cork": Spec(
+        ("exit_velocity_m_s", "exit_time_ms"),
+        mu=({"mu": 0.0}, {"mu": 2.0}),
+        mesh=({"n_r": 1, "n_z": 3},),
+        c_N_factors=(1e-4, 1e4),
+    ),
 }
 
 
@@ -162,14 +246,25 @@ def _points():
         c0 = _default(scene, spec.c_N)
         dynamic = spec.dt is not None or scene == "cork"
         for f in spec.c_N_factors or (C_N_DYN if dynamic else C_N):
-            for d in (DT if spec.dt else (1.0,)):
-                points.append((scene, dict(_with_step(spec, scene, spec.base, d), **{spec.c_N: c0 * f}),
-                               f"c_N x {f:g}" + (f", dt x {d:g}" if spec.dt else "")))
+            for d in DT if spec.dt else (1.0,):
+                points.append(
+                    (
+                        scene,
+                        dict(_with_step(spec, scene, spec.base, d), **{spec.c_N: c0 * f}),
+                        f"c_N x {f:g}" + (f", dt x {d:g}" if spec.dt else ""),
+                    )
+                )
         if spec.dt:
             points.append((scene, _with_step(spec, scene, spec.base, DT_ALONE), f"dt x {DT_ALONE:g}"))
             f, keep = spec.tiny
-            points.append((scene, _with_step(spec, scene, dict(spec.base, **keep), f),
-                           f"dt x {f:g}" + (f" ({_text(keep)})" if keep else ""), keep))
+            points.append(
+                (
+                    scene,
+                    _with_step(spec, scene, dict(spec.base, **keep), f),
+                    f"dt x {f:g}" + (f" ({_text(keep)})" if keep else ""),
+                    keep,
+                )
+            )
         for over in spec.mesh:
             points.append((scene, dict(base, **over), "mesh " + _text(over)))
         for over in spec.mu:
@@ -177,8 +272,13 @@ def _points():
         for over in spec.methods:
             points.append((scene, dict(base, **over), "method " + _text(over)))
             if spec.dt and not any(k in over for k in ("courant", "c_N", "c_N_factor")):
-                points.append((scene, dict(_with_step(spec, scene, spec.base, 10.0), **over),
-                               "method " + _text(over) + ", dt x 10"))
+                points.append(
+                    (
+                        scene,
+                        dict(_with_step(spec, scene, spec.base, 10.0), **over),
+                        "method " + _text(over) + ", dt x 10",
+                    )
+                )
     return points
 
 
@@ -194,14 +294,17 @@ def reference_overrides(scene, over, keep=None):
     ref.update(spec.base)
     ref.update(keep or {})
     ref.update(spec.reference)
-    if scene == "cork":        # its dt is the gas ramp's (p_step a step): the pop's fine step and travel refined
+    if scene == "cork":  # its dt is the gas ramp's (p_step a step): the pop's fine step and travel refined
         ref.update(dt_fine=_default(scene, "dt_fine") * REFINE, travel_max=_default(scene, "travel_max") * REFINE)
     elif spec.dt:
-        step = _default(scene, spec.dt) * REFINE         # a run finer than that is checked against it
+        step = _default(scene, spec.dt) * REFINE  # a run finer than that is checked against it
         ref[spec.dt] = step
-        if spec.steps:                                  # the run's end time, in the reference's steps
-            end = float(over.get(spec.dt, _default(scene, spec.dt))) * over["n_steps"] if "n_steps" in over \
+        if spec.steps:  # the run's end time, in the reference's steps
+            end = (
+                float(over.get(spec.dt, _default(scene, spec.dt))) * over["n_steps"]
+                if "n_steps" in over
                 else spec.steps
+            )
             ref["n_steps"] = max(1, round(end / step))
     if over.get("enforcement", "penalty") == "penalty":
         c0 = _default(scene, spec.c_N)
@@ -246,10 +349,15 @@ def attempt(scene, over, seconds=TIME_LIMIT):
             one = bool(text) and "\n" not in text.strip()
             kind = ("refused" if isinstance(err, ValueError) else "stopped") if one else "crashed"
             return dict(outcome=kind, error=f"{type(err).__name__}: {text}"[:300], time_s=time.perf_counter() - t0)
-        except Exception as err:                    # noqa: BLE001 (anything else is a crash, counted)
+        except Exception as err:  # noqa: BLE001 (anything else is a crash, counted)
             return dict(outcome="crashed", error=f"{type(err).__name__}: {err}"[:300], time_s=time.perf_counter() - t0)
-    flags = sorted({str(w.message).split(" = ")[0].removeprefix("accuracy: ") for w in caught
-                    if issubclass(w.category, AccuracyWarning)})
+    flags = sorted(
+        {
+            str(w.message).split(" = ")[0].removeprefix("accuracy: ")
+            for w in caught
+            if issubclass(w.category, AccuracyWarning)
+        }
+    )
     failing = sorted(k for k, v in (r.get("accuracy") or {}).items() if isinstance(v, dict) and not v.get("ok", True))
     return dict(outcome="ran", result=r, flags=sorted(set(flags) | set(failing)), time_s=time.perf_counter() - t0)
 
@@ -288,8 +396,17 @@ def classify(scene, run, ref):
     return ("wrong" if off else "within"), errors
 
 
-OUTCOMES = ("within", "flagged (off)", "flagged (within)", "refused", "stopped", "wrong", "crashed", "late",
-            "no reference")
+OUTCOMES = (
+    "within",
+    "flagged (off)",
+    "flagged (within)",
+    "refused",
+    "stopped",
+    "wrong",
+    "crashed",
+    "late",
+    "no reference",
+)
 
 
 def extremes_study(quick=False, progress=None, seconds=TIME_LIMIT):
@@ -304,18 +421,34 @@ def extremes_study(quick=False, progress=None, seconds=TIME_LIMIT):
                 refs[key] = attempt(scene, dict(key[1]), seconds)
             ref = refs[key]
         outcome, errors = classify(scene, run, ref)
-        row = dict(scene=scene, axis=axis, overrides=over, outcome=outcome, errors=errors,
-                   flags=run.get("flags", []), error=run.get("error", ""), time_s=run["time_s"])
+        row = dict(
+            scene=scene,
+            axis=axis,
+            overrides=over,
+            outcome=outcome,
+            errors=errors,
+            flags=run.get("flags", []),
+            error=run.get("error", ""),
+            time_s=run["time_s"],
+        )
         if ref is not None:
-            row["reference"] = dict(overrides=dict(key[1]), outcome=ref["outcome"], error=ref.get("error", ""),
-                                    flags=ref.get("flags", []))
+            row["reference"] = dict(
+                overrides=dict(key[1]), outcome=ref["outcome"], error=ref.get("error", ""), flags=ref.get("flags", [])
+            )
         rows.append(row)
         if progress:
             progress(f"extremes: {scene} {axis}: {outcome} {_errors_text(errors)} {row['error'][:80]}")
     counts = {k: sum(r["outcome"] == k for r in rows) for k in OUTCOMES}
-    return dict(tol=TOL, refine=REFINE, quick=bool(quick), runs=len(rows), reference_runs=len(refs),
-                counts=counts, rows=rows, time_s=sum(r["time_s"] for r in rows) +
-                sum(r["time_s"] for r in refs.values()))
+    return dict(
+        tol=TOL,
+        refine=REFINE,
+        quick=bool(quick),
+        runs=len(rows),
+        reference_runs=len(refs),
+        counts=counts,
+        rows=rows,
+        time_s=sum(r["time_s"] for r in rows) + sum(r["time_s"] for r in refs.values()),
+    )
 
 
 def _errors_text(errors):
@@ -347,20 +480,41 @@ QUICK = [
 
 # what the grid found wrong and unflagged, and what was added (measured when each was found, not by this run)
 FINDINGS = [
-    ("bar_impact, c_N x 1e-4", "duration 44 %, rebound 200 % off: the run ends in contact and reads its rebound "
-     "mid-impact", "`separated` (an impact scene in contact at its end)"),
-    ("block, nx = 3, ny = 1", "largest displacement 26 % off 16 elements through the height",
-     "`mesh_height` (at least 4; measured at nx = 3, 10, 25)"),
-    ("sloping_impact, n_el = 3", "rebound v_y 31 % off the 16-element ring's", "`facets` (the angle one element "
-     "of a ring spans, at most 0.8 rad: 8 elements)"),
-    ("rolling_ring, c_N x 1e4", "x_end 5.9 % off (its closed-form indicator allowed 10 %)",
-     "`x_end` against the closed form to 5 % (2.1 % at the preset)"),
-    ("bar_impact, energy-consistent, courant x 10", "rebound 11 % off, its energy exact", "`penalty_steps` for "
-     "the midpoint rule too (its period error is Newmark's)"),
-    ("funnel, c_N x 1e18", "never ended: the parts of a halved step were halved again without end (1e-11 of "
-     "the step)", "a fixed step is halved at most max_cuts times in all: the run stops in one line"),
-    ("cork, c_N x 1e-4", "exit velocity 22 %, exit time 21 % off, no penetration indicator (the cork had no "
-     "lengths)", "the cork's lengths: `penetration` as every scene's"),
+    (
+        "bar_impact, c_N x 1e-4",
+        "duration 44 %, rebound 200 % off: the run ends in contact and reads its rebound mid-impact",
+        "`separated` (an impact scene in contact at its end)",
+    ),
+    (
+        "block, nx = 3, ny = 1",
+        "largest displacement 26 % off 16 elements through the height",
+        "`mesh_height` (at least 4; measured at nx = 3, 10, 25)",
+    ),
+    (
+        "sloping_impact, n_el = 3",
+        "rebound v_y 31 % off the 16-element ring's",
+        "`facets` (the angle one element of a ring spans, at most 0.8 rad: 8 elements)",
+    ),
+    (
+        "rolling_ring, c_N x 1e4",
+        "x_end 5.9 % off (its closed-form indicator allowed 10 %)",
+        "`x_end` against the closed form to 5 % (2.1 % at the preset)",
+    ),
+    (
+        "bar_impact, energy-consistent, courant x 10",
+        "rebound 11 % off, its energy exact",
+        "`penalty_steps` for the midpoint rule too (its period error is Newmark's)",
+    ),
+    (
+        "funnel, c_N x 1e18",
+        "never ended: the parts of a halved step were halved again without end (1e-11 of the step)",
+        "a fixed step is halved at most max_cuts times in all: the run stops in one line",
+    ),
+    (
+        "cork, c_N x 1e-4",
+        "exit velocity 22 %, exit time 21 % off, no penetration indicator (the cork had no lengths)",
+        "the cork's lengths: `penetration` as every scene's",
+    ),
 ]
 
 
@@ -368,32 +522,52 @@ def extremes_markdown(res):
     """The BENCHMARKS.md section of the study."""
     c = res["counts"]
     judged = res["runs"]
-    L = ["## Extremes: every run within its reference, flagged, refused or stopped", "",
-         f"{judged} runs over the numerical ranges of every scene ({res['reference_runs']} refined reference runs "
-         f"besides; {res['time_s']:.0f} s in all). A run is *within* when no accuracy indicator is past its "
-         f"threshold and every headline quantity is within {100 * res['tol']:g} % of its reference (the closed "
-         "form where the scene has one, else the same problem with the step "
-         f"{res['refine']:g} times the scene's, the penalty no softer than the scene's, the finer mesh and the "
-         "default methods); *flagged* when an indicator is past its threshold (off: a headline more than "
-         f"{100 * res['tol']:g} % off as well); *wrong* when neither. The grid and each choice: "
-         "contactfem/lab/bench/extremes.py.", "",
-         "| outcome | runs |", "|---|---|"]
+    L = [
+        "## Extremes: every run within its reference, flagged, refused or stopped",
+        "",
+        f"{judged} runs over the numerical ranges of every scene ({res['reference_runs']} refined reference runs "
+        f"besides; {res['time_s']:.0f} s in all). A run is *within* when no accuracy indicator is past its "
+        f"threshold and every headline quantity is within {100 * res['tol']:g} % of its reference (the closed "
+        "form where the scene has one, else the same problem with the step "
+        f"{res['refine']:g} times the scene's, the penalty no softer than the scene's, the finer mesh and the "
+        "default methods); *flagged* when an indicator is past its threshold (off: a headline more than "
+        f"{100 * res['tol']:g} % off as well); *wrong* when neither. The grid and each choice: "
+        "contactfem/lab/bench/extremes.py.",
+        "",
+        "| outcome | runs |",
+        "|---|---|",
+    ]
     L += [f"| {k} | {c.get(k, 0)} |" for k in OUTCOMES]
-    L += ["", "Each scene's part of the grid (contactfem/lab/bench/extremes.py, SCENES: every run at the fast "
-          "preset; the penalty and the step crossed on the dynamic scenes, each other axis alone):", "",
-          "| scene | headline quantities | reference | coarsest and fine meshes | smallest step |",
-          "|---|---|---|---|---|"]
+    L += [
+        "",
+        "Each scene's part of the grid (contactfem/lab/bench/extremes.py, SCENES: every run at the fast "
+        "preset; the penalty and the step crossed on the dynamic scenes, each other axis alone):",
+        "",
+        "| scene | headline quantities | reference | coarsest and fine meshes | smallest step |",
+        "|---|---|---|---|---|",
+    ]
     for scene, spec in SCENES.items():
-        ref = "closed form" if not needs_reference(scene) else "refined run" + (
-            f" ({_text(spec.reference)})" if spec.reference else "")
+        ref = (
+            "closed form"
+            if not needs_reference(scene)
+            else "refined run" + (f" ({_text(spec.reference)})" if spec.reference else "")
+        )
         tiny = "-" if not spec.dt else f"{spec.tiny[0]:g} x" + (f" ({_text(spec.tiny[1])})" if spec.tiny[1] else "")
         meshes = "; ".join(_text(m) for m in spec.mesh)
         L.append(f"| {scene} | {', '.join(spec.headlines)} | {ref} | {meshes} | {tiny} |")
-    L += ["", "What the grid found wrong and unflagged, and what was added (measured when each was found, not "
-          "by this run):", "", "| run | what was wrong | added |", "|---|---|---|"]
+    L += [
+        "",
+        "What the grid found wrong and unflagged, and what was added (measured when each was found, not by this run):",
+        "",
+        "| run | what was wrong | added |",
+        "|---|---|---|",
+    ]
     L += [f"| {a} | {b} | {c} |" for a, b, c in FINDINGS]
-    L += ["", "| scene | setting | outcome | headline errors | indicators past their thresholds / the error |",
-          "|---|---|---|---|---|"]
+    L += [
+        "",
+        "| scene | setting | outcome | headline errors | indicators past their thresholds / the error |",
+        "|---|---|---|---|---|",
+    ]
     for r in res["rows"]:
         what = ", ".join(r["flags"]) if r["flags"] else r["error"][:120].replace("|", "/")
         errors = _errors_text(r["errors"]) or "-"

@@ -15,6 +15,7 @@ import numpy as np
 from ...plots import default_outdir, figure, pyplot
 from ...plots.data import save_figure
 
+
 def bench_json_path():
     """$CONTACTFEM_BENCH if set, else bench.json at the repository root (may not exist)."""
     env = os.environ.get("CONTACTFEM_BENCH")
@@ -57,8 +58,9 @@ def bench_tangents(preset="fast", outdir=None):
             r = rows[v]
             if r["converged"]:
                 ax.bar(i, r["iterations"], color=colors[v])
-                ax.text(i, r["iterations"], f"{r['iterations']}\n{r['time_s']:.2g} s", ha="center", va="bottom",
-                        fontsize=8)
+                ax.text(
+                    i, r["iterations"], f"{r['iterations']}\n{r['time_s']:.2g} s", ha="center", va="bottom", fontsize=8
+                )
             else:
                 ax.bar(i, top * 1.1, color="none", edgecolor=colors[v], hatch="//")
                 ax.text(i, top * 0.5, "diverged", ha="center", rotation=90, fontsize=9)
@@ -76,8 +78,9 @@ def _save(fig, outdir, preset, stem, section):
     source, kind and machine as the parameters."""
     b = load_bench(preset)
     path = bench_json_path()
-    parameters = dict(source=path.name if path.exists() else "a quick bench run", quick=b.get("quick"),
-                      machine=b.get("machine"))
+    parameters = dict(
+        source=path.name if path.exists() else "a quick bench run", quick=b.get("quick"), machine=b.get("machine")
+    )
     return save_figure(fig, Path(outdir or default_outdir(preset)) / f"{stem}.png", {section: b[section]}, parameters)
 
 
@@ -100,53 +103,91 @@ def bench_work_precision(preset="fast", outdir=None):
     ax.loglog([r["time_s"] for r in rows], [abs(r["error_p0"]) for r in rows], "o-", label="|error p0|" + slope)
     ax.loglog([r["time_s"] for r in rows], [abs(r["error_a"]) for r in rows], "s--", label="|error a| (fit)")
     for r in rows:
-        ax.annotate(f"{r['n_quads']} quads", (r["time_s"], abs(r["error_p0"])), fontsize=7,
-                    textcoords="offset points", xytext=(4, 4))
+        ax.annotate(
+            f"{r['n_quads']} quads",
+            (r["time_s"], abs(r["error_p0"])),
+            fontsize=7,
+            textcoords="offset points",
+            xytext=(4, 4),
+        )
     ax.set_title("Hertz, mesh refinement")
     ax.set_xlabel("wall time of the solve [s]")
     ax.set_ylabel("relative error")
     ax.legend(fontsize=7, loc="lower left")
 
     ax = axes[1]
-    series = [("ring_dt_newmark_0.7/0.4", "dt, Newmark 0.7/0.4", "o-"),
-              ("ring_dt_newmark_0.5/0.25", "dt, Newmark 0.5/0.25", "v-"),
-              ("ring_mesh", "mesh (n_el)", "s--")]
+    series = [
+        ("ring_dt_newmark_0.7/0.4", "dt, Newmark 0.7/0.4", "o-"),
+        ("ring_dt_newmark_0.5/0.25", "dt, Newmark 0.5/0.25", "v-"),
+        ("ring_mesh", "mesh (n_el)", "s--"),
+    ]
     for key, label, style in series:
         rows = [r for r in _rows(wp[key]) if r["error_x_roll"]]
         if rows:
             ax.loglog([r["time_s"] for r in rows], [r["error_x_roll"] for r in rows], style, label=label)
-            if key == "ring_dt_newmark_0.7/0.4":       # the paper's Newmark: which dt is which
+            if key == "ring_dt_newmark_0.7/0.4":  # the paper's Newmark: which dt is which
                 for r in rows:
-                    ax.annotate(f"dt {r['dt']}", (r["time_s"], r["error_x_roll"]), fontsize=6,
-                                textcoords="offset points", xytext=(0, 6), ha="center")
+                    ax.annotate(
+                        f"dt {r['dt']}",
+                        (r["time_s"], r["error_x_roll"]),
+                        fontsize=6,
+                        textcoords="offset points",
+                        xytext=(0, 6),
+                        ha="center",
+                    )
             elif key == "ring_dt_newmark_0.5/0.25":
                 for r in rows:
-                    ax.annotate(f"dt {r['dt']}", (r["time_s"], r["error_x_roll"]), fontsize=6, color="C1",
-                                textcoords="offset points", xytext=(4, -9))
-            elif key == "ring_mesh":                     # and which mesh (at dt = 0.01)
+                    ax.annotate(
+                        f"dt {r['dt']}",
+                        (r["time_s"], r["error_x_roll"]),
+                        fontsize=6,
+                        color="C1",
+                        textcoords="offset points",
+                        xytext=(4, -9),
+                    )
+            elif key == "ring_mesh":  # and which mesh (at dt = 0.01)
                 for r in rows:
-                    ax.annotate(f"{r['n_el']} el", (r["time_s"], r["error_x_roll"]), fontsize=6,
-                                textcoords="offset points", xytext=(4, -8))
+                    ax.annotate(
+                        f"{r['n_el']} el",
+                        (r["time_s"], r["error_x_roll"]),
+                        fontsize=6,
+                        textcoords="offset points",
+                        xytext=(4, -8),
+                    )
     for r in _rows(wp["ring_kind"]):
         if r["error_x_roll"]:
-            ax.loglog(r["time_s"], r["error_x_roll"], "*" if r["kind"] == "continuum" else "D", ms=10,
-                      mfc="none" if r["kind"] == "beam" else None, mew=1.5,
-                      label=f"{r['kind']} ring ({r['n_el']} el, dt {r['dt']})")
-    ax.set_title("Rolling ring: error of the rolling point x*\n(dt study on 120 elements; mesh study at dt 0.01)",
-                 fontsize=10)
+            ax.loglog(
+                r["time_s"],
+                r["error_x_roll"],
+                "*" if r["kind"] == "continuum" else "D",
+                ms=10,
+                mfc="none" if r["kind"] == "beam" else None,
+                mew=1.5,
+                label=f"{r['kind']} ring ({r['n_el']} el, dt {r['dt']})",
+            )
+    ax.set_title(
+        "Rolling ring: error of the rolling point x*\n(dt study on 120 elements; mesh study at dt 0.01)", fontsize=10
+    )
     ax.set_xlabel("wall time of the run [s]")
     ax.set_ylabel("|x_roll / x*_rigid - 1|")
     ax.legend(fontsize=6.5, loc="best")
 
     ax = axes[2]
     b = wp["bar_implicit_explicit"]
-    for key, label, style in (("newmark", "implicit Newmark 1/2, 1/4", "o-"),
-                              ("central_difference", "explicit central differences", "s-")):
+    for key, label, style in (
+        ("newmark", "implicit Newmark 1/2, 1/4", "o-"),
+        ("central_difference", "explicit central differences", "s-"),
+    ):
         rows = b[key]
         ax.loglog([r["time_s"] for r in rows], [abs(r["error_duration"]) for r in rows], style, label=label)
         for r in rows:
-            ax.annotate(f"c dt/h = {r['courant']}", (r["time_s"], abs(r["error_duration"])), fontsize=7,
-                        textcoords="offset points", xytext=(3, 3))
+            ax.annotate(
+                f"c dt/h = {r['courant']}",
+                (r["time_s"], abs(r["error_duration"])),
+                fontsize=7,
+                textcoords="offset points",
+                xytext=(3, 3),
+            )
     ax.set_title(f"Bar impact ({b['n_el']} elements): contact duration")
     from matplotlib.ticker import NullFormatter
 
@@ -167,8 +208,12 @@ def bench_cost(preset="fast", outdir=None):
     c = load_bench(preset)["cost"]
     fig, (ax, ax2) = plt.subplots(1, 2, figsize=(13, 4.2), gridspec_kw=dict(width_ratios=[2, 1]))
     names = list(c["cases"])
-    parts = (("bulk_s", "bulk (body.internal)", "C0"), ("contact_s", "contact", "C3"),
-             ("assembly_s", "global assembly", "C7"), ("solve_s", "linear solve", "C2"))
+    parts = (
+        ("bulk_s", "bulk (body.internal)", "C0"),
+        ("contact_s", "contact", "C3"),
+        ("assembly_s", "global assembly", "C7"),
+        ("solve_s", "linear solve", "C2"),
+    )
     bottom = np.zeros(len(names))
     for key, label, color in parts:
         vals = np.array([c["cases"][n][key] for n in names])
@@ -205,8 +250,11 @@ def bench_speed(preset="fast", outdir=None):
     sp = load_bench(preset)["speed"]
     rows = sp["iterations"]
     fig, (ax, ax2) = plt.subplots(1, 2, figsize=(13, 4.6), gridspec_kw=dict(width_ratios=[3, 2]))
-    names = [r["scene"] + "".join(f", {v}" for v in r["overrides"].values()) + f"\n{r['ndof']} unknowns, "
-             f"{r['linear_algebra']}" for r in rows]
+    names = [
+        r["scene"] + "".join(f", {v}" for v in r["overrides"].values()) + f"\n{r['ndof']} unknowns, "
+        f"{r['linear_algebra']}"
+        for r in rows
+    ]
     colors = dict(bulk="C0", contact="C3", assembly="C7", solve="C2", overhead="C8")
     ms = np.array([[1e3 * r[f"{part}_s"] for part in PARTS] for r in rows])
     total = ms.sum(axis=1)
@@ -217,16 +265,33 @@ def bench_speed(preset="fast", outdir=None):
     scale = np.where(shrunk, 0.98 * xmax / total, 1.0)
     left = np.zeros(len(rows))
     for k, part in enumerate(PARTS):
-        ax.barh(range(len(rows)), ms[:, k] * scale, left=left, color=colors[part], label=part,
-                hatch=["//" if s else "" for s in shrunk], edgecolor="w", linewidth=0)
+        ax.barh(
+            range(len(rows)),
+            ms[:, k] * scale,
+            left=left,
+            color=colors[part],
+            label=part,
+            hatch=["//" if s else "" for s in shrunk],
+            edgecolor="w",
+            linewidth=0,
+        )
         left += ms[:, k] * scale
-    goals = {("sloping_impact", "frictional"): T["sloping_impact_iteration_s"],
-             ("rolling_ring", None): T["rolling_ring_iteration_s"]}
+    goals = {
+        ("sloping_impact", "frictional"): T["sloping_impact_iteration_s"],
+        ("rolling_ring", None): T["rolling_ring_iteration_s"],
+    }
     for i, r in enumerate(rows):
         label = f"{total[i]:.3g} ms" + (", shrunk to fit" if shrunk[i] else "")
-        ax.text(left[i] * 0.99 if shrunk[i] else left[i] + 0.01 * xmax, i, label, va="center",
-                ha="right" if shrunk[i] else "left", fontsize=8, color="w" if shrunk[i] else "k",
-                bbox=dict(facecolor="k", alpha=0.7, lw=0, pad=1.5) if shrunk[i] else None)
+        ax.text(
+            left[i] * 0.99 if shrunk[i] else left[i] + 0.01 * xmax,
+            i,
+            label,
+            va="center",
+            ha="right" if shrunk[i] else "left",
+            fontsize=8,
+            color="w" if shrunk[i] else "k",
+            bbox=dict(facecolor="k", alpha=0.7, lw=0, pad=1.5) if shrunk[i] else None,
+        )
         goal = goals.get((r["scene"], r["overrides"].get("variant")))
         if goal and r["preset"] == "paper":
             ax.plot([1e3 * goal] * 2, [i - 0.4, i + 0.4], "k-", lw=2)
@@ -238,8 +303,12 @@ def bench_speed(preset="fast", outdir=None):
     ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=6)
     ax.set_title(f"{sp['preset']} preset: where an iteration goes", fontsize=9)
     st = sp["startup"]
-    procs = (("python", "python -c pass"), ("list", "contactfem list"),
-             ("scipy_skfem", "import scipy.sparse.linalg, skfem"), ("run_block", "contactfem run block\n--preset paper"))
+    procs = (
+        ("python", "python -c pass"),
+        ("list", "contactfem list"),
+        ("scipy_skfem", "import scipy.sparse.linalg, skfem"),
+        ("run_block", "contactfem run block\n--preset paper"),
+    )
     walls = [st[k]["wall_s"] for k, _ in procs]
     ax2.barh(range(len(procs)), walls, color=["C7", "C0", "C7", "C0"])
     for i, w in enumerate(walls):
@@ -251,8 +320,11 @@ def bench_speed(preset="fast", outdir=None):
     ax2.invert_yaxis()
     ax2.set_xlim(0, 1.15 * max(walls + [block_goal, T["list_s"]]))
     ax2.set_xlabel("whole process, wall [s] (median)")
-    ax2.set_title(f"start-up: list {st['list_over_python']:.1f} x python, run block "
-                  f"{st['run_block_over_scipy_skfem']:.2f} x scipy + skfem", fontsize=9)
+    ax2.set_title(
+        f"start-up: list {st['list_over_python']:.1f} x python, run block "
+        f"{st['run_block_over_scipy_skfem']:.2f} x scipy + skfem",
+        fontsize=9,
+    )
     fig.tight_layout()
     return _save(fig, outdir, preset, "bench_speed", "speed")
 
@@ -281,29 +353,69 @@ def bench_adaptive(preset="fast", outdir=None):
     for ax, (name, s) in zip(axes[0], scenes.items()):
         fixed = [f for f in s["fixed"] if f.get("error")]
         adaptive = [a for a in s["adaptive"] if a.get("error")]
-        ax.loglog([f["error"] for f in fixed], [f["residual_evaluations"] for f in fixed], "o-", color="C0",
-                  label=f"fixed {s['step']}, preset")
+        ax.loglog(
+            [f["error"] for f in fixed],
+            [f["residual_evaluations"] for f in fixed],
+            "o-",
+            color="C0",
+            label=f"fixed {s['step']}, preset",
+        )
         for f in fixed:
-            ax.annotate(f"{f['h']:g}", (f["error"], f["residual_evaluations"]), fontsize=6, color="C0",
-                        textcoords="offset points", xytext=(3, 3))
+            ax.annotate(
+                f"{f['h']:g}",
+                (f["error"], f["residual_evaluations"]),
+                fontsize=6,
+                color="C0",
+                textcoords="offset points",
+                xytext=(3, 3),
+            )
         trap = [f for f in s.get("fixed_trapezoidal", []) if f.get("error")]
         if trap:
-            ax.loglog([f["error"] for f in trap], [f["residual_evaluations"] for f in trap], "^-", color="C2",
-                      label=f"fixed {s['step']}, trapezoidal rule")
+            ax.loglog(
+                [f["error"] for f in trap],
+                [f["residual_evaluations"] for f in trap],
+                "^-",
+                color="C2",
+                label=f"fixed {s['step']}, trapezoidal rule",
+            )
             for f in trap:
-                ax.annotate(f"{f['h']:g}", (f["error"], f["residual_evaluations"]), fontsize=6, color="C2",
-                            textcoords="offset points", xytext=(3, -9))
-        ax.loglog([a["error"] for a in adaptive], [a["residual_evaluations"] for a in adaptive], "s--", color="C3",
-                  label="accuracy = TOL")
+                ax.annotate(
+                    f"{f['h']:g}",
+                    (f["error"], f["residual_evaluations"]),
+                    fontsize=6,
+                    color="C2",
+                    textcoords="offset points",
+                    xytext=(3, -9),
+                )
+        ax.loglog(
+            [a["error"] for a in adaptive],
+            [a["residual_evaluations"] for a in adaptive],
+            "s--",
+            color="C3",
+            label="accuracy = TOL",
+        )
         for a in adaptive:
-            ax.annotate(f"TOL {a['accuracy']:g}", (a["error"], a["residual_evaluations"]), fontsize=6, color="C3",
-                        textcoords="offset points", xytext=(3, -9))
+            ax.annotate(
+                f"TOL {a['accuracy']:g}",
+                (a["error"], a["residual_evaluations"]),
+                fontsize=6,
+                color="C3",
+                textcoords="offset points",
+                xytext=(3, -9),
+            )
         if s.get("reference_change"):
-            ax.axvspan(ax.get_xlim()[0], s["reference_change"], color="0.85", zorder=0,
-                       label="below the reference's own change")
-        ax.set_title(f"{name} ({s['preset']}): {', '.join(s['keys'])}\nreference: {s['step']} = {s['h_reference']:g} "
-                     f"({s.get('reference_with', 'preset')})",
-                     fontsize=9)
+            ax.axvspan(
+                ax.get_xlim()[0],
+                s["reference_change"],
+                color="0.85",
+                zorder=0,
+                label="below the reference's own change",
+            )
+        ax.set_title(
+            f"{name} ({s['preset']}): {', '.join(s['keys'])}\nreference: {s['step']} = {s['h_reference']:g} "
+            f"({s.get('reference_with', 'preset')})",
+            fontsize=9,
+        )
         from matplotlib.ticker import NullFormatter
 
         ax.xaxis.set_minor_formatter(NullFormatter())
@@ -311,5 +423,6 @@ def bench_adaptive(preset="fast", outdir=None):
         ax.set_ylabel("residual evaluations (Newton iterations, rejected steps too)")
         ax.legend(fontsize=7, loc="best")
     fig.tight_layout()
-    return save_figure(fig, Path(outdir or default_outdir(preset)) / "bench_adaptive.png", {"adaptive": study},
-                       parameters)
+    return save_figure(
+        fig, Path(outdir or default_outdir(preset)) / "bench_adaptive.png", {"adaptive": study}, parameters
+    )

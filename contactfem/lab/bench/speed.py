@@ -35,16 +35,30 @@ PARTS = ("bulk", "contact", "assembly", "solve", "overhead")
 # what the speed work aims at (whole-process and per-iteration times on 2 cores)
 # (the iterations: wall_time_s / newton_iterations_total of a paper run, about ten times the floor
 # that iteration_limit measures for the sloping impact)
-SPEED_TARGETS = dict(list_s=0.25, sloping_impact_iteration_s=0.25e-3, rolling_ring_iteration_s=0.25e-3,
-                     table2_s=60.0, run_block_over_scipy_skfem=1.3, run_block_canonical_over_numpy=1.6)
+SPEED_TARGETS = dict(
+    list_s=0.25,
+    sloping_impact_iteration_s=0.25e-3,
+    rolling_ring_iteration_s=0.25e-3,
+    table2_s=60.0,
+    run_block_over_scipy_skfem=1.3,
+    run_block_canonical_over_numpy=1.6,
+)
 # the block's start-up, layer by layer: (key, what the process runs, label)
-STARTUP_LAYERS = (("numpy", ["-c", "import numpy"], "`python -c \"import numpy\"`"),
-                  ("scipy_sparse", ["-c", "import scipy.sparse"], "`python -c \"import scipy.sparse\"`"),
-                  ("skfem", ["-c", "import skfem"], "`python -c \"import skfem\"`"),
-                  ("run_block_canonical", ["-m", "contactfem", "run", "block", "--preset", "canonical"],
-                   "`contactfem run block --preset canonical`"))
-RINGS = ("run_rings", ["-m", "contactfem", "run", "sloping_impact", "--set", "n_steps=5"],
-         "`contactfem run sloping_impact --set n_steps=5`")
+STARTUP_LAYERS = (
+    ("numpy", ["-c", "import numpy"], '`python -c "import numpy"`'),
+    ("scipy_sparse", ["-c", "import scipy.sparse"], '`python -c "import scipy.sparse"`'),
+    ("skfem", ["-c", "import skfem"], '`python -c "import skfem"`'),
+    (
+        "run_block_canonical",
+        ["-m", "contactfem", "run", "block", "--preset", "canonical"],
+        "`contactfem run block --preset canonical`",
+    ),
+)
+RINGS = (
+    "run_rings",
+    ["-m", "contactfem", "run", "sloping_impact", "--set", "n_steps=5"],
+    "`contactfem run sloping_impact --set n_steps=5`",
+)
 
 
 def _process(args, repeat=5):
@@ -73,7 +87,7 @@ def compile_bytecode():
     package = Path(__file__).resolve().parents[2]
     try:
         return bool(compileall.compile_dir(str(package), quiet=2))
-    except OSError:                                   # a read-only install: compiled by pip
+    except OSError:  # a read-only install: compiled by pip
         return False
 
 
@@ -96,9 +110,11 @@ def startup_study(repeat=5):
     out["run_block_over_scipy_skfem"] = out["run_block"]["wall_s"] / out["scipy_skfem"]["wall_s"]
     for key in ("skfem", "run_block_canonical", "run_rings"):
         out[f"{key}_over_numpy"] = out[key]["wall_s"] / out["numpy"]["wall_s"]
-    out["loads"] = {"skfem_assembly": _loads("import skfem.assembly"),
-                    "run_block_canonical": _loads(_cli_run(STARTUP_LAYERS[-1][1][3:])),
-                    "run_rings": _loads(_cli_run(RINGS[1][3:]))}
+    out["loads"] = {
+        "skfem_assembly": _loads("import skfem.assembly"),
+        "run_block_canonical": _loads(_cli_run(STARTUP_LAYERS[-1][1][3:])),
+        "run_rings": _loads(_cli_run(RINGS[1][3:])),
+    }
     return out
 
 
@@ -137,12 +153,21 @@ def iteration_split(scene, preset="paper", overrides=None):
     parts = {k: sec[k] for k in ("bulk", "contact", "assembly", "solve")}
     parts["overhead"] = sec["newton"] - sum(parts.values())
     out = {f"{k}_s": v / n for k, v in parts.items()}
-    out.update(iteration_s=sec["newton"] / n, solves=timings.solves, newton_cpu_s=sec["newton"],
-               outside_newton_s=sum(timings.outside.values()),
-               run_wall_s=wall, run_cpu_s=cpu, run_thread_s=thread, linear_algebra=res.get("linear_algebra"),
-               ordering=res.get("ordering"), ndof=res.get("unknowns"),
-               residual_evaluations=res.get("residual_evaluations"), wall_time_s=res.get("wall_time_s"),
-               newton_iterations_total=res.get("newton_iterations_total"))
+    out.update(
+        iteration_s=sec["newton"] / n,
+        solves=timings.solves,
+        newton_cpu_s=sec["newton"],
+        outside_newton_s=sum(timings.outside.values()),
+        run_wall_s=wall,
+        run_cpu_s=cpu,
+        run_thread_s=thread,
+        linear_algebra=res.get("linear_algebra"),
+        ordering=res.get("ordering"),
+        ndof=res.get("unknowns"),
+        residual_evaluations=res.get("residual_evaluations"),
+        wall_time_s=res.get("wall_time_s"),
+        newton_iterations_total=res.get("newton_iterations_total"),
+    )
     return out
 
 
@@ -163,7 +188,7 @@ def iteration_limit(repeat=7, number=200):
     body = scene.build(params).system.bodies[0]
     n = body.ndof
     rng = np.random.default_rng(0)
-    u = 1e-3 * rng.standard_normal(n)                   # a deformed ring: a regular K, a non-zero G
+    u = 1e-3 * rng.standard_normal(n)  # a deformed ring: a regular K, a non-zero G
     G, rows, cols, vals = body.internal_coo(u, params["dt"])
     index = np.concatenate([rows * n + cols, np.arange(n) * (n + 1)])
     values = np.concatenate([vals, body.mass() / (params["beta_newmark"] * params["dt"] ** 2)])
@@ -183,14 +208,26 @@ def iteration_limit(repeat=7, number=200):
         return min(times)
 
     a, b = rng.standard_normal(32), rng.standard_normal(32)
-    return dict(n=n, entries=int(vals.size), assembly_s=best(assemble), solve_s=best(lambda: np.linalg.solve(K, -G)),
-                limit_s=best(lambda: np.linalg.solve(assemble(), -G)), numpy_call_s=best(lambda: a * b))
+    return dict(
+        n=n,
+        entries=int(vals.size),
+        assembly_s=best(assemble),
+        solve_s=best(lambda: np.linalg.solve(K, -G)),
+        limit_s=best(lambda: np.linalg.solve(assemble(), -G)),
+        numpy_call_s=best(lambda: a * b),
+    )
 
 
 # the paper's scenes at the paper preset (quick: the fast preset)
-SCENES = (("block", {}), ("rolling_ring", {}), ("sloping_impact", {"variant": "frictional"}),
-          ("sloping_impact", {"variant": "frictionless"}), ("funnel", {"variant": "frictional"}),
-          ("cork", {}), ("hertz", {}))
+SCENES = (
+    ("block", {}),
+    ("rolling_ring", {}),
+    ("sloping_impact", {"variant": "frictional"}),
+    ("sloping_impact", {"variant": "frictionless"}),
+    ("funnel", {"variant": "frictional"}),
+    ("cork", {}),
+    ("hertz", {}),
+)
 
 
 def table2_study(n_els=(16, 32, 64, 128), jobs=2, refine=8):
@@ -207,9 +244,27 @@ def table2_study(n_els=(16, 32, 64, 128), jobs=2, refine=8):
     with tempfile.TemporaryDirectory() as tmp:
         for dt, n_steps in ((0.1, 200), (0.1 / refine, 200 * refine)):
             table = Path(tmp) / f"table2_dt{n_steps}.csv"
-            args = [sys.executable, "-m", "contactfem", "sweep", "sloping_impact", "--preset", "paper",
-                    "--set", "variant=frictionless,frictional", "--set", "n_el=" + ",".join(map(str, n_els)),
-                    "--set", f"dt={dt:g}", "--set", f"n_steps={n_steps}", "--jobs", str(jobs), "--out", str(table)]
+            args = [
+                sys.executable,
+                "-m",
+                "contactfem",
+                "sweep",
+                "sloping_impact",
+                "--preset",
+                "paper",
+                "--set",
+                "variant=frictionless,frictional",
+                "--set",
+                "n_el=" + ",".join(map(str, n_els)),
+                "--set",
+                f"dt={dt:g}",
+                "--set",
+                f"n_steps={n_steps}",
+                "--jobs",
+                str(jobs),
+                "--out",
+                str(table),
+            ]
             r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
             t0 = time.perf_counter()
             proc = subprocess.run(args, capture_output=True, text=True)
@@ -224,14 +279,21 @@ def table2_study(n_els=(16, 32, 64, 128), jobs=2, refine=8):
             with open(table, newline="") as fh:
                 for row in csv.DictReader(fh):
                     variant = row["param.variant"]
-                    num = lambda k: float(row[k]) if row.get(k) not in (None, "") else None   # noqa: E731
-                    out["rows"].append(dict(variant=variant, n_el=int(row["param.n_el"]), dt=dt,
-                                            error=row.get("error") or None,
-                                            rebound_vx=num("rebound_vx"), rebound_vy=num("rebound_vy"),
-                                            rebound_angle_deg=num("rebound_angle_deg"),
-                                            rebound_spin=num("rebound_spin"),
-                                            newton_iterations_total=num("newton_iterations_total"),
-                                            paper=PAPER_TABLE2.get(variant)))
+                    num = lambda k: float(row[k]) if row.get(k) not in (None, "") else None  # noqa: E731
+                    out["rows"].append(
+                        dict(
+                            variant=variant,
+                            n_el=int(row["param.n_el"]),
+                            dt=dt,
+                            error=row.get("error") or None,
+                            rebound_vx=num("rebound_vx"),
+                            rebound_vy=num("rebound_vy"),
+                            rebound_angle_deg=num("rebound_angle_deg"),
+                            rebound_spin=num("rebound_spin"),
+                            newton_iterations_total=num("newton_iterations_total"),
+                            paper=PAPER_TABLE2.get(variant),
+                        )
+                    )
     out["rows"].sort(key=lambda r: (r["variant"], r["dt"] < 0.1, r["n_el"]))
     out["total_wall_s"] = sum(sw["wall_s"] for sw in out["sweeps"])
     out["total_cpu_s"] = sum(sw["cpu_s"] for sw in out["sweeps"])
@@ -243,12 +305,17 @@ def iteration_split_fresh(scene, preset="paper", overrides=None, repeat=3):
     holds results that slow Python's garbage collector down), best of `repeat` runs."""
     import json
 
-    code = ("import json, sys\nfrom contactfem.lab.bench.speed import iteration_split\n"
-            "print(json.dumps(iteration_split(*json.loads(sys.argv[1]))))")
+    code = (
+        "import json, sys\nfrom contactfem.lab.bench.speed import iteration_split\n"
+        "print(json.dumps(iteration_split(*json.loads(sys.argv[1]))))"
+    )
     best = None
     for _ in range(repeat):
-        proc = subprocess.run([sys.executable, "-c", code, json.dumps([scene, preset, dict(overrides or {})])],
-                              capture_output=True, text=True)
+        proc = subprocess.run(
+            [sys.executable, "-c", code, json.dumps([scene, preset, dict(overrides or {})])],
+            capture_output=True,
+            text=True,
+        )
         if proc.returncode != 0:
             raise RuntimeError(f"bench: the iteration split of {scene} failed: {proc.stderr.strip()[-500:]}")
         out = json.loads(proc.stdout.strip().splitlines()[-1])
@@ -269,5 +336,11 @@ def speed_study(quick=False):
         row.update(iteration_split_fresh(scene, preset, over, repeat=1 if quick else 3))
         rows.append(row)
     load = list(os.getloadavg()) if hasattr(os, "getloadavg") else None
-    return dict(preset=preset, iterations=rows, limit=iteration_limit(), startup=startup_study(repeat=1 if quick else 5),
-                table2=None if quick else table2_study(), load_average=load)
+    return dict(
+        preset=preset,
+        iterations=rows,
+        limit=iteration_limit(),
+        startup=startup_study(repeat=1 if quick else 5),
+        table2=None if quick else table2_study(),
+        load_average=load,
+    )

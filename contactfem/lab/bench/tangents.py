@@ -23,8 +23,9 @@ def _block_variant(params, variant):
         if variant == "staggered":
             b = block.build(dict(params, tangent="consistent"))
             system = b.system
-            stepper = Staggered(Static(system, atol=params["atol"], rtol=params["rtol"], maxit=params["maxit"]),
-                                max_cycles=200)
+            stepper = Staggered(
+                Static(system, atol=params["atol"], rtol=params["rtol"], maxit=params["maxit"]), max_cycles=200
+            )
             u = np.zeros(system.ndof)
             u, _, _, res = stepper.step(0.0, u, u, u, 1.0, label="block, staggered", state=system.start(u))
             extra = dict(cycles=res.cycles, phase_iterations=res.phase_iterations)
@@ -32,10 +33,21 @@ def _block_variant(params, variant):
             s = block.solve(dict(params, tangent=variant))
             u, res, extra = s["u"], s["result"], {}
     except NewtonError as err:
-        return dict(converged=False, iterations=None, time_s=time.perf_counter() - t0,
-                    error=str(err).splitlines()[0][:200], residuals=list(err.history)[:12])
-    return dict(converged=True, iterations=int(res.iterations), time_s=time.perf_counter() - t0,
-                residuals=list(res.residuals), u=u, **extra)
+        return dict(
+            converged=False,
+            iterations=None,
+            time_s=time.perf_counter() - t0,
+            error=str(err).splitlines()[0][:200],
+            residuals=list(err.history)[:12],
+        )
+    return dict(
+        converged=True,
+        iterations=int(res.iterations),
+        time_s=time.perf_counter() - t0,
+        residuals=list(res.residuals),
+        u=u,
+        **extra,
+    )
 
 
 def _impact_variant(params, variant):
@@ -51,17 +63,35 @@ def _impact_variant(params, variant):
     u0 = np.zeros(ring.body.ndof)
     t0 = time.perf_counter()
     try:
-        hist = integrate(stepper, 0.0, u0, ring.initial_velocity((params["vx0"], params["vy0"])),
-                         n_steps=params["n_steps"], dt=params["dt"], cutback=True, max_cuts=6)
+        hist = integrate(
+            stepper,
+            0.0,
+            u0,
+            ring.initial_velocity((params["vx0"], params["vy0"])),
+            n_steps=params["n_steps"],
+            dt=params["dt"],
+            cutback=True,
+            max_cuts=6,
+        )
     except NewtonError as err:
         part = getattr(err, "partial", None)
-        return dict(converged=False, iterations=None, time_s=time.perf_counter() - t0,
-                    error=str(err).splitlines()[0][:200],
-                    steps_done=int(len(part.t) - 1) if part is not None else None)
+        return dict(
+            converged=False,
+            iterations=None,
+            time_s=time.perf_counter() - t0,
+            error=str(err).splitlines()[0][:200],
+            steps_done=int(len(part.t) - 1) if part is not None else None,
+        )
     vx, vy = ring.velocity_of_mass(hist.v)
-    return dict(converged=True, iterations=int(np.sum(hist.iterations)), time_s=time.perf_counter() - t0,
-                step_cuts=int(np.sum(hist.cuts)), rebound_vx=float(vx), rebound_vy=float(vy),
-                max_iterations_per_step=int(np.max(hist.iterations)))
+    return dict(
+        converged=True,
+        iterations=int(np.sum(hist.iterations)),
+        time_s=time.perf_counter() - t0,
+        step_cuts=int(np.sum(hist.cuts)),
+        rebound_vx=float(vx),
+        rebound_vy=float(vy),
+        max_iterations_per_step=int(np.max(hist.iterations)),
+    )
 
 
 VARIANTS = ("consistent", "symmetric", "frozen", "staggered")
@@ -72,7 +102,7 @@ def tangent_study(quick=False):
     (paper Table 1); the frictional sloping impact (paper data, 200 steps; 60 if quick)."""
     block = get_scene("block")
     out = {"block": {}, "sloping_impact": {}}
-    _block_variant(block.resolve("paper", {"law": "coulomb"}), "consistent")   # warm-up: first-call costs untimed
+    _block_variant(block.resolve("paper", {"law": "coulomb"}), "consistent")  # warm-up: first-call costs untimed
     for law in ("coulomb",) if quick else ("coulomb", "parabolic"):
         params = block.resolve("paper", {"law": law})
         rows = {v: _block_variant(params, v) for v in VARIANTS}

@@ -9,6 +9,7 @@ import time
 from ...scenes import run_scene
 from .common import PAPER_SCENES, TARGETS
 
+
 def _process_time(args):
     """Wall time and CPU time (user + sys) of a whole `python -m contactfem ...` process,
     imports included. On a loaded machine the wall time exceeds the CPU time."""
@@ -35,7 +36,7 @@ def targets_study(quick=False):
     preset = "fast" if quick else "paper"
     known = all_scenes()
     if not quick:
-        compile_bytecode()                    # whole processes measured as an installed package runs
+        compile_bytecode()  # whole processes measured as an installed package runs
     rows = []
     for name in PAPER_SCENES:
         if name not in known:
@@ -61,10 +62,15 @@ def targets_study(quick=False):
                 row["process_s"], row["process_cpu_s"] = _process_time(["run", name, "--preset", preset, *sets])
             rows.append(row)
     total = sum(r.get("process_s", r.get("solve_s", 0.0)) or 0.0 for r in rows)
-    out = dict(preset=preset, scenes=rows, total_s=total,
-               each_under_10s=all(r.get("ok") and max(r.get("process_s") or 0, r["solve_s"]) < TARGETS["scene_s"]
-                                  for r in rows),
-               all_under_60s=total < TARGETS["all_s"])
+    out = dict(
+        preset=preset,
+        scenes=rows,
+        total_s=total,
+        each_under_10s=all(
+            r.get("ok") and max(r.get("process_s") or 0, r["solve_s"]) < TARGETS["scene_s"] for r in rows
+        ),
+        all_under_60s=total < TARGETS["all_s"],
+    )
     # hertz on about 4,000 quads (64^2 = 4096), whole process
     n = 32 if quick else 64
     if quick:
@@ -73,14 +79,19 @@ def targets_study(quick=False):
     else:
         import tempfile
 
-        with tempfile.TemporaryDirectory() as tmp:                # (the JSON written as a user would)
+        with tempfile.TemporaryDirectory() as tmp:  # (the JSON written as a user would)
             out_json = os.path.join(tmp, "hertz.json")
             runs = [_process_time(["run", "hertz", "--preset", "paper", "--json", out_json]) for _ in range(3)]
-        process, process_cpu = min(w for w, _ in runs), min(c for _, c in runs)      # best of 3
+        process, process_cpu = min(w for w, _ in runs), min(c for _, c in runs)  # best of 3
         r = run_scene("hertz", "paper", {"n_el": n})
-    out["hertz"] = dict(n_quads=r["n_quads"], error_p0=r["error_p0"], solve_s=r["wall_time_s"], process_s=process,
-                        process_cpu_s=process_cpu,
-                        p0_within=abs(r["error_p0"]) < TARGETS["hertz_p0_error"],
-                        under_1p5s=(process < TARGETS["hertz_process_s"]) if process is not None else None)
+    out["hertz"] = dict(
+        n_quads=r["n_quads"],
+        error_p0=r["error_p0"],
+        solve_s=r["wall_time_s"],
+        process_s=process,
+        process_cpu_s=process_cpu,
+        p0_within=abs(r["error_p0"]) < TARGETS["hertz_p0_error"],
+        under_1p5s=(process < TARGETS["hertz_process_s"]) if process is not None else None,
+    )
     out["process_overhead_s"], out["process_overhead_cpu_s"] = _process_time(["list"])  # imports, registry
     return out

@@ -21,10 +21,11 @@ def _scene_point_run(scene, preset, over, keys):
     over = dict(over)
     try:
         r = run_scene(scene, preset, over)
-    except Exception as err:       # recorded, not hidden: a failed point is a result
+    except Exception as err:  # recorded, not hidden: a failed point is a result
         return dict(over, ok=False, error=f"{type(err).__name__}: {str(err).splitlines()[0][:160]}")
-    return dict(over, ok=True, time_s=r["wall_time_s"], iterations=r["newton_iterations_total"],
-                **{k: r.get(k) for k in keys})
+    return dict(
+        over, ok=True, time_s=r["wall_time_s"], iterations=r["newton_iterations_total"], **{k: r.get(k) for k in keys}
+    )
 
 
 def _bar_run(params, explicit):
@@ -32,9 +33,14 @@ def _bar_run(params, explicit):
     from ...scenes import bar_impact
 
     r, wall = timed(bar_impact.SCENE.run, dict(params, integrator="central_difference" if explicit else "newmark"))
-    return dict(time_s=wall, steps=int(r["n_steps"]), iterations=int(r["newton_iterations_total"]),
-                error_duration=float(r["error_duration"]), error_rebound=float(r["error_rebound"]),
-                energy_error=float(r["energy_error"]))
+    return dict(
+        time_s=wall,
+        steps=int(r["n_steps"]),
+        iterations=int(r["newton_iterations_total"]),
+        error_duration=float(r["error_duration"]),
+        error_rebound=float(r["error_rebound"]),
+        energy_error=float(r["energy_error"]),
+    )
 
 
 def work_precision(quick=False):
@@ -42,8 +48,7 @@ def work_precision(quick=False):
     out = {}
     # hertz: mesh refinement (per-length penalty), exact a and p0
     n_hertz = (8, 16, 32) if quick else (8, 16, 32, 64, 96)
-    rows = [_scene_point("hertz", "paper", {"n_el": n}, ("error_p0", "error_a", "n_quads", "n_dofs"))
-            for n in n_hertz]
+    rows = [_scene_point("hertz", "paper", {"n_el": n}, ("error_p0", "error_a", "n_quads", "n_dofs")) for n in n_hertz]
     for r in rows:
         r["h"] = 1.0 / r["n_el"]
     ok = [r for r in rows if r["ok"]]
@@ -58,28 +63,39 @@ def work_precision(quick=False):
     dts = (0.04, 0.02) if quick else (0.04, 0.02, 0.01, 0.005)
     newmarks = {"0.7/0.4": {}, "0.5/0.25": {"delta": 0.5, "beta_newmark": 0.25}}
     for name, nm in newmarks.items():
-        rows = [_scene_point("rolling_ring", "paper", dict(base, n_el=n_el, dt=dt, **nm), keys)
-                for dt in (dts[-1:] if quick and nm else dts)]
+        rows = [
+            _scene_point("rolling_ring", "paper", dict(base, n_el=n_el, dt=dt, **nm), keys)
+            for dt in (dts[-1:] if quick and nm else dts)
+        ]
         out[f"ring_dt_newmark_{name}"] = _ring_rows(rows, "dt")
     n_els = (20, 40) if quick else (30, 60, 120, 240)
-    rows = [_scene_point("rolling_ring", "paper", dict(base, n_el=n, dt=dts[-1] if quick else 0.01), keys)
-            for n in n_els]
+    rows = [
+        _scene_point("rolling_ring", "paper", dict(base, n_el=n, dt=dts[-1] if quick else 0.01), keys) for n in n_els
+    ]
     for r in rows:
         r["h"] = 1.0 / r["n_el"]
     out["ring_mesh"] = _ring_rows(rows, "h")
     kinds = {}
     for kind in ("beam", "continuum"):
-        kinds[kind] = _scene_point("rolling_ring", "paper", dict(base, kind=kind, n_el=n_el if quick else 60,
-                                                                dt=dts[-1] if quick else 0.01), keys)
+        kinds[kind] = _scene_point(
+            "rolling_ring",
+            "paper",
+            dict(base, kind=kind, n_el=n_el if quick else 60, dt=dts[-1] if quick else 0.01),
+            keys,
+        )
     out["ring_kind"] = _ring_rows(list(kinds.values()), None)
 
     # implicit Newmark (trapezoidal, courant 1) against explicit central differences
     bar = get_scene("bar_impact")
     n_bar = 40 if quick else 100
-    impl = [dict(courant=c, **_bar_run(bar.resolve("paper", {"n_el": n_bar, "courant": c}), False))
-            for c in ((1.0,) if quick else (2.0, 1.0, 0.5, 0.25))]
-    expl = [dict(courant=c, **_bar_run(bar.resolve("paper", {"n_el": n_bar, "courant": c}), True))
-            for c in ((0.5,) if quick else (0.7, 0.5, 0.25))]
+    impl = [
+        dict(courant=c, **_bar_run(bar.resolve("paper", {"n_el": n_bar, "courant": c}), False))
+        for c in ((1.0,) if quick else (2.0, 1.0, 0.5, 0.25))
+    ]
+    expl = [
+        dict(courant=c, **_bar_run(bar.resolve("paper", {"n_el": n_bar, "courant": c}), True))
+        for c in ((0.5,) if quick else (0.7, 0.5, 0.25))
+    ]
     out["bar_implicit_explicit"] = dict(n_el=n_bar, newmark=impl, central_difference=expl)
     return out
 

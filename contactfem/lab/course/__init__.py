@@ -111,10 +111,12 @@ def _test_cell(part):
     import nbformat
 
     args = ", ".join(part.answers)
-    src = (f'""" # BEGIN TEST CONFIG\npoints: {part.points}\n""" # END TEST CONFIG\n'
-           f"def test_{part.name}({args}):\n"
-           f"    from contactfem.lab.course.checks import {part.name}\n"
-           f"    {part.name}({args})")
+    src = (
+        f'""" # BEGIN TEST CONFIG\npoints: {part.points}\n""" # END TEST CONFIG\n'
+        f"def test_{part.name}({args}):\n"
+        f"    from contactfem.lab.course.checks import {part.name}\n"
+        f"    {part.name}({args})"
+    )
     return nbformat.v4.new_code_cell(src)
 
 
@@ -125,13 +127,14 @@ def assignment(nb, name):
 
     from .checks import EXERCISES
 
-    nb = nbformat.from_dict(nbformat.from_dict(nb))    # a copy
+    nb = nbformat.from_dict(nbformat.from_dict(nb))  # a copy
     config = nbformat.v4.new_raw_cell(
         "# ASSIGNMENT CONFIG\n"
         f"name: {name}\n"
         "init_cell: true\ncheck_all_cell: false\nexport_cell: false\nrun_tests: false\n"
         "tests:\n  files: false\n  ok_format: false\n"
-        "generate:\n  pdf: false\n")
+        "generate:\n  pdf: false\n"
+    )
     cells, current = [config], None
     for c in nb.cells:
         if c.cell_type == "raw" and QUESTION.match(_first_line(c)):
@@ -148,7 +151,7 @@ def assignment(nb, name):
             current = None
         cells.append(c)
     nb.cells = cells
-    for c in nb.cells:          # otter adds ids where the format wants them
+    for c in nb.cells:  # otter adds ids where the format wants them
         c.pop("id", None)
     nb.nbformat_minor = 4
     return nb
@@ -230,7 +233,7 @@ def build_versions(outs, repo=None, only=None, force=False, work=None, on_write=
     sources = [s for s in lecture_sources(repo) if only is None or s.stem in only]
     for version, out in outs.items():
         handout.check_version(out, version)
-    if not force:                                # a notebook changed since the last build: refused before work
+    if not force:  # a notebook changed since the last build: refused before work
         for out in outs.values():
             changed = handout.changed_since_built(out, [s.name for s in sources])
             if changed:
@@ -239,7 +242,7 @@ def build_versions(outs, repo=None, only=None, force=False, work=None, on_write=
         Path(work).mkdir(parents=True, exist_ok=True)
     written = {v: [] for v in outs}
     with tempfile.TemporaryDirectory(prefix="contactfem-course-", dir=work) as tmp:
-        plan = {v: {} for v in outs}             # version: {name in out: file made here}
+        plan = {v: {} for v in outs}  # version: {name in out: file made here}
         for src in sources:
             built = None
             if questions(nbformat.read(src, as_version=4)):
@@ -253,23 +256,24 @@ def build_versions(outs, repo=None, only=None, force=False, work=None, on_write=
                     plan[version][src.name] = built[1]
                     plan[version][f"autograder/{src.stem}.zip"] = built[2]
         examples = sorted((Path(repo or REPO) / "lectures" / "examples").glob("*.*"))
-        for version in plan:                      # the files the lectures read (a scene file, its mesh)
+        for version in plan:  # the files the lectures read (a scene file, its mesh)
             plan[version].update({f"examples/{f.name}": f for f in examples if f.is_file()})
         hidden = Path(repo or REPO) / "lectures" / "hidden_checks.py"
-        if "instructor" in plan and hidden.is_file():   # the hidden checks: instructor material only
+        if "instructor" in plan and hidden.is_file():  # the hidden checks: instructor material only
             plan["instructor"]["autograder/hidden_checks.py"] = hidden
         if "student" in plan:
             notebooks = [p for n, p in plan["student"].items() if n.endswith(".ipynb")]
             extras = [(n, p) for n, p in plan["student"].items() if n.startswith("examples/")]
-            plan["student"][handout.STUDENT_ZIP] = handout.student_zip(notebooks, Path(tmp) / handout.STUDENT_ZIP,
-                                                                       extras)
+            plan["student"][handout.STUDENT_ZIP] = handout.student_zip(
+                notebooks, Path(tmp) / handout.STUDENT_ZIP, extras
+            )
         guarded = {v: {n: p for n, p in files.items() if not n.startswith("autograder/")} for v, files in plan.items()}
         found = {v: handout.conflicts(outs[v], guarded[v]) for v in outs}
         if not force:
             for v, names in found.items():
                 if names:
                     raise ValueError(handout.refusal(outs[v], names))
-        with hold_interrupts():                  # all notebooks of the build, or none of them
+        with hold_interrupts():  # all notebooks of the build, or none of them
             if on_write:
                 on_write()
             for version, out in outs.items():

@@ -65,15 +65,15 @@ MANUAL_MARK = re.compile(r"<!--\s*manual:\s*(\w+)\s*-->")
 NOTEBOOK_TIMEOUT = 900.0
 CHECK_TIMEOUT = 20.0
 MEMORY_LIMIT = 4 * 2**30
-MAX_REPLY = 64 * 2**20    # bytes of one answer of the submission (an array of some 6 million numbers)
-GRACE = 5.0          # how long past a check's limit the submission's process may take to answer
+MAX_REPLY = 64 * 2**20  # bytes of one answer of the submission (an array of some 6 million numbers)
+GRACE = 5.0  # how long past a check's limit the submission's process may take to answer
 
 
 @dataclass(frozen=True)
 class Limits:
-    notebook: float = NOTEBOOK_TIMEOUT       # seconds for a whole notebook: its cells and its checks
-    check: float = CHECK_TIMEOUT             # seconds for one call of the student's code
-    memory: int | None = MEMORY_LIMIT        # bytes of address space of the submission's process
+    notebook: float = NOTEBOOK_TIMEOUT  # seconds for a whole notebook: its cells and its checks
+    check: float = CHECK_TIMEOUT  # seconds for one call of the student's code
+    memory: int | None = MEMORY_LIMIT  # bytes of address space of the submission's process
 
 
 class Stopped(Exception):
@@ -86,9 +86,11 @@ class LibraryCall(Exception):
 
 # -- the submission's process, seen from the grader -------------------------------------------
 
+
 class Remote:
     """An object of the submission's process (its function, class or instance): calling it or
     reading an attribute asks that process; what comes back is data or another Remote."""
+
     remote = True
 
     def __init__(self, box, meta):
@@ -112,9 +114,12 @@ class Remote:
         params = self._meta.get("params")
         if params is None:
             return None
-        return inspect.Signature([inspect.Parameter(n, inspect._ParameterKind(k),
-                                                    default=None if d else inspect.Parameter.empty)
-                                  for n, k, d in params])
+        return inspect.Signature(
+            [
+                inspect.Parameter(n, inspect._ParameterKind(k), default=None if d else inspect.Parameter.empty)
+                for n, k, d in params
+            ]
+        )
 
     def __repr__(self):
         return self._meta.get("name") or self._meta.get("type") or "object"
@@ -129,12 +134,13 @@ def _set_limits(memory):
     """What the submission's process sets up before it starts (POSIX): death with the worker
     (Linux), its memory limit (where the platform allows one), a process group of its own (its
     children end with it; a signal to the worker's group does not reach it)."""
+
     def limit():
         import ctypes
         import resource
 
         try:
-            ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, 9)      # PR_SET_PDEATHSIG, SIGKILL
+            ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, 9)  # PR_SET_PDEATHSIG, SIGKILL
         except (OSError, AttributeError):
             pass
         if memory:
@@ -143,6 +149,7 @@ def _set_limits(memory):
             except (ValueError, OSError):
                 pass
         os.setpgrp()
+
     return limit
 
 
@@ -158,13 +165,24 @@ class Box:
         self.where = "starting"
         req_r, self._req_w = os.pipe()
         self._rep_r, rep_w = os.pipe()
-        env = dict(os.environ, MPLBACKEND="Agg", OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1",
-                   PYTHONPATH=os.pathsep.join(p for p in [str(REPO), os.environ.get("PYTHONPATH", "")] if p))
+        env = dict(
+            os.environ,
+            MPLBACKEND="Agg",
+            OPENBLAS_NUM_THREADS="1",
+            OMP_NUM_THREADS="1",
+            PYTHONPATH=os.pathsep.join(p for p in [str(REPO), os.environ.get("PYTHONPATH", "")] if p),
+        )
         code = f"from contactfem.lab.course.sandbox import serve; serve({req_r}, {rep_w})"
-        self.proc = subprocess.Popen([sys.executable, "-c", code], pass_fds=(req_r, rep_w), cwd=workdir, env=env,
-                                     stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                                     stderr=subprocess.DEVNULL,
-                                     preexec_fn=_set_limits(limits.memory) if os.name == "posix" else None)
+        self.proc = subprocess.Popen(
+            [sys.executable, "-c", code],
+            pass_fds=(req_r, rep_w),
+            cwd=workdir,
+            env=env,
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            preexec_fn=_set_limits(limits.memory) if os.name == "posix" else None,
+        )
         os.close(req_r)
         os.close(rep_w)
         from multiprocessing.connection import Connection
@@ -178,7 +196,7 @@ class Box:
 
         try:
             os.killpg(self.proc.pid, signal.SIGKILL)
-        except (ProcessLookupError, PermissionError, AttributeError):      # AttributeError: not POSIX
+        except (ProcessLookupError, PermissionError, AttributeError):  # AttributeError: not POSIX
             pass
         if self.proc.poll() is None:
             self.proc.kill()
@@ -197,7 +215,7 @@ class Box:
     def _gone(self):
         try:
             code = self.proc.wait(timeout=2.0)
-        except subprocess.TimeoutExpired:        # alive, but its connection is broken or garbled
+        except subprocess.TimeoutExpired:  # alive, but its connection is broken or garbled
             self._stop(f"the submission broke its connection to the grader {self.where}")
         what = f"died (signal {-code})" if code < 0 else f"exited with code {code}"
         if code == -9 and self.limits.memory:
@@ -304,6 +322,7 @@ def _wire(v):
 
 # -- the instructor's material ------------------------------------------------------------------
 
+
 def hidden_checks_file(material=None, repo=None):
     """The hidden checks: MATERIAL/hidden_checks.py, else the checkout's lectures/hidden_checks.py."""
     for folder in ([Path(material)] if material else []) + [Path(repo or REPO) / "lectures"]:
@@ -324,13 +343,15 @@ def load_hidden(path):
 
 # -- one notebook ------------------------------------------------------------------------------
 
+
 def read_notebook(path):
     """The notebook's cells [(type, source)]; ValueError if it is not a notebook."""
     try:
         nb = json.loads(Path(path).read_text(errors="replace"))
         cells = nb["cells"]
-        return [(c.get("cell_type"), "".join(c["source"]) if isinstance(c["source"], list) else c["source"])
-                for c in cells], nb.get("metadata", {})
+        return [
+            (c.get("cell_type"), "".join(c["source"]) if isinstance(c["source"], list) else c["source"]) for c in cells
+        ], nb.get("metadata", {})
     except (ValueError, KeyError, TypeError, AttributeError) as err:
         raise ValueError(f"not a notebook ({type(err).__name__}: {' '.join(str(err).split())[:80]})") from None
 
@@ -382,14 +403,17 @@ def manual_answers(cells):
             current = None
             continue
         out[current][0 if kind == "code" else 1].append(src.strip())
-    return {k: ("\n\n".join(c for c in code if c), "\n\n".join(t for t in text if t))
-            for k, (code, text) in out.items()}
+    return {
+        k: ("\n\n".join(c for c in code if c), "\n\n".join(t for t in text if t)) for k, (code, text) in out.items()
+    }
 
 
 def library_hint(exercise, used):
     names = ", ".join(sorted(s.replace(":", ".") for s in used))
-    return (f"your answer uses the library's own {names}: this exercise asks you to implement it yourself "
-            "(write the computation; the library's version is what your answer is compared with)")
+    return (
+        f"your answer uses the library's own {names}: this exercise asks you to implement it yourself "
+        "(write the computation; the library's version is what your answer is compared with)"
+    )
 
 
 def grade_notebook(path, lecture, material, limits):
@@ -449,7 +473,7 @@ def _grade_part(box, part, hidden, guard, named):
         msg = str(err)
     except LibraryCall:
         pass
-    except Exception as err:         # noqa: BLE001  (an answer the check did not foresee: the part fails)
+    except Exception as err:  # noqa: BLE001  (an answer the check did not foresee: the part fails)
         msg = f"the check could not use your answer: {type(err).__name__}: {' '.join(str(err).split())[:200]}"
     if box.used:
         return 0.0, part.points, library_hint(part.name, box.used)
@@ -457,6 +481,7 @@ def _grade_part(box, part, hidden, guard, named):
 
 
 # -- the batch -----------------------------------------------------------------------------------
+
 
 def submissions(folder):
     """The notebooks of a folder of submissions (subfolders included), sorted."""
@@ -502,11 +527,13 @@ def read_roster(path):
         reader = csv.DictReader(f)
         missing = {"id", "name", "file"} - set(reader.fieldnames or ())
         if missing:
-            raise ValueError(f"--roster {path}: no column {', '.join(sorted(missing))}; "
-                             "give the columns id, name, file")
-        rows = [Student(r["id"].strip(), r["name"].strip(), (r["file"] or "").strip(),
-                        (r.get("submitted") or "").strip())
-                for r in reader]
+            raise ValueError(
+                f"--roster {path}: no column {', '.join(sorted(missing))}; give the columns id, name, file"
+            )
+        rows = [
+            Student(r["id"].strip(), r["name"].strip(), (r["file"] or "").strip(), (r.get("submitted") or "").strip())
+            for r in reader
+        ]
     ids = [s.id for s in rows]
     if "" in ids or len(set(ids)) != len(ids):
         raise ValueError(f"--roster {path}: every student needs an id of their own")
@@ -540,8 +567,20 @@ class GradingInterrupted(KeyboardInterrupt):
         self.message = message
 
 
-def grade(folder, out_csv, autograders=None, jobs=1, repo=None, roster=None, deadline=None, lecture=None,
-          limits=Limits(), review=None, feedback=None, progress=None):
+def grade(
+    folder,
+    out_csv,
+    autograders=None,
+    jobs=1,
+    repo=None,
+    roster=None,
+    deadline=None,
+    lecture=None,
+    limits=Limits(),
+    review=None,
+    feedback=None,
+    progress=None,
+):
     """Grade every notebook in `folder` and write `out_csv`: one row per submission (and per
     student of the roster), columns id, name, submission, lecture, one per exercise and written
     question, total, possible, status, late, notes. The review files of the written answers go
@@ -568,8 +607,10 @@ def grade(folder, out_csv, autograders=None, jobs=1, repo=None, roster=None, dea
     if autograders is not None:
         autograders = Path(autograders)
         if not autograders.is_dir() or not (list(autograders.glob("*.zip")) or (autograders / HIDDEN_FILE).is_file()):
-            raise ValueError(f"--autograders {autograders}: no grading configurations (*.zip, {HIDDEN_FILE}) "
-                             "there; give the autograder/ folder of `contactfem course build --instructor`")
+            raise ValueError(
+                f"--autograders {autograders}: no grading configurations (*.zip, {HIDDEN_FILE}) "
+                "there; give the autograder/ folder of `contactfem course build --instructor`"
+            )
     students = read_roster(roster) if roster else None
     deadline = parse_time(deadline) if isinstance(deadline, str) else deadline
     review = Path(review) if review else out_csv.with_name(out_csv.stem + "-review")
@@ -582,10 +623,10 @@ def grade(folder, out_csv, autograders=None, jobs=1, repo=None, roster=None, dea
     rel = {p: p.relative_to(folder).as_posix() for p in subs}
     which = {p: lecture or lecture_of(p, names) for p in subs}
     known = {w for w in which.values() if w}
-    if len(known) == 1 and not lecture:     # a class of one lecture: a missing or unreadable notebook is of it
+    if len(known) == 1 and not lecture:  # a class of one lecture: a missing or unreadable notebook is of it
         lecture = known.pop()
         which = {p: w or (lecture if not _readable(p) else None) for p, w in which.items()}
-    entries = []        # (student or None, path or None)
+    entries = []  # (student or None, path or None)
     if students:
         by_file = {s.file: s for s in students if s.file}
         for s in students:
@@ -621,24 +662,38 @@ def grade(folder, out_csv, autograders=None, jobs=1, repo=None, roster=None, dea
     for s, p in entries:
         if interrupted and p is not None and str(p) not in results:
             continue
-        row, detail = _row(s, p, rel.get(p, ""), which.get(p) if p is not None else (lecture or ""),
-                           results.get(str(p)), columns, manual, scores_read, deadline)
+        row, detail = _row(
+            s,
+            p,
+            rel.get(p, ""),
+            which.get(p) if p is not None else (lecture or ""),
+            results.get(str(p)),
+            columns,
+            manual,
+            scores_read,
+            deadline,
+        )
         if students and s is None:
             row["notes"] = " | ".join(x for x in ("not on the roster", row["notes"]) if x)
         rows.append(row)
         details.append(detail)
-    fields = (["id", "name", "submission", "lecture"] + columns + manual
-              + ["total", "possible", "status", "late", "notes"])
+    fields = (
+        ["id", "name", "submission", "lecture"] + columns + manual + ["total", "possible", "status", "late", "notes"]
+    )
     _write_csv(out_csv, fields, rows)
     if interrupted:
-        raise GradingInterrupted(f"interrupted: {n_done} of {len(tasks)} notebooks graded; their rows are in "
-                                 f"{out_csv} (the others are not; no review or feedback files written)")
+        raise GradingInterrupted(
+            f"interrupted: {n_done} of {len(tasks)} notebooks graded; their rows are in "
+            f"{out_csv} (the others are not; no review or feedback files written)"
+        )
     try:
         _write_reviews(review, lectures, details, scores_read)
         _write_feedback(feedback, details)
     except KeyboardInterrupt:
-        raise GradingInterrupted(f"interrupted after every notebook was graded: {out_csv} is complete; the review "
-                                 f"files ({review}) and the feedback files ({feedback}) may be incomplete") from None
+        raise GradingInterrupted(
+            f"interrupted after every notebook was graded: {out_csv} is complete; the review "
+            f"files ({review}) and the feedback files ({feedback}) may be incomplete"
+        ) from None
     return rows
 
 
@@ -653,7 +708,7 @@ def _readable(path):
 def _write_csv(path, fields, rows):
     from ...io.outputs import make_parents
 
-    make_parents(path)                        # the folders the output names, made when it is written
+    make_parents(path)  # the folders the output names, made when it is written
     tmp = path.with_name(f".{path.name}.part")
     with open(tmp, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=fields)
@@ -665,8 +720,12 @@ def _write_csv(path, fields, rows):
 def _row(student, path, rel, lec, outcome, columns, manual, scores_read, deadline):
     from . import checks
 
-    row = {"id": student.id if student else "", "name": student.name if student else "", "submission": rel,
-           "lecture": lec or ""}
+    row = {
+        "id": student.id if student else "",
+        "name": student.name if student else "",
+        "submission": rel,
+        "lecture": lec or "",
+    }
     notes, parts, answers, stop = [], [], {}, None
     mine = [e for e in columns if checks.EXERCISES[e].lecture == lec]
     my_manual = [m for m in manual if checks.MANUAL[m].lecture == lec]
@@ -677,8 +736,9 @@ def _row(student, path, rel, lec, outcome, columns, manual, scores_read, deadlin
     elif not lec:
         try:
             read_notebook(path)
-            notes.append("not a lecture of this course (no otter assignment name in its metadata, no NN_ prefix); "
-                         "give --lecture")
+            notes.append(
+                "not a lecture of this course (no otter assignment name in its metadata, no NN_ prefix); give --lecture"
+            )
         except ValueError as err:
             notes.append(str(err))
         status = "not graded"
@@ -687,8 +747,9 @@ def _row(student, path, rel, lec, outcome, columns, manual, scores_read, deadlin
     elif not outcome.ok:
         status = "not graded"
         reason = outcome.reason or ""
-        notes.append(reason.replace("error: ValueError: ", "") if "not a notebook" in reason
-                     else f"not graded: {reason}")
+        notes.append(
+            reason.replace("error: ValueError: ", "") if "not a notebook" in reason else f"not graded: {reason}"
+        )
     else:
         res = outcome.value
         parts = res["parts"]
@@ -699,7 +760,7 @@ def _row(student, path, rel, lec, outcome, columns, manual, scores_read, deadlin
         notes += res["errors"][:3] + ([f"and {more} more cells failed"] if more > 0 else [])
         if res["printed"] > 2**20:
             notes.append(f"printed {res['printed'] / 2**20:.0f} MB (not kept)")
-    if path is not None and lec:      # the written answers, read here: a notebook stopped early has them too
+    if path is not None and lec:  # the written answers, read here: a notebook stopped early has them too
         try:
             answers = manual_answers(read_notebook(path)[0])
         except ValueError:
@@ -734,13 +795,17 @@ def _row(student, path, rel, lec, outcome, columns, manual, scores_read, deadlin
     possible = sum(checks.EXERCISES[e].points for e in mine) + sum(checks.MANUAL[m].points for m in my_manual)
     late = ""
     if deadline is not None and path is not None:
-        when = parse_time(student.submitted) if student and student.submitted else \
-            dt.datetime.fromtimestamp(path.stat().st_mtime).astimezone()
+        when = (
+            parse_time(student.submitted)
+            if student and student.submitted
+            else dt.datetime.fromtimestamp(path.stat().st_mtime).astimezone()
+        )
         late = _late(when, deadline)
         if late:
             notes.append(f"late by {late}")
-    row.update(total=f"{total:g}", possible=f"{possible:g}", status=status, late="yes" if late else "",
-               notes=" | ".join(notes))
+    row.update(
+        total=f"{total:g}", possible=f"{possible:g}", status=status, late="yes" if late else "", notes=" | ".join(notes)
+    )
     detail = dict(row=row, parts=parts, answers=answers, manual=my_manual, lecture=lec)
     return row, detail
 
@@ -780,32 +845,48 @@ def _write_reviews(review, lectures, details, scores_read):
         if not qs:
             continue
         mine = [d for d in details if d["lecture"] == lec and d["row"]["submission"]]
-        parts = [f"<!doctype html><meta charset=utf-8><title>Written answers: {html.escape(lec)}</title>",
-                 "<style>body{font-family:sans-serif;margin:2em}table{border-collapse:collapse;width:100%}"
-                 "td,th{border:1px solid #ccc;vertical-align:top;padding:.5em;width:50%}"
-                 "pre{white-space:pre-wrap;margin:0}section{margin-bottom:2em}</style>",
-                 f"<h1>Written answers: {html.escape(lec)}</h1>",
-                 f"<p>{len(mine)} submissions. Enter the scores in <code>{html.escape(lec)}-scores.csv</code> "
-                 "(column score) and run <code>contactfem course grade</code> again: they go into the CSV.</p>"]
+        parts = [
+            f"<!doctype html><meta charset=utf-8><title>Written answers: {html.escape(lec)}</title>",
+            "<style>body{font-family:sans-serif;margin:2em}table{border-collapse:collapse;width:100%}"
+            "td,th{border:1px solid #ccc;vertical-align:top;padding:.5em;width:50%}"
+            "pre{white-space:pre-wrap;margin:0}section{margin-bottom:2em}</style>",
+            f"<h1>Written answers: {html.escape(lec)}</h1>",
+            f"<p>{len(mine)} submissions. Enter the scores in <code>{html.escape(lec)}-scores.csv</code> "
+            "(column score) and run <code>contactfem course grade</code> again: they go into the CSV.</p>",
+        ]
         for d in mine:
             r = d["row"]
             who = " ".join(x for x in (r["id"], r["name"]) if x) or r["submission"]
-            parts.append(f"<section id=\"{html.escape(r['submission'])}\"><h2>{html.escape(who)}</h2>"
-                         f"<p>{html.escape(r['submission'])}</p>")
+            parts.append(
+                f'<section id="{html.escape(r["submission"])}"><h2>{html.escape(who)}</h2>'
+                f"<p>{html.escape(r['submission'])}</p>"
+            )
             for q in qs:
                 code, text = d["answers"].get(q.name, ("", ""))
                 given = scores_read.get(lec, {}).get((r["submission"], q.name))
                 score = f"{given:g}" if given is not None else "not scored"
-                parts.append(f"<h3>{html.escape(q.name)} ({q.points:g} points; {score}): {html.escape(q.what)}</h3>"
-                             "<table><tr><th>code</th><th>answer</th></tr><tr>"
-                             f"<td><pre>{html.escape(code) or '(no code)'}</pre></td>"
-                             f"<td><pre>{html.escape(text) or '(no answer)'}</pre></td></tr></table>")
+                parts.append(
+                    f"<h3>{html.escape(q.name)} ({q.points:g} points; {score}): {html.escape(q.what)}</h3>"
+                    "<table><tr><th>code</th><th>answer</th></tr><tr>"
+                    f"<td><pre>{html.escape(code) or '(no code)'}</pre></td>"
+                    f"<td><pre>{html.escape(text) or '(no answer)'}</pre></td></tr></table>"
+                )
             parts.append("</section>")
         (review / f"{lec}.html").write_text("\n".join(parts))
         sheet = review / f"{lec}-scores.csv"
         if not sheet.exists():
-            rows = [{"submission": d["row"]["submission"], "id": d["row"]["id"], "name": d["row"]["name"],
-                     "question": q.name, "points": f"{q.points:g}", "score": ""} for d in mine for q in qs]
+            rows = [
+                {
+                    "submission": d["row"]["submission"],
+                    "id": d["row"]["id"],
+                    "name": d["row"]["name"],
+                    "question": q.name,
+                    "points": f"{q.points:g}",
+                    "score": "",
+                }
+                for d in mine
+                for q in qs
+            ]
             _write_csv(sheet, ["submission", "id", "name", "question", "points", "score"], rows)
 
 
@@ -817,8 +898,11 @@ def _write_feedback(feedback, details):
     for d in details:
         r = d["row"]
         stem = r["id"] or Path(r["submission"]).with_suffix("").as_posix().replace("/", "_")
-        lines = [f"# {d['lecture'] or 'course'}: feedback for {r['name'] or r['id'] or r['submission']}", "",
-                 f"Total: {r['total']} of {r['possible']} ({r['status']})."]
+        lines = [
+            f"# {d['lecture'] or 'course'}: feedback for {r['name'] or r['id'] or r['submission']}",
+            "",
+            f"Total: {r['total']} of {r['possible']} ({r['status']}).",
+        ]
         if r["late"]:
             lines.append("Submitted late.")
         if r["status"] != "graded" or r["notes"] and not d["parts"]:

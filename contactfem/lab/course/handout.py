@@ -45,8 +45,9 @@ def check_version(out, version):
     never replaces a student folder unnoticed, nor the other way round."""
     other = _record(out).get("version")
     if other in ("student", "instructor") and other != version and manifest(out):
-        raise ValueError(f"--out {out}: holds the {other} version of the course; build the {version} version "
-                         "into another folder")
+        raise ValueError(
+            f"--out {out}: holds the {other} version of the course; build the {version} version into another folder"
+        )
 
 
 def changed_since_built(out, names):
@@ -77,10 +78,15 @@ def conflicts(out, new):
 
 def refusal(out, names, force_option="--force"):
     """The one line that refuses to overwrite `names` in `out`."""
-    more = f" (and {len(names) - 1} more: {', '.join(names[1:4])}{', ...' if len(names) > 4 else ''})" \
-        if len(names) > 1 else ""
-    return (f"--out {out}: {names[0]}{more} differs from what the build would write (answers or edits in it "
-            f"would be lost): move it away, or add {force_option} to keep it in {Path(out) / 'backup-TIME'}/")
+    more = (
+        f" (and {len(names) - 1} more: {', '.join(names[1:4])}{', ...' if len(names) > 4 else ''})"
+        if len(names) > 1
+        else ""
+    )
+    return (
+        f"--out {out}: {names[0]}{more} differs from what the build would write (answers or edits in it "
+        f"would be lost): move it away, or add {force_option} to keep it in {Path(out) / 'backup-TIME'}/"
+    )
 
 
 def back_up(out, names):

@@ -30,8 +30,10 @@ from multiprocessing.connection import Connection
 import numpy as np
 
 MAX_REPLY = 60 * 2**20
-OTTER_LINE = re.compile(r"^\s*(import otter\b.*|grader\s*=\s*otter\.Notebook\(.*\)|grader\.check(_all)?\(.*\)|"
-                        r"grader\.export\(.*\))?\s*(#.*)?$")
+OTTER_LINE = re.compile(
+    r"^\s*(import otter\b.*|grader\s*=\s*otter\.Notebook\(.*\)|grader\.check(_all)?\(.*\)|"
+    r"grader\.export\(.*\))?\s*(#.*)?$"
+)
 MAGIC = re.compile(r"^(\s*)([%!].*)$", re.M)
 
 
@@ -117,8 +119,13 @@ class Sandbox:
     def ref(self, v):
         i = len(self.refs)
         self.refs[i] = v
-        out = {"t": "ref", "id": i, "callable": callable(v), "type": type(v).__name__,
-               "name": getattr(v, "__name__", None) if isinstance(getattr(v, "__name__", None), str) else None}
+        out = {
+            "t": "ref",
+            "id": i,
+            "callable": callable(v),
+            "type": type(v).__name__,
+            "name": getattr(v, "__name__", None) if isinstance(getattr(v, "__name__", None), str) else None,
+        }
         if callable(v):
             try:
                 sig = inspect.signature(v)
@@ -146,10 +153,13 @@ class Sandbox:
         code = MAGIC.sub(r"\1pass  # \2", source)
         try:
             exec(compile(code, "<cell>", "exec"), self.env)
-        except BaseException as err:          # noqa: BLE001  (sys.exit and KeyboardInterrupt are the cell's too)
+        except BaseException as err:  # noqa: BLE001  (sys.exit and KeyboardInterrupt are the cell's too)
             msg = " ".join(str(err).split())[:200]
-            return {"ok": False, "error": f"{type(err).__name__}: {msg}" if msg else type(err).__name__,
-                    "printed": self.sink.count}
+            return {
+                "ok": False,
+                "error": f"{type(err).__name__}: {msg}" if msg else type(err).__name__,
+                "printed": self.sink.count,
+            }
         return {"ok": True, "printed": self.sink.count}
 
     def get(self, name):
@@ -181,7 +191,7 @@ class Sandbox:
             reply = {"timeout": True}
         except LibraryUsed:
             reply = {"exc": "LibraryUsed", "msg": ""}
-        except BaseException as err:     # noqa: BLE001
+        except BaseException as err:  # noqa: BLE001
             reply = {"exc": type(err).__name__, "msg": " ".join(str(err).split())[:300]}
         finally:
             signal.setitimer(signal.ITIMER_REAL, 0)
@@ -210,7 +220,7 @@ class Sandbox:
                 self.used.add(_spec)
                 raise LibraryUsed()
 
-            if isinstance(orig, type):         # a class: its construction is the tripwire
+            if isinstance(orig, type):  # a class: its construction is the tripwire
                 saved.append((orig, "__init__", orig.__dict__.get("__init__")))
                 orig.__init__ = wire
                 continue
@@ -229,6 +239,7 @@ class Sandbox:
                     delattr(owner, name)
                 else:
                     setattr(owner, name, value)
+
         return undo
 
 
@@ -267,12 +278,13 @@ def serve(fd_in, fd_out):
         kind, *args = req
         try:
             reply = getattr(box, kind)(*args)
-        except BaseException as err:      # noqa: BLE001  (a request that cannot be answered is a reply too)
-            reply = {"exc": type(err).__name__, "msg": " ".join(str(err).split())[:300],
-                     "trace": traceback.format_exc()[-1500:]}
+        except BaseException as err:  # noqa: BLE001  (a request that cannot be answered is a reply too)
+            reply = {
+                "exc": type(err).__name__,
+                "msg": " ".join(str(err).split())[:300],
+                "trace": traceback.format_exc()[-1500:],
+            }
         data = json.dumps(reply).encode()
         if len(data) > MAX_REPLY:
             data = json.dumps({"exc": "TooLarge", "msg": f"a reply of {len(data) / 2**20:.0f} MB"}).encode()
         conn_out.send_bytes(data)
-
-

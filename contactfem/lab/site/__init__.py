@@ -57,16 +57,19 @@ def check_out(out, option="--out"):
     if out.is_dir() and not (work_dir(out).is_dir() or (out / ".buildinfo").is_file()):
         other = sorted(p.name for p in out.iterdir())
         if other:
-            raise ValueError(f"{option} {out}: holds files that are not a site built by contactfem site "
-                             f"({', '.join(other[:3])}{', ...' if len(other) > 3 else ''}): give a new or empty folder")
+            raise ValueError(
+                f"{option} {out}: holds files that are not a site built by contactfem site "
+                f"({', '.join(other[:3])}{', ...' if len(other) > 3 else ''}): give a new or empty folder"
+            )
     return out
 
 
 def scrub(out, replacements):
     """Replace the builder's absolute paths in the built pages (printed by a lecture, e.g.
     where its figures went) by the names a reader understands: {path: name}."""
-    pairs = sorted(((str(k), v) for k, v in replacements.items() if str(k) not in ("", "/")),
-                   key=lambda kv: -len(kv[0]))
+    pairs = sorted(
+        ((str(k), v) for k, v in replacements.items() if str(k) not in ("", "/")), key=lambda kv: -len(kv[0])
+    )
     for page in Path(out).rglob("*"):
         if page.suffix not in (".html", ".js", ".txt") or not page.is_file():
             continue
@@ -107,9 +110,15 @@ def _kernel_env(work, env):
     machine has registered as "python3" (the same arrangement as tests/test_lectures.py)."""
     spec = work / "jupyter" / "kernels" / "python3"
     spec.mkdir(parents=True, exist_ok=True)
-    (spec / "kernel.json").write_text(json.dumps({
-        "argv": [sys.executable, "-m", "ipykernel_launcher", "-f", "{connection_file}"],
-        "display_name": "Python 3 (contactfem site)", "language": "python"}))
+    (spec / "kernel.json").write_text(
+        json.dumps(
+            {
+                "argv": [sys.executable, "-m", "ipykernel_launcher", "-f", "{connection_file}"],
+                "display_name": "Python 3 (contactfem site)",
+                "language": "python",
+            }
+        )
+    )
     env["JUPYTER_PATH"] = os.pathsep.join([str(work / "jupyter")] + [p for p in [env.get("JUPYTER_PATH")] if p])
     env["PYTHONPATH"] = os.pathsep.join([str(REPO)] + [p for p in [env.get("PYTHONPATH")] if p])
 
@@ -140,22 +149,49 @@ def build(out=None, repo=None, quiet=True, instructor=False, only=None, on_write
         _prepare_cache(cache)
         env = dict(os.environ)
         _kernel_env(work / "kernel", env)
-        env.update(CONTACTFEM_PRESET="fast", CONTACTFEM_FIGURES=str(work / "figures"),
-                   CONTACTFEM_SITE_CACHE=str(cache / "notebooks"), MPLBACKEND="module://matplotlib_inline.backend_inline",
-                   JUPYTER_RUNTIME_DIR=str(work / "runtime"), IPYTHONDIR=str(work / "ipython"))
-        if html.exists():                     # what an interrupted build left
+        env.update(
+            CONTACTFEM_PRESET="fast",
+            CONTACTFEM_FIGURES=str(work / "figures"),
+            CONTACTFEM_SITE_CACHE=str(cache / "notebooks"),
+            MPLBACKEND="module://matplotlib_inline.backend_inline",
+            JUPYTER_RUNTIME_DIR=str(work / "runtime"),
+            IPYTHONDIR=str(work / "ipython"),
+        )
+        if html.exists():  # what an interrupted build left
             shutil.rmtree(html)
         # Sphinx writes into work/html; MyST-NB puts its executed notebooks beside that, in
         # work/jupyter_execute, and its cache and Sphinx its read pages in work/cache
-        cmd = [sys.executable, "-m", "sphinx", "-b", "html", "-W", "--keep-going", "-q",
-               "-d", str(cache / "doctrees"), str(src), str(html)]
+        cmd = [
+            sys.executable,
+            "-m",
+            "sphinx",
+            "-b",
+            "html",
+            "-W",
+            "--keep-going",
+            "-q",
+            "-d",
+            str(cache / "doctrees"),
+            str(src),
+            str(html),
+        ]
         proc = subprocess.run(cmd, env=env, cwd=str(src), capture_output=quiet, text=True)
         if proc.returncode != 0:
             msg = (proc.stdout or "")[-6000:] + (proc.stderr or "")[-6000:] if quiet else ""
             raise RuntimeError(f"the site build failed (Sphinx exit code {proc.returncode}):\n{msg}")
-        scrub(html, {(work / "figures").resolve(): "figures", work / "figures": "figures", work.resolve(): WORK,
-                     work: WORK, out.resolve(): ".", repo.resolve(): ".", Path.home(): "~"})
-        with hold_interrupts():               # the new pages replace the old ones together
+        scrub(
+            html,
+            {
+                (work / "figures").resolve(): "figures",
+                work / "figures": "figures",
+                work.resolve(): WORK,
+                work: WORK,
+                out.resolve(): ".",
+                repo.resolve(): ".",
+                Path.home(): "~",
+            },
+        )
+        with hold_interrupts():  # the new pages replace the old ones together
             if on_write:
                 on_write()
             for page in sorted(html.iterdir()):
@@ -165,7 +201,7 @@ def build(out=None, repo=None, quiet=True, instructor=False, only=None, on_write
                 elif dst.exists() or dst.is_symlink():
                     dst.unlink()
                 os.replace(page, dst)
-    finally:                              # keep the cache only: the rest is made again by the next build
+    finally:  # keep the cache only: the rest is made again by the next build
         for part in TRANSIENT:
             shutil.rmtree(work / part, ignore_errors=True)
     return out / "index.html"

@@ -38,9 +38,19 @@ from functools import partial
 from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 
-CHROMIUM_FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-                  "--disable-background-networking", "--disable-component-update", "--disable-sync",
-                  "--disable-dev-shm-usage", "--hide-scrollbars", "--mute-audio"]
+CHROMIUM_FLAGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--disable-dev-shm-usage",
+    "--hide-scrollbars",
+    "--mute-audio",
+]
 PROBE_PATH = "/__contactfem_probe.js"
 PROBE_ID = "contactfem-probe"
 
@@ -92,8 +102,12 @@ PROBE_JS = r"""
 
 def find_chromium():
     """Debian's Chromium (or CHROMIUM=path); None if it is not installed."""
-    for cand in [os.environ.get("CHROMIUM"), "/usr/bin/chromium", shutil.which("chromium"),
-                 shutil.which("chromium-browser")]:
+    for cand in [
+        os.environ.get("CHROMIUM"),
+        "/usr/bin/chromium",
+        shutil.which("chromium"),
+        shutil.which("chromium-browser"),
+    ]:
         if cand and Path(cand).exists():
             return cand
     return None
@@ -157,13 +171,18 @@ def open_page(url, chromium=None, screenshot=None, timeout=120, budget_ms=30000)
     proc = _chromium([f"--virtual-time-budget={budget_ms}", "--dump-dom", url], chromium, timeout)
     m = re.search(rf'<pre id="{PROBE_ID}"[^>]*>(.*?)</pre>', proc.stdout, re.S)
     if not m:
-        raise RuntimeError(f"the page {url} did not finish loading in the browser "
-                           f"(no probe report; exit code {proc.returncode}):\n{proc.stderr[-2000:]}")
+        raise RuntimeError(
+            f"the page {url} did not finish loading in the browser "
+            f"(no probe report; exit code {proc.returncode}):\n{proc.stderr[-2000:]}"
+        )
     found = json.loads(html.unescape(m.group(1)))
     if screenshot:
         Path(screenshot).parent.mkdir(parents=True, exist_ok=True)
-        _chromium([f"--virtual-time-budget={budget_ms}", "--window-size=1280,1600",
-                   f"--screenshot={screenshot}", url], chromium, timeout)
+        _chromium(
+            [f"--virtual-time-budget={budget_ms}", "--window-size=1280,1600", f"--screenshot={screenshot}", url],
+            chromium,
+            timeout,
+        )
         found["screenshot"] = str(screenshot) if Path(screenshot).exists() else None
     return found
 
@@ -257,7 +276,7 @@ def crawl(base, start="index.html", max_pages=2000):
 
 
 def _rel(base, url):
-    return url[len(base):] if url.startswith(base) else url
+    return url[len(base) :] if url.startswith(base) else url
 
 
 def check_site(root, pages=("index.html",), shots=None, chromium=None, math_pages=None):

@@ -41,7 +41,7 @@ def readme_section(text, heading=GALLERY_HEADING):
     except StopIteration:
         raise ValueError(f"README.md has no section starting with {heading!r}") from None
     end = next((i for i in range(start + 1, len(lines)) if lines[i].startswith("## ")), len(lines))
-    return lines[start + 1:end]
+    return lines[start + 1 : end]
 
 
 _COMMENT = re.compile(r"^\s*<!--.*-->\s*$")
@@ -52,11 +52,13 @@ _IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".gif", ".svg")
 def _repo_link(line):
     """A link of the README to a repository file that is not a figure: the file's path as
     text (the site does not carry it)."""
+
     def sub(m):
         label, target = m.groups()
         if re.match(r"[a-z]+:", target) or target.startswith("#") or target.lower().endswith(_IMAGE_SUFFIXES):
             return m.group(0)
         return f"`{target}`" if label == target else f"{label} (`{target}` in the repository)"
+
     return _ANY_LINK.sub(sub, line)
 
 
@@ -73,7 +75,7 @@ def _figure_block(label, target, repo):
         body = path.read_text().splitlines()
         out = []
         for ln in body:
-            if ln.startswith("#"):       # the table's own title: a caption, not a section
+            if ln.startswith("#"):  # the table's own title: a caption, not a section
                 out.append(f"**{ln.lstrip('#').strip()}**")
             else:
                 out.append(ln)
@@ -87,17 +89,20 @@ def gallery_page(repo):
     repo = Path(repo)
     section = readme_section((repo / "README.md").read_text())
     out = ["# Gallery: the paper's examples, ours beside the paper's", ""]
-    rows, rest = [], []                 # the summary table (the section's first), and what follows it
+    rows, rest = [], []  # the summary table (the section's first), and what follows it
     for ln in section:
         if rest or (rows and not ln.startswith("|")):
-            rest.append(ln)             # later tables (Table 2's readings) stay tables, in the text below
+            rest.append(ln)  # later tables (Table 2's readings) stay tables, in the text below
         elif ln.startswith("|"):
             rows.append(ln)
         else:
             out.append(ln)
-    for i, row in enumerate(rows):      # tables (.md) are shown inline in the row's section below
-        out.append(re.sub(r"\[([^\]]+)\]\(figures/[^)\s]+\.md\)",
-                          lambda m, i=i: f"{{ref}}`{m.group(1)} <gallery-row-{i}>`", row))
+    for i, row in enumerate(rows):  # tables (.md) are shown inline in the row's section below
+        out.append(
+            re.sub(
+                r"\[([^\]]+)\]\(figures/[^)\s]+\.md\)", lambda m, i=i: f"{{ref}}`{m.group(1)} <gallery-row-{i}>`", row
+            )
+        )
     out.append("")
     header = [h.lower() for h in _cells(rows[0])] if rows else []
     for i, row in enumerate(rows[2:], start=2):
@@ -115,7 +120,7 @@ def gallery_page(repo):
     for ln in rest:
         m = _IMAGE_LINE.match(ln)
         if m:
-            continue                    # the README's showcase images are in the rows above
+            continue  # the README's showcase images are in the rows above
         extra.append(ln)
     if any(ln.strip() for ln in extra):
         out += ["## Verification problems and more", ""] + extra + [""]
@@ -149,17 +154,21 @@ def equations_page():
     API entry of the function, class or module that implements it."""
     from ...equations import INDEX, NOT_MAPPED
 
-    out = ["# Equation index", "",
-           "For each numbered equation of Wriggers, Vu Van & Stein (1990), the function, class or "
-           "module of `contactfem` that implements it (the same index as `contactfem equations`). "
-           "Each name links to its entry in the [API reference](api/index.md), where the docstring "
-           "cites the equation.", "",
-           "| eq | what | implemented in |", "|---:|---|---|"]
+    out = [
+        "# Equation index",
+        "",
+        "For each numbered equation of Wriggers, Vu Van & Stein (1990), the function, class or "
+        "module of `contactfem` that implements it (the same index as `contactfem equations`). "
+        "Each name links to its entry in the [API reference](api/index.md), where the docstring "
+        "cites the equation.",
+        "",
+        "| eq | what | implemented in |",
+        "|---:|---|---|",
+    ]
     for k in sorted(INDEX):
         e = INDEX[k]
         out.append(f"| ({k}) | `{_escape_bars(e.what)}` | {_role(e.where)} |")
-    out += ["", "## Equations without an entry of their own", "",
-            "| eq | why |", "|---:|---|"]
+    out += ["", "## Equations without an entry of their own", "", "| eq | why |", "|---:|---|"]
     for k in sorted(NOT_MAPPED):
         out.append(f"| ({k}) | {_escape_bars(NOT_MAPPED[k])} |")
     return "\n".join(out) + "\n"
@@ -187,10 +196,20 @@ def api_pages(package="contactfem"):
         groups.setdefault(key, []).append(name)
     pages = {}
     order = sorted(groups, key=lambda k: (k == "core", k))
-    index = ["# API reference", "",
-             "Generated from the docstrings. The layers, low to high: laws, contact, bodies, "
-             "solver, scenes, plots and io, the lab (benchmarks, reconstruction, sweeps, this site), the command line.", "",
-             "```{toctree}", ":maxdepth: 2", ""] + [f"{k}" for k in order] + ["```", ""]
+    index = (
+        [
+            "# API reference",
+            "",
+            "Generated from the docstrings. The layers, low to high: laws, contact, bodies, "
+            "solver, scenes, plots and io, the lab (benchmarks, reconstruction, sweeps, this site), the command line.",
+            "",
+            "```{toctree}",
+            ":maxdepth: 2",
+            "",
+        ]
+        + [f"{k}" for k in order]
+        + ["```", ""]
+    )
     pages["index.md"] = "\n".join(index)
     for key in order:
         title = f"`{package}.{key}`" if key != "core" else f"`{package}`: package, equation index, command line"
@@ -214,11 +233,19 @@ def copy_mathjax(dst):
 
     spec = importlib.util.find_spec("mathjax")
     roots = list(spec.submodule_search_locations or []) if spec else []
-    es5 = next((Path(r) / "static" / "mathjax" / "es5" for r in roots
-                if (Path(r) / "static" / "mathjax" / "es5" / "tex-chtml.js").exists()), None)
+    es5 = next(
+        (
+            Path(r) / "static" / "mathjax" / "es5"
+            for r in roots
+            if (Path(r) / "static" / "mathjax" / "es5" / "tex-chtml.js").exists()
+        ),
+        None,
+    )
     if es5 is None:
-        raise RuntimeError("MathJax not found: install the site extra, pip install -e '.[site]' "
-                           "(the package django-static-mathjax ships MathJax 3)")
+        raise RuntimeError(
+            "MathJax not found: install the site extra, pip install -e '.[site]' "
+            "(the package django-static-mathjax ships MathJax 3)"
+        )
     dst = Path(dst)
     if dst.exists():
         shutil.rmtree(dst)
@@ -254,12 +281,12 @@ def stage(repo, dst, instructor=False, only=None, work=None):
     nbs = build_versions(outs, repo=repo, only=only, work=work)["instructor" if instructor else "student"]
     if instructor:
         shutil.copy2(work / "student" / STUDENT_ZIP, dst / STUDENT_ZIP)
-    shutil.rmtree(dst / "autograder", ignore_errors=True)   # grading configurations: not pages
+    shutil.rmtree(dst / "autograder", ignore_errors=True)  # grading configurations: not pages
     (dst / MANIFEST).unlink(missing_ok=True)
     shutil.copy2(lectures / "README.md", dst / "course.md")
     gallery = gallery_page(repo)
     (dst / "gallery.md").write_text(gallery)
-    for rel in figures_used(gallery):   # images only: markdown tables are shown inline
+    for rel in figures_used(gallery):  # images only: markdown tables are shown inline
         (dst / rel).parent.mkdir(parents=True, exist_ok=True)
         shutil.copy2(repo / rel, dst / rel)
     (dst / "equations.md").write_text(equations_page())

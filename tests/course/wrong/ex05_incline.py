@@ -12,10 +12,25 @@ def ring_on_incline(theta_deg, mu, t_end=0.5):
     th = np.radians(theta_deg)
     n = np.array([-np.sin(th), np.cos(th)])
     R, h = P["R"], P["thickness"]
-    ring = make_ring(kind="beam", R=R, thickness=h, width=P["width"], n_el=P["n_el"], E=P["E"], nu=P["nu"],
-                     rho=P["rho"], center=(R + h / 2) * n)
-    contact = NodeToSegment(ring.body, ring.contact_nodes, RigidLine((0.0, 0.0), n), normal=PowerLaw(P["c_N"], 1.0),
-                            friction=None, offset=ring.offset)
+    ring = make_ring(
+        kind="beam",
+        R=R,
+        thickness=h,
+        width=P["width"],
+        n_el=P["n_el"],
+        E=P["E"],
+        nu=P["nu"],
+        rho=P["rho"],
+        center=(R + h / 2) * n,
+    )
+    contact = NodeToSegment(
+        ring.body,
+        ring.contact_nodes,
+        RigidLine((0.0, 0.0), n),
+        normal=PowerLaw(P["c_N"], 1.0),
+        friction=None,
+        offset=ring.offset,
+    )
     system = System([ring.body], [contact], [ring.gravity(P["g"])])
     stepper = Newmark(system, P["delta"], P["beta_newmark"], atol=1e-6, rtol=1e-10, maxit=30)
     down = np.array([-np.cos(th), -np.sin(th)])

@@ -7,7 +7,7 @@ class QuadraticNormal:
     def traction(self, g_N):
         g_N = np.asarray(g_N, dtype=float)
         approach = np.where(g_N < 0.0, -g_N, 0.0)
-        return -self.c_N * approach ** 2, 2.0 * self.c_N * approach
+        return -self.c_N * approach**2, 2.0 * self.c_N * approach
 
     def energy(self, g_N):
         g_N = np.asarray(g_N, dtype=float)
