@@ -16,7 +16,7 @@ _HOMES = {
     "check_law": "laws",
     "LawError": "laws",
     "LawValueError": "laws",
-    "AccuracyWarning": "scenes.accuracy",
+    "AccuracyWarning": "problem.accuracy",
 }
 
 

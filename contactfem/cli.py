@@ -125,7 +125,7 @@ def _show_value(v):
 def cmd_run(args):
     from . import scenes
     from .io.outputs import Outputs
-    from .scenes.base import check_resources, describe
+    from .problem.scene import check_resources, describe
 
     scene = scenes.get_scene(args.scene)
     overrides, laws, notes = laws_from_args(args)  # law.NAME=... go to --friction / --normal

@@ -162,7 +162,7 @@ def test_steps_kept_past_twice_their_share_are_at_the_floor_and_their_time_is_re
     cut below it by Newton, or the run's shortened last step); and a budget past 2 needs such steps
     (a run whose every step is within twice its share sums to at most twice the allowed error)."""
     from contactfem.scenes import simulate
-    from contactfem.scenes.accuracy import at_floor
+    from contactfem.problem.accuracy import at_floor
 
     scene = get_scene("rolling_ring")
     params = scene.resolve("fast", {"accuracy": 1e-2, "t_end": 0.5})
@@ -210,7 +210,7 @@ def test_a_tolerance_the_run_cannot_vouch_for_warns():
     rolling ring's polygon touches down node after node and the trapezoidal rule keeps the
     vibrations each touch-down excites, so the estimate asks for steps below the floor dt TOL (it
     warns today); the bar, whose one impact the estimate resolves, stays within its budget."""
-    from contactfem.scenes.accuracy import AccuracyWarning
+    from contactfem.problem.accuracy import AccuracyWarning
 
     for scene, over in (("rolling_ring", {"accuracy": 1e-2, "t_end": 0.6}), ("bar_impact", {"accuracy": 1e-2})):
         with warnings.catch_warnings(record=True) as caught:

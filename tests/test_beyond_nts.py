@@ -1,4 +1,4 @@
-"""Mortar contact and the semi-smooth Newton method in the scenes (scenes/enforcement.py):
+"""Mortar contact and the semi-smooth Newton method in the scenes (problem/enforcement.py):
 what they must show, computed by the runs.
 
 * the contact patch test (non-matching meshes at the fast and paper presets and two other
@@ -165,7 +165,7 @@ def test_semismooth_newton_does_not_depend_on_c_N_or_c_T(block_ssn, law):
 @pytest.mark.parametrize("law", list(LAWS))
 def test_semismooth_newton_tractions_are_the_augmented_lagrangians(block_ssn, law):
     """Uzawa to uzawa_tol = 1e-11 (its violation stalls at 7e-12, round-off of the shifted gap): its
-    tractions are off by about c_N h tol = 2e-7 (scenes/enforcement.py), 1e-9 of the pressure scale
+    tractions are off by about c_N h tol = 2e-7 (problem/enforcement.py), 1e-9 of the pressure scale
     p_y = 200, a decade below the 1e-8 compared."""
     aug = run_scene("block", "paper", dict(LAWS[law], enforcement="augmented", uzawa_tol=1e-11))
     r = block_ssn[law]

@@ -12,7 +12,7 @@ import types
 import pytest
 
 from contactfem import clock
-from contactfem.scenes import base
+from contactfem.problem import scene as base
 
 STATE = types.ModuleType("clock_test_state")  # the fake time, advanced by the modules below
 STATE.t = 0.0

@@ -44,7 +44,7 @@ from hypothesis import strategies as st  # noqa: E402
 from contactfem.cli import main  # noqa: E402
 from contactfem.io import load_run, save_run  # noqa: E402
 from contactfem.scenes import all_scenes  # noqa: E402
-from contactfem.scenes.resources import LIMITS  # noqa: E402
+from contactfem.problem.resources import LIMITS  # noqa: E402
 
 LONG = os.environ.get("CONTACTFEM_FUZZ") == "long"
 EXAMPLES = (

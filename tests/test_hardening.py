@@ -90,7 +90,7 @@ def test_a_forced_solver_counts_its_own_matrices():
     """The estimate adds what a forced solver holds: a dense K and its LU copy (16 bytes an
     entry), a band of about 3 sqrt(n) each side (72 bytes per n^1.5); auto and sparse keep
     the sparse model (the System chooses dense or banded only where they are small)."""
-    from contactfem.scenes.resources import BAND_BYTES, DENSE_BYTES, estimate
+    from contactfem.problem.resources import BAND_BYTES, DENSE_BYTES, estimate
 
     size = {"elements": 16384, "unknowns": 33282, "steps": 1}
     auto = estimate(size)["memory_bytes"]

@@ -1,11 +1,11 @@
 """The layout is the architecture: every module of contactfem belongs to a layer, and no
 module imports from a layer above its own (lazy imports inside functions included).
 
-    clock < laws < contact < bodies < solver < scenes < plots, io, equations < lab < cli
+    clock < laws < contact < bodies < solver < problem < scenes < plots, io, equations < lab < cli
 
 ``clock`` (a run's wall time without the time spent importing) imports nothing of
 contactfem, so the command line can start it first. The physics library is everything
-below ``lab``: laws, contact, bodies, solver, scenes,
+below ``lab``: laws, contact, bodies, solver, problem (the framework scenes are written in), scenes,
 and beside them plots (the paper's figures), io (saving runs, ParaView export,
 animations, progress bars) and equations (the index of the paper's equations in the
 code). ``lab`` is what is built around the library, not part of it: the course
@@ -28,12 +28,13 @@ ORDER = [
     ("contact",),
     ("bodies",),
     ("solver",),
+    ("problem",),
     ("scenes",),
     ("plots", "io", "equations"),
     ("lab",),
     ("cli", "__main__"),
 ]
-LIBRARY = ("clock", "laws", "contact", "bodies", "solver", "scenes", "plots", "io", "equations")
+LIBRARY = ("clock", "laws", "contact", "bodies", "solver", "problem", "scenes", "plots", "io", "equations")
 LAYER = {name: level for level, names in enumerate(ORDER) for name in names}
 
 
@@ -90,7 +91,7 @@ def test_no_import_from_a_higher_layer(path):
         if target in LAYER and LAYER[target] > LAYER[own]
     ]
     assert not back, (
-        "back edges against clock < laws < contact < bodies < solver < scenes < plots/io/equations < lab < cli:\n"
+        "back edges against clock < laws < contact < bodies < solver < problem < scenes < plots/io/equations < lab < cli:\n"
         + "\n".join(back)
     )
 

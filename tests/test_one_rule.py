@@ -1,4 +1,4 @@
-"""Each scene parameter is checked in one place, its Param (scenes/params.py): every value out
+"""Each scene parameter is checked in one place, its Param (problem/params.py): every value out
 of its range (its own, or the one the other parameters leave: a Limit) is refused once, in one
 line naming the parameter and its range, before any work, from Python (run_scene) as from the
 command line (exit 2); and every value inside it passes every later rule (the scene's build
@@ -9,7 +9,7 @@ import warnings
 
 import pytest
 
-import contactfem.scenes.base as base
+import contactfem.problem.scene as base
 from contactfem.cli import main
 from contactfem.scenes import all_scenes, run_scene
 

@@ -276,7 +276,7 @@ def _fig8_docs():
     nb = json.loads((repo / "lectures" / "04_block.ipynb").read_text())
     texts = {
         "README.md": README[README.index("### Table 1 and Fig 8") : README.index("### Table 2")],
-        "scenes/block_params.py": (repo / "contactfem" / "scenes" / "block_params.py").read_text(),
+        "contactfem/scenes/block.py": (repo / "contactfem" / "scenes" / "block.py").read_text(),
         "scenes/block.py": get_scene("block").notes,
         "lectures/04_block.md": (repo / "lectures" / "04_block.md").read_text(),
         "lectures/04_block.ipynb": "".join("".join(c["source"]) for c in nb["cells"]),
@@ -293,7 +293,7 @@ def test_fig8_claim_is_the_studys(study):
     moves: the readings that show it (how many, the best one's rank, facts and parameters: the
     preset fig8, the reading of figures/fig08b_block_fig8_readings.json), and whether any of them
     also meets Table 1's conical facts (4 residuals, nodes slipping): the README, the scene's notes,
-    block_params and lecture 04 (both twins) say 'no reading that meets Table 1's conical facts'
+    the block's module and lecture 04 (both twins) say 'no reading that meets Table 1's conical facts'
     exactly when the study finds none."""
     from contactfem.plots.data import load
 

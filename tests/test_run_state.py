@@ -7,7 +7,7 @@ import pytest
 
 from contactfem.io import load_record, save_record
 from contactfem.scenes import get_scene
-from contactfem.scenes.base import simulate
+from contactfem.problem.scene import simulate
 from contactfem.solver.march import resume
 
 # every scene whose model is one Stage (the cork's two stages: test_cork_twice_gives_the_same_records)

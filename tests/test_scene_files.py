@@ -1,4 +1,4 @@
-"""A scene a user writes in a file of its own (contactfem/scenes/files.py) runs like a shipped
+"""A scene a user writes in a file of its own (contactfem/problem/files.py) runs like a shipped
 one: `contactfem run FILE.py`, `show`, `sweep` with law.FIELD, `--friction`, `--json`, and
 run_scene("FILE.py") from Python, with the same numbers; a broken file fails in one line
 naming the file and the cause."""

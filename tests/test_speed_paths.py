@@ -317,15 +317,15 @@ def numbers_agree(
 
 
 def cork_press_fit(preset):
-    from contactfem.scenes import cork, cork_measure, cork_stages
+    from contactfem.scenes import cork
 
     params = get_scene("cork").resolve(preset)
     model = cork.build(params)
-    last, fit = cork_stages.press_fit(model, params)
+    last, fit = cork.press_fit(model, params)
     system = model.systems[0]  # the press fit's (the pop's is the second)
     return dict(
         fit,
-        **cork_measure.contact_forces(last.contacts),
+        **cork.contact_forces(last.contacts),
         u=last.u,
         linear_algebra=system.linear_algebra,
         ordering=system.ordering,

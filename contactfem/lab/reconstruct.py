@@ -41,7 +41,7 @@ conical and parabolic) and Fig 8's remark.
 
 Outcomes (block). Every reading ends in one of: converged (admissible: ranked);
 no_equilibrium (the side load exceeds the friction the foundation can carry under one of
-the laws, ``scenes.block_params.friction_capacity``: no solve is attempted); no_convergence (Newton
+the laws, ``scenes.block.friction_capacity``: no solve is attempted); no_convergence (Newton
 failed); rejected_inverted (the deformed mesh has an element with det J <= 0: a displacement
 far outside the small-strain model); rejected_penetration (the block sinks into the rigid
 foundation by more than PENETRATION_FRACTION of its height, argued beside the constant).
@@ -144,7 +144,7 @@ def _quiet_run(scene, params):
     outcomes (penetration, inverted elements, energy gain, no rebound), not warned about one by one."""
     import warnings
 
-    from ..scenes.accuracy import AccuracyWarning
+    from ..problem.accuracy import AccuracyWarning
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", AccuracyWarning)
@@ -189,11 +189,11 @@ def block_case_outcome(case, height):
 
 
 def fig8_remark(conical, parabolic):
-    """Fig 8's remark on the two solves of a reading (``scenes.block_params.fig8_remark``, the
+    """Fig 8's remark on the two solves of a reading (``scenes.block.fig8_remark``, the
     measure the figures use): the fraction of the nodes in the top quartile of the conical
     normal pressure where the parabolic |t_T| is at least 5 % below the conical one, and the
     smallest relative reduction there."""
-    from ..scenes.block_params import fig8_remark as measure
+    from ..scenes.block import fig8_remark as measure
 
     if not (conical.get("converged") and parabolic.get("converged")):
         return 0.0, float("nan")
@@ -202,7 +202,7 @@ def fig8_remark(conical, parabolic):
 
 def score_block(reading, conical, parabolic):
     """Facts met and the residual distance of one reading (see the module docstring)."""
-    from ..scenes.block_params import PAPER_TABLE1
+    from ..scenes.block import PAPER_TABLE1
 
     r0 = conical["residuals"][0] if conical.get("converged") else reading.get("first_residual")
     n_con = len(conical["residuals"]) if conical.get("converged") else None
@@ -254,10 +254,10 @@ def block_reading_params(reading, law):
 
 def block_equilibrium(reading, law):
     """(tangential load |p_x| H, the friction the foundation can carry at most): the block
-    scene's own bound (scenes.block_params.friction_capacity). A reading whose load exceeds it has no
+    scene's own bound (scenes.block.friction_capacity). A reading whose load exceeds it has no
     static equilibrium: no solve can give one."""
     from ..scenes.block import SCENE
-    from ..scenes.block_params import friction_capacity
+    from ..scenes.block import friction_capacity
 
     p = dict(SCENE.resolve("fast"), **block_reading_overrides(reading, law))
     return abs(p["p_x"]) * p["height"], friction_capacity(p)[0]
@@ -763,7 +763,7 @@ def main(scene, quick=False, top=25, json_path=None, cache=True):
             criteria=dict(
                 penetration_fraction_of_height=PENETRATION_FRACTION,
                 inverted="an element with det J <= 0 at a corner of the deformed mesh",
-                no_equilibrium="|p_x| H above the friction capacity (scenes.block_params.friction_capacity)",
+                no_equilibrium="|p_x| H above the friction capacity (scenes.block.friction_capacity)",
             ),
             best_pulled_rank=pull["rank"] if pull is not None else None,
             readings=rows,

@@ -117,7 +117,7 @@ def plan(scene, grid, preset="fast", jobs=1, scheduler=None, friction=None, norm
     its parameters, its laws, unless ``check`` is False the laws over the range the scene meets,
     and unless ``force`` its size against the limits of `contactfem run` (resources.LIMITS),
     the memory of the runs that go at once (``jobs`` of them locally) together."""
-    from ..scenes.resources import LIMITS, check_resources, describe
+    from ..problem.resources import LIMITS, check_resources, describe
 
     sc = get_scene(scene)
     points = [dict(zip(grid, combo)) for combo in itertools.product(*grid.values())]

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from ..scenes.block import SCENE, solve
-from ..scenes.block_params import FIG8_DROP, PAPER_TABLE1, PAPER_TABLE1_UNCERTAIN, fig8_remark
+from ..scenes.block import FIG8_DROP, PAPER_TABLE1, PAPER_TABLE1_UNCERTAIN, fig8_remark
 from ..solver.newton import NewtonError
 from . import cached_run, default_outdir, describe_newton, figure, fitted_words, pyplot, savefig  # noqa: F401
 from .data import save_figure
@@ -204,7 +204,7 @@ def fig08(preset="fast", outdir=None, r=None, conical=None):
 
 def fig8_reading_data(preset="fast", other="fig8"):
     """What fig08b draws, for the block's ``preset`` and the reading of preset ``other``: per
-    reading the measure of Fig 8's remark (scenes.block_params.fig8_remark: fig8_fraction,
+    reading the measure of Fig 8's remark (scenes.block.fig8_remark: fig8_fraction,
     fig8_min_reduction, fig8_nodes), each law's n_slip and newton_residuals, and the stresses along
     the contact side; and the parameters of both runs."""
     data, params = {"fig8_drop": FIG8_DROP, "readings": {}}, {}

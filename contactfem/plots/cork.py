@@ -497,14 +497,14 @@ def exit_cases():
 
 
 def exit_case(case, preset=EXIT_PRESET):
-    """One run of the cork (the stages of scenes/cork_stages.py, as the scene simulates them) with the
+    """One run of the cork (the stages of scenes/cork.py, as the scene simulates them) with the
     closing step of its contact on or off in each stage and, with a ramp step, the time step
     refined under the unchanged pressure ramp. Returns the case with the exit time and
     velocity, the press-fit force and the slowest speed of the cork after the ramp (its stall)."""
     from ..scenes import get_scene
     from ..scenes.cork import build
-    from ..scenes.cork_measure import contact_forces, history
-    from ..scenes.cork_stages import pop, press_fit, stage_systems
+    from ..scenes.cork import contact_forces, history
+    from ..scenes.cork import pop, press_fit, stage_systems
 
     group, label, over, (fit_rule, pop_rule), ramp = case
     row = dict(

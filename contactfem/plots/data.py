@@ -63,7 +63,7 @@ def dumps(record):
 def figure_record(stem, data, parameters):
     """The dict written to NAME.json: figure, code_version, parameters, then ``data``'s keys
     (numpy values made plain; a key of RESERVED in ``data`` is a ValueError)."""
-    from ..scenes.base import jsonable
+    from ..problem.scene import jsonable
 
     clash = [k for k in data if k in RESERVED]
     if clash:

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ..scenes.sloping_impact import PAPER_TABLE2
-from ..scenes.time_integration import newmark_of
+from ..problem.time_integration import newmark_of
 from . import cached_run, default_outdir, figure, fitted_words, pyplot
 from .data import save_figure, write_data
 

@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..scenes.block_params import PAPER_TABLE1
+from ..scenes.block import PAPER_TABLE1
 from . import cached_run, default_outdir, figure
 
 START, END = "<!-- summary:start -->", "<!-- summary:end -->"

@@ -9,15 +9,15 @@ Listing the scenes imports every scene module, so a scene module imports scikit-
 import importlib
 import pkgutil
 
-from .base import Limit, Model, Param, Scene, Stage, jsonable, simulate
-from .files import SceneError, is_scene_file, load_scene_file
+from ..problem.scene import Limit, Model, Param, Scene, Stage, jsonable, simulate
+from ..problem.files import SceneError, is_scene_file, load_scene_file
 
 
 def all_scenes():
     """name -> Scene, for every module of this package that defines SCENE."""
     found = {}
     for info in sorted(pkgutil.iter_modules(__path__), key=lambda i: i.name):
-        if info.name == "base" or info.name.startswith("_"):
+        if info.name.startswith("_"):
             continue
         mod = importlib.import_module(f"{__name__}.{info.name}")
         scene = getattr(mod, "SCENE", None)
@@ -41,7 +41,7 @@ def get_scene(name):
                 f"SCENE); known are {', '.join(all_scenes())}"
             )
         return load_scene_file(name)
-    if isinstance(name, str) and name.isidentifier() and not name.startswith("_") and name != "base":
+    if isinstance(name, str) and name.isidentifier() and not name.startswith("_"):
         module = f"{__name__}.{name}"
         try:
             scene = getattr(importlib.import_module(module), "SCENE", None)
@@ -88,7 +88,7 @@ def run_scene(
     often they were evaluated (``residual_evaluations``, ``contact_evaluations``).
     ``overrides``: {parameter name: value}, a value given as a number or as the text of one (the
     same rule as the command line's --set: an integer parameter takes 12, 12.0 or "12"; see
-    scenes.params); a TypeError names ``overrides`` or ``progress`` given as anything else.
+    problem.params); a TypeError names ``overrides`` or ``progress`` given as anything else.
     ``linear_algebra``: auto|dense|banded|sparse for every System the scene builds (None: auto,
     chosen by size and band width), to compare the solvers on one scene.
     ``progress(t0, t_end, label)``: a progress-callback factory for the scene's time loops
@@ -107,7 +107,7 @@ def run_scene(
     from ..laws.protocol import as_normal_law, describe
     from ..solver.assembly import KINDS
 
-    from .params import check_overrides
+    from ..problem.params import check_overrides
 
     scene = get_scene(name)
     overrides = check_overrides(overrides)

@@ -59,9 +59,9 @@ import numpy as np
 from ..contact import RigidLine, tributary_lengths
 from ..laws import PowerLaw
 from ..solver import CentralDifference, History, System
-from . import enforcement, time_integration
-from .accuracy import references
-from .base import Model, Param, Scene, Stage
+from ..problem import enforcement, time_integration
+from ..problem.accuracy import references
+from ..problem.scene import Model, Param, Scene, Stage
 
 
 def bar_exact(L, E, rho, v0):

@@ -35,8 +35,8 @@ from ..bodies.ring import make_ring
 from ..contact import NodeToSegment, RigidPolyline
 from ..laws import ParabolicSlip, PowerLaw
 from ..solver import Dirichlet, History, Steps, System
-from . import time_integration
-from .base import Model, Param, Scene, Stage
+from ..problem import time_integration
+from ..problem.scene import Model, Param, Scene, Stage
 from .rings import MASS_MATRIX_PARAM, RING_PARAMS, penalty_pressure, ring_history, ring_size, snapshot_indices
 
 VARIANTS = ("frictionless", "frictional")

@@ -47,9 +47,9 @@ import numpy as np
 from ..contact import RigidLine, tributary_lengths
 from ..laws import PowerLaw
 from ..solver import Dirichlet, History, Static, Steps, System
-from . import enforcement
-from .accuracy import HERTZ_SOURCE, HERTZ_TOL, hertz_half_width, references
-from .base import PENALTIES, PENALTY_DOC, Model, Param, Scene, Stage
+from ..problem import enforcement
+from ..problem.accuracy import HERTZ_SOURCE, HERTZ_TOL, hertz_half_width, references
+from ..problem.scene import PENALTIES, PENALTY_DOC, Model, Param, Scene, Stage
 
 
 def hertz_exact(P, R, E, nu, E2=np.inf, nu2=0.0):

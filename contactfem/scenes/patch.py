@@ -66,8 +66,8 @@ import numpy as np
 from ..contact import BodySurface, tributary_lengths
 from ..laws import Coulomb, PowerLaw
 from ..solver import Dirichlet, History, Static, Steps, System
-from . import enforcement
-from .base import Model, Param, Scene, Stage
+from ..problem import enforcement
+from ..problem.scene import Model, Param, Scene, Stage
 
 
 def block(xs, y0, y1, ny, name, E, nu):
@@ -208,7 +208,7 @@ def measure(m, params, records):
         s = body.cauchy_stress(system.local(body, u))
         s_dev = max(s_dev, float(np.max(np.abs(s[:, 1, 1] + p)) / p))
     result["stress_deviation_max"] = s_dev
-    from .accuracy import PRESSURE_TOL, indicator
+    from ..problem.accuracy import PRESSURE_TOL, indicator
 
     result["accuracy"] = dict(
         pressure_deviation=indicator(

@@ -14,7 +14,7 @@ history moved on).
 import numpy as np
 
 from ..laws.return_map import OPEN, SLIP
-from .base import Limit, Param
+from ..problem.scene import Limit, Param
 
 # The mass matrix of every ring scene (the scan does not say which the paper used).
 MASS_MATRIX_PARAM = Param(

@@ -55,9 +55,9 @@ from ..bodies.ring import make_ring
 from ..contact import NodeToSegment, RigidLine
 from ..laws import Coulomb, PowerLaw
 from ..solver import History, System
-from . import time_integration
-from .accuracy import V_FINAL_TOL, X_END_TOL, references
-from .base import Model, Param, Scene, Stage
+from ..problem import time_integration
+from ..problem.accuracy import V_FINAL_TOL, X_END_TOL, references
+from ..problem.scene import Model, Param, Scene, Stage
 from .rings import (
     MASS_MATRIX_PARAM,
     THICKNESS_LIMIT,

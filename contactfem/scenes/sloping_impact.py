@@ -35,8 +35,8 @@ from ..contact import NodeToSegment, RigidLine, tributary_lengths
 from ..contact.tangents import TANGENTS
 from ..laws import ParabolicSlip, PowerLaw
 from ..solver import History, System
-from . import time_integration
-from .base import PENALTIES, PENALTY_DOC, Model, Param, Scene, Stage
+from ..problem import time_integration
+from ..problem.scene import PENALTIES, PENALTY_DOC, Model, Param, Scene, Stage
 from .rings import MASS_MATRIX_PARAM, RING_PARAMS, penalty_pressure, ring_history, ring_size, snapshot_indices
 
 VARIANTS = ("frictionless", "frictional", "viscoplastic")

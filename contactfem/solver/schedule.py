@@ -133,7 +133,7 @@ class Adaptive(_Cuts):
 # term is the method's numerical damping: it takes the energy of the vibrations an impact excites,
 # and a rebound's or a rolling ring's speed with it (bench study 10 measures what it costs against
 # the trapezoidal rule). A scene at a tolerance therefore integrates with the trapezoidal rule (delta = 1/2, beta = 1/4,
-# scenes/time_integration.py) or the energy-consistent stepper, both second order. There the first
+# problem/time_integration.py) or the energy-consistent stepper, both second order. There the first
 # term vanishes and the error is the second, dt^3 a'' / 12, from the second difference of the
 # accelerations over the last two steps (hs their sizes, s = (a+ - a) / h their slopes):
 #

@@ -24,7 +24,8 @@ accuracy it did not ask for, and the study says how much."""
 
 import warnings
 
-from ...scenes import run_scene, time_integration
+from ...problem import time_integration
+from ...scenes import run_scene
 from .common import timed
 
 # the trapezoidal rule as a scene's parameters (the integrator of a run at a tolerance)

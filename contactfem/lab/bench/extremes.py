@@ -37,7 +37,7 @@ import warnings
 from dataclasses import dataclass, field
 
 from ...scenes import get_scene, run_scene
-from ...scenes.accuracy import AccuracyWarning
+from ...problem.accuracy import AccuracyWarning
 
 TOL = 0.05  # a headline quantity more than 5 % off its reference is wrong
 REFINE = 0.25  # the reference's step, times the scene's (the presets are first order at worst:

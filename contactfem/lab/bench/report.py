@@ -5,7 +5,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ...scenes.accuracy import ERROR_BUDGET
+from ...problem.accuracy import ERROR_BUDGET
 from .adaptive import STUDY
 from .common import TARGETS
 from .enforcement import enforcement_markdown

@@ -1029,7 +1029,7 @@ def margin_block(slip_margin):
 
     def run():
         from ...solver.march import march
-        from ...scenes.block_params import friction_law
+        from ...scenes.block import friction_law
 
         model, P = _scene_model("block", {"law": "conical"})
         st = model.stage

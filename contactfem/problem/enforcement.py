@@ -10,7 +10,7 @@ import numpy as np
 from ..contact import NodeToSegment
 from ..contact.augmented import AugmentedNodeToSegment
 from ..solver.uzawa import Uzawa
-from .base import Param
+from .scene import Param
 
 ENFORCEMENTS = ("penalty", "augmented", "lagrange")
 DISCRETIZATIONS = ("node_to_segment", "mortar")

@@ -10,7 +10,7 @@ from ..solver import Adaptive, Newmark, Steps
 from ..solver.schedule import at_tolerance
 from ..solver.conserving import EnergyConsistent
 from ..solver.newmark import BETA_RANGE, DELTA_RANGE
-from .base import Param
+from .scene import Param
 
 CONTACT_INTEGRATIONS = ("standard", "energy_consistent")
 

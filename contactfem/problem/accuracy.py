@@ -35,7 +35,7 @@ import numpy as np
 
 
 class AccuracyWarning(UserWarning):
-    """A run's accuracy indicator is past its threshold (contactfem.scenes.accuracy)."""
+    """A run's accuracy indicator is past its threshold (contactfem.problem.accuracy)."""
 
 
 def indicator(value, threshold, what, source, upper=True):

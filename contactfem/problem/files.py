@@ -29,7 +29,7 @@ import traceback
 from dataclasses import replace
 from pathlib import Path
 
-from .base import Model, Scene
+from .scene import Model, Scene
 
 
 class SceneError(RuntimeError):

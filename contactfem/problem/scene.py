@@ -48,7 +48,7 @@ def run(scene, params, normal=None, friction=None, progress=None, linear_algebra
     ``ordering``, ``unknowns``, ``band_kl``, ``band_ku``) and how often they were evaluated
     (``residual_evaluations``: System evaluations, one per residual Newton needs;
     ``contact_evaluations``: contact evaluations, one per contact in each), an ``accuracy`` section
-    (scenes/accuracy.py; AccuracyWarning past a threshold) and ``stepping`` where a scene takes ``accuracy``."""
+    (problem/accuracy.py; AccuracyWarning past a threshold) and ``stepping`` where a scene takes ``accuracy``."""
     from ..clock import imports_timed
     from .accuracy import collect, stepping, warn
 
