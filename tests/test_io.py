@@ -157,6 +157,58 @@ def test_progress_bar():
         ProgressBar()
 
 
+@pytest.fixture
+def clock(monkeypatch):
+    """tqdm's clock, faked: a list whose one number is the time; no monitor thread."""
+    import tqdm.std
+
+    now = [0.0]
+    monkeypatch.setattr(tqdm.std, "time", lambda: now[0])
+    monkeypatch.setattr(tqdm.std.tqdm, "monitor_interval", 0)
+    return now
+
+
+def redraws(stream):
+    return stream.getvalue().count("\r")
+
+
+@pytest.mark.parametrize("by", ["time", "steps"])
+def test_the_bar_moves_during_a_run(clock, by):
+    """A run of 5 s (100 records, 0.05 s apart) redraws its bar about every interval (0.2 s), for a
+    bar over [t0, t_end] (whose total is the fraction 1) as for one counting steps: at least 10
+    redraws, not the first and the last only."""
+    out = io.StringIO()
+    bar = ProgressBar(t0=0.0, t_end=1.0, stream=out) if by == "time" else ProgressBar(total=100, stream=out)
+    for k in range(1, 101):
+        clock[0] += 0.05
+        bar(k / 100) if by == "time" else bar.update()
+    bar.close()
+    assert redraws(out) >= 10
+    assert redraws(out) <= 5.0 / 0.2 + 2  # by time: at most one redraw an interval, and the first and the last
+
+
+def test_the_notebook_bar_moves_too(clock, monkeypatch):
+    """In Jupyter the bar is tqdm's widget (tqdm.auto): redrawn as the text bar is."""
+    pytest.importorskip("ipywidgets")
+    from tqdm.notebook import tqdm as widget
+
+    from contactfem.io import progress
+
+    drawn = []
+
+    class Widget(progress._Fields, widget):
+        def display(self, *args, **kwargs):
+            drawn.append(self.n)
+
+    monkeypatch.setattr(progress, "_AutoBar", Widget)
+    bar = ProgressBar(t0=0.0, t_end=1.0)
+    for k in range(1, 101):
+        clock[0] += 0.05
+        bar(k / 100)
+    bar.close()
+    assert len(drawn) >= 10 and drawn[-1] == 1.0
+
+
 def test_compare_runs_walks_every_number():
     """compare_runs: the largest relative difference over the numbers both results hold (an
     array scaled by its largest value), text compared for equality, what describes the run

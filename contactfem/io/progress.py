@@ -70,7 +70,7 @@ class ProgressBar:
             total=total if total is not None else 1.0,
             desc=f"{label} " if label else "",
             mininterval=float(interval),
-            miniters=1,
+            miniters=0,  # redrawn by time alone: a bar over [t0, t_end] moves by fractions of its total of 1
             ascii=".#",
             bar_format=FORMAT.replace("{bar}", f"{{bar:{int(width)}}}"),
         )
