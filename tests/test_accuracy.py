@@ -167,3 +167,18 @@ def test_a_saved_run_carries_its_accuracy(tmp_path, ext):
     r, _ = _run("block", {"c_N": 10})
     save_run(as_arrays(r), tmp_path / f"run.{ext}")
     assert load_run(tmp_path / f"run.{ext}")["accuracy"] == r["accuracy"]
+
+
+def test_the_equilibrium_indicator_is_the_residual_over_the_force_scale():
+    """On the block (one step, its last residual 7e-13 at most, below Newton's atol = 1e-12) the value is
+    what its label says, the converged residual over the force scale (about 6e-15), not 0; the force
+    scale's floor atol / 1e-6 moves it by atol / (1e-6 F), under 1e-7 of it here."""
+    from contactfem.scenes import get_scene
+    from contactfem.problem.scene import simulate
+
+    scene = get_scene("block")
+    params = scene.resolve("fast")
+    model = scene.build(params)
+    ratios = [r.result.ratios[-1] for r in simulate(model, params)[1:]]  # max |G_f| / F of each converged step
+    value = run_scene("block", "fast")["accuracy"]["equilibrium"]["value"]
+    assert 0 < value <= max(ratios) and value == pytest.approx(max(ratios), rel=1e-7)

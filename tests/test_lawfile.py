@@ -92,3 +92,18 @@ def test_a_normal_law_from_a_file(tmp_path):
     )
     laws = laws_from_options(normal=f"{f}:Lin", friction=SAT, law_sets=split_sets({"law.c_N": "3"})[1])
     assert laws["normal"].c_N == 3.0 and laws["friction"].mu0 == 0.3
+
+
+def test_an_integer_field_takes_integers_only(tmp_path):
+    """A field annotated int takes 3, "3", "3.0" (the integer 3) and refuses 2.5 as not an integer."""
+    path = tmp_path / "stepped.py"
+    path.write_text(
+        "from dataclasses import dataclass\nimport numpy as np\n\n\n@dataclass(frozen=True)\nclass Stepped:\n"
+        "    c_T: float = 10.0\n    k: int = 2\n\n    def slip_bound(self, p, q):\n"
+        "        return 0.1 * self.k * np.asarray(p)\n"
+    )
+    for text in ("3", "3.0", "3e0"):
+        law = laws_from_options(friction=f"{path}:Stepped", law_sets=split_sets({"law.k": text})[1])["friction"]
+        assert law.k == 3 and type(law.k) is int
+    with pytest.raises(ValueError, match=r"^law parameter k must be an integer, got '2.5'$"):
+        laws_from_options(friction=f"{path}:Stepped", law_sets=split_sets({"law.k": "2.5"})[1])

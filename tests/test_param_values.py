@@ -47,3 +47,13 @@ def test_progress_must_be_callable(progress):
 def test_the_same_value_gives_the_same_run():
     a, b = (run_scene("block", "canonical", {"nx": v, "ny": 10}) for v in (20, "20.0"))
     assert a["newton_residuals"] == b["newton_residuals"] and a["parameters"]["nx"] == b["parameters"]["nx"] == 20
+
+
+@pytest.mark.parametrize("value", ["abc", True])
+def test_a_tolerance_that_is_no_number_is_called_so(value):
+    """Text or a boolean for accuracy is not a number (not a number out of range)."""
+    pattern = r"^parameter accuracy must be a number: 0 \(fixed steps\) or \[0.001, 0.1\], got "
+    with pytest.raises(ValueError, match=pattern):
+        get_scene("rolling_ring").resolve("fast", {"accuracy": value})
+    with pytest.raises(ValueError, match=r"^parameter accuracy = 0.5 is out of range: allowed 0 \(fixed steps\)"):
+        get_scene("rolling_ring").resolve("fast", {"accuracy": 0.5})

@@ -206,9 +206,14 @@ def _convert(value, field):
     if t is str:
         return value
     try:
-        return int(value) if t is int else float(value)
+        number = float(value)
     except ValueError:
         raise ValueError(f"law parameter {field.name} must be a number, got {value!r}") from None
+    if t is not int:
+        return number
+    if not number.is_integer():  # 12, 12.0 and 1.2e1 are the integer 12 (the rule of problem/params.py)
+        raise ValueError(f"law parameter {field.name} must be an integer, got {value!r}")
+    return int(number)
 
 
 def make_law(cls, values=None, scene_params=None, option="--friction", notes=None):

@@ -8,7 +8,8 @@ command line prints those warnings and ``--strict`` makes them exit code 1.
 
 The indicators that apply to a run (``collect``), from its records and the model's sizes:
 
-    equilibrium     the largest converged residual over the step's force scale (solver/newton.py)
+    equilibrium     the largest converged residual over the step's force scale (solver/newton.py: plus
+                    atol / 1e-6, so that a residual within Newton's absolute floor atol is within 1e-6)
     penetration     the largest penetration over the local element size, and over the body's size
     facets          a ring's elements against its radius: the angle one element spans (few: no ring)
     energy_gain     the energy balance's error, both signs: a gain (the integrator adds energy)
@@ -107,7 +108,8 @@ def collect(model, params, records, results):
         out["equilibrium"] = indicator(
             max(ratios),
             EQUILIBRIUM,
-            "largest converged residual / the step's force scale",
+            "largest converged residual / the step's force scale (plus atol / 1e-6: a residual within Newton's "
+            "absolute floor atol is within the threshold)",
             "Newton's round-off tolerance (solver.newton.ROUNDOFF_RTOL); its own is 1e-8",
         )
     sizes = model.sizes

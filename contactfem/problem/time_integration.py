@@ -117,11 +117,13 @@ class Tolerance(Param):
     def parse(self, value):
         try:
             v = super().parse(value)
-        except ValueError:
-            raise ValueError(
-                f"parameter {self.name} = {value!r} is out of range: allowed {self.range_text()}"
-            ) from None
-        if 0.0 < v < ACCURACY_MIN:
+        except ValueError as err:
+            if "must be a number" in str(err):  # text or a boolean: no number at all
+                raise ValueError(
+                    f"parameter {self.name} must be a number: {self.range_text()}, got {value!r}"
+                ) from None
+            v = None  # a number out of the parameter's own range
+        if v is None or 0.0 < v < ACCURACY_MIN:
             raise ValueError(f"parameter {self.name} = {value!r} is out of range: allowed {self.range_text()}")
         return v
 

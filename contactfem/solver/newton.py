@@ -30,8 +30,8 @@ waived at k = 0, when the residual is below atol or NEGLIGIBLE (1e-3) times its 
 iterate's own error, K^-1 G, is then negligible whatever the last correction was), and when the
 correction is at the round-off of u (1e3 machine epsilon of max |u_k|); there the residual cannot fall further, and
 ROUNDOFF_RTOL F is accepted instead of rtol F (a very stiff penalty: one round-off of a gap is a
-force; ``residual_ratio`` says what was reached). atol (force units) is a floor for a step in
-which nothing carries a force. ``residuals`` keeps the Euclidean norms ||G_k|| for reports.
+force; ``residual_ratio`` says what was reached: max |G| / (F + atol / ROUNDOFF_RTOL)). atol (force
+units) is a floor for a step in which nothing carries a force. ``residuals`` keeps the Euclidean norms ||G_k|| for reports.
 
 Defaults (RTOL = 1e-8, CTOL = 1e-6), measured on the fast presets of the scenes (their headline
 results against a run with 1e-10 / 1e-8, and the residual evaluations): Abaqus' 5e-3 / 1e-2 saves
@@ -104,7 +104,8 @@ class NewtonResult:
     evaluation: object = None  # what fun returned at u (G, K, contact states, ...)
     evaluations: int = 0  # calls of fun (residuals + line-search trials)
     force_scale: float = 0.0  # F at u (module docstring)
-    residual_ratio: float = 0.0  # (max |G_f| - atol)+ / F at u: what the test accepted above atol
+    residual_ratio: float = 0.0  # max |G_f| / (F + atol / ROUNDOFF_RTOL) at u: at most ROUNDOFF_RTOL when the
+    # loosest test passes (max |G_f| <= atol + ROUNDOFF_RTOL F); the force scale where F >> atol / ROUNDOFF_RTOL
     correction_ratio: float = 0.0  # the last correction / the step's increment (0 at k = 0)
     ratios: list = field(default_factory=list)  # max |G_f| / F of every iterate
     local_error: float | None = None  # a time stepper's estimate of the step's error (schedule.Estimated)
@@ -229,7 +230,7 @@ def _newton(fun, u0, free, atol, rtol, maxit, label, line_search, instrument, ct
                     evaluation=out,
                     evaluations=calls,
                     force_scale=F,
-                    residual_ratio=max(r_max - atol, 0.0) / F if F > 0 else 0.0,
+                    residual_ratio=r_max / (F + atol / ROUNDOFF_RTOL) if r_max > 0 else 0.0,
                     correction_ratio=c_ratio if k else 0.0,
                     ratios=ratios,
                 )
