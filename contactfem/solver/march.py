@@ -43,6 +43,12 @@ class Record:
     cuts, failures  halvings before the step converged, the first line of each failure
     state           the SystemState after the step (solver/system.py): what the next step
                     starts from
+
+    Two records are equal (``==``) when their values are, bit for bit: what save_record keeps of
+    them and a run goes on from (k, t, dt, u, v, a, the energies, cuts and failures, the residual
+    G with its reactions and the loads P, Newton's iterations and residuals, the step's error
+    estimate, the SystemState). Their tangents and contact states, which follow from those, are
+    not compared: a record read back by load_record equals the one saved.
     """
 
     k: int
@@ -58,6 +64,14 @@ class Record:
     failures: tuple = ()
     state: object = None
 
+    def __eq__(self, other):
+        if not isinstance(other, Record):
+            return NotImplemented
+        return self is other or same_value(_kept(self), _kept(other))
+
+    def __hash__(self):  # equal records have equal k, t and dt
+        return hash((self.k, self.t, self.dt))
+
     @property
     def contacts(self):
         """The converged contact states (contact/state.py), one per contact of the System."""
@@ -70,6 +84,43 @@ class Record:
     @property
     def residuals(self):
         return list(self.result.residuals) if self.result is not None else []
+
+
+def _kept(rec):
+    """What a record is as a value (Record.__eq__): what save_record keeps of it."""
+    result, ev = rec.result, rec.evaluation
+    return (
+        (rec.k, rec.t, rec.dt, rec.u, rec.v, rec.a, rec.energy, rec.cuts, tuple(rec.failures)),
+        (ev.G if result is None else result.G, getattr(ev, "P", None), rec.iterations, rec.residuals),
+        (getattr(result, "local_error", None), getattr(result, "error_share", None), rec.state),
+    )
+
+
+def same_value(a, b):
+    """Whether a and b hold the same values, bit for bit (NaN equal to NaN): numbers, text, arrays,
+    sparse matrices, and tuples, lists, dicts and dataclasses of them, compared element by element."""
+    import dataclasses
+    import numbers
+
+    from scipy import sparse
+
+    if a is b:
+        return True
+    if isinstance(a, (numbers.Number, np.generic)) and isinstance(b, (numbers.Number, np.generic)):
+        return bool(a == b) or (a != a and b != b)  # NaN: the same value
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        a, b = np.asarray(a), np.asarray(b)
+        return a.shape == b.shape and np.array_equal(a, b, equal_nan=a.dtype.kind in "fc" and b.dtype.kind in "fc")
+    if sparse.issparse(a) or sparse.issparse(b):
+        return sparse.issparse(a) and sparse.issparse(b) and a.shape == b.shape and (a != b).nnz == 0
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() == b.keys() and all(same_value(a[k], b[k]) for k in a)
+    if isinstance(a, (tuple, list)) and isinstance(b, (tuple, list)):
+        return len(a) == len(b) and all(same_value(x, y) for x, y in zip(a, b))
+    if dataclasses.is_dataclass(a) and not isinstance(a, type):
+        fields = [f.name for f in dataclasses.fields(a)]
+        return type(a) is type(b) and all(same_value(getattr(a, f), getattr(b, f)) for f in fields)
+    return type(a) is type(b) and bool(a == b)
 
 
 def march(stepper, schedule, t0, u0, v0=None, *, a0=None, label=None, state=None):
@@ -91,6 +142,12 @@ def resume(stepper, schedule, record, *, label=None):
     rec = record
     if not isinstance(rec.state, SystemState):
         raise ValueError(f"record {rec.k} has no SystemState to resume from (state = {type(rec.state).__name__})")
+    ndof = stepper.system.ndof
+    if np.shape(rec.u) != (ndof,):
+        raise ValueError(
+            f"record {rec.k} holds {np.size(rec.u)} unknowns, the model {ndof}: a record resumes only a model "
+            "of the run that made it (the same mesh and bodies)"
+        )
     try:
         while (dt := schedule.next_dt(rec)) is not None:
             cuts, failures = 0, []
@@ -204,8 +261,12 @@ def watch(records, progress, t0, t_end, name):
 
 @dataclass
 class History:
-    """A march collected into arrays (``integrate``): one entry per record, entry 0 the
-    initial state. ``records`` keeps the records themselves."""
+    """A march collected into arrays (``integrate``, ``History.of(records)``): ``t``, ``dt``,
+    ``iterations``, ``cuts``, the energies (``kinetic``, ``strain``, ``contact``, ``dissipation``,
+    ``external_work``) and ``residuals`` hold one entry per record, entry 0 the initial state;
+    ``u``, ``v``, ``a`` and ``result`` are the last record's (the state the run ended in: read
+    another step's from ``records[k].u``); ``failures`` lists every step's; ``records`` keeps
+    the records themselves."""
 
     t: np.ndarray | None = None
     dt: np.ndarray | None = None

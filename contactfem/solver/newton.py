@@ -31,7 +31,8 @@ iterate's own error, K^-1 G, is then negligible whatever the last correction was
 correction is at the round-off of u (1e3 machine epsilon of max |u_k|); there the residual cannot fall further, and
 ROUNDOFF_RTOL F is accepted instead of rtol F (a very stiff penalty: one round-off of a gap is a
 force; ``residual_ratio`` says what was reached: max |G| / (F + atol / ROUNDOFF_RTOL)). atol (force
-units) is a floor for a step in which nothing carries a force. ``residuals`` keeps the Euclidean norms ||G_k|| for reports.
+units) is a floor for a step in which nothing carries a force. ``residuals`` keeps the Euclidean
+norms ||G_k|| for reports.
 
 Defaults (RTOL = 1e-8, CTOL = 1e-6), measured on the fast presets of the scenes (their headline
 results against a run with 1e-10 / 1e-8, and the residual evaluations): Abaqus' 5e-3 / 1e-2 saves
