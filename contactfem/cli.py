@@ -69,7 +69,8 @@ def cmd_show(args):
 
     sc = scenes.get_scene(args.scene)
     print(f"{sc.name}: {sc.title}")
-    fast, paper = sc.resolve("fast"), sc.resolve("paper")
+    fast = sc.resolve("fast")
+    paper = sc.resolve("paper") if "paper" in sc.presets else fast  # a scene file may have no paper preset
     rows = [("parameter", "fast (run)", "paper", "unit", "allowed")]
     for p in sc.params:
         rows.append(

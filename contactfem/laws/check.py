@@ -453,6 +453,10 @@ def hold_capacity(L, T, N, L_c, w_min, q_max, v_max, dt):
 HOLD_MARGIN = 0.01
 
 
+# the range of a scene that declares none (Scene.law_range): check_law's own defaults at scale 1
+DEFAULT_RANGE = dict(p=1e4, q=10.0, v=10.0, dt=1.0, g=1.0)
+
+
 def preflight(friction=None, normal=None, p=1.0, q=1.0, v=1.0, dt=1.0, g=1.0, hold=None):
     """Check law objects over a scene's range (Scene.law_range: the largest pressure p, slip
     q, slip rate v, the time step dt, the deepest penetration g, and for a body held by
@@ -501,6 +505,7 @@ __all__ = [
     "check_friction_law",
     "check_normal_law",
     "preflight",
+    "DEFAULT_RANGE",
     "hold_capacity",
     "explain_call_error",
 ]

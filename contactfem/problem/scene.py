@@ -31,12 +31,26 @@ PENALTY_DOC = (
 
 
 def simulate(model, params=None, progress=None):
-    """The records of the model's stage (``model.stage``): the initial state and every step."""
+    """The records of the model's stage (``model.stage``): the initial state and every step. A
+    NewtonError that ends the run carries the records so far (``error.records``)."""
     from ..solver.march import march, watch
+    from ..solver.newton import NewtonError
 
     st = model.stage
-    records = march(st.stepper, st.schedule, st.t0, st.u0, st.v0, a0=st.a0, label=st.label)
-    return list(watch(records, progress, st.t0, st.schedule.t_end, st.name or model.name))
+    records = []
+    try:
+        for rec in watch(
+            march(st.stepper, st.schedule, st.t0, st.u0, st.v0, a0=st.a0, label=st.label),
+            progress,
+            st.t0,
+            st.schedule.t_end,
+            st.name or model.name,
+        ):
+            records.append(rec)
+    except NewtonError as err:
+        err.records = records
+        raise
+    return records
 
 
 def run(scene, params, normal=None, friction=None, progress=None, linear_algebra="auto", instrument=None):
@@ -126,9 +140,9 @@ class Scene:
 
     def resolve(self, preset="fast", overrides=None):
         """Defaults, then the preset, then the user's overrides; every value validated."""
-        if preset not in ("fast", "paper") and preset not in self.presets:
-            names = ["fast", "paper", *(k for k in self.presets if k not in ("fast", "paper"))]
-            raise ValueError(f"parameter preset = {preset!r} is not allowed: one of {'|'.join(names)}")
+        if preset != "fast" and preset not in self.presets:  # fast: the defaults, where no preset says more
+            names = ["fast", *(k for k in self.presets if k != "fast")]
+            raise ValueError(f"parameter preset = {preset!r} is not allowed for {self.name}: one of {'|'.join(names)}")
         known = {p.name: p for p in self.params}
         values = {p.name: p.default for p in self.params}
         values.update(self.presets.get(preset, {}))
@@ -216,15 +230,17 @@ class Scene:
         return name if str(value) in map(str, self.law_choice[1]) else f"{value} with {name}"
 
     def preflight(self, params, laws):
-        """Check law objects over the range the scene meets (``law_range``) before solving:
-        returns warning sentences (a derivative that disagrees with finite differences);
-        raises LawError (one line) for a value no law may return (NaN, Y < 0, t_N > 0), a
-        law that breaks the protocol, or a block its friction cannot hold."""
-        from ..laws.check import preflight
+        """Check law objects over the range the scene meets (``law_range``; a scene without one,
+        over check_law's default range, laws.check.DEFAULT_RANGE) before solving: returns warning
+        sentences (a derivative that disagrees with finite differences); raises LawError (one
+        line) for a value no law may return (NaN, Y < 0, t_N > 0), a law that breaks the
+        protocol, or a block its friction cannot hold."""
+        from ..laws.check import DEFAULT_RANGE, preflight
 
-        if not laws or self.law_range is None:
+        if not laws:
             return []
-        return preflight(laws.get("friction"), laws.get("normal"), **self.law_range(params))
+        limits = DEFAULT_RANGE if self.law_range is None else self.law_range(params)
+        return preflight(laws.get("friction"), laws.get("normal"), **limits)
 
     def estimate(self, params, linear_algebra="auto"):
         """Size of the run from the resolved parameters (resources.estimate), or None."""

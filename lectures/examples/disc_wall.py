@@ -10,6 +10,7 @@ from contactfem.scenes import Model, Param, Scene, Stage
 from contactfem.solver import History, Newmark, Steps, System
 
 WALL = [(-3.0, 0.0), (1.0, 0.0), (4.0, 2.0)]  # left to right: the disc is on the wall's left side
+R = 1.0  # the disc's radius in disc.msh
 PARAMS = (
     Param("v0", 2.0, "length/time", 0.0, 20.0, doc="speed of the throw, 45 degrees down"),
     Param("mu", 0.3, "", 0.0, 2.0, doc="Coulomb friction coefficient (friction law)"),
@@ -35,15 +36,24 @@ def build(p, *, normal=None, friction=None, system_options=None):
     system = System([disc], [contact], **(system_options or {}))
     v0 = np.zeros(disc.ndof)
     v0[disc.xdofs] = p["v0"] * np.array([0.5**0.5, -(0.5**0.5)])
-    stage = Stage(Newmark(system, 0.5, 0.25), Steps(p["dt"], n_steps=p["n_steps"]), np.zeros(disc.ndof), v0)
-    return Model(systems=(system,), stage=stage, parts=dict(disc=disc))
+    steps = Steps(p["dt"], n_steps=p["n_steps"], max_cuts=4)  # a step Newton fails is halved, up to 4 times
+    ends = disc.mesh.p[:, disc.mesh.facets[:, disc.mesh.boundary_facets()]]  # the surface's edges: (x|y, end, edge)
+    sizes = dict(element=float(np.hypot(*(ends[:, 1] - ends[:, 0])).max()), body=2 * R)  # the penetration's yardsticks
+    stage = Stage(Newmark(system, 0.5, 0.25), steps, np.zeros(disc.ndof), v0)
+    return Model(systems=(system,), stage=stage, sizes=sizes, parts=dict(disc=disc))
 
 
 def measure(model, p, records):
     disc, hist = model.parts["disc"], History.of(records)
     m = disc.mass()[disc.xdofs[:, 0]]  # lumped nodal masses
-    vx, vy = m @ hist.v[disc.xdofs] / m.sum()  # the centre of mass's velocity at the end
+    vx, vy = (
+        m @ hist.v[disc.xdofs] / m.sum()
+    )  # the centre of mass's velocity at the end (History: u, v, a are the last)
     return dict(rebound_vx=float(vx), rebound_vy=float(vy), energy_kinetic=hist.kinetic)
+
+
+def law_range(p):  # what the laws meet: a node's spring pressed a radius deep; slip and slip rate of a spinning disc
+    return dict(p=p["c_N"] * R, q=3 * p["v0"] * p["n_steps"] * p["dt"], v=3 * p["v0"], dt=p["dt"], g=R)
 
 
 SCENE = Scene(
@@ -54,4 +64,5 @@ SCENE = Scene(
     measure,
     laws=("normal", "friction"),
     law_params={"normal": ("c_N",), "friction": ("c_T", "mu")},
+    law_range=law_range,
 )
