@@ -16,6 +16,7 @@ points done); 143 ended by SIGTERM, the same without the line.
 $CONTACTFEM_READY_FILE, if set, names a file the command line creates as soon as it
 answers Ctrl-C with its one line (for a supervisor, or a test, that interrupts it)."""
 
+import contextlib
 import os
 import sys
 import time
@@ -196,8 +197,14 @@ def cmd_run(args):
             print(f"{k}: [{', '.join(f'{x:.6g}' for x in v)}]")
     for what, path in out.paths.items():
         print(f"{what} -> {path}")
-    if args.strict and any(note.startswith("accuracy:") for note in notes):
-        return 1  # an accuracy indicator past its threshold
+    flagged = [note.removeprefix("accuracy: ").split(" = ")[0] for note in notes if note.startswith("accuracy:")]
+    if args.strict and flagged:  # an accuracy indicator past its threshold: said last, after the results
+        print(
+            f"contactfem: strict: the run is flagged by {len(flagged)} accuracy warning"
+            f"{'s' if len(flagged) > 1 else ''} above ({', '.join(flagged)}): exit code 1",
+            file=sys.stderr,
+        )
+        return 1
 
 
 def run_quietly(fn):
@@ -256,7 +263,7 @@ def cmd_figures(args):
 
 def cmd_sweep(args):
     from .io.outputs import check_output_path
-    from .lab.sweep import Table, parse_grid, sweep
+    from .lab.sweep import Table, parse_grid, point_text, sweep
 
     if args.jobs < 1:
         raise ValueError(f"parameter jobs = {args.jobs} is out of range: allowed [1, inf)")
@@ -272,34 +279,56 @@ def cmd_sweep(args):
     grid = parse_grid(parse_sets(args.set))
     table = Table(args.out, resume=args.resume)  # with --resume, the rows already done are read now
     _RUN.update(phase="sweep", table=table)
-    rows = sweep(
-        args.scene,
-        grid,
-        args.preset,
-        args.jobs,
-        args.scheduler,
-        friction=args.friction,
-        normal=args.normal,
-        check=not args.no_check,
-        force=args.force,
-        table=table,
-        timeout=args.time_limit,
-    )
-    _RUN["phase"] = "done"
-    done, failed, left = table.counts()
-    kept = f" ({table.kept} kept from the table)" if table.kept else ""
-    print(f"{len(table.points)} points: {done} done{kept}, {failed} failed, {left} left -> {args.out}")
-    for r in rows:
-        if r.get("error"):
-            point = ", ".join(f"{k[6:]}={v}" for k, v in r.items() if k.startswith("param."))
-            print(f"  failed: {point}: {r['error']}")
-    if failed:
-        print(
-            f"contactfem: sweep: {failed} of {len(rows)} points failed (the table's error column says why)",
-            file=sys.stderr,
+    with said_at_once():  # the laws' check, then each flagged point as it ends: one line each
+        rows = sweep(
+            args.scene,
+            grid,
+            args.preset,
+            args.jobs,
+            args.scheduler,
+            friction=args.friction,
+            normal=args.normal,
+            check=not args.no_check,
+            force=args.force,
+            table=table,
+            timeout=args.time_limit,
         )
+    _RUN["phase"] = "done"
+    done, failed, left = table.counts(strict=args.strict)
+    flagged = table.flagged()
+    kept = f" ({table.kept} kept from the table)" if table.kept else ""
+    marked = f" ({len(flagged)} flagged)" if flagged and not args.strict else ""
+    print(f"{len(table.points)} points: {done} done{kept}{marked}, {failed} failed, {left} left -> {args.out}")
+    for r in rows:
+        point = point_text({k[6:]: v for k, v in r.items() if k.startswith("param.")})
+        if r.get("error"):
+            print(f"  failed: {point}: {r['error']}")
+        elif r in flagged:
+            what = f"accuracy flagged: {r.get('accuracy.flags') or r.get('warnings')}"
+            print(f"  failed: {point}: {what}" if args.strict else f"  flagged: {point}: {what}")
+    if failed:
+        strict = len(flagged) if args.strict else 0
+        why = ["the table's error column says why"] if failed > strict else []
+        why += [f"{strict} flagged, with --strict: its accuracy.flags and warnings columns say why"] if strict else []
+        print(f"contactfem: sweep: {failed} of {len(rows)} points failed ({'; '.join(why)})", file=sys.stderr)
         return 1
     return 0
+
+
+@contextlib.contextmanager
+def said_at_once():
+    """contactfem's warnings printed as they come, one line each (`contactfem: warning: ...`);
+    other libraries' dropped, as a run drops them (run_quietly)."""
+    import warnings
+
+    def say(message, category, filename, lineno, file=None, line=None):
+        if issubclass(category, UserWarning) and "contactfem" in str(filename):
+            print(f"contactfem: warning: {message}", file=sys.stderr, flush=True)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        warnings.showwarning = say
+        yield
 
 
 def cmd_equations(args):
@@ -644,6 +673,12 @@ def build_parser():
     )
     sw.add_argument("--normal", metavar="LAW", help="the normal law of every run, as for run")
     sw.add_argument("--no-check", action="store_true", help="skip the laws' check before the runs, as for run")
+    sw.add_argument(
+        "--strict",
+        action="store_true",
+        help="count a point whose run is flagged (an accuracy indicator past its threshold: its warning line, "
+        "the table's accuracy.flags) as failed, in the summary and the exit code 1",
+    )
     sw.add_argument(
         "--force",
         action="store_true",

@@ -158,7 +158,7 @@ def test_a_law_with_a_wrong_derivative_is_named_before_the_run(tmp_path, capsys)
         "        p = np.asarray(p, dtype=float)\n        return self.mu * p, 2 * self.mu + 0 * p, 0 * p\n"
     )
     warning = "contactfem: warning: friction law WrongDeriv: dY/dp does not match finite differences"
-    for scene in ("block", EXAMPLE):
+    for scene in ("block", EXAMPLE, edited(tmp_path, ("    law_range=law_range,\n", ""))):  # the last: no law_range
         assert main(["run", str(scene), "--friction", f"{law}:WrongDeriv", "--set", "n_steps=1"]) == 0
         err = capsys.readouterr().err
         assert err.startswith(warning), err

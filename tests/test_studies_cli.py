@@ -265,3 +265,111 @@ def test_ctrl_c_during_a_parallel_sweep_is_one_line(tmp_path, delay):
         done, failed, left = map(int, re.search(r"\((\d+) done, (\d+) failed, (\d+) left", lines[0]).groups())
         rows = list(csv.DictReader((tmp_path / "s.csv").open()))
         assert len(rows) == done + failed and done + failed + left == 6 and failed == 0
+
+
+# ---- what each point of a sweep is worth -------------------------------------------------
+
+
+def merged(monkeypatch):
+    """stdout and stderr into one stream, in the order they are written."""
+    import io
+
+    stream = io.StringIO()
+    monkeypatch.setattr(sys, "stdout", stream)
+    monkeypatch.setattr(sys, "stderr", stream)
+    return stream
+
+
+@pytest.mark.parametrize("strict", [False, True])
+def test_a_flagged_point_is_one_warning_line_a_flag_in_the_table_and_with_strict_a_failure(
+    tmp_path, monkeypatch, strict
+):
+    """The block at c_N = 10 sinks 235 times a tenth of an element into its foundation (flagged), at
+    c_N = 1e6 not: one warning line names the flagged point, before the summary; the table flags it;
+    --strict counts it as failed (exit code 1)."""
+    out = tmp_path / "s.csv"
+    stream = merged(monkeypatch)
+    argv = ["sweep", "block", "--set", "c_N=10,1e6", "--out", str(out)] + (["--strict"] if strict else [])
+    assert main(argv) == (1 if strict else 0)
+    lines = stream.getvalue().splitlines()
+    warned = [i for i, x in enumerate(lines) if x.startswith("contactfem: warning:")]
+    assert len(warned) == 1 and lines[warned[0]].startswith(
+        "contactfem: warning: accuracy: point c_N=10: penetration = "
+    )
+    summary = next(i for i, x in enumerate(lines) if x.startswith("2 points: "))
+    assert warned[0] < summary and "AccuracyWarning" not in stream.getvalue()
+    expected = "1 done, 1 failed" if strict else "2 done (1 flagged), 0 failed"
+    assert lines[summary].startswith(f"2 points: {expected}, 0 left"), lines[summary]
+    rows = {r["param.c_N"]: r for r in csv.DictReader(out.open())}
+    assert rows["10"]["accuracy.flags"] == "penetration penetration_body" and rows["10"]["error"] == ""
+    assert rows["1e6"]["accuracy.flags"] == "" and float(rows["1e6"]["accuracy.penetration"]) < 0.1
+    assert rows["10"]["warnings"].startswith("penetration = ")
+    readme = " ".join((Path(__file__).resolve().parents[1] / "README.md").read_text().split())
+    assert lines[warned[0]].split(";")[0] + "; ..." in readme  # the README's example is this run's line
+
+
+def test_the_sweep_warns_once_per_flagged_point_from_python():
+    from contactfem import AccuracyWarning
+    from contactfem.lab.sweep import sweep
+
+    with pytest.warns(AccuracyWarning) as caught:
+        rows = sweep("block", {"c_N": ["10", "20", "1e6"]})
+    said = [str(w.message) for w in caught if issubclass(w.category, AccuracyWarning)]
+    assert [s.split(":")[1] for s in said] == [" point c_N=10", " point c_N=20"], said
+    assert [r["accuracy.flags"] != "" for r in rows] == [True, True, False]
+
+
+def test_error_bars_become_columns_when_the_runs_carry_them():
+    """The uncertainty section of a run (per headline quantity: value, band, relative band, ...) is
+    flattened generically into FIELD.NAME columns beside the accuracy indicators'."""
+    from contactfem.lab.sweep import accuracy_columns
+
+    res = {
+        "rebound_vy": 1.46,
+        "accuracy": {
+            "equilibrium": {"value": 1e-14, "ok": True, "threshold": 1e-6},
+            "energy_loss": {"value": 0.4, "ok": False, "threshold": 0.3},
+        },
+        "uncertainty": {
+            "rebound_vy": {
+                "value": 1.46,
+                "band": 0.12,
+                "rel_band": 0.082,
+                "order": 0.98,
+                "levels": [0.1, 0.2, 0.4],
+                "class": "monotone",
+                "parts": {"dt": 0.12},
+            },
+        },
+    }
+    cols = accuracy_columns(res)
+    assert cols == {
+        "accuracy.flags": "energy_loss",
+        "accuracy.equilibrium": 1e-14,
+        "accuracy.energy_loss": 0.4,
+        "band.rebound_vy": 0.12,
+        "rel_band.rebound_vy": 0.082,
+        "order.rebound_vy": 0.98,
+        "class.rebound_vy": "monotone",
+    }
+
+
+def test_a_sweep_says_what_the_laws_check_found_before_the_runs(tmp_path, capsys):
+    """A law whose dY/dp is off by 10 %: the sweep warns once, as `run` does, before the points run."""
+    law = Path(__file__).parent / "data" / "wrong_derivative.py"
+    out = tmp_path / "s.csv"
+    assert (
+        main(["sweep", "block", "--friction", f"{law}:WrongSlope", "--set", "law.mu=0.3,0.4", "--out", str(out)]) == 0
+    )
+    err = capsys.readouterr().err.splitlines()
+    derivative = [x for x in err if "dY/dp does not match finite differences" in x]
+    assert len(derivative) == 1 and derivative[0].startswith("contactfem: warning: friction law WrongSlope: ")
+
+
+def test_run_strict_ends_with_the_line_that_says_why(capsys):
+    assert main(["run", "block", "--set", "c_N=10", "--strict"]) == 1
+    last = capsys.readouterr().err.strip().splitlines()[-1]
+    assert (
+        last
+        == "contactfem: strict: the run is flagged by 2 accuracy warnings above (penetration, penetration_body): exit code 1"
+    )

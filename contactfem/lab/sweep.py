@@ -10,6 +10,13 @@ each run builds its laws from the same specification as ``contactfem run`` (law 
 module path or shipped law), so a sweep point equals that run. Every point is validated
 (parameters, laws, the laws' check over the scene's range) before any run starts.
 
+Each row says how accurate its run is: ``accuracy.flags`` (the indicators past their
+thresholds, by name), ``accuracy.NAME`` (each indicator's value), the error bars of the
+headline quantities where the run carries them (its ``uncertainty`` section: ``band.NAME``,
+``rel_band.NAME``, ... for each field of a quantity's entry), and ``warnings`` (the run's
+accuracy warnings, in short). A flagged point is one warning (``AccuracyWarning``) naming the
+point, as it ends.
+
 Every run is a task of a worker process, also with one job: a worker that dies (killed by
 the out-of-memory killer, or ended by a law calling ``os._exit``) is replaced and its point
 run once more, then recorded as failed with the reason ("worker died: signal 9", "worker
@@ -31,9 +38,11 @@ import itertools
 import json
 import os
 import secrets
+import warnings
 from contextlib import closing
 from pathlib import Path
 
+from ..problem.accuracy import AccuracyWarning
 from ..scenes import check_laws, get_scene, is_scene_file, run_scene
 
 
@@ -67,16 +76,52 @@ def build_laws(scene, preset, point, friction=None, normal=None, notes=None):
 
 def _one(scene, preset, point, friction=None, normal=None):
     """One run, reduced to its scalar results (lists and dicts are left out of the table; so
-    are results that repeat a swept parameter, which has its column param.NAME)."""
+    are results that repeat a swept parameter, which has its column param.NAME), its accuracy
+    (accuracy_columns) and its accuracy warnings (``warnings``: their first clauses, joined by
+    "; "); the run's other warnings (numpy's, libraries') are dropped, as `contactfem run` drops them."""
     try:
         overrides, laws = build_laws(scene, preset, point, friction, normal)
-        res = run_scene(scene, preset, overrides, check=False, **laws)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            res = run_scene(scene, preset, overrides, check=False, **laws)
         row = {k: v for k, v in res.items() if not isinstance(v, (list, dict)) and k not in point}
+        row.update(accuracy_columns(res))
+        said = [str(w.message).split(" (")[0] for w in caught if issubclass(w.category, AccuracyWarning)]
+        row["warnings"] = "; ".join(dict.fromkeys(s.removeprefix("accuracy: ") for s in said))
         row["error"] = ""
     except Exception as exc:  # a failed point is a row of the table, not the end of the sweep
         row = {"error": f"{type(exc).__name__}: {' '.join(str(exc).split())}"}
     row.update({f"param.{k}": v for k, v in point.items()})
     return row
+
+
+def accuracy_columns(res):
+    """A run's accuracy as columns of its row: ``accuracy.flags``, the names of the indicators past
+    their thresholds (space-separated; empty: none), ``accuracy.NAME``, each indicator's value, and,
+    where the results carry an ``uncertainty`` section, ``FIELD.NAME`` for every number or text of a
+    quantity's entry but its value (which is the quantity's own column): ``band.NAME``, ..."""
+    accuracy = {k: v for k, v in (res.get("accuracy") or {}).items() if isinstance(v, dict) and "value" in v}
+    cols = {"accuracy.flags": " ".join(k for k, ind in accuracy.items() if not ind.get("ok", True))}
+    cols.update({f"accuracy.{k}": ind["value"] for k, ind in accuracy.items()})
+    for name, entry in (res.get("uncertainty") or {}).items():
+        items = entry.items() if isinstance(entry, dict) else [("uncertainty", entry)]
+        cols.update({f"{field}.{name}": v for field, v in items if field != "value" and _scalar(v)})
+    return cols
+
+
+def _scalar(v):
+    return v is None or isinstance(v, (str, bool, int, float))
+
+
+def flagged(row):
+    """Whether a row's run is flagged: an accuracy indicator past its threshold, or an accuracy
+    warning (the error bars'); False for a failed row and for rows of tables without the columns."""
+    return not row.get("error") and bool(row.get("accuracy.flags") or row.get("warnings"))
+
+
+def point_text(point):
+    """'c_N=10, nx=12': a point as the summary and the warnings name it."""
+    return ", ".join(f"{k}={v}" for k, v in point.items())
 
 
 def laws_text(friction=None, normal=None):
@@ -116,12 +161,14 @@ def plan(scene, grid, preset="fast", jobs=1, scheduler=None, friction=None, norm
     """The points of the grid (dicts NAME -> value), every one validated (ValueError, one line):
     its parameters, its laws, unless ``check`` is False the laws over the range the scene meets,
     and unless ``force`` its size against the limits of `contactfem run` (resources.LIMITS),
-    the memory of the runs that go at once (``jobs`` of them locally) together."""
+    the memory of the runs that go at once (``jobs`` of them locally) together; and the
+    warnings of the laws' check (a derivative that disagrees with finite differences), each
+    finding once (with the numbers of the first point that shows it)."""
     from ..problem.resources import LIMITS, check_resources, describe
 
     sc = get_scene(scene)
     points = [dict(zip(grid, combo)) for combo in itertools.product(*grid.values())]
-    largest = None
+    largest, notes = None, []
     for p in points:  # validate every point before starting anything
         overrides, laws = build_laws(scene, preset, p, friction, normal)
         params = sc.resolve(preset, overrides)
@@ -129,7 +176,7 @@ def plan(scene, grid, preset="fast", jobs=1, scheduler=None, friction=None, norm
         if est is not None and (largest is None or est["memory_bytes"] > largest["memory_bytes"]):
             largest = est
         if check and laws:
-            sc.preflight(params, laws)
+            notes += sc.preflight(params, laws)
     together = 1 if scheduler else min(jobs, len(points))
     if not force and largest is not None and together * largest["memory_bytes"] > LIMITS["memory_bytes"]:
         raise ValueError(
@@ -138,7 +185,10 @@ def plan(scene, grid, preset="fast", jobs=1, scheduler=None, friction=None, norm
             f"together: above the limit of {LIMITS['memory_bytes'] / 1e9:.2g} GB (lower --jobs, "
             "or add --force to run it anyway)"
         )
-    return points
+    found = {}  # each finding once, with the numbers of the first point that shows it
+    for note in notes:
+        found.setdefault(note.split(": worst")[0], note)
+    return points, list(found.values())
 
 
 def sweep(
@@ -159,13 +209,16 @@ def sweep(
     dicts, in the grid's order. Every point is validated first (``plan``). ``table``: a Table
     that keeps the rows (on disk if it has a path, written as each point ends, and with
     ``resume`` the rows it already holds); ``timeout``: seconds a local run may take before it
-    is stopped and recorded as failed."""
+    is stopped and recorded as failed. The laws' check warns (UserWarning) before the first run;
+    each flagged point (``flagged``) warns as it ends (AccuracyWarning, naming the point)."""
     args = (scene, grid, preset, jobs, scheduler, friction, normal, check, force)
-    points, version = (
+    (points, notes), version = (
         _guarded(_prepare, args, laws_text(friction, normal))
         if friction is not None or normal is not None
         else _prepare(*args)
     )
+    for note in notes:
+        warnings.warn(note, UserWarning, stacklevel=2)
     table = Table() if table is None else table
     same = dict(scene=get_scene(scene).name, preset=preset, laws=laws_text(friction, normal), code_version=version)
     todo = table.start(points, same)
@@ -174,6 +227,9 @@ def sweep(
     with closing(runs):  # an exception here (Ctrl-C, SIGTERM) stops the workers at once
         for i, row in runs:
             table.add(i, row)
+            if flagged(row):
+                said = row["warnings"] or f"past their thresholds: {row['accuracy.flags']}"
+                warnings.warn(f"accuracy: point {point_text(points[i])}: {said}", AccuracyWarning, stacklevel=2)
     return table.grid_rows()
 
 
@@ -351,10 +407,14 @@ class Table:
         self.rows[i] = row
         self.write()
 
-    def counts(self):
-        """(done, failed, left) of the grid's points."""
-        failed = sum(1 for r in self.rows.values() if r.get("error"))
+    def counts(self, strict=False):
+        """(done, failed, left) of the grid's points; ``strict``: flagged points count as failed."""
+        failed = sum(1 for r in self.rows.values() if r.get("error") or (strict and flagged(r)))
         return len(self.rows) - failed, failed, len(self.points) - len(self.rows)
+
+    def flagged(self):
+        """The rows of the grid's points whose runs are flagged (``flagged``), in the grid's order."""
+        return [r for r in self.grid_rows() if flagged(r)]
 
     def grid_rows(self):
         return [self.rows[i] for i in range(len(self.points)) if i in self.rows]
