@@ -373,3 +373,22 @@ def test_run_strict_ends_with_the_line_that_says_why(capsys):
         last
         == "contactfem: strict: the run is flagged by 2 accuracy warnings above (penetration, penetration_body): exit code 1"
     )
+
+
+@pytest.mark.slow
+def test_a_sweep_in_workers_prints_no_raw_python_warning(tmp_path):
+    """The runs' warnings are raised in the worker processes: they come out as the sweep's own line,
+    before the summary, never as Python's `file:line: AccuracyWarning` with a source line."""
+    proc = subprocess.run(
+        [sys.executable, "-m", "contactfem", "sweep", "block", "--set", "c_N=10,20,1e6", "--jobs", "2"],
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        timeout=300,
+    )
+    lines = proc.stdout.splitlines()
+    assert proc.returncode == 0 and "AccuracyWarning" not in proc.stdout and "warnings.warn" not in proc.stdout
+    warned = [i for i, x in enumerate(lines) if x.startswith("contactfem: warning: accuracy: point c_N=")]
+    summary = next(i for i, x in enumerate(lines) if x.startswith("3 points: 3 done (2 flagged)"))
+    assert len(warned) == 2 and max(warned) < summary, proc.stdout
