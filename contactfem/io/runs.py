@@ -32,6 +32,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..problem.scene import RUN_KEYS  # what describes how a run went: compare_runs leaves it out
+
 FORMAT = "contactfem-run/1"
 _TAG = "__ndarray__"
 
@@ -234,25 +236,6 @@ class Recorder:
     def as_dict(self):
         """{'t': ..., 'u': ..., 'v': ...}, ready for save_run."""
         return {"t": self.t, "u": self.u, "v": self.v}
-
-
-# what describes how a run went rather than what it computed: not compared
-RUN_KEYS = (
-    "wall_time_s",
-    "import_time_s",
-    "linear_algebra",
-    "ordering",
-    "unknowns",
-    "band_kl",
-    "band_ku",
-    "residual_evaluations",
-    "contact_evaluations",
-    "scene",
-    "preset",
-    "parameters",
-    "accuracy",
-    "stepping",
-)
 
 
 def compare_runs(mine, ref, skip=RUN_KEYS):

@@ -44,28 +44,15 @@ import numpy as np
 
 from .model import Stage
 from .params import Param, parse_all
-from .scene import LAW_RANGE_KEYS, Model, Scene
+from .scene import LAW_RANGE_KEYS, RUN_KEYS, Model, Scene
 
-# names of results the run sets itself (problem.scene.run, scenes.run_scene, the command line and
-# the error bars); ``accuracy`` is the run's section too, where a scene adds its own indicators
-RESERVED_RESULTS = (
-    "stepping",
-    "uncertainty",
-    "wall_time_s",
-    "import_time_s",
-    "linear_algebra",
-    "ordering",
-    "unknowns",
-    "band_kl",
-    "band_ku",
-    "residual_evaluations",
-    "contact_evaluations",
-    "scene",
+# names of results the run sets itself (RUN_KEYS, and what scenes.run_scene and the error bars add);
+# ``accuracy`` is the run's section, where a scene adds its own indicators
+RESERVED_RESULTS = tuple(k for k in RUN_KEYS if k != "accuracy") + (
     "scene_file",
-    "preset",
-    "parameters",
     "friction_law",
     "normal_law",
+    "uncertainty",
 )
 # parameter names the run reserves: ``accuracy`` (a run at a tolerance reads it: a file takes it
 # as time_integration.ACCURACY_PARAM or not at all) and ``tolerance`` (an option of every run)

@@ -22,6 +22,25 @@ from .model import Model, Stage  # noqa: F401  (scene modules take them here)
 from .params import Limit, Param, check_overrides, parse_all  # noqa: F401  (scene modules take Param, Limit here)
 from .resources import check_resources, describe  # noqa: F401  (the command line takes them from here)
 
+# what a run reports of itself, how it went rather than what it computed (set by run and
+# scenes.run_scene; io.compare_runs leaves them out): a scene's measure may not return them
+RUN_KEYS = (
+    "wall_time_s",
+    "import_time_s",
+    "linear_algebra",
+    "ordering",
+    "unknowns",
+    "band_kl",
+    "band_ku",
+    "residual_evaluations",
+    "contact_evaluations",
+    "scene",
+    "preset",
+    "parameters",
+    "accuracy",
+    "stepping",
+)
+
 PENALTIES = ("per_length", "per_node")
 PENALTY_DOC = (
     "unit of c_N and c_T: per_length = tractions per unit gap and per unit length of the contact "
