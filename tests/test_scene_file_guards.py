@@ -39,7 +39,7 @@ def one_line(capsys, argv, code):
 MEASURE = "    return dict(rebound_vx=float(vx), rebound_vy=float(vy), energy_kinetic=hist.kinetic)"
 RESULTS = {
     "complex": ("    return dict(rebound_vx=complex(vx, 1.0), rebound_vy=float(vy))", "rebound_vx is complex"),
-    "object": ("    return dict(rebound_vx=object(), rebound_vy=float(vy))", "rebound_vx is a object"),
+    "object": ("    return dict(rebound_vx=object(), rebound_vy=float(vy))", "rebound_vx is of type object"),
     "nan": ("    return dict(rebound_vx=float('nan'), rebound_vy=float(vy))", "rebound_vx = nan is not finite"),
     "nan_in_list": ("    return dict(rebound_vx=[1.0, float('nan')])", r"rebound_vx[1] = nan is not finite"),
     "accuracy": ("    return dict(rebound_vx=float(vx), accuracy=0.5)", "accuracy is a float: accuracy is the run's"),
@@ -180,3 +180,19 @@ def test_the_readme_states_the_default_law_range():
     readme = " ".join((Path(__file__).resolve().parents[1] / "README.md").read_text().split())
     assert r["q"] == r["v"]
     assert f"(p up to {r['p']:g}, q and v up to {r['q']:g}, g up to {r['g']:g})" in readme
+
+
+@pytest.mark.parametrize(
+    "returned, expected",
+    [
+        ("dict(p=0.0, dt=0.01)", "law_range: p = 0.0 is not a finite number > 0"),
+        ("dict(p=1.0, q=float('nan'))", "law_range: q = nan is not a finite number >= 0"),
+        ("dict(pressure=1.0)", "law_range: 'pressure' is not one of p, q, v, dt, g, hold"),
+        ("[1.0]", "law_range: returned list, not a dict"),
+    ],
+)
+def test_a_bad_law_range_is_one_line_naming_it(tmp_path, capsys, returned, expected):
+    path = edited(tmp_path, ('    return dict(p=p["c_N"] * R,', f"    return {returned}\n    dict(p=p['c_N'] * R,"))
+    law = f"{DATA / 'coulomb_law.py'}:MyCoulomb"
+    line = one_line(capsys, ["run", path, "--friction", law, "--set", "law.c_T=1e3", "--set", "law.mu=0.3"], 1)
+    assert line == f"contactfem: scene failed: scene file edited.py, {expected}", line

@@ -44,7 +44,7 @@ import numpy as np
 
 from .model import Stage
 from .params import Param, parse_all
-from .scene import LAW_RANGE_KEYS, RUN_KEYS, Model, Scene
+from .scene import LAW_RANGE_KEYS, RUN_KEYS, Model, Scene, simulate
 
 # names of results the run sets itself (RUN_KEYS, and what scenes.run_scene and the error bars add);
 # ``accuracy`` is the run's section, where a scene adds its own indicators
@@ -231,7 +231,7 @@ def _bad_value(value, key):
         return next((b for i, v in enumerate(value) if (b := _bad_value(v, f"{key}[{i}]"))), None)
     if isinstance(value, dict):
         return next((b for k, v in value.items() if (b := _bad_key(k, key) or _bad_value(v, f"{key}[{k!r}]"))), None)
-    kind = "complex" if isinstance(value, (complex, np.complexfloating)) else f"a {type(value).__name__}"
+    kind = "complex" if isinstance(value, (complex, np.complexfloating)) else f"of type {type(value).__name__}"
     return f"{key} is {kind} ({str(value)[:40]}): results are real numbers, text, and lists and dicts of them"
 
 
@@ -287,9 +287,9 @@ def _checked_measure(measure, path):
     return call
 
 
-def _checked_numbers(fn, path, role, keys):
-    """size and law_range: a dict of numbers >= 0 under the keys the run reads (law_range's hold: a
-    dict of numbers too)."""
+def _checked_numbers(fn, path, role, keys, positive=()):
+    """size and law_range: a dict of finite numbers >= 0 (> 0 under the keys ``positive``) under
+    the keys the run reads (law_range's hold: a dict of such numbers too)."""
 
     def call(params):
         out = fn(params)
@@ -300,20 +300,21 @@ def _checked_numbers(fn, path, role, keys):
                 raise SceneError(f"scene file {path.name}, {role}: {key!r} is not one of {', '.join(keys)}")
             values = value.items() if key == "hold" and isinstance(value, dict) else [(key, value)]
             for name, v in values:
-                if not _real(v) or np.isnan(v) or v < 0:
-                    raise SceneError(f"scene file {path.name}, {role}: {name} = {v!r} is not a number >= 0")
+                what = "> 0" if name in positive else ">= 0"
+                if not _real(v) or not np.isfinite(v) or (v <= 0 if name in positive else v < 0):
+                    raise SceneError(f"scene file {path.name}, {role}: {name} = {v!r} is not a finite number {what}")
         return out
 
     return call
 
 
-def _named_overlap(simulate, path):
-    """simulate, with a run that fails after starting from overlapping bodies saying so."""
+def _named_overlap(fn, path):
+    """A scene's simulate ``fn``, with a run that fails after starting from overlapping bodies saying so."""
     from ..solver.newton import NewtonError
 
     def call(model, params, progress):
         try:
-            return simulate(model, params, progress)
+            return fn(model, params, progress)
         except NewtonError as err:
             first = (getattr(err, "records", None) or [getattr(err, "record", None)])[0]
             overlap = _overlap(first, model) if first is not None and first.k == 0 else None
@@ -377,8 +378,10 @@ def _check_declaration(scene, path):
             raise ValueError(f"{where}: preset {preset} {what} (its parameters: {', '.join(names)})")
     for kind, params in dict(scene.law_params).items():
         unknown = [k for k in params if k not in names]
-        if kind not in ("normal", "friction") or unknown:
-            raise ValueError(f"{where}: law_params[{kind!r}] names no law kind or parameter of the file")
+        if kind not in ("normal", "friction"):
+            raise ValueError(f"{where}: law_params has the kind {kind!r}: the kinds of law are normal and friction")
+        if unknown:
+            raise ValueError(f"{where}: law_params[{kind!r}] names {unknown[0]!r}, not a parameter of the file")
 
 
 def load_scene_file(path):
@@ -393,13 +396,12 @@ def load_scene_file(path):
     _check_declaration(scene, path)
     checked = dict(
         size=scene.size and _checked_numbers(scene.size, path, "size", ("elements", "unknowns", "steps")),
-        law_range=scene.law_range and _checked_numbers(scene.law_range, path, "law_range", LAW_RANGE_KEYS),
+        law_range=scene.law_range
+        and _checked_numbers(scene.law_range, path, "law_range", LAW_RANGE_KEYS, positive=("p", "dt", "g")),
         build=_checked_build(scene.build, path, scene.simulate is not None),
         measure=_checked_measure(scene.measure, path),
         check=scene.check,
         simulate=scene.simulate,
     )
     guarded = {role: _guarded(fn, path, role) for role, fn in checked.items() if fn is not None}
-    from .scene import simulate
-
     return replace(scene, **guarded, simulate=_named_overlap(guarded.get("simulate", simulate), path))
