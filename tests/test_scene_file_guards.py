@@ -29,10 +29,12 @@ def edited(tmp_path, *changes, name="edited.py"):
 
 
 def one_line(capsys, argv, code):
-    """Run the command line; its exit code must be `code`, its stderr one line (returned)."""
-    assert main([str(a) for a in argv]) == code
+    """Run the command line with --json beside the scene file; its exit code must be `code`, its
+    stderr one line (returned), and nothing written."""
+    out = Path(argv[1]).with_name("written.json")
+    assert main([str(a) for a in argv] + ["--json", str(out)]) == code
     err = capsys.readouterr().err.strip()
-    assert "\n" not in err, err
+    assert "\n" not in err and not out.exists(), err
     return err
 
 
@@ -52,10 +54,8 @@ RESULTS = {
 def test_a_bad_result_of_measure_is_one_line_naming_it(tmp_path, capsys, case):
     new, expected = RESULTS[case]
     path = edited(tmp_path, (MEASURE, new))
-    out = tmp_path / "out.json"
-    line = one_line(capsys, ["run", path, "--set", "n_steps=2", "--json", out], 1)
+    line = one_line(capsys, ["run", path, "--set", "n_steps=2"], 1)
     assert line.startswith("contactfem: scene failed: scene file edited.py, measure: ") and expected in line, line
-    assert not out.exists()  # nothing written
     with pytest.raises(SceneError, match=r"^scene file edited.py, measure: "):
         run_scene(str(path), "fast", {"n_steps": 2})
 
@@ -127,10 +127,8 @@ def test_the_framework_accuracy_param_is_welcome(tmp_path):
 
 def test_a_preset_the_file_lacks_is_refused(tmp_path, capsys):
     """disc_wall has no presets: fast is its defaults, and --preset paper is no preset of it."""
-    out = tmp_path / "out.json"
-    line = one_line(capsys, ["run", EXAMPLE, "--preset", "paper", "--json", out], 2)
+    line = one_line(capsys, ["run", edited(tmp_path), "--preset", "paper"], 2)
     assert "parameter preset = 'paper' is not allowed for disc_wall: one of fast" in line, line
-    assert not out.exists()
     path = edited(
         tmp_path, ("    law_range=law_range,\n", "    law_range=law_range,\n    presets={'paper': {'nx': 3}},\n")
     )
@@ -168,8 +166,7 @@ def test_a_law_with_a_wrong_derivative_is_named_before_the_run(tmp_path, capsys)
 def test_a_law_that_returns_nan_is_refused_before_the_run(tmp_path, capsys, scene):
     """NaN above p = 50: refused (exit 2) before the run, over the file's law_range, or over check_law's
     default range where the file declares none."""
-    if scene == "no_range":
-        scene = edited(tmp_path, ("    law_range=law_range,\n", ""))
+    scene = edited(tmp_path, *([("    law_range=law_range,\n", "")] if scene == "no_range" else []))
     line = one_line(capsys, ["run", scene, "--friction", f"{DATA / 'lying_laws.py'}:NaNAbove"], 2)
     assert line.startswith("contactfem: error: friction law NaNAbove.slip_bound returned NaN or inf"), line
 
