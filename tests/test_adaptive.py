@@ -120,9 +120,11 @@ def test_accuracy_is_a_parameter_off_by_default(scene):
     s = get_scene(scene)
     assert s.resolve("fast")["accuracy"] == 0.0
     assert s.resolve("fast", {"accuracy": "1e-3"})["accuracy"] == 1e-3
-    for bad in (-1e-3, 0.5, "tight", 1e-4, 1e-300, float("nan")):  # below 1e-3: steps below round-off
+    for bad in (-1e-3, 0.5, 1e-4, 1e-300, float("nan")):  # below 1e-3: steps below round-off
         with pytest.raises(ValueError, match=r"parameter accuracy = .* allowed 0 \(fixed steps\) or \[0.001, 0.1\]"):
             s.resolve("fast", {"accuracy": bad})
+    with pytest.raises(ValueError, match=r"parameter accuracy must be a number: 0 \(fixed steps\) or \[0.001, 0.1\]"):
+        s.resolve("fast", {"accuracy": "tight"})
 
 
 def test_accuracy_refused_with_the_explicit_stepper_and_multipliers():
