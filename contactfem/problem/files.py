@@ -326,13 +326,17 @@ def _named_overlap(fn, path):
 
 
 def _overlap(record, model):
-    """'the initial configuration overlaps: contact wall, 12 nodes up to 0.31 inside' or None."""
+    """'the initial configuration overlaps: contact wall, 12 nodes up to 0.31 inside' or None;
+    gaps within the round-off of the coordinates (1e3 machine epsilon of the largest) are touching."""
     system = getattr(getattr(model.stage, "stepper", None), "system", None) or model.system
     contacts = getattr(system, "contacts", [])
+    extent = max(
+        (float(np.max(np.abs(b.X), initial=0.0)) for b in getattr(system, "bodies", ()) if hasattr(b, "X")), default=0.0
+    )
     parts = []
     for i, state in enumerate(getattr(record.evaluation, "contacts", ()) or ()):
         g = np.asarray(getattr(state, "g_N", ()), dtype=float)
-        inside = g[np.isfinite(g) & (g < 0)]
+        inside = g[np.isfinite(g) & (g < -1e3 * np.finfo(float).eps * extent)]
         if inside.size:
             name = getattr(contacts[i], "name", "") if i < len(contacts) else ""
             parts.append(f"contact {name or i}, {inside.size} nodes up to {-inside.min():.3g} inside its master")
