@@ -23,7 +23,7 @@ import numpy as np
 from ..scenes.block import SCENE, solve
 from ..scenes.block import FIG8_DROP, PAPER_TABLE1, PAPER_TABLE1_UNCERTAIN, fig8_remark
 from ..solver.newton import NewtonError
-from . import cached_run, default_outdir, describe_newton, figure, fitted_words, pyplot, savefig  # noqa: F401
+from . import cached_run, default_outdir, describe_newton, diverged_at, figure, fitted_words, pyplot, savefig  # noqa: F401
 from .data import save_figure
 
 STATE_COLORS = {"stick": "tab:blue", "slip": "tab:red", "open": "0.6"}
@@ -308,8 +308,8 @@ def residual_histories(preset="fast", results=None):
             "newton_residuals"
         ]
         out["verdict"]["coulomb, symmetric tangent"] = describe_newton(out["coulomb, symmetric tangent"], True)
-    except NewtonError as err:
-        out["coulomb, symmetric tangent"] = err.history
+    except NewtonError as err:  # the residuals up to the first past DIVERGED: after it, they are rounding
+        out["coulomb, symmetric tangent"] = list(err.history[: diverged_at(err.history)])
         out["verdict"]["coulomb, symmetric tangent"] = describe_newton(err.history, False)
     out["parameters"] = pick("conical")["parameters"]
     out["fitted"] = pick("conical").get("fitted") or {}
