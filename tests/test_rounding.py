@@ -1,0 +1,123 @@
+"""What rounding does to a result: the conditions that disturb a run (solver/rounding.py), the
+spread a study records beside a figure's numbers and the comparison that holds a fresh run
+within it (plots/rounding.py, plots/data.py)."""
+
+import json
+
+import pytest
+
+from contactfem.plots import data as D
+from contactfem.plots import describe_newton, diverged_at
+from contactfem.plots import rounding as R
+from contactfem.solver.rounding import current, rounding
+
+
+def test_a_condition_reaches_every_system_and_march_and_leaves_no_trace():
+    from contactfem.scenes import run_scene
+
+    base = run_scene("block", "paper")
+    with rounding(linear_algebra="sparse"):
+        sparse = run_scene("block", "paper")
+    with rounding(perturbation=1e-13):
+        moved = run_scene("block", "paper")
+        again = run_scene("block", "paper")
+    after = run_scene("block", "paper")
+    assert base["linear_algebra"] == "banded" and sparse["linear_algebra"] == "sparse"
+    assert after["newton_residuals"] == base["newton_residuals"] and current().tag() == ""
+    assert moved["newton_residuals"] == again["newton_residuals"]  # seeded: the same condition, the same run
+    # the perturbation moves the initial state, by about 1e-13 of the block's size (4): the first
+    # residual, K u0 - P, by c_N 4e-13 = 4e-8 at most, the others within the Newton tolerance
+    first = abs(moved["newton_residuals"][0] - base["newton_residuals"][0])
+    assert 0 < first < 1e-7 and len(moved["newton_residuals"]) == len(base["newton_residuals"])
+    assert moved["newton_residuals"][1] == pytest.approx(base["newton_residuals"][1], rel=1e-8)
+
+
+def test_a_bad_condition_names_its_parameter():
+    with pytest.raises(ValueError, match=r"linear_algebra = 'lu' is not allowed: one of auto\|dense"):
+        with rounding(linear_algebra="lu"):
+            pass
+    with pytest.raises(ValueError, match=r"perturbation = 0.01 is out of range: allowed \[0, 1e-06\]"):
+        with rounding(perturbation=0.01):
+            pass
+    from contactfem.cli import main
+
+    assert main(["figures", "--preset", "paper", "--perturb", "x", "--outdir", "/tmp/none"]) == 2
+    assert main(["figures", "--rounding", "--outdir", "/tmp/none"]) == 2  # the fast preset
+
+
+def test_a_diverging_history_keeps_no_digits_past_the_bound():
+    h = [171.9, 8.4, 155.6, 6.0e4, 2.6e4, 1.2e19, 6.4e17]
+    assert diverged_at(h) == 5 and diverged_at(h[:5]) is None
+    assert describe_newton(h, False) == "diverges (past 1e+15 in 5 solves)"
+    # another kernel: the same solves up to the bound, other digits past it (Table 1's symmetrised tangent)
+    assert describe_newton(h[:5] + [3.3e18, 8.0e2], False) == describe_newton(h, False)
+
+
+def figure(**over):
+    return dict(dict(figure="f", code_version="0.1.0+src.a", parameters={}, v=29.90, n=839, x=[1.0, 2.0]), **over)
+
+
+def test_the_spread_of_samples_is_what_moved_past_rtol():
+    samples = [
+        figure(runs=[dict(v=29.90, exits=True)], t=[0.0, 1.0, 2.0], text="exit 2.64 ms"),
+        figure(runs=[dict(v=30.13, exits=True)], t=[0.0, 1.0], text="exit 2.61 ms", n=840),
+        figure(runs=[dict(v=29.95, exits=False)], t=[0.0, 1.0, 2.0], text="exit 2.55 ms", x=[1.0, 2.0 + 1e-6]),
+        figure(runs=[dict(v=29.90 * (1 + 1e-12), exits=True)], t=[0.0, 1.0, 2.0], text="exit 2.64 ms"),
+    ]
+    spread = R.spread_of(samples)
+    assert spread == {
+        "runs[0].v": {"lo": 29.90, "hi": 30.13},
+        "runs[0].exits": {"values": [True, False]},
+        "t": {"len": [2, 3]},
+        "text": {"texts": ["exit 2.55 ms", "exit 2.61 ms", "exit 2.64 ms"]},
+        "n": {"lo": 839, "hi": 840},
+        "x[]": {"width": pytest.approx(1e-6)},
+    }
+
+
+def test_a_fresh_run_is_held_within_twice_the_recorded_spread():
+    spread = {"v": {"lo": 29.90, "hi": 30.13}, "n": {"lo": 839, "hi": 840}, "x[]": {"width": 1e-6}}
+    written = figure(rounding=dict(spread=spread), t=[0.0, 1.0], note="exit 2.64 ms")
+    spread.update({"t": {"len": [2, 3]}, "note": {"texts": ["exit 2.55 ms", "exit 2.64 ms"]}})
+    assert D.differences(written, figure(v=30.36, n=841, x=[1.0, 2.0 - 1.9e-6], t=[0.0], note="exit 2.6 ms")) == []
+    problems = D.differences(written, figure(v=30.40, n=842, x=[1.0, 2.0 + 3e-6], t=[], note="sticks"))
+    assert problems == [
+        "v: 29.9 in the file, 30.4 from the run (rounding moves it 0.23)",
+        "n: 839 in the file, 842 from the run (rounding moves it 1)",
+        "x[1]: 2.0 in the file, 2.000003 from the run (rounding moves it 1e-06)",
+        "t: 0 entries from the run, 2 to 3 under rounding",
+        "note: 'exit 2.64 ms' in the file, 'sticks' from the run",
+    ]
+    # without a rounding section, RTOL as before
+    assert D.differences(figure(), figure(v=29.90 * (1 + 1e-7))) != []
+
+
+def test_the_study_records_the_spread_beside_the_numbers_and_a_redraw_keeps_it(tmp_path, monkeypatch):
+    base = figure()
+    (tmp_path / "f.json").write_text(D.dumps(base))
+    drawn = {}
+    for i, c in enumerate(R.CONDITIONS):
+        path = tmp_path / f"{i}.json"
+        path.write_text(json.dumps(figure(v=29.90 + 0.01 * i)))
+        drawn[c] = path
+    drawn["perturbation"] = None  # a condition whose run failed is named so
+    spread = R.record("f", tmp_path, drawn)
+    d = D.load(tmp_path / "f.json")
+    assert spread == {"v": {"lo": 29.90, "hi": pytest.approx(29.93)}} and d["rounding"]["spread"] == spread
+    assert d["rounding"]["conditions"]["perturbation"].endswith(": failed") and d["v"] == 29.90
+    assert R.spread("f", "v", tmp_path) == pytest.approx(0.03) and R.spread("f", "n", tmp_path) == 0.0
+    D.write_data(tmp_path / "f.json", dict(v=29.91, n=839, x=[1.0, 2.0]), {})
+    assert D.load(tmp_path / "f.json")["rounding"] == d["rounding"]
+
+
+@pytest.mark.slow
+def test_the_study_draws_each_figure_in_a_process_under_its_condition(tmp_path, monkeypatch):
+    """One cheap figure (Fig 1, the interface law: no run) under every condition, kept for a second call."""
+    monkeypatch.setenv("CONTACTFEM_CACHE", str(tmp_path / "cache"))
+    base = D.load(D.Path(__file__).resolve().parents[1] / "figures" / "fig01_true_contact_area.json")
+    seen = []
+    paths = [R.draw("fig01_true_contact_area", c, base, log=seen.append) for c in R.CONDITIONS]
+    assert len(seen) == len(R.CONDITIONS) and all(line.endswith("done") for line in seen)
+    assert all(D.differences(base, D.load(p)) == [] for p in paths)
+    assert R.draw("fig01_true_contact_area", "kernel Prescott", base, log=seen.append) == paths[1]
+    assert len(seen) == len(R.CONDITIONS)  # kept: not drawn again
