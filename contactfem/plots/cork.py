@@ -27,6 +27,7 @@ import numpy as np
 from ..contact.masters import bottle_neck
 from . import cached_run, default_outdir, figure, pyplot, stored
 from .data import save_figure, write_data
+from .rounding import held, recorded
 
 # the cork run's headline numbers, in the data of each of Figs 14-17 (the summary's row reads them)
 CORK_KEYS = (
@@ -244,11 +245,21 @@ def sensitivity_rows(preset="fast", cases=SENSITIVITY, jobs=2, runs=None):
     """One row per case: label, press-fit force, and the outcome for each n_ramp of
     P0_STEPS (``runs``: sensitivity_runs made before, else made here)."""
     out = runs or sensitivity_runs(preset, cases, jobs)
+    spread = recorded("table_cork_sensitivity", preset)  # an exit velocity rounding moves: with its spread
+
+    def v(k):
+        x = out[k]
+        return (
+            x["v"]
+            if x["exit_velocity_m_s"] is None
+            else held(x["exit_velocity_m_s"], spread.get(f"runs[{k}].exit_velocity_m_s"), 1)
+        )
+
     rows = []
     for i, (label, _) in enumerate(cases):
-        res = out[i * len(P0_STEPS) : (i + 1) * len(P0_STEPS)]
-        F = next((x["F"] for x in res if x["F"] is not None), None)
-        rows.append((label, F, [x["v"] for x in res]))
+        ks = range(i * len(P0_STEPS), (i + 1) * len(P0_STEPS))
+        F = next((out[k]["F"] for k in ks if out[k]["F"] is not None), None)
+        rows.append((label, F, [v(k) for k in ks]))
     return rows
 
 

@@ -40,9 +40,9 @@ RTOL = 1e-8
 ROUNDOFF = 1e-9
 # Where rounding moves a number past RTOL (plots/rounding.py measures it: ``contactfem figures
 # --rounding``), a fresh run agrees with the written one within MARGIN times the recorded spread.
-# The spread is the range of six samples of what rounding does (the committed run and five
-# conditions); another machine's kernel is one more sample, which falls outside the range of the six
-# with probability 2/7 when the samples are alike. Twice the range (the range widened by its own width
+# The spread is the range of five samples of what rounding does (the committed run and four
+# conditions); another machine's kernel is one more sample, which falls outside the range of the five
+# with probability 2/6 when the samples are alike. Twice the range (the range widened by its own width
 # on either side of any sample inside it) holds it unless rounding moves that machine's result twice
 # as far as any condition did, which would be a knife edge the study missed: worth a failure.
 MARGIN = 2.0

@@ -22,6 +22,8 @@ stopped. The bench's figures draw the bench's file (bench.json): they run nothin
 """
 
 import json
+import math
+import re
 import os
 import subprocess
 import sys
@@ -30,12 +32,12 @@ from pathlib import Path
 from . import cache_dir, default_outdir, load_all
 from .data import ROUNDOFF, RTOL, code_version, dumps, is_number, load, source_hash
 
-# the conditions: name -> (environment, what it changes). Three OpenBLAS kernels (each picks other
-# instructions, so other summation orders, in every BLAS call), SuperLU in place of the band or
-# dense LU (another factorisation and pivoting), and the initial state moved by 1e-13 of itself,
-# a few hundred units in the last place: what a different order of summation in building it leaves
+# the conditions: name -> (environment, what it changes). Two OpenBLAS kernels other than the one the
+# project's machines pick (Haswell's, on an AMD EPYC): each takes other instructions, so other summation
+# orders, in every BLAS call; SuperLU in place of the band or dense LU (another factorisation and
+# pivoting); the initial state moved by 1e-13 of itself, a few hundred units in the last place: what a
+# different order of summation in building it leaves
 CONDITIONS = {
-    "kernel Haswell": ({"OPENBLAS_CORETYPE": "Haswell"}, "OpenBLAS's Haswell kernels"),
     "kernel Prescott": ({"OPENBLAS_CORETYPE": "Prescott"}, "OpenBLAS's Prescott kernels (SSE3)"),
     "kernel Sandybridge": ({"OPENBLAS_CORETYPE": "Sandybridge"}, "OpenBLAS's Sandybridge kernels (AVX, no FMA)"),
     "factorisation": ({"CONTACTFEM_LINEAR_ALGEBRA": "sparse"}, "SuperLU for every system (--linear-algebra sparse)"),
@@ -169,3 +171,99 @@ def spread(stem, key, folder=None):
     if "width" in entry:
         return entry["width"]
     return entry["hi"] - entry["lo"] if "hi" in entry else None
+
+
+def recorded(stem, preset="paper"):
+    """The spread the study recorded for the committed figure ``stem`` (figures/NAME.json's rounding
+    section; the study measures the paper preset): {} for another preset or where none is recorded."""
+    path = Path(__file__).resolve().parents[2] / "figures" / f"{stem}.json"
+    if preset != "paper" or not path.exists():
+        return {}
+    return (load(path).get("rounding") or {}).get("spread", {})
+
+
+def held(value, entry, decimals, band=0.0):
+    """``value`` printed with ``decimals`` decimals where rounding leaves that many digits (``entry``:
+    its recorded spread, {} or None where none is recorded), else with the spread it has, rounded up to
+    the printed digit: "29.7 ± 0.1". ``band``: an error band of the value (the discretisation's): the
+    ± is the larger of the two, printed where it reaches the printed digit. A count (decimals 0) that
+    rounding moves, without a band, prints as its range: "839-840"."""
+    text = f"{value:.{decimals}f}"
+    lo, hi = (min(entry["lo"], value), max(entry["hi"], value)) if entry and "lo" in entry else (value, value)
+    unit = 10.0**-decimals
+    if f"{lo:.{decimals}f}" == f"{hi:.{decimals}f}" and band < unit / 2:
+        return text
+    if decimals == 0 and not band and all(float(v).is_integer() for v in (lo, hi, value)):
+        return f"{lo:.0f}-{hi:.0f}"
+    return f"{text} ± {math.ceil(max(hi - lo, band) / unit - 1e-9) * unit:.{decimals}f}"
+
+
+def extreme(data, side, spread=None):
+    """A copy of figure record ``data`` with every number its spread records at ``side`` ("lo" or "hi")
+    of its range: what a run under another rounding could have written (the printed tables must
+    say the same of it)."""
+    out = json.loads(json.dumps(data))
+    for key, entry in (spread if spread is not None else (data.get("rounding") or {}).get("spread", {})).items():
+        if side in entry:
+            *path, last = _parts(key)
+            _committed_value(out, path)[last] = entry[side]
+    return out
+
+
+# -- the table of what rounding moves (figures/rounding.md, the README) ---------------------------
+RANGE_HEAD = ["| figure | number | committed | under rounding | printed | tested |", "|---|---|---|---|---|---|"]
+
+
+def _parts(key):
+    """The steps of a spread's path: "runs[2].v" -> ["runs", 2, "v"] (a series' "[]" dropped)."""
+    return [int(p[1:-1]) if p.startswith("[") else p for p in re.findall(r"[^.\[\]]+|\[\d+\]", key)]
+
+
+def _committed_value(data, key):
+    """The committed value at a path of the spread ("runs[2].v", "x[]"; or its steps), or None."""
+    node = data
+    for part in _parts(key) if isinstance(key, str) else key:
+        try:
+            node = node[part]
+        except (KeyError, IndexError, TypeError):
+            return None
+    return node
+
+
+def _describe(entry, value):
+    """(committed, under rounding, tested) in words, for one entry of a spread."""
+    if "lo" in entry:
+        w = entry["hi"] - entry["lo"]
+        return (
+            f"{value:.6g}",
+            f"{entry['lo']:.6g} to {entry['hi']:.6g} (spread {w:.2g})",
+            f"within {MARGIN:g} x {w:.2g}",
+        )
+    if "width" in entry:
+        return (
+            "a series",
+            f"its entries move by up to {entry['width']:.2g}",
+            f"each within {MARGIN:g} x {entry['width']:.2g}",
+        )
+    if "len" in entry:
+        lo, hi = entry["len"]
+        n = len(value) if isinstance(value, list) else "-"
+        return f"{n} entries", f"{lo} to {hi} entries", "its length within the range widened by its width"
+    if "texts" in entry:
+        return f"{value}", " / ".join(entry["texts"]), "by its words (its numbers move)"
+    return f"{value}", " / ".join(json.dumps(v) for v in entry["values"]), "any of these"
+
+
+def table_lines(folder=None):
+    """The table's lines: every number of the committed figures that rounding moves past plots.data.RTOL,
+    with how it is printed (PRINTED) and tested."""
+    folder = Path(folder or default_outdir("paper"))
+    lines = list(RANGE_HEAD)
+    for stem in stems():
+        path = folder / f"{stem}.json"
+        data = load(path) if path.exists() else {}
+        for key, entry in (data.get("rounding") or {}).get("spread", {}).items():
+            committed, moved, tested = _describe(entry, _committed_value(data, key))
+            printed = next((text for (s, prefix), text in PRINTED.items() if s == stem and key.startswith(prefix)), "-")
+            lines.append(f"| {stem} | `{key}` | {committed} | {moved} | {printed} | {tested} |".replace("\n", " "))
+    return lines
