@@ -152,6 +152,8 @@ def study(folder=None, only=None, log=print):
         base = load(folder / f"{stem}.json")
         out[stem] = record(stem, folder, {c: draw(stem, c, base, log) for c in CONDITIONS})
         log(f"{stem}: {len(out[stem])} number(s) moved under rounding")
+    (folder / "rounding.md").write_text(markdown(folder))
+    log(f"{folder / 'rounding.md'}: the table (python -m contactfem.plots.summary copies it into the README)")
     return out
 
 
@@ -265,5 +267,22 @@ def table_lines(folder=None):
         for key, entry in (data.get("rounding") or {}).get("spread", {}).items():
             committed, moved, tested = _describe(entry, _committed_value(data, key))
             printed = next((text for (s, prefix), text in PRINTED.items() if s == stem and key.startswith(prefix)), "-")
-            lines.append(f"| {stem} | `{key}` | {committed} | {moved} | {printed} | {tested} |".replace("\n", " "))
+            cells = [stem, f"`{key}`", committed, moved, printed, tested]
+            lines.append("| " + " | ".join(c.replace("|", "\\|").replace("\n", " ") for c in cells) + " |")
     return lines
+
+
+def markdown(folder=None):
+    """figures/rounding.md: the table, under a title and what it was measured with."""
+    conditions = "; ".join(f"{c}: {text}" for c, (_, text) in CONDITIONS.items())
+    return "\n".join(
+        [
+            "# What rounding does to the published numbers",
+            "",
+            "Written by `contactfem figures --preset paper --rounding` (contactfem/plots/rounding.py) from the "
+            f"figures' rounding sections. Conditions: {conditions}. Every number that moved past 1e-8 of itself.",
+            "",
+            *table_lines(folder),
+            "",
+        ]
+    )

@@ -28,6 +28,7 @@ from ..scenes.block import PAPER_TABLE1
 from . import cached_run, default_outdir, figure
 
 START, END = "<!-- summary:start -->", "<!-- summary:end -->"
+ROUNDING_START, ROUNDING_END = "<!-- rounding:start -->", "<!-- rounding:end -->"  # plots/rounding.py's table
 HEAD = ["| paper | what | paper's value | ours | figure |", "|---|---|---|---|---|"]
 
 
@@ -336,15 +337,16 @@ def summary(preset="fast", outdir=None):
     return [str(path)]
 
 
-def update_readme(readme="README.md", summary_md="figures/summary.md"):
-    """Copy the table of summary.md into the README between the markers."""
+def update_readme(readme="README.md", summary_md="figures/summary.md", start=START, end=END):
+    """Copy the table of summary.md (or another generated file's) into the README between the markers."""
     text = Path(readme).read_text()
-    if START not in text or END not in text:
-        raise ValueError(f"{readme} has no {START} ... {END} block")
-    table = "\n".join(ln.replace("](", "](figures/") for ln in table_lines(Path(summary_md).read_text()))
-    head, rest = text.split(START, 1)
-    tail = rest.split(END, 1)[1]
-    Path(readme).write_text(f"{head}{START}\n{table}\n{END}{tail}")
+    if start not in text or end not in text:
+        raise ValueError(f"{readme} has no {start} ... {end} block")
+    lines = [ln.strip() for ln in Path(summary_md).read_text().splitlines() if ln.strip().startswith("|")]
+    table = "\n".join(ln.replace("](", "](figures/") for ln in lines)
+    head, rest = text.split(start, 1)
+    tail = rest.split(end, 1)[1]
+    Path(readme).write_text(f"{head}{start}\n{table}\n{end}{tail}")
 
 
 if __name__ == "__main__":
@@ -353,12 +355,14 @@ if __name__ == "__main__":
     repo = Path(__file__).resolve().parents[2]
     cli = argparse.ArgumentParser(
         prog="python -m contactfem.plots.summary",
-        description="Copy the table of figures/summary.md into the README, between its markers.",
+        description="Copy the tables of figures/summary.md and figures/rounding.md into the README, between "
+        "their markers.",
     )
     cli.add_argument("readme", nargs="?", default=repo / "README.md")
     cli.add_argument("summary_md", nargs="?", default=repo / "figures" / "summary.md")
     args = cli.parse_args()
     try:
         update_readme(args.readme, args.summary_md)
+        update_readme(args.readme, Path(args.summary_md).parent / "rounding.md", ROUNDING_START, ROUNDING_END)
     except (OSError, ValueError) as err:
         sys.exit(f"python -m contactfem.plots.summary: error: {err}")
