@@ -121,3 +121,53 @@ def test_the_study_draws_each_figure_in_a_process_under_its_condition(tmp_path, 
     assert all(D.differences(base, D.load(p)) == [] for p in paths)
     assert R.draw("fig01_true_contact_area", "kernel Prescott", base, log=seen.append) == paths[0]
     assert len(seen) == len(R.CONDITIONS)  # kept: not drawn again
+
+
+# -- the printed tables hold under rounding -----------------------------------------------------
+# Every printed table made again from the committed figures' data with each number that rounding
+# moves at one end of its recorded range, then at the other: what a run under another rounding
+# could have written. The tables must say the same (a number printed with its spread within twice
+# it, as tests/test_published_tables.py compares them).
+REPO = D.Path(__file__).resolve().parents[1]
+FIGURES = REPO / "figures"
+
+
+@pytest.mark.parametrize("side", ["lo", "hi"])
+def test_the_readme_table_says_the_same_at_either_end_of_every_spread(side):
+    from contactfem.plots import summary as S
+    from test_published_tables import assert_same_text
+
+    committed = S.committed(FIGURES)
+    written = "\n".join(S.summary_table("paper", committed))
+    assert_same_text(
+        "summary.md", written, "\n".join(S.summary_table("paper", lambda s: R.extreme(committed(s), side)))
+    )
+
+
+@pytest.mark.parametrize("side", ["lo", "hi"])
+def test_the_cork_tables_say_the_same_at_either_end_of_every_spread(side):
+    from contactfem.plots import cork as F
+    from test_published_tables import assert_same_text
+
+    d = R.extreme(D.load(FIGURES / "cork_exit_time.json"), side)
+    assert_same_text("cork_exit_time.md", (FIGURES / "cork_exit_time.md").read_text(), F.exit_time_markdown(d))
+    d = R.extreme(D.load(FIGURES / "table_cork_sensitivity.json"), side)
+    runs = [
+        dict(v=x["outcome"], F=x["press_fit_normal_force_N"], exit_velocity_m_s=x["exit_velocity_m_s"])
+        for x in d["runs"]
+    ]
+    fresh = F.sensitivity_markdown(F.sensitivity_rows("paper", runs=runs), "paper")
+    assert_same_text("table_cork_sensitivity.md", (FIGURES / "table_cork_sensitivity.md").read_text(), fresh)
+
+
+def test_the_readme_shows_the_table_of_what_rounding_moves():
+    from contactfem.plots import summary as S
+
+    readme = (REPO / "README.md").read_text()
+    block = readme.split(S.ROUNDING_START, 1)[1].split(S.ROUNDING_END, 1)[0]
+    lines = [ln for ln in block.splitlines() if ln.startswith("|")]
+    assert lines == R.table_lines(FIGURES), (
+        "README.md's table of what rounding moves is not what figures/*.json record: `contactfem figures "
+        "--preset paper --rounding`, then `python -m contactfem.plots.summary`"
+    )
+    assert (FIGURES / "rounding.md").read_text() == R.markdown(FIGURES)

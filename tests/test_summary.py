@@ -38,7 +38,7 @@ def test_ours_is_computed_from_the_figures_data():
     }
     row = S.row_table1("paper", data.get)
     assert "conical 3 (7 nodes slip), parabolic 7" in row[3] and "first 171.37" in row[3]
-    assert "(123 down, 45 along)" in S.row_block_equilibrium("paper", data.get)[3]
+    assert "; 123 down, 45 along" in S.row_block_equilibrium("paper", data.get)[3]
 
 
 def test_readme_table_is_the_committed_figures_data():

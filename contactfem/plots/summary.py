@@ -26,10 +26,32 @@ import numpy as np
 
 from ..scenes.block import PAPER_TABLE1
 from . import cached_run, default_outdir, figure
+from .data import ROUNDOFF
+from .rounding import held, recorded
 
 START, END = "<!-- summary:start -->", "<!-- summary:end -->"
 ROUNDING_START, ROUNDING_END = "<!-- rounding:start -->", "<!-- rounding:end -->"  # plots/rounding.py's table
 HEAD = ["| paper | what | paper's value | ours | figure |", "|---|---|---|---|---|"]
+
+
+def floor(x):
+    """A residual or an equilibrium error: its digits where they are the run's, "below 1e-09 (round-off)"
+    where they are rounding's (plots.data.ROUNDOFF: 1e-14 of the loads; another kernel prints others)."""
+    return f"below {ROUNDOFF:.0e} (round-off)" if abs(x) < ROUNDOFF else f"{x:.0e}"
+
+
+def held_number(preset, stem, data, key, decimals):
+    """``data[key]`` of figure ``stem`` printed to the digits it holds (plots.rounding.held): with ±
+    the larger of its error band (``band``) and the rounding spread recorded for it, where that reaches
+    the printed digit."""
+    return held(data[key], recorded(stem, preset).get(key), decimals, band(data, key))
+
+
+def band(data, key):
+    """The error band of headline number ``key`` in a figure's data: the entry of its ``uncertainty``
+    section (a number, or a dict with "band"); 0.0 where it has none."""
+    entry = (data.get("uncertainty") or {}).get(key, 0.0)
+    return float(entry.get("band", 0.0) if isinstance(entry, dict) else entry)
 
 
 def _links(*pairs):
@@ -113,8 +135,8 @@ def row_laws(preset, record=None):
 def row_block_equilibrium(preset, record=None):
     r = (record or fresh(preset))("fig07_block_conical_stresses")
     ours = (
-        f"equilibrium to {r['equilibrium_error']:.0e} ({-r['total_normal']:.0f} down, "
-        f"{r['total_tangential']:.0f} along)"
+        f"equilibrium error {floor(r['equilibrium_error'])}; {-r['total_normal']:.0f} down, "
+        f"{r['total_tangential']:.0f} along"
     )
     what = "block on a rough foundation, whole load in one step"
     if r.get("fitted"):
@@ -160,9 +182,10 @@ def row_table1(preset, record=None):
     record = record or fresh(preset)
     c, t = record("fig07_block_conical_stresses"), record("table1_block_newton_residuals")
     rc, rp = t["conical"], t["parabolic"]
-    ours = (
-        f"conical {len(rc)} ({c['n_slip']} nodes slip), parabolic {len(rp)}; "
-        f"first {rc[0]:.2f}; last {rc[-1]:.0e} and {rp[-1]:.0e}"
+    ours = f"conical {len(rc)} ({c['n_slip']} nodes slip), parabolic {len(rp)}; first {rc[0]:.2f}; " + (
+        f"last {floor(rc[-1])} in both"
+        if floor(rc[-1]) == floor(rp[-1])
+        else f"last {floor(rc[-1])} and {floor(rp[-1])}"
     )
     return (
         "Table 1",
