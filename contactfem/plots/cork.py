@@ -660,18 +660,20 @@ def exit_time_markdown(d):
         "|---|---|---|---:|---:|---:|---:|---:|",
     ]
     onoff = {True: "on", False: "off"}
-    for r in d["cases"]:
+    spread = recorded("cork_exit_time", d["preset"])  # a number rounding moves: with its spread (a count: range)
+    for i, r in enumerate(d["cases"]):
+        f = lambda key, decimals: held(r[key], spread.get(f"cases[{i}].{key}"), decimals)  # noqa: E731
         if r["error"]:
             tail = f"| {r['error']} | | | | |"
         elif r["exited"]:
             tail = (
-                f"| {r['exit_time_ms']:.3f} | {r['exit_velocity_m_s']:.2f} | {r['v_min_after_ramp_m_s']:.2f} at "
-                f"{r['t_v_min_ms']:.2f} | {r['press_fit_normal_force_N']:.1f} | {r['steps']} |"
+                f"| {f('exit_time_ms', 3)} | {f('exit_velocity_m_s', 2)} | {f('v_min_after_ramp_m_s', 2)} at "
+                f"{f('t_v_min_ms', 2)} | {f('press_fit_normal_force_N', 1)} | {f('steps', 0)} |"
             )
         else:
             tail = (
-                f"| stays in | - | {r['v_min_after_ramp_m_s']:.2f} at {r['t_v_min_ms']:.2f} | "
-                f"{r['press_fit_normal_force_N']:.1f} | {r['steps']} |"
+                f"| stays in | - | {f('v_min_after_ramp_m_s', 2)} at {f('t_v_min_ms', 2)} | "
+                f"{f('press_fit_normal_force_N', 1)} | {f('steps', 0)} |"
             )
         lines.append(
             f"| {r['group']} | {r['label']} | {onoff[r['closing_step_press_fit']]}, "
