@@ -397,11 +397,12 @@ def cork_knife_edge(preset="fast", outdir=None, data=None):
     for o in d["field"]:
         if o["error"]:
             ax.plot(o["mu"], o["R_tip"], "k^", ms=7)
-    for o in d["runs"]:
+    spread = recorded("cork_knife_edge")  # the same runs whatever the preset (KNIFE_PRESET)
+    for i, o in enumerate(d["runs"]):
         if o["error"]:
             text, style = "solver failed", dict(marker="^", color="k")
-        elif o["exited"]:
-            text, style = f"{o['v']:.1f} m/s", dict(marker="o", color="tab:green")
+        elif o["exited"]:  # a velocity rounding moves: with its spread
+            text, style = f"{held(o['v'], spread.get(f'runs[{i}].v'), 1)} m/s", dict(marker="o", color="tab:green")
         else:
             text, style = "stays in", dict(marker="x", color="tab:red", mew=2)
         ax.plot(o["mu"], o["R_tip"], ls="none", ms=9, **style)
