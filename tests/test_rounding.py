@@ -171,3 +171,5 @@ def test_the_readme_shows_the_table_of_what_rounding_moves():
         "--preset paper --rounding`, then `python -m contactfem.plots.summary`"
     )
     assert (FIGURES / "rounding.md").read_text() == R.markdown(FIGURES)
+    unsaid = [ln for ln in lines[2:] if ln.split(" | ")[4] == "-"]
+    assert not unsaid, "plots.rounding.PRINTED does not say how these numbers are printed:\n" + "\n".join(unsaid)

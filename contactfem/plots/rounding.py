@@ -30,7 +30,7 @@ import sys
 from pathlib import Path
 
 from . import cache_dir, default_outdir, load_all
-from .data import ROUNDOFF, RTOL, code_version, dumps, is_number, load, source_hash
+from .data import MARGIN, ROUNDOFF, RTOL, code_version, dumps, is_number, load, source_hash
 
 # the conditions: name -> (environment, what it changes). Two OpenBLAS kernels other than the one the
 # project's machines pick (Haswell's, on an AMD EPYC): each takes other instructions, so other summation
@@ -46,8 +46,9 @@ CONDITIONS = {
 
 
 def stems():
-    """The figures the study reruns: every registered figure that runs the library."""
-    return sorted(s for s in load_all() if not s.startswith("bench_"))
+    """The figures the study reruns: every registered figure that runs the library and writes its data
+    (not the bench's, which draw bench.json, nor the summary, which reads the others' data)."""
+    return sorted(s for s in load_all() if not s.startswith("bench_") and s != "summary")
 
 
 def work_dir(condition):
@@ -213,6 +214,22 @@ def extreme(data, side, spread=None):
 
 
 # -- the table of what rounding moves (figures/rounding.md, the README) ---------------------------
+# where a figure's numbers are printed, and how: (figure, a pattern of the path) -> words; the first
+# that matches
+PRINTED = {
+    ("cork_exit_time", r".*newton_failures"): "not printed",
+    ("cork_exit_time", r".*steps"): "cork_exit_time.md: its range",
+    ("cork_exit_time", r"cases\["): "cork_exit_time.md: with ± its spread",
+    ("cork_exit_time", r"summary\."): "cork_exit_time.md, its figure's title: with ± its spread",
+    ("cork_knife_edge", r"runs\[\d+\]\.v$"): "the knife edge's labels: with ± its spread",
+    ("table_cork_sensitivity", r".*exit_velocity_m_s"): "table_cork_sensitivity.md: with ± its spread",
+    ("table_cork_sensitivity", r".*outcome"): "not printed (the table prints the velocity held)",
+    ("fig09b_rolling_ring_convergence", r""): "plotted, not printed",
+    ("table1_block_newton_residuals", r"coulomb, symmetric tangent"): (
+        "table1_block_newton_residuals.md: 'diverges (past 1e+15 in N solves)', the residuals before it"
+    ),
+    ("table1_block_newton_residuals", r"verdict\."): "table1_block_newton_residuals.md: the verdict",
+}
 RANGE_HEAD = ["| figure | number | committed | under rounding | printed | tested |", "|---|---|---|---|---|---|"]
 
 
@@ -266,7 +283,9 @@ def table_lines(folder=None):
         data = load(path) if path.exists() else {}
         for key, entry in (data.get("rounding") or {}).get("spread", {}).items():
             committed, moved, tested = _describe(entry, _committed_value(data, key))
-            printed = next((text for (s, prefix), text in PRINTED.items() if s == stem and key.startswith(prefix)), "-")
+            printed = next(
+                (text for (s, pattern), text in PRINTED.items() if s == stem and re.match(pattern, key)), "-"
+            )
             cells = [stem, f"`{key}`", committed, moved, printed, tested]
             lines.append("| " + " | ".join(c.replace("|", "\\|").replace("\n", " ") for c in cells) + " |")
     return lines
