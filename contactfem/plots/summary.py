@@ -199,8 +199,9 @@ def row_table1(preset, record=None):
 
 def row_rolling_ring(preset, record=None):
     r = (record or fresh(preset))("fig09_rolling_ring")
-    x_roll = "did not roll" if not r["rolled"] else f"x_roll = {r['x_roll']:.1f} cm"
-    ours = f"{x_roll}, x(2 s) = {r['x_end']:.1f} cm, v = {r['v_final']:.1f} cm/s"
+    f = lambda key: held_number(preset, "fig09_rolling_ring", r, key, 1)  # noqa: E731
+    x_roll = "did not roll" if not r["rolled"] else f"x_roll = {f('x_roll')} cm"
+    ours = f"{x_roll}, x(2 s) = {f('x_end')} cm, v = {f('v_final')} cm/s"
     return (
         "Sec. 5.2, Fig 9",
         "ring sliding, then rolling (exact: rigid thin ring)",
@@ -218,7 +219,8 @@ def row_sloping_impact(preset, record=None):
         ("frictional", "fig11a_sloping_impact_frictional"),
     ):
         r = record(stem)
-        parts.append(f"{variant} ({r['rebound_vx']:.2f}, {r['rebound_vy']:.2f}), {r['rebound_angle_deg']:.1f} deg")
+        f = lambda key, decimals: held_number(preset, stem, r, key, decimals)  # noqa: E731
+        parts.append(f"{variant} ({f('rebound_vx', 2)}, {f('rebound_vy', 2)}), {f('rebound_angle_deg', 1)} deg")
     n_el = record("fig10_sloping_impact_frictionless")["parameters"]["n_el"]
     ours = "; ".join(parts) + f" ({n_el} elements)"
     fitted = record("fig10_sloping_impact_frictionless").get("fitted") or {}
@@ -268,8 +270,9 @@ def cork_refined_exit(preset, record=None):
 def row_cork(preset, record=None):
     record = record or fresh(preset)
     r = record("fig14_cork_mesh")
+    f = lambda key, decimals: held_number(preset, "fig14_cork_mesh", r, key, decimals)  # noqa: E731
     exit_text = (
-        f"exit {r['exit_time_ms']:.2f} ms at {r['exit_velocity_m_s']:.1f} m/s" if r["exited"] else "the cork stays in"
+        f"exit {f('exit_time_ms', 2)} ms at {f('exit_velocity_m_s', 1)} m/s" if r["exited"] else "the cork stays in"
     )
     if r["exited"] and preset == "paper":
         fine, dt = cork_refined_exit(preset, record)
