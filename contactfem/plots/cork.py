@@ -634,7 +634,15 @@ def exit_time_summary(d):
 
 def exit_time_markdown(d):
     s = exit_time_summary(d)
-    fit, ref = s["press_fit_refined_ms"], s["refined_ms"]
+    spread = recorded("cork_exit_time", d["preset"])  # a number rounding moves: with its spread (a count: range)
+
+    def ms(*key):  # a number of the summary, to 3 decimals or to what rounding leaves of them
+        return held(s[key[0]] if len(key) == 1 else s[key[0]][key[1]], spread.get(".".join(("summary",) + key)), 3)
+
+    fit, ref = (
+        {k: ms("press_fit_refined_ms", k) for k in ("with", "without")},
+        {k: ms("refined_ms", k) for k in ("with", "without")},
+    )
     lines = [
         "# The cork's exit time: the closing step and the discretisation (paper preset)",
         "",
@@ -643,22 +651,23 @@ def exit_time_markdown(d):
         + " The paper: exit between 2.6 and 2.7 ms at about 28 m/s.",
         "",
         f"- At the paper's time step in the neck ({s['dt_paper_s']:g} s) and the preset's {s['n_press']} press-fit "
-        f"increments the cork leaves at {s['exit_ms']:.3f} ms with the closing step, at "
-        f"{s['exit_without_ms']:.3f} ms without it ({s['shift_ms']:+.3f} ms).",
+        f"increments the cork leaves at {ms('exit_ms')} ms with the closing step, at "
+        f"{ms('exit_without_ms')} ms without it ({s['shift_ms']:+.3f} ms).",
         "- The rule acts through the press fit: with the closing step in the press fit only, the exit "
         + (
             f"moves by {s['pop_rule_shift_ms']:+.1e} ms."
             if s["pop_rule_shift_ms"]
             else f"does not move (the two runs agree to {RTOL:.0e} of it: rounding)."
         ),
-        f"- With the press fit refined to {s['n_press_refined']} increments both rules give {fit['with']:.3f} and "
-        f"{fit['without']:.3f} ms: the closing step is {abs(s['exit_ms'] - fit['with']):.3f} ms from that with "
-        f"{s['n_press']} increments, the rule without it {abs(s['exit_without_ms'] - fit['without']):.3f} ms "
+        f"- With the press fit refined to {s['n_press_refined']} increments both rules give {fit['with']} and "
+        f"{fit['without']} ms: the closing step is "
+        f"{abs(s['exit_ms'] - s['press_fit_refined_ms']['with']):.3f} ms from that with {s['n_press']} increments, "
+        f"the rule without it {abs(s['exit_without_ms'] - s['press_fit_refined_ms']['without']):.3f} ms "
         "(it loads the stick springs of the nodes that touch during an increment with the travel "
         "made before touching, an error of the increment's size).",
         f"- With the time step in the neck refined to {s['dt_refined_s']:g} s (the pressure ramp kept at 8 x 0.1 ms) "
-        f"both rules give {ref['with']:.3f} and {ref['without']:.3f} ms: the paper's step leaves a "
-        f"time-discretisation error of {s['exit_ms'] - ref['with']:+.3f} ms in the stall after the ramp.",
+        f"both rules give {ref['with']} and {ref['without']} ms: the paper's step leaves a "
+        f"time-discretisation error of {s['exit_ms'] - s['refined_ms']['with']:+.3f} ms in the stall after the ramp.",
         "- The slowest speed after the ramp is that stall: the gas expands (Boyle), its pressure falls "
         "below the static breakaway, the cork slows down; how far it slows sets the exit time.",
         "",
