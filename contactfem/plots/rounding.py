@@ -160,15 +160,12 @@ def study(folder=None, only=None, log=print):
 
 # -- reading the recorded spread ----------------------------------------------------------------
 def spread(stem, key, folder=None):
-    """The recorded rounding spread (hi - lo, or a series' width) of figure ``stem``'s number at
-    ``key`` (a path as plots.data.differences names it: "v_final", "runs[1].v", a series
-    "x_err"); 0.0 where rounding moved it by less than plots.data.RTOL, None where the study
-    recorded no number there (its length, a text) or the figure has no rounding section."""
-    folder = Path(folder or default_outdir("paper"))
-    section = load(folder / f"{stem}.json").get("rounding")
-    if section is None:
-        return None
-    entry = section["spread"].get(key) or section["spread"].get(f"{key}[]")
+    """The recorded rounding spread (hi - lo, or a series' width) of figure ``stem``'s number at ``key``
+    (a path as plots.data.differences names it: "v_final", "runs[1].v", a series "x_err"), in the
+    committed figures (or ``folder``'s); 0.0 where none is recorded (rounding moved it by less than
+    plots.data.RTOL), None where the study recorded no number there (a length, a text)."""
+    entries = recorded(stem, folder=folder)
+    entry = entries.get(key) or entries.get(f"{key}[]")
     if entry is None:
         return 0.0
     if "width" in entry:
@@ -176,10 +173,11 @@ def spread(stem, key, folder=None):
     return entry["hi"] - entry["lo"] if "hi" in entry else None
 
 
-def recorded(stem, preset="paper"):
-    """The spread the study recorded for the committed figure ``stem`` (figures/NAME.json's rounding
-    section; the study measures the paper preset): {} for another preset or where none is recorded."""
-    path = Path(__file__).resolve().parents[2] / "figures" / f"{stem}.json"
+def recorded(stem, preset="paper", folder=None):
+    """The spread the study recorded for figure ``stem`` in the committed figures (or ``folder``'s):
+    NAME.json's rounding section; {} for another preset than the paper's (the study measures it) or
+    where none is recorded."""
+    path = Path(folder or Path(__file__).resolve().parents[2] / "figures") / f"{stem}.json"
     if preset != "paper" or not path.exists():
         return {}
     return (load(path).get("rounding") or {}).get("spread", {})
@@ -209,7 +207,7 @@ def extreme(data, side, spread=None):
     for key, entry in (spread if spread is not None else (data.get("rounding") or {}).get("spread", {})).items():
         if side in entry:
             *path, last = _parts(key)
-            _committed_value(out, path)[last] = entry[side]
+            _at(out, path)[last] = entry[side]
     return out
 
 
@@ -230,7 +228,7 @@ PRINTED = {
     ),
     ("table1_block_newton_residuals", r"verdict\."): "table1_block_newton_residuals.md: the verdict",
 }
-RANGE_HEAD = ["| figure | number | committed | under rounding | printed | tested |", "|---|---|---|---|---|---|"]
+TABLE_HEAD = ["| figure | number | committed | under rounding | printed | tested |", "|---|---|---|---|---|---|"]
 
 
 def _parts(key):
@@ -238,7 +236,7 @@ def _parts(key):
     return [int(p[1:-1]) if p.startswith("[") else p for p in re.findall(r"[^.\[\]]+|\[\d+\]", key)]
 
 
-def _committed_value(data, key):
+def _at(data, key):
     """The committed value at a path of the spread ("runs[2].v", "x[]"; or its steps), or None."""
     node = data
     for part in _parts(key) if isinstance(key, str) else key:
@@ -277,12 +275,12 @@ def table_lines(folder=None):
     """The table's lines: every number of the committed figures that rounding moves past plots.data.RTOL,
     with how it is printed (PRINTED) and tested."""
     folder = Path(folder or default_outdir("paper"))
-    lines = list(RANGE_HEAD)
+    lines = list(TABLE_HEAD)
     for stem in stems():
         path = folder / f"{stem}.json"
         data = load(path) if path.exists() else {}
         for key, entry in (data.get("rounding") or {}).get("spread", {}).items():
-            committed, moved, tested = _describe(entry, _committed_value(data, key))
+            committed, moved, tested = _describe(entry, _at(data, key))
             printed = next(
                 (text for (s, pattern), text in PRINTED.items() if s == stem and re.match(pattern, key)), "-"
             )
