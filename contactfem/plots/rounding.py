@@ -247,6 +247,23 @@ def _at(data, key):
     return node
 
 
+def _which(data, key):
+    """Words naming the entry of a list a path goes through ("mu = 0.098, closing step off, off"), or ""."""
+    node, words = data, []
+    for part in _parts(key):
+        node = node[part] if isinstance(node, (dict, list)) else None
+        if isinstance(part, int) and isinstance(node, dict):
+            words += [str(node[k]) for k in ("label", "case") if k in node]
+            if "closing_step_press_fit" in node:
+                words.append(
+                    "closing step "
+                    + ", ".join(("off", "on")[node[k]] for k in ("closing_step_press_fit", "closing_step_pop"))
+                )
+            words += [f"n_ramp = {node['overrides']['n_ramp']}"] if "n_ramp" in node.get("overrides", {}) else []
+            words += [f"mu = {node['mu']:g}, R_tip = {node['R_tip']:g}"] if {"mu", "R_tip"} <= set(node) else []
+    return ", ".join(words)
+
+
 def _describe(entry, value):
     """(committed, under rounding, tested) in words, for one entry of a spread."""
     if "lo" in entry:
@@ -284,7 +301,8 @@ def table_lines(folder=None):
             printed = next(
                 (text for (s, pattern), text in PRINTED.items() if s == stem and re.match(pattern, key)), "-"
             )
-            cells = [stem, f"`{key}`", committed, moved, printed, tested]
+            which = _which(data, key)
+            cells = [stem, f"`{key}`" + (f" ({which})" if which else ""), committed, moved, printed, tested]
             lines.append("| " + " | ".join(c.replace("|", "\\|").replace("\n", " ") for c in cells) + " |")
     return lines
 
