@@ -23,7 +23,8 @@ import numpy as np
 from ..scenes.block import SCENE, solve
 from ..scenes.block import FIG8_DROP, PAPER_TABLE1, PAPER_TABLE1_UNCERTAIN, fig8_remark
 from ..solver.newton import NewtonError
-from . import cached_run, default_outdir, describe_newton, diverged_at, figure, fitted_words, pyplot, savefig  # noqa: F401
+from . import cached_run, default_outdir, describe_newton, diverged_at, figure  # noqa: F401
+from . import fitted_words, pyplot, savefig  # noqa: F401
 from .data import save_figure
 
 STATE_COLORS = {"stick": "tab:blue", "slip": "tab:red", "open": "0.6"}
