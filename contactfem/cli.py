@@ -249,9 +249,13 @@ def cmd_figures(args):
 
     if args.only and not any(args.only in stem for stem in load_all()):
         raise ValueError(f"--only {args.only!r} matches no figure: the figures are {', '.join(sorted(load_all()))}")
-    from .solver.rounding import checked, rounding
+    from .solver.rounding import checked, current, rounding
 
-    condition = checked(args.linear_algebra, args.perturb)  # before any work
+    # an option overrides the condition in the environment (the rounding study's processes carry theirs there)
+    given = current()
+    condition = checked(  # before any work
+        args.linear_algebra or given.linear_algebra, given.perturbation if args.perturb is None else args.perturb
+    )
     if args.rounding:
         if args.preset != "paper" or condition.tag():
             raise ValueError("--rounding measures the paper preset's figures: give it with --preset paper alone")

@@ -110,6 +110,22 @@ def test_the_study_records_the_spread_beside_the_numbers_and_a_redraw_keeps_it(t
     assert D.load(tmp_path / "f.json")["rounding"] == d["rounding"]
 
 
+def test_the_figures_command_keeps_the_condition_the_environment_gives(tmp_path, monkeypatch):
+    """The study's processes get their condition from the environment: `contactfem figures` without
+    --linear-algebra or --perturb draws under it, and an option overrides it."""
+    from contactfem import plots
+    from contactfem.cli import main
+
+    seen = []
+    monkeypatch.setattr(plots, "make_all", lambda *a: seen.append(current()) or [])
+    monkeypatch.setenv("CONTACTFEM_LINEAR_ALGEBRA", "sparse")
+    monkeypatch.setenv("CONTACTFEM_PERTURB", "1e-13")
+    out = ["--preset", "paper", "--only", "fig01", "--outdir", str(tmp_path)]
+    assert main(["figures", *out]) in (0, None)
+    assert main(["figures", *out, "--linear-algebra", "dense", "--perturb", "0"]) in (0, None)
+    assert [(c.linear_algebra, c.perturbation) for c in seen] == [("sparse", 1e-13), ("dense", 0.0)]
+
+
 @pytest.mark.slow
 def test_the_study_draws_each_figure_in_a_process_under_each_condition(tmp_path, monkeypatch):
     """`contactfem figures --preset paper --rounding --only fig01` on a copy of the committed Fig 1 (the
