@@ -175,13 +175,22 @@ def test_the_cork_tables_say_the_same_at_either_end_of_every_spread(side):
 
     d = R.extreme(D.load(FIGURES / "cork_exit_time.json"), side)
     assert_same_text("cork_exit_time.md", (FIGURES / "cork_exit_time.md").read_text(), F.exit_time_markdown(d))
-    d = R.extreme(D.load(FIGURES / "table_cork_sensitivity.json"), side)
-    runs = [
-        dict(v=x["outcome"], F=x["press_fit_normal_force_N"], exit_velocity_m_s=x["exit_velocity_m_s"])
-        for x in d["runs"]
-    ]
-    fresh = F.sensitivity_markdown(F.sensitivity_rows("paper", runs=runs), "paper")
+    fresh = F.sensitivity_reprinted(R.extreme(D.load(FIGURES / "table_cork_sensitivity.json"), side))
     assert_same_text("table_cork_sensitivity.md", (FIGURES / "table_cork_sensitivity.md").read_text(), fresh)
+
+
+def test_the_printed_cork_tables_are_what_their_data_and_spreads_print(tmp_path):
+    """What the study redraws once it has recorded the spreads (plots.rounding.reprint), from a copy of the
+    committed data: the committed tables, character for character (no run: the same numbers print the same)."""
+    import shutil
+
+    stems = ["cork_exit_time", "table_cork_sensitivity"]
+    for stem in stems:
+        shutil.copy(FIGURES / f"{stem}.json", tmp_path)
+    written = R.reprint(tmp_path, stems)
+    assert sorted(D.Path(p).name for p in written if p.endswith(".md")) == sorted(f"{s}.md" for s in stems)
+    for stem in stems:
+        assert (tmp_path / f"{stem}.md").read_text() == (FIGURES / f"{stem}.md").read_text(), stem
 
 
 def test_the_readme_shows_the_table_of_what_rounding_moves():

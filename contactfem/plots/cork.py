@@ -274,6 +274,13 @@ def sensitivity_markdown(rows, preset):
     return "\n".join(lines) + "\n"
 
 
+def sensitivity_reprinted(d):
+    """table_cork_sensitivity.md made again from its data (``d``: NAME.json's record), without a run."""
+    keys = dict(v="outcome", F="press_fit_normal_force_N", exit_velocity_m_s="exit_velocity_m_s")
+    runs = [{k: x[v] for k, v in keys.items()} for x in d["runs"]]
+    return sensitivity_markdown(sensitivity_rows(d["preset"], runs=runs), d["preset"])
+
+
 @figure("table_cork_sensitivity", "Sec 5.5")
 def table_cork_sensitivity(preset="fast", outdir=None):
     """Markdown table of the exit velocity against the reconstructed data (and its numbers, .json)."""
