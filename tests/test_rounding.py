@@ -206,3 +206,16 @@ def test_the_readme_shows_the_table_of_what_rounding_moves():
     assert (FIGURES / "rounding.md").read_text() == R.markdown(FIGURES)
     unsaid = [ln for ln in lines[2:] if ln.split(" | ")[4] == "-"]
     assert not unsaid, "plots.rounding.PRINTED does not say how these numbers are printed:\n" + "\n".join(unsaid)
+
+
+@pytest.mark.parametrize("sign", [-1.0, 1.0])
+def test_table1_prints_our_residuals_to_the_digits_rounding_leaves(sign):
+    """Each of our residuals moved by 1e-15 of its history's first, ten times what another kernel moves it
+    (Prescott: 1.5e-14 of 172), prints Table 1 the same."""
+    from contactfem.plots.block import table1_markdown
+
+    hist = D.load(FIGURES / "table1_block_newton_residuals.json")
+    moved = dict(hist)
+    for law in ("conical", "parabolic", "coulomb"):
+        moved[law] = [r + sign * 1e-15 * hist[law][0] for r in hist[law]]
+    assert table1_markdown(moved) == table1_markdown(hist) == (FIGURES / "table1_block_newton_residuals.md").read_text()
