@@ -105,6 +105,7 @@ def test_the_study_records_the_spread_beside_the_numbers_and_a_redraw_keeps_it(t
     d = D.load(tmp_path / "f.json")
     assert spread == {"v": {"lo": 29.90, "hi": pytest.approx(29.92)}} and d["rounding"]["spread"] == spread
     assert d["rounding"]["conditions"]["perturbation"].endswith(": failed") and d["v"] == 29.90
+    assert R.unmeasured(d) == ["perturbation"] and R.unmeasured(base) == list(R.CONDITIONS)  # the table says so
     assert R.spread("f", "v", tmp_path) == pytest.approx(0.02) and R.spread("f", "n", tmp_path) == 0.0
     D.write_data(tmp_path / "f.json", dict(v=29.91, n=839, x=[1.0, 2.0]), {})
     assert D.load(tmp_path / "f.json")["rounding"] == d["rounding"]

@@ -252,6 +252,9 @@ PRINTED = {
     ("table_cork_sensitivity", r".*exit_velocity_m_s"): "table_cork_sensitivity.md: with ± its spread",
     ("table_cork_sensitivity", r".*outcome"): "not printed (the table prints the velocity held)",
     ("fig09b_rolling_ring_convergence", r""): "plotted, not printed",
+    ("verif_bar_impact", r"error_"): "its figure's title, in percent to 2 and 1 decimals (the spread: 1e-8 %)",
+    ("verif_bar_impact", r"contact_stress"): "plotted, not printed",
+    ("verif_hertz_pressure", r"error_a"): "its figure's title, in percent to 2 decimals (the spread: 1e-8 %)",
     ("table1_block_newton_residuals", r"coulomb, symmetric tangent"): (
         "table1_block_newton_residuals.md: 'diverges (past 1e+15 in N solves)', the residuals before it"
     ),
@@ -333,7 +336,18 @@ def table_lines(folder=None):
             which = _which(data, key)
             cells = [stem, f"`{key}`" + (f" ({which})" if which else ""), committed, moved, printed, tested]
             lines.append("| " + " | ".join(c.replace("|", "\\|").replace("\n", " ") for c in cells) + " |")
+        if unmeasured(data):
+            moved = f"not measured under {', '.join(unmeasured(data))}"
+            lines.append(
+                f"| {stem} | every number | - | {moved} | as the others measured | within twice what they moved |"
+            )
     return lines
+
+
+def unmeasured(data):
+    """The conditions a figure record's rounding section lacks or names as failed (all, where it has none)."""
+    drawn = (data.get("rounding") or {}).get("conditions", {})
+    return [c for c in CONDITIONS if c not in drawn or drawn[c].endswith(": failed")]
 
 
 def markdown(folder=None):
