@@ -249,6 +249,7 @@ PRINTED = {
     ("cork_exit_time", r"cases\["): "cork_exit_time.md: with ± its spread",
     ("cork_exit_time", r"summary\."): "cork_exit_time.md, its figure's title: with ± its spread",
     ("cork_knife_edge", r"runs\[\d+\]\.v$"): "the knife edge's labels: with ± its spread",
+    ("cork_knife_edge", r"p0\["): "plotted against p0, not printed",
     ("table_cork_sensitivity", r".*exit_velocity_m_s"): "table_cork_sensitivity.md: with ± its spread",
     ("table_cork_sensitivity", r".*outcome"): "not printed (the table prints the velocity held)",
     ("fig09b_rolling_ring_convergence", r""): "plotted, not printed",
