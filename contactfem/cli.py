@@ -257,8 +257,23 @@ def cmd_figures(args):
 
     if args.only and not any(args.only in stem for stem in load_all()):
         raise ValueError(f"--only {args.only!r} matches no figure: the figures are {', '.join(sorted(load_all()))}")
-    for path in make_all(args.preset, args.outdir, args.only):
-        print(path)
+    from .solver.rounding import checked, current, rounding
+
+    # an option overrides the condition in the environment (the rounding study's processes carry theirs there)
+    given = current()
+    condition = checked(  # before any work
+        args.linear_algebra or given.linear_algebra, given.perturbation if args.perturb is None else args.perturb
+    )
+    if args.rounding:
+        if args.preset != "paper" or condition.tag():
+            raise ValueError("--rounding measures the paper preset's figures: give it with --preset paper alone")
+        from .plots.rounding import study
+
+        study(args.outdir, args.only)
+        return 0
+    with rounding(condition.linear_algebra, condition.perturbation):
+        for path in make_all(args.preset, args.outdir, args.only):
+            print(path)
 
 
 def cmd_sweep(args):
@@ -614,6 +629,26 @@ def build_parser():
         "figures/fast/ for the fast preset",
     )
     fp.add_argument("--only", default=None, help="only figures whose file name contains this text")
+    fp.add_argument(
+        "--linear-algebra",
+        default=None,
+        choices=["auto", "dense", "banded", "sparse"],
+        help="the factorisation of every system the figures' runs solve (default auto: each its own)",
+    )
+    fp.add_argument(
+        "--perturb",
+        default=None,
+        metavar="EPS",
+        help="start every time loop from the initial state perturbed by EPS of itself (at most 1e-6): "
+        "what the figures' numbers hold under rounding",
+    )
+    fp.add_argument(
+        "--rounding",
+        action="store_true",
+        help="measure what rounding does to every figure of --preset paper: draw each again under other "
+        "OpenBLAS kernels, SuperLU and a perturbed initial state, and record each number's spread in the "
+        "figure's NAME.json (its rounding section)",
+    )
     fp.set_defaults(func=cmd_figures)
     ep = sub.add_parser("equations", help="the equation index: paper equation -> implementing function")
     ep.add_argument("--markdown", action="store_true", help="a Markdown table (the default when not on a terminal)")

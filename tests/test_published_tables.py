@@ -12,7 +12,9 @@ tests of this session), and compared with the committed file cell by cell:
     figures/cork_exit_time.md             the whole file from its committed JSON, and the JSON's
                                           quick-profile cases against runs (test_cork runs them)
 
-A number agrees when it is printed the same; a number below ROUNDOFF in both (a residual or an
+A number agrees when it is printed the same, a number printed with its spread ("29.7 ± 0.1":
+rounding moves it past its digits, plots.rounding.held) within twice that spread (plots.data.MARGIN);
+a number below ROUNDOFF in both (a residual or an
 equilibrium error at the round-off of loads of order 1e2-1e3, e.g. 3e-12) is not a result of
 the run but of its rounding, and agrees when both are below it. A failure names the file, the
 row and the column, both values, and the command that regenerates the file.
@@ -23,6 +25,8 @@ import re
 from pathlib import Path
 
 import pytest
+
+from contactfem.plots.data import MARGIN
 
 REPO = Path(__file__).resolve().parents[1]
 FIGURES = REPO / "figures"
@@ -45,21 +49,32 @@ HOW = {
 }
 
 
+# a number printed with its spread, "29.7 ± 0.1" (plots.rounding.held: rounding moves it past its
+# printed digits)
+HELD = re.compile(rf"({NUMBER.pattern}) ± ({NUMBER.pattern})")
+
+
 def _skeleton(text):
-    """The text with every number replaced by '#', and the numbers."""
-    return NUMBER.sub("#", text), [m.group(0) for m in NUMBER.finditer(text)]
+    """The text with every number replaced by '#' (a number with its spread by '#±'), the numbers
+    and the (number, spread) pairs."""
+    held = [(float(m.group(1)), float(m.group(2))) for m in HELD.finditer(text)]
+    text = HELD.sub("#±", text)
+    return NUMBER.sub("#", text), [m.group(0) for m in NUMBER.finditer(text)], held
 
 
 def cell_difference(written, fresh):
     """None if the two cells agree (module docstring), else a short reason."""
     if written == fresh:
         return None
-    (sw, nw), (sf, nf) = _skeleton(written), _skeleton(fresh)
+    (sw, nw, hw), (sf, nf, hf) = _skeleton(written), _skeleton(fresh)
     if sw != sf or len(nw) != len(nf):
         return "the text differs"
     for a, b in zip(nw, nf):
         if a != b and not (abs(float(a)) < ROUNDOFF and abs(float(b)) < ROUNDOFF):
             return f"{a} in the file, {b} from the run"
+    for (a, wa), (b, wb) in zip(hw, hf):  # within twice the spread, as plots.data.differences holds it
+        if abs(a - b) > MARGIN * max(wa, wb) * (1 + 1e-9):
+            return f"{a:g} ± {wa:g} in the file, {b:g} ± {wb:g} from the run"
     return None
 
 
@@ -107,6 +122,10 @@ def test_the_comparison_finds_a_changed_number_and_ignores_roundoff():
     assert cell_difference("x = 149.2 cm", "x = 149.3 cm") == "149.2 in the file, 149.3 from the run"
     assert cell_difference("3e-12 (800 down)", "3e-12 (801 down)") is not None
     assert cell_difference("stays in", "28.8") == "the text differs"
+    assert cell_difference("v = 29.7 ± 0.1 m/s", "v = 29.5 ± 0.1 m/s") is None
+    moved = cell_difference("v = 29.7 ± 0.1 m/s", "v = 29.4 ± 0.1 m/s")
+    assert moved == "29.7 ± 0.1 in the file, 29.4 ± 0.1 from the run"
+    assert cell_difference("v = 29.7 ± 0.1 m/s", "v = 29.7 m/s") == "the text differs"
     with pytest.raises(AssertionError, match=r"row 'Table 2', column 'ours': 1.46 in the file, 1.45 from the run"):
         assert_same_text(
             "summary.md",

@@ -38,7 +38,7 @@ def test_ours_is_computed_from_the_figures_data():
     }
     row = S.row_table1("paper", data.get)
     assert "conical 3 (7 nodes slip), parabolic 7" in row[3] and "first 171.37" in row[3]
-    assert "(123 down, 45 along)" in S.row_block_equilibrium("paper", data.get)[3]
+    assert "; 123 down, 45 along" in S.row_block_equilibrium("paper", data.get)[3]
 
 
 def test_readme_table_is_the_committed_figures_data():
@@ -80,3 +80,11 @@ def test_block_titles_say_what_the_run_found():
     base = dict(contact=dict(x=[0.0] * 17), n_stick=17, n_open=0)
     assert slip_words(dict(base, n_slip=0)).startswith("no node reaches the slip bound")
     assert slip_words(dict(base, n_slip=4, n_stick=13)).startswith("4 of 17 nodes slip")
+
+
+def test_a_headline_number_is_printed_with_the_larger_of_its_band_and_its_rounding_spread():
+    base = dict(rolled=True, x_roll=229.43, x_end=375.81, v_final=149.28)
+    row = lambda data: S.row_rolling_ring("paper", lambda stem: data)[3]  # noqa: E731
+    assert row(base) == "x_roll = 229.4 cm, x(2 s) = 375.8 cm, v = 149.3 cm/s"
+    banded = dict(base, uncertainty=dict(v_final=dict(band=0.26), x_end=0.01))
+    assert row(banded) == "x_roll = 229.4 cm, x(2 s) = 375.8 cm, v = 149.3 ± 0.3 cm/s"

@@ -296,6 +296,15 @@ def evaluate_block(reading, solve):
     return row
 
 
+def ranking_key(r):
+    """The order of converged readings: most facts, then nearest. Distances are ordered to 8 significant digits,
+    the order of readings that tie there kept (the grid's): the runs hold their numbers to about 1e-10
+    (plots.data.RTOL's argument), so two readings closer than that are the same fit, which rounding would
+    otherwise order (the sloping impact's start gaps 0.05 and 0.25 give the same rebound, shifted in time:
+    their distances agree to 1e-13)."""
+    return (-r["n_facts"], float(f"{r['distance']:.8g}"))
+
+
 def rank(rows, kinds=OUTCOMES, eligible=None):
     """The admissible readings (outcome converged, and ``eligible(row)`` if given) ranked: most
     facts met first, then the distance; the converged readings that are not eligible next,
@@ -305,12 +314,9 @@ def rank(rows, kinds=OUTCOMES, eligible=None):
     def ok(r):
         return r.get("outcome", "converged") == "converged"
 
-    order = lambda r: (-r["n_facts"], r["distance"])  # noqa: E731
-    ranked = sorted((r for r in rows if ok(r) and (eligible is None or eligible(r))), key=order)
-    shown = sorted((r for r in rows if ok(r) and eligible is not None and not eligible(r)), key=order)
-    rest = sorted(
-        (r for r in rows if not ok(r)), key=lambda r: (kinds.index(r["outcome"]), -r["n_facts"], r["distance"])
-    )
+    ranked = sorted((r for r in rows if ok(r) and (eligible is None or eligible(r))), key=ranking_key)
+    shown = sorted((r for r in rows if ok(r) and eligible is not None and not eligible(r)), key=ranking_key)
+    rest = sorted((r for r in rows if not ok(r)), key=lambda r: (kinds.index(r["outcome"]), *ranking_key(r)))
     for i, r in enumerate(ranked, 1):
         r["rank"] = i
     for r in shown + rest:

@@ -12,6 +12,8 @@ import pkgutil
 from functools import lru_cache
 from pathlib import Path
 
+from ..solver.rounding import current
+
 REGISTRY = {}  # file stem -> (paper label, function)
 
 
@@ -72,8 +74,11 @@ def pyplot():
 
 def cache_dir():
     """Where the figures keep their runs between processes: $CONTACTFEM_CACHE/figures (default
-    ~/.cache/contactfem/figures)."""
-    return Path(os.environ.get("CONTACTFEM_CACHE") or Path.home() / ".cache" / "contactfem") / "figures"
+    ~/.cache/contactfem/figures); under a rounding condition (solver.rounding) a folder of its own,
+    figures-TAG, so that runs of one condition never answer for another."""
+    tag = current().tag()
+    base = Path(os.environ.get("CONTACTFEM_CACHE") or Path.home() / ".cache" / "contactfem")
+    return base / (f"figures-{tag}" if tag else "figures")
 
 
 def stored(fn):
@@ -107,8 +112,8 @@ def _run(scene, preset, changed):
 
 
 @lru_cache(maxsize=64)
-def _cached(scene, preset, changed):
-    return stored(_run)(scene, preset, changed)
+def _cached(scene, preset, changed, condition):
+    return stored(_run)(scene, preset, changed)  # the condition is in cache_dir()
 
 
 def cached_run(scene, preset="fast", **overrides):
@@ -120,7 +125,7 @@ def cached_run(scene, preset="fast", **overrides):
 
     sc = get_scene(scene)
     base, full = sc.resolve(preset), sc.resolve(preset, overrides)
-    return _cached(scene, preset, tuple(sorted((k, v) for k, v in full.items() if v != base[k])))
+    return _cached(scene, preset, tuple(sorted((k, v) for k, v in full.items() if v != base[k])), current())
 
 
 def savefig(fig, outdir, stem):
@@ -148,15 +153,31 @@ def fitted_words(r, to, width=95):
     return "\n".join(textwrap.wrap(text, width))
 
 
+# A residual past DIVERGED has left every scale of the problems here (loads 1e2-1e3, first residuals
+# 1e2): its iterate is 1e12 or more times the solution, where one rounding error of a product of the
+# tangent (1e-16 of terms far larger than the residual itself) decides the next iterate. Its digits are
+# rounding (the block's symmetrised tangent, the 8th residual: 1.2e+19 under one OpenBLAS kernel, 3.3e+18
+# under another), only that it passed the bound holds.
+DIVERGED = 1e15
+
+
+def diverged_at(history):
+    """The number of solves after which a residual history first passed DIVERGED (None: never)."""
+    return next((k for k, v in enumerate(history) if float(v) > DIVERGED), None)
+
+
 def describe_newton(history, converged):
     """What a Newton residual history shows, in words computed from the numbers (for
-    figure titles and table notes): "converges in k linear solves", "diverges (||G||
-    grows from a to b in k solves)" when the last residuals exceed the first tenfold,
-    else "does not converge in k solves (||G|| = b)"."""
+    figure titles and table notes): "converges in k linear solves", "diverges (past 1e+15 in
+    k solves)" when a residual passed DIVERGED (its digits are rounding), "diverges (||G||
+    grows from a to b in k solves)" when the last residuals exceed the first tenfold, else
+    "does not converge in k solves (||G|| = b)"."""
     h = [float(v) for v in history]
     k = len(h) - 1
     if converged:
         return f"converges in {k} linear solves"
+    if diverged_at(h) is not None:
+        return f"diverges (past {DIVERGED:.0e} in {diverged_at(h)} solves)"
     if max(h[-3:]) > 10.0 * h[0]:
         return f"diverges (||G|| grows from {h[0]:.2e} to {max(h[-3:]):.2e} in {k} solves)"
     return f"does not converge in {k} solves (||G|| = {h[-1]:.2e})"

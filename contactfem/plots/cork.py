@@ -26,7 +26,8 @@ import numpy as np
 
 from ..contact.masters import bottle_neck
 from . import cached_run, default_outdir, figure, pyplot, stored
-from .data import save_figure, write_data
+from .data import RTOL, save_figure, write_data
+from .rounding import held, recorded
 
 # the cork run's headline numbers, in the data of each of Figs 14-17 (the summary's row reads them)
 CORK_KEYS = (
@@ -244,11 +245,21 @@ def sensitivity_rows(preset="fast", cases=SENSITIVITY, jobs=2, runs=None):
     """One row per case: label, press-fit force, and the outcome for each n_ramp of
     P0_STEPS (``runs``: sensitivity_runs made before, else made here)."""
     out = runs or sensitivity_runs(preset, cases, jobs)
+    spread = recorded("table_cork_sensitivity", preset)  # an exit velocity rounding moves: with its spread
+
+    def v(k):
+        x = out[k]
+        return (
+            x["v"]
+            if x["exit_velocity_m_s"] is None
+            else held(x["exit_velocity_m_s"], spread.get(f"runs[{k}].exit_velocity_m_s"), 1)
+        )
+
     rows = []
     for i, (label, _) in enumerate(cases):
-        res = out[i * len(P0_STEPS) : (i + 1) * len(P0_STEPS)]
-        F = next((x["F"] for x in res if x["F"] is not None), None)
-        rows.append((label, F, [x["v"] for x in res]))
+        ks = range(i * len(P0_STEPS), (i + 1) * len(P0_STEPS))
+        F = next((out[k]["F"] for k in ks if out[k]["F"] is not None), None)
+        rows.append((label, F, [v(k) for k in ks]))
     return rows
 
 
@@ -261,6 +272,13 @@ def sensitivity_markdown(rows, preset):
     lines.append("")
     lines.append(f"Paper: ~2500 N, 28 m/s at p0 = 0.8 MPa. Preset: {preset}.")
     return "\n".join(lines) + "\n"
+
+
+def sensitivity_reprinted(d):
+    """table_cork_sensitivity.md made again from its data (``d``: NAME.json's record), without a run."""
+    keys = dict(v="outcome", F="press_fit_normal_force_N", exit_velocity_m_s="exit_velocity_m_s")
+    runs = [{k: x[v] for k, v in keys.items()} for x in d["runs"]]
+    return sensitivity_markdown(sensitivity_rows(d["preset"], runs=runs), d["preset"])
 
 
 @figure("table_cork_sensitivity", "Sec 5.5")
@@ -386,11 +404,12 @@ def cork_knife_edge(preset="fast", outdir=None, data=None):
     for o in d["field"]:
         if o["error"]:
             ax.plot(o["mu"], o["R_tip"], "k^", ms=7)
-    for o in d["runs"]:
+    spread = recorded("cork_knife_edge")  # the same runs whatever the preset (KNIFE_PRESET)
+    for i, o in enumerate(d["runs"]):
         if o["error"]:
             text, style = "solver failed", dict(marker="^", color="k")
-        elif o["exited"]:
-            text, style = f"{o['v']:.1f} m/s", dict(marker="o", color="tab:green")
+        elif o["exited"]:  # a velocity rounding moves: with its spread
+            text, style = f"{held(o['v'], spread.get(f'runs[{i}].v'), 1)} m/s", dict(marker="o", color="tab:green")
         else:
             text, style = "stays in", dict(marker="x", color="tab:red", mew=2)
         ax.plot(o["mu"], o["R_tip"], ls="none", ms=9, **style)
@@ -602,12 +621,14 @@ def exit_time_summary(d):
     refined = [r for r in rows if r["group"] == _STEP and "n_press" not in r["overrides"]]
     dt_min = min(r["overrides"]["dt"] for r in refined)
     fine = {name: find(f"dt = {dt_min:g} s", rl)["exit_time_ms"] for name, rl in (("with", _ON), ("without", _OFF))}
+    # a shift within RTOL of the exit (2e-8 ms on this machine) is rounding's, not the rule's: 0
+    pop_shift = fit_only["exit_time_ms"] - on["exit_time_ms"]
     return dict(
         exit_ms=on["exit_time_ms"],
         exit_velocity_m_s=on["exit_velocity_m_s"],
         exit_without_ms=off["exit_time_ms"],
         shift_ms=on["exit_time_ms"] - off["exit_time_ms"],
-        pop_rule_shift_ms=fit_only["exit_time_ms"] - on["exit_time_ms"],
+        pop_rule_shift_ms=pop_shift if abs(pop_shift) > RTOL * on["exit_time_ms"] else 0.0,
         n_press=paper["n_press"],
         n_press_refined=n_max,
         press_fit_refined_ms=fit,
@@ -620,7 +641,20 @@ def exit_time_summary(d):
 
 def exit_time_markdown(d):
     s = exit_time_summary(d)
-    fit, ref = s["press_fit_refined_ms"], s["refined_ms"]
+    spread = recorded("cork_exit_time", d["preset"])  # a number rounding moves: with its spread (a count: range)
+
+    def ms(*key):  # a number of the summary, to 3 decimals or to what rounding leaves of them
+        return held(s[key[0]] if len(key) == 1 else s[key[0]][key[1]], spread.get(".".join(("summary",) + key)), 3)
+
+    def apart(a, b):  # a difference of two of them, with at most the sum of their spreads
+        entries = [spread.get("summary." + k) or {} for k in (a, b)]
+        value = lambda k: s[k] if k in s else s[k.split(".")[0]][k.split(".")[1]]
+        return held(value(a) - value(b), None, 3, sum(e["hi"] - e["lo"] for e in entries if "hi" in e))
+
+    fit, ref = (
+        {k: ms("press_fit_refined_ms", k) for k in ("with", "without")},
+        {k: ms("refined_ms", k) for k in ("with", "without")},
+    )
     lines = [
         "# The cork's exit time: the closing step and the discretisation (paper preset)",
         "",
@@ -629,18 +663,23 @@ def exit_time_markdown(d):
         + " The paper: exit between 2.6 and 2.7 ms at about 28 m/s.",
         "",
         f"- At the paper's time step in the neck ({s['dt_paper_s']:g} s) and the preset's {s['n_press']} press-fit "
-        f"increments the cork leaves at {s['exit_ms']:.3f} ms with the closing step, at "
-        f"{s['exit_without_ms']:.3f} ms without it ({s['shift_ms']:+.3f} ms).",
-        f"- The rule acts through the press fit: with the closing step in the press fit only, the exit "
-        f"moves by {s['pop_rule_shift_ms']:+.1e} ms.",
-        f"- With the press fit refined to {s['n_press_refined']} increments both rules give {fit['with']:.3f} and "
-        f"{fit['without']:.3f} ms: the closing step is {abs(s['exit_ms'] - fit['with']):.3f} ms from that with "
-        f"{s['n_press']} increments, the rule without it {abs(s['exit_without_ms'] - fit['without']):.3f} ms "
+        f"increments the cork leaves at {ms('exit_ms')} ms with the closing step, at "
+        f"{ms('exit_without_ms')} ms without it (a shift of {ms('shift_ms')} ms).",
+        "- The rule acts through the press fit: with the closing step in the press fit only, the exit "
+        + (
+            f"moves by {s['pop_rule_shift_ms']:+.1e} ms."
+            if s["pop_rule_shift_ms"]
+            else f"does not move (the two runs agree to {RTOL:.0e} of it: rounding)."
+        ),
+        f"- With the press fit refined to {s['n_press_refined']} increments both rules give {fit['with']} and "
+        f"{fit['without']} ms: the closing step is "
+        f"{apart('press_fit_refined_ms.with', 'exit_ms')} ms from that with {s['n_press']} increments, "
+        f"the rule without it {apart('press_fit_refined_ms.without', 'exit_without_ms')} ms "
         "(it loads the stick springs of the nodes that touch during an increment with the travel "
         "made before touching, an error of the increment's size).",
         f"- With the time step in the neck refined to {s['dt_refined_s']:g} s (the pressure ramp kept at 8 x 0.1 ms) "
-        f"both rules give {ref['with']:.3f} and {ref['without']:.3f} ms: the paper's step leaves a "
-        f"time-discretisation error of {s['exit_ms'] - ref['with']:+.3f} ms in the stall after the ramp.",
+        f"both rules give {ref['with']} and {ref['without']} ms: the paper's step leaves a "
+        f"time-discretisation error of {apart('exit_ms', 'refined_ms.with')} ms in the stall after the ramp.",
         "- The slowest speed after the ramp is that stall: the gas expands (Boyle), its pressure falls "
         "below the static breakaway, the cork slows down; how far it slows sets the exit time.",
         "",
@@ -649,18 +688,20 @@ def exit_time_markdown(d):
         "|---|---|---|---:|---:|---:|---:|---:|",
     ]
     onoff = {True: "on", False: "off"}
-    for r in d["cases"]:
+    spread = recorded("cork_exit_time", d["preset"])  # a number rounding moves: with its spread (a count: range)
+    for i, r in enumerate(d["cases"]):
+        f = lambda key, decimals: held(r[key], spread.get(f"cases[{i}].{key}"), decimals)  # noqa: E731
         if r["error"]:
             tail = f"| {r['error']} | | | | |"
         elif r["exited"]:
             tail = (
-                f"| {r['exit_time_ms']:.3f} | {r['exit_velocity_m_s']:.2f} | {r['v_min_after_ramp_m_s']:.2f} at "
-                f"{r['t_v_min_ms']:.2f} | {r['press_fit_normal_force_N']:.1f} | {r['steps']} |"
+                f"| {f('exit_time_ms', 3)} | {f('exit_velocity_m_s', 2)} | {f('v_min_after_ramp_m_s', 2)} at "
+                f"{f('t_v_min_ms', 2)} | {f('press_fit_normal_force_N', 1)} | {f('steps', 0)} |"
             )
         else:
             tail = (
-                f"| stays in | - | {r['v_min_after_ramp_m_s']:.2f} at {r['t_v_min_ms']:.2f} | "
-                f"{r['press_fit_normal_force_N']:.1f} | {r['steps']} |"
+                f"| stays in | - | {f('v_min_after_ramp_m_s', 2)} at {f('t_v_min_ms', 2)} | "
+                f"{f('press_fit_normal_force_N', 1)} | {f('steps', 0)} |"
             )
         lines.append(
             f"| {r['group']} | {r['label']} | {onoff[r['closing_step_press_fit']]}, "

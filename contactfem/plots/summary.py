@@ -26,9 +26,32 @@ import numpy as np
 
 from ..scenes.block import PAPER_TABLE1
 from . import cached_run, default_outdir, figure
+from .data import ROUNDOFF
+from .rounding import held, recorded
 
 START, END = "<!-- summary:start -->", "<!-- summary:end -->"
+ROUNDING_START, ROUNDING_END = "<!-- rounding:start -->", "<!-- rounding:end -->"  # plots/rounding.py's table
 HEAD = ["| paper | what | paper's value | ours | figure |", "|---|---|---|---|---|"]
+
+
+def floor(x):
+    """A residual or an equilibrium error: its digits where they are the run's, "below 1e-09 (round-off)"
+    where they are rounding's (plots.data.ROUNDOFF: 1e-14 of the loads; another kernel prints others)."""
+    return f"below {ROUNDOFF:.0e} (round-off)" if abs(x) < ROUNDOFF else f"{x:.0e}"
+
+
+def held_number(preset, stem, data, key, decimals):
+    """``data[key]`` of figure ``stem`` printed to the digits it holds (plots.rounding.held): with ±
+    the larger of its error band (``band``) and the rounding spread recorded for it, where that reaches
+    the printed digit."""
+    return held(data[key], recorded(stem, preset).get(key), decimals, band(data, key))
+
+
+def band(data, key):
+    """The error band of headline number ``key`` in a figure's data: the entry of its ``uncertainty``
+    section (a number, or a dict with "band"); 0.0 where it has none."""
+    entry = (data.get("uncertainty") or {}).get(key, 0.0)
+    return float(entry.get("band", 0.0) if isinstance(entry, dict) else entry)
 
 
 def _links(*pairs):
@@ -112,8 +135,8 @@ def row_laws(preset, record=None):
 def row_block_equilibrium(preset, record=None):
     r = (record or fresh(preset))("fig07_block_conical_stresses")
     ours = (
-        f"equilibrium to {r['equilibrium_error']:.0e} ({-r['total_normal']:.0f} down, "
-        f"{r['total_tangential']:.0f} along)"
+        f"equilibrium error {floor(r['equilibrium_error'])}; {-r['total_normal']:.0f} down, "
+        f"{r['total_tangential']:.0f} along"
     )
     what = "block on a rough foundation, whole load in one step"
     if r.get("fitted"):
@@ -159,9 +182,10 @@ def row_table1(preset, record=None):
     record = record or fresh(preset)
     c, t = record("fig07_block_conical_stresses"), record("table1_block_newton_residuals")
     rc, rp = t["conical"], t["parabolic"]
-    ours = (
-        f"conical {len(rc)} ({c['n_slip']} nodes slip), parabolic {len(rp)}; "
-        f"first {rc[0]:.2f}; last {rc[-1]:.0e} and {rp[-1]:.0e}"
+    ours = f"conical {len(rc)} ({c['n_slip']} nodes slip), parabolic {len(rp)}; first {rc[0]:.2f}; " + (
+        f"last {floor(rc[-1])} in both"
+        if floor(rc[-1]) == floor(rp[-1])
+        else f"last {floor(rc[-1])} and {floor(rp[-1])}"
     )
     return (
         "Table 1",
@@ -175,8 +199,9 @@ def row_table1(preset, record=None):
 
 def row_rolling_ring(preset, record=None):
     r = (record or fresh(preset))("fig09_rolling_ring")
-    x_roll = "did not roll" if not r["rolled"] else f"x_roll = {r['x_roll']:.1f} cm"
-    ours = f"{x_roll}, x(2 s) = {r['x_end']:.1f} cm, v = {r['v_final']:.1f} cm/s"
+    f = lambda key: held_number(preset, "fig09_rolling_ring", r, key, 1)  # noqa: E731
+    x_roll = "did not roll" if not r["rolled"] else f"x_roll = {f('x_roll')} cm"
+    ours = f"{x_roll}, x(2 s) = {f('x_end')} cm, v = {f('v_final')} cm/s"
     return (
         "Sec. 5.2, Fig 9",
         "ring sliding, then rolling (exact: rigid thin ring)",
@@ -194,7 +219,8 @@ def row_sloping_impact(preset, record=None):
         ("frictional", "fig11a_sloping_impact_frictional"),
     ):
         r = record(stem)
-        parts.append(f"{variant} ({r['rebound_vx']:.2f}, {r['rebound_vy']:.2f}), {r['rebound_angle_deg']:.1f} deg")
+        f = lambda key, decimals: held_number(preset, stem, r, key, decimals)  # noqa: E731
+        parts.append(f"{variant} ({f('rebound_vx', 2)}, {f('rebound_vy', 2)}), {f('rebound_angle_deg', 1)} deg")
     n_el = record("fig10_sloping_impact_frictionless")["parameters"]["n_el"]
     ours = "; ".join(parts) + f" ({n_el} elements)"
     fitted = record("fig10_sloping_impact_frictionless").get("fitted") or {}
@@ -244,8 +270,9 @@ def cork_refined_exit(preset, record=None):
 def row_cork(preset, record=None):
     record = record or fresh(preset)
     r = record("fig14_cork_mesh")
+    f = lambda key, decimals: held_number(preset, "fig14_cork_mesh", r, key, decimals)  # noqa: E731
     exit_text = (
-        f"exit {r['exit_time_ms']:.2f} ms at {r['exit_velocity_m_s']:.1f} m/s" if r["exited"] else "the cork stays in"
+        f"exit {f('exit_time_ms', 2)} ms at {f('exit_velocity_m_s', 1)} m/s" if r["exited"] else "the cork stays in"
     )
     if r["exited"] and preset == "paper":
         fine, dt = cork_refined_exit(preset, record)
@@ -336,15 +363,16 @@ def summary(preset="fast", outdir=None):
     return [str(path)]
 
 
-def update_readme(readme="README.md", summary_md="figures/summary.md"):
-    """Copy the table of summary.md into the README between the markers."""
+def update_readme(readme="README.md", summary_md="figures/summary.md", start=START, end=END):
+    """Copy the table of summary.md (or another generated file's) into the README between the markers."""
     text = Path(readme).read_text()
-    if START not in text or END not in text:
-        raise ValueError(f"{readme} has no {START} ... {END} block")
-    table = "\n".join(ln.replace("](", "](figures/") for ln in table_lines(Path(summary_md).read_text()))
-    head, rest = text.split(START, 1)
-    tail = rest.split(END, 1)[1]
-    Path(readme).write_text(f"{head}{START}\n{table}\n{END}{tail}")
+    if start not in text or end not in text:
+        raise ValueError(f"{readme} has no {start} ... {end} block")
+    lines = [ln.strip() for ln in Path(summary_md).read_text().splitlines() if ln.strip().startswith("|")]
+    table = "\n".join(ln.replace("](", "](figures/") for ln in lines)
+    head, rest = text.split(start, 1)
+    tail = rest.split(end, 1)[1]
+    Path(readme).write_text(f"{head}{start}\n{table}\n{end}{tail}")
 
 
 if __name__ == "__main__":
@@ -353,12 +381,14 @@ if __name__ == "__main__":
     repo = Path(__file__).resolve().parents[2]
     cli = argparse.ArgumentParser(
         prog="python -m contactfem.plots.summary",
-        description="Copy the table of figures/summary.md into the README, between its markers.",
+        description="Copy the tables of figures/summary.md and figures/rounding.md into the README, between "
+        "their markers.",
     )
     cli.add_argument("readme", nargs="?", default=repo / "README.md")
     cli.add_argument("summary_md", nargs="?", default=repo / "figures" / "summary.md")
     args = cli.parse_args()
     try:
         update_readme(args.readme, args.summary_md)
+        update_readme(args.readme, Path(args.summary_md).parent / "rounding.md", ROUNDING_START, ROUNDING_END)
     except (OSError, ValueError) as err:
         sys.exit(f"python -m contactfem.plots.summary: error: {err}")

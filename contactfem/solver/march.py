@@ -26,6 +26,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from .newton import NewtonError
+from .rounding import perturbed
 from .schedule import Steps
 from .system import SystemState
 
@@ -180,10 +181,10 @@ def initial(stepper, schedule, t0, u0, v0=None, a0=None, state=None):
     evaluation (with the schedule's first dt, for rate-dependent bodies and laws), a0 from eq 29."""
     s = stepper.system
     dt = schedule.dt
-    u = s.apply_dirichlet(u0, t0)
+    v = np.zeros(s.ndof) if v0 is None else np.array(v0, dtype=float)
+    u, v = perturbed(s, s.apply_dirichlet(u0, t0), v)  # as it is, outside solver.rounding's conditions
     state = s.start(u, t0) if state is None else state
     ev = s.evaluate(u, t0, dt, state=state)
-    v = np.zeros(s.ndof) if v0 is None else np.array(v0, dtype=float)
     if a0 is not None:
         a = np.array(a0, dtype=float)
     else:

@@ -46,6 +46,7 @@ import numpy as np
 
 from .assembly import TangentAssembler
 from .instrument import timed
+from .rounding import current
 
 
 @dataclass(frozen=True, eq=False)
@@ -167,6 +168,8 @@ class System:
         self.free_dofs = np.setdiff1d(np.arange(self.ndof), self.fixed_dofs)
         self._mass = None
         self._cM = (None, None)  # (c, c M) of the last lumped effective tangent
+        if linear_algebra == "auto":  # a solver.rounding condition may name another factorisation
+            linear_algebra = current().linear_algebra or "auto"
         self._requested = linear_algebra
         self._tangent = TangentAssembler(self.ndof, linear_algebra, self.free_dofs)
         self.evaluations = 0
