@@ -418,21 +418,23 @@ def test_every_written_question_is_in_its_lecture_with_its_points():
 
 
 def test_hidden_checks_pass_every_solution_and_cover_the_exercises():
-    """Every hidden check passes the instructor's solution (run here, in one process), and the
-    stub fails the hidden checks of every exercise; every exercise but one (two long scene runs)
-    has some."""
+    """Every hidden check passes the instructor's solution (run here, in one process) at the
+    parameters of three seeds, and the stub fails the hidden checks of every exercise; every
+    exercise but one (two long scene runs) has some."""
     import numpy as np
 
     from contactfem.lab.course import lecture_sources, solution_cells
     from contactfem.lab.course.checks import EXERCISES
-    from contactfem.lab.course.grade import hidden_checks_file, load_hidden
+    from contactfem.lab.course.hidden import hidden_folder, load_hidden, read_hidden, rng_for
 
-    hidden = load_hidden(hidden_checks_file())
-    parts = {p.name for e in EXERCISES.values() for p in e.parts}
-    assert set(hidden) <= parts
+    sources = read_hidden(hidden_folder())
+    assert sorted(sources) == sorted({e.lecture for e in EXERCISES.values()})
+    hidden = {lec: load_hidden(text, lec) for lec, text in sources.items()}
+    for lec, checks in hidden.items():
+        assert set(checks) <= {p.name for e in EXERCISES.values() if e.lecture == lec for p in e.parts}, lec
     scenes = {"ex05_incline"}  # two scene runs of 120 s allowed each: public only
     for name, e in EXERCISES.items():
-        assert any(p.name in hidden for p in e.parts) == (name not in scenes), name
+        assert any(p.name in hidden[e.lecture] for p in e.parts) == (name not in scenes), name
     sols = {}
     for src in lecture_sources():
         sols.update(solution_cells(nbformat.read(src, as_version=4)))
@@ -453,13 +455,14 @@ def test_hidden_checks_pass_every_solution_and_cover_the_exercises():
             stub,
         )
         failed = 0
-        for p in e.parts:
-            for check in hidden.get(p.name, ()):
-                check(**{a: env.get(a) for a in p.answers})
-                try:
-                    check(**{a: stub.get(a) for a in p.answers})
-                except AssertionError:
-                    failed += 1
+        for seed in (1, 2, 3):
+            for p in e.parts:
+                for check in hidden[e.lecture].get(p.name, ()):
+                    check(**{a: env.get(a) for a in p.answers}, rng=rng_for(seed, p.name, check.__name__))
+                    try:
+                        check(**{a: stub.get(a) for a in p.answers}, rng=rng_for(seed, p.name, check.__name__))
+                    except AssertionError:
+                        failed += 1
         assert failed or name in scenes, f"{name}: no hidden check fails the stub"
 
 
@@ -614,16 +617,18 @@ def _alive(pid):
 
 
 def test_the_hidden_checks_are_not_in_the_package():
-    """The installed package (contactfem/) holds no hidden check: not the file, not one of its
+    """The installed package (contactfem/) holds no hidden check: not a file, not one of their
     functions; the grader finds them in the instructor's material (the checkout's lectures/)."""
     from pathlib import Path
 
     import contactfem
-    from contactfem.lab.course.grade import hidden_checks_file, load_hidden
+    from contactfem.lab.course.hidden import hidden_folder, load_hidden, read_hidden
 
-    path = hidden_checks_file()
-    assert path is not None and path.parent.name == "lectures"
-    names = {f.__name__ for fs in load_hidden(path).values() for f in fs}
+    folder = hidden_folder()
+    assert folder is not None and folder.parent.name == "lectures"
+    names = {
+        f.__name__ for lec, text in read_hidden(folder).items() for fs in load_hidden(text, lec).values() for f in fs
+    }
     assert len(names) >= 20
     package = Path(contactfem.__file__).parent
     assert not list(package.rglob("hidden_checks*"))

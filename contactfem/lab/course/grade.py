@@ -36,12 +36,12 @@ import ast
 import csv
 import datetime as dt
 import html
-import importlib.util
 import io
 import json
 import os
 import pickle
 import re
+import secrets
 import subprocess
 import sys
 import tempfile
@@ -51,8 +51,9 @@ from pathlib import Path
 
 import numpy as np
 
+from .hidden import FOLDER, hidden_folder, load_hidden, read_hidden, rng_for
+
 REPO = Path(__file__).resolve().parents[3]
-HIDDEN_FILE = "hidden_checks.py"
 MANUAL_MARK = re.compile(r"<!--\s*manual:\s*(\w+)\s*-->")
 
 # The limits, and why these defaults. A notebook's cells run its lecture in the fast preset and
@@ -320,27 +321,6 @@ def _wire(v):
     return v
 
 
-# -- the instructor's material ------------------------------------------------------------------
-
-
-def hidden_checks_file(material=None, repo=None):
-    """The hidden checks: MATERIAL/hidden_checks.py, else the checkout's lectures/hidden_checks.py."""
-    for folder in ([Path(material)] if material else []) + [Path(repo or REPO) / "lectures"]:
-        if (folder / HIDDEN_FILE).is_file():
-            return folder / HIDDEN_FILE
-    return None
-
-
-def load_hidden(path):
-    """{public part name: [hidden check functions]} of a hidden_checks.py (its HIDDEN)."""
-    if path is None:
-        return {}
-    spec = importlib.util.spec_from_file_location("contactfem_hidden_checks", path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return {k: list(v) if isinstance(v, (list, tuple)) else [v] for k, v in mod.HIDDEN.items()}
-
-
 # -- one notebook ------------------------------------------------------------------------------
 
 
@@ -416,7 +396,7 @@ def library_hint(exercise, used):
     )
 
 
-def grade_notebook(path, lecture, material, limits):
+def grade_notebook(path, lecture, hidden_source, seed, limits):
     """Grade one notebook (the function the batch's workers run): a dict with the parts
     [(exercise, part, points scored, points possible, message)], the cells that failed, what
     it printed, and `stopped` (why the submission's process ended early, or None)."""
@@ -424,7 +404,7 @@ def grade_notebook(path, lecture, material, limits):
 
     t0 = time.monotonic()
     cells, _ = read_notebook(path)
-    hidden = load_hidden(hidden_checks_file(material))
+    hidden = load_hidden(hidden_source, lecture) if hidden_source else {}
     checks.TIME_LIMIT = limits.check
     checks._MEMO.clear()
     mine = [e for e in checks.EXERCISES.values() if e.lecture == lecture]
@@ -446,7 +426,8 @@ def grade_notebook(path, lecture, material, limits):
                 names = {a for p in e.parts for a in p.answers}
                 named = set().union(*(library_named(src, guard, names) for _, src in code_cells)) if guard else set()
                 for p in e.parts:
-                    out["parts"].append((e.name, p.name, *_grade_part(box, p, hidden.get(p.name, ()), guard, named)))
+                    result = _grade_part(box, p, hidden.get(p.name, ()), seed, guard, named)
+                    out["parts"].append((e.name, p.name, *result))
         finally:
             box.close()
             out["stopped"] = box.dead
@@ -454,7 +435,7 @@ def grade_notebook(path, lecture, material, limits):
     return out
 
 
-def _grade_part(box, part, hidden, guard, named):
+def _grade_part(box, part, hidden, seed, guard, named):
     """(points, possible, message) of one part: its public check and its hidden checks, in this
     process, on the submission's answers."""
     if named:
@@ -464,7 +445,8 @@ def _grade_part(box, part, hidden, guard, named):
     try:
         env = {a: box.get(a) for a in part.answers}
         for check in [part.check, *hidden]:
-            check(**env)
+            extra = {} if check is part.check else {"rng": rng_for(seed, part.name, check.__name__)}
+            check(**env, **extra)
             if box.used:
                 break
     except AssertionError as err:
@@ -580,6 +562,7 @@ def grade(
     review=None,
     feedback=None,
     progress=None,
+    seed=None,
 ):
     """Grade every notebook in `folder` and write `out_csv`: one row per submission (and per
     student of the roster), columns id, name, submission, lecture, one per exercise and written
@@ -606,9 +589,9 @@ def grade(
         raise ValueError(f"--lecture {lecture}: not a lecture of this course ({', '.join(names)})")
     if autograders is not None:
         autograders = Path(autograders)
-        if not autograders.is_dir() or not (list(autograders.glob("*.zip")) or (autograders / HIDDEN_FILE).is_file()):
+        if not autograders.is_dir() or not (list(autograders.glob("*.zip")) or (autograders / FOLDER).is_dir()):
             raise ValueError(
-                f"--autograders {autograders}: no grading configurations (*.zip, {HIDDEN_FILE}) "
+                f"--autograders {autograders}: no grading configurations (*.zip, {FOLDER}/) "
                 "there; give the autograder/ folder of `contactfem course build --instructor`"
             )
     students = read_roster(roster) if roster else None
@@ -638,11 +621,12 @@ def grade(
 
     lectures = sorted({w for w in which.values() if w} | ({lecture} if lecture else set()))
     scores_read = {lec: _read_manual_scores(review / f"{lec}-scores.csv") for lec in lectures}
-    material = hidden_checks_file(autograders, repo)
+    sources = read_hidden(hidden_folder(autograders, repo))  # read once, before any submission runs
+    seed = secrets.randbits(64) if seed is None else seed
     tasks, results = [], {}
     for _, p in entries:
         if p is not None and which.get(p) and any(e.lecture == which[p] for e in checks.EXERCISES.values()):
-            tasks.append((str(p), (str(p), which[p], str(material.parent) if material else None, limits)))
+            tasks.append((str(p), (str(p), which[p], sources.get(which[p]), seed, limits)))
     n_done, interrupted = 0, False
     batch = run_batch(grade_notebook, tasks, jobs=jobs, timeout=limits.notebook + 60.0, retries=1)
     try:
