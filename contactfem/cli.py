@@ -388,6 +388,8 @@ def cmd_course_grade(args):
             review=args.review,
             feedback=args.feedback,
             progress=progress if sys.stderr.isatty() else None,
+            seed=args.seed,
+            unsafe_no_sandbox=args.unsafe_no_sandbox,
         )
     except course.GradingInterrupted as exc:
         print(f"\ncontactfem: {exc.message}" if sys.stderr.isatty() else f"contactfem: {exc.message}", file=sys.stderr)
@@ -698,9 +700,9 @@ def build_parser():
         "--autograders",
         default=None,
         metavar="DIR",
-        help="the instructor's grading material: a folder holding hidden_checks.py (the hidden "
-        "checks), e.g. the autograder/ folder of an instructor build (default, and where DIR has "
-        "none: the checkout's lectures/hidden_checks.py)",
+        help="the instructor's grading material: a folder holding hidden_checks/ (the hidden "
+        "checks, one file per lecture), e.g. the autograder/ folder of an instructor build (default, "
+        "and where DIR has none: the checkout's lectures/hidden_checks/)",
     )
     cg.add_argument("--jobs", type=int, default=1, help="submissions graded in parallel (default 1)")
     cg.add_argument(
@@ -745,7 +747,20 @@ def build_parser():
         type=float,
         default=4096.0,
         metavar="MB",
-        help="memory limit of each submission's process in MB (default 4096; 0: none)",
+        help="memory limit of each process of a submission's sandbox in MB (default 4096; 0: none)",
+    )
+    cg.add_argument(
+        "--unsafe-no-sandbox",
+        action="store_true",
+        help="grade without the sandbox (where user namespaces are not to be had): the submissions then run "
+        "as you, see your files and can change them; every row says so",
+    )
+    cg.add_argument(
+        "--seed",
+        type=int,
+        default=None,
+        metavar="N",
+        help="the seed of the hidden checks' parameters (default: drawn afresh; give one to repeat a grading)",
     )
     cg.add_argument(
         "--review",

@@ -20,8 +20,9 @@ writes them into the notebook as otter's test cells and runs ``otter assign``:
   (``NN_topic.zip``).
 
 :func:`grade` (:mod:`contactfem.lab.course.grade`) grades every submitted notebook of a
-folder, each in a process of its own apart from the checks, and writes one CSV row per
-submission: the points of each exercise, the total, the points possible and the hints.
+folder, each in a sandbox of its own (:mod:`.sandbox`) with the students' edition of the library
+(:mod:`.edition`), the checks outside it, and writes one CSV row per submission: the points of
+each exercise, the total, the points possible and the hints.
 """
 
 import contextlib
@@ -292,4 +293,5 @@ def build_versions(outs, repo=None, only=None, force=False, work=None, on_write=
 
 # -- grading: contactfem.lab.course.grade -------------------------------------------------------
 
-from .grade import GradingInterrupted, Limits, grade, lecture_of, submissions  # noqa: E402,F401
+from .grade import GradingInterrupted, grade, lecture_of  # noqa: E402,F401
+from .sandbox import Limits, NoSandbox  # noqa: E402,F401
