@@ -27,6 +27,7 @@ import nbformat
 
 LECTURE = "01_interface_laws"
 REPO = Path(__file__).resolve().parents[1]
+UNSAFE_NOTE = "graded without a sandbox (--unsafe-no-sandbox)"
 MARK = "contactfem-mischief"  # in the command line of every process an attempt starts
 DEADLINE = "2026-12-03T12:00:00+00:00"
 ON_TIME, LATE = 1796292000.0, 1796310000.0  # 2026-12-03 10:00 and 15:00 UTC, epoch seconds
@@ -383,19 +384,22 @@ def notebook(cells, path, written=WRITTEN):
 
 
 def fingerprint(path):
-    """{file: sha256 or its kind} of every file under `path` (or of the file), links not followed
-    and nothing opened that is not a regular file."""
+    """{file: sha256, or its kind} of every file under `path` (or of the file), links not followed
+    and nothing opened that is not a regular file (the checkout's environment, git and caches left out)."""
     path = Path(path)
-    files = [path] if not path.is_dir() or path.is_symlink() else sorted(p for p in path.rglob("*"))
-    out = {}
-    for p in files:
+    files = [path]
+    if path.is_dir() and not path.is_symlink():
         skip = {".git", ".venv", "__pycache__", ".pytest_cache", ".mypy_cache", ".ruff_cache", "build"}
-        if skip & set(p.relative_to(path).parts if p != path else ()):
-            continue
+        files = []
+        for top, dirs, names in os.walk(path):
+            dirs[:] = [d for d in dirs if d not in skip]
+            files += [Path(top) / n for n in names] + [Path(top) / d for d in dirs if (Path(top) / d).is_symlink()]
+    out = {}
+    for p in sorted(files):
         st = os.lstat(p)
         if stat.S_ISREG(st.st_mode):
             out[str(p)] = hashlib.sha256(p.read_bytes()).hexdigest()
-        elif not stat.S_ISDIR(st.st_mode):
+        else:
             out[str(p)] = f"kind {stat.S_IFMT(st.st_mode):o}" + (f" -> {os.readlink(p)}" if p.is_symlink() else "")
     return out
 
@@ -446,6 +450,7 @@ def grade_class(root, members, material, jobs=2, victim="full1", extra=()):
     where = {}
     roster = [["id", "name", "file", "submitted"]]
     names = [m[0] for m in members]
+    assert names[0] == victim  # roster id u00
     for i, (name, cells) in enumerate(members):
         w = Where(out, root / "scores-review", root / "scores-feedback", subs, material, subs / f"{victim}.ipynb")
         where[name] = w
@@ -454,6 +459,10 @@ def grade_class(root, members, material, jobs=2, victim="full1", extra=()):
             os.symlink(next(material.rglob("*.ipynb"), REPO / "lectures" / f"{LECTURE}.ipynb"), path)
         elif name == "fifo_submitted":
             os.mkfifo(path)
+        elif name == "corrupt":
+            path.write_text('{"cells": [ this is not json')
+        elif name == "absent":
+            pass
         else:
             notebook(
                 cells(w) if callable(cells) else cells,
@@ -461,7 +470,9 @@ def grade_class(root, members, material, jobs=2, victim="full1", extra=()):
                 written=HUGE if name == "huge_answer" else f"{name} says: stiff is accurate.",
             )
         timed = name not in ("utime", victim) or "utime" not in names
-        roster.append([f"u{i:02d}", f"Student {name}", f"{name}.ipynb", "2026-12-03T10:00:00+00:00" if timed else ""])
+        when = "2026-12-03T14:00:00+00:00" if name == "late" else "2026-12-03T10:00:00+00:00" if timed else ""
+        if name != "stray":
+            roster.append([f"u{i:02d}", f"Student {name}", f"{name}.ipynb", when])
     if "utime" in names:  # its own file late, its victim's on time, before grading
         os.utime(subs / "utime.ipynb", (LATE, LATE))
         os.utime(subs / f"{victim}.ipynb", (ON_TIME, ON_TIME))

@@ -325,8 +325,10 @@ class Box:
             code = self.proc.wait(timeout=2.0)
         except subprocess.TimeoutExpired:  # alive, but its connection is broken or garbled
             self._stop(f"the submission broke its connection to the grader {self.where}")
+        if code > 128 and not self.unsafe:  # bwrap's way of saying its command died of signal code - 128
+            code = 128 - code
         what = f"died (signal {-code})" if code < 0 else f"exited with code {code}"
-        if code in (-9, 137) and self.limits.memory:
+        if code == -9 and self.limits.memory:
             what += " (killed: out of memory?)"
         self._stop(f"the submission's process {what} {self.where}")
 

@@ -122,11 +122,30 @@ class _Grader:
     check_all = export = check
 
 
+def _own_builtins():
+    """A copy of the builtins for the notebook (its `import builtins` too): a notebook that
+    replaces isinstance or AssertionError changes its own names, not those this server runs on."""
+    import builtins
+    import types
+
+    mine = types.ModuleType("builtins")
+    mine.__dict__.update(builtins.__dict__)
+    real_import = builtins.__import__
+
+    def imp(name, globals=None, locals=None, fromlist=(), level=0):
+        if name == "builtins" and level == 0:
+            return mine
+        return real_import(name, globals, locals, fromlist, level)
+
+    mine.__import__ = imp
+    return mine.__dict__
+
+
 class Notebook:
     """The notebook's namespace, the objects handed to the grader, and what it printed."""
 
     def __init__(self):
-        self.env = {"__name__": "__main__", "grader": _Grader()}
+        self.env = {"__name__": "__main__", "grader": _Grader(), "__builtins__": _own_builtins()}
         self.refs = {}
         self.models = {}  # the scenes' models built for recipes: (scene, overrides) -> model
         self.sink = Sink()
