@@ -198,7 +198,7 @@ for place in places:
 for path in found:
     try:
         for c in json.load(open(path))["cells"]:
-            if c["cell_type"] == "code":
+            if c["cell_type"] == "code" and ("def power_law" in "".join(c["source"]) or "class Tresca" in "".join(c["source"])):
                 try:
                     exec("".join(c["source"]), globals())
                 except Exception:
@@ -351,7 +351,12 @@ def _huge_answer(w):
 EXPLOITS = [
     ("object_new", lambda w: [HEAD, OBJECT_NEW, TR], (0, 5), "left out while your notebook is graded"),
     ("exec_source", lambda w: [HEAD, FIND_SOURCE, TR], (0, 5), "left out while your notebook is graded"),
-    ("tripwire_off", lambda w: [HEAD, TRIPWIRE_OFF, PL_LIBRARY, TR], (0, 5), "left out while your notebook is graded"),
+    (
+        "tripwire_off",
+        lambda w: [HEAD, TRIPWIRE_OFF, PL_LIBRARY_HIDDEN, TR],
+        (0, 5),
+        "left out while your notebook is graded",
+    ),
     ("solution", lambda w: [HEAD, PL_STUB, TR_STUB, SOLUTION], (0, 0), "`...`"),
     ("tailored", lambda w: [HEAD, TAILORED], (0, 2), "expected"),
     ("symlink", None, (0, 0), "a symbolic link"),

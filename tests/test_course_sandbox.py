@@ -27,7 +27,7 @@ def _check(graded, expected):
             r for r in graded.rows.values() if r["name"] == f"Student {name}"
         )
         if earned is not None:
-            assert scores(row) == earned, (name, row["notes"])
+            assert scores(row) == earned, (name, scores(row), row["notes"])
         assert note in row["notes"], (name, row["notes"])
     changed = sorted(k for k in set(graded.before) | set(graded.after) if graded.before.get(k) != graded.after.get(k))
     assert not changed, changed

@@ -46,7 +46,7 @@ class ScenePart(Recipe):
         return walk(built[key], self.path)
 
     def data(self):
-        return {"scene": self.scene, "set": self.overrides, "path": list(self.path)}
+        return {"t": "scene", "scene": self.scene, "set": self.overrides, "path": list(self.path)}
 
     def __repr__(self):
         return ".".join(self.path) if self.path else self.scene
