@@ -513,9 +513,11 @@ def grade_class(root, members, material, jobs=2, victim="full1", extra=()):
 
 
 def material_copy(root):
-    """A copy of the instructor's material (the hidden checks of the checkout) to grade with."""
+    """The instructor's material to grade with: a copy of the hidden checks of the checkout, and
+    the lecture's notebook with its solutions (here the two answers: what an instructor build holds)."""
     folder = root / "material"
     folder.mkdir()
+    notebook([HEAD, PL, TR], folder / f"{LECTURE}.ipynb")
     for name in ("hidden_checks", "hidden_checks.py"):
         src = REPO / "lectures" / name
         if src.is_dir():
