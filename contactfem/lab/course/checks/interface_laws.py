@@ -118,7 +118,7 @@ EXERCISES = [
 
 
 LIBRARY = {
-    "ex01_power_law": ("contactfem.laws.normal:PowerLaw",),
+    "ex01_power_law": ("contactfem.laws.normal:PowerLaw", "contactfem.contact.reference:power_law"),
     "ex01_tresca": ("contactfem.laws.friction:Coulomb", "contactfem.laws.friction:ParabolicSlip"),
 }
 

@@ -202,6 +202,14 @@ EXERCISES = [
 
 
 LIBRARY = {
-    "ex02_circle_gap": ("contactfem.contact.masters:RigidArc", "contactfem.contact.kinematics:arc_variations"),
-    "ex02_normal_tangent": ("contactfem.contact.element:normal_element", "contactfem.contact.element:contact_element"),
+    "ex02_circle_gap": (
+        "contactfem.contact.masters:RigidArc",
+        "contactfem.contact.kinematics:arc_variations",
+        "contactfem.contact.reference:arc_pair",
+    ),
+    "ex02_normal_tangent": (
+        "contactfem.contact.element:normal_element",
+        "contactfem.contact.element:contact_element",
+        "contactfem.contact.reference:segment_element",
+    ),
 }

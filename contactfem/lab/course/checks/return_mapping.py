@@ -145,6 +145,6 @@ EXERCISES = [
 
 
 LIBRARY = {
-    "ex03_coulomb_return": ("contactfem.laws.return_map:return_map",),
-    "ex03_slip_moduli": ("contactfem.laws.return_map:return_map",),
+    "ex03_coulomb_return": ("contactfem.laws.return_map:return_map", "contactfem.contact.reference:return_map"),
+    "ex03_slip_moduli": ("contactfem.laws.return_map:return_map", "contactfem.contact.reference:return_map"),
 }
