@@ -362,6 +362,7 @@ def cmd_course_build(args):
 
 
 def cmd_course_grade(args):
+    import secrets
     import time
 
     from .io.outputs import check_output_path, make_parents
@@ -373,6 +374,7 @@ def cmd_course_grade(args):
         memory=int(args.memory * 2**20) if args.memory else None,
     )
     make_parents(check_output_path(args.out, "--out", (".csv",)))  # the table's folder, as every output's
+    seed = secrets.randbits(63) if args.seed is None else args.seed  # said at the end: --seed repeats the grading
     t0 = time.perf_counter()
 
     def progress(done, total):
@@ -391,7 +393,7 @@ def cmd_course_grade(args):
             review=args.review,
             feedback=args.feedback,
             progress=progress if sys.stderr.isatty() else None,
-            seed=args.seed,
+            seed=seed,
             unsafe_no_sandbox=args.unsafe_no_sandbox,
         )
     except course.GradingInterrupted as exc:
@@ -399,7 +401,7 @@ def cmd_course_grade(args):
         return 130
     count = {s: sum(1 for r in rows if r["status"] == s) for s in ("graded", "stopped", "not graded", "missing")}
     what = ", ".join(f"{n} {s}" for s, n in count.items() if n)
-    print(f"{len(rows)} rows ({what}) in {time.perf_counter() - t0:.0f} s -> {args.out}")
+    print(f"{len(rows)} rows ({what}) in {time.perf_counter() - t0:.0f} s, hidden checks' seed {seed} -> {args.out}")
 
 
 def cmd_site(args):
@@ -720,7 +722,7 @@ def build_parser():
         default=None,
         metavar="TIME",
         help="ISO time (e.g. 2026-12-03T23:59); a submission after it is flagged late (its time: the "
-        "roster's submitted, else the file's modification time)",
+        "roster's submitted, else the file's modification time when the grader copied it, before any notebook ran)",
     )
     cg.add_argument(
         "--lecture",

@@ -13,7 +13,8 @@ pytestmark = pytest.mark.slow  # end-to-end: command lines and processes (the fa
 
 nbformat = pytest.importorskip("nbformat")
 
-from grading_class import HEAD, LECTURE, PATCH_CHECKS, PATCH_NUMPY, PL, PL_LIBRARY_HIDDEN, PL_STUB, TR, TR_STUB  # noqa: E402
+from grading_class import HEAD, LECTURE, PATCH_CHECKS, PATCH_NUMPY, PL, PL_LIBRARY_HIDDEN  # noqa: E402
+from grading_class import PL_STUB, TR, TR_STUB  # noqa: E402
 from grading_class import notebook as _notebook  # noqa: E402
 
 

@@ -13,6 +13,8 @@ import sys
 import pytest
 from grading_class import EXPLOITS, HONEST, HUGE, UNSAFE_NOTE, grade_class, material_copy, scores
 
+from contactfem.lab.course.review import ANSWER_CHARS
+
 pytestmark = pytest.mark.slow  # end-to-end: the command line in processes, a class graded
 
 OTHERS = [("corrupt", None, None, "not a notebook"), ("absent", None, None, "no submission")]
@@ -27,7 +29,7 @@ def _check(graded, expected):
             r for r in graded.rows.values() if r["name"] == f"Student {name}"
         )
         if earned is not None:
-            assert scores(row) == earned, (name, scores(row), row["notes"])
+            assert scores(row) == earned and float(row["total"]) == sum(earned), (name, scores(row), row["notes"])
         assert note in row["notes"], (name, row["notes"])
     changed = sorted(k for k in set(graded.before) | set(graded.after) if graded.before.get(k) != graded.after.get(k))
     assert not changed, changed
@@ -72,6 +74,8 @@ def test_an_attempt_alone(name, tmp_path):
     _check(graded, [*honest, attempt])
     if name == "utime":
         assert (graded.rows["utime.ipynb"]["late"], graded.rows["full1.ipynb"]["late"]) == ("yes", "")
+    if name == "huge_answer":  # 3 MB of written answer: the review page stays small
+        assert len(graded.review) < 10 * ANSWER_CHARS
 
 
 def _no_user_namespaces():

@@ -278,6 +278,9 @@ def grade(
         if path.is_symlink():
             raise ValueError(f"{what} {path}: a symbolic link; give a real folder")
     notebooks(folder)  # a folder with notebooks, or ValueError
+    sources = read_hidden(hidden_folder(autograders, repo))
+    for lec, text in sources.items():  # each file loads (ValueError naming it), before any work
+        load_hidden(text, lec)
     scores_read = {}  # the instructor's scores of the written answers, read before any work
     for lec in names:
         sheet = review / f"{lec}-scores.csv"
@@ -294,7 +297,6 @@ def grade(
                 ) from None
         received = take(folder, staging / "submissions", max_bytes)  # before any submission runs
         read = {rel: _read(r) for rel, r in received.items()}  # the copies as the grader reads them
-        sources = read_hidden(hidden_folder(autograders, repo))
         seed = secrets.randbits(63) if seed is None else seed
         entries, which, graded = _entries(received, read, students, names, lecture)
         editions = {
@@ -425,7 +427,8 @@ def _row(student, received, read, lec, outcome, columns, manual, scores_read, de
         notes.append(
             read
             if isinstance(read, str)
-            else "not a lecture of this course (no otter assignment name in its metadata, no NN_ prefix); give --lecture"
+            else "not a lecture of this course (no otter assignment name in its metadata, no NN_ prefix); "
+            "give --lecture"
         )
     elif outcome is None:
         status, _ = "not graded", notes.append(f"lecture {lec} has no exercises")

@@ -187,7 +187,7 @@ def _environment(home, figures):
     }
 
 
-def _unsafe_argv(edition, limits, scratch):
+def _unsafe_argv(edition, limits):
     setup = {"uid": None, "limits": limits.rlimits()}
     code = f"import sys; sys.path.insert(0, {str(edition)!r}); import contactfem_serve; contactfem_serve.main()"
     return [sys.executable, "-I", "-c", code, json.dumps(setup)]
@@ -255,7 +255,7 @@ class Box:
         if unsafe:
             shutil.copytree(Path(edition) / "examples", work / "work" / "examples")
             env = _environment(str(work / "home"), str(work / "figures")) | {"TMPDIR": str(work)}
-            argv, cwd = _unsafe_argv(edition, limits, work), work / "work"
+            argv, cwd = _unsafe_argv(edition, limits), work / "work"
         else:
             args_r, args_w = os.pipe()  # the arguments through a pipe: the sandbox reads none of them
             options, command = bwrap_argv(edition, limits, PACKAGE, REPO if (REPO / "lectures").is_dir() else None)
