@@ -40,6 +40,8 @@ def test_written_scores_are_read_back_into_the_csv(tmp_path):
     assert (rows[0]["ex01_discussion"], rows[0]["total"], rows[0]["possible"]) == ("1.5", "6.5", "12")
     assert rows[1]["ex01_discussion"] == "" and rows[1]["total"] == "0"
     assert open(sheet).read().count("1.5") == 1  # the instructor's sheet is kept
+    digest = __import__("hashlib").sha256((subs / "a.ipynb").read_bytes()).hexdigest()
+    assert f"SHA-256 {digest}" in (tmp_path / "s-feedback" / f"a-{LECTURE}.md").read_text()  # what was graded
 
 
 def test_patching_the_checks_in_the_notebook_scores_nothing(tmp_path):

@@ -493,5 +493,6 @@ def _row(student, received, read, lec, outcome, columns, manual, scores_read, de
     row.update(
         total=f"{total:g}", possible=f"{possible:g}", status=status, late="yes" if late else "", notes=" | ".join(notes)
     )
-    detail = dict(row=row, parts=parts, answers=written, manual=my_manual, lecture=lec)
+    got = received if received is not None and received.copy is not None else None
+    detail = dict(row=row, parts=parts, answers=written, manual=my_manual, lecture=lec, received=got)
     return row, detail

@@ -10,6 +10,7 @@ place (:func:`contactfem.io.outputs.write_atomic`), in folders that are not symb
 """
 
 import csv
+import datetime as dt
 import html
 import io
 import re
@@ -119,6 +120,9 @@ def write_feedback(feedback, details):
             "",
             f"Total: {r['total']} of {r['possible']} ({r['status']}).",
         ]
+        if d.get("received"):  # what was graded: the copy taken before any notebook ran
+            when = dt.datetime.fromtimestamp(d["received"].mtime).astimezone().isoformat(timespec="seconds")
+            lines.append(f"Graded: the file received {when}, SHA-256 {d['received'].sha256}.")
         if r["late"]:
             lines.append("Submitted late.")
         if r["status"] != "graded" or r["notes"] and not d["parts"]:
