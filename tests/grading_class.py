@@ -29,6 +29,7 @@ LECTURE = "01_interface_laws"
 REPO = Path(__file__).resolve().parents[1]
 UNSAFE_NOTE = "graded without a sandbox (--unsafe-no-sandbox)"
 MARK = "contactfem-mischief"  # in the command line of every process an attempt starts
+COMM = "cfem-mischief"  # or its name (a forked child keeps its parent's command line)
 DEADLINE = "2026-12-03T12:00:00+00:00"
 ON_TIME, LATE = 1796292000.0, 1796310000.0  # 2026-12-03 10:00 and 15:00 UTC, epoch seconds
 
@@ -141,12 +142,13 @@ class Where:
 
 
 def _run_cell(code):
-    """A cell that starts `code` in a process of its own, detached (setsid, double fork): it
-    outlives the notebook unless a sandbox ends it."""
+    """A cell that starts `code` in a process of its own, detached (a double fork around setsid): its
+    parent gone, in a session of its own, it outlives the notebook unless a sandbox ends it."""
+    detach = "import os\nif os.fork():\n    os._exit(0)\nos.setsid()\nif os.fork():\n    os._exit(0)\n"
     return (
         "import subprocess, sys\n"
-        f"subprocess.Popen([sys.executable, '-c', {code!r}, {MARK!r}], start_new_session=True,\n"
-        "                 stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)"
+        f"subprocess.run([sys.executable, '-c', {detach + code!r}, {MARK!r}],\n"
+        "               stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)"
     )
 
 
@@ -313,7 +315,7 @@ def _kill_grader(w):
         TR,
         "import os, signal\nfor pid in os.listdir('/proc'):\n    try:\n"
         "        cmd = open(f'/proc/{pid}/cmdline', 'rb').read()\n"
-        "        if b'contactfem.cli' in cmd and int(pid) != os.getpid():\n"
+        f"        if b'contactfem.cli' in cmd and {str(w.subs).encode()!r} in cmd:\n"
         "            os.kill(int(pid), signal.SIGKILL)\n    except (OSError, ValueError):\n        pass",
     ]
 
@@ -337,15 +339,22 @@ def _figures(w):
     ]
 
 
+FORK_BOMB = f"""import ctypes, os, time
+ctypes.CDLL(None).prctl(15, {COMM.encode()!r}, 0, 0, 0)  # its name, inherited by every child
+me, refused = os.getpid(), 0
+for _ in range(12):  # every process forks, 4096 wanted
+    try:
+        os.fork()
+    except OSError:
+        refused += 1
+if os.getpid() != me:
+    time.sleep(120)
+    os._exit(0)
+raise RuntimeError(f"forks refused: {{refused}} of 12" if refused else "no fork refused")"""
+
+
 def _fork_bomb(w):
-    return [
-        HEAD,
-        PL,
-        TR,
-        "import os, time\nn = 0\nfor n in range(300):\n    try:\n        if os.fork() == 0:\n"
-        "            time.sleep(60)\n            os._exit(0)\n    except OSError:\n        break\n"
-        "raise RuntimeError(f'forks refused after {n}' if n < 299 else 'no fork refused')",
-    ]
+    return [HEAD, PL, TR, FORK_BOMB]
 
 
 def _huge_answer(w):
@@ -374,7 +383,7 @@ EXPLOITS = [
     ("fifo", _fifo, (5, 5), ""),
     ("fifo_submitted", None, (0, 0), "not a regular file"),
     ("figures", _figures, (5, 5), ""),
-    ("fork_bomb", _fork_bomb, (5, 5), "forks refused after"),
+    ("fork_bomb", _fork_bomb, (5, 5), "forks refused: "),
     ("huge_answer", _huge_answer, (5, 5), ""),
 ]
 WRITTEN = "Penetration against conditioning."
@@ -415,11 +424,12 @@ def fingerprint(path):
 
 
 def marked_processes():
-    """The processes an attempt started (MARK in their command line), alive."""
+    """The processes an attempt started (MARK in their command line, or COMM their name), alive."""
     found = []
     for d in os.listdir("/proc"):
         try:
-            if MARK.encode() in open(f"/proc/{d}/cmdline", "rb").read() and _alive(int(d)):
+            marked = MARK.encode() in open(f"/proc/{d}/cmdline", "rb").read()
+            if (marked or open(f"/proc/{d}/comm").read().strip() == COMM) and _alive(int(d)):
                 found.append(int(d))
         except (OSError, ValueError):
             continue

@@ -131,6 +131,7 @@ def test_grade_refuses_bad_options(tmp_path, capsys):
         (["--roster", str(tmp_path / "bad_roster.csv")], "no column id, name"),
         (["--deadline", "tomorrow"], "--deadline"),
         (["--lecture", "99_none"], "--lecture"),
+        (["--seed", "-1"], "--seed -1: give an integer from 0"),
     ]
     for extra, what in cases:
         capsys.readouterr()

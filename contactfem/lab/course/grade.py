@@ -251,6 +251,8 @@ def grade(
     out_csv = check_output_path(out_csv, "--out", (".csv",))
     if jobs < 1:
         raise ValueError(f"--jobs {jobs}: give a number of parallel gradings >= 1")
+    if seed is not None and not 0 <= seed < 2**63:
+        raise ValueError(f"--seed {seed}: give an integer from 0 to 2**63 - 1")
     for what, v in (("--notebook-timeout", limits.notebook), ("--check-timeout", limits.check)):
         if not v > 0:
             raise ValueError(f"{what} {v}: give a time limit in seconds > 0")
