@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from contactfem.lab.course.checks.answers import call, compare, draw
+from contactfem.lab.course.checks.answers import Built, call, compare, draw
 from contactfem.lab.course.checks.runs import ScenePart, as_list, counts, memo, scene_model
 
 
@@ -29,7 +29,7 @@ def _census_short(census, steps):
     def student():
         schedule = ScenePart(*funnel, "stage", "schedule").make({})
         stage = [ScenePart(*funnel, "stage", k) for k in ("stepper", "u0", "v0")]
-        short = Steps(schedule.dt, n_steps=steps, t0=schedule.t0)
+        short = Built(Steps, dt=schedule.dt, n_steps=steps, t0=schedule.t0)
         return call(census, "census", stage[0], short, *stage[1:], timeout=120.0)
 
     def reference():

@@ -377,20 +377,15 @@ class Box:
         recipe, or a dataclass of the library (rebuilt from its fields in the sandbox)."""
         from dataclasses import fields, is_dataclass
 
-        from .checks.answers import Recipe
+        from .checks.answers import Built, Recipe
 
         if isinstance(v, Remote) and v._box is self:
             return {"t": "handle", "id": v._id}
+        if is_dataclass(v) and not isinstance(v, type) and type(v).__module__.startswith("contactfem."):
+            v = Built(type(v), **{f.name: getattr(v, f.name) for f in fields(v)})
         if isinstance(v, Recipe):
             d = v.data()
             return d | {"set": encode(d["set"], self._argument)}
-        if is_dataclass(v) and not isinstance(v, type) and type(v).__module__.startswith("contactfem."):
-            data = {f.name: getattr(v, f.name) for f in fields(v)}
-            return {
-                "t": "lib",
-                "cls": f"{type(v).__module__}:{type(v).__qualname__}",
-                "fields": encode(data, self._argument),
-            }
         raise TypeError(f"a {type(v).__name__} cannot be handed to an answer (plain data and library objects only)")
 
     def cell(self, i, source):

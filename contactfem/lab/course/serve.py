@@ -6,8 +6,8 @@ notebook's code cells one by one, then asks for the student's answers and calls 
 checks' arguments. Everything that crosses is plain data in JSON: numbers, strings, lists,
 tuples and dicts of them, arrays as ``.npy`` bytes read without pickle, a handle (a number) for
 an object that stays here, and two kinds of recipe for the library objects a check hands to an
-answer, built here from the students' edition: a dataclass of the library from its fields, and
-a part of a scene's model. Nothing of the checks is here; nothing from here runs in the grader.
+answer, built here from the students' edition: an object of a class of the library from plain
+data (a dataclass from its fields, a schedule from its steps), and a part of a scene's model. Nothing of the checks is here; nothing from here runs in the grader.
 
 Before the first request, :func:`main` sets the process up: when the grader is root, it takes
 an unprivileged user id in a user namespace of its own (so that its limits bind); then its
@@ -18,7 +18,6 @@ Needs nothing but Python and numpy: it is not part of the package the notebook s
 
 import base64
 import ctypes
-import dataclasses
 import importlib
 import inspect
 import io
@@ -173,8 +172,8 @@ class Notebook:
             if not module.startswith("contactfem.") or not name.isidentifier():
                 raise ValueError(f"not a class of the library: {d.get('cls')!r}")
             cls = getattr(importlib.import_module(module), name)
-            fields = decode(d.get("fields"), self.argument)
-            if not dataclasses.is_dataclass(cls) or type(fields) is not dict:
+            fields = decode(d.get("set"), self.argument)
+            if not isinstance(cls, type) or type(fields) is not dict:
                 raise ValueError(f"not a class of the library: {d.get('cls')!r}")
             return cls(**fields)
         if t == "scene":

@@ -38,6 +38,22 @@ class Recipe:
         raise NotImplementedError
 
 
+class Built(Recipe):
+    """A library object its class makes from plain data, e.g. ``Built(Steps, dt=1e-3, n_steps=12)``."""
+
+    def __init__(self, cls, **fields):
+        self.cls, self.fields = cls, fields
+
+    def make(self, built):
+        return self.cls(**self.fields)
+
+    def data(self):
+        return {"t": "lib", "cls": f"{self.cls.__module__}:{self.cls.__qualname__}", "set": self.fields}
+
+    def __repr__(self):
+        return f"{self.cls.__name__}({', '.join(f'{k}={v!r}' for k, v in self.fields.items())})"
+
+
 @contextmanager
 def _time_limit(seconds):
     """Stop the student's code after `seconds` (an endless loop must not stop the grading)."""
