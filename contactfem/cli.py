@@ -370,11 +370,14 @@ def plain_table(markdown):
     return "\n".join("  ".join(c.ljust(w) for c, w in zip(r, widths)).rstrip() for r in rows)
 
 
-def _course_layer():
-    try:
-        import otter  # noqa: F401  (the grading tool of the course extra)
-    except ImportError:
-        raise ValueError("contactfem course needs the course extra: pip install -e '.[course]'") from None
+def _course_layer(otter=True):
+    """The course's layer; with `otter`, the build tool of the course extra must be there (grading
+    needs it not: its sandbox says what it lacks)."""
+    if otter:
+        try:
+            import otter  # noqa: F401
+        except ImportError:
+            raise ValueError("contactfem course needs the course extra: pip install -e '.[course]'") from None
     from .lab import course
 
     return course
@@ -404,17 +407,19 @@ def cmd_course_build(args):
 
 
 def cmd_course_grade(args):
+    import secrets
     import time
 
     from .io.outputs import check_output_path, make_parents
 
-    course = _course_layer()
+    course = _course_layer(otter=False)
     limits = course.Limits(
         notebook=args.notebook_timeout,
         check=args.check_timeout,
         memory=int(args.memory * 2**20) if args.memory else None,
     )
     make_parents(check_output_path(args.out, "--out", (".csv",)))  # the table's folder, as every output's
+    seed = secrets.randbits(63) if args.seed is None else args.seed  # said at the end: --seed repeats the grading
     t0 = time.perf_counter()
 
     def progress(done, total):
@@ -433,13 +438,15 @@ def cmd_course_grade(args):
             review=args.review,
             feedback=args.feedback,
             progress=progress if sys.stderr.isatty() else None,
+            seed=seed,
+            unsafe_no_sandbox=args.unsafe_no_sandbox,
         )
     except course.GradingInterrupted as exc:
         print(f"\ncontactfem: {exc.message}" if sys.stderr.isatty() else f"contactfem: {exc.message}", file=sys.stderr)
         return 130
     count = {s: sum(1 for r in rows if r["status"] == s) for s in ("graded", "stopped", "not graded", "missing")}
     what = ", ".join(f"{n} {s}" for s, n in count.items() if n)
-    print(f"{len(rows)} rows ({what}) in {time.perf_counter() - t0:.0f} s -> {args.out}")
+    print(f"{len(rows)} rows ({what}) in {time.perf_counter() - t0:.0f} s, hidden checks' seed {seed} -> {args.out}")
 
 
 def cmd_site(args):
@@ -769,9 +776,9 @@ def build_parser():
         "--autograders",
         default=None,
         metavar="DIR",
-        help="the instructor's grading material: a folder holding hidden_checks.py (the hidden "
-        "checks), e.g. the autograder/ folder of an instructor build (default, and where DIR has "
-        "none: the checkout's lectures/hidden_checks.py)",
+        help="the instructor's grading material: a folder holding hidden_checks/ (the hidden "
+        "checks, one file per lecture), e.g. the autograder/ folder of an instructor build (default, "
+        "and where DIR has none: the checkout's lectures/hidden_checks/)",
     )
     cg.add_argument("--jobs", type=int, default=1, help="submissions graded in parallel (default 1)")
     cg.add_argument(
@@ -786,7 +793,7 @@ def build_parser():
         default=None,
         metavar="TIME",
         help="ISO time (e.g. 2026-12-03T23:59); a submission after it is flagged late (its time: the "
-        "roster's submitted, else the file's modification time)",
+        "roster's submitted, else the file's modification time when the grader copied it, before any notebook ran)",
     )
     cg.add_argument(
         "--lecture",
@@ -816,7 +823,20 @@ def build_parser():
         type=float,
         default=4096.0,
         metavar="MB",
-        help="memory limit of each submission's process in MB (default 4096; 0: none)",
+        help="memory limit of each process of a submission's sandbox in MB (default 4096; 0: none)",
+    )
+    cg.add_argument(
+        "--unsafe-no-sandbox",
+        action="store_true",
+        help="grade without the sandbox (where user namespaces are not to be had): the submissions then run "
+        "as you, see your files and can change them; every row says so",
+    )
+    cg.add_argument(
+        "--seed",
+        type=int,
+        default=None,
+        metavar="N",
+        help="the seed of the hidden checks' parameters (default: drawn afresh; give one to repeat a grading)",
     )
     cg.add_argument(
         "--review",

@@ -180,9 +180,11 @@ def test_the_student_zip_holds_no_solution(tmp_path):
         assert not re.search(r"BEGIN\s+SOLUTION|END\s+SOLUTION", text, re.I), name
     assert files[f"{LEC}.ipynb"] == (outs["student"] / f"{LEC}.ipynb").read_text()
     # the hidden checks are the instructor's material: in its autograder/, nowhere in the student's
-    hidden = (REPO / "lectures" / "hidden_checks.py").read_text()
-    assert (outs["instructor"] / "autograder" / "hidden_checks.py").read_text() == hidden
+    sources = sorted((REPO / "lectures" / "hidden_checks").glob("*.py"))
+    for f in sources:
+        assert (outs["instructor"] / "autograder" / "hidden_checks" / f.name).read_text() == f.read_text()
     assert not list(outs["student"].rglob("hidden_checks*"))
+    hidden = "\n".join(f.read_text() for f in sources)
     defs = [ln.strip() for ln in hidden.splitlines() if ln.startswith("def ")]
     assert defs and not any(d in text for d in defs for text in files.values())
 

@@ -43,10 +43,10 @@ def offenders(text):
     ]
 
 
-# The grader's sandbox is the one place that must do both: it gives a submission a copy of the
-# builtins of its own (so that patching them changes nothing outside it), and the checks reach the
-# submission's objects through handles that forward to its process.
-SANDBOX = ("contactfem/lab/course/sandbox.py", "contactfem/lab/course/grade.py")
+# The grader's sandbox is the one place that must do both: it gives a notebook a copy of the
+# builtins of its own (serve.py: patching them changes nothing of the server beside it), and the
+# checks reach the submission's objects through handles that forward to its sandbox (sandbox.py).
+SANDBOX = ("contactfem/lab/course/sandbox.py", "contactfem/lab/course/serve.py")
 
 
 def test_no_attribute_forwarding_and_no_swapped_builtins():

@@ -184,3 +184,33 @@ class hold_interrupts:
             if self.pending and kind is None:
                 raise KeyboardInterrupt
         return False
+
+
+def write_atomic(path, data):
+    """Write `data` (bytes or text) to `path` through a temporary file of its folder, created
+    afresh (never through a symbolic link), then renamed onto `path`: a reader sees the old file
+    or the new one, and a symbolic link at `path` is replaced, not followed."""
+    path = Path(path)
+    data = data.encode() if isinstance(data, str) else data
+    tmp = path.with_name(f".{path.name}.{secrets.token_hex(4)}.part")
+    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o644)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+
+
+def own_dir(path, what):
+    """The folder `path`, made (with its parents) if missing; ValueError naming the option if it
+    is a symbolic link or not a folder (what is written there must land there, not where a link
+    points)."""
+    path = Path(path)
+    if path.is_symlink():
+        raise ValueError(f"{what} {path}: a symbolic link; give a real folder")
+    if path.exists() and not path.is_dir():
+        raise ValueError(f"{what} {path}: a file, not a folder")
+    path.mkdir(parents=True, exist_ok=True)
+    return path

@@ -8,7 +8,8 @@ One source: each lecture in ``lectures/`` holds its exercises in otter-grader's
 assignment format (raw cells ``# BEGIN QUESTION`` / ``name: exNN_...``, ``# BEGIN
 SOLUTION`` ... ``# END QUESTION``, solution lines between ``# BEGIN SOLUTION`` and
 ``# END SOLUTION`` comments). The checks of each exercise live in
-:mod:`contactfem.lab.course.checks` (parts with points and hints); :func:`build`
+:mod:`contactfem.lab.course.checks`, one module per lecture (parts with points and hints);
+:func:`build`
 writes them into the notebook as otter's test cells and runs ``otter assign``:
 
 * the **student** version (``build/course/student``): solutions replaced by ``...``,
@@ -19,14 +20,14 @@ writes them into the notebook as otter's test cells and runs ``otter assign``:
   (``NN_topic.zip``).
 
 :func:`grade` (:mod:`contactfem.lab.course.grade`) grades every submitted notebook of a
-folder, each in a process of its own apart from the checks, and writes one CSV row per
-submission: the points of each exercise, the total, the points possible and the hints.
+folder, each in a sandbox of its own (:mod:`.sandbox`) with the students' edition of the library
+(:mod:`.edition`), the checks outside it, and writes one CSV row per submission: the points of
+each exercise, the total, the points possible and the hints.
 """
 
 import contextlib
 import io
 import logging
-import os
 import re
 import shutil
 import sys
@@ -114,7 +115,7 @@ def _test_cell(part):
     src = (
         f'""" # BEGIN TEST CONFIG\npoints: {part.points}\n""" # END TEST CONFIG\n'
         f"def test_{part.name}({args}):\n"
-        f"    from contactfem.lab.course.checks import {part.name}\n"
+        f"    from {part.check.__module__} import {part.name}\n"
         f"    {part.name}({args})"
     )
     return nbformat.v4.new_code_cell(src)
@@ -258,9 +259,9 @@ def build_versions(outs, repo=None, only=None, force=False, work=None, on_write=
         examples = sorted((Path(repo or REPO) / "lectures" / "examples").glob("*.*"))
         for version in plan:  # the files the lectures read (a scene file, its mesh)
             plan[version].update({f"examples/{f.name}": f for f in examples if f.is_file()})
-        hidden = Path(repo or REPO) / "lectures" / "hidden_checks.py"
-        if "instructor" in plan and hidden.is_file():  # the hidden checks: instructor material only
-            plan["instructor"]["autograder/hidden_checks.py"] = hidden
+        hidden = Path(repo or REPO) / "lectures" / "hidden_checks"
+        if "instructor" in plan:  # the hidden checks: instructor material only
+            plan["instructor"].update({f"autograder/hidden_checks/{f.name}": f for f in sorted(hidden.glob("*.py"))})
         if "student" in plan:
             notebooks = [p for n, p in plan["student"].items() if n.endswith(".ipynb")]
             extras = [(n, p) for n, p in plan["student"].items() if n.startswith("examples/")]
@@ -292,4 +293,5 @@ def build_versions(outs, repo=None, only=None, force=False, work=None, on_write=
 
 # -- grading: contactfem.lab.course.grade -------------------------------------------------------
 
-from .grade import GradingInterrupted, Limits, grade, lecture_of, submissions  # noqa: E402,F401
+from .grade import GradingInterrupted, grade, lecture_of  # noqa: E402,F401
+from .sandbox import Limits, NoSandbox  # noqa: E402,F401

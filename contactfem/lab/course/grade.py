@@ -2,343 +2,47 @@
 
     contactfem course grade FOLDER --out scores.csv [--roster R.csv] [--deadline T] [--jobs N]
 
-Each notebook is graded in a worker of :func:`contactfem.lab.batch.run_batch`, in two
-processes that share nothing:
+In this order, before any submission runs: the options are checked; the sandbox is tried
+(:func:`.sandbox.check_sandbox`: without one, grading refuses, unless ``--unsafe-no-sandbox``);
+every submission is copied into a private staging folder (:mod:`.snapshot`: regular files only,
+each with its hash and the time it was received, by which lateness is judged); the hidden checks
+are read (:mod:`.hidden`) and a seed for their parameters drawn; and the students' edition of
+the library is written for each lecture (:mod:`.edition`).
 
-* the **submission's process** (:mod:`.sandbox`) runs the notebook's code cells, with a
-  memory limit, its output discarded (counted), and answers the grader's calls of the
-  student's functions, each under the per-check time limit;
-* the **grader's process** (the worker) holds the checks: the public ones of
-  :mod:`.checks` and the hidden ones of the instructor's material (``hidden_checks.py``:
-  not part of the installed package, not in the student notebooks). The references the
-  checks compare with are computed here, where the submission has never run. What comes
-  back from the submission is plain data (numbers, arrays read without pickle) or a handle
-  to call: patching modules, builtins, numpy or the checks in the notebook changes nothing
-  the grader computes.
+Then each copy is graded in a worker of :func:`contactfem.lab.batch.run_batch`: its code cells
+run in its sandbox (:mod:`.sandbox`), and the worker, which holds the checks, calls the
+student's answers there, sending arguments and receiving results as plain data. A part of an
+exercise scores its points when its public check and its hidden checks pass. The answers are
+graded with the students' edition of the library: what an exercise asks for is not in it.
 
-A part of an exercise scores its points when its public check and its hidden checks pass.
-An exercise that asks for part of the method (``implements``) is graded with the library's
-implementation of that part (checks.LIBRARY) out of reach: the answer's definition is read
-for it, and during the calls it is replaced by a tripwire in the submission's process; an
-answer that uses it scores zero for the part, with a hint that says so.
-
-What a submission can still do, running as the grader's user: end its own process (its row
-says how), kill the worker that grades it (the row says "worker died"), read files. What it
-cannot do is change a reference, a check or a score.
-
-Written answers (checks.MANUAL) are collected into one review file per lecture
-(``REVIEW/LECTURE.html``: one section per student, code and answer side by side); the
-instructor's scores, entered in ``REVIEW/LECTURE-scores.csv``, are read back into the CSV on
-the next run. Every student gets a feedback file (``FEEDBACK/ID-LECTURE.md``).
+The CSV, the review files and the feedback files are written by the grader alone, each through
+a temporary file renamed into place; the CSV is final when :func:`grade` returns, since nothing
+a submission started outlives its sandbox.
 """
 
-import ast
 import csv
 import datetime as dt
-import html
-import importlib.util
-import io
 import json
-import os
-import pickle
 import re
-import subprocess
-import sys
+import secrets
+import shutil
 import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
+from ...io.outputs import make_parents, own_dir, write_atomic
+from .checks import EXERCISES, LIBRARY, MANUAL, answers, runs
+from .edition import PACKAGE, build_edition
+from .hidden import FOLDER, hidden_folder, load_hidden, read_hidden, rng_for
+from .sandbox import Box, Limits, NoSandbox, Stopped, check_sandbox
+from .review import csv_text, read_manual_scores, write_feedback, write_reviews
+from .snapshot import MAX_BYTES, take
 
-REPO = Path(__file__).resolve().parents[3]
-HIDDEN_FILE = "hidden_checks.py"
+REPO = PACKAGE.parent
+
 MANUAL_MARK = re.compile(r"<!--\s*manual:\s*(\w+)\s*-->")
-
-# The limits, and why these defaults. A notebook's cells run its lecture in the fast preset and
-# its checks run the student's functions: graded two at a time on a shared 2-core machine, the
-# solutions of the twelve lectures took 19 s (02) to 271 s (08, the cork); 900 s leaves more
-# than three times the slowest. A call of the student's code in a check takes milliseconds
-# (closed forms, small arrays): 20 s is an endless loop; the checks that run a scene give their
-# calls 60-120 s, which this limit does not lower. Memory: a lecture's fast runs need a few
-# hundred MB; 4 GB stops a runaway allocation before it takes the machine.
-NOTEBOOK_TIMEOUT = 900.0
-CHECK_TIMEOUT = 20.0
-MEMORY_LIMIT = 4 * 2**30
-MAX_REPLY = 64 * 2**20  # bytes of one answer of the submission (an array of some 6 million numbers)
-GRACE = 5.0  # how long past a check's limit the submission's process may take to answer
-
-
-@dataclass(frozen=True)
-class Limits:
-    notebook: float = NOTEBOOK_TIMEOUT  # seconds for a whole notebook: its cells and its checks
-    check: float = CHECK_TIMEOUT  # seconds for one call of the student's code
-    memory: int | None = MEMORY_LIMIT  # bytes of address space of the submission's process
-
-
-class Stopped(Exception):
-    """The submission's process is gone (killed at a time limit, exited, crashed)."""
-
-
-class LibraryCall(Exception):
-    pass
-
-
-# -- the submission's process, seen from the grader -------------------------------------------
-
-
-class Remote:
-    """An object of the submission's process (its function, class or instance): calling it or
-    reading an attribute asks that process; what comes back is data or another Remote."""
-
-    remote = True
-
-    def __init__(self, box, meta):
-        self.__dict__.update(_box=box, _id=meta["id"], _meta=meta)
-
-    def __call__(self, *args, **kwargs):
-        return self._box.call(self._id, args, kwargs)
-
-    def __getattr__(self, name):
-        if name.startswith("__"):
-            raise AttributeError(name)
-        return self._box.getattr(self._id, name)
-
-    def __setattr__(self, name, value):
-        raise AttributeError("the grader does not change the submission's objects")
-
-    @property
-    def __signature__(self):
-        import inspect
-
-        params = self._meta.get("params")
-        if params is None:
-            return None
-        return inspect.Signature(
-            [
-                inspect.Parameter(n, inspect._ParameterKind(k), default=None if d else inspect.Parameter.empty)
-                for n, k, d in params
-            ]
-        )
-
-    def __repr__(self):
-        return self._meta.get("name") or self._meta.get("type") or "object"
-
-
-class Handle:
-    def __init__(self, i):
-        self.id = i
-
-
-def _set_limits(memory):
-    """What the submission's process sets up before it starts (POSIX): death with the worker
-    (Linux), its memory limit (where the platform allows one), a process group of its own (its
-    children end with it; a signal to the worker's group does not reach it)."""
-
-    def limit():
-        import ctypes
-        import resource
-
-        try:
-            ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, 9)  # PR_SET_PDEATHSIG, SIGKILL
-        except (OSError, AttributeError):
-            pass
-        if memory:
-            try:
-                resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
-            except (ValueError, OSError):
-                pass
-        os.setpgrp()
-
-    return limit
-
-
-class Box:
-    """The submission's process (see :mod:`.sandbox`): started on the first request."""
-
-    def __init__(self, limits, workdir):
-        self.limits = limits
-        self.deadline = time.monotonic() + limits.notebook
-        self.guard = ()
-        self.used = set()
-        self.dead = None
-        self.where = "starting"
-        req_r, self._req_w = os.pipe()
-        self._rep_r, rep_w = os.pipe()
-        env = dict(
-            os.environ,
-            MPLBACKEND="Agg",
-            OPENBLAS_NUM_THREADS="1",
-            OMP_NUM_THREADS="1",
-            PYTHONPATH=os.pathsep.join(p for p in [str(REPO), os.environ.get("PYTHONPATH", "")] if p),
-        )
-        code = f"from contactfem.lab.course.sandbox import serve; serve({req_r}, {rep_w})"
-        self.proc = subprocess.Popen(
-            [sys.executable, "-c", code],
-            pass_fds=(req_r, rep_w),
-            cwd=workdir,
-            env=env,
-            stdin=subprocess.DEVNULL,
-            stdout=subprocess.DEVNULL,
-            stderr=subprocess.DEVNULL,
-            preexec_fn=_set_limits(limits.memory) if os.name == "posix" else None,
-        )
-        os.close(req_r)
-        os.close(rep_w)
-        from multiprocessing.connection import Connection
-
-        self.conn_out = Connection(self._req_w, readable=False)
-        self.conn_in = Connection(self._rep_r, writable=False)
-
-    def _kill(self):
-        """The submission's process and what it started (its process group)."""
-        import signal
-
-        try:
-            os.killpg(self.proc.pid, signal.SIGKILL)
-        except (ProcessLookupError, PermissionError, AttributeError):  # AttributeError: not POSIX
-            pass
-        if self.proc.poll() is None:
-            self.proc.kill()
-        self.proc.wait()
-
-    def close(self):
-        self._kill()
-        self.conn_out.close()
-        self.conn_in.close()
-
-    def _stop(self, reason):
-        self._kill()
-        self.dead = reason
-        raise Stopped(reason)
-
-    def _gone(self):
-        try:
-            code = self.proc.wait(timeout=2.0)
-        except subprocess.TimeoutExpired:  # alive, but its connection is broken or garbled
-            self._stop(f"the submission broke its connection to the grader {self.where}")
-        what = f"died (signal {-code})" if code < 0 else f"exited with code {code}"
-        if code == -9 and self.limits.memory:
-            what += " (killed: out of memory?)"
-        self._stop(f"the submission's process {what} {self.where}")
-
-    def request(self, req, limit=None):
-        if self.dead:
-            raise Stopped(self.dead)
-        left = self.deadline - time.monotonic()
-        wait = left if limit is None else min(left, limit + GRACE)
-        try:
-            self.conn_out.send_bytes(_dumps(req))
-            if not self.conn_in.poll(max(wait, 0.0)):
-                if time.monotonic() >= self.deadline:
-                    self._stop(f"time limit {self.limits.notebook:g} s for the notebook reached {self.where}")
-                self._stop(f"the submission did not answer within {limit + GRACE:g} s {self.where}")
-            data = self.conn_in.recv_bytes(MAX_REPLY)
-            return json.loads(data)
-        except (EOFError, OSError, ValueError):
-            self._gone()
-
-    def decode(self, v):
-        t = v.get("t")
-        if t == "none":
-            return None
-        if t == "ellipsis":
-            return Ellipsis
-        if t == "py":
-            return v["v"]
-        if t in ("tuple", "list"):
-            return (tuple if t == "tuple" else list)(self.decode(x) for x in v["v"])
-        if t == "dict":
-            return {k: self.decode(x) for k, x in v["v"].items()}
-        if t in ("nd", "np"):
-            import base64
-
-            a = np.load(io.BytesIO(base64.b64decode(v["v"])), allow_pickle=False)
-            return a if t == "nd" else a[()]
-        if t == "ref":
-            return Remote(self, v)
-        if "exc" in v:
-            raise _error(v["exc"], v.get("msg", ""))
-        raise Stopped(f"the submission's process answered nonsense {self.where}")
-
-    def cell(self, i, source):
-        self.where = f"running cell {i}"
-        return self.request(("cell", source))
-
-    def get(self, name):
-        self.where = f"reading `{name}`"
-        v = self.request(("get", name))
-        return None if v.get("t") == "missing" else self.decode(v)
-
-    def getattr(self, i, name):
-        from . import checks
-
-        v = self.request(("getattr", i, name), limit=checks.TIME_LIMIT)
-        if v.get("t") == "missing":
-            raise AttributeError(name)
-        return self.decode(v)
-
-    def call(self, i, args, kwargs):
-        from . import checks
-
-        limit = checks.CALL_LIMIT[0] or checks.TIME_LIMIT
-        self.where = "in a call of the answer"
-        reply = self.request(("call", i, _wire(args), _wire(kwargs), limit, tuple(self.guard)), limit=limit)
-        self.used.update(reply.get("library", ()))
-        if reply.get("timeout"):
-            raise checks.Timeout()
-        if reply.get("exc") == "LibraryUsed":
-            raise LibraryCall("the answer called the library")
-        if "exc" in reply:
-            raise _error(reply["exc"], reply.get("msg", ""))
-        return self.decode(reply["ok"])
-
-
-def _dumps(req):
-    """A request for the submission's process: pickled; a library object that pickle cannot
-    take (a stepper holding lambdas) by dill, which sends functions by value."""
-    try:
-        return pickle.dumps(req)
-    except (pickle.PicklingError, AttributeError, TypeError):
-        import dill
-
-        return dill.dumps(req, recurse=True)
-
-
-def _error(name, msg):
-    name = name if re.fullmatch(r"[A-Za-z_]\w{0,60}", name or "") else "Error"
-    return type(name, (Exception,), {})(msg)
-
-
-def _wire(v):
-    if isinstance(v, Remote):
-        return Handle(v._id)
-    if type(v) in (tuple, list):
-        return type(v)(_wire(x) for x in v)
-    if type(v) is dict:
-        return {k: _wire(x) for k, x in v.items()}
-    return v
-
-
-# -- the instructor's material ------------------------------------------------------------------
-
-
-def hidden_checks_file(material=None, repo=None):
-    """The hidden checks: MATERIAL/hidden_checks.py, else the checkout's lectures/hidden_checks.py."""
-    for folder in ([Path(material)] if material else []) + [Path(repo or REPO) / "lectures"]:
-        if (folder / HIDDEN_FILE).is_file():
-            return folder / HIDDEN_FILE
-    return None
-
-
-def load_hidden(path):
-    """{public part name: [hidden check functions]} of a hidden_checks.py (its HIDDEN)."""
-    if path is None:
-        return {}
-    spec = importlib.util.spec_from_file_location("contactfem_hidden_checks", path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return {k: list(v) if isinstance(v, (list, tuple)) else [v] for k, v in mod.HIDDEN.items()}
+UNSAFE = "graded without a sandbox (--unsafe-no-sandbox)"
 
 
 # -- one notebook ------------------------------------------------------------------------------
@@ -348,42 +52,15 @@ def read_notebook(path):
     """The notebook's cells [(type, source)]; ValueError if it is not a notebook."""
     try:
         nb = json.loads(Path(path).read_text(errors="replace"))
-        cells = nb["cells"]
-        return [
-            (c.get("cell_type"), "".join(c["source"]) if isinstance(c["source"], list) else c["source"]) for c in cells
-        ], nb.get("metadata", {})
+        cells = [
+            (c.get("cell_type"), "".join(c["source"]) if isinstance(c["source"], list) else c["source"])
+            for c in nb["cells"]
+        ]
+        if not all(isinstance(kind, str) and isinstance(source, str) for kind, source in cells):
+            raise TypeError("a cell that is not text")
+        return cells, nb.get("metadata", {})
     except (ValueError, KeyError, TypeError, AttributeError) as err:
         raise ValueError(f"not a notebook ({type(err).__name__}: {' '.join(str(err).split())[:80]})") from None
-
-
-def _answer_nodes(tree, names):
-    """The definitions of the answers `names` in a parsed cell: def, class, or assignment."""
-    for node in ast.walk(tree):
-        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)) and node.name in names:
-            yield node
-        elif isinstance(node, (ast.Assign, ast.AnnAssign)):
-            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
-            if any(isinstance(t, ast.Name) and t.id in names for t in targets) and node.value is not None:
-                yield node.value
-
-
-def library_named(source, guard, names):
-    """The library names of `guard` ("module:Name.attr") that the definitions of the answers
-    `names` in this code use (other code of the cell, a comparison with the library, is free)."""
-    wanted = {spec.partition(":")[2].split(".")[0]: spec for spec in guard}
-    try:
-        tree = ast.parse(source)
-    except SyntaxError:
-        return set()
-    found = set()
-    for top in _answer_nodes(tree, names):
-        for node in ast.walk(top):
-            name = node.id if isinstance(node, ast.Name) else node.attr if isinstance(node, ast.Attribute) else None
-            if name in wanted:
-                found.add(wanted[name])
-            if isinstance(node, (ast.Import, ast.ImportFrom)):
-                found |= {wanted[a.name.split(".")[-1]] for a in node.names if a.name.split(".")[-1] in wanted}
-    return found
 
 
 def manual_answers(cells):
@@ -408,45 +85,41 @@ def manual_answers(cells):
     }
 
 
-def library_hint(exercise, used):
-    names = ", ".join(sorted(s.replace(":", ".") for s in used))
-    return (
-        f"your answer uses the library's own {names}: this exercise asks you to implement it yourself "
-        "(write the computation; the library's version is what your answer is compared with)"
-    )
-
-
-def grade_notebook(path, lecture, material, limits):
+def grade_notebook(path, lecture, hidden_source, seed, limits, edition, unsafe):
     """Grade one notebook (the function the batch's workers run): a dict with the parts
-    [(exercise, part, points scored, points possible, message)], the cells that failed, what
-    it printed, and `stopped` (why the submission's process ended early, or None)."""
-    from . import checks
-
+    [(exercise, part, points scored, points possible, message)], the cells that failed, how many
+    cells used what the exercises ask for, what it printed, and `stopped` (why the sandbox ended
+    early, or None)."""
     t0 = time.monotonic()
     cells, _ = read_notebook(path)
-    hidden = load_hidden(hidden_checks_file(material))
-    checks.TIME_LIMIT = limits.check
-    checks._MEMO.clear()
-    mine = [e for e in checks.EXERCISES.values() if e.lecture == lecture]
-    code_cells = [(i, src) for i, (kind, src) in enumerate(cells, 1) if kind == "code"]
-    out = {"parts": [], "errors": [], "stopped": None, "printed": 0}
-    with tempfile.TemporaryDirectory(prefix="contactfem-submission-") as work:
-        box = Box(limits, work)
+    hidden = load_hidden(hidden_source, lecture) if hidden_source else {}
+    answers.TIME_LIMIT = limits.check
+    runs._MEMO.clear()
+    mine = [e for e in EXERCISES.values() if e.lecture == lecture]
+    out = {"parts": [], "errors": [], "left_out": 0, "stopped": None, "printed": 0}
+    with tempfile.TemporaryDirectory(prefix="contactfem-sandbox-") as work:
         try:
-            for i, src in code_cells:
+            box = Box(limits, edition, work, unsafe=unsafe)
+        except NoSandbox as err:
+            out["stopped"] = f"the sandbox did not start: {err}"
+            out["parts"] = [(e.name, p.name, 0.0, p.points, out["stopped"]) for e in mine for p in e.parts]
+            return out
+        try:
+            for i, (kind, src) in enumerate(cells, 1):
+                if kind != "code":
+                    continue
                 try:
                     r = box.cell(i, src)
                 except Stopped:
                     break
-                out["printed"] = r.get("printed", 0)
-                if not r.get("ok"):
-                    out["errors"].append(f"cell {i}: {r.get('error') or r.get('msg')}")
+                out["printed"] = r.get("printed", 0) if isinstance(r.get("printed"), int) else 0
+                if r.get("left_out") is True:
+                    out["left_out"] += 1
+                elif not r.get("ok"):
+                    out["errors"].append(f"cell {i}: {str(r.get('error') or r.get('msg'))[:200]}")
             for e in mine:
-                guard = checks.LIBRARY.get(e.name, ()) if e.implements else ()
-                names = {a for p in e.parts for a in p.answers}
-                named = set().union(*(library_named(src, guard, names) for _, src in code_cells)) if guard else set()
                 for p in e.parts:
-                    out["parts"].append((e.name, p.name, *_grade_part(box, p, hidden.get(p.name, ()), guard, named)))
+                    out["parts"].append((e.name, p.name, *_grade_part(box, p, hidden.get(p.name, ()), seed)))
         finally:
             box.close()
             out["stopped"] = box.dead
@@ -454,44 +127,25 @@ def grade_notebook(path, lecture, material, limits):
     return out
 
 
-def _grade_part(box, part, hidden, guard, named):
+def _grade_part(box, part, hidden, seed):
     """(points, possible, message) of one part: its public check and its hidden checks, in this
     process, on the submission's answers."""
-    if named:
-        return 0.0, part.points, library_hint(part.name, named)
-    box.guard, box.used = guard, set()
     msg = "passed"
     try:
         env = {a: box.get(a) for a in part.answers}
-        for check in [part.check, *hidden]:
-            check(**env)
-            if box.used:
-                break
+        part.check(**env)
+        for check in hidden:
+            check(**env, rng=rng_for(seed, part.name, check.__name__))
     except AssertionError as err:
         msg = " ".join(str(err).split())
     except Stopped as err:
         msg = str(err)
-    except LibraryCall:
-        pass
     except Exception as err:  # noqa: BLE001  (an answer the check did not foresee: the part fails)
         msg = f"the check could not use your answer: {type(err).__name__}: {' '.join(str(err).split())[:200]}"
-    if box.used:
-        return 0.0, part.points, library_hint(part.name, box.used)
     return (part.points if msg == "passed" else 0.0), part.points, msg
 
 
 # -- the batch -----------------------------------------------------------------------------------
-
-
-def submissions(folder):
-    """The notebooks of a folder of submissions (subfolders included), sorted."""
-    folder = Path(folder)
-    if not folder.is_dir():
-        raise ValueError(f"course grade: {folder} is not a folder of submitted notebooks")
-    found = sorted(p for p in folder.rglob("*.ipynb") if ".ipynb_checkpoints" not in p.parts)
-    if not found:
-        raise ValueError(f"course grade: no notebooks (*.ipynb) in {folder}")
-    return found
 
 
 def lecture_of(path, names):
@@ -580,22 +234,25 @@ def grade(
     review=None,
     feedback=None,
     progress=None,
+    seed=None,
+    unsafe_no_sandbox=False,
+    max_bytes=MAX_BYTES,
 ):
     """Grade every notebook in `folder` and write `out_csv`: one row per submission (and per
     student of the roster), columns id, name, submission, lecture, one per exercise and written
     question, total, possible, status, late, notes. The review files of the written answers go
     to `review`, a feedback file per student to `feedback` (default: next to the CSV, named
-    after it). Returns the rows."""
+    after it). `seed`: of the hidden checks' parameters (default: drawn afresh). Without a
+    sandbox, NoSandbox (a ValueError) before any work, unless `unsafe_no_sandbox`. Returns
+    the rows."""
     from ...io.outputs import check_output_path
-    from ..batch import run_batch
-    from . import checks
     from . import lecture_sources
 
-    folder = Path(folder)
-    subs = submissions(folder)
     out_csv = check_output_path(out_csv, "--out", (".csv",))
     if jobs < 1:
         raise ValueError(f"--jobs {jobs}: give a number of parallel gradings >= 1")
+    if seed is not None and not 0 <= seed < 2**63:
+        raise ValueError(f"--seed {seed}: give an integer from 0 to 2**63 - 1")
     for what, v in (("--notebook-timeout", limits.notebook), ("--check-timeout", limits.check)):
         if not v > 0:
             raise ValueError(f"{what} {v}: give a time limit in seconds > 0")
@@ -606,9 +263,9 @@ def grade(
         raise ValueError(f"--lecture {lecture}: not a lecture of this course ({', '.join(names)})")
     if autograders is not None:
         autograders = Path(autograders)
-        if not autograders.is_dir() or not (list(autograders.glob("*.zip")) or (autograders / HIDDEN_FILE).is_file()):
+        if not autograders.is_dir() or not (list(autograders.glob("*.zip")) or (autograders / FOLDER).is_dir()):
             raise ValueError(
-                f"--autograders {autograders}: no grading configurations (*.zip, {HIDDEN_FILE}) "
+                f"--autograders {autograders}: no grading configurations (*.zip, {FOLDER}/) "
                 "there; give the autograder/ folder of `contactfem course build --instructor`"
             )
     students = read_roster(roster) if roster else None
@@ -616,79 +273,74 @@ def grade(
     review = Path(review) if review else out_csv.with_name(out_csv.stem + "-review")
     feedback = Path(feedback) if feedback else out_csv.with_name(out_csv.stem + "-feedback")
     from . import check_out_dir
+    from .snapshot import notebooks
 
-    check_out_dir(review, "--review")
-    check_out_dir(feedback, "--feedback")
-
-    rel = {p: p.relative_to(folder).as_posix() for p in subs}
-    which = {p: lecture or lecture_of(p, names) for p in subs}
-    known = {w for w in which.values() if w}
-    if len(known) == 1 and not lecture:  # a class of one lecture: a missing or unreadable notebook is of it
-        lecture = known.pop()
-        which = {p: w or (lecture if not _readable(p) else None) for p, w in which.items()}
-    entries = []  # (student or None, path or None)
-    if students:
-        by_file = {s.file: s for s in students if s.file}
-        for s in students:
-            p = folder / s.file if s.file else None
-            entries.append((s, p if p is not None and p in rel else None))
-        entries += [(None, p) for p in subs if rel[p] not in by_file]
-    else:
-        entries = [(None, p) for p in subs]
+    for path, what in ((review, "--review"), (feedback, "--feedback")):
+        check_out_dir(path, what)
+        if path.is_symlink():
+            raise ValueError(f"{what} {path}: a symbolic link; give a real folder")
+    notebooks(folder)  # a folder with notebooks, or ValueError
+    sources = read_hidden(hidden_folder(autograders, repo))
+    for lec, text in sources.items():  # each file loads (ValueError naming it), before any work
+        load_hidden(text, lec)
+    scores_read = {}  # the instructor's scores of the written answers, read before any work
+    for lec in names:
+        sheet = review / f"{lec}-scores.csv"
+        scores_read[lec] = read_manual_scores(sheet) if sheet.is_file() else {}
+    staging = Path(tempfile.mkdtemp(prefix="contactfem-grade-"))  # the grader's own: mode 0700
+    try:
+        if not unsafe_no_sandbox:
+            try:
+                check_sandbox(staging)
+            except NoSandbox as err:
+                raise NoSandbox(
+                    f"course grade: no sandbox here ({err}); every submission runs in bubblewrap, which needs Linux "
+                    "with user namespaces (--unsafe-no-sandbox grades without one)"
+                ) from None
+        received = take(folder, staging / "submissions", max_bytes)  # before any submission runs
+        read = {rel: _read(r) for rel, r in received.items()}  # the copies as the grader reads them
+        seed = secrets.randbits(63) if seed is None else seed
+        entries, which, graded = _entries(received, read, students, names, lecture)
+        editions = {
+            lec: build_edition(staging / f"edition-{lec}", left_out(lec), Path(repo or REPO) / "lectures" / "examples")
+            for lec in sorted(set(graded.values()))
+        }
+        tasks = [
+            (rel, (str(received[rel].copy), lec, sources.get(lec), seed, limits, str(editions[lec]), unsafe_no_sandbox))
+            for rel, lec in graded.items()
+        ]
+        results, interrupted = _run(tasks, jobs, limits, progress)
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
 
     lectures = sorted({w for w in which.values() if w} | ({lecture} if lecture else set()))
-    scores_read = {lec: _read_manual_scores(review / f"{lec}-scores.csv") for lec in lectures}
-    material = hidden_checks_file(autograders, repo)
-    tasks, results = [], {}
-    for _, p in entries:
-        if p is not None and which.get(p) and any(e.lecture == which[p] for e in checks.EXERCISES.values()):
-            tasks.append((str(p), (str(p), which[p], str(material.parent) if material else None, limits)))
-    n_done, interrupted = 0, False
-    batch = run_batch(grade_notebook, tasks, jobs=jobs, timeout=limits.notebook + 60.0, retries=1)
-    try:
-        for outcome in batch:
-            results[outcome.key] = outcome
-            n_done += 1
-            if progress:
-                progress(n_done, len(tasks))
-    except KeyboardInterrupt:
-        interrupted = True
-    finally:
-        batch.close()
-
-    columns = [e for e in checks.EXERCISES if checks.EXERCISES[e].lecture in lectures]
-    manual = [m for m in checks.MANUAL if checks.MANUAL[m].lecture in lectures]
+    columns = [e for e in EXERCISES if EXERCISES[e].lecture in lectures]
+    manual = [m for m in MANUAL if MANUAL[m].lecture in lectures]
     rows, details = [], []
-    for s, p in entries:
-        if interrupted and p is not None and str(p) not in results:
+    for s, r in entries:
+        if interrupted and r is not None and r.rel in graded and r.rel not in results:
             continue
-        row, detail = _row(
-            s,
-            p,
-            rel.get(p, ""),
-            which.get(p) if p is not None else (lecture or ""),
-            results.get(str(p)),
-            columns,
-            manual,
-            scores_read,
-            deadline,
-        )
-        if students and s is None:
-            row["notes"] = " | ".join(x for x in ("not on the roster", row["notes"]) if x)
+        lec = which.get(r.rel) if r is not None else (lecture or (lectures[0] if len(lectures) == 1 else ""))
+        outcome, written = (results.get(r.rel), read[r.rel]) if r else (None, None)
+        row, detail = _row(s, r, written, lec, outcome, columns, manual, scores_read, deadline)
+        notes = ["not on the roster"] if students and s is None else []
+        notes += [UNSAFE] if unsafe_no_sandbox else []
+        row["notes"] = " | ".join(x for x in (*notes, row["notes"]) if x)
         rows.append(row)
         details.append(detail)
     fields = (
         ["id", "name", "submission", "lecture"] + columns + manual + ["total", "possible", "status", "late", "notes"]
     )
-    _write_csv(out_csv, fields, rows)
+    make_parents(out_csv)  # the folders the output names, made when it is written
+    write_atomic(out_csv, csv_text(fields, rows))
     if interrupted:
         raise GradingInterrupted(
-            f"interrupted: {n_done} of {len(tasks)} notebooks graded; their rows are in "
+            f"interrupted: {len(results)} of {len(tasks)} notebooks graded; their rows are in "
             f"{out_csv} (the others are not; no review or feedback files written)"
         )
     try:
-        _write_reviews(review, lectures, details, scores_read)
-        _write_feedback(feedback, details)
+        write_reviews(own_dir(review, "--review"), lectures, details, scores_read)
+        write_feedback(own_dir(feedback, "--feedback"), details)
     except KeyboardInterrupt:
         raise GradingInterrupted(
             f"interrupted after every notebook was graded: {out_csv} is complete; the review "
@@ -697,51 +349,89 @@ def grade(
     return rows
 
 
-def _readable(path):
+def left_out(lecture):
+    """{"module:Name": exercise} of what the exercises of `lecture` ask for: left out of its edition."""
+    return {spec: ex for ex, specs in LIBRARY.items() if EXERCISES[ex].lecture == lecture for spec in specs}
+
+
+def _entries(received, read, students, names, lecture):
+    """([(student or None, Received or None)] in the CSV's order, {path: lecture or None}, {path:
+    lecture} of the copies to grade)."""
+    which = {rel: lecture or (lecture_of(r.copy, names) if r.copy else None) for rel, r in received.items()}
+    known = {w for w in which.values() if w}
+    if len(known) == 1 and not lecture:  # a class of one lecture: a refused or unreadable notebook is of it
+        only = known.pop()
+        which = {rel: w or (only if isinstance(read[rel], str) else None) for rel, w in which.items()}
+    if students:
+        files = {s.file for s in students if s.file}
+        entries = [(s, received.get(s.file) if s.file else None) for s in students]
+        entries += [(None, r) for rel, r in received.items() if rel not in files]
+    else:
+        entries = [(None, r) for r in received.values()]
+    lectures_with_checks = {e.lecture for e in EXERCISES.values()}
+    graded = {
+        r.rel: which[r.rel]
+        for _, r in entries
+        if r is not None and r.copy is not None and which[r.rel] in lectures_with_checks
+    }
+    return entries, which, graded
+
+
+def _run(tasks, jobs, limits, progress):
+    """({path: Outcome}, interrupted) of the batch of gradings."""
+    from ..batch import run_batch
+
+    results, interrupted = {}, False
+    batch = run_batch(grade_notebook, tasks, jobs=jobs, timeout=limits.notebook + 60.0, retries=1)
     try:
-        read_notebook(path)
-        return True
-    except ValueError:
-        return False
+        for outcome in batch:
+            results[outcome.key] = outcome
+            if progress:
+                progress(len(results), len(tasks))
+    except KeyboardInterrupt:
+        interrupted = True
+    finally:
+        batch.close()
+    return results, interrupted
 
 
-def _write_csv(path, fields, rows):
-    from ...io.outputs import make_parents
-
-    make_parents(path)  # the folders the output names, made when it is written
-    tmp = path.with_name(f".{path.name}.part")
-    with open(tmp, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=fields)
-        w.writeheader()
-        w.writerows(rows)
-    os.replace(tmp, path)
+def _read(r):
+    """The written answers of a received notebook ({question: (code, answer)}), or why it is not a notebook."""
+    if r.copy is None:
+        return r.refused
+    try:
+        return manual_answers(read_notebook(r.copy)[0])
+    except ValueError as err:
+        return str(err)
 
 
-def _row(student, path, rel, lec, outcome, columns, manual, scores_read, deadline):
-    from . import checks
-
+def _row(student, received, read, lec, outcome, columns, manual, scores_read, deadline):
+    """The CSV row of one student or submission, and what the review and feedback files need. `read`:
+    the notebook's written answers, or why it could not be read."""
     row = {
         "id": student.id if student else "",
         "name": student.name if student else "",
-        "submission": rel,
+        "submission": received.rel if received else "",
         "lecture": lec or "",
     }
-    notes, parts, answers, stop = [], [], {}, None
-    mine = [e for e in columns if checks.EXERCISES[e].lecture == lec]
-    my_manual = [m for m in manual if checks.MANUAL[m].lecture == lec]
+    notes, parts, written, stop = [], [], {}, None
+    mine = [e for e in columns if EXERCISES[e].lecture == lec]
+    my_manual = [m for m in manual if MANUAL[m].lecture == lec]
     status = "graded"
-    if path is None:
+    if received is None:
         status = "missing"
         notes.append("no submission" + (f" (the roster names {student.file})" if student and student.file else ""))
-    elif not lec:
-        try:
-            read_notebook(path)
-            notes.append(
-                "not a lecture of this course (no otter assignment name in its metadata, no NN_ prefix); give --lecture"
-            )
-        except ValueError as err:
-            notes.append(str(err))
+    elif received.copy is None:
         status = "not graded"
+        notes.append(f"not graded: {received.refused}")
+    elif not lec:
+        status = "not graded"
+        notes.append(
+            read
+            if isinstance(read, str)
+            else "not a lecture of this course (no otter assignment name in its metadata, no NN_ prefix); "
+            "give --lecture"
+        )
     elif outcome is None:
         status, _ = "not graded", notes.append(f"lecture {lec} has no exercises")
     elif not outcome.ok:
@@ -758,13 +448,12 @@ def _row(student, path, rel, lec, outcome, columns, manual, scores_read, deadlin
             notes.append(res["stopped"])
         more = len(res["errors"]) - 3
         notes += res["errors"][:3] + ([f"and {more} more cells failed"] if more > 0 else [])
+        if res["left_out"]:
+            notes.append(f"{res['left_out']} cells used what this lecture's exercises ask for (left out while grading)")
         if res["printed"] > 2**20:
             notes.append(f"printed {res['printed'] / 2**20:.0f} MB (not kept)")
-    if path is not None and lec:  # the written answers, read here: a notebook stopped early has them too
-        try:
-            answers = manual_answers(read_notebook(path)[0])
-        except ValueError:
-            pass
+    if isinstance(read, dict) and lec:  # a notebook stopped early has them too
+        written = read
     total = 0.0
     for e in columns:
         if e in mine:
@@ -782,7 +471,7 @@ def _row(student, path, rel, lec, outcome, columns, manual, scores_read, deadlin
         if m not in my_manual:
             row[m] = ""
             continue
-        got = scores_read.get(lec, {}).get((rel, m))
+        got = scores_read.get(lec, {}).get((row["submission"], m))
         if got is None:
             row[m] = ""
             if status == "graded":
@@ -792,13 +481,13 @@ def _row(student, path, rel, lec, outcome, columns, manual, scores_read, deadlin
             total += got
     if unscored:
         notes.append(f"written answers to score: {', '.join(unscored)} (see the review file of {lec})")
-    possible = sum(checks.EXERCISES[e].points for e in mine) + sum(checks.MANUAL[m].points for m in my_manual)
+    possible = sum(EXERCISES[e].points for e in mine) + sum(MANUAL[m].points for m in my_manual)
     late = ""
-    if deadline is not None and path is not None:
+    if deadline is not None and received is not None:  # received: the roster's time, or the snapshot's
         when = (
             parse_time(student.submitted)
             if student and student.submitted
-            else dt.datetime.fromtimestamp(path.stat().st_mtime).astimezone()
+            else dt.datetime.fromtimestamp(received.mtime).astimezone()
         )
         late = _late(when, deadline)
         if late:
@@ -806,117 +495,6 @@ def _row(student, path, rel, lec, outcome, columns, manual, scores_read, deadlin
     row.update(
         total=f"{total:g}", possible=f"{possible:g}", status=status, late="yes" if late else "", notes=" | ".join(notes)
     )
-    detail = dict(row=row, parts=parts, answers=answers, manual=my_manual, lecture=lec)
+    got = received if received is not None and received.copy is not None else None
+    detail = dict(row=row, parts=parts, answers=written, manual=my_manual, lecture=lec, received=got)
     return row, detail
-
-
-def _read_manual_scores(path):
-    """{(submission, question): score} of the instructor's scores file (blank: not scored)."""
-    if not path.is_file():
-        return {}
-    from . import checks
-
-    out = {}
-    with open(path, newline="") as f:
-        for r in csv.DictReader(f):
-            text = (r.get("score") or "").strip()
-            if not text:
-                continue
-            q = r.get("question", "")
-            try:
-                v = float(text)
-            except ValueError:
-                raise ValueError(f"{path}: score {text!r} of {r.get('submission')}, {q} is not a number") from None
-            top = checks.MANUAL[q].points if q in checks.MANUAL else None
-            if top is not None and not 0 <= v <= top:
-                raise ValueError(f"{path}: score {v:g} of {r.get('submission')}, {q} is outside 0..{top:g}")
-            out[(r.get("submission", ""), q)] = v
-    return out
-
-
-def _write_reviews(review, lectures, details, scores_read):
-    """REVIEW/LECTURE.html (one section per student, code and answer side by side) and
-    REVIEW/LECTURE-scores.csv for the instructor's scores (kept if it exists: it is theirs)."""
-    from . import checks
-
-    review.mkdir(parents=True, exist_ok=True)
-    for lec in lectures:
-        qs = [m for m in checks.MANUAL.values() if m.lecture == lec]
-        if not qs:
-            continue
-        mine = [d for d in details if d["lecture"] == lec and d["row"]["submission"]]
-        parts = [
-            f"<!doctype html><meta charset=utf-8><title>Written answers: {html.escape(lec)}</title>",
-            "<style>body{font-family:sans-serif;margin:2em}table{border-collapse:collapse;width:100%}"
-            "td,th{border:1px solid #ccc;vertical-align:top;padding:.5em;width:50%}"
-            "pre{white-space:pre-wrap;margin:0}section{margin-bottom:2em}</style>",
-            f"<h1>Written answers: {html.escape(lec)}</h1>",
-            f"<p>{len(mine)} submissions. Enter the scores in <code>{html.escape(lec)}-scores.csv</code> "
-            "(column score) and run <code>contactfem course grade</code> again: they go into the CSV.</p>",
-        ]
-        for d in mine:
-            r = d["row"]
-            who = " ".join(x for x in (r["id"], r["name"]) if x) or r["submission"]
-            parts.append(
-                f'<section id="{html.escape(r["submission"])}"><h2>{html.escape(who)}</h2>'
-                f"<p>{html.escape(r['submission'])}</p>"
-            )
-            for q in qs:
-                code, text = d["answers"].get(q.name, ("", ""))
-                given = scores_read.get(lec, {}).get((r["submission"], q.name))
-                score = f"{given:g}" if given is not None else "not scored"
-                parts.append(
-                    f"<h3>{html.escape(q.name)} ({q.points:g} points; {score}): {html.escape(q.what)}</h3>"
-                    "<table><tr><th>code</th><th>answer</th></tr><tr>"
-                    f"<td><pre>{html.escape(code) or '(no code)'}</pre></td>"
-                    f"<td><pre>{html.escape(text) or '(no answer)'}</pre></td></tr></table>"
-                )
-            parts.append("</section>")
-        (review / f"{lec}.html").write_text("\n".join(parts))
-        sheet = review / f"{lec}-scores.csv"
-        if not sheet.exists():
-            rows = [
-                {
-                    "submission": d["row"]["submission"],
-                    "id": d["row"]["id"],
-                    "name": d["row"]["name"],
-                    "question": q.name,
-                    "points": f"{q.points:g}",
-                    "score": "",
-                }
-                for d in mine
-                for q in qs
-            ]
-            _write_csv(sheet, ["submission", "id", "name", "question", "points", "score"], rows)
-
-
-def _write_feedback(feedback, details):
-    """FEEDBACK/<id or submission>-<lecture>.md: the student's score per part and the hints."""
-    from . import checks
-
-    feedback.mkdir(parents=True, exist_ok=True)
-    for d in details:
-        r = d["row"]
-        stem = r["id"] or Path(r["submission"]).with_suffix("").as_posix().replace("/", "_")
-        lines = [
-            f"# {d['lecture'] or 'course'}: feedback for {r['name'] or r['id'] or r['submission']}",
-            "",
-            f"Total: {r['total']} of {r['possible']} ({r['status']}).",
-        ]
-        if r["late"]:
-            lines.append("Submitted late.")
-        if r["status"] != "graded" or r["notes"] and not d["parts"]:
-            lines += ["", f"Notes: {r['notes']}"]
-        for e in [e for e in checks.EXERCISES.values() if e.lecture == d["lecture"]]:
-            ps = [p for p in d["parts"] if p[0] == e.name]
-            got = sum(p[2] for p in ps)
-            lines += ["", f"## {e.name}: {got:g} of {e.points:g}", f"{e.what}", ""]
-            if e.name in checks.BUILDS_ON:
-                lines[-1:] = [f"(It builds on the library on purpose: {checks.BUILDS_ON[e.name]}.)", ""]
-            for _, part, pts, possible, msg in ps:
-                lines.append(f"- {part}: {pts:g} of {possible:g}" + ("" if msg == "passed" else f": {msg}"))
-        for q in d["manual"]:
-            m = checks.MANUAL[q]
-            got = f"{r[q]} of {m.points:g}" if r.get(q) else f"to be scored, {m.points:g} points"
-            lines += ["", f"## {q} (written): {got}", m.what]
-        (feedback / f"{stem}-{d['lecture'] or 'none'}.md").write_text("\n".join(lines) + "\n")

