@@ -70,7 +70,8 @@ class Evaluation(NamedTuple):
     """The System at one trial u: residual G, tangent K, the contacts' states, the loads P and
     the SystemState it was evaluated with (a tuple, so ``G, K = evaluation[:2]`` reads as before);
     a time stepper's effective evaluation also carries the inertia M a it added to G (Newton's
-    force scale reads it)."""
+    force scale reads it) and the round-off of that inertia (``roundoff``: eps times its largest
+    operand, in force units; Newton's test adds it to atol: solver/newton.py)."""
 
     G: np.ndarray
     K: object
@@ -78,6 +79,7 @@ class Evaluation(NamedTuple):
     P: np.ndarray | None = None
     state: SystemState | None = None
     inertia: np.ndarray | None = None
+    roundoff: float = 0.0
 
 
 class Dirichlet:
