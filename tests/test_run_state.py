@@ -10,11 +10,12 @@ from contactfem.scenes import get_scene
 from contactfem.problem.scene import simulate
 from contactfem.solver.march import resume
 
-# every scene whose model is one Stage (the cork's two stages: test_cork_twice_gives_the_same_records)
+# every scene (the cork: two stages, shortened)
 CASES = [
     ("bar_impact", {}),
     ("bar_impact", {"contact_integration": "energy_consistent"}),
     ("block", {}),
+    ("cork", {"t_end": 0.0004, "n_press": 2}),
     ("block", {"law": "parabolic"}),
     ("block", {"enforcement": "augmented"}),
     ("block", {"enforcement": "lagrange"}),
@@ -34,7 +35,10 @@ CASES = [
 
 def same(r, q):
     """Two records equal bit for bit: state of motion, energies, Newton's residuals, contact states."""
-    assert (r.k, r.t, r.dt, r.cuts) == (q.k, q.t, q.dt, q.cuts)
+    assert (r.k, r.t, r.dt, r.cuts, r.stage, r.error) == (q.k, q.t, q.dt, q.cuts, q.stage, q.error)
+    assert (r.state.slope is None) == (q.state.slope is None)
+    if r.state.slope is not None:
+        assert r.state.slope.dt == q.state.slope.dt and np.array_equal(r.state.slope.value, q.state.slope.value)
     for a, b in ((r.u, q.u), (r.v, q.v), (r.a, q.a)):
         assert np.array_equal(a, b)
     assert r.energy == q.energy and r.residuals == q.residuals
@@ -56,8 +60,7 @@ def model_of(name, over):
 )
 def test_marching_the_same_model_twice_gives_the_same_records(name, over):
     scene, params, model = model_of(name, over)
-    run = scene.simulate or simulate
-    first, second = run(model, params), run(model, params)
+    first, second = simulate(model, params), simulate(model, params)
     assert len(first) == len(second) > 1
     for r, q in zip(first, second):
         same(r, q)
@@ -102,6 +105,23 @@ def test_a_run_restarted_from_its_saved_kth_record_goes_on_as_it_went(name, over
     rest = list(resume(st.stepper, st.schedule, loaded, label=st.label))
     assert len(rest) == len(records) - k - 1 > 0
     for r, q in zip(rest, records[k + 1 :]):
+        same(r, q)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("suffix", [None, ".npz"])
+def test_the_cork_resumed_from_a_record_of_its_pop_goes_on_as_it_went(suffix, tmp_path):
+    """The pop, the stage built from the press fit's last record, resumed from its kth record (read
+    back from a file too: the gas's state, the contacts' histories): the same records from k on."""
+    scene, params, model = model_of("cork", {"t_end": 0.0006, "n_press": 2})
+    records = simulate(model, params)
+    fit, pop = [r for r in records if r.stage == 0], [r for r in records if r.stage == 1]
+    st = model.stages[1](fit[-1])
+    k = len(pop) // 2
+    start = pop[k] if suffix is None else load_record(save_record(pop[k], tmp_path / f"record{suffix}"))
+    rest = list(resume(st.stepper, st.schedule, start, label=st.label))
+    assert len(rest) == len(pop) - k - 1 > 0
+    for r, q in zip(rest, pop[k + 1 :]):
         same(r, q)
 
 
@@ -205,14 +225,14 @@ def test_the_readme_example_resumes_a_run(tmp_path, monkeypatch):
 
 @pytest.mark.slow
 def test_the_cork_twice_gives_the_same_records():
-    """Both stages of the cork (press fit, pop) run twice on the same model: the same records;
-    the model is not changed by a run (the pop's neck at rest is a new master)."""
+    """Both stages of the cork (press fit, then the pop built from its last record) run twice on the
+    same model: the same records, each marked with its stage; the model is not changed by a run (the
+    pop's neck at rest is a new master)."""
     scene, params, model = model_of("cork", {"t_end": 0.0004, "n_press": 2})
     motion = model.parts["neck"].motion
-    first, second = scene.simulate(model, params), scene.simulate(model, params)
+    first, second = simulate(model, params), simulate(model, params)
     assert model.parts["neck"].motion is motion is not None
-    same(first["fit_last"], second["fit_last"])
-    assert len(first["records"]) == len(second["records"]) > 1
-    for r, q in zip(first["records"], second["records"]):
+    assert [r.stage for r in first] == [0] * 3 + [1] * (len(first) - 3)  # n_press = 2: k = 0, 1, 2
+    assert len(first) == len(second) > 4
+    for r, q in zip(first, second):
         same(r, q)
-    assert np.array_equal(first["pressures"], second["pressures"])

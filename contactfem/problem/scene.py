@@ -1,12 +1,13 @@
 """What a scene is: named parameters with units and ranges, presets, and three steps,
 
-    model = scene.build(params, normal=..., friction=..., system_options=...)   # a Model: Systems, Stage
-    records = simulate(model, params, progress)   # the time loop (solver.march) over the model's Stage
+    model = scene.build(params, normal=..., friction=..., system_options=...)   # a Model: Systems, Stages
+    records = simulate(model, params, progress)   # the time loop (solver.march) over the model's Stages
     results = scene.measure(model, params, records)   # a JSON-able dict from the records
 
 that ``run`` puts together (one function for every scene: it also reports the size of the
-system, how it was solved and how often it was evaluated). A scene with more than one stage
-(the cork: press fit, then pop) gives its own ``simulate``.
+system, how it was solved and how often it was evaluated). A scene of several stages (the cork:
+press fit, then pop) marches them in turn: its records carry the stage that made them
+(``record.stage``), and a stage may start from the last record of the one before it.
 
 A scene module defines ``SCENE = Scene(...)``; the registry in ``contactfem.scenes`` finds
 it. Parameter names follow the paper's symbols (c_N, c_T, m, n, alpha, beta, mu, E, nu, dt,
@@ -31,12 +32,19 @@ PENALTY_DOC = (
 
 
 def simulate(model, params=None, progress=None):
-    """The records of the model's stage (``model.stage``): the initial state and every step."""
+    """The records of the model's stages in turn (``model.stages``), each stage's initial state and
+    every step, as one list (``record.stage``: which stage made it); a stage given as a function is
+    built from the last record of the stage before it, and its ``until`` may end it early."""
     from ..solver.march import march, watch
 
-    st = model.stage
-    records = march(st.stepper, st.schedule, st.t0, st.u0, st.v0, a0=st.a0, label=st.label)
-    return list(watch(records, progress, st.t0, st.schedule.t_end, st.name or model.name))
+    records = []
+    for i, stage in enumerate(model.stages):
+        st = stage if isinstance(stage, Stage) else stage(records[-1])
+        marched = march(st.stepper, st.schedule, st.t0, st.u0, st.v0, a0=st.a0, label=st.label, state=st.state, stage=i)
+        if st.until is not None:
+            marched = st.until(marched)
+        records += watch(marched, progress, st.t0, st.schedule.t_end, st.name or model.name)
+    return records
 
 
 def run(scene, params, normal=None, friction=None, progress=None, linear_algebra="auto", instrument=None):
@@ -93,7 +101,7 @@ class Scene:
     params: tuple
     build: Callable  # (params, *, normal, friction, system_options) -> Model
     measure: Callable  # (model, params, records) -> results dict
-    simulate: Callable | None = None  # (model, params, progress) -> records; default: the model's stage
+    simulate: Callable | None = None  # (model, params, progress) -> records; default: the model's stages
     presets: dict = field(default_factory=dict)  # preset name -> {param: value}
     reports: tuple = ()  # names of the main results, for `show`
     check: Callable[[dict], None] | None = None  # cross-parameter checks (ValueError), before any run

@@ -43,6 +43,7 @@ with the derivative of X on the diagonal.
 import numpy as np
 
 from ..bodies.discrete_gradient import cayley
+from .estimate import MIDPOINT
 from .newmark import increment, inertia_roundoff
 from .newton import newton
 from .system import Evaluation
@@ -54,6 +55,7 @@ class EnergyConsistent:
     ``newton_options`` go to ``newton``."""
 
     dynamic = True
+    error_model = MIDPOINT  # how its step errs (estimate.py)
 
     def __init__(self, system, **newton_options):
         self.system, self.newton_options = system, newton_options

@@ -25,8 +25,9 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .estimate import StepError, local_error
 from .newton import NewtonError
-from .schedule import Steps
+from .schedule import StepRejected, Steps
 from .system import SystemState
 
 
@@ -43,6 +44,9 @@ class Record:
     cuts, failures  halvings before the step converged, the first line of each failure
     state           the SystemState after the step (solver/system.py): what the next step
                     starts from
+    error           the step's StepError (estimate.py: its local error, and the share of a
+                    tolerance it may have); None at k = 0 and for a static stepper
+    stage           which of its model's stages made it (0 for a model of one stage)
     """
 
     k: int
@@ -57,6 +61,8 @@ class Record:
     cuts: int = 0
     failures: tuple = ()
     state: object = None
+    error: StepError | None = None
+    stage: int = 0
 
     @property
     def contacts(self):
@@ -72,15 +78,16 @@ class Record:
         return list(self.result.residuals) if self.result is not None else []
 
 
-def march(stepper, schedule, t0, u0, v0=None, *, a0=None, label=None, state=None):
+def march(stepper, schedule, t0, u0, v0=None, *, a0=None, label=None, state=None, stage=0):
     """Step from (t0, u0, v0) as the schedule says; yield the initial Record, then one per
-    accepted step. A step whose Newton fails is retried with the size ``schedule.cut`` gives,
-    until it gives None: then the NewtonError is raised with the last record as ``record``.
+    accepted step. A step whose Newton fails, or whose local error the schedule rejects, is
+    retried with the size ``schedule.cut`` gives, until it gives None: then the NewtonError is
+    raised with the last record as ``record``.
     ``a0``: the initial acceleration (default: M a0 = -G(u0), eq 29; 0 for a static stepper).
     ``label(k, t1, dt)``: the text naming a step in an error (default: step k, t, dt).
     ``state``: the SystemState to start from (default: ``system.start(u0, t0)``; e.g. the
-    contacts' histories a previous stage ended with)."""
-    rec = initial(stepper, schedule, t0, u0, v0, a0, state)
+    contacts' histories a previous stage ended with). ``stage``: the records' ``stage``."""
+    rec = initial(stepper, schedule, t0, u0, v0, a0, state, stage)
     yield rec
     yield from resume(stepper, schedule, rec, label=label)
 
@@ -102,6 +109,11 @@ def resume(stepper, schedule, record, *, label=None):
                 )
                 try:
                     trial = stepper.step(rec.t, rec.u, rec.v, rec.a, dt, name, state=rec.state)
+                    error, slope = estimate(stepper, schedule, rec, trial[2], dt)
+                    if error is not None and schedule.rejects(error, dt):
+                        raise StepRejected(
+                            f"local error {error.local:.3g} is past twice its share {error.share:.3g}", []
+                        )
                     break
                 except NewtonError as err:
                     failures.append(str(err).splitlines()[0][:200] if str(err) else "Newton failed")
@@ -110,7 +122,7 @@ def resume(stepper, schedule, record, *, label=None):
                         err.record = rec
                         raise
                     dt, cuts = smaller, cuts + 1
-            rec = accept(stepper.system, rec, schedule.end_time(rec.t, dt), dt, trial, cuts, failures)
+            rec = accept(stepper.system, rec, schedule.end_time(rec.t, dt), dt, trial, cuts, failures, error, slope)
             yield rec
     except KeyboardInterrupt as interrupt:  # Ctrl-C: say where (the innermost loop names it)
         if not hasattr(interrupt, "step"):
@@ -118,7 +130,18 @@ def resume(stepper, schedule, record, *, label=None):
         raise
 
 
-def initial(stepper, schedule, t0, u0, v0=None, a0=None, state=None):
+def estimate(stepper, schedule, rec, a1, dt):
+    """A converged step's StepError (estimate.py: its local error, and the share of the schedule's
+    tolerance it may have) and the Slope it hands to the next step; (None, None) for a stepper
+    without an error model (a static one)."""
+    model = stepper.error_model
+    if model is None:
+        return None, None
+    e, slope = local_error(model, stepper.system.lumped_mass(), rec.a, a1, dt, rec.state.slope)
+    return StepError(e, schedule.share(dt), model), slope
+
+
+def initial(stepper, schedule, t0, u0, v0=None, a0=None, state=None, stage=0):
     """The Record of the initial state: the SystemState started at u0 (or ``state``), one
     evaluation (with the schedule's first dt, for rate-dependent bodies and laws), a0 from eq 29."""
     s = stepper.system
@@ -132,14 +155,15 @@ def initial(stepper, schedule, t0, u0, v0=None, a0=None, state=None):
     else:
         a = acceleration(s, ev.G) if stepper.dynamic else np.zeros(s.ndof)
     energy = dict(s.energies(u, v, ev, dt), dissipation=0.0, external_work=0.0)
-    return Record(k=0, t=t0, dt=0.0, u=u, v=v, a=a, evaluation=ev, energy=energy, state=state)
+    return Record(k=0, t=t0, dt=0.0, u=u, v=v, a=a, evaluation=ev, energy=energy, state=state, stage=stage)
 
 
-def accept(system, rec, t1, dt, trial, cuts=0, failures=()):
+def accept(system, rec, t1, dt, trial, cuts=0, failures=(), error=None, slope=None):
     """Commit a converged step and make its Record: the next SystemState from the converged
-    evaluation; the energies are those of the converged state, the dissipation that of its
-    contact states, the external work the trapezoidal rule 1/2 (F_n + F_n+1) . (u_n+1 - u_n)
-    over the loads P and the support reactions (the prescribed-dof part of G)."""
+    evaluation (with the ``slope`` the step hands on, estimate.py); the energies are those of the
+    converged state, the dissipation that of its contact states, the external work the trapezoidal
+    rule 1/2 (F_n + F_n+1) . (u_n+1 - u_n) over the loads P and the support reactions (the
+    prescribed-dof part of G)."""
     u1, v1, a1, result = trial
     ev = result.evaluation
     fixed = system.fixed_dofs
@@ -149,8 +173,8 @@ def accept(system, rec, t1, dt, trial, cuts=0, failures=()):
     work = rec.energy["external_work"] + 0.5 * (P0 + P1) @ du + 0.5 * (F0 + F1) @ du[fixed]
     dissipation = rec.energy["dissipation"] + sum(st.dissipation for st in ev.contacts)
     state = system.commit(ev, u1, t1, dt)
-    if getattr(result, "carry", None) is not None:  # what the stepper hands to its next step
-        state = replace(state, stepper=result.carry)
+    if slope is not None:
+        state = replace(state, slope=slope)
     energy = dict(system.energies(u1, v1, ev, dt, state), dissipation=dissipation, external_work=float(work))
     return Record(
         k=rec.k + 1,
@@ -165,6 +189,8 @@ def accept(system, rec, t1, dt, trial, cuts=0, failures=()):
         cuts=cuts,
         failures=tuple(failures),
         state=state,
+        error=error,
+        stage=rec.stage,
     )
 
 
@@ -187,13 +213,20 @@ def acceleration(system, G):
 def watch(records, progress, t0, t_end, name):
     """The records, passed through a progress display: ``progress(t0, t_end, name)`` makes a
     callback (e.g. contactfem.io.ProgressBar) called with each record's (t, u, v, a) and
-    closed at the end. None: the records unchanged."""
+    closed at the end. None: the records unchanged. Records that end before t_end with a text
+    (a generator's return value: a Stage's ``until``) draw the bar full with that text (``finish``)."""
     if progress is None:
-        yield from records
-        return
+        return (yield from records)
     bar = progress(t0, t_end, name)
     try:
-        for rec in records:
+        records = iter(records)
+        while True:
+            try:
+                rec = next(records)
+            except StopIteration as stop:
+                if stop.value and hasattr(bar, "finish"):
+                    bar.finish(stop.value)
+                return stop.value
             bar(rec.t, rec.u, rec.v, rec.a)
             yield rec
     finally:

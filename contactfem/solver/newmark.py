@@ -31,6 +31,7 @@ import warnings
 import numpy as np
 
 from ..laws.validation import require
+from .estimate import newmark_error_model
 from .march import acceleration
 from .newton import NewtonError, NewtonResult, newton
 
@@ -90,6 +91,7 @@ class Newmark:
                 )
         self.system, self.delta, self.beta = system, delta, beta
         self.newton_options = newton_options
+        self.error_model = newmark_error_model(delta, beta)  # how its step errs (estimate.py)
 
     def step(self, t, u, v, a, dt, label="", *, state):
         assert dt > 0, SIZE_CHECKED
@@ -134,6 +136,7 @@ class Static:
     """
 
     dynamic = False
+    error_model = None  # no inertia: no time-stepping error to estimate
 
     def __init__(self, system, **newton_options):
         self.system, self.newton_options = system, newton_options
@@ -166,6 +169,7 @@ class CentralDifference:
     """
 
     dynamic = True
+    error_model = newmark_error_model(0.5, 0.0)  # its velocities: the trapezoidal rule (estimate.py)
 
     def __init__(self, system):
         if np.any(system.lumped_mass()[system.free_dofs] <= 0):

@@ -121,9 +121,6 @@ class NewtonResult:
     residual_ratio: float = 0.0  # (max |G_f| - floor)+ / F at u: what the test accepted above atol and round-off
     correction_ratio: float = 0.0  # the last correction / the step's increment (0 at k = 0)
     ratios: list = field(default_factory=list)  # max |G_f| / F of every iterate
-    local_error: float | None = None  # a time stepper's estimate of the step's error (schedule.Estimated)
-    carry: object = None  # what the stepper hands to its next step (SystemState.stepper)
-    error_share: float | None = None  # the error its share allows a step of its size (schedule.Estimated)
 
 
 # The default tolerances of the convergence test (module docstring; BENCHMARKS.md argues them)

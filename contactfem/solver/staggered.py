@@ -151,7 +151,7 @@ class Staggered:
 
     def __init__(self, stepper, max_cycles=60):
         self.stepper, self.max_cycles = stepper, max_cycles
-        self.system, self.dynamic = stepper.system, stepper.dynamic
+        self.system, self.dynamic, self.error_model = stepper.system, stepper.dynamic, stepper.error_model
         if self.dynamic and not hasattr(stepper, "beta"):
             raise ValueError("parameter stepper must be a Newmark or Static stepper (an implicit one)")
 

@@ -56,14 +56,14 @@ class SystemState:
     bodies    one per body: its internal variables (a viscoplastic beam's plastic strains;
               None for an elastic body)
     loads     one per load: its state (the gas pressure's value; None for most loads)
-    stepper   what the time stepper carries to its next step (None for most; a run at a
-              tolerance: the last step's change of the accelerations, schedule.Estimated)
+    slope     what the last step hands to the next step's error estimate (estimate.Slope;
+              None at a march's start and for a static stepper)
     """
 
     contacts: tuple = ()
     bodies: tuple = ()
     loads: tuple = ()
-    stepper: object = None
+    slope: object = None
 
 
 class Evaluation(NamedTuple):

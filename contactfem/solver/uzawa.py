@@ -55,9 +55,6 @@ class UzawaResult:
     violations: list = field(default_factory=list)
     gap_violation: float = 0.0
     gap_violations: list = field(default_factory=list)
-    local_error: float | None = None  # a time stepper's estimate of the step's error (schedule.Estimated)
-    carry: object = None  # what the stepper hands to its next step (SystemState.stepper)
-    error_share: float | None = None  # the error its share allows a step of its size (schedule.Estimated)
 
 
 class Uzawa:
@@ -81,7 +78,7 @@ class Uzawa:
         self.contacts = [c for c in contacts if isinstance(c, AugmentedNodeToSegment)]
         if not self.contacts:
             raise ValueError("Uzawa needs at least one augmented interface (enforcement = 'augmented')")
-        self.system, self.dynamic = stepper.system, stepper.dynamic
+        self.system, self.dynamic, self.error_model = stepper.system, stepper.dynamic, stepper.error_model
 
     def step(self, t, u, v, a, dt, label="", *, state):
         start = u
