@@ -78,3 +78,15 @@ def test_sloping_impact_at_dt_1e_6_converges_through_its_first_impact(tmp_path):
     r = json.loads(out.read_text())
     assert r["t_first_contact"] == pytest.approx(0.025, rel=1e-3) and r["step_cuts_total"] == 0
     assert r["accuracy"]["equilibrium"]["ok"]
+
+
+@pytest.mark.slow
+def test_the_corks_pop_goes_on_at_a_tiny_step():
+    """The cork's pop, in contact from its start (the press fit's state), at dt = 1e-6 s (a hundredth of the
+    paper's) and at 1e-9 s: 100 steps each, without a halving, each within its force test."""
+    from contactfem import run_scene
+
+    for dt in (1e-6, 1e-9):
+        r = run_scene("cork", "fast", dict(dt=dt, dt_fine=dt, t_end=100 * dt, n_press=2))
+        assert r["n_steps"] == 100 and r["newton_failures"] == 0 and r["accuracy"]["equilibrium"]["ok"]
+        assert min(r["contact_nodes"]) > 0
