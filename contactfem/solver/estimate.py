@@ -107,10 +107,13 @@ MIDPOINT = ErrorModel(0.5, 0.25)  # the energy-consistent midpoint rule: c = 1/1
 @dataclass(frozen=True, eq=False)
 class Slope:
     """What a step hands to the next step's estimate (SystemState.slope): the slope of the
-    accelerations over it, (a+ - a) / dt (None after a march's first step), and its size dt."""
+    accelerations over it, (a+ - a) / dt (None after a march's first step), its size dt, and
+    ``careful``: a flight a run at a tolerance steps again, in the kinetic energy's norm, after its
+    optimistic try ended in a contact (march.py), until the next contact."""
 
     value: np.ndarray | None
     dt: float
+    careful: bool = False
 
 
 @dataclass(frozen=True)
@@ -129,18 +132,38 @@ def norm(mass, d):
     return float(np.sqrt(np.sum(mass * d * d) / np.sum(mass)))
 
 
-def local_error(model, mass, a, a1, dt, before):
-    """The step's local error in the velocities (module docstring) and the Slope it hands on.
-    ``model``: the stepper's ErrorModel; ``mass``: the lumped mass; ``a``, ``a1``: the step's
+def momentum_norm(mass, d, positions):
+    """|d| in the bodies' momentum: each body's mass-weighted mean of d over its positions (the
+    error of its centre of mass's velocity, per direction), in the mass-weighted root mean square
+    over the bodies. ``positions``: one (nodes, dim) array of global dofs a body."""
+    total, out = 0.0, 0.0
+    for x in positions:
+        m = mass[x]
+        body = float(np.sum(m[:, 0]))
+        out += body * float(np.sum((np.sum(m * d[x], axis=0) / body) ** 2))
+        total += body
+    return float(np.sqrt(out / total))
+
+
+def error_vector(model, a, a1, dt, before):
+    """The step's local error in the velocities, a vector (module docstring; its size: ``norm``),
+    and the Slope it hands on. ``model``: the stepper's ErrorModel; ``a``, ``a1``: the step's
     accelerations at its start and end; ``before``: the Slope the step before handed on (None at a
     march's first step). The first step hands on no slope (Slope(None, dt)): it starts from the
     initial acceleration, which a scene may set by hand, so the second step takes the first-
     difference bound too."""
     slope = (a1 - a) / dt
-    handed = Slope(None if before is None else slope, dt)
+    handed = Slope(None if before is None else slope, dt, False if before is None else before.careful)
     if model.order == 1 or before is None or before.value is None:
-        return model.c * dt * norm(mass, a1 - a), handed
-    return dt**3 / 12.0 * norm(mass, (slope - before.value) / (0.5 * (dt + before.dt))), handed
+        return model.c * dt * (a1 - a), handed
+    return dt**3 / 12.0 * (slope - before.value) / (0.5 * (dt + before.dt)), handed
+
+
+def local_error(model, mass, a, a1, dt, before):
+    """The step's local error in the velocities in the kinetic energy's norm (module docstring), and
+    the Slope it hands on (error_vector; ``mass``: the lumped mass)."""
+    d, handed = error_vector(model, a, a1, dt, before)
+    return norm(mass, d), handed
 
 
 def time_error(records):

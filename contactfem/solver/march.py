@@ -25,7 +25,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from .estimate import StepError, local_error
+from .estimate import Slope, StepError, error_vector, momentum_norm, norm
 from .newton import NewtonError
 from .schedule import StepRejected, Steps
 from .system import SystemState
@@ -94,12 +94,22 @@ def march(stepper, schedule, t0, u0, v0=None, *, a0=None, label=None, state=None
 
 def resume(stepper, schedule, record, *, label=None):
     """The records after ``record`` (not itself), stepped as ``march`` steps: from a record of
-    a run (its u, v, a, energies, reactions and SystemState), the rest of that run exactly."""
+    a run (its u, v, a, energies, reactions and SystemState), the rest of that run exactly.
+
+    A run at a tolerance (``schedule.share``) flies optimistically: the steps of a flight (from a
+    record without contact) hold only the error of the bodies' momentum, the only error a flight
+    that ends the run hands to its results (no contact or load changes a body's momentum while no
+    force acts, and the integrators keep it); such steps are held back until the flight has ended
+    the run. A flight that ends in a contact is stepped again from the record it started at, in
+    the kinetic energy's norm (the contact sees the vibrations the flight carried), marked
+    ``careful`` in its Slope until the contact, so a run resumed from any record goes on as it went."""
     rec = record
     if not isinstance(rec.state, SystemState):
         raise ValueError(f"record {rec.k} has no SystemState to resume from (state = {type(rec.state).__name__})")
+    start, flight = None, []  # an optimistic flight: the record it started at, its records held back
     try:
         while (dt := schedule.next_dt(rec)) is not None:
+            optimistic = _optimistic(schedule, rec, dt)
             cuts, failures = 0, []
             while True:
                 name = (
@@ -109,7 +119,7 @@ def resume(stepper, schedule, record, *, label=None):
                 )
                 try:
                     trial = stepper.step(rec.t, rec.u, rec.v, rec.a, dt, name, state=rec.state)
-                    error, slope = estimate(stepper, schedule, rec, trial[2], dt)
+                    error, slope = estimate(stepper, schedule, rec, trial, dt, optimistic)
                     if error is not None and schedule.rejects(error, dt):
                         raise StepRejected(
                             f"local error {error.local:.3g} is past twice its share {error.share:.3g}", []
@@ -122,22 +132,58 @@ def resume(stepper, schedule, record, *, label=None):
                         err.record = rec
                         raise
                     dt, cuts = smaller, cuts + 1
-            rec = accept(stepper.system, rec, schedule.end_time(rec.t, dt), dt, trial, cuts, failures, error, slope)
+            new = accept(stepper.system, rec, schedule.end_time(rec.t, dt), dt, trial, cuts, failures, error, slope)
+            if optimistic and _touching(new):  # the flight ended in a contact: again from its start, carefully
+                rec, start, flight = _careful(start or rec), None, []
+                continue
+            if optimistic:
+                start, rec = start or rec, new
+                flight.append(new)
+                continue
+            rec = new
             yield rec
+        yield from flight  # the flight ended the run
     except KeyboardInterrupt as interrupt:  # Ctrl-C: say where (the innermost loop names it)
         if not hasattr(interrupt, "step"):
             interrupt.t, interrupt.step, interrupt.n_steps = rec.t, rec.k + 1, schedule.n_steps
         raise
 
 
-def estimate(stepper, schedule, rec, a1, dt):
+def _touching(rec):
+    return any(st.n_active for st in rec.contacts)
+
+
+def _optimistic(schedule, rec, dt):
+    """Whether the step after ``rec`` flies optimistically (resume): a run at a tolerance, a record
+    without contact, not a flight stepped again after its optimistic try (its Slope's ``careful``)."""
+    careful = rec.state.slope is not None and rec.state.slope.careful
+    return schedule.share(dt) is not None and not careful and not _touching(rec)
+
+
+def _careful(rec):
+    """The record a flight started at, marked to step the flight again in the kinetic energy's norm."""
+    slope = rec.state.slope or Slope(None, rec.dt)
+    return replace(rec, state=replace(rec.state, slope=replace(slope, careful=True)))
+
+
+def estimate(stepper, schedule, rec, trial, dt, optimistic=False):
     """A converged step's StepError (estimate.py: its local error, and the share of the schedule's
     tolerance it may have) and the Slope it hands to the next step; (None, None) for a stepper
-    without an error model (a static one)."""
+    without an error model (a static one). The error is the kinetic energy's norm of the error
+    vector, or its bodies' momentum's in an optimistic flight (resume); a Slope stays ``careful``
+    until the step that touches."""
     model = stepper.error_model
     if model is None:
         return None, None
-    e, slope = local_error(model, stepper.system.lumped_mass(), rec.a, a1, dt, rec.state.slope)
+    s = stepper.system
+    d, slope = error_vector(model, rec.a, trial[2], dt, rec.state.slope)
+    mass = s.lumped_mass()
+    if optimistic:
+        e = momentum_norm(mass, d, [s.offset(b) + np.asarray(b.xdofs) for b in s.bodies])
+    else:
+        e = norm(mass, d)
+    if slope.careful and any(st.n_active for st in trial[3].evaluation.contacts):
+        slope = replace(slope, careful=False)
     return StepError(e, schedule.share(dt), model), slope
 
 
