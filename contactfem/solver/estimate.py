@@ -169,7 +169,10 @@ def local_error(model, mass, a, a1, dt, before):
 def time_error(records):
     """The time part of a run's error bar from its own records: the sum of its steps' local errors
     (rec.error.local, the velocities' unit), which bounds the error of the velocities at the run's
-    end (module docstring); None where no step has an estimate (a static run). The error of a
-    velocity the run reports (a rebound, an exit velocity) over its scale is this over that scale."""
+    end (module docstring); None where no step has an estimate (a static run). A velocity the run
+    reports (a rebound, the centre of mass's: a mass-weighted mean, which the kinetic energy's norm
+    bounds) errs by at most this. A bound, not an estimate: on the fast presets' fixed steps it is 10
+    to 70 times the error a refined run shows (problem/accuracy.py, _time_resolution); a run at a
+    tolerance holds it to its tolerance (schedule.AtTolerance)."""
     errors = [r.error.local for r in records if r.error is not None]
     return float(sum(errors)) if errors else None

@@ -18,7 +18,9 @@ uninterrupted run went on.
 
 The schedule (schedule.py) decides the step sizes: fixed steps, or an adaptive rule of
 the last record, with the halving of a failed step; the scene decides when to stop, by
-leaving the loop. ``integrate`` collects a march into a ``History`` of arrays.
+leaving the loop. The loop estimates each dynamic step's local error (estimate.py; the record's
+``error``), which a schedule at a tolerance sizes the next step from and may reject a step by
+(``resume``: and its flights). ``integrate`` collects a march into a ``History`` of arrays.
 """
 
 from dataclasses import dataclass, field, replace

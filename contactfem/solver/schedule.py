@@ -138,7 +138,7 @@ class Adaptive(_Cuts):
 # sum over the run within tol speed (error per unit step). A step is chosen from the last one's error
 # (error_step) and taken; one whose error is past twice its share (the step into an impact or out of
 # it: the rule cannot see an event coming) is retried halved, as a step whose Newton fails
-# (StepRejected), down to the first step's size.
+# (StepRejected), down to the first step's size. A flight's steps hold the bodies' momentum (march.resume).
 
 
 class StepRejected(NewtonError):
