@@ -171,16 +171,15 @@ def _deepest(records):
     """The deepest penetration max(-g_N) over every contact state of every record, or None."""
     deepest = None
     for r in records:
-        for st in getattr(r.evaluation, "contacts", ()) or ():
-            g = getattr(st, "g_N", None)
-            if g is not None and np.size(g):
-                d = float(np.max(-np.asarray(g), initial=0.0))
+        for st in r.evaluation.contacts:
+            if np.size(st.g_N):
+                d = float(np.max(-np.asarray(st.g_N), initial=0.0))
                 deepest = d if deepest is None else max(deepest, d)
     return deepest
 
 
 def _touching(rec):
-    return any(np.any(np.asarray(getattr(st, "t_N", ())) != 0) for st in getattr(rec.evaluation, "contacts", ()) or ())
+    return any(np.any(np.asarray(st.t_N) != 0) for st in rec.evaluation.contacts)
 
 
 def _time_resolution(model, records, tolerance=TOLERANCE):
@@ -238,23 +237,21 @@ def _time_resolution(model, records, tolerance=TOLERANCE):
 
 def _penalty_steps(model, steps):
     """The largest dt sqrt(k / m) over the steps in contact: k = dt_N w at the stiffest touching node
-    of a contact, m its lumped mass; None without a contact node of a body with positions."""
+    of a contact, m its lumped mass; None where no step is in contact."""
     system = model.system
     if system is None:
         return None
     m = system.lumped_mass()
     best = None
     for r in steps:
-        for st, c in zip(r.evaluation.contacts, system.contacts):
-            dtn = getattr(st, "dt_N", None)
-            body = getattr(c, "slave", None)
-            if dtn is None or body is None or not np.size(dtn):
+        for st, c in zip(r.evaluation.contacts, system.contacts):  # (every contact's state: per slave node)
+            k = np.abs(np.asarray(st.dt_N)) * st.weights
+            if not np.size(k):
                 continue
-            w = np.broadcast_to(np.asarray(getattr(st, "weights", getattr(c, "weights", 1.0)), float), np.shape(dtn))
-            k = np.abs(np.asarray(dtn)) * w
             j = int(np.argmax(k))
-            if k[j] <= 0 or len(c.nodes) != len(k) or not hasattr(body, "xdofs"):
+            if k[j] <= 0:
                 continue
+            body = c.slave
             dof = system.offset(body) + body.xdofs[c.nodes[j], 1]
             if m[dof] <= 0:
                 continue
