@@ -42,8 +42,9 @@ def touching(rec):
 )
 def test_a_tiny_step_goes_on_from_a_record_in_contact(name, over):
     """From the fifth record in contact (a displacement of the run's own size), 100 steps
-    of 1e-5 of the scene's step: each converges without a halving, to the tolerance of its own forces. (Before the steps iterated on the increment, every case but the sloping
-    impact stopped here: 'no convergence', the residual flat at c M eps |u|.)"""
+    of 1e-5 of the scene's step: each converges without a halving, to the tolerance of its own forces.
+    (Before the steps iterated on the increment, every case but the sloping impact stopped here: 'no
+    convergence', the residual flat at c M eps |u|.)"""
     scene = get_scene(name)
     params = scene.resolve("fast", over)
     stage = scene.build(params).stage

@@ -33,8 +33,9 @@ def _oscillator(model, omega_dt, n):
 def test_half_period_error_is_the_integrators_over_half_a_period(delta, beta, n):
     """At w dt = pi / n, n steps are half a period: the exact motion ends at u = -1, and the error the
     amplification matrix gives is the distance the steps themselves end at: to rounding for the
-    trapezoidal rule (1e-6: a small difference of two numbers near 1), within (w dt)^2 / 2 where delta > 1/2 (the start (1, 0, -1) is off the principal
-    pair's eigenvectors by O(w dt)^2 there: measured 0.11 (w dt)^2 from 3 to 60 steps)."""
+    trapezoidal rule (1e-6: a small difference of two numbers near 1), within (w dt)^2 / 2 where
+    delta > 1/2 (the start (1, 0, -1) is off the principal pair's eigenvectors by O(w dt)^2 there:
+    measured 0.11 (w dt)^2 from 3 to 60 steps)."""
     model = ErrorModel(delta, beta)
     u, w = _oscillator(model, math.pi / n, n)
     rel = 1e-6 if delta == 0.5 else (math.pi / n) ** 2 / 2

@@ -1,6 +1,7 @@
 """The local error of a time step: one estimator for the steps of a run at a tolerance
 (schedule.py), its ``error_budget`` indicator and the time resolution's thresholds
-(problem/accuracy.py: ErrorModel.half_period_error). The time loop (march.py) estimates every dynamic step and records it,
+(problem/accuracy.py: ErrorModel.half_period_error). The time loop (march.py) estimates every
+dynamic step and records it,
 
     rec.error     StepError(local, share): the step's local error, and what its tolerance allows
     rec.state.slope   Slope: what the next step's estimate needs (the run carries it as a value)
