@@ -47,8 +47,6 @@ class Contact(Protocol):
     name: str
     integration: str  # "standard" | "energy_consistent"
     unknowns: int  # unknowns of its own (0: only the bodies' dofs)
-    slave: object  # the slave body (contactfem.bodies.interfaces.Body)
-    nodes: np.ndarray  # (nc,) its slave node numbers; each state has g_N, t_N, dt_N, weights per slave node
 
     def start(self, u: np.ndarray, t: float = 0.0, *, offsets: dict | None = None) -> object:
         """The history at the initial state u (a value)."""

@@ -237,7 +237,9 @@ def _time_resolution(model, records, tolerance=TOLERANCE):
 
 def _penalty_steps(model, steps):
     """The largest dt sqrt(k / m) over the steps in contact: k = dt_N w at the stiffest touching node
-    of a contact, m its lumped mass; None where no step is in contact."""
+    of a contact, m its lumped mass; None where no step is in contact. (Besides the solver's Contact protocol it
+    reads what every contact of contactfem.contact has: its slave body and nodes, and its states' per-node
+    dt_N and weights, as _deepest and _touching read their g_N and t_N.)"""
     system = model.system
     if system is None:
         return None
