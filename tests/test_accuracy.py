@@ -88,8 +88,8 @@ def test_bar_impact_off_its_closed_form_is_flagged(over):
 
 def test_sloping_impact_coarse_step_is_flagged():
     r, flagged = _run("sloping_impact", {"dt": 1})
-    assert {"impact_steps", "energy_loss", "local_error"} <= flagged
-    assert r["accuracy"]["energy_loss"]["value"] > 0.3
+    assert {"impact_steps", "energy_loss", "penalty_steps"} <= flagged
+    assert r["accuracy"]["energy_loss"]["value"] > 0.3 and r["accuracy"]["impact_steps"]["value"] <= 3
 
 
 @pytest.mark.parametrize("integration", ["standard", "energy_consistent"])
@@ -101,22 +101,25 @@ def test_rolling_ring_coarse_step_is_flagged_by_v_final(integration):
 def test_rolling_ring_sliding_reference():
     r, flagged = _run("rolling_ring", {"mu": 1e-9})
     assert r["v_final_exact"] == pytest.approx(300.0, rel=1e-6)  # the ring slides to the end: v0 - mu g t
-    assert abs(r["v_final_rel_err"]) < 1e-6 and not flagged
+    assert abs(r["v_final_rel_err"]) < 1e-6 and flagged == {"penalty_steps"}  # (its contact: dt sqrt(k/m) = 25)
 
 
 @pytest.mark.slow
-def test_presets_unflagged():
+def test_presets_unflagged_but_their_unresolved_contacts():
+    """The static scenes pass; the rings' contacts oscillate faster than their steps resolve (dt sqrt(k/m) =
+    3.6 on the sloping impact, 25 on the rolling ring, where Newmark 0.7, 0.4 errs by 5 % over half a period
+    at 0.16), and say so."""
     for name in ("sloping_impact", "rolling_ring", "block", "patch"):
         r, flagged = _run(name, {})
-        assert not flagged, (name, flagged)
+        assert flagged == ({"penalty_steps"} if name in ("sloping_impact", "rolling_ring") else set()), (name, flagged)
         assert "equilibrium" in r["accuracy"]
 
 
-def test_funnel_paper_penalty_is_flagged_by_its_penetration_alone():
-    """The paper's funnel (c_N = 10, dt = 0.1) sits between two indicators: its ring penetrates just
-    past a tenth of an element, and twice the penalty is no longer resolved by the step."""
+def test_funnel_paper_penalty_is_flagged_by_its_penetration_and_its_step():
+    """The paper's funnel (c_N = 10, dt = 0.1): its ring penetrates just past a tenth of an element, and
+    its contact oscillates at dt sqrt(k/m) = 3.1 a step; twice the penalty goes less deep."""
     r, flagged = _run("funnel", {})
-    assert flagged == {"penetration"} and 0.1 < r["accuracy"]["penetration"]["value"] < 0.11
+    assert flagged == {"penetration", "penalty_steps"} and 0.1 < r["accuracy"]["penetration"]["value"] < 0.11
     assert _run("funnel", {"c_N": 20})[1] == {"penalty_steps"}
 
 

@@ -156,6 +156,16 @@ def hertz_runs():
     return out
 
 
+def test_an_augmented_runs_equilibrium_is_its_newton_solves():
+    """The equilibrium indicator of a run with the Uzawa loop reads the converged Newton solve of each step (it
+    once read 0 for every step: the loop's result had no residual_ratio). Hertz's contact forces (~1e3) leave
+    a converged residual of a few ulps of them above newton's atol (1e-12), so its ratio is not 0."""
+    from contactfem.problem.accuracy import EQUILIBRIUM
+
+    eq = run_scene("hertz", "fast", {"enforcement": "augmented", "uzawa_tol": 1e-8})["accuracy"]["equilibrium"]
+    assert 0.0 < eq["value"] <= EQUILIBRIUM
+
+
 @pytest.mark.slow
 def test_hertz_augmented_reaches_1e8_in_6_updates(hertz_runs):
     r = hertz_runs["default"]

@@ -269,7 +269,8 @@ def test_a_laws_own_fields_keep_their_defaults_and_cli_equals_python(capsys, tmp
         "--json",
         str(out),
     )
-    assert rc == 0 and err == [], err
+    # (no note: the fields have defaults; the ring's contact is not resolved by its step, and its accuracy says so)
+    assert rc == 0 and [e for e in err if "warning: accuracy: penalty_steps" not in e] == [], err
     a = json.loads(out.read_text())
     assert a["friction_law"]["fields"] == {"c_T": 10.0, "mu": 0.2, "m": 0.5, "delta": 0.05}
     assert a["parameters"]["m"] == 1.0 and a["parameters"]["delta"] == 0.7  # the scene's own, untouched

@@ -10,11 +10,12 @@ from contactfem.scenes import get_scene
 from contactfem.problem.scene import simulate
 from contactfem.solver.march import resume
 
-# every scene whose model is one Stage (the cork's two stages: test_cork_twice_gives_the_same_records)
+# every scene (the cork: two stages, shortened)
 CASES = [
     ("bar_impact", {}),
     ("bar_impact", {"contact_integration": "energy_consistent"}),
     ("block", {}),
+    ("cork", {"t_end": 0.0004, "n_press": 2}),
     ("block", {"law": "parabolic"}),
     ("block", {"enforcement": "augmented"}),
     ("block", {"enforcement": "lagrange"}),
@@ -54,8 +55,7 @@ def model_of(name, over):
 )
 def test_marching_the_same_model_twice_gives_the_same_records(name, over):
     scene, params, model = model_of(name, over)
-    run = scene.simulate or simulate
-    first, second = run(model, params), run(model, params)
+    first, second = simulate(model, params), simulate(model, params)
     assert len(first) == len(second) > 1
     for r, q in zip(first, second):
         same(r, q)
@@ -134,6 +134,21 @@ def test_resuming_a_record_on_a_model_of_another_size_names_both_sizes():
     _, _, other = model_of("block", {"n_steps": 1, "nx": 12})
     with pytest.raises(ValueError, match=rf"^record 1 holds {len(record.u)} unknowns, the model {other.system.ndof}:"):
         next(resume(other.stage.stepper, other.stage.schedule, record))
+@pytest.mark.slow
+@pytest.mark.parametrize("suffix", [None, ".npz"])
+def test_the_cork_resumed_from_a_record_of_its_pop_goes_on_as_it_went(suffix, tmp_path):
+    """The pop, the stage built from the press fit's last record, resumed from its kth record (read
+    back from a file too: the gas's state, the contacts' histories): the same records from k on."""
+    scene, params, model = model_of("cork", {"t_end": 0.0006, "n_press": 2})
+    records = simulate(model, params)
+    fit, pop = [r for r in records if r.stage == 0], [r for r in records if r.stage == 1]
+    st = model.stages[1](fit[-1])
+    k = len(pop) // 2
+    start = pop[k] if suffix is None else load_record(save_record(pop[k], tmp_path / f"record{suffix}"))
+    rest = list(resume(st.stepper, st.schedule, start, label=st.label))
+    assert len(rest) == len(pop) - k - 1 > 0
+    for r, q in zip(rest, pop[k + 1 :]):
+        same(r, q)
 
 
 def test_a_record_that_is_not_one_is_refused(tmp_path):
@@ -236,14 +251,14 @@ def test_the_readme_example_resumes_a_run(tmp_path, monkeypatch):
 
 @pytest.mark.slow
 def test_the_cork_twice_gives_the_same_records():
-    """Both stages of the cork (press fit, pop) run twice on the same model: the same records;
-    the model is not changed by a run (the pop's neck at rest is a new master)."""
+    """Both stages of the cork (press fit, then the pop built from its last record) run twice on the
+    same model: the same records, each marked with its stage; the model is not changed by a run (the
+    pop's neck at rest is a new master)."""
     scene, params, model = model_of("cork", {"t_end": 0.0004, "n_press": 2})
     motion = model.parts["neck"].motion
-    first, second = scene.simulate(model, params), scene.simulate(model, params)
+    first, second = simulate(model, params), simulate(model, params)
     assert model.parts["neck"].motion is motion is not None
-    same(first["fit_last"], second["fit_last"])
-    assert len(first["records"]) == len(second["records"]) > 1
-    for r, q in zip(first["records"], second["records"]):
+    assert [r.stage for r in first] == [0] * 3 + [1] * (len(first) - 3)  # n_press = 2: k = 0, 1, 2
+    assert len(first) == len(second) > 4
+    for r, q in zip(first, second):
         same(r, q)
-    assert np.array_equal(first["pressures"], second["pressures"])

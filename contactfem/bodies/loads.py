@@ -173,11 +173,9 @@ def swept_volume(x):
 @dataclass(frozen=True)
 class GasState:
     """What the gas column remembers (GasPressure): the swept volume S0 of the initial state,
-    the number k of pressures set, the value set from the last converged state, whether the
-    gas has escaped and when."""
+    the value (Boyle's) set from the last converged state, whether the gas has escaped and when."""
 
     S0: float
-    k: int = 0
     value: float = 0.0
     released: bool = False
     released_at: float | None = None
@@ -187,7 +185,8 @@ class GasPressure(Pressure):
     """The pressure of a gas column under the face ``boundary_name`` of an axisymmetric
     body (the champagne under the cork): a follower ``Pressure`` whose value is
 
-        ramp:   p = p_step * ceil(t / dt_ramp) while t <= n_ramp dt_ramp (by time)
+        ramp:   p = p_step * ceil(n_ramp t / t_ramp) while t <= t_ramp (by time: n_ramp
+                increments of p_step, each held t_ramp / n_ramp)
         Boyle:  p = p0 V0 / V after the ramp (p0 = n_ramp p_step, V0 = area * column,
                 V = V0 + the volume swept by the face since ``start``)
         open:   p = 0 once the face's outer edge has reached z_release (the gas escapes).
@@ -198,11 +197,11 @@ class GasPressure(Pressure):
     The state is a GasState value, carried by the System like a contact's history.
     """
 
-    def __init__(self, body, boundary_name, face_nodes, area, column, p_step, n_ramp, dt_ramp, z_release):
+    def __init__(self, body, boundary_name, face_nodes, area, column, p_step, n_ramp, t_ramp, z_release):
         super().__init__(body, boundary_name, None, follower=True)
         self.face = np.asarray(face_nodes)
         self.V0 = area * column
-        self.p_step, self.n_ramp, self.dt_ramp, self.z_release = p_step, n_ramp, dt_ramp, z_release
+        self.p_step, self.n_ramp, self.t_ramp, self.z_release = p_step, n_ramp, t_ramp, z_release
         self.p0 = p_step * n_ramp
 
     def face_positions(self, u, offsets=None):
@@ -227,26 +226,21 @@ class GasPressure(Pressure):
         return self.face_positions(u, offsets)[-1, 1]
 
     def update(self, u, t, state, offsets=None):
-        """The GasState with the pressure for the next step from the converged u (explicit
-        coupling); t is recorded as ``released_at`` at the release."""
-        k, released, released_at = state.k + 1, state.released, state.released_at
+        """The GasState with Boyle's pressure for the next step from the converged u (explicit
+        coupling; it acts once the ramp is over); t is recorded as ``released_at`` at the release."""
+        released, released_at = state.released, state.released_at
         if not released and self.edge_z(u, offsets) >= self.z_release:
             released, released_at = True, t
-        if released:
-            value = 0.0
-        elif k <= self.n_ramp:
-            value = self.p_step * k
-        else:
-            value = self.p0 * self.V0 / self.volume(u, state, offsets)
-        return replace(state, k=k, value=value, released=released, released_at=released_at)
+        value = 0.0 if released else self.p0 * self.V0 / self.volume(u, state, offsets)
+        return replace(state, value=value, released=released, released_at=released_at)
 
     def pressure(self, t, state):
         """The value at time t with the GasState ``state``: the ramp by time, then the value
         set by ``update``."""
         if state.released:
             return 0.0
-        if t <= self.n_ramp * self.dt_ramp * (1 + 1e-9):
-            return self.p_step * np.ceil(t / self.dt_ramp - 1e-6)
+        if t <= self.t_ramp * (1 + 1e-9):
+            return self.p_step * np.ceil(self.n_ramp * t / self.t_ramp - 1e-6)
         return state.value
 
     def _value(self, t, state):

@@ -110,6 +110,11 @@ class ContactState:
             master=c.master.reference(self.u, self.offsets),
         )
 
+    @property
+    def weights(self):
+        """(nc,) the contact's per-slave weights of the tractions (as a mortar state's own)."""
+        return self.contact.weights
+
     @cached_property
     def energy(self):
         """Energy stored in the interface: the normal law's potential plus the elastic

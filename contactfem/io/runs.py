@@ -319,9 +319,11 @@ def _state_types():
     from ..contact.mortar import Pairs
     from ..contact.mortar_contact import MortarHistory
     from ..contact.state import ContactHistory
+    from ..solver.estimate import Slope
     from ..solver.system import SystemState
 
-    return {t.__name__: t for t in (SystemState, ContactHistory, AugmentedHistory, MortarHistory, Pairs, GasState)}
+    types = (SystemState, ContactHistory, AugmentedHistory, MortarHistory, Pairs, GasState, Slope)
+    return {t.__name__: t for t in types}
 
 
 def _state_to_plain(obj, where, types):
@@ -356,9 +358,8 @@ def _state_from_plain(obj, types):
 
 def save_record(record, path):
     """Write one record of a march (k, t, dt, u, v, a, energies, Newton's residuals, the
-    reactions and loads the next step's work needs, its SystemState, and in a run at a tolerance
-    its step's local error and share) to `path` (.json or .npz, as save_run). Returns the path as
-    a string."""
+    reactions and loads the next step's work needs, its SystemState, its step's local error and
+    share, its stage) to `path` (.json or .npz, as save_run). Returns the path as a string."""
     ev, result = record.evaluation, record.result
     G = result.G if result is not None else ev.G  # the prescribed-dof part: the reactions
     doc = dict(
@@ -377,8 +378,10 @@ def save_record(record, path):
         residuals=[float(r) for r in record.residuals],
         state=_state_to_plain(record.state, "state", _state_types()),
         # a run at a tolerance sizes its next step from these (solver/schedule.py)
-        local_error=getattr(result, "local_error", None),
-        error_share=getattr(result, "error_share", None),
+        local_error=None if record.error is None else record.error.local,
+        error_share=None if record.error is None else record.error.share,
+        error_model=None if record.error is None else [record.error.model.delta, record.error.model.beta],
+        stage=int(record.stage),
     )
     return save_run({"record": doc}, path)
 
@@ -387,6 +390,7 @@ def load_record(path):
     """The record save_record wrote, to resume a march from (contactfem.solver.march.resume):
     its numbers bit for bit, its SystemState, the residual and loads of its evaluation (no
     tangent, no contact states: those of the steps after it are recomputed)."""
+    from ..solver.estimate import ErrorModel, StepError
     from ..solver.march import Record
     from ..solver.newton import NewtonResult
     from ..solver.system import Evaluation
@@ -404,11 +408,15 @@ def load_record(path):
             iterations=int(r["iterations"]),
             G=r["G"],
             evaluation=ev,
-            local_error=r.get("local_error"),
-            error_share=r.get("error_share"),
         )
         if r["k"] > 0
         else None
+    )
+    model = r.get("error_model")
+    error = (
+        None
+        if r.get("local_error") is None
+        else StepError(r["local_error"], r.get("error_share"), None if model is None else ErrorModel(*model))
     )
     return Record(
         k=int(r["k"]),
@@ -423,4 +431,6 @@ def load_record(path):
         cuts=int(r["cuts"]),
         failures=tuple(r["failures"]),
         state=state,
+        error=error,
+        stage=int(r.get("stage", 0)),
     )

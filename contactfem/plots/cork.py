@@ -209,7 +209,7 @@ SENSITIVITY = (
     ("rho = 2.4e-10 (240 kg/m^3, lighter)", {"rho": 2.4e-10}),
     ("R_tip = 10.5 mm (less taper)", {"R_tip": 10.5}),
 )
-P0_STEPS = (8, 9)  # n_ramp: p0 = 0.8 MPa (paper) and 0.9 MPa
+P0_STEPS = (8, 9)  # n_ramp: p0 = 0.8 MPa (paper) and 0.9 MPa, at the paper's 0.1 MPa every 0.1 ms (t_ramp)
 
 
 def _case(preset, over):
@@ -231,7 +231,7 @@ def sensitivity_runs(preset="fast", cases=SENSITIVITY, jobs=2):
     """The outcome of each case at each n_ramp of P0_STEPS (case, overrides, the run's exit
     velocity and press-fit force; "v": as the table prints it); the runs in parallel on `jobs`
     cores (joblib, if installed; else one by one)."""
-    todo = [(label, dict(over, n_ramp=n)) for label, over in cases for n in P0_STEPS]
+    todo = [(label, dict(over, n_ramp=n, t_ramp=n * _RAMP)) for label, over in cases for n in P0_STEPS]
     try:
         from joblib import Parallel, delayed
     except ImportError:
@@ -475,7 +475,7 @@ def cork_knife_edge(preset="fast", outdir=None, data=None):
 # the press fit refined eightfold, one refined time step; CONTACTFEM_SLOW=1: every case.
 EXIT_PRESET = "paper"
 _ON, _OFF = (True, True), (False, False)
-_RAMP = 1e-4  # s: the paper's ramp, 8 steps of 0.1 MPa every 0.1 ms, kept when dt is refined
+_RAMP = 1e-4  # s: the paper's ramp, 8 steps of 0.1 MPa every 0.1 ms (t_ramp / n_ramp), kept when dt is refined
 _STEP = "time step in the neck (ramp kept)"
 EXIT_CASES_QUICK = (
     # group, label, scene overrides, (closing step in the press fit, in the pop), ramp step (s)
@@ -520,10 +520,9 @@ def exit_case(case, preset=EXIT_PRESET):
     closing step of its contact on or off in each stage and, with a ramp step, the time step
     refined under the unchanged pressure ramp. Returns the case with the exit time and
     velocity, the press-fit force and the slowest speed of the cork after the ramp (its stall)."""
+    from ..problem.scene import simulate
     from ..scenes import get_scene
-    from ..scenes.cork import build
-    from ..scenes.cork import contact_forces, history
-    from ..scenes.cork import pop, press_fit, stage_systems
+    from ..scenes.cork import build, contact_forces, exit_of, history, stage_systems, stages
 
     group, label, over, (fit_rule, pop_rule), ramp = case
     row = dict(
@@ -535,30 +534,19 @@ def exit_case(case, preset=EXIT_PRESET):
         ramp_step_s=ramp,
     )
     try:
-        P = get_scene("cork").resolve(preset, over)
+        P = get_scene("cork").resolve(preset, over)  # (the ramp is t_ramp's: a finer dt keeps it)
         model = build(P)
-        if ramp is not None:
-            model.parts["gas"].dt_ramp = ramp
         contacts = model.parts["contacts"]
-        model = replace(
-            model,
-            systems=stage_systems(
-                model.parts,
-                P,
-                contacts=(
-                    [c.with_closing_step(fit_rule) for c in contacts],
-                    [c.with_closing_step(pop_rule) for c in contacts],
-                ),
-            ),
-        )
-        fit_last, _ = press_fit(model, P)
-        records, pressures, exit_time, gas = pop(model, P, fit_last.u, histories=fit_last.state.contacts)
+        rules = ([c.with_closing_step(fit_rule) for c in contacts], [c.with_closing_step(pop_rule) for c in contacts])
+        systems = stage_systems(model.parts, P, contacts=rules)
+        model = replace(model, systems=systems, stages=stages(systems, model.parts, P))
+        records = simulate(model, P)
     except Exception as err:  # a failed run is a row of the study, not hidden
         return dict(row, exited=None, error=f"{type(err).__name__}: {str(err).splitlines()[0][:100]}")
-    exited = bool(gas.released and records[-1].contacts[0].n_active == 0)
-    h = history(model, dict(records=records, pressures=pressures))
-    t_ramp = P["n_ramp"] * (ramp or P["dt"])
-    after = np.flatnonzero(h["t"] > t_ramp * (1 + 1e-9))
+    fit_last, pop = [r for r in records if r.stage == 0][-1], [r for r in records if r.stage == 1]
+    exited, exit_time, _ = exit_of(pop)
+    h = history(model, pop)
+    after = np.flatnonzero(h["t"] > P["t_ramp"] * (1 + 1e-9))
     k = after[np.argmin(h["v_cm"][after])]
     return dict(
         row,
@@ -570,7 +558,7 @@ def exit_case(case, preset=EXIT_PRESET):
         v_min_after_ramp_m_s=float(h["v_cm"][k]),
         t_v_min_ms=float(h["t"][k] * 1e3),
         steps=int(len(h["t"]) - 1),
-        newton_failures=sum(len(rec.failures) for rec in records),
+        newton_failures=sum(len(rec.failures) for rec in pop),
     )
 
 

@@ -1,12 +1,13 @@
 """What a scene is: named parameters with units and ranges, presets, and three steps,
 
-    model = scene.build(params, normal=..., friction=..., system_options=...)   # a Model: Systems, Stage
-    records = simulate(model, params, progress)   # the time loop (solver.march) over the model's Stage
+    model = scene.build(params, normal=..., friction=..., system_options=...)   # a Model: Systems, Stages
+    records = simulate(model, params, progress)   # the time loop (solver.march) over the model's Stages
     results = scene.measure(model, params, records)   # a JSON-able dict from the records
 
 that ``run`` puts together (one function for every scene: it also reports the size of the
-system, how it was solved and how often it was evaluated). A scene with more than one stage
-(the cork: press fit, then pop) gives its own ``simulate``.
+system, how it was solved and how often it was evaluated). A scene of several stages (the cork:
+press fit, then pop) marches them in turn: its records carry the stage that made them
+(``record.stage``), and a stage may start from the last record of the one before it.
 
 A scene module defines ``SCENE = Scene(...)``; the registry in ``contactfem.scenes`` finds
 it. Parameter names follow the paper's symbols (c_N, c_T, m, n, alpha, beta, mu, E, nu, dt,
@@ -50,22 +51,22 @@ PENALTY_DOC = (
 
 
 def simulate(model, params=None, progress=None):
-    """The records of the model's stage (``model.stage``): the initial state and every step. A
+    """The records of the model's stages in turn (``model.stages``), each stage's initial state and
+    every step, as one list (``record.stage``: which stage made it); a stage given as a function is
+    built from the last record of the stage before it, and its ``until`` may end it early. A
     NewtonError that ends the run carries the records so far (``error.records``)."""
     from ..solver.march import march, watch
     from ..solver.newton import NewtonError
 
-    st = model.stage
     records = []
     try:
-        for rec in watch(
-            march(st.stepper, st.schedule, st.t0, st.u0, st.v0, a0=st.a0, label=st.label),
-            progress,
-            st.t0,
-            st.schedule.t_end,
-            st.name or model.name,
-        ):
-            records.append(rec)
+        for i, stage in enumerate(model.stages):
+            st = stage if isinstance(stage, Stage) else stage(records[-1])
+            marched = march(st.stepper, st.schedule, st.t0, st.u0, st.v0, a0=st.a0, label=st.label, state=st.state, stage=i)
+            if st.until is not None:
+                marched = st.until(marched)
+            for rec in watch(marched, progress, st.t0, st.schedule.t_end, st.name or model.name):
+                records.append(rec)
     except NewtonError as err:
         err.records = records
         raise
@@ -113,9 +114,7 @@ def run(scene, params, normal=None, friction=None, progress=None, linear_algebra
     results["residual_evaluations"] = int(sum(s.evaluations for s in systems))
     contacts = {id(c): c for s in systems for c in s.contacts}
     results["contact_evaluations"] = int(sum(c.evaluations for c in contacts.values()))
-    results.setdefault(
-        "newton_iterations_total", int(sum(getattr(r, "iterations", 0) for r in records))
-    )  # if not counted
+    results.setdefault("newton_iterations_total", int(sum(r.iterations for r in records)))  # if not counted
     return results
 
 
@@ -126,7 +125,7 @@ class Scene:
     params: tuple
     build: Callable  # (params, *, normal, friction, system_options) -> Model
     measure: Callable  # (model, params, records) -> results dict
-    simulate: Callable | None = None  # (model, params, progress) -> records; default: the model's stage
+    simulate: Callable | None = None  # (model, params, progress) -> records; default: the model's stages
     presets: dict = field(default_factory=dict)  # preset name -> {param: value}
     reports: tuple = ()  # names of the main results, for `show`
     check: Callable[[dict], None] | None = None  # cross-parameter checks (ValueError), before any run

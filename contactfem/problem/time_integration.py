@@ -6,8 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..solver import Adaptive, Newmark, Steps
-from ..solver.schedule import at_tolerance
+from ..solver import Newmark, Steps
+from ..solver.schedule import AtTolerance
 from ..solver.conserving import EnergyConsistent
 from ..solver.newmark import BETA_RANGE, DELTA_RANGE
 from .scene import Param
@@ -148,21 +148,13 @@ ACCURACY_PARAM = Tolerance(
 def plan(params, stepper, *, dt, speed, max_cuts, t_end=None, n_steps=None, duration=None, t0=0.0):
     """The stepper and the schedule of a dynamic scene's march: fixed steps of dt (``n_steps`` of
     them, or up to t_end) when params['accuracy'] is 0; else steps chosen from the local error
-    estimate (schedule.error_step) at the tolerance params['accuracy'], relative to ``speed``
+    estimate (schedule.AtTolerance) at the tolerance params['accuracy'], relative to ``speed``
     (the scene's velocity scale) over ``duration`` (the time its errors add up over; default: the
-    run's, n_steps dt or t_end - t0), no step
-    longer than dt, the first dt * accuracy; a step past twice its share of the error is retried
-    halved (schedule.at_tolerance)."""
+    run's, n_steps dt or t_end - t0), no step longer than dt, the first dt * accuracy; a step past
+    twice its share of the error is retried halved."""
     tol = params.get("accuracy") or 0.0
     if not tol:
         return stepper, Steps(dt, n_steps=n_steps, t_end=None if n_steps else t_end, t0=t0, max_cuts=max_cuts)
-    duration = duration or (n_steps * dt if n_steps else t_end - t0)
-    estimated, rule, rejections = at_tolerance(stepper, tol, speed, duration, dt)
-    return estimated, Adaptive(
-        rule,
-        t_end=t0 + n_steps * dt if n_steps else t_end,
-        dt=dt * tol,
-        t0=t0,
-        max_cuts=max_cuts + rejections,
-        growth=2.0,
-    )
+    end = t0 + n_steps * dt if n_steps else t_end
+    duration = duration or end - t0
+    return stepper, AtTolerance(tol, speed, duration, dt, end, stepper.error_model, t0=t0, max_cuts=max_cuts)

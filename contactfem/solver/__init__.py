@@ -16,7 +16,9 @@ sizes and the halving of failed steps; a scene stops by leaving the loop.
 
 Files: system.py (System, Dirichlet, Evaluation), newton.py (newton, NewtonResult, NewtonError),
 newmark.py (Newmark, Static, CentralDifference), march.py (march, Record, integrate, History),
-schedule.py (Steps, Adaptive; at_tolerance: steps chosen from a local error estimate), conserving.py (EnergyConsistent), uzawa.py (the augmented
+schedule.py (Steps, Adaptive; AtTolerance: steps chosen from a local error estimate), estimate.py (a step's
+local error: the one estimator of the adaptive steps, the indicators and the time part of the bands),
+conserving.py (EnergyConsistent), uzawa.py (the augmented
 Lagrangian's outer loop), staggered.py (the two-step algorithm of Sec. 2.2), interfaces.py
 (what a stepper and a schedule are). A stepper's ``step`` never commits; the time loop commits
 only converged steps.

@@ -43,6 +43,8 @@ with the derivative of X on the diagonal.
 import numpy as np
 
 from ..bodies.discrete_gradient import cayley
+from .estimate import MIDPOINT
+from .newmark import increment, inertia_roundoff
 from .newton import newton
 from .system import Evaluation
 
@@ -53,6 +55,7 @@ class EnergyConsistent:
     ``newton_options`` go to ``newton``."""
 
     dynamic = True
+    error_model = MIDPOINT  # how its step errs (estimate.py)
 
     def __init__(self, system, **newton_options):
         self.system, self.newton_options = system, newton_options
@@ -95,17 +98,19 @@ class EnergyConsistent:
         t1, tm = t + dt, t + 0.5 * dt
         M = s.mass()  # lumped (a vector) or consistent (a sparse matrix)
         c_mass = 2.0 / dt**2
+        m = s.lumped_mass()
 
         def inertia(D):  # d (c_mass M (dq - dt v)) / d u1 = c_mass M diag(D)
             return sp.diags(c_mass * M * D) if isinstance(M, np.ndarray) else c_mass * (M @ sp.diags(D))
 
         rot = self.rotations
 
-        def fun(u1):
+        def fun(d):  # d = u1 - u, Newton's unknown (newton's base: round-off of d, not of u1)
             s.evaluations += 1
-            dq, D, chord, dchord = cayley(u1 - u, rot)
+            u1 = s.apply_dirichlet(u + d, t1)
+            dq, D, chord, dchord = cayley(d, rot)
             G, rows, cols, vals = self._bodies(u, u1)
-            um = 0.5 * (u + u1)
+            um = u + 0.5 * d
             states = []
             # the contacts and loads, conjugate to d: on an angle, their moment times chord is
             # conjugate to dq (chord dq = d there); the derivative of chord on the diagonal
@@ -136,20 +141,20 @@ class EnergyConsistent:
             K = sp.coo_matrix(
                 (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(s.ndof, s.ndof)
             ).tocsr() + inertia(D)
-            return Evaluation(G, K, tuple(states), Pm, state, ma)
+            return Evaluation(G, K, tuple(states), Pm, state, ma, inertia_roundoff(m, c_mass, dq, dt * v))
 
-        guess = s.apply_dirichlet(u + dt * v + 0.5 * dt**2 * a, t1)
         result = newton(
             fun,
-            guess,
+            increment(s, u, dt * v + 0.5 * dt**2 * a, t1),
             s.free_dofs,
             instrument=s.instrument,
             label=label or f"t = {t1:.6g}, dt = {dt:.3g}",
-            start=u,
+            base=u,
             **self.newton_options,
         )
-        u1 = result.u
+        d = result.u
+        u1 = s.apply_dirichlet(u + d, t1)
         result.evaluation = result.evaluation._replace(P=s.external_force(u1, t1, state))  # the loads' work
-        v1 = 2.0 * cayley(u1 - u, rot)[0] / dt - v
+        v1 = 2.0 * cayley(d, rot)[0] / dt - v
         a1 = (v1 - v) / dt
         return u1, v1, a1, result

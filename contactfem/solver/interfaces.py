@@ -14,6 +14,7 @@ class Stepper(Protocol):
 
     system: object  # the System it steps
     dynamic: bool  # inertia (v, a) or quasi-static
+    error_model: object  # how its step errs (estimate.ErrorModel), None for a static stepper
 
     def step(
         self, t: float, u: np.ndarray, v: np.ndarray, a: np.ndarray, dt: float, label: str = "", *, state: object
@@ -50,3 +51,9 @@ class Schedule(Protocol):
 
     def end_time(self, t: float, dt: float) -> float:
         """The time a step of dt from t ends at."""
+
+    def share(self, dt: float) -> object:
+        """The local error a step of dt may have (a run at a tolerance), or None."""
+
+    def rejects(self, error: object, dt: float) -> bool:
+        """Whether a converged step of dt with this StepError is retried halved."""

@@ -18,16 +18,19 @@ uninterrupted run went on.
 
 The schedule (schedule.py) decides the step sizes: fixed steps, or an adaptive rule of
 the last record, with the halving of a failed step; the scene decides when to stop, by
-leaving the loop. ``integrate`` collects a march into a ``History`` of arrays.
+leaving the loop. The loop estimates each dynamic step's local error (estimate.py; the record's
+``error``), which a schedule at a tolerance sizes the next step from and may reject a step by
+(``resume``: and its flights). ``integrate`` collects a march into a ``History`` of arrays.
 """
 
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .estimate import Slope, StepError, error_vector, momentum_norm, norm
 from .newton import NewtonError
 from .rounding import perturbed
-from .schedule import Steps
+from .schedule import StepRejected, Steps
 from .system import SystemState
 
 
@@ -44,11 +47,14 @@ class Record:
     cuts, failures  halvings before the step converged, the first line of each failure
     state           the SystemState after the step (solver/system.py): what the next step
                     starts from
+    error           the step's StepError (estimate.py: its local error, and the share of a
+                    tolerance it may have); None at k = 0 and for a static stepper
+    stage           which of its model's stages made it (0 for a model of one stage)
 
     Two records are equal (``==``) when their values are, bit for bit: what save_record keeps of
     them and a run goes on from (k, t, dt, u, v, a, the energies, cuts and failures, the residual
     G with its reactions and the loads P, Newton's iterations and residuals, the step's error
-    estimate, the SystemState). Their tangents and contact states, which follow from those, are
+    estimate and stage, the SystemState). Their tangents and contact states, which follow from those, are
     not compared: a record read back by load_record equals the one saved.
     """
 
@@ -64,6 +70,8 @@ class Record:
     cuts: int = 0
     failures: tuple = ()
     state: object = None
+    error: StepError | None = None
+    stage: int = 0
 
     def __eq__(self, other):
         if not isinstance(other, Record):
@@ -93,7 +101,7 @@ def _kept(rec):
     return (
         (rec.k, rec.t, rec.dt, rec.u, rec.v, rec.a, rec.energy, rec.cuts, tuple(rec.failures)),
         (ev.G if result is None else result.G, getattr(ev, "P", None), rec.iterations, rec.residuals),
-        (getattr(result, "local_error", None), getattr(result, "error_share", None), rec.state),
+        (rec.error, rec.stage, rec.state),
     )
 
 
@@ -124,22 +132,31 @@ def same_value(a, b):
     return type(a) is type(b) and bool(a == b)
 
 
-def march(stepper, schedule, t0, u0, v0=None, *, a0=None, label=None, state=None):
+def march(stepper, schedule, t0, u0, v0=None, *, a0=None, label=None, state=None, stage=0):
     """Step from (t0, u0, v0) as the schedule says; yield the initial Record, then one per
-    accepted step. A step whose Newton fails is retried with the size ``schedule.cut`` gives,
-    until it gives None: then the NewtonError is raised with the last record as ``record``.
+    accepted step. A step whose Newton fails, or whose local error the schedule rejects, is
+    retried with the size ``schedule.cut`` gives, until it gives None: then the NewtonError is
+    raised with the last record as ``record``.
     ``a0``: the initial acceleration (default: M a0 = -G(u0), eq 29; 0 for a static stepper).
     ``label(k, t1, dt)``: the text naming a step in an error (default: step k, t, dt).
     ``state``: the SystemState to start from (default: ``system.start(u0, t0)``; e.g. the
-    contacts' histories a previous stage ended with)."""
-    rec = initial(stepper, schedule, t0, u0, v0, a0, state)
+    contacts' histories a previous stage ended with). ``stage``: the records' ``stage``."""
+    rec = initial(stepper, schedule, t0, u0, v0, a0, state, stage)
     yield rec
     yield from resume(stepper, schedule, rec, label=label)
 
 
 def resume(stepper, schedule, record, *, label=None):
     """The records after ``record`` (not itself), stepped as ``march`` steps: from a record of
-    a run (its u, v, a, energies, reactions and SystemState), the rest of that run exactly."""
+    a run (its u, v, a, energies, reactions and SystemState), the rest of that run exactly.
+
+    A run at a tolerance (``schedule.share``) flies optimistically: the steps of a flight (from a
+    record without contact) hold only the error of the bodies' momentum, the only error a flight
+    that ends the run hands to its results (no contact or load changes a body's momentum while no
+    force acts, and the integrators keep it); such steps are held back until the flight has ended
+    the run. A flight that ends in a contact is stepped again from the record it started at, in
+    the kinetic energy's norm (the contact sees the vibrations the flight carried), marked
+    ``careful`` in its Slope until the contact, so a run resumed from any record goes on as it went."""
     rec = record
     if not isinstance(rec.state, SystemState):
         raise ValueError(f"record {rec.k} has no SystemState to resume from (state = {type(rec.state).__name__})")
@@ -149,8 +166,10 @@ def resume(stepper, schedule, record, *, label=None):
             f"record {rec.k} holds {np.size(rec.u)} unknowns, the model {ndof}: a record resumes only a model "
             "of the run that made it (the same mesh and bodies)"
         )
+    start, flight = None, []  # an optimistic flight: the record it started at, its records held back
     try:
         while (dt := schedule.next_dt(rec)) is not None:
+            optimistic = _optimistic(schedule, rec, dt)
             cuts, failures = 0, []
             while True:
                 name = (
@@ -160,6 +179,11 @@ def resume(stepper, schedule, record, *, label=None):
                 )
                 try:
                     trial = stepper.step(rec.t, rec.u, rec.v, rec.a, dt, name, state=rec.state)
+                    error, slope = estimate(stepper, schedule, rec, trial, dt, optimistic)
+                    if error is not None and schedule.rejects(error, dt):
+                        raise StepRejected(
+                            f"local error {error.local:.3g} is past twice its share {error.share:.3g}", []
+                        )
                     break
                 except NewtonError as err:
                     failures.append(str(err).splitlines()[0][:200] if str(err) else "Newton failed")
@@ -168,15 +192,62 @@ def resume(stepper, schedule, record, *, label=None):
                         err.record = rec
                         raise
                     dt, cuts = smaller, cuts + 1
-            rec = accept(stepper.system, rec, schedule.end_time(rec.t, dt), dt, trial, cuts, failures)
+            new = accept(stepper.system, rec, schedule.end_time(rec.t, dt), dt, trial, cuts, failures, error, slope)
+            if optimistic and _touching(new):  # the flight ended in a contact: again from its start, carefully
+                rec, start, flight = _careful(start or rec), None, []
+                continue
+            if optimistic:
+                start, rec = start or rec, new
+                flight.append(new)
+                continue
+            rec = new
             yield rec
+        yield from flight  # the flight ended the run
     except KeyboardInterrupt as interrupt:  # Ctrl-C: say where (the innermost loop names it)
         if not hasattr(interrupt, "step"):
             interrupt.t, interrupt.step, interrupt.n_steps = rec.t, rec.k + 1, schedule.n_steps
         raise
 
 
-def initial(stepper, schedule, t0, u0, v0=None, a0=None, state=None):
+def _touching(rec):
+    return any(st.n_active for st in rec.contacts)
+
+
+def _optimistic(schedule, rec, dt):
+    """Whether the step after ``rec`` flies optimistically (resume): a run at a tolerance, a record
+    without contact, not a flight stepped again after its optimistic try (its Slope's ``careful``)."""
+    careful = rec.state.slope is not None and rec.state.slope.careful
+    return schedule.share(dt) is not None and not careful and not _touching(rec)
+
+
+def _careful(rec):
+    """The record a flight started at, marked to step the flight again in the kinetic energy's norm."""
+    slope = rec.state.slope or Slope(None, rec.dt)
+    return replace(rec, state=replace(rec.state, slope=replace(slope, careful=True)))
+
+
+def estimate(stepper, schedule, rec, trial, dt, optimistic=False):
+    """A converged step's StepError (estimate.py: its local error, and the share of the schedule's
+    tolerance it may have) and the Slope it hands to the next step; (None, None) for a stepper
+    without an error model (a static one). The error is the kinetic energy's norm of the error
+    vector, or its bodies' momentum's in an optimistic flight (resume); a Slope stays ``careful``
+    until the step that touches."""
+    model = stepper.error_model
+    if model is None:
+        return None, None
+    s = stepper.system
+    d, slope = error_vector(model, rec.a, trial[2], dt, rec.state.slope)
+    mass = s.lumped_mass()
+    if optimistic:
+        e = momentum_norm(mass, d, [s.offset(b) + np.asarray(b.xdofs) for b in s.bodies])
+    else:
+        e = norm(mass, d)
+    if slope.careful and any(st.n_active for st in trial[3].evaluation.contacts):
+        slope = replace(slope, careful=False)
+    return StepError(e, schedule.share(dt), model), slope
+
+
+def initial(stepper, schedule, t0, u0, v0=None, a0=None, state=None, stage=0):
     """The Record of the initial state: the SystemState started at u0 (or ``state``), one
     evaluation (with the schedule's first dt, for rate-dependent bodies and laws), a0 from eq 29."""
     s = stepper.system
@@ -190,14 +261,15 @@ def initial(stepper, schedule, t0, u0, v0=None, a0=None, state=None):
     else:
         a = acceleration(s, ev.G) if stepper.dynamic else np.zeros(s.ndof)
     energy = dict(s.energies(u, v, ev, dt), dissipation=0.0, external_work=0.0)
-    return Record(k=0, t=t0, dt=0.0, u=u, v=v, a=a, evaluation=ev, energy=energy, state=state)
+    return Record(k=0, t=t0, dt=0.0, u=u, v=v, a=a, evaluation=ev, energy=energy, state=state, stage=stage)
 
 
-def accept(system, rec, t1, dt, trial, cuts=0, failures=()):
+def accept(system, rec, t1, dt, trial, cuts=0, failures=(), error=None, slope=None):
     """Commit a converged step and make its Record: the next SystemState from the converged
-    evaluation; the energies are those of the converged state, the dissipation that of its
-    contact states, the external work the trapezoidal rule 1/2 (F_n + F_n+1) . (u_n+1 - u_n)
-    over the loads P and the support reactions (the prescribed-dof part of G)."""
+    evaluation (with the ``slope`` the step hands on, estimate.py); the energies are those of the
+    converged state, the dissipation that of its contact states, the external work the trapezoidal
+    rule 1/2 (F_n + F_n+1) . (u_n+1 - u_n) over the loads P and the support reactions (the
+    prescribed-dof part of G)."""
     u1, v1, a1, result = trial
     ev = result.evaluation
     fixed = system.fixed_dofs
@@ -207,8 +279,8 @@ def accept(system, rec, t1, dt, trial, cuts=0, failures=()):
     work = rec.energy["external_work"] + 0.5 * (P0 + P1) @ du + 0.5 * (F0 + F1) @ du[fixed]
     dissipation = rec.energy["dissipation"] + sum(st.dissipation for st in ev.contacts)
     state = system.commit(ev, u1, t1, dt)
-    if getattr(result, "carry", None) is not None:  # what the stepper hands to its next step
-        state = replace(state, stepper=result.carry)
+    if slope is not None:
+        state = replace(state, slope=slope)
     energy = dict(system.energies(u1, v1, ev, dt, state), dissipation=dissipation, external_work=float(work))
     return Record(
         k=rec.k + 1,
@@ -223,6 +295,8 @@ def accept(system, rec, t1, dt, trial, cuts=0, failures=()):
         cuts=cuts,
         failures=tuple(failures),
         state=state,
+        error=error,
+        stage=rec.stage,
     )
 
 
@@ -245,13 +319,20 @@ def acceleration(system, G):
 def watch(records, progress, t0, t_end, name):
     """The records, passed through a progress display: ``progress(t0, t_end, name)`` makes a
     callback (e.g. contactfem.io.ProgressBar) called with each record's (t, u, v, a) and
-    closed at the end. None: the records unchanged."""
+    closed at the end. None: the records unchanged. Records that end before t_end with a text
+    (a generator's return value: a Stage's ``until``) draw the bar full with that text (``finish``)."""
     if progress is None:
-        yield from records
-        return
+        return (yield from records)
     bar = progress(t0, t_end, name)
     try:
-        for rec in records:
+        records = iter(records)
+        while True:
+            try:
+                rec = next(records)
+            except StopIteration as stop:
+                if stop.value and hasattr(bar, "finish"):
+                    bar.finish(stop.value)
+                return stop.value
             bar(rec.t, rec.u, rec.v, rec.a)
             yield rec
     finally:

@@ -31,6 +31,7 @@ import warnings
 import numpy as np
 
 from ..laws.validation import require
+from .estimate import newmark_error_model
 from .march import acceleration
 from .newton import NewtonError, NewtonResult, newton
 
@@ -38,6 +39,7 @@ from .newton import NewtonError, NewtonResult, newton
 # step amplifies (no stable step size); beta = 0 is explicit (CentralDifference); beta <= 1/2.
 DELTA_RANGE = dict(low=0.5, high=1.0)
 BETA_RANGE = dict(low=0.0, high=0.5, low_open=True)
+EPS = float(np.finfo(float).eps)
 SIZE_CHECKED = "a step's size comes from its Schedule, which checks it (schedule.check_dt)"
 
 
@@ -47,6 +49,22 @@ def initial_acceleration(system, t, u, dt=None, state=None):
     from the data)."""
     state = system.start(u, t) if state is None else state
     return acceleration(system, system.evaluate(u, t, dt, state=state).G)
+
+
+def inertia_roundoff(m, c, d, d_pred):
+    """The round-off of a stepper's inertia c M (d - d_pred) (Evaluation.roundoff; solver/newton.py): eps
+    times its largest operand, c m (|d| + |d_pred|) at the heaviest-loaded dof (m the lumped mass)."""
+    return EPS * float(np.max(c * m * (np.abs(d) + np.abs(d_pred)), initial=0.0))
+
+
+def increment(system, u, d, t1):
+    """A step's first increment d over u with the prescribed values at t1 written in (their dofs:
+    the prescribed value - u) and the contact's own unknowns (multipliers) kept as they were (0)."""
+    d = np.array(d, dtype=float)
+    fixed = system.fixed_dofs
+    d[fixed] = system.apply_dirichlet(u, t1)[fixed] - u[fixed]
+    d[system.contact_dofs] = 0.0
+    return d
 
 
 class Newmark:
@@ -73,38 +91,40 @@ class Newmark:
                 )
         self.system, self.delta, self.beta = system, delta, beta
         self.newton_options = newton_options
+        self.error_model = newmark_error_model(delta, beta)  # how its step errs (estimate.py)
 
     def step(self, t, u, v, a, dt, label="", *, state):
         assert dt > 0, SIZE_CHECKED
         s, beta, delta = self.system, self.beta, self.delta
         t1 = t + dt
         c = 1.0 / (beta * dt**2)
-        cM = c * s.mass()  # the step's constants: c M and the predictor
+        cM = c * s.mass()  # the step's constants: c M and the predictor's increment
         lumped = isinstance(cM, np.ndarray)  # a diagonal (ndof,), else a sparse consistent M
-        u_pred = u + dt * v + dt**2 * (0.5 - beta) * a
+        m = s.lumped_mass()
+        d_pred = dt * v + dt**2 * (0.5 - beta) * a  # u_pred - u
 
-        def effective(u1):  # eq 29 with a+ = c (u1 - u_pred); tangent K + c M
-            ev = s.evaluate(u1, t1, dt, u, mass_coefficient=c, state=state)
-            du = u1 - u_pred
-            inertia = cM * du if lumped else cM @ du
-            return ev._replace(G=ev.G + inertia, inertia=inertia)
+        # Newton's unknown is the step's increment d = u+ - u (newton's ``base``): a+ = c (d - d_pred) then
+        # carries the round-off of d, not of u (solver/newton.py: the inertia's round-off)
+        def effective(d):  # eq 29 with a+ = c (d - d_pred); tangent K + c M
+            ev = s.evaluate(s.apply_dirichlet(u + d, t1), t1, dt, u, mass_coefficient=c, state=state)
+            inertia = cM * (d - d_pred) if lumped else cM @ (d - d_pred)
+            return ev._replace(G=ev.G + inertia, inertia=inertia, roundoff=inertia_roundoff(m, c, d, d_pred))
 
-        # initial guess: the acceleration stays a (u + dt v + dt^2 a / 2); multipliers as they were
-        guess = s.apply_dirichlet(u_pred + beta * dt**2 * a, t1)
-        own = s.contact_dofs
-        guess[own] = u[own]
+        # initial guess: the acceleration stays a (d = dt v + dt^2 a / 2); multipliers as they were
         result = newton(
             effective,
-            guess,
+            increment(s, u, d_pred + beta * dt**2 * a, t1),
             s.free_dofs,
             instrument=s.instrument,
-            start=u,
+            base=u,
             label=label or f"t = {t1:.6g}, dt = {dt:.3g}",
             **self.newton_options,
         )
-        u1 = result.u
-        a1 = c * (u1 - u_pred)
+        d = result.u
+        u1 = s.apply_dirichlet(u + d, t1)
+        a1 = c * (d - d_pred)
         v1 = v + dt * ((1 - delta) * a + delta * a1)
+        own = s.contact_dofs
         a1[own], v1[own] = 0.0, 0.0
         return u1, v1, a1, result
 
@@ -116,6 +136,7 @@ class Static:
     """
 
     dynamic = False
+    error_model = None  # no inertia: no time-stepping error to estimate
 
     def __init__(self, system, **newton_options):
         self.system, self.newton_options = system, newton_options
@@ -148,6 +169,7 @@ class CentralDifference:
     """
 
     dynamic = True
+    error_model = newmark_error_model(0.5, 0.0)  # its velocities: the trapezoidal rule (estimate.py)
 
     def __init__(self, system):
         if np.any(system.lumped_mass()[system.free_dofs] <= 0):

@@ -18,7 +18,7 @@ and the banded solve raise as well).
 
 Convergence test, in the units of the problem (as Abaqus/Standard's, with tighter defaults):
 
-    max |G_k|        <= atol + rtol * F_k                 (the residual, against the step's forces)
+    max |G_k|        <= atol + OPERANDS roundoff_k + rtol * F_k      (the residual, against the step's forces)
     max |du_(k-1)|   <= ctol * max |u_k - u_start|        (the last correction, against the increment)
 
 over the free dofs. F_k (``force_scale``) is the largest nodal force of the iterate among the
@@ -30,9 +30,24 @@ waived at k = 0, when the residual is below atol or NEGLIGIBLE (1e-3) times its 
 iterate's own error, K^-1 G, is then negligible whatever the last correction was), and when the
 correction is at the round-off of u (1e3 machine epsilon of max |u_k|); there the residual cannot fall further, and
 ROUNDOFF_RTOL F is accepted instead of rtol F (a very stiff penalty: one round-off of a gap is a
-force; ``residual_ratio`` says what was reached: max |G| / (F + atol / ROUNDOFF_RTOL)). atol (force
-units) is a floor for a step in which nothing carries a force. ``residuals`` keeps the Euclidean
+force; ``residual_ratio`` says what was reached: max |G| / (F + floor / ROUNDOFF_RTOL), the floor
+atol plus the round-off of G's own terms). atol (force units) is a floor for a step in which
+nothing carries a force. ``residuals`` keeps the Euclidean
 norms ||G_k|| for reports.
+
+The round-off of a time step's residual. A stepper's inertia is c M times a difference of
+displacements, c = 1 / (beta dt^2) (Newmark; 2 / dt^2 the midpoint rule). Written in the total
+displacement u, that difference carries u's round-off, eps |u|, and G a round-off c M eps |u| that
+grows as 1 / dt^2: the sloping impact's ring (a node's mass 0.039, |u| = 0.05 at first touch) at
+dt = 3e-6, halved to 4.7e-8 by the failed tries, has 3e-4 there, a hundred times the contact force
+of the step (3e-6): Newton's corrections fall below u's round-off and the residual stays at the
+force scale. So the steppers iterate on the step's increment d = u+ - u (``base``: u), whose
+round-off is eps |d|, eps |v| dt: the inertia's becomes c M eps |d| ~ M eps |v| / (beta dt), which
+the stepper reports (``Evaluation.roundoff``: eps times the inertia's largest operand) and the test
+adds to atol (OPERANDS of it: a few ulps). Below that no iterate can go: a contact force that
+changes the step's increment by less than its own round-off (F beta dt^2 / M < eps |d|) is a
+step converged to round-off, and the test accepts it. The static terms keep their own round-off,
+K eps |u|, which the correction test above sees (corrections below u's round-off: ``stalled``).
 
 Defaults (RTOL = 1e-8, CTOL = 1e-6), measured on the fast presets of the scenes (their headline
 results against a run with 1e-10 / 1e-8, and the residual evaluations): Abaqus' 5e-3 / 1e-2 saves
@@ -105,13 +120,10 @@ class NewtonResult:
     evaluation: object = None  # what fun returned at u (G, K, contact states, ...)
     evaluations: int = 0  # calls of fun (residuals + line-search trials)
     force_scale: float = 0.0  # F at u (module docstring)
-    residual_ratio: float = 0.0  # max |G_f| / (F + atol / ROUNDOFF_RTOL) at u: at most ROUNDOFF_RTOL when the
-    # loosest test passes (max |G_f| <= atol + ROUNDOFF_RTOL F); the force scale where F >> atol / ROUNDOFF_RTOL
+    residual_ratio: float = 0.0  # max |G_f| / (F + floor / ROUNDOFF_RTOL) at u, floor = atol + the round-off of G's
+    # terms: at most ROUNDOFF_RTOL when the loosest test passes; the force scale where F >> floor / ROUNDOFF_RTOL
     correction_ratio: float = 0.0  # the last correction / the step's increment (0 at k = 0)
     ratios: list = field(default_factory=list)  # max |G_f| / F of every iterate
-    local_error: float | None = None  # a time stepper's estimate of the step's error (schedule.Estimated)
-    carry: object = None  # what the stepper hands to its next step (SystemState.stepper)
-    error_share: float | None = None  # the error its share allows a step of its size (schedule.Estimated)
 
 
 # The default tolerances of the convergence test (module docstring; BENCHMARKS.md argues them)
@@ -119,6 +131,8 @@ RTOL = 1e-8  # the largest residual over the step's force scale
 CTOL = 1e-6  # the largest correction over the step's largest increment
 ROUNDOFF = 1e3 * np.finfo(float).eps  # a correction below this times max |u| is at u's round-off
 ROUNDOFF_RTOL = 1e-6  # accepted when the corrections are at u's round-off: Newton can do no better
+OPERANDS = 4.0  # the round-off of G's own terms (Evaluation.roundoff, eps times its largest operand) is a few
+# ulps: one for the unknown's quantisation, one for the subtraction d - d_pred, one for the product with c M
 NEGLIGIBLE = 1e-3  # a residual this far below its tolerance: the iterate's own error (K^-1 G) is negligible
 # whatever the last correction was; one more iteration could only flip a contact
 # node sitting at g_N = 0 (and cycle: a disc on a polyline wall did)
@@ -146,7 +160,18 @@ def force_scale(evaluation, free):
 
 
 def newton(
-    fun, u0, free, atol=1e-12, rtol=RTOL, maxit=25, label="", line_search=0, instrument=None, ctol=CTOL, start=None
+    fun,
+    u0,
+    free,
+    atol=1e-12,
+    rtol=RTOL,
+    maxit=25,
+    label="",
+    line_search=0,
+    instrument=None,
+    ctol=CTOL,
+    start=None,
+    base=None,
 ):
     """Full Newton method: K_ff du_f = -G_f, u_f += du_f, until converged.
 
@@ -159,6 +184,9 @@ def newton(
             (module docstring): atol in force units, rtol against the step's force scale F_k, ctol
             against the step's increment
     start : the state at the step's start (default u0), for the increment
+    base  : None, or the state the unknowns are increments over (a time step's start): fun then takes the
+            increment x = u - base, the correction test measures x itself (``start`` unused), and a
+            correction is at round-off when it is below the round-off of base + x (module docstring)
     maxit : maximal number of linear solves
     label : names the step/time in error messages
     line_search : 0 (default: full Newton steps, the paper's method) or the number of
@@ -172,13 +200,13 @@ def newton(
     Returns a NewtonResult; raises NewtonError (never returns NaN).
     """
     with timed(instrument, "newton"):
-        result = _newton(fun, u0, free, atol, rtol, maxit, label, line_search, instrument, ctol, start)
+        result = _newton(fun, u0, free, atol, rtol, maxit, label, line_search, instrument, ctol, start, base)
     if instrument is not None:
         instrument.solves += result.iterations
     return result
 
 
-def _newton(fun, u0, free, atol, rtol, maxit, label, line_search, instrument, ctol=CTOL, start=None):
+def _newton(fun, u0, free, atol, rtol, maxit, label, line_search, instrument, ctol=CTOL, start=None, base=None):
     if maxit < 0:
         raise ValueError(f"maxit must be >= 0, got {maxit}")
     if not (atol >= 0 and rtol >= 0 and ctol >= 0):
@@ -193,6 +221,8 @@ def _newton(fun, u0, free, atol, rtol, maxit, label, line_search, instrument, ct
         raise ValueError(f"parameter line_search = {line_search} is out of range: allowed integers [0, inf)")
     history, largest, ratios = [], [], []  # ||G_f||, max |G_f| and max |G_f| / F of every iterate
     calls = 0
+    if base is not None:  # u is an increment over base: it starts from 0, and u's round-off is that of base + u
+        start, base = np.zeros(len(u)), np.asarray(base, dtype=float)[free]
     u_start = (u if start is None else np.asarray(start, dtype=float))[free]
     du, tol, F = None, atol, 0.0
 
@@ -217,12 +247,13 @@ def _newton(fun, u0, free, atol, rtol, maxit, label, line_search, instrument, ct
         r_max = float(np.max(np.abs(G_f), initial=0.0))
         largest.append(r_max)
         F = force_scale(out, free)
-        tol = atol + rtol * F
+        floor = atol + OPERANDS * getattr(out, "roundoff", 0.0)  # atol and the round-off of G's own terms
+        tol = floor + rtol * F
         ratios.append(r_max / F if F > 0 else (0.0 if r_max == 0 else math.inf))
         c_ratio = _correction(du, u[free], u_start)
-        stalled = _at_roundoff(du, u[free])  # the corrections no longer move u
-        if r_max <= tol or (stalled and r_max <= atol + max(rtol, ROUNDOFF_RTOL) * F):
-            if k == 0 or r_max <= atol or r_max <= NEGLIGIBLE * tol or c_ratio <= ctol or stalled:
+        stalled = _at_roundoff(du, u[free] if base is None else base + u[free])  # the corrections no longer move u
+        if r_max <= tol or (stalled and r_max <= floor + max(rtol, ROUNDOFF_RTOL) * F):
+            if k == 0 or r_max <= floor or r_max <= NEGLIGIBLE * tol or c_ratio <= ctol or stalled:
                 return NewtonResult(
                     u=u,
                     residuals=history,
@@ -231,7 +262,7 @@ def _newton(fun, u0, free, atol, rtol, maxit, label, line_search, instrument, ct
                     evaluation=out,
                     evaluations=calls,
                     force_scale=F,
-                    residual_ratio=r_max / (F + atol / ROUNDOFF_RTOL) if r_max > 0 else 0.0,
+                    residual_ratio=r_max / (F + floor / ROUNDOFF_RTOL) if r_max > 0 else 0.0,
                     correction_ratio=c_ratio if k else 0.0,
                     ratios=ratios,
                 )

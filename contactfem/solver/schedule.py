@@ -2,17 +2,18 @@
 
     Steps(dt, n_steps=200)                   fixed steps of dt (or up to t_end)
     Adaptive(rule, t_end, dt=...)            rule(record) -> the size of the next step
-    at_tolerance(stepper, tol, speed, ...)   a stepper that estimates its local error and the
-                                             rule that keeps it at a tolerance (error_step)
+    AtTolerance(tol, speed, duration, ...)   steps that keep each step's local error (estimate.py,
+                                             rec.error) at its share of a tolerance (error_step)
 
-Both halve a step whose Newton fails, up to ``max_cuts`` times and never below
+Each halves a step whose Newton fails, up to ``max_cuts`` times and never below
 ``min_dt`` (``cut``); the march then retries the step with the smaller size. A schedule
 answers three questions: the size of the next step after a record (None: the run is
-over), the size after a failure, and the time a step ends at.
+over), the size after a failure, and the time a step ends at; and two of a converged step's local
+error (rec.error): the error its share allows (``share``) and whether it is retried halved
+(``rejects``).
 """
 
 import math
-from dataclasses import replace
 from functools import partial
 
 import numpy as np
@@ -38,6 +39,14 @@ class _Cuts:
         if cuts >= self.max_cuts or (self.min_dt is not None and dt / 2 < self.min_dt * (1 - 1e-9)):
             return None
         return dt / 2
+
+    def share(self, dt):
+        """The error a step of dt may have (AtTolerance); None: no tolerance to keep."""
+        return None
+
+    def rejects(self, error, dt):
+        """Whether a converged step with this StepError is retried halved (AtTolerance); never here."""
+        return False
 
 
 class Steps(_Cuts):
@@ -124,136 +133,63 @@ class Adaptive(_Cuts):
 
 # -- steps chosen from a local error estimate (a scene's ``accuracy``) ----------------------------
 #
-# A step of Newmark (delta, beta) updates the velocities by dt ((1 - delta) a + delta a+); against
-# the Taylor series of the exact motion its local error is
-#
-#     (delta - 1/2) dt^2 a' + (delta / 2 - 1/6) dt^3 a'' + ...,     a' ~ (a+ - a) / dt,
-#
-# first order in dt where delta > 1/2 (the paper's 0.7): c dt |a+ - a| with c = delta - 1/2. This
-# term is the method's numerical damping: it takes the energy of the vibrations an impact excites,
-# and a rebound's or a rolling ring's speed with it (bench study 10 measures what it costs against
-# the trapezoidal rule). A scene at a tolerance therefore integrates with the trapezoidal rule (delta = 1/2, beta = 1/4,
-# problem/time_integration.py) or the energy-consistent stepper, both second order. There the first
-# term vanishes and the error is the second, dt^3 a'' / 12, from the second difference of the
-# accelerations over the last two steps (hs their sizes, s = (a+ - a) / h their slopes):
-#
-#     a'' ~ (s - s_prev) / ((h + h_prev) / 2)
-#
-# (the midpoint rule's is dt^3 a'' / 24: 1/12 bounds both). Its norm is the kinetic energy's, a
-# mass-weighted root mean square (sum m_i d_i^2 / sum m_i)^(1/2): the vibrations an impact excites
-# change the contact forces while the bodies touch, and the headline quantities with them. The
-# first step has no slope before it: its estimate is the bound c dt |a+ - a|, c = |beta - 1/6|
-# (Zienkiewicz and Xie's, 1/12 for both steppers), and so has the second (the first step's slope
-# starts from an initial acceleration a scene may set by hand). A step hands its slope to the
-# next one in its SystemState (``stepper``): the run carries it as a value. The local errors of the steps add up;
-# holding each at ``tol speed dt / duration`` (its share) keeps their sum over the run within
-# tol speed (error per unit step). A step is chosen from the last one's error (error_step) and
-# taken; one whose error is past twice its share (the step into an impact or out of it: the rule
-# cannot see an event coming) is retried halved, as a step whose Newton fails (StepRejected), down
-# to the first step's size.
-
-
-def error_constant(stepper):
-    """c of the first-difference estimate c dt |a+ - a| (the comment above), and the power of the
-    error's ratio that gives the next step (1 for a first-order velocity update, 1/2 for a
-    second-order one, whose later steps use the second difference). A wrapping stepper (Uzawa's
-    outer loop) is looked through."""
-    stepper = getattr(stepper, "stepper", stepper)
-    if type(stepper).__name__ == "EnergyConsistent":
-        return 1.0 / 12.0, 0.5
-    delta, beta = getattr(stepper, "delta", None), getattr(stepper, "beta", None)
-    if delta is None or beta is None:
-        raise ValueError(
-            f"accuracy needs an implicit Newmark or the energy-consistent stepper, not {type(stepper).__name__}"
-        )
-    if abs(delta - 0.5) > 1e-12:
-        return abs(delta - 0.5), 1.0
-    return abs(beta - 1.0 / 6.0), 0.5
+# The march estimates every dynamic step's local error (estimate.py) and records it (rec.error). The
+# local errors of the steps add up; holding each at ``tol speed dt / duration`` (its share) keeps their
+# sum over the run within tol speed (error per unit step). A step is chosen from the last one's error
+# (error_step) and taken; one whose error is past twice its share (the step into an impact or out of
+# it: the rule cannot see an event coming) is retried halved, as a step whose Newton fails
+# (StepRejected), down to the first step's size. A flight's steps hold the bodies' momentum (march.resume).
 
 
 class StepRejected(NewtonError):
     """A converged step whose local error is past twice its share: the march retries it halved."""
 
 
-class Estimated:
-    """A dynamic stepper whose step results carry ``local_error``, the estimate of the comment
-    above, ``error_share``, the error a step of its size may have (None without a share), and
-    ``carry``, (the step's slope of the accelerations, its size) for the next step's estimate (the
-    march puts it in the SystemState, ``state.stepper``). ``share(dt)``: the error a step of dt
-    may have; a step longer than ``floor`` with more than twice that raises StepRejected (None:
-    every step kept). Anything else is the wrapped stepper's (``stepper``: its system, whether it
-    is dynamic, its Newmark parameters)."""
-
-    def __init__(self, stepper, share=None, floor=0.0):
-        self.stepper, self.share, self.floor = stepper, share, floor
-        self.c, self.power = error_constant(stepper)
-        self.mass = stepper.system.lumped_mass()
-
-    @property
-    def system(self):
-        return self.stepper.system
-
-    @property
-    def dynamic(self):
-        return self.stepper.dynamic
-
-    def norm(self, d):
-        """|d|: the kinetic energy's norm, (sum m_i d_i^2 / sum m_i)^(1/2)."""
-        return float(np.sqrt(np.sum(self.mass * d * d) / np.sum(self.mass)))
-
-    def estimate(self, a, a1, dt, before):
-        """The step's local error in the velocities and what it hands to the next step, (its slope
-        (a1 - a) / dt, dt); ``before``: what the step before handed on (SystemState.stepper), or
-        None at the first step. The first step's slope is not handed on (None): it starts from the
-        initial acceleration, which a scene may set by hand (the cork's pop starts at rest with
-        a0 = 0), so the second step takes the first-difference bound too."""
-        slope = (a1 - a) / dt
-        handed = (None if before is None else slope, dt)
-        if self.power == 1.0 or before is None or before[0] is None:
-            return self.c * dt * self.norm(a1 - a), handed
-        s0, h0 = before
-        return dt**3 / 12.0 * self.norm((slope - s0) / (0.5 * (dt + h0))), handed
-
-    def step(self, t, u, v, a, dt, label="", *, state):
-        u1, v1, a1, result = self.stepper.step(t, u, v, a, dt, label, state=state)
-        e, handed = self.estimate(a, a1, dt, getattr(state, "stepper", None))
-        if self.share is not None and dt > self.floor * (1 + 1e-9) and e > 2.0 * self.share(dt):
-            raise StepRejected(f"local error {e:.3g} is past twice its share {self.share(dt):.3g}", [], label)
-        return (
-            u1,
-            v1,
-            a1,
-            replace(result, local_error=e, carry=handed, error_share=None if self.share is None else self.share(dt)),
-        )
-
-
 def error_step(rec, tol, speed, duration, dt_first, dt_max, power=1.0):
-    """Adaptive's rule for a run at a tolerance: the size of the step after ``rec`` from its
-    step's local error e (``rec.result.local_error``, Estimated): the step whose error would be
-    tol speed dt / duration, dt (tol speed dt / (duration e))^power, between dt_first and dt_max;
-    dt_first for the first step (no estimate yet). (The floor: an acceleration that jumps, as a
-    friction force from stick to slip, gives an error that no step makes smaller.)"""
-    e = getattr(rec.result, "local_error", None)
-    if rec.k == 0 or e is None:
+    """The rule of a run at a tolerance: the size of the step after ``rec`` from its step's local
+    error e (``rec.error.local``, estimate.py): the step whose error would be tol speed dt /
+    duration, dt (tol speed dt / (duration e))^power, between dt_first and dt_max; dt_first for the
+    first step (no estimate yet). (The floor: an acceleration that jumps, as a friction force from
+    stick to slip, gives an error that no step makes smaller.)"""
+    if rec.k == 0 or rec.error is None:
         return dt_first
+    e = rec.error.local
     if not e > 0:
         return dt_max
     return min(dt_max, max(dt_first, rec.dt * (tol * speed * rec.dt / (duration * e)) ** power))
 
 
-def at_tolerance(stepper, tol, speed, duration, dt_max):
-    """A run at the tolerance tol (relative to ``speed``, its errors adding up over ``duration``,
-    no step longer than dt_max): the stepper (Estimated, rejecting a step past twice its share),
-    Adaptive's rule (error_step, the first step dt_max tol) and the halvings a step may need
-    on top of its Newton's (a rejected step down to the first step's size)."""
-    dt_first = dt_max * tol
-    share = partial(_share, tol * speed / duration)
-    estimated = Estimated(stepper, share=share, floor=dt_first)
-    rule = partial(
-        error_step, tol=tol, speed=speed, duration=duration, dt_first=dt_first, dt_max=dt_max, power=estimated.power
-    )
-    return estimated, rule, int(math.ceil(math.log2(1.0 / tol)))
+class AtTolerance(Adaptive):
+    """The steps of a run at the tolerance ``tol``, relative to ``speed``, its errors adding up over
+    ``duration``, no step longer than ``dt_max``: error_step's rule (the first step dt_max tol, the
+    floor), with the power of the stepper's ErrorModel (``model``); each step's share of the error
+    (``share``) is tol speed dt / duration, and a step above the floor past twice its share is
+    rejected (``rejects``), with the halvings that needs (down to the floor) on top of Newton's
+    ``max_cuts``. ``limit(rec)``: a largest step of the scene's own after a record (None: dt_max),
+    e.g. the cork's travel per step."""
 
+    def __init__(self, tol, speed, duration, dt_max, t_end, model, t0=0.0, max_cuts=0, limit=None):
+        self.tol, self.speed, self.duration, self.dt_max = float(tol), float(speed), float(duration), check_dt(dt_max)
+        self.floor, self.limit = self.dt_max * self.tol, limit
+        rule = partial(
+            error_step,
+            tol=self.tol,
+            speed=self.speed,
+            duration=self.duration,
+            dt_first=self.floor,
+            dt_max=self.dt_max,
+            power=model.power,
+        )
+        self.error_rule = rule
+        rejections = int(math.ceil(math.log2(1.0 / self.tol)))
+        super().__init__(self._rule, t_end, dt=self.floor, t0=t0, max_cuts=max_cuts + rejections, growth=2.0)
 
-def _share(rate, dt):
-    return rate * dt
+    def _rule(self, rec):
+        h = self.error_rule(rec)
+        return h if self.limit is None else min(h, self.limit(rec))
+
+    def share(self, dt):
+        return self.tol * self.speed * dt / self.duration
+
+    def rejects(self, error, dt):
+        return dt > self.floor * (1 + 1e-9) and error.local > 2.0 * error.share

@@ -58,6 +58,7 @@ class StaggeredResult:
     evaluations: int = 0
     cycles: int = 0
     phase_iterations: list = field(default_factory=list)
+    residual_ratio: float = 0.0  # (max |G_f| - atol)+ / F of the full residual it converged at (as newton's)
 
 
 def staggered(
@@ -84,6 +85,10 @@ def staggered(
     def converged(ev):
         return float(np.max(np.abs(ev.G[free]), initial=0.0)) <= tolerance(ev)
 
+    def ratio(ev):  # what the test accepted above atol, against the force scale (NewtonResult.residual_ratio)
+        F = force_scale(ev, free)
+        return max(float(np.max(np.abs(ev.G[free]), initial=0.0)) - atol, 0.0) / F if F > 0 else 0.0
+
     solves, per_phase = 0, []
     for cycle in range(1, max_cycles + 1):
         if converged(ev):
@@ -96,6 +101,7 @@ def staggered(
                 evaluations=calls,
                 cycles=cycle - 1,
                 phase_iterations=per_phase,
+                residual_ratio=ratio(ev),
             )
         for kind in ("normal", "friction"):
             if kind == "friction":  # freeze from the full state at the end of the normal phase
@@ -134,6 +140,7 @@ def staggered(
             evaluations=calls,
             cycles=max_cycles,
             phase_iterations=per_phase,
+            residual_ratio=ratio(ev),
         )
     raise NewtonError(
         f"staggered: no convergence in {max_cycles} cycles{where}; full residuals "
@@ -151,7 +158,7 @@ class Staggered:
 
     def __init__(self, stepper, max_cycles=60):
         self.stepper, self.max_cycles = stepper, max_cycles
-        self.system, self.dynamic = stepper.system, stepper.dynamic
+        self.system, self.dynamic, self.error_model = stepper.system, stepper.dynamic, stepper.error_model
         if self.dynamic and not hasattr(stepper, "beta"):
             raise ValueError("parameter stepper must be a Newmark or Static stepper (an implicit one)")
 

@@ -57,21 +57,22 @@ class SystemState:
     bodies    one per body: its internal variables (a viscoplastic beam's plastic strains;
               None for an elastic body)
     loads     one per load: its state (the gas pressure's value; None for most loads)
-    stepper   what the time stepper carries to its next step (None for most; a run at a
-              tolerance: the last step's change of the accelerations, schedule.Estimated)
+    slope     what the last step hands to the next step's error estimate (estimate.Slope;
+              None at a march's start and for a static stepper)
     """
 
     contacts: tuple = ()
     bodies: tuple = ()
     loads: tuple = ()
-    stepper: object = None
+    slope: object = None
 
 
 class Evaluation(NamedTuple):
     """The System at one trial u: residual G, tangent K, the contacts' states, the loads P and
     the SystemState it was evaluated with (a tuple, so ``G, K = evaluation[:2]`` reads as before);
     a time stepper's effective evaluation also carries the inertia M a it added to G (Newton's
-    force scale reads it)."""
+    force scale reads it) and the round-off of that inertia (``roundoff``: eps times its largest
+    operand, in force units; Newton's test adds it to atol: solver/newton.py)."""
 
     G: np.ndarray
     K: object
@@ -79,6 +80,7 @@ class Evaluation(NamedTuple):
     P: np.ndarray | None = None
     state: SystemState | None = None
     inertia: np.ndarray | None = None
+    roundoff: float = 0.0
 
 
 class Dirichlet:

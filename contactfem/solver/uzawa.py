@@ -41,7 +41,8 @@ class UzawaResult:
     step. ``uzawa_iterations``: Newton solves (outer iterations); ``updates`` =
     uzawa_iterations - 1 multiplier updates; ``newton_per_outer``: linear solves of each;
     ``violations``: the violation after each; ``gap_violations``: the largest penetration /
-    length after each; ``gap_violation``: its last value (the converged state)."""
+    length after each; ``gap_violation``: its last value (the converged state); ``residual_ratio``: the converged Newton
+    solve's."""
 
     u: np.ndarray
     residuals: list = field(default_factory=list)
@@ -55,9 +56,7 @@ class UzawaResult:
     violations: list = field(default_factory=list)
     gap_violation: float = 0.0
     gap_violations: list = field(default_factory=list)
-    local_error: float | None = None  # a time stepper's estimate of the step's error (schedule.Estimated)
-    carry: object = None  # what the stepper hands to its next step (SystemState.stepper)
-    error_share: float | None = None  # the error its share allows a step of its size (schedule.Estimated)
+    residual_ratio: float = 0.0  # the converged Newton solve's (NewtonResult.residual_ratio)
 
 
 class Uzawa:
@@ -81,7 +80,7 @@ class Uzawa:
         self.contacts = [c for c in contacts if isinstance(c, AugmentedNodeToSegment)]
         if not self.contacts:
             raise ValueError("Uzawa needs at least one augmented interface (enforcement = 'augmented')")
-        self.system, self.dynamic = stepper.system, stepper.dynamic
+        self.system, self.dynamic, self.error_model = stepper.system, stepper.dynamic, stepper.error_model
 
     def step(self, t, u, v, a, dt, label="", *, state):
         start = u
@@ -130,6 +129,7 @@ class Uzawa:
                 violations=viols,
                 gap_violation=gap,
                 gap_violations=list(gaps),
+                residual_ratio=res.residual_ratio,
             )
             return u1, v1, a1, result
         ours = set(map(id, self.contacts))

@@ -205,8 +205,8 @@ SCENES = {
         mu=({"variant": "frictional", "alpha": 0.0, "beta": 0.0}, {"variant": "frictional", "alpha": 0.0, "beta": 2.0}),
         methods=({"contact_integration": "energy_consistent"}, {"variant": "frictional"}),
     ),
-    # 8 s a run at the fast preset: the penalty's ends, friction's and the coarse mesh only; its dt sets
-    # the gas ramp (p_step a step), so the reference refines the pop's dt_fine and travel_max
+    # 8 s a run at the fast preset: the penalty's ends, friction's and the coarse mesh only; the reference
+    # refines the pop's dt_fine and travel_max
     "cork": Spec(
         ("exit_velocity_m_s", "exit_time_ms"),
         mu=({"mu": 0.0}, {"mu": 2.0}),
@@ -294,7 +294,7 @@ def reference_overrides(scene, over, keep=None):
     ref.update(spec.base)
     ref.update(keep or {})
     ref.update(spec.reference)
-    if scene == "cork":  # its dt is the gas ramp's (p_step a step): the pop's fine step and travel refined
+    if scene == "cork":  # the pop's fine step and travel refined
         ref.update(dt_fine=_default(scene, "dt_fine") * REFINE, travel_max=_default(scene, "travel_max") * REFINE)
     elif spec.dt:
         step = _default(scene, spec.dt) * REFINE  # a run finer than that is checked against it

@@ -85,8 +85,11 @@ def convergence_order_last(convergence_order):
 
 # settings for a tolerance: the frictionless sloping impact, run to t = 4 (the rebound is over by 2.4)
 TOLERANCE_END = 4.0
-TOLERANCE_BUDGET = {0.05: 100, 0.01: 400}  # steps: a tolerance's settings may cost this much at most
-TOLERANCE_REFERENCE = dict(c_N=5000.0, dt=0.004)  # 100 times the paper's penalty, a 25th of its step
+# steps: a tolerance's settings may cost this much at most (the largest steps that resolve the contact at the
+# penalty the tolerance needs, dt sqrt(c_N / m) <= 0.16 (penalty_steps), take 890 and 2860)
+TOLERANCE_BUDGET = {0.05: 1000, 0.01: 3000}
+# 10 times the paper's penalty at a step that resolves it (dt sqrt(c_N / m) = 0.11)
+TOLERANCE_REFERENCE = dict(c_N=500.0, dt=0.001)
 _TOLERANCE_RUNS = {}
 
 
