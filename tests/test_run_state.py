@@ -134,6 +134,8 @@ def test_resuming_a_record_on_a_model_of_another_size_names_both_sizes():
     _, _, other = model_of("block", {"n_steps": 1, "nx": 12})
     with pytest.raises(ValueError, match=rf"^record 1 holds {len(record.u)} unknowns, the model {other.system.ndof}:"):
         next(resume(other.stage.stepper, other.stage.schedule, record))
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("suffix", [None, ".npz"])
 def test_the_cork_resumed_from_a_record_of_its_pop_goes_on_as_it_went(suffix, tmp_path):

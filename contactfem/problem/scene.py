@@ -62,7 +62,9 @@ def simulate(model, params=None, progress=None):
     try:
         for i, stage in enumerate(model.stages):
             st = stage if isinstance(stage, Stage) else stage(records[-1])
-            marched = march(st.stepper, st.schedule, st.t0, st.u0, st.v0, a0=st.a0, label=st.label, state=st.state, stage=i)
+            marched = march(
+                st.stepper, st.schedule, st.t0, st.u0, st.v0, a0=st.a0, label=st.label, state=st.state, stage=i
+            )
             if st.until is not None:
                 marched = st.until(marched)
             for rec in watch(marched, progress, st.t0, st.schedule.t_end, st.name or model.name):
