@@ -127,9 +127,13 @@ def cmd_run(args):
     from .io.outputs import Outputs
     from .problem.scene import check_resources, describe
 
+    from .problem.uncertainty import check_tolerance, error_bars_default, line
+
     scene = scenes.get_scene(args.scene)
     overrides, laws, notes = laws_from_args(args)  # law.NAME=... go to --friction / --normal
     params = scene.resolve(args.preset, overrides)
+    tolerance = check_tolerance(args.tolerance)
+    error_bars = not args.no_error_bars and error_bars_default()
     out = Outputs()  # every output checked before the run
     if args.json is not None:  # (an empty name is refused, not skipped)
         out.add("--json", args.json, (".json",))
@@ -167,6 +171,8 @@ def cmd_run(args):
             progress=progress,
             linear_algebra=args.linear_algebra,
             check=False,
+            error_bars=error_bars,
+            tolerance=tolerance,
             **laws,
         )
     )
@@ -193,6 +199,14 @@ def cmd_run(args):
             print(f"{k}: {v}")
         elif isinstance(v, list) and 0 < len(v) <= 8 and all(isinstance(x, (int, float)) for x in v):
             print(f"{k}: [{', '.join(f'{x:.6g}' for x in v)}]")
+    bars = res.get("uncertainty")
+    if bars:  # each headline quantity with its band, and what the bands cost
+        for name, entry in bars["quantities"].items():
+            print(line(name, entry))
+        print(
+            f"error bars: {bars['runs']} coarser or finer runs in {bars['wall_time_s']:.3g} s (the run alone: "
+            f"{res['wall_time_s']:.3g} s); tolerance {bars['tolerance']:g}"
+        )
     for what, path in out.paths.items():
         print(f"{what} -> {path}")
     if args.strict and any(note.startswith("accuracy:") for note in notes):
@@ -257,8 +271,11 @@ def cmd_sweep(args):
     from .io.outputs import check_output_path
     from .lab.sweep import Table, parse_grid, sweep
 
+    from .problem.uncertainty import check_tolerance, error_bars_default
+
     if args.jobs < 1:
         raise ValueError(f"parameter jobs = {args.jobs} is out of range: allowed [1, inf)")
+    tolerance = check_tolerance(args.tolerance)
     if args.time_limit is not None and not args.time_limit > 0:
         raise ValueError(f"parameter time-limit = {args.time_limit:g} is out of range: allowed (0, inf) seconds")
     if args.time_limit is not None and args.scheduler:
@@ -283,6 +300,8 @@ def cmd_sweep(args):
         force=args.force,
         table=table,
         timeout=args.time_limit,
+        error_bars=not args.no_error_bars and error_bars_default(),
+        tolerance=tolerance,
     )
     _RUN["phase"] = "done"
     done, failed, left = table.counts()
@@ -502,6 +521,24 @@ def write_animation(res, path):
     return path
 
 
+def add_error_bar_options(parser):
+    """--no-error-bars and --tolerance, as run and sweep take them."""
+    parser.add_argument(
+        "--no-error-bars",
+        action="store_true",
+        help="skip the error bands of the headline quantities (by default each comes with its numerical "
+        "uncertainty, from runs at coarser steps and meshes: the JSON's uncertainty section)",
+    )
+    parser.add_argument(
+        "--tolerance",
+        type=float,
+        default=0.05,
+        metavar="TOL",
+        help="the relative error band (and error against a closed form) past which a headline quantity warns "
+        "(default 0.05; --strict makes it exit 1)",
+    )
+
+
 def build_parser():
     ap = Parser(prog="contactfem", description=__doc__.split("\n\n")[0])
     sub = ap.add_subparsers(dest="command", required=True)
@@ -561,6 +598,7 @@ def build_parser():
         help="exit with code 1 when an accuracy indicator of the run is past its threshold (each one "
         "prints a warning line either way)",
     )
+    add_error_bar_options(rp)
     rp.add_argument("--save", metavar="FILE", help="save the run (.json or .npz) for contactfem.io.load_run")
     rp.add_argument(
         "--force",
@@ -643,6 +681,7 @@ def build_parser():
     )
     sw.add_argument("--normal", metavar="LAW", help="the normal law of every run, as for run")
     sw.add_argument("--no-check", action="store_true", help="skip the laws' check before the runs, as for run")
+    add_error_bar_options(sw)
     sw.add_argument(
         "--force",
         action="store_true",

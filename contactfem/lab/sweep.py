@@ -65,12 +65,13 @@ def build_laws(scene, preset, point, friction=None, normal=None, notes=None):
     return overrides, laws_from_options(friction, normal, law_sets, from_scene, notes)
 
 
-def _one(scene, preset, point, friction=None, normal=None):
+def _one(scene, preset, point, friction=None, normal=None, error_bars=None, tolerance=None):
     """One run, reduced to its scalar results (lists and dicts are left out of the table; so
-    are results that repeat a swept parameter, which has its column param.NAME)."""
+    are results that repeat a swept parameter, which has its column param.NAME). ``error_bars``,
+    ``tolerance``: as for run_scene."""
     try:
         overrides, laws = build_laws(scene, preset, point, friction, normal)
-        res = run_scene(scene, preset, overrides, check=False, **laws)
+        res = run_scene(scene, preset, overrides, check=False, error_bars=error_bars, tolerance=tolerance, **laws)
         row = {k: v for k, v in res.items() if not isinstance(v, (list, dict)) and k not in point}
         row["error"] = ""
     except Exception as exc:  # a failed point is a row of the table, not the end of the sweep
@@ -153,13 +154,16 @@ def sweep(
     force=False,
     table=None,
     timeout=None,
+    error_bars=None,
+    tolerance=None,
 ):
     """Run `scene` at every point of the grid (parameters and law fields law.NAME, with the
     laws named by ``friction`` / ``normal`` as on the command line); returns the list of row
     dicts, in the grid's order. Every point is validated first (``plan``). ``table``: a Table
     that keeps the rows (on disk if it has a path, written as each point ends, and with
     ``resume`` the rows it already holds); ``timeout``: seconds a local run may take before it
-    is stopped and recorded as failed."""
+    is stopped and recorded as failed. ``error_bars``, ``tolerance``: every run's, as for run_scene (each
+    row's ``uncertainty`` section is a plain dict of the run's results)."""
     args = (scene, grid, preset, jobs, scheduler, friction, normal, check, force)
     points, version = (
         _guarded(_prepare, args, laws_text(friction, normal))
@@ -169,7 +173,7 @@ def sweep(
     table = Table() if table is None else table
     same = dict(scene=get_scene(scene).name, preset=preset, laws=laws_text(friction, normal), code_version=version)
     todo = table.start(points, same)
-    tasks = [(i, (scene, preset, points[i], friction, normal)) for i in todo]
+    tasks = [(i, (scene, preset, points[i], friction, normal, error_bars, tolerance)) for i in todo]
     runs = _on_dask(scheduler, tasks) if scheduler else _local(tasks, jobs, timeout)
     with closing(runs):  # an exception here (Ctrl-C, SIGTERM) stops the workers at once
         for i, row in runs:

@@ -107,7 +107,8 @@ from ..contact.masters import bottle_neck
 from ..laws.friction import SlipHardening
 from ..laws.normal import PowerLaw
 from ..problem import time_integration
-from ..problem.scene import PENALTIES, PENALTY_DOC, Limit, Model, Param, Scene
+from ..problem.scene import PENALTIES, PENALTY_DOC, Limit, Model, Param, Quantity, Scene
+from ..problem.uncertainty import mesh, time_step
 from ..problem.time_integration import newmark_params
 
 
@@ -728,4 +729,12 @@ SCENE = Scene(
     laws=("normal", "friction"),
     law_params={"friction": ("c_T", "mu", "h"), "normal": ("c_N", "m")},
     law_range=law_range,
+    # the gas is coupled explicitly (a step acts with the pressure before it): first order in the step whatever
+    # the integrator. The step's ladder scales the fine step and the travel limit; dt also sets the gas ramp
+    # (p_step a step), so it stays
+    quantities=tuple(
+        Quantity(name, unit, ("step", "mesh"), orders={"step": 1.0})
+        for name, unit in (("exit_velocity_m_s", "m/s"), ("exit_time_ms", "ms"))
+    ),
+    discretisations=(time_step("dt_fine", also=("travel_max",)), mesh("n_r", "n_z", low={"n_z": 3})),
 )

@@ -1,0 +1,492 @@
+"""Bench study: do the error bands hold? Every scene over the ranges of its discretisations (step, mesh,
+penalty, enforcement, integrator, both presets, and the physics that move them: penalty, friction),
+each run with its error bars as a user gets them (problem/uncertainty.py, tolerance 5 %), against the
+true error of each headline quantity.
+
+The true error is measured against a converged reference of the same physical problem: the closed form
+where the scene has one (Hertz's a and p0, the continuous bar's contact duration and rebound, the
+patch test's uniform pressure), else a ladder refined in every discretisation that moves the quantity
+at once (the step halved and the elements doubled, level after level, with the trapezoidal rule) until
+two successive levels agree to REF_AGREE (0.1 %); the finest level is the reference and the ladder is
+recorded. Runs that differ only in their discretisation (step, mesh, integrator, penalty where it
+regularises a constraint, enforcement) share their reference. Errors are relative to the quantity's
+reference value, or to the scale below which it counts as near zero (the Quantity's own), never
+inflated otherwise.
+
+Each run ends in one of:
+
+    covered      every headline quantity's true error lies within its band (+ the reference's own change)
+    uncovered    a quantity's band does not hold its true error
+    no band      a quantity got no band (the run warns, naming it)
+    closed form  the scene's headline is its error against a closed form, which the run knows (the patch)
+    refused      a ValueError of one line before any work
+    stopped      a one-line error during the run
+    crashed      anything else (must stay empty), or past the time limit
+
+and it is *silent-wrong* when it exits without an error and without any AccuracyWarning while a
+quantity's true error passes TOL (5 %): that count must be 0. Band efficiency: the median of band /
+true error over the covered quantities (1 is a band that holds exactly; large is a loose band).
+
+The study keeps its runs in a checkpoint ($CONTACTFEM_CACHE/coverage, keyed by the runs' parameters and a
+digest of the sources they use), so that a study stopped midway goes on where it was; ``quick`` is the
+slice the test suite runs."""
+
+import hashlib
+import json
+import math
+import os
+import signal
+import threading
+import time
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ...problem.accuracy import AccuracyWarning
+from ...scenes import get_scene, run_scene
+
+TOL = 0.05  # the tolerance every run of the study has (the default): a true error past it is wrong
+REF_AGREE = 1e-3  # two successive levels of a reference ladder agree to this (relative)
+TIME_LIMIT = 1800.0  # seconds a run with its error bars may take
+TRAPEZOIDAL = {"delta": 0.5, "beta_newmark": 0.25}
+
+
+@dataclass(frozen=True)
+class Physics:
+    """A physical problem of a scene: the parameters that make it (``over``), and how its reference is
+    refined (``refine(k)``: the overrides of level k; None: the scene's closed forms), from level 0 up to
+    ``levels`` levels at most."""
+
+    scene: str
+    over: dict = field(default_factory=dict)
+    refine: object = None
+    levels: int = 6
+
+
+def _ring_refine(dt0, n0, t_end=None):
+    """A ring scene's reference ladder: the step halved and the elements doubled each level, the
+    trapezoidal rule; ``t_end``: the n_steps that reach it (the scenes counted in steps)."""
+
+    def refine(k):
+        dt = dt0 / 2**k
+        out = dict(TRAPEZOIDAL, dt=dt, n_el=n0 * 2**k)
+        if t_end is not None:
+            out["n_steps"] = math.ceil(t_end / dt - 1e-9)
+        return out
+
+    return refine
+
+
+def _block_refine(k):
+    return {"ny": 8 * 2**k}
+
+
+def _cork_refine(k):
+    return dict(TRAPEZOIDAL, dt_fine=1e-5 / 2**k, travel_max=0.5 / 2**k, n_r=6 * 2**k, n_z=19 * 2**k, n_press=20 * 2**k)
+
+
+# the rebound is decided by t = 4 (the impact is over by 3 at every step and penalty below): without
+# gravity the centre of mass keeps its velocity in flight, so the reference flies to 4, the runs to 20
+SLOPING = _ring_refine(0.025, 16, t_end=4.0)
+PHYSICS = {
+    "sloping frictionless": Physics("sloping_impact", {}, SLOPING),
+    "sloping frictional": Physics("sloping_impact", {"variant": "frictional"}, SLOPING),
+    "sloping frictionless c_N 500": Physics("sloping_impact", {"c_N": 500.0}, _ring_refine(0.0125, 16, 4.0)),
+    "sloping frictionless c_N 5": Physics("sloping_impact", {"c_N": 5.0}, _ring_refine(0.025, 16, t_end=10.0)),
+    "sloping frictional beta 1": Physics(
+        "sloping_impact", {"variant": "frictional", "alpha": 0.0, "beta": 1.0}, SLOPING
+    ),
+    "rolling mu 0.15": Physics("rolling_ring", {}, _ring_refine(0.005, 120)),
+    "rolling mu 0.3": Physics("rolling_ring", {"mu": 0.3}, _ring_refine(0.005, 120)),
+    "rolling mu 0.05": Physics("rolling_ring", {"mu": 0.05}, _ring_refine(0.005, 120)),
+    "rolling c_N 100": Physics("rolling_ring", {"c_N": 100.0}, _ring_refine(0.0025, 120)),
+    "funnel frictionless": Physics("funnel", {}, _ring_refine(0.05, 30, 15.0)),
+    "funnel frictional": Physics("funnel", {"variant": "frictional"}, _ring_refine(0.05, 30, 15.0)),
+    "funnel c_N 20": Physics("funnel", {"c_N": 20.0}, _ring_refine(0.05, 30, 15.0)),
+    "block conical": Physics("block", {}, _block_refine),
+    "block parabolic": Physics("block", {"law": "parabolic"}, _block_refine),
+    "block coulomb": Physics("block", {"law": "coulomb", "mu": 0.3}, _block_refine),
+    "block c_N 1e4": Physics("block", {"c_N": 1e4}, _block_refine),
+    "block lagrange": Physics("block", {"enforcement": "lagrange"}, _block_refine),
+    "cork": Physics("cork", {}, _cork_refine, levels=3),
+    "hertz": Physics("hertz"),
+    "bar": Physics("bar_impact"),
+    "patch": Physics("patch"),
+}
+
+
+def _sweep(physics, axis, values, extra=None, preset="fast"):
+    """Cases of one physics along one axis: (physics, preset, overrides, label)."""
+    return [(physics, preset, dict(extra or {}, **{axis: v}), f"{axis}={v:g}") for v in values]
+
+
+def _steps(physics, dts, t_end, extra=None, preset="fast", label=""):
+    """Cases at the steps dts of a scene counted in steps (n_steps kept at t_end / dt)."""
+    return [
+        (physics, preset, dict(extra or {}, dt=dt, n_steps=math.ceil(t_end / dt - 1e-9)), f"dt={dt:g}{label}")
+        for dt in dts
+    ]
+
+
+def cases():
+    """The study's runs: (physics, preset, overrides, label)."""
+    out = []
+    # sloping impact: both presets are the paper's (Newmark 0.7 / 0.4, dt = 0.1, 16 elements)
+    for ph in ("sloping frictionless", "sloping frictional"):
+        out += [(ph, "paper", {}, "paper preset"), (ph, "fast", {"n_steps": 40}, "fast preset, 40 steps")]
+        out += _steps(ph, (0.2, 0.05, 0.025), 4.0)
+        out += _steps(ph, (0.1, 0.05, 0.025, 0.0125), 4.0, TRAPEZOIDAL, label=", trapezoidal")
+        out += _steps(ph, (0.1, 0.025), 4.0, {"contact_integration": "energy_consistent"}, label=", energy-consistent")
+        out += [(ph, "fast", {"n_el": n, "n_steps": 40}, f"n_el={n}") for n in (8, 32, 64)]
+        out += [(ph, "fast", {"accuracy": a, "n_steps": 40}, f"accuracy={a:g}") for a in (0.03, 0.01)]
+        out += [(ph, "fast", {"mass_matrix": "consistent", "n_steps": 40}, "consistent mass")]
+    for ph, t_end in (
+        ("sloping frictionless c_N 500", 4.0),
+        ("sloping frictionless c_N 5", 10.0),
+        ("sloping frictional beta 1", 4.0),
+    ):
+        out += _steps(ph, (0.1, 0.025), t_end) + _steps(ph, (0.05,), t_end, TRAPEZOIDAL, label=", trapezoidal")
+    # rolling ring: fast (40 elements, dt = 0.02) and paper (120, 0.01)
+    ph = "rolling mu 0.15"
+    out += [(ph, "fast", {}, "fast preset"), (ph, "paper", {}, "paper preset")]
+    out += _sweep(ph, "dt", (0.04, 0.005), preset="paper")
+    out += _sweep(ph, "n_el", (60, 240), preset="paper")
+    out += _sweep(ph, "n_el", (80, 160))
+    out += [
+        (ph, "paper", TRAPEZOIDAL, "trapezoidal"),
+        (ph, "paper", {"contact_integration": "energy_consistent"}, "EC"),
+    ]
+    out += [(ph, "paper", {"accuracy": 0.01}, "accuracy=0.01")]
+    for ph in ("rolling mu 0.3", "rolling mu 0.05", "rolling c_N 100"):
+        out += [(ph, "fast", {}, "fast preset"), (ph, "paper", {}, "paper preset"), (ph, "paper", {"dt": 0.005}, "dt")]
+    # funnel: fast = paper (30 elements of the half ring, dt = 0.1)
+    for ph in ("funnel frictionless", "funnel frictional"):
+        out += [(ph, "fast", {}, "preset")] + _sweep(ph, "dt", (0.2, 0.05, 0.025))
+        out += _sweep(ph, "n_el", (15, 60))
+        out += [
+            (ph, "fast", TRAPEZOIDAL, "trapezoidal"),
+            (ph, "fast", {"contact_integration": "energy_consistent"}, "EC"),
+        ]
+    out += [("funnel c_N 20", "fast", {}, "c_N=20")] + _sweep("funnel c_N 20", "dt", (0.05,))
+    # block: static, nx the problem's own; the mesh through the height
+    for ph in ("block conical", "block parabolic", "block coulomb", "block c_N 1e4"):
+        out += [(ph, "fast", {}, "preset")] + _sweep(ph, "ny", (2, 4, 16))
+    out += [("block conical", "fast", {"contact_discretization": "mortar"}, "mortar")]
+    out += [("block lagrange", "fast", {}, "lagrange")] + _sweep("block lagrange", "ny", (4, 16))
+    out += [("block lagrange", "fast", {"enforcement": "augmented"}, "augmented")]
+    # hertz: closed form; mesh, penalty, grading, enforcement, discretisation
+    out += [("hertz", "fast", {}, "fast preset"), ("hertz", "paper", {}, "paper preset")]
+    out += _sweep("hertz", "n_el", (8, 16, 48))
+    out += _sweep("hertz", "c_N", (1e6, 1e7, 1e8, 1e10))
+    out += _sweep("hertz", "grading", (0.0, 2.0))
+    out += [("hertz", "fast", {"penalty": "per_node", "c_N": 1e8}, "per node")]
+    out += [("hertz", "fast", {"enforcement": e}, e) for e in ("augmented", "lagrange")]
+    out += [("hertz", "fast", {"contact_discretization": "mortar"}, "mortar")]
+    out += [("hertz", "fast", {"contact_discretization": "mortar", "n_el": 64}, "mortar, n_el=64")]
+    # bar: closed form; step, mesh, penalty, integrators, enforcement
+    out += [("bar", "fast", {}, "fast preset"), ("bar", "paper", {}, "paper preset")]
+    out += _sweep("bar", "courant", (0.25, 0.5, 2.0, 4.0))
+    out += _sweep("bar", "n_el", (10, 20, 80, 200))
+    out += _sweep("bar", "c_N_factor", (0.1, 0.3, 3.0, 10.0, 100.0))
+    out += [
+        ("bar", "fast", {"integrator": "central_difference", "courant": c}, f"central differences {c:g}")
+        for c in (0.5, 0.9)
+    ]
+    out += [("bar", "fast", {"contact_integration": "energy_consistent"}, "EC")]
+    out += [("bar", "fast", {"delta": 0.7, "beta_newmark": 0.4}, "Newmark 0.7")]
+    out += [("bar", "fast", {"enforcement": e}, e) for e in ("augmented", "lagrange")]
+    out += [("bar", "fast", {"contact_discretization": "mortar"}, "mortar")]
+    out += [("bar", "fast", {"accuracy": a}, f"accuracy={a:g}") for a in (0.01, 0.003)]
+    # patch: closed form, no band (its headline is its error)
+    out += [("patch", "fast", {}, "fast preset"), ("patch", "paper", {}, "paper preset")]
+    out += [("patch", "fast", {"nx_lower": a, "nx_upper": b}, f"{a}|{b}") for a, b in ((11, 5), (17, 3), (2, 3))]
+    out += [
+        ("patch", "fast", o, t)
+        for o, t in (
+            ({"passes": 2}, "two passes"),
+            ({"contact_discretization": "mortar"}, "mortar"),
+            ({"enforcement": "lagrange"}, "lagrange"),
+            ({"mu": 0.3, "E_upper": 500.0}, "friction"),
+        )
+    ]
+    # the cork: its preset, and its step varied (the fine step and the travel limit)
+    out += [("cork", "fast", {}, "fast preset"), ("cork", "paper", {}, "paper preset")]
+    out += [("cork", "fast", {"dt_fine": 2e-5 * f, "travel_max": 1.0 * f}, f"step x {f:g}") for f in (0.5, 2.0)]
+    out += [("cork", "fast", TRAPEZOIDAL, "trapezoidal")]
+    return out
+
+
+QUICK = [
+    ("bar", "fast", {"n_el": 10}, "n_el=10"),
+    ("hertz", "fast", {"n_el": 8}, "n_el=8"),
+    ("patch", "fast", {}, "fast preset"),
+    ("block conical", "fast", {"ny": 4}, "ny=4"),
+]
+
+
+# -- running, with a checkpoint ---------------------------------------------------------------------
+
+
+def _digest():
+    """A digest of the library's sources (what a run computes), for the checkpoint's keys."""
+    import contactfem
+
+    root = Path(contactfem.__file__).parent
+    h = hashlib.sha256()
+    for f in sorted(root.rglob("*.py")):
+        if "lab" not in f.relative_to(root).parts:
+            h.update(str(f.relative_to(root)).encode() + b"\0" + f.read_bytes())
+    return h.hexdigest()[:16]
+
+
+class Checkpoint:
+    """The study's runs kept on disk as they end (one JSON file per run, keyed by what it ran and the
+    code's digest), so that a study stopped midway goes on where it was. ``path`` None: none kept."""
+
+    def __init__(self, path):
+        self.path = None if path is None else Path(path)
+
+    def _file(self, key):
+        return self.path / (hashlib.sha256(json.dumps(key, sort_keys=True).encode()).hexdigest()[:24] + ".json")
+
+    def get(self, key, compute):
+        if self.path is None:
+            return compute()
+        f = self._file(key)
+        if f.exists():
+            return json.loads(f.read_text())
+        value = compute()
+        self.path.mkdir(parents=True, exist_ok=True)
+        tmp = f.with_suffix(".tmp")
+        tmp.write_text(json.dumps(value))
+        tmp.replace(f)
+        return value
+
+
+def default_checkpoint():
+    root = Path(os.environ.get("CONTACTFEM_CACHE") or Path.home() / ".cache" / "contactfem")
+    return root / "coverage"
+
+
+class _Late(Exception):
+    pass
+
+
+def _limited(fn, seconds):
+    if seconds is None or threading.current_thread() is not threading.main_thread() or not hasattr(signal, "SIGALRM"):
+        return fn()
+
+    def stop(signum, frame):
+        raise _Late()
+
+    old = signal.signal(signal.SIGALRM, stop)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        return fn()
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+
+
+def _values(scene, r):
+    """The headline quantities' values, their closed forms and what they are relative to."""
+    sc = get_scene(scene)
+    out = {}
+    for q in sc.quantities:
+        v = r.get(q.name)
+        exact = r.get(q.exact) if isinstance(q.exact, str) else q.exact
+        out[q.name] = dict(value=v if isinstance(v, (int, float)) and not isinstance(v, bool) else None, exact=exact)
+    return out
+
+
+def attempt(scene, preset, over, error_bars=True, seconds=TIME_LIMIT):
+    """One run as a user gets it: dict(outcome=ran|refused|stopped|crashed, values, uncertainty,
+    warnings (the AccuracyWarning lines), time_s)."""
+    t0 = time.perf_counter()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            r = _limited(lambda: run_scene(scene, preset, over, error_bars=error_bars, tolerance=TOL), seconds)
+        except _Late:
+            return dict(outcome="crashed", error=f"past {seconds:g} s", time_s=time.perf_counter() - t0)
+        except (ValueError, RuntimeError, ArithmeticError) as err:
+            text = str(err)
+            one = bool(text) and "\n" not in text.strip()
+            kind = ("refused" if isinstance(err, ValueError) else "stopped") if one else "crashed"
+            return dict(outcome=kind, error=f"{type(err).__name__}: {text}"[:300], time_s=time.perf_counter() - t0)
+        except Exception as err:  # noqa: BLE001 (anything else is a crash, counted)
+            return dict(outcome="crashed", error=f"{type(err).__name__}: {err}"[:300], time_s=time.perf_counter() - t0)
+    lines = [str(w.message) for w in caught if issubclass(w.category, AccuracyWarning)]
+    u = r.get("uncertainty") or {}
+    separated = (r.get("accuracy") or {}).get("separated", {}).get("ok", True)
+    return dict(
+        outcome="ran",
+        values=_values(scene, r),
+        uncertainty=u.get("quantities", {}),
+        bars_s=u.get("wall_time_s"),
+        bar_runs=u.get("runs"),
+        run_s=r["wall_time_s"],
+        warnings=lines,
+        separated=separated,
+        time_s=time.perf_counter() - t0,
+    )
+
+
+def reference(name, checkpoint, progress=None):
+    """The converged reference of a physics (module docstring): dict(values, change, ladder, converged),
+    or None for a scene's closed forms."""
+    ph = PHYSICS[name]
+    if ph.refine is None:
+        return None
+    sc = get_scene(ph.scene)
+    ladder, prev = [], None
+    for k in range(ph.levels):
+        over = dict(ph.over, **ph.refine(k))
+        run = checkpoint.get(["reference", ph.scene, over, _digest()], lambda: attempt(ph.scene, "paper", over, False))
+        level = dict(k=k, overrides=over, outcome=run["outcome"], error=run.get("error"), time_s=run["time_s"])
+        if run["outcome"] == "ran" and not run["separated"]:
+            level.update(outcome="stopped", error="ends in contact: its rebound would be read mid-impact")
+        if level["outcome"] != "ran":
+            ladder.append(level)
+            break
+        values = {q: v["value"] for q, v in run["values"].items()}
+        level["values"] = values
+        ladder.append(level)
+        if progress:
+            progress(f"coverage: reference {name} level {k}: {values}")
+        if prev is not None:
+            params = sc.resolve("paper", over)
+            change = {}
+            for q in sc.quantities:
+                a, b = prev.get(q.name), values.get(q.name)
+                if a is None or b is None:
+                    change[q.name] = 0.0 if a is None and b is None else math.inf
+                else:
+                    change[q.name] = abs(b - a) / max(q.reference(params, b), 1e-300)
+            level["change"] = change
+            if max(change.values(), default=0.0) <= REF_AGREE:
+                return dict(values=values, change=change, ladder=ladder, converged=True)
+        prev = values
+    return dict(values=None, change=None, ladder=ladder, converged=False)
+
+
+def judge(scene, preset, over, run, ref):
+    """A run's outcome (module docstring), its true errors and bands per quantity, and whether it is
+    silent-wrong."""
+    if run["outcome"] != "ran":
+        return dict(outcome=run["outcome"], quantities={}, silent_wrong=False)
+    sc = get_scene(scene)
+    params = sc.resolve(preset, over)
+    rows, outcome = {}, "covered"
+    for q in sc.quantities:
+        v = run["values"].get(q.name, {})
+        value = v.get("value")
+        if value is None:
+            continue
+        if ref is None:
+            truth, ref_change = v.get("exact"), 0.0
+        else:
+            truth = (ref.get("values") or {}).get(q.name)
+            ref_change = (ref.get("change") or {}).get(q.name, 0.0)
+        if truth is None:
+            continue
+        scale = q.reference(params, truth)
+        error = abs(value - truth) / scale
+        u = run["uncertainty"].get(q.name)
+        band = None if u is None or u.get("band") is None else u["band"] / scale
+        row = dict(value=value, reference=truth, error=error, band=band, reference_change=ref_change)
+        if not q.controls:
+            row["kind"] = "closed form"
+        elif band is None:
+            row["kind"] = "no band"
+        else:
+            row["kind"] = "covered" if error <= band + ref_change else "uncovered"
+        rows[q.name] = row
+    kinds = {r["kind"] for r in rows.values()}
+    for k in ("uncovered", "no band", "closed form"):
+        if k in kinds:
+            outcome = k
+            break
+    if not rows:
+        outcome = "no reference"
+    wrong = any(r["error"] > TOL for r in rows.values())
+    return dict(outcome=outcome, quantities=rows, silent_wrong=bool(wrong and not run["warnings"]))
+
+
+OUTCOMES = ("covered", "uncovered", "no band", "closed form", "refused", "stopped", "crashed", "no reference")
+
+
+def coverage_study(quick=False, progress=None, checkpoint=None, seconds=TIME_LIMIT):
+    """Run the study (``quick``: the test suite's slice; ``checkpoint``: a folder for the runs, None:
+    $CONTACTFEM_CACHE/coverage, False: none); rows, references, counts and the coverage figures."""
+    store = Checkpoint(None if checkpoint is False else (checkpoint or default_checkpoint()))
+    todo = QUICK if quick else cases()
+    refs, rows = {}, []
+    digest = _digest()
+    for name, preset, over, label in todo:
+        ph = PHYSICS[name]
+        full = dict(ph.over, **over)
+        if name not in refs:
+            refs[name] = reference(name, store, progress)
+        run = store.get(["run", ph.scene, preset, full, digest], lambda: attempt(ph.scene, preset, full, True, seconds))
+        verdict = judge(ph.scene, preset, full, run, refs[name])
+        row = dict(
+            scene=ph.scene,
+            physics=name,
+            preset=preset,
+            overrides=full,
+            label=label,
+            outcome=verdict["outcome"],
+            silent_wrong=verdict["silent_wrong"],
+            quantities=verdict["quantities"],
+            warnings=run.get("warnings", []),
+            error=run.get("error", ""),
+            run_s=run.get("run_s"),
+            bars_s=run.get("bars_s"),
+            bar_runs=run.get("bar_runs"),
+        )
+        rows.append(row)
+        if progress:
+            progress(f"coverage: {name} {preset} {label}: {row['outcome']} {_text(row['quantities'])}")
+    return summarise(rows, refs, quick)
+
+
+def summarise(rows, refs, quick=False):
+    """The study's counts and figures from its rows (module docstring)."""
+    counts = {k: sum(r["outcome"] == k for r in rows) for k in OUTCOMES}
+    banded = [r for r in rows if r["outcome"] in ("covered", "uncovered")]
+    pairs = [q for r in rows for q in r["quantities"].values() if q["kind"] in ("covered", "uncovered")]
+    held = [q for q in pairs if q["kind"] == "covered" and q["error"] > 0]
+    ratios = sorted(q["band"] / q["error"] for q in held)
+    overhead = sorted((r["run_s"] + r["bars_s"]) / r["run_s"] for r in rows if r.get("bars_s") and r.get("run_s"))
+    return dict(
+        tol=TOL,
+        reference_agreement=REF_AGREE,
+        quick=bool(quick),
+        runs=len(rows),
+        counts=counts,
+        runs_with_bands=len(banded),
+        coverage=counts["covered"] / len(banded) if banded else None,
+        quantities_with_bands=len(pairs),
+        quantity_coverage=sum(q["kind"] == "covered" for q in pairs) / len(pairs) if pairs else None,
+        silent_wrong=sum(r["silent_wrong"] for r in rows),
+        band_efficiency=_median(ratios),
+        overhead_median=_median(overhead),
+        references={k: None if v is None else dict(v, ladder=v["ladder"]) for k, v in refs.items()},
+        rows=rows,
+    )
+
+
+def _median(xs):
+    xs = sorted(xs)
+    if not xs:
+        return None
+    n = len(xs)
+    return xs[n // 2] if n % 2 else 0.5 * (xs[n // 2 - 1] + xs[n // 2])
+
+
+def _text(quantities):
+    return ", ".join(
+        f"{k} {100 * q['error']:.2g} % / " + ("-" if q["band"] is None else f"{100 * q['band']:.2g} %")
+        for k, q in quantities.items()
+    )
