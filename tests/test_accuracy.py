@@ -88,8 +88,7 @@ def test_bar_impact_off_its_closed_form_is_flagged(over):
 
 def test_sloping_impact_coarse_step_is_flagged():
     r, flagged = _run("sloping_impact", {"dt": 1})
-    assert {"impact_steps", "energy_loss", "local_error"} <= flagged
-    assert r["accuracy"]["energy_loss"]["value"] > 0.3
+    assert {"impact_steps", "local_error"} <= flagged
 
 
 @pytest.mark.parametrize("integration", ["standard", "energy_consistent"])
@@ -147,7 +146,7 @@ def test_patch_pressure_covers_both_blocks(lower, upper, off):
     r, flagged = _run("patch", {"nx_lower": lower, "nx_upper": upper})
     assert r["pressure_deviation_lower"] == pytest.approx(off, rel=0.01)  # master nodes that get no load
     assert r["pressure_deviation_max"] >= r["pressure_deviation_lower"]
-    assert "pressure_deviation" in flagged
+    assert "pressure_deviation_max" in flagged
     mortar, flagged = _run("patch", {"nx_lower": lower, "nx_upper": upper, "contact_discretization": "mortar"})
     assert mortar["pressure_deviation_max"] < 1e-9 and not flagged  # mortar passes on both blocks
 

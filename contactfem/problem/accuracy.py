@@ -11,9 +11,10 @@ The indicators that apply to a run (``collect``), from its records and the model
     equilibrium     the largest converged residual over the step's force scale (solver/newton.py)
     penetration     the largest penetration over the local element size, and over the body's size
     facets          a ring's elements against its radius: the angle one element spans (few: no ring)
-    energy_gain     the energy balance's error, both signs: a gain (the integrator adds energy)
-    energy_loss     and a loss (the integrator takes it), friction's dissipation and the loads' work
-                    counted as the balance counts them (time_integration.energy_error)
+    energy_gain     the energy balance's error: a gain (the integrator adds energy), friction's dissipation
+                    and the loads' work counted as the balance counts them (time_integration.energy_error);
+                    a loss is what the damping of Newmark's delta > 1/2 takes, and what it does to the
+                    headline quantities is the time step's part of their error bands (problem/uncertainty.py)
     impact_steps    the fewest steps that resolve one contact episode (from touch-down to lift-off)
     penalty_steps   dt against the penalty's period, dt sqrt(k / m) at the stiffest contact node
     separated       an impact scene (the model's ``rebound``): the body has left the obstacle by the run's
@@ -56,10 +57,6 @@ EQUILIBRIUM = 1e-6  # solver.newton.ROUNDOFF_RTOL: what Newton accepts when roun
 PENETRATION_ELEMENT = 0.1  # ANSYS's default penetration tolerance (FTOLN): 0.1 of the underlying element
 PENETRATION_BODY = 0.01  # 1 % of the body's size: the contact changes the body's geometry visibly
 ENERGY_GAIN = 0.01  # a gain of 1 % is no Newton tolerance's share (1e-6 at most)
-ENERGY_LOSS_SOURCE = (
-    "twice the run's tolerance: a speed v carries the energy m v^2 / 2, so a relative loss dE / E makes a "
-    "relative speed error of about dE / 2E"
-)
 IMPACT_STEPS = 5  # measured: the presets resolve their impacts with >= 23 steps; dt = 1 on the
 # sloping impact with 3
 PENALTY_STEPS = 4.0  # dt sqrt(k/m): Newmark's (and the energy-consistent midpoint rule's) period error passes
@@ -110,8 +107,8 @@ def hertz_half_width(x, f):
 
 
 def collect(model, params, records, results, tolerance=0.05):
-    """The generic indicators of a run (module docstring), as a dict name -> indicator; the thresholds of
-    facets and energy_loss follow from the run's ``tolerance``."""
+    """The generic indicators of a run (module docstring), as a dict name -> indicator; the threshold of
+    facets follows from the run's ``tolerance``."""
     out = {}
     if isinstance(records, dict):  # a scene of several stages (the cork): their records in turn
         records = [r for part in records.values() if isinstance(part, list) for r in part if hasattr(r, "result")]
@@ -154,13 +151,6 @@ def collect(model, params, records, results, tolerance=0.05):
             ENERGY_GAIN,
             "energy gained over the run / initial energy (dissipation and the loads' work counted)",
             "a gain above 1 % is the integrator's, not Newton's (1e-6 at most)",
-        )
-    if isinstance(err, float) and not model.plastic:  # plastic work is no integrator's loss
-        out["energy_loss"] = indicator(
-            max(-err, 0.0),
-            2.0 * tolerance,
-            "energy lost to the integrator / initial energy (friction's dissipation counted apart)",
-            ENERGY_LOSS_SOURCE,
         )
     if model.rebound and steps:
         out["separated"] = indicator(

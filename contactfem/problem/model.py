@@ -27,8 +27,7 @@ class Model:
     """What a scene's ``build`` returns: every System it built (``systems``), the march that
     runs it (``stage``; None for a scene with its own ``simulate``), the lengths the accuracy
     indicators compare the penetration with (``sizes``: ``element``, ``body``, and ``radius``
-    for a ring), whether the scene reads a rebound after the impact (``rebound``) or dissipates
-    energy by plasticity (``plastic``: no integrator's loss), the name progress shows, and the
+    for a ring), whether the scene reads a rebound after the impact (``rebound``), the name progress shows, and the
     scene's own objects (``parts``: bodies, contacts, node sets, closed forms) for its
     ``measure`` and plots."""
 
@@ -36,7 +35,6 @@ class Model:
     stage: Stage | None = None
     sizes: dict = field(default_factory=dict)
     rebound: bool = False
-    plastic: bool = False
     name: str = ""
     parts: dict = field(default_factory=dict)
 

@@ -196,26 +196,37 @@ def factor_of_safety(P):
 
 
 def observed_order(e21, e32, r21, r32):
-    """The observed order p of monotone levels (0 < e21 / e32 < 1) with refinement ratios r21, r32
-    (Celik et al. 2008: a fixed point of p = ln(|e32 / e21| (r21^p - 1) / (r32^p - 1)) / ln r21... with
-    equal ratios, p = ln(e32 / e21) / ln r)."""
-    p = math.log(abs(e32 / e21)) / math.log(r21)
-    for _ in range(100):
-        q = math.log((r21**p - 1.0) / (r32**p - 1.0)) if p > 0 else 0.0
-        new = max((math.log(abs(e32 / e21)) + q) / math.log(r21), 1e-6)
-        if abs(new - p) < 1e-12 * max(1.0, p):
-            return new
-        p = new
-    return p
+    """The observed order p of monotone levels with refinement ratios r21, r32: the root of
+    e32 / e21 = r21^p (r32^p - 1) / (r21^p - 1) (Celik et al. 2008; with equal ratios p = ln(e32 / e21) / ln r),
+    found by bisection in ln p (the right side grows with p from ln r32 / ln r21)."""
+    target = math.log(e32 / e21)
+
+    def gap(p):
+        return p * math.log(r21) + math.log(math.expm1(p * math.log(r32)) / math.expm1(p * math.log(r21))) - target
+
+    lo, hi = 1e-9, 64.0
+    if gap(lo) >= 0.0:
+        return lo
+    if gap(hi) <= 0.0:
+        return hi
+    for _ in range(200):
+        mid = math.sqrt(lo * hi)
+        lo, hi = (mid, hi) if gap(mid) < 0.0 else (lo, mid)
+        if hi / lo - 1.0 < 1e-14:
+            break
+    return math.sqrt(lo * hi)
 
 
-def classify(f1, f2, f3, scale):
-    """The convergence class of three levels (finest first): converged (they agree to NOISE of the
-    scale), monotone, oscillatory or divergent (module docstring)."""
+def classify(f1, f2, f3, scale, r21=2.0, r32=2.0):
+    """The convergence class of three levels (finest first, refinement ratios r21, r32): converged (they
+    agree to NOISE of the scale), monotone, oscillatory or divergent (module docstring). With unequal ratios
+    R is e21 / e32 times ln r32 / ln r21, so that R < 1 is still convergence at some order p > 0 (the ratio
+    e32 / e21 of a power law h^p falls to ln r32 / ln r21 as p -> 0). Levels of which two agree to NOISE and
+    the third does not are divergent (R = 0 or infinite: no order)."""
     e21, e32 = f2 - f1, f3 - f2
     if max(abs(e21), abs(e32)) <= NOISE * scale:
         return "converged"
-    if e32 == 0.0 or e21 / e32 >= 1.0:
+    if min(abs(e21), abs(e32)) <= NOISE * scale or (e21 / e32) * math.log(r32) / math.log(r21) >= 1.0:
         return "divergent"
     return "monotone" if e21 / e32 > 0 else "oscillatory"
 
@@ -227,14 +238,16 @@ def estimate(levels, p_th, user=0, scale=None):
     (h1, f1), (h2, f2), (h3, f3) = levels
     f_user = levels[user][1]
     scale = scale if scale is not None else max(abs(f1), abs(f2), abs(f3))
-    cls = classify(f1, f2, f3, scale)
+    r21, r32 = h2 / h1, h3 / h2
+    cls = classify(f1, f2, f3, scale, r21, r32)
     out = dict(cls=cls, observed_order=None, P=None, factor_of_safety=None, richardson=None, method=None)
     known = abs(f_user - f1)  # the difference to the finest level (0 where the run is the finest)
     if cls == "converged":
         return dict(out, band=known + max(abs(f2 - f1), abs(f3 - f2)), method="levels agree")
+    if cls == "oscillatory":  # the exact value within the levels' envelope (Stern et al. 2001)
+        return dict(out, band=max(abs(f - f_user) for f in (f1, f2, f3)), method="envelope of oscillatory levels")
     if cls != "monotone":
         return dict(out, band=None)
-    r21, r32 = h2 / h1, h3 / h2
     p = observed_order(f2 - f1, f3 - f2, r21, r32)
     P = p / p_th
     delta = (f2 - f1) / (r21**p - 1.0)
@@ -248,7 +261,9 @@ def estimate(levels, p_th, user=0, scale=None):
 
 def acceptable(est):
     """Whether a triplet's estimate is one to keep (else a finer triplet is tried): converged levels, or
-    monotone ones whose observed order is in range (P <= P_MAX)."""
+    monotone ones whose observed order is in range (P <= P_MAX). Oscillatory levels, or an order far
+    above the scheme's, are often a coarsest level outside the asymptotic range: a finer triplet is tried,
+    and the finest one's envelope (or Roache's band) is taken where none is better."""
     return est["cls"] == "converged" or (est["cls"] == "monotone" and est["P"] <= P_MAX)
 
 

@@ -143,7 +143,6 @@ def build(params, *, normal=None, friction=None, system_options=None):
     return Model(
         systems=(system,),
         stage=stage,
-        plastic=params["variant"] == "viscoplastic",  # its plastic work is no integrator's loss
         sizes=dict(
             element=2.0 * np.pi * params["R"] / params["n_el"],
             body=2.0 * params["R"],  # (elements' length)
