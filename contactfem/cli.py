@@ -460,8 +460,9 @@ BENCH_STUDIES = (
     "speed",
     "semismooth",
     "scaling",
-    "extremes",
+    "coverage",
     "adaptive",
+    "error_bars",
 )  # = lab.bench.STUDIES
 
 
@@ -825,7 +826,7 @@ def build_parser():
     bp = sub.add_parser(
         "bench",
         help="speed against accuracy: tangents, work-precision, cost, targets, "
-        "enforcement, speed, semi-smooth Newton, scaling against plain scikit-fem, the extremes grid "
+        "enforcement, speed, semi-smooth Newton, scaling against plain scikit-fem, the error bands' coverage and cost "
         "(writes bench.json and BENCHMARKS.md)",
     )
     bp.add_argument("--quick", action="store_true", help="fast presets and fewer points (seconds)")

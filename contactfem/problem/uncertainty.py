@@ -10,9 +10,10 @@ so that the user's run stays the finest and costs what it did. From the three va
 f2, f3 of a quantity at the sizes h1 < h2 < h3:
 
     e21 = f2 - f1, e32 = f3 - f2, R = e21 / e32     convergence class: monotone 0 < R < 1,
-                                                      oscillatory R < 0, divergent R >= 1
-    p from  ln|e32 / e21| = p ln r21 + ln((r21^p - 1) / (r32^p - 1))    the observed order
-            (Celik et al. 2008, the refinement ratios r21 = h2 / h1, r32 = h3 / h2 need not be equal)
+                                                      oscillatory R < 0, divergent R >= 1 (with unequal
+                                                      ratios R is scaled by ln r32 / ln r21)
+    p from  e32 / e21 = r21^p (r32^p - 1) / (r21^p - 1)   the observed order (Celik et al. 2008; the
+                                                      ratios r21 = h2 / h1, r32 = h3 / h2 need not be equal)
     delta = e21 / (r21^p - 1)                        Richardson's estimate of f1's error; f1 - delta
                                                       the extrapolated value
     band = FS(P) |delta|,  P = p / p_th              Xing & Stern's factor of safety (2010), p_th the
@@ -22,15 +23,20 @@ f2, f3 of a quantity at the sizes h1 < h2 < h3:
 Xing & Stern chose FS0 and FS1 so that the band holds the true error with 95 % reliability over
 304 grid triplets of 17 studies (fluids, heat transfer, structures), at and away from the asymptotic
 range; Roache's Grid Convergence Index (the factor 1.25 where p is near p_th, 3 elsewhere) holds
-less often where p > p_th (its band shrinks with delta while its factor stays 1.25). Where the
-levels are not monotone, a coarser level failed or is outside its parameter's range, or P > P_MAX
-(the coarsest level is outside the asymptotic range: its difference is far larger than the order
-predicts), the ladder moves one level finer (h / 2, h, 2 h; then h / 4, h / 2, h), whose cost is
-counted; the band of the run is then the known difference to the finest level plus the band of that
-level. Monotone levels with P > P_MAX on the finest triplet take Roache's band for an order that
-cannot be trusted: 3 |e21| / (r21^p_th - 1), the slowest convergence the scheme allows. Levels that
-agree to Newton's tolerance are ``converged``. Oscillatory or divergent levels on the finest
-triplet give no band, and the run warns, naming the quantity.
+less often where p > p_th (its band shrinks with delta while its factor stays 1.25).
+
+The coarser levels do not always serve. A level may fail, or fall outside its parameter's range (a
+ring of fewer than 8 elements); the levels may oscillate, diverge, or show an order far above the
+scheme's (P > P_MAX), which in a contact problem is most often a coarsest level outside the
+asymptotic range: the paper's sloping impact gives 1.462, 1.455 and 1.330 at dt, 2 dt and 4 dt (an
+order of 4 for a first-order integrator), while the run refined in time goes to 1.58. Then the ladder
+moves one level finer (h / 2, h, 2 h; then h / 4, h / 2, h), whose cost is counted, and the band of the
+run is its known difference to the finest level plus the band of that level. Where even the finest
+triplet is not acceptable: monotone levels with P > P_MAX take Roache's band for an order that cannot
+be trusted, 3 |e21| / (r21^p_th - 1) (the slowest convergence the scheme allows); oscillatory levels
+take their envelope (the exact value between the levels' extremes, Stern et al. 2001): the largest
+distance of a level from the run's value; levels that agree to Newton's tolerance are ``converged``;
+divergent levels, or levels that fail, give no band, and the run warns, naming the quantity.
 
 The parts of a quantity's band (one per discretisation) add up: their errors were estimated one
 discretisation at a time and may have the same sign, so a root sum of squares (V&V 20's combination
@@ -463,10 +469,14 @@ def _digits(v, band):
 
 def run_level(scene_run, scene, params, overrides):
     """One level of a ladder: the scene at ``params`` with ``overrides`` (checked as a user's values
-    are: a level outside a parameter's range is not taken), without error bars and without its
-    warnings. Returns the results, or the Exception that stopped it."""
+    are: a level outside a parameter's range, or past the resources a run may take without --force, is
+    not taken), without error bars and without its warnings. Returns the results, or the Exception that
+    stopped it."""
+    from .resources import check_resources
+
     try:
         p = scene.with_values(params, overrides)
+        check_resources(scene, p)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             return scene_run(p)

@@ -98,8 +98,6 @@ PHYSICS = {
     ),
     "rolling mu 0.15": Physics("rolling_ring", {}, _ring_refine(0.005, 120)),
     "rolling mu 0.3": Physics("rolling_ring", {"mu": 0.3}, _ring_refine(0.005, 120)),
-    "rolling mu 0.05": Physics("rolling_ring", {"mu": 0.05}, _ring_refine(0.005, 120)),
-    "rolling c_N 100": Physics("rolling_ring", {"c_N": 100.0}, _ring_refine(0.0025, 120)),
     "funnel frictionless": Physics("funnel", {}, _ring_refine(0.05, 30, 15.0)),
     "funnel frictional": Physics("funnel", {"variant": "frictional"}, _ring_refine(0.05, 30, 15.0)),
     "funnel c_N 20": Physics("funnel", {"c_N": 20.0}, _ring_refine(0.05, 30, 15.0)),
@@ -108,6 +106,7 @@ PHYSICS = {
     "block coulomb": Physics("block", {"law": "coulomb", "mu": 0.3}, _block_refine),
     "block c_N 1e4": Physics("block", {"c_N": 1e4}, _block_refine),
     "block lagrange": Physics("block", {"enforcement": "lagrange"}, _block_refine),
+    "block nx 10": Physics("block", {"nx": 10}, _block_refine),
     "cork": Physics("cork", {}, _cork_refine, levels=3),
     "hertz": Physics("hertz"),
     "bar": Physics("bar_impact"),
@@ -149,16 +148,12 @@ def cases():
     # rolling ring: fast (40 elements, dt = 0.02) and paper (120, 0.01)
     ph = "rolling mu 0.15"
     out += [(ph, "fast", {}, "fast preset"), (ph, "paper", {}, "paper preset")]
-    out += _sweep(ph, "dt", (0.04, 0.005), preset="paper")
-    out += _sweep(ph, "n_el", (60, 240), preset="paper")
-    out += _sweep(ph, "n_el", (80, 160))
-    out += [
-        (ph, "paper", TRAPEZOIDAL, "trapezoidal"),
-        (ph, "paper", {"contact_integration": "energy_consistent"}, "EC"),
-    ]
-    out += [(ph, "paper", {"accuracy": 0.01}, "accuracy=0.01")]
-    for ph in ("rolling mu 0.3", "rolling mu 0.05", "rolling c_N 100"):
-        out += [(ph, "fast", {}, "fast preset"), (ph, "paper", {}, "paper preset"), (ph, "paper", {"dt": 0.005}, "dt")]
+    out += _sweep(ph, "dt", (0.04, 0.005)) + _sweep(ph, "n_el", (40, 60, 240))
+    out += [(ph, "fast", TRAPEZOIDAL, "trapezoidal"), (ph, "fast", {"contact_integration": "energy_consistent"}, "EC")]
+    out += [(ph, "fast", {"accuracy": 0.01}, "accuracy=0.01")]
+    ph = "rolling mu 0.3"
+    out += [(ph, "fast", {}, "fast preset"), (ph, "paper", {}, "paper preset")]
+    out += _sweep(ph, "dt", (0.04, 0.005)) + _sweep(ph, "n_el", (60,)) + [(ph, "fast", TRAPEZOIDAL, "trapezoidal")]
     # funnel: fast = paper (30 elements of the half ring, dt = 0.1)
     for ph in ("funnel frictionless", "funnel frictional"):
         out += [(ph, "fast", {}, "preset")] + _sweep(ph, "dt", (0.2, 0.05, 0.025))
@@ -169,7 +164,7 @@ def cases():
         ]
     out += [("funnel c_N 20", "fast", {}, "c_N=20")] + _sweep("funnel c_N 20", "dt", (0.05,))
     # block: static, nx the problem's own; the mesh through the height
-    for ph in ("block conical", "block parabolic", "block coulomb", "block c_N 1e4"):
+    for ph in ("block conical", "block parabolic", "block coulomb", "block c_N 1e4", "block nx 10"):
         out += [(ph, "fast", {}, "preset")] + _sweep(ph, "ny", (2, 4, 16))
     out += [("block conical", "fast", {"contact_discretization": "mortar"}, "mortar")]
     out += [("block lagrange", "fast", {}, "lagrange")] + _sweep("block lagrange", "ny", (4, 16))
@@ -178,7 +173,8 @@ def cases():
     out += [("hertz", "fast", {}, "fast preset"), ("hertz", "paper", {}, "paper preset")]
     out += _sweep("hertz", "n_el", (8, 16, 48))
     out += _sweep("hertz", "c_N", (1e6, 1e7, 1e8, 1e10))
-    out += _sweep("hertz", "grading", (0.0, 2.0))
+    out += _sweep("hertz", "grading", (0.0, 2.0)) + _sweep("hertz", "grading", (0.0,), {"n_el": 16})
+    out += _sweep("hertz", "n_el", (24,)) + _sweep("hertz", "c_N", (1e7,), {"n_el": 16})
     out += [("hertz", "fast", {"penalty": "per_node", "c_N": 1e8}, "per node")]
     out += [("hertz", "fast", {"enforcement": e}, e) for e in ("augmented", "lagrange")]
     out += [("hertz", "fast", {"contact_discretization": "mortar"}, "mortar")]
@@ -188,6 +184,7 @@ def cases():
     out += _sweep("bar", "courant", (0.25, 0.5, 2.0, 4.0))
     out += _sweep("bar", "n_el", (10, 20, 80, 200))
     out += _sweep("bar", "c_N_factor", (0.1, 0.3, 3.0, 10.0, 100.0))
+    out += _sweep("bar", "c_N_factor", (0.3, 3.0), {"n_el": 100}) + _sweep("bar", "courant", (0.5, 2.0), {"n_el": 20})
     out += [
         ("bar", "fast", {"integrator": "central_difference", "courant": c}, f"central differences {c:g}")
         for c in (0.5, 0.9)
@@ -227,15 +224,19 @@ QUICK = [
 # -- running, with a checkpoint ---------------------------------------------------------------------
 
 
-def _digest():
-    """A digest of the library's sources (what a run computes), for the checkpoint's keys."""
+def _digest(physics_only=False):
+    """A digest of the library's sources (what a run computes), for the checkpoint's keys; ``physics_only``:
+    of what a run without error bars computes its values with (not its indicators, bands, plots or files)."""
     import contactfem
 
     root = Path(contactfem.__file__).parent
     h = hashlib.sha256()
     for f in sorted(root.rglob("*.py")):
-        if "lab" not in f.relative_to(root).parts:
-            h.update(str(f.relative_to(root)).encode() + b"\0" + f.read_bytes())
+        parts = f.relative_to(root).parts
+        skip = ("plots", "io", "cli.py", "equations.py", "uncertainty.py", "accuracy.py")
+        if "lab" in parts or (physics_only and (parts[0] in skip or parts[-1] in skip)):
+            continue
+        h.update(str(f.relative_to(root)).encode() + b"\0" + f.read_bytes())
     return h.hexdigest()[:16]
 
 
@@ -342,7 +343,9 @@ def reference(name, checkpoint, progress=None):
     ladder, prev = [], None
     for k in range(ph.levels):
         over = dict(ph.over, **ph.refine(k))
-        run = checkpoint.get(["reference", ph.scene, over, _digest()], lambda: attempt(ph.scene, "paper", over, False))
+        run = checkpoint.get(
+            ["reference", ph.scene, over, _digest(physics_only=True)], lambda: attempt(ph.scene, "paper", over, False)
+        )
         level = dict(k=k, overrides=over, outcome=run["outcome"], error=run.get("error"), time_s=run["time_s"])
         if run["outcome"] == "ran" and not run["separated"]:
             level.update(outcome="stopped", error="ends in contact: its rebound would be read mid-impact")
@@ -490,3 +493,66 @@ def _text(quantities):
         f"{k} {100 * q['error']:.2g} % / " + ("-" if q["band"] is None else f"{100 * q['band']:.2g} %")
         for k, q in quantities.items()
     )
+
+
+def coverage_markdown(res):
+    """The BENCHMARKS.md section of the study."""
+    c = res["counts"]
+    pct = lambda x: "-" if x is None else f"{100 * x:.1f} %"
+    L = [
+        "## Do the error bands hold? Coverage",
+        "",
+        f"{res['runs']} runs over every scene (contactfem/lab/bench/coverage.py), each with its error bars as a user "
+        f"gets them (tolerance {100 * res['tol']:g} %), against the true error of each headline quantity: the "
+        "closed form where the scene has one, else a reference refined in step and mesh at once (trapezoidal rule) "
+        f"until two successive levels agree to {100 * res['reference_agreement']:g} % (each reference's ladder is in "
+        "bench.json). A run is *covered* when every quantity's true error lies within its band (plus its "
+        "reference's own last change); *silent-wrong* when it exits without an error and without any accuracy "
+        f"warning while a quantity is more than {100 * res['tol']:g} % off. Figure: bench_coverage.",
+        "",
+        f"- coverage: **{pct(res['coverage'])}** of the {res['runs_with_bands']} runs with bands "
+        f"({pct(res['quantity_coverage'])} of their {res['quantities_with_bands']} quantities)",
+        f"- silent-wrong runs: **{res['silent_wrong']}**",
+        f"- band efficiency (median band / true error, covered quantities): {_f(res['band_efficiency'])}",
+        f"- error bars' cost over these runs (median of (run + error bars) / run): {_f(res['overhead_median'])}",
+        "",
+        "| outcome | runs |",
+        "|---|---|",
+    ]
+    L += [f"| {k} | {c.get(k, 0)} |" for k in OUTCOMES]
+    L += [
+        "",
+        "References (the finest level of each ladder; its last change between levels):",
+        "",
+        "| physics | scene | converged | levels | reference values | last change |",
+        "|---|---|---|---|---|---|",
+    ]
+    for name, ref in res["references"].items():
+        if ref is None:
+            L.append(f"| {name} | {PHYSICS[name].scene} | closed form | - | - | - |")
+            continue
+        values = ", ".join(f"{k} {v:.6g}" for k, v in (ref["values"] or {}).items() if v is not None) or "-"
+        change = ", ".join(f"{k} {v:.1e}" for k, v in (ref["change"] or {}).items()) or "-"
+        L.append(
+            f"| {name} | {PHYSICS[name].scene} | {_f(ref['converged'])} | {len(ref['ladder'])} | {values} | {change} |"
+        )
+    L += [
+        "",
+        "| scene | physics | preset | setting | outcome | true error / band per quantity | warnings or error |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for r in res["rows"]:
+        what = "; ".join(w.split(" (")[0][:70] for w in r["warnings"]) or r["error"][:100]
+        L.append(
+            f"| {r['scene']} | {r['physics']} | {r['preset']} | {r['label']} | {r['outcome']} | "
+            f"{_text(r['quantities']) or '-'} | {what.replace('|', '/') or '-'} |"
+        )
+    return L + [""]
+
+
+def _f(x):
+    if x is None:
+        return "-"
+    if isinstance(x, bool):
+        return "yes" if x else "no"
+    return f"{x:.3g}"

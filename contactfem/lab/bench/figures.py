@@ -426,3 +426,65 @@ def bench_adaptive(preset="fast", outdir=None):
     return save_figure(
         fig, Path(outdir or default_outdir(preset)) / "bench_adaptive.png", {"adaptive": study}, parameters
     )
+
+
+def _coverage_section(preset):
+    """The coverage study of the bench JSON, or its quick slice run here (seconds)."""
+    b = load_bench(preset)
+    if "coverage" in b:
+        return b["coverage"], dict(source=bench_json_path().name, quick=b.get("quick"), machine=b.get("machine"))
+    if "coverage_quick" not in _CACHE:
+        from ...scenes import jsonable
+        from .coverage import coverage_study
+
+        _CACHE["coverage_quick"] = jsonable(coverage_study(quick=True, checkpoint=False))
+    return _CACHE["coverage_quick"], dict(source="a quick bench run", quick=True)
+
+
+@figure("bench_coverage", "bench")
+def bench_coverage(preset="fast", outdir=None):
+    """True error against the error band of every headline quantity of the coverage study, log-log, with the
+    diagonal: below it the band holds the error. Quantities with no band are drawn at the band axis' foot."""
+    plt = pyplot()
+    study, parameters = _coverage_section(preset)
+    pairs = [
+        (r["scene"], q, bool(r["warnings"]))
+        for r in study["rows"]
+        for q in r["quantities"].values()
+        if q["kind"] in ("covered", "uncovered", "no band") and q["error"] > 0
+    ]
+    fig, ax = plt.subplots(figsize=(6.4, 5.6))
+    floor = 1e-6
+    lo = max(floor, min([q["error"] for _, q, _ in pairs] + [q["band"] for _, q, _ in pairs if q["band"]] + [1.0]))
+    scenes = sorted({s for s, _, _ in pairs})
+    for i, name in enumerate(scenes):
+        for warned in (False, True):
+            mine = [q for s, q, w in pairs if s == name and w == warned]
+            if not mine:
+                continue
+            ax.loglog(
+                [max(q["band"] or 0.0, lo / 3) for q in mine],
+                [max(q["error"], floor) for q in mine],
+                "o" if warned else "s",
+                color=f"C{i}",
+                mfc="none" if warned else f"C{i}",
+                ms=5,
+                label=f"{name}" + (" (warned)" if warned else ""),
+            )
+    top = max([q["error"] for _, q, _ in pairs] + [q["band"] or 0 for _, q, _ in pairs] + [1.0])
+    ax.loglog([lo / 3, 2 * top], [lo / 3, 2 * top], "k-", lw=0.8, label="true error = band")
+    ax.axhline(study["tol"], color="0.5", ls=":", lw=0.8)
+    ax.axvline(study["tol"], color="0.5", ls=":", lw=0.8)
+    ax.set_xlabel("relative error band (no band: at the left edge)")
+    ax.set_ylabel("relative true error")
+    cov = study.get("coverage")
+    ax.set_title(
+        f"{study['runs']} runs: coverage {'-' if cov is None else f'{100 * cov:.1f} %'}, "
+        f"{study['silent_wrong']} silent-wrong (dotted: the tolerance)",
+        fontsize=9,
+    )
+    ax.legend(fontsize=6, loc="lower right", ncol=2)
+    fig.tight_layout()
+    return save_figure(
+        fig, Path(outdir or default_outdir(preset)) / "bench_coverage.png", {"coverage": study}, parameters
+    )
