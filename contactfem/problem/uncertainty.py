@@ -62,6 +62,8 @@ ROACHE_FS = 3.0  # Roache's factor of safety where the observed order cannot be 
 NOISE = 1e-8  # levels that agree to this fraction of the quantity differ by Newton's tolerance only
 FACTORS = (2.0, 4.0)  # the coarser levels, as multiples of the run's size
 FINER = 2  # at most this many finer levels (h / 2, h / 4) where the coarser ones do not serve
+FINER_COST = 4.0  # and none that costs more than this many times the run (its unknowns times its steps): a
+# time step halved twice, a ring's mesh refined twice, a 2-D mesh refined once
 
 
 @dataclass(frozen=True)
@@ -467,6 +469,12 @@ def _digits(v, band):
     return f"{v:.{min(keep, 12)}g}"
 
 
+def _work(scene, params):
+    """A run's size as its cost: unknowns times steps (Scene.size; 1 where the scene does not say)."""
+    size = scene.size(params) if scene.size is not None else {}
+    return float(max(1.0, size.get("unknowns", 1))) * float(max(1.0, size.get("steps", 1)))
+
+
 def run_level(scene_run, scene, params, overrides):
     """One level of a ladder: the scene at ``params`` with ``overrides`` (checked as a user's values
     are: a level outside a parameter's range, or past the resources a run may take without --force, is
@@ -477,6 +485,9 @@ def run_level(scene_run, scene, params, overrides):
     try:
         p = scene.with_values(params, overrides)
         check_resources(scene, p)
+        ratio = _work(scene, p) / _work(scene, params)
+        if ratio > FINER_COST * (1 + 1e-9):
+            raise ValueError(f"a level {ratio:.3g} times the run's size is not taken (at most {FINER_COST:g})")
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             return scene_run(p)
