@@ -333,6 +333,14 @@ def ladder(run, params, results, quantities, disc):
             richardson=None if est is None else est["richardson"],
             method=None if est is None else est["method"],
             levels=est["levels"] if est is not None else tried[-1]["levels"],
+            tried=[
+                dict(
+                    factors=[lv["factor"] for lv in t["levels"]],
+                    values=[lv["value"] for lv in t["levels"]],
+                    why=t["why"],
+                )
+                for t in tried
+            ],
         )
         if part["band"] is None:
             part["why"] = "; ".join(f"levels {_text(t['levels'])}: {t['why']}" for t in tried)
