@@ -14,6 +14,8 @@ answers (by name) as the part it belongs to, and raises AssertionError with a hi
 import numpy as np
 
 from contactfem.lab.course.checks import (
+    _band,
+    _library_band,
     _tresca,
     call,
     compare,
@@ -223,6 +225,26 @@ def tolerance_error_tight(settings_for):
 
 def tolerance_budget_tight(settings_for):
     tolerance_budget_at(settings_for, 0.01)
+
+
+def band_other_levels(band_from_three):
+    """Other monotone levels and ratios: the order, the extrapolation and the band as the library's."""
+    for f, r, p_th in (((3.0, 2.9, 2.6), 2.0, 1.0), ((0.5, 0.51, 0.53), 1.7, 2.0), ((10.0, 10.4, 11.5), 3.0, 2.0)):
+        p, f_ex, band = _band(band_from_three, f, r, p_th)
+        want = _library_band(f, r, p_th)
+        compare(
+            f"observed order of {f}, r = {r:g}",
+            p,
+            want["observed_order"],
+            {"f": ", ".join(f"{x:.6g}" for x in f)},
+            rtol=1e-8,
+        )
+        compare(
+            f"Richardson's value of {f}", f_ex, want["richardson"], {"f": ", ".join(f"{x:.6g}" for x in f)}, rtol=1e-8
+        )
+        compare(
+            f"the band of {f}, p_th = {p_th:g}", band, want["band"], {"f": ", ".join(f"{x:.6g}" for x in f)}, rtol=1e-8
+        )
 
 
 # -- lecture 10 ----------------------------------------------------------------------------------
@@ -482,6 +504,9 @@ HIDDEN = {
     "tolerance_indicators": [tolerance_indicators_tight],
     "tolerance_error": [tolerance_error_tight],
     "tolerance_budget": [tolerance_budget_tight],
+    "band_order": [band_other_levels],
+    "band_richardson": [band_other_levels],
+    "band_factor_of_safety": [band_other_levels],
     "hardening_bound": [hardening_other],
     "hardening_derivatives": [hardening_other],
     "quadratic_traction": [quadratic_other],

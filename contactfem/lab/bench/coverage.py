@@ -88,14 +88,10 @@ def _cork_refine(k):
 # the paper's 20 time units: a refined ring without damping can touch the plane again after its first
 # contact (64 elements: contact from 0 to 2.4 and again from 3 to 5.6), so no shorter run is safe
 SLOPING = _ring_refine(0.025, 16, t_end=20.0)
+SLOPING_LEVELS = 5  # to 256 elements at dt = 0.0016: a level past it costs an hour on two shared cores
 PHYSICS = {
-    "sloping frictionless": Physics("sloping_impact", {}, SLOPING),
-    "sloping frictional": Physics("sloping_impact", {"variant": "frictional"}, SLOPING),
-    "sloping frictionless c_N 500": Physics("sloping_impact", {"c_N": 500.0}, _ring_refine(0.0125, 16, 20.0)),
-    "sloping frictionless c_N 5": Physics("sloping_impact", {"c_N": 5.0}, SLOPING),
-    "sloping frictional beta 1": Physics(
-        "sloping_impact", {"variant": "frictional", "alpha": 0.0, "beta": 1.0}, SLOPING
-    ),
+    "sloping frictionless": Physics("sloping_impact", {}, SLOPING, SLOPING_LEVELS),
+    "sloping frictional": Physics("sloping_impact", {"variant": "frictional"}, SLOPING, SLOPING_LEVELS),
     "rolling mu 0.15": Physics("rolling_ring", {}, _ring_refine(0.005, 120)),
     "rolling mu 0.3": Physics("rolling_ring", {"mu": 0.3}, _ring_refine(0.005, 120)),
     "funnel frictionless": Physics("funnel", {}, _ring_refine(0.05, 30, 15.0)),
@@ -139,8 +135,6 @@ def cases():
         out += [(ph, "fast", {"n_el": n}, f"n_el={n}") for n in (8, 32, 64)]
         out += [(ph, "fast", {"accuracy": a}, f"accuracy={a:g}") for a in (0.03, 0.01)]
         out += [(ph, "fast", {"mass_matrix": "consistent"}, "consistent mass")]
-    for ph in ("sloping frictionless c_N 500", "sloping frictionless c_N 5", "sloping frictional beta 1"):
-        out += _steps(ph, (0.1, 0.025), 20.0) + _steps(ph, (0.05,), 20.0, TRAPEZOIDAL, label=", trapezoidal")
     # rolling ring: fast (120 elements, dt = 0.02) and paper (120, 0.01)
     ph = "rolling mu 0.15"
     out += [(ph, "fast", {}, "fast preset"), (ph, "paper", {}, "paper preset")]
@@ -165,6 +159,7 @@ def cases():
     out += [("block conical", "fast", {"contact_discretization": "mortar"}, "mortar")]
     out += [("block lagrange", "fast", {}, "lagrange")] + _sweep("block lagrange", "ny", (4, 16))
     out += [("block lagrange", "fast", {"enforcement": "augmented"}, "augmented")]
+    out += _sweep("block lagrange", "ny", (2,)) + _sweep("block nx 10", "ny", (32,))
     # hertz: closed form; mesh, penalty, grading, enforcement, discretisation
     out += [("hertz", "fast", {}, "fast preset"), ("hertz", "paper", {}, "paper preset")]
     out += _sweep("hertz", "n_el", (8, 16, 48))
@@ -175,12 +170,20 @@ def cases():
     out += [("hertz", "fast", {"enforcement": e}, e) for e in ("augmented", "lagrange")]
     out += [("hertz", "fast", {"contact_discretization": "mortar"}, "mortar")]
     out += [("hertz", "fast", {"contact_discretization": "mortar", "n_el": 64}, "mortar, n_el=64")]
+    out += [("hertz", "fast", {"penalty": "per_node", "c_N": c}, f"per node, c_N={c:g}") for c in (1e6, 1e7)]
+    out += [("hertz", "fast", {"n_el": n, "grading": 2.0}, f"n_el={n}, grading=2") for n in (8, 16)]
     # bar: closed form; step, mesh, penalty, integrators, enforcement
     out += [("bar", "fast", {}, "fast preset"), ("bar", "paper", {}, "paper preset")]
     out += _sweep("bar", "courant", (0.25, 0.5, 2.0, 4.0))
     out += _sweep("bar", "n_el", (10, 20, 80, 200))
     out += _sweep("bar", "c_N_factor", (0.1, 0.3, 3.0, 10.0, 100.0))
     out += _sweep("bar", "c_N_factor", (0.3, 3.0), {"n_el": 100}) + _sweep("bar", "courant", (0.5, 2.0), {"n_el": 20})
+    out += _sweep("bar", "courant", (0.5, 2.0), {"n_el": 100}) + _sweep(
+        "bar", "n_el", (10, 20, 80), {"c_N_factor": 3.0}
+    )
+    out += [
+        ("bar", "fast", {"delta": 0.7, "beta_newmark": 0.4, "n_el": n}, f"Newmark 0.7, n_el={n}") for n in (20, 100)
+    ]
     out += [
         ("bar", "fast", {"integrator": "central_difference", "courant": c}, f"central differences {c:g}")
         for c in (0.5, 0.9)
@@ -205,7 +208,9 @@ def cases():
     # the cork: its preset, and its step varied (the fine step and the travel limit)
     out += [("cork", "fast", {}, "fast preset"), ("cork", "paper", {}, "paper preset")]
     out += [("cork", "fast", {"dt_fine": 2e-5 * f, "travel_max": 1.0 * f}, f"step x {f:g}") for f in (0.5, 2.0)]
-    return out
+    # the cheap scenes first: a study stopped midway has judged the most runs
+    order = ("block", "hertz", "bar_impact", "patch", "funnel", "rolling_ring", "sloping_impact", "cork")
+    return sorted(out, key=lambda c: order.index(PHYSICS[c[0]].scene))
 
 
 QUICK = [
