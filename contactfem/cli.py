@@ -112,6 +112,17 @@ def cmd_show(args):
         print("Laws: none to replace (no contact interface of its own).")
     if sc.reports:
         print("reports: " + ", ".join(sc.reports))
+    if sc.quantities:  # what run's error bars band, and what moves each
+        labels = {d.name: d.label for d in sc.discretisations}
+        print(
+            "headline quantities (with error bands unless --no-error-bars): "
+            + "; ".join(
+                f"{q.name}"
+                + (f" [{q.unit}]" if q.unit else "")
+                + (f" ({', '.join(labels[c] for c in q.controls)})" if q.controls else " (its closed form)")
+                for q in sc.quantities
+            )
+        )
 
 
 def _show_value(v):
@@ -596,8 +607,8 @@ def build_parser():
     rp.add_argument(
         "--strict",
         action="store_true",
-        help="exit with code 1 when an accuracy indicator of the run is past its threshold (each one "
-        "prints a warning line either way)",
+        help="exit with code 1 when an accuracy indicator of the run is past its threshold, a headline "
+        "quantity's error band past the tolerance among them (each one prints a warning line either way)",
     )
     add_error_bar_options(rp)
     rp.add_argument("--save", metavar="FILE", help="save the run (.json or .npz) for contactfem.io.load_run")

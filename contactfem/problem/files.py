@@ -155,4 +155,24 @@ def load_scene_file(path):
     }
     build = _guarded(_checked_build(scene.build, path, scene.simulate is not None), path, "build")
     measure = _guarded(_checked_measure(scene.measure, path), path, "measure")
-    return replace(scene, build=build, measure=measure, **guarded)
+    discretisations = tuple(_guarded_discretisation(d, path) for d in scene.discretisations)
+    if scene.settles is not None:
+        guarded["settles"] = _guarded(scene.settles, path, "settles")
+    return replace(scene, build=build, measure=measure, discretisations=discretisations, **guarded)
+
+
+def _guarded_discretisation(d, path):
+    """A scene file's Discretisation with its callables guarded; a ValueError of ``coarsen`` passes (no
+    level that coarse: the ladder takes another), any other error is one SceneError line."""
+    role = f"discretisation {d.name}"
+
+    def coarsen(params, r):
+        try:
+            return d.coarsen(params, r)
+        except ValueError:
+            raise
+        except (Exception, SystemExit) as err:  # noqa: BLE001
+            raise _error(err, path, role + ", coarsen") from None
+
+    calls = {f: _guarded(getattr(d, f), path, f"{role}, {f}") for f in ("size", "order", "applies")}
+    return replace(d, coarsen=coarsen, **calls)

@@ -116,6 +116,8 @@ def integrator_order(params):
         return 1.0
     if params.get("integrator", "newmark") != "newmark" or contact_integration(params) == "energy_consistent":
         return 2.0
+    if "delta" not in params:  # a scene file's own stepper: the trapezoidal rule's, unless it says (order=)
+        return 2.0
     delta, _ = newmark_of(params)
     return 2.0 if delta == 0.5 else 1.0
 
@@ -124,7 +126,8 @@ def time_step(dt="dt", count=None, also=(), order=integrator_order):
     """The time step: the parameter ``dt`` times r, and the parameters in ``also`` with it (the cork's
     fine step and travel limit); ``count``: the parameter that counts the steps (n_steps), divided by r
     and rounded up, dt then set so that the run ends when it did. A run at a tolerance (its parameter
-    ``accuracy`` > 0) is coarsened in its tolerance instead, up to its largest allowed value."""
+    ``accuracy`` > 0) is coarsened in its tolerance instead, up to its largest allowed value. ``order``: the
+    theoretical order, a function of the parameters or a number (a scene file's own integrator)."""
     from .time_integration import ACCURACY_PARAM
 
     def coarsen(params, r):
@@ -140,7 +143,7 @@ def time_step(dt="dt", count=None, also=(), order=integrator_order):
         return params["accuracy"] if params.get("accuracy") else params[dt]
 
     _ = ACCURACY_PARAM  # (a coarser tolerance past its range is refused by the Param, and the level is not taken)
-    return Discretisation("step", "time step", coarsen, size, order)
+    return Discretisation("step", "time step", coarsen, size, order if callable(order) else (lambda params: order))
 
 
 def mesh(*counts, low=None, order=2.0, extra=None):

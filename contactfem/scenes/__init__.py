@@ -10,6 +10,7 @@ import importlib
 import pkgutil
 
 from ..problem.scene import Limit, Model, Param, Scene, Stage, jsonable, simulate
+from ..problem.uncertainty import Discretisation, Quantity, mesh, penalty, time_step
 from ..problem.files import SceneError, is_scene_file, load_scene_file
 
 
@@ -158,7 +159,12 @@ def run_scene(
 
 
 __all__ = [
+    "Discretisation",
     "Limit",
+    "Quantity",
+    "mesh",
+    "penalty",
+    "time_step",
     "Model",
     "Param",
     "Scene",

@@ -6,7 +6,7 @@ from skfem import MeshTri
 from contactfem.bodies.continuum import Continuum
 from contactfem.contact import NodeToSegment, RigidPolyline
 from contactfem.laws import Coulomb, PowerLaw
-from contactfem.scenes import Model, Param, Scene, Stage
+from contactfem.scenes import Model, Param, Quantity, Scene, Stage, time_step
 from contactfem.solver import History, Newmark, Steps, System
 
 WALL = [(-3.0, 0.0), (1.0, 0.0), (4.0, 2.0)]  # left to right: the disc is on the wall's left side
@@ -54,4 +54,6 @@ SCENE = Scene(
     measure,
     laws=("normal", "friction"),
     law_params={"normal": ("c_N",), "friction": ("c_T", "mu")},
+    quantities=(Quantity("rebound_vx", "length/time"), Quantity("rebound_vy", "length/time")),  # error bars in dt
+    discretisations=(time_step("dt", count="n_steps"),),
 )
