@@ -25,8 +25,9 @@ The indicators that apply to a run (``collect``), from its records and the model
                     the error the tolerance allows (the sum of its steps' local error estimates over the sum
                     of their shares, solver/schedule.py); past 2 the tolerance is not assured
 
-and a scene adds its own (``reference``): its closed-form references in every regime its
-ranges allow, each error measure covering every contact surface.
+and, from the scene's headline quantities (problem/uncertainty.py): the error against each closed form a
+quantity declares (``references``, NAME: held to the run's tolerance), and with error bars each quantity's
+relative band against the same tolerance (NAME_band; no value where no band could be estimated).
 """
 
 import sys
