@@ -59,9 +59,10 @@ def test_factor_of_safety_is_xing_and_sterns():
     assert min(factor_of_safety(P / 100) for P in range(1, 201)) >= FS1 - 1e-12
 
 
-def test_oscillatory_levels_take_finer_ones_then_their_envelope():
+def test_oscillatory_levels_take_finer_ones_then_give_no_band():
     """A coarsest level outside the asymptotic range can swing back (the block with one element through its
-    height): the finer triplet is taken; where it oscillates too, its envelope is the band."""
+    height): the finer triplet is taken; where it oscillates too, no band (an envelope would not hold a drift
+    under the oscillation)."""
     table = {0.4: 1.0117, 0.2: 0.9899, 0.1: 1.0145, 0.05: 1.0327, 0.025: 1.0423}
     run, _ = _fake(lambda h: table[round(h, 6)])
     section, _ = bands(run, PARAMS, {"q": 1.0145}, [Q], [DT])
@@ -69,9 +70,9 @@ def test_oscillatory_levels_take_finer_ones_then_their_envelope():
     assert entry["convergence"] == "monotone" and entry["band"] >= 1.0476 - 1.0145
     wobble = {0.4: 1.05, 0.2: 0.97, 0.1: 1.0, 0.05: 0.98, 0.025: 1.01}
     run, _ = _fake(lambda h: wobble[round(h, 6)])
-    section, _ = bands(run, PARAMS, {"q": 1.0}, [Q], [DT])
+    section, indicators = bands(run, PARAMS, {"q": 1.0}, [Q], [DT])
     assert section["quantities"]["q"]["convergence"] == "oscillatory"
-    assert section["quantities"]["q"]["band"] == pytest.approx(0.02)  # the finest triplet: 1.01, 0.98, 1.0
+    assert section["quantities"]["q"]["band"] is None and not indicators["q_band"]["ok"]
 
 
 @pytest.mark.parametrize(
@@ -263,3 +264,50 @@ def test_a_closed_form_is_an_indicator_held_to_the_tolerance():
 def test_the_time_step_of_a_run_at_a_tolerance_is_its_tolerance():
     steps = time_step("dt", count="n_steps")
     assert math.isclose(steps.size({"dt": 0.1, "accuracy": 0.02}), 0.02)
+
+
+# -- the defaults the issue found 5-8 % off, unflagged: each warns with a band that holds its error, or is
+# accurate. The references are computed here (the same model refined in time at its own mesh: the time step's
+# part of the band must hold the time step's error); the coverage study holds them in step and mesh at once.
+
+
+def _time_refined(over, dt=0.003125):
+    """The sloping impact refined in time at its own mesh (the paper's Newmark: the issue's reference)."""
+    return run_scene("sloping_impact", "fast", dict(over, dt=dt, n_steps=round(4.0 / dt)), error_bars=False)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("variant, name", [("frictionless", "rebound_vy"), ("frictional", "rebound_vy")])
+def test_the_paper_sloping_impact_warns_with_a_time_band_that_holds_its_time_error(variant, name):
+    r, lines = _banded("sloping_impact", {"variant": variant})
+    ref = _time_refined({"variant": variant})[name]
+    entry = r["uncertainty"]["quantities"][name]
+    step = entry["parts"]["step"]
+    assert step["band"] is not None and step["band"] >= abs(r[name] - ref), (r[name], ref, step)
+    assert any(x.startswith(f"accuracy: {name}_band") for x in lines)  # it warns, naming the quantity
+    assert entry["parts"]["step"]["label"] == "time step" and "time step" in line(name, entry)
+
+
+@pytest.mark.slow
+def test_the_paper_frictional_rebound_vx_oscillates_in_time_and_warns_without_a_band():
+    """The frictional v_x oscillates as the step is refined (1.009, 1.033, 1.027 at dt, 2 dt, 4 dt; 1.012, 0.996
+    at dt / 2, dt / 4) while it drifts to 0.96: no ladder within four times the run can bound that, so the run
+    says it has no band for it, naming the quantity and the time step."""
+    r, lines = _banded("sloping_impact", {"variant": "frictional"})
+    entry = r["uncertainty"]["quantities"]["rebound_vx"]
+    assert entry["band"] is None and entry["parts"]["step"]["convergence"] == "oscillatory"
+    warning = next(x for x in lines if x.startswith("accuracy: rebound_vx_band"))
+    assert "no error band of rebound_vx" in warning and "time step" in warning
+
+
+@pytest.mark.slow
+def test_the_rolling_ring_default_is_accurate_and_its_band_holds_the_hoops_error():
+    """The fast preset's ring has the paper's 120 elements: v_final within its band of the rigid hoop's and
+    within the tolerance (the old 40-gon was 5.8 % off and said nothing)."""
+    r, lines = _banded("rolling_ring", {})
+    entry = r["uncertainty"]["quantities"]["v_final"]
+    assert entry["band"] >= abs(r["v_final"] - r["v_final_exact"])
+    assert abs(r["v_final"] / r["v_final_exact"] - 1) < 0.05 and entry["relative_band"] < 0.05
+    assert not any(x.startswith("accuracy: v_final") for x in lines)
+    coarse = run_scene("rolling_ring", "fast", {"n_el": 40}, error_bars=False)
+    assert abs(coarse["v_final"] / coarse["v_final_exact"] - 1) > 0.05 and not coarse["accuracy"]["v_final"]["ok"]
