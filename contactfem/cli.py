@@ -504,8 +504,12 @@ def cmd_bench(args):
             "would replace or mix with it: write it to another folder (--out DIR)"
         )
     res = run_bench(quick=args.quick, only=args.only, progress=lambda m: print(m, file=sys.stderr, flush=True))
-    if args.only and earlier is not None:  # keep the other studies of an earlier run
-        res = dict(earlier, **res)
+    if args.only and earlier is not None:  # keep the other studies of an earlier run (those the bench still has)
+        from .lab.bench import STUDIES
+
+        meta = ("quick", "machine", "target_values")
+        kept = {k: v for k, v in earlier.items() if k in meta or k.removesuffix("_bench_s") in STUDIES}
+        res = dict(kept, **res)
     for path in write_outputs(res, out):
         print(path)
 

@@ -240,7 +240,8 @@ PHYSICS_SOURCES = (
 
 
 def _digest(physics_only=False):
-    """A digest of the library's sources (what a run computes), for the checkpoint's keys; ``physics_only``:
+    """A digest of the library's sources that runs compute with (not the command line, the plots, the files
+    or the lab), for the checkpoint's keys; ``physics_only``:
     of the sources a run's values come from (PHYSICS_SOURCES; not its indicators, bands, plots or files)."""
     import contactfem
 
@@ -248,7 +249,7 @@ def _digest(physics_only=False):
     h = hashlib.sha256()
     for f in sorted(root.rglob("*.py")):
         rel = f.relative_to(root)
-        if "lab" in rel.parts:
+        if rel.parts[0] in ("lab", "plots", "io", "cli.py", "equations.py", "__main__.py"):  # (not what runs compute)
             continue
         if physics_only and not any(str(rel) == p or str(rel).startswith(p + "/") for p in PHYSICS_SOURCES):
             continue
