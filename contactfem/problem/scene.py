@@ -48,7 +48,7 @@ def run(
     progress=None,
     linear_algebra="auto",
     instrument=None,
-    error_bars=True,
+    error_bars=False,
     tolerance=TOLERANCE,
 ):
     """Build, simulate and measure a scene with resolved parameters; ``linear_algebra`` and
@@ -152,10 +152,11 @@ class Scene:
         progress=None,
         linear_algebra="auto",
         instrument=None,
-        error_bars=True,
+        error_bars=False,
         tolerance=TOLERANCE,
     ):
-        """Build, simulate and measure, and the error bands (module function ``run``)."""
+        """Build, simulate and measure, and with ``error_bars`` the error bands (module function ``run``;
+        run_scene and the command line ask for them by default)."""
         return run(
             self,
             params,
