@@ -61,7 +61,6 @@ FS0, FS1 = 2.45, 1.6  # Xing & Stern (2010): the factor of safety at P = 0 and P
 P_MAX = 2.0  # beyond, the coarsest level of the triplet is outside the asymptotic range
 ROACHE_FS = 3.0  # Roache's factor of safety where the observed order cannot be used
 NOISE = 1e-8  # levels that agree to this fraction of the quantity differ by Newton's tolerance only
-FACTORS = (2.0, 4.0)  # the coarser levels, as multiples of the run's size
 FINER = 2  # at most this many finer levels (h / 2, h / 4) where the coarser ones do not serve
 FINER_COST = 4.0  # and none that costs more than this many times the run (its unknowns times its steps): a
 # time step halved twice, a ring's mesh refined twice, a 2-D mesh refined once
@@ -128,8 +127,8 @@ def time_step(dt="dt", count=None, also=(), order=integrator_order):
     fine step and travel limit); ``count``: the parameter that counts the steps (n_steps), divided by r
     and rounded up, dt then set so that the run ends when it did. A run at a tolerance (its parameter
     ``accuracy`` > 0) is coarsened in its tolerance instead, up to its largest allowed value. ``order``: the
-    theoretical order, a function of the parameters or a number (a scene file's own integrator)."""
-    from .time_integration import ACCURACY_PARAM
+    theoretical order, a function of the parameters or a number (a scene file's own integrator). A coarser
+    tolerance past its range, like any level outside a parameter's range, is refused and not taken."""
 
     def coarsen(params, r):
         if params.get("accuracy"):
@@ -143,7 +142,6 @@ def time_step(dt="dt", count=None, also=(), order=integrator_order):
     def size(params):
         return params["accuracy"] if params.get("accuracy") else params[dt]
 
-    _ = ACCURACY_PARAM  # (a coarser tolerance past its range is refused by the Param, and the level is not taken)
     return Discretisation("step", "time step", coarsen, size, order if callable(order) else (lambda params: order))
 
 
@@ -399,7 +397,7 @@ def bands(run, params, results, quantities, discretisations, tolerance=TOLERANCE
         parts = entry["parts"]
         value = entry["value"]
         if value is None:  # not a number in this run (a ring that never rolls): nothing to band
-            entry.update(band=None, relative_band=None, convergence=None, observed_order=None, levels=0, runs=0)
+            entry.update(band=None, relative_band=None, convergence=None, observed_order=None, levels=1)
             continue
         missing = [p["label"] for p in parts.values() if p["band"] is None]
         band = None if missing else sum(p["band"] for p in parts.values())
@@ -410,8 +408,7 @@ def bands(run, params, results, quantities, discretisations, tolerance=TOLERANCE
             relative_band=None if band is None or ref == 0 else band / ref,
             convergence=_worst([p["convergence"] for p in parts.values()]),
             observed_order=None if dominant is None else dominant["observed_order"],
-            levels=len({id(L) for p in parts.values() for L in p["levels"]}),
-            runs=sum(len(p["levels"]) - 1 for p in parts.values()),
+            levels=1 + sum(len(p["levels"]) - 1 for p in parts.values()),  # the run and the levels its bands used
         )
         if band is None:
             why = "; ".join(f"{p['label']}: {p['why']}" for p in parts.values() if p["band"] is None)
@@ -422,7 +419,7 @@ def bands(run, params, results, quantities, discretisations, tolerance=TOLERANCE
             indicators[f"{q.name}_band"] = indicator(
                 band / ref,
                 tolerance,
-                f"the error band of {q.name} = {line(q.name, entry)} over "
+                f"the error band of {line(q.name, entry)} over "
                 + ("its value" if ref == abs(value) else f"its scale {ref:g}"),
                 "the run's tolerance (--tolerance; 5 % by default)",
             )
