@@ -103,14 +103,6 @@ def test_rolling_ring_sliding_reference():
     assert abs(r["v_final_rel_err"]) < 1e-6 and not flagged
 
 
-@pytest.mark.slow
-def test_presets_unflagged():
-    for name in ("sloping_impact", "rolling_ring", "block", "patch"):
-        r, flagged = _run(name, {})
-        assert not flagged, (name, flagged)
-        assert "equilibrium" in r["accuracy"]
-
-
 def test_funnel_paper_penalty_is_flagged_by_its_penetration_alone():
     """The paper's funnel (c_N = 10, dt = 0.1) sits between two indicators: its ring penetrates just
     past a tenth of an element, and twice the penalty is no longer resolved by the step."""

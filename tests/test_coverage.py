@@ -104,7 +104,10 @@ def test_readme_and_benchmarks_state_the_committed_study():
     md = (REPO / "BENCHMARKS.md").read_text()
     assert "\n".join(cov.coverage_markdown(res)) in md
     if "error_bars" in bench:
+        from contactfem.lab.bench.error_bars import error_bars_sentence
+
         assert "\n".join(error_bars_markdown(bench["error_bars"])) in md
+        assert " ".join(error_bars_sentence(bench["error_bars"]).split()) in readme
     assert res["runs"] >= 150 and not res["quick"]
     assert res["silent_wrong"] == 0
     assert all(r["scene"] in all_scenes() for r in res["rows"])

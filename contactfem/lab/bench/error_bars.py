@@ -56,3 +56,14 @@ def error_bars_markdown(res):
             f"{r['ratio']:.2f} |"
         )
     return L + [""]
+
+
+def error_bars_sentence(res):
+    """The README's line on the study (a test holds the README to it)."""
+    rows = ", ".join(f"{r['scene']} {r['ratio']:.2g}" for r in sorted(res["rows"], key=lambda r: r["ratio"]))
+    met = "within" if res["median_ratio"] <= res["target"] else "**above**"
+    return (
+        f"What they cost (`contactfem bench --only error_bars`, each scene's fast preset, (run + error bars) / run): "
+        f"{rows}; the median over the scenes {res['median_ratio']:.2f}, {met} the {res['target']:g} the design "
+        "aimed at."
+    )
