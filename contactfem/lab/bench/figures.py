@@ -33,6 +33,15 @@ def load_bench(preset="fast"):
     return quick_bench()
 
 
+@lru_cache(maxsize=4)
+def quick_study(name):
+    """One study's quick run, measured in this process once (for a figure whose bench JSON lacks it)."""
+    from ...scenes import jsonable
+    from . import STUDIES
+
+    return jsonable(STUDIES[name](True))
+
+
 @lru_cache(maxsize=1)
 def quick_bench():
     """The quick bench of the four studies the figures need (measured in this process: timings
@@ -334,12 +343,7 @@ def _adaptive_section(preset):
     b = load_bench(preset)
     if "adaptive" in b:
         return b["adaptive"], dict(source=bench_json_path().name, quick=b.get("quick"), machine=b.get("machine"))
-    if "adaptive_quick" not in _CACHE:
-        from ...scenes import jsonable
-        from .adaptive import adaptive_study
-
-        _CACHE["adaptive_quick"] = jsonable(adaptive_study(quick=True))
-    return _CACHE["adaptive_quick"], dict(source="a quick bench run", quick=True)
+    return quick_study("adaptive"), dict(source="a quick bench run", quick=True)
 
 
 @figure("bench_adaptive", "bench")
@@ -433,12 +437,7 @@ def _coverage_section(preset):
     b = load_bench(preset)
     if "coverage" in b:
         return b["coverage"], dict(source=bench_json_path().name, quick=b.get("quick"), machine=b.get("machine"))
-    if "coverage_quick" not in _CACHE:
-        from ...scenes import jsonable
-        from .coverage import coverage_study
-
-        _CACHE["coverage_quick"] = jsonable(coverage_study(quick=True, checkpoint=False))
-    return _CACHE["coverage_quick"], dict(source="a quick bench run", quick=True)
+    return quick_study("coverage"), dict(source="a quick bench run", quick=True)
 
 
 @figure("bench_coverage", "bench")
