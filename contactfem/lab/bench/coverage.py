@@ -91,14 +91,15 @@ def _cork_refine(k):
 # contact (64 elements: contact from 0 to 2.4 and again from 3 to 5.6), so no shorter run is safe
 SLOPING = _ring_refine(0.025, 16, t_end=20.0)
 SLOPING_LEVELS = 5  # to 256 elements at dt = 0.0016: a level past it costs an hour on two shared cores
+RING_LEVELS = 5  # the rolling ring to 1920 elements, the funnel's half ring to 480: likewise
 PHYSICS = {
     "sloping frictionless": Physics("sloping_impact", {}, SLOPING, SLOPING_LEVELS),
     "sloping frictional": Physics("sloping_impact", {"variant": "frictional"}, SLOPING, SLOPING_LEVELS),
-    "rolling mu 0.15": Physics("rolling_ring", {}, _ring_refine(0.005, 120)),
-    "rolling mu 0.3": Physics("rolling_ring", {"mu": 0.3}, _ring_refine(0.005, 120)),
-    "funnel frictionless": Physics("funnel", {}, _ring_refine(0.05, 30, 15.0)),
-    "funnel frictional": Physics("funnel", {"variant": "frictional"}, _ring_refine(0.05, 30, 15.0)),
-    "funnel c_N 20": Physics("funnel", {"c_N": 20.0}, _ring_refine(0.05, 30, 15.0)),
+    "rolling mu 0.15": Physics("rolling_ring", {}, _ring_refine(0.005, 120), RING_LEVELS),
+    "rolling mu 0.3": Physics("rolling_ring", {"mu": 0.3}, _ring_refine(0.005, 120), RING_LEVELS),
+    "funnel frictionless": Physics("funnel", {}, _ring_refine(0.05, 30, 15.0), RING_LEVELS),
+    "funnel frictional": Physics("funnel", {"variant": "frictional"}, _ring_refine(0.05, 30, 15.0), RING_LEVELS),
+    "funnel c_N 20": Physics("funnel", {"c_N": 20.0}, _ring_refine(0.05, 30, 15.0), RING_LEVELS),
     "block conical": Physics("block", {}, _block_refine),
     "block parabolic": Physics("block", {"law": "parabolic"}, _block_refine),
     "block coulomb": Physics("block", {"law": "coulomb", "mu": 0.3}, _block_refine),
