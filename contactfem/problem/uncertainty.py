@@ -26,7 +26,9 @@ range; Roache's Grid Convergence Index (the factor 1.25 where p is near p_th, 3 
 less often where p > p_th (its band shrinks with delta while its factor stays 1.25).
 
 The coarser levels do not always serve. A level may fail, or fall outside its parameter's range (a
-ring of fewer than 8 elements); the levels may oscillate, diverge, or show an order far above the
+ring of fewer than 8 elements), or, coarser in time, no longer resolve the contacts' period (``resolved``:
+the penalty's spring rings under the step, and its quantities do not converge like the scheme's order);
+the levels may oscillate, diverge, or show an order far above the
 scheme's (P > P_MAX), which in a contact problem is most often a coarsest level outside the
 asymptotic range: the paper's sloping impact gives 1.462, 1.455 and 1.330 at dt, 2 dt and 4 dt (an
 order of 4 for a first-order integrator), while the run refined in time goes to 1.58. Then the ladder
@@ -275,11 +277,24 @@ def acceptable(est):
     return est["cls"] == "converged" or (est["cls"] == "monotone" and est["P"] <= P_MAX)
 
 
-def ladder(run, params, results, quantities, disc):
+def resolved(results, tolerance):
+    """Whether a run resolves its contacts' period in time: dt sqrt(k / m) (its ``penalty_steps``) at most
+    sqrt(12 tolerance), where the trapezoidal rule's period error, (omega dt)^2 / 12 (Hughes 1987, Sec. 9.3;
+    Newmark's with delta > 1/2 is of the same order), is within the tolerance. A run without that
+    indicator (no impact) resolves what it has."""
+    ind = (results.get("accuracy") or {}).get("penalty_steps")
+    return ind is None or ind.get("value") is None or ind["value"] <= math.sqrt(12.0 * tolerance)
+
+
+def ladder(run, params, results, quantities, disc, tolerance=TOLERANCE):
     """The part of each quantity's band that ``disc`` makes: levels 2 h and 4 h first, then finer
     triplets where a level fails, leaves its parameter's range, or the levels are not acceptable.
     ``run(overrides)`` -> results or an Exception (one call per level, shared by the quantities);
-    ``results``: the run's own (the level k = 0). Returns name -> part dict, and the levels run."""
+    ``results``: the run's own (the level k = 0). A coarser level of the time step that does not resolve the
+    contacts' period (``resolved``) is outside the asymptotic range and is not taken: the penalty's spring
+    rings under the step and its quantities do not converge like its order (the sloping impact's trapezoidal
+    v_y is 1.671, 1.565, 1.534 at dt = 0.2, 0.1, 0.05, then 1.581 and 1.623 at 0.025 and 0.0125). Returns
+    name -> part dict, and the levels run."""
     cache = {0: dict(overrides={}, h=disc.size(params), results=results, error=None)}
 
     def level(k):  # the run at size h r^k (k = 0: the user's run)
@@ -294,6 +309,8 @@ def ladder(run, params, results, quantities, disc):
             h = disc.size(dict(params, **over))
             if not isinstance(res, Exception) and not res.get("accuracy", {}).get("separated", {}).get("ok", True):
                 res = RuntimeError("the level ends in contact: its rebound would be read mid-impact")
+            if not isinstance(res, Exception) and k > 0 and disc.name == "step" and not resolved(res, tolerance):
+                res = RuntimeError("the level does not resolve the contacts' period (penalty_steps)")
             cache[k] = dict(
                 overrides=over,
                 h=h,
@@ -321,9 +338,9 @@ def ladder(run, params, results, quantities, disc):
             found.append(est)
             if acceptable(est):
                 break
-        # none acceptable: the finest triplet with a band (Roache's, or levels that agree), else the finest
-        if found and not acceptable(found[-1]):
-            est = next((e for e in reversed(found) if e["band"] is not None), found[-1])
+        # none acceptable: the finest triplet the ladder could run decides (Roache's band where it is monotone
+        # with P > P_MAX; no band where it oscillates or diverges): a coarser triplet was judged already
+        est = found[-1] if found else None
         part = dict(
             band=None if est is None else est["band"],
             convergence=None if est is None else est["cls"],
@@ -387,7 +404,7 @@ def bands(run, params, results, quantities, discretisations, tolerance=TOLERANCE
         moved = [q for q in quantities if d.name in q.controls and value_of(results, q) is not None]
         if not moved:
             continue
-        parts, level_runs = ladder(run, dict(params, **(settled or {})), results, moved, d)
+        parts, level_runs = ladder(run, dict(params, **(settled or {})), results, moved, d, tolerance)
         runs += level_runs
         for name, part in parts.items():
             out[name]["parts"][d.name] = dict(part, label=d.label)

@@ -459,7 +459,13 @@ def coverage_study(quick=False, progress=None, checkpoint=None, seconds=TIME_LIM
         full = dict(ph.over, **over)
         if name not in refs:
             refs[name] = reference(name, store, progress)
-        run = store.get(["run", ph.scene, preset, full, digest], lambda: attempt(ph.scene, preset, full, True, seconds))
+        unjudged = refs[name] is not None and not refs[name]["converged"]
+        if unjudged and not label.endswith("preset"):  # no truth to judge it by: only the presets are run (README)
+            run = dict(outcome="ran", values={}, uncertainty={}, warnings=[], time_s=0.0, skipped=True)
+        else:
+            run = store.get(
+                ["run", ph.scene, preset, full, digest], lambda: attempt(ph.scene, preset, full, True, seconds)
+            )
         verdict = judge(ph.scene, preset, full, run, refs[name])
         row = dict(
             scene=ph.scene,
