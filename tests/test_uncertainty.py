@@ -253,6 +253,24 @@ def test_a_run_at_a_tolerance_records_the_integrator_it_used():
     assert (p["delta"], p["beta_newmark"]) == (0.5, 0.25)
 
 
+def test_a_scene_file_declaring_accuracy_is_refused_at_load_naming_the_file(tmp_path):
+    from pathlib import Path
+
+    from contactfem.scenes import get_scene
+
+    example = Path(__file__).resolve().parents[1] / "lectures" / "examples" / "disc_wall.py"
+    old = '    Param("dt", 0.01,'
+    assert old in example.read_text()
+    own = tmp_path / "own_accuracy.py"
+    own.write_text(example.read_text().replace(old, '    Param("accuracy", 0.0, "", 0.0, 1.0),\n' + old))
+    with pytest.raises(
+        ValueError, match=r"^scene file own_accuracy.py: the parameter name 'accuracy' is reserved"
+    ) as e:
+        get_scene(str(own))
+    assert "\n" not in str(e.value)
+    assert get_scene(str(example)).param("dt")  # the example itself loads
+
+
 def test_a_closed_form_is_an_indicator_held_to_the_tolerance():
     r = run_scene("bar_impact", "fast", {"n_el": 20}, error_bars=False)
     ind = r["accuracy"]["duration"]

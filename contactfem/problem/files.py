@@ -30,6 +30,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from .scene import Model, Scene
+from .time_integration import ACCURACY_PARAM
 
 
 class SceneError(RuntimeError):
@@ -148,6 +149,12 @@ def load_scene_file(path):
     if not isinstance(scene, Scene):
         found = "" if scene is None else f" (SCENE is a {type(scene).__name__})"
         raise ValueError(f"scene file {path.name} defines no SCENE = Scene(...){found}: see contactfem.scenes.Scene")
+    own = [p for p in scene.params if p.name == "accuracy" and p is not ACCURACY_PARAM]
+    if own:  # the framework's name for a run's tolerance (run_scene's accuracy): a file's own would be taken over
+        raise ValueError(
+            f"scene file {path.name}: the parameter name 'accuracy' is reserved (a run's tolerance for its time "
+            "steps, contactfem.problem.time_integration.ACCURACY_PARAM): rename it"
+        )
     guarded = {
         role: _guarded(getattr(scene, role), path, role)
         for role in ("check", "size", "law_range", "simulate")
