@@ -478,8 +478,8 @@ def bench_coverage(preset="fast", outdir=None):
     ax.set_ylabel("relative true error")
     cov = study.get("coverage")
     ax.set_title(
-        f"{study['runs']} runs: coverage {'-' if cov is None else f'{100 * cov:.1f} %'}, "
-        f"{study['silent_wrong']} silent-wrong (dotted: the tolerance)",
+        f"{study['runs']} runs: the bands hold {'-' if cov is None else f'{100 * cov:.1f} %'} of the "
+        f"{study['runs_with_bands']} with bands; {study['silent_wrong']} silent-wrong (dotted: the tolerance)",
         fontsize=9,
     )
     ax.legend(fontsize=6, loc="lower right", ncol=2)
