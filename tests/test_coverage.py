@@ -110,6 +110,7 @@ def test_readme_and_benchmarks_state_the_committed_study():
         assert " ".join(error_bars_sentence(bench["error_bars"]).split()) in readme
     assert res["runs"] >= 150 and not res["quick"]
     assert res["silent_wrong"] == 0
+    assert res["coverage"] >= 0.95  # Xing and Stern's reliability target for a band's factor of safety
     assert all(r["scene"] in all_scenes() for r in res["rows"])
     for ref in res["references"].values():
         if ref is not None:
