@@ -144,30 +144,10 @@ class Scene:
     settles: Callable[[dict, dict], dict] | None = None  # (params, results) -> overrides that end the ladder's
     # levels once the quantities are decided (a rebound in free flight)
 
-    def run(
-        self,
-        params,
-        normal=None,
-        friction=None,
-        progress=None,
-        linear_algebra="auto",
-        instrument=None,
-        error_bars=False,
-        tolerance=TOLERANCE,
-    ):
-        """Build, simulate and measure, and with ``error_bars`` the error bands (module function ``run``;
-        run_scene and the command line ask for them by default)."""
-        return run(
-            self,
-            params,
-            normal=normal,
-            friction=friction,
-            progress=progress,
-            linear_algebra=linear_algebra,
-            instrument=instrument,
-            error_bars=error_bars,
-            tolerance=tolerance,
-        )
+    def run(self, params, **options):
+        """Build, simulate and measure, and with ``error_bars`` the error bands (module function ``run``, whose
+        keywords ``options`` are; run_scene and the command line ask for the bands by default)."""
+        return run(self, params, **options)
 
     def with_values(self, params, overrides):
         """Resolved ``params`` with ``overrides`` (a coarser level of a ladder), each value checked as

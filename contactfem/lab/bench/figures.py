@@ -338,12 +338,12 @@ def bench_speed(preset="fast", outdir=None):
     return _save(fig, outdir, preset, "bench_speed", "speed")
 
 
-def _adaptive_section(preset):
-    """The adaptive study of the bench JSON, or a quick one run here (the bar impact, seconds)."""
+def _section(name, preset):
+    """A study of the bench JSON (adaptive, coverage), or its quick run here (seconds) where the JSON lacks it."""
     b = load_bench(preset)
-    if "adaptive" in b:
-        return b["adaptive"], dict(source=bench_json_path().name, quick=b.get("quick"), machine=b.get("machine"))
-    return quick_study("adaptive"), dict(source="a quick bench run", quick=True)
+    if name in b:
+        return b[name], dict(source=bench_json_path().name, quick=b.get("quick"), machine=b.get("machine"))
+    return quick_study(name), dict(source="a quick bench run", quick=True)
 
 
 @figure("bench_adaptive", "bench")
@@ -351,7 +351,7 @@ def bench_adaptive(preset="fast", outdir=None):
     """Work against precision of the dynamic scenes: residual evaluations against the error of
     the headline quantities, fixed steps against the adaptive mode at several tolerances."""
     plt = pyplot()
-    study, parameters = _adaptive_section(preset)
+    study, parameters = _section("adaptive", preset)
     scenes = study["scenes"]
     fig, axes = plt.subplots(1, len(scenes), figsize=(4.6 * len(scenes), 4.0), squeeze=False)
     for ax, (name, s) in zip(axes[0], scenes.items()):
@@ -432,20 +432,12 @@ def bench_adaptive(preset="fast", outdir=None):
     )
 
 
-def _coverage_section(preset):
-    """The coverage study of the bench JSON, or its quick slice run here (seconds)."""
-    b = load_bench(preset)
-    if "coverage" in b:
-        return b["coverage"], dict(source=bench_json_path().name, quick=b.get("quick"), machine=b.get("machine"))
-    return quick_study("coverage"), dict(source="a quick bench run", quick=True)
-
-
 @figure("bench_coverage", "bench")
 def bench_coverage(preset="fast", outdir=None):
     """True error against the error band of every headline quantity of the coverage study, log-log, with the
     diagonal: below it the band holds the error. Quantities with no band are drawn at the band axis' foot."""
     plt = pyplot()
-    study, parameters = _coverage_section(preset)
+    study, parameters = _section("coverage", preset)
     pairs = [
         (r["scene"], q, bool(r["warnings"]))
         for r in study["rows"]
