@@ -56,6 +56,32 @@ def test_errors_are_relative_to_the_quantity_unless_it_is_near_zero():
     assert v.reference(funnel.resolve("fast"), 3.36) == 3.36
 
 
+class _Ladder:
+    """A checkpoint that hands the reference ladder canned levels instead of running them."""
+
+    def __init__(self, levels):
+        self.levels = iter(levels)
+
+    def get(self, key, compute):
+        values = next(self.levels)
+        quantities = {k: dict(value=v, exact=None) for k, v in values.items()}
+        return dict(outcome="ran", values=quantities, separated=True, time_s=0.0)
+
+
+def test_a_reference_judges_only_the_quantities_whose_levels_agree():
+    """The funnel's y_c_min settles (last change 2e-4) while its v_c_final still moves (1 %): y_c_min is judged by
+    the finest level, v_c_final by nothing; where every quantity agrees the ladder stops there, converged."""
+    levels = [{"y_c_min": 18.0 + 0.1 / 2**k, "v_c_final": 3.0 * (1 + 0.01 * (-1) ** k)} for k in range(9)]
+    ref = cov.reference("funnel frictionless", _Ladder(levels))
+    assert not ref["converged"] and ref["values"] == {"y_c_min": levels[4]["y_c_min"]}
+    assert len(ref["ladder"]) == cov.PHYSICS["funnel frictionless"].levels
+    settled = [{"y_c_min": 18.0 + 0.1 / 10**k, "v_c_final": 3.0 + 0.1 / 10**k} for k in range(9)]
+    ref = cov.reference("funnel frictionless", _Ladder(settled))
+    assert ref["converged"] and set(ref["values"]) == {"y_c_min", "v_c_final"} and len(ref["ladder"]) < 5
+    moving = [{"y_c_min": 18.0 * (1 + 0.01 * (-1) ** k), "v_c_final": 3.0 * (1 + 0.01 * (-1) ** k)} for k in range(9)]
+    assert cov.reference("funnel frictionless", _Ladder(moving))["values"] is None
+
+
 def _run(values, warnings=(), bands=None, outcome="ran"):
     quantities = {k: dict(value=v, exact=None) for k, v in values.items()}
     return dict(outcome=outcome, values=quantities, uncertainty=bands or {}, warnings=list(warnings))

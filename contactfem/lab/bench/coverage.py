@@ -8,7 +8,8 @@ where the scene has one (Hertz's a and p0, the continuous bar's contact duration
 patch test's uniform pressure), else a ladder refined in every discretisation that moves the quantity
 at once (the step halved and the elements doubled, level after level, with the trapezoidal rule) until
 two successive levels agree to REF_AGREE (0.1 %); the finest level is the reference and the ladder is
-recorded. Runs that differ only in their discretisation (step, mesh, integrator, penalty where it
+recorded (where the ladder ends before every quantity agrees, the quantities whose last two levels agree
+are judged by them and the others are not judged). Runs that differ only in their discretisation (step, mesh, integrator, penalty where it
 regularises a constraint, enforcement) share their reference. Errors are relative to the quantity's
 reference value, or to the scale below which it counts as near zero (the Quantity's own), never
 inflated otherwise.
@@ -395,7 +396,13 @@ def reference(name, checkpoint, progress=None):
             if max(change.values(), default=0.0) <= REF_AGREE:
                 return dict(values=values, change=change, ladder=ladder, converged=True)
         prev = values
-    return dict(values=None, change=None, ladder=ladder, converged=False)
+    # not every quantity agreed: those whose last two levels did are judged by them, the others by none
+    last = next((lv for lv in reversed(ladder) if "change" in lv), None)
+    agreed = [q for q, c in (last or {}).get("change", {}).items() if c <= REF_AGREE]
+    if not agreed:
+        return dict(values=None, change=None, ladder=ladder, converged=False)
+    pick = lambda d: {q: d[q] for q in agreed}
+    return dict(values=pick(last["values"]), change=pick(last["change"]), ladder=ladder, converged=False)
 
 
 def judge(scene, preset, over, run, ref):
@@ -459,7 +466,7 @@ def coverage_study(quick=False, progress=None, checkpoint=None, seconds=TIME_LIM
         full = dict(ph.over, **over)
         if name not in refs:
             refs[name] = reference(name, store, progress)
-        unjudged = refs[name] is not None and not refs[name]["converged"]
+        unjudged = refs[name] is not None and not refs[name]["values"]
         if unjudged and not label.endswith("preset"):  # no truth to judge it by: only the presets are run (README)
             run = dict(outcome="ran", values={}, uncertainty={}, warnings=[], time_s=0.0, skipped=True)
         else:
@@ -572,9 +579,10 @@ def coverage_markdown(res):
             continue
         values = ", ".join(f"{k} {v:.6g}" for k, v in (ref["values"] or {}).items() if v is not None) or "-"
         change = ", ".join(f"{k} {v:.1e}" for k, v in (ref["change"] or {}).items()) or "-"
-        L.append(
-            f"| {name} | {PHYSICS[name].scene} | {_f(ref['converged'])} | {len(ref['ladder'])} | {values} | {change} |"
+        converged = (
+            _f(ref["converged"]) if ref["converged"] or not ref["values"] else "only " + ", ".join(ref["values"])
         )
+        L.append(f"| {name} | {PHYSICS[name].scene} | {converged} | {len(ref['ladder'])} | {values} | {change} |")
     L += [
         "",
         "| scene | physics | preset | setting | outcome | true error / band per quantity | warnings or error |",
