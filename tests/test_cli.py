@@ -202,7 +202,7 @@ def test_show_says_which_preset_its_columns_are(capsys):
     text = capsys.readouterr().out
     head = text.splitlines()[1].split()
     assert head[:4] == ["parameter", "fast", "(run)", "paper"]
-    row = next(ln for ln in text.splitlines() if ln.startswith("n_el "))
-    assert row.split()[1:3] == ["40", "120"]  # the fast preset's, then where paper differs
+    row = next(ln for ln in text.splitlines() if ln.startswith("dt "))
+    assert row.split()[1:3] == ["0.02", "0.01"]  # the fast preset's, then where paper differs
     assert "what `contactfem run` uses unless --preset is given" in text
     assert "c_T " in text and "builds the friction law" in text

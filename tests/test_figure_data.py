@@ -88,6 +88,7 @@ REPO = Path(__file__).resolve().parents[1]
 FIGURES = REPO / "figures"
 FAST = (
     "bench_adaptive",
+    "bench_coverage",
     "bench_cost",
     "bench_speed",
     "bench_tangents",

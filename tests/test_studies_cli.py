@@ -321,36 +321,47 @@ def test_the_sweep_warns_once_per_flagged_point_from_python():
 
 def test_error_bars_become_columns_when_the_runs_carry_them():
     """The uncertainty section of a run (per headline quantity: value, band, relative band, ...) is
-    flattened generically into FIELD.NAME columns beside the accuracy indicators'."""
+    flattened into FIELD.NAME columns beside the accuracy indicators': a run's own section, and one
+    written out."""
     from contactfem.lab.sweep import accuracy_columns
+    from contactfem.scenes import run_scene
 
+    res = run_scene("sloping_impact", "fast", {"n_steps": 40}, error_bars=True)
+    entry = res["uncertainty"]["quantities"]["rebound_vy"]
+    cols = accuracy_columns(res)
+    assert cols["band.rebound_vy"] == entry["band"] and cols["relative_band.rebound_vy"] == entry["relative_band"]
+    assert "value.rebound_vy" not in cols and "parts.rebound_vy" not in cols  # the value is its own column
+    assert all(k.startswith("accuracy.") or k.split(".")[1] in res["uncertainty"]["quantities"] for k in cols)
     res = {
         "rebound_vy": 1.46,
         "accuracy": {
             "equilibrium": {"value": 1e-14, "ok": True, "threshold": 1e-6},
-            "energy_loss": {"value": 0.4, "ok": False, "threshold": 0.3},
+            "energy_gain": {"value": 0.4, "ok": False, "threshold": 0.01},
         },
         "uncertainty": {
-            "rebound_vy": {
-                "value": 1.46,
-                "band": 0.12,
-                "rel_band": 0.082,
-                "order": 0.98,
-                "levels": [0.1, 0.2, 0.4],
-                "class": "monotone",
-                "parts": {"dt": 0.12},
+            "tolerance": 0.05,
+            "quantities": {
+                "rebound_vy": {
+                    "value": 1.46,
+                    "band": 0.12,
+                    "relative_band": 0.082,
+                    "observed_order": 0.98,
+                    "levels": 3,
+                    "convergence": "monotone",
+                    "parts": {"step": {"band": 0.12}},
+                },
             },
         },
     }
-    cols = accuracy_columns(res)
-    assert cols == {
-        "accuracy.flags": "energy_loss",
+    assert accuracy_columns(res) == {
+        "accuracy.flags": "energy_gain",
         "accuracy.equilibrium": 1e-14,
-        "accuracy.energy_loss": 0.4,
+        "accuracy.energy_gain": 0.4,
         "band.rebound_vy": 0.12,
-        "rel_band.rebound_vy": 0.082,
-        "order.rebound_vy": 0.98,
-        "class.rebound_vy": "monotone",
+        "relative_band.rebound_vy": 0.082,
+        "observed_order.rebound_vy": 0.98,
+        "levels.rebound_vy": 3,
+        "convergence.rebound_vy": "monotone",
     }
 
 

@@ -13,7 +13,7 @@ module path or shipped law), so a sweep point equals that run. Every point is va
 Each row says how accurate its run is: ``accuracy.flags`` (the indicators past their
 thresholds, by name), ``accuracy.NAME`` (each indicator's value), the error bars of the
 headline quantities where the run carries them (its ``uncertainty`` section: ``band.NAME``,
-``rel_band.NAME``, ... for each field of a quantity's entry), and ``warnings`` (the run's
+``relative_band.NAME``, ... for each field of a quantity's entry), and ``warnings`` (the run's
 accuracy warnings, in short). A flagged point is one warning (``AccuracyWarning``) naming the
 point, as it ends.
 
@@ -74,16 +74,17 @@ def build_laws(scene, preset, point, friction=None, normal=None, notes=None):
     return overrides, laws_from_options(friction, normal, law_sets, from_scene, notes)
 
 
-def _one(scene, preset, point, friction=None, normal=None):
+def _one(scene, preset, point, friction=None, normal=None, error_bars=None, tolerance=None):
     """One run, reduced to its scalar results (lists and dicts are left out of the table; so
     are results that repeat a swept parameter, which has its column param.NAME), its accuracy
     (accuracy_columns) and its accuracy warnings (``warnings``: their first clauses, joined by
-    "; "); the run's other warnings (numpy's, libraries') are dropped, as `contactfem run` drops them."""
+    "; "); the run's other warnings (numpy's, libraries') are dropped, as `contactfem run` drops them.
+    ``error_bars``, ``tolerance``: as for run_scene."""
     try:
         overrides, laws = build_laws(scene, preset, point, friction, normal)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            res = run_scene(scene, preset, overrides, check=False, **laws)
+            res = run_scene(scene, preset, overrides, check=False, error_bars=error_bars, tolerance=tolerance, **laws)
         row = {k: v for k, v in res.items() if not isinstance(v, (list, dict)) and k not in point}
         row.update(accuracy_columns(res))
         said = [str(w.message).split(" (")[0] for w in caught if issubclass(w.category, AccuracyWarning)]
@@ -99,13 +100,13 @@ def accuracy_columns(res):
     """A run's accuracy as columns of its row: ``accuracy.flags``, the names of the indicators past
     their thresholds (space-separated; empty: none), ``accuracy.NAME``, each indicator's value, and,
     where the results carry an ``uncertainty`` section, ``FIELD.NAME`` for every number or text of a
-    quantity's entry but its value (which is the quantity's own column): ``band.NAME``, ..."""
+    quantity's entry but its value (which is the quantity's own column) and its parts by discretisation:
+    ``band.NAME``, ``relative_band.NAME``, ``observed_order.NAME``, ..."""
     accuracy = {k: v for k, v in (res.get("accuracy") or {}).items() if isinstance(v, dict) and "value" in v}
     cols = {"accuracy.flags": " ".join(k for k, ind in accuracy.items() if not ind.get("ok", True))}
     cols.update({f"accuracy.{k}": ind["value"] for k, ind in accuracy.items()})
-    for name, entry in (res.get("uncertainty") or {}).items():
-        items = entry.items() if isinstance(entry, dict) else [("uncertainty", entry)]
-        cols.update({f"{field}.{name}": v for field, v in items if field != "value" and _scalar(v)})
+    for name, entry in ((res.get("uncertainty") or {}).get("quantities") or {}).items():
+        cols.update({f"{field}.{name}": v for field, v in entry.items() if field != "value" and _scalar(v)})
     return cols
 
 
@@ -203,14 +204,18 @@ def sweep(
     force=False,
     table=None,
     timeout=None,
+    error_bars=None,
+    tolerance=None,
 ):
     """Run `scene` at every point of the grid (parameters and law fields law.NAME, with the
     laws named by ``friction`` / ``normal`` as on the command line); returns the list of row
     dicts, in the grid's order. Every point is validated first (``plan``). ``table``: a Table
     that keeps the rows (on disk if it has a path, written as each point ends, and with
     ``resume`` the rows it already holds); ``timeout``: seconds a local run may take before it
-    is stopped and recorded as failed. The laws' check warns (UserWarning) before the first run;
-    each flagged point (``flagged``) warns as it ends (AccuracyWarning, naming the point)."""
+    is stopped and recorded as failed. ``error_bars``, ``tolerance``: every run's, as for run_scene
+    (each row's ``uncertainty`` section is a plain dict of the run's results). The laws' check warns
+    (UserWarning) before the first run; each flagged point (``flagged``) warns as it ends
+    (AccuracyWarning, naming the point)."""
     args = (scene, grid, preset, jobs, scheduler, friction, normal, check, force)
     (points, notes), version = (
         _guarded(_prepare, args, laws_text(friction, normal))
@@ -222,7 +227,7 @@ def sweep(
     table = Table() if table is None else table
     same = dict(scene=get_scene(scene).name, preset=preset, laws=laws_text(friction, normal), code_version=version)
     todo = table.start(points, same)
-    tasks = [(i, (scene, preset, points[i], friction, normal)) for i in todo]
+    tasks = [(i, (scene, preset, points[i], friction, normal, error_bars, tolerance)) for i in todo]
     runs = _on_dask(scheduler, tasks) if scheduler else _local(tasks, jobs, timeout)
     with closing(runs):  # an exception here (Ctrl-C, SIGTERM) stops the workers at once
         for i, row in runs:

@@ -108,7 +108,7 @@ def _with_code(fn, code, args, kwargs):
 def _run(scene, preset, changed):
     from ..scenes import run_scene
 
-    return run_scene(scene, preset, dict(changed))
+    return run_scene(scene, preset, dict(changed), error_bars=False)  # (the figures draw the runs, not bands)
 
 
 @lru_cache(maxsize=64)

@@ -406,6 +406,30 @@ def load_scene_file(path):
         measure=_checked_measure(scene.measure, path),
         check=scene.check,
         simulate=scene.simulate,
+        settles=scene.settles,
     )
     guarded = {role: _guarded(fn, path, role) for role, fn in checked.items() if fn is not None}
-    return replace(scene, **guarded, simulate=_named_overlap(guarded.get("simulate", simulate), path))
+    discretisations = tuple(_guarded_discretisation(d, path) for d in scene.discretisations)
+    return replace(
+        scene,
+        **guarded,
+        discretisations=discretisations,
+        simulate=_named_overlap(guarded.get("simulate", simulate), path),
+    )
+
+
+def _guarded_discretisation(d, path):
+    """A scene file's Discretisation with its callables guarded; a ValueError of ``coarsen`` passes (no
+    level that coarse: the ladder takes another), any other error is one SceneError line."""
+    role = f"discretisation {d.name}"
+
+    def coarsen(params, r):
+        try:
+            return d.coarsen(params, r)
+        except ValueError:
+            raise
+        except (Exception, SystemExit) as err:  # noqa: BLE001
+            raise _error(err, path, role + ", coarsen") from None
+
+    calls = {f: _guarded(getattr(d, f), path, f"{role}, {f}") for f in ("size", "order", "applies")}
+    return replace(d, coarsen=coarsen, **calls)

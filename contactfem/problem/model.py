@@ -33,8 +33,7 @@ class Model:
     run it (``stages``, in turn: a Stage, or a function that builds the Stage from the last record
     of the stage before it; ``stage=``: a model of one), the lengths the accuracy
     indicators compare the penetration with (``sizes``: ``element``, ``body``, and ``radius``
-    for a ring), whether the scene reads a rebound after the impact (``rebound``) or dissipates
-    energy by plasticity (``plastic``: no integrator's loss), the name progress shows, and the
+    for a ring), whether the scene reads a rebound after the impact (``rebound``), the name progress shows, and the
     scene's own objects (``parts``: bodies, contacts, node sets, closed forms) for its
     ``measure`` and plots."""
 
@@ -43,7 +42,6 @@ class Model:
     stages: tuple = ()
     sizes: dict = field(default_factory=dict)
     rebound: bool = False
-    plastic: bool = False
     name: str = ""
     parts: dict = field(default_factory=dict)
 

@@ -22,6 +22,7 @@ import numpy as np
 from .model import Model, Stage  # noqa: F401  (scene modules take them here)
 from .params import Limit, Param, check_overrides, parse_all  # noqa: F401  (scene modules take Param, Limit here)
 from .resources import check_resources, describe  # noqa: F401  (the command line takes them from here)
+from .uncertainty import TOLERANCE, Discretisation, Quantity  # noqa: F401  (scene modules take them here)
 
 # what a run reports of itself, how it went rather than what it computed (set by run and
 # scenes.run_scene; io.compare_runs leaves them out): a scene's measure may not return them
@@ -75,7 +76,17 @@ def simulate(model, params=None, progress=None):
     return records
 
 
-def run(scene, params, normal=None, friction=None, progress=None, linear_algebra="auto", instrument=None):
+def run(
+    scene,
+    params,
+    normal=None,
+    friction=None,
+    progress=None,
+    linear_algebra="auto",
+    instrument=None,
+    error_bars=False,
+    tolerance=TOLERANCE,
+):
     """Build, simulate and measure a scene with resolved parameters; ``linear_algebra`` and
     ``instrument`` (solver.instrument.Timings) go to every System the scene builds (its
     ``system_options``). The results come with the run's own wall time (``wall_time_s``:
@@ -84,9 +95,12 @@ def run(scene, params, normal=None, friction=None, progress=None, linear_algebra
     ``ordering``, ``unknowns``, ``band_kl``, ``band_ku``) and how often they were evaluated
     (``residual_evaluations``: System evaluations, one per residual Newton needs;
     ``contact_evaluations``: contact evaluations, one per contact in each), an ``accuracy`` section
-    (problem/accuracy.py; AccuracyWarning past a threshold) and ``stepping`` where a scene takes ``accuracy``."""
+    (problem/accuracy.py; AccuracyWarning past a threshold) and ``stepping`` where a scene takes ``accuracy``.
+    With ``error_bars``, the scene's headline quantities (``scene.quantities``) get their error bands from
+    coarser runs (problem/uncertainty.py: the section ``uncertainty``; a band past ``tolerance``, relative,
+    warns); each closed form a quantity declares is an accuracy indicator held to ``tolerance`` too."""
     from ..clock import imports_timed
-    from .accuracy import collect, stepping, warn
+    from .accuracy import collect, references, stepping, warn
 
     with imports_timed() as imported:  # modules loaded on first use: not the run's time
         t0 = time.perf_counter()
@@ -102,21 +116,39 @@ def run(scene, params, normal=None, friction=None, progress=None, linear_algebra
     systems = model.systems
     if "accuracy" in params:  # how the run stepped: fixed, or at a tolerance
         results["stepping"] = stepping(params, records)
-    accuracy = collect(model, params, records, results)
-    accuracy.update(results.pop("accuracy", None) or {})  # the scene's own (its references)
-    results["accuracy"] = accuracy
-    warn(accuracy, stacklevel=3)
+    accuracy = collect(model, params, records, results, tolerance)
+    accuracy.update(results.pop("accuracy", None) or {})  # the scene's own
+    accuracy.update(references(scene.quantities, params, results, tolerance))  # the closed forms it declares
     results["wall_time_s"] = wall - imported[0]
     results["linear_algebra"] = "+".join(dict.fromkeys(s.linear_algebra for s in systems)) or None
     results["ordering"] = "+".join(dict.fromkeys(s.ordering for s in systems)) or None
     results["unknowns"] = max((s.ndof for s in systems), default=None)
-    bands = [s.band for s in systems if s.band is not None]
-    results["band_kl"] = max((kl for kl, _ in bands), default=None)  # banded: the widest band
-    results["band_ku"] = max((ku for _, ku in bands), default=None)
+    widths = [s.band for s in systems if s.band is not None]
+    results["band_kl"] = max((kl for kl, _ in widths), default=None)  # banded: the widest band
+    results["band_ku"] = max((ku for _, ku in widths), default=None)
     results["residual_evaluations"] = int(sum(s.evaluations for s in systems))
     contacts = {id(c): c for s in systems for c in s.contacts}
     results["contact_evaluations"] = int(sum(c.evaluations for c in contacts.values()))
     results.setdefault("newton_iterations_total", int(sum(r.iterations for r in records)))  # if not counted
+    del records, model, systems, contacts  # (the ladder's runs need the memory)
+    if error_bars and scene.quantities:
+        from .uncertainty import bands, run_level
+
+        def level(p):
+            return run(scene, p, normal, friction, linear_algebra=linear_algebra, error_bars=False)
+
+        results["uncertainty"], indicators = bands(
+            lambda over: run_level(level, scene, params, over),
+            params,
+            results,
+            scene.quantities,
+            scene.discretisations,
+            tolerance,
+            settled=scene.settles(params, results) if scene.settles else None,
+        )
+        accuracy.update(indicators)
+    results["accuracy"] = accuracy
+    warn(accuracy, stacklevel=3)
     return results
 
 
@@ -139,18 +171,25 @@ class Scene:
     law_params: dict = field(default_factory=dict)  # kind -> the parameters that build the scene's law of that kind
     law_choice: tuple | None = None  # (parameter, values): those values of it choose the friction law
     law_range: Callable[[dict], dict] | None = None  # the range a law meets (LAW_RANGE_KEYS), for the pre-flight
+    # The headline quantities and the discretisations that move them (problem/uncertainty.py): their error
+    # bands, and their closed forms as accuracy indicators
+    quantities: tuple = ()  # Quantity: name, unit, the discretisations that move it, its closed form
+    discretisations: tuple = ()  # Discretisation: how a coarser level's parameters follow from the run's
+    settles: Callable[[dict, dict], dict] | None = None  # (params, results) -> overrides that end the ladder's
+    # levels once the quantities are decided (a rebound in free flight)
 
-    def run(self, params, normal=None, friction=None, progress=None, linear_algebra="auto", instrument=None):
-        """Build, simulate and measure (module function ``run``)."""
-        return run(
-            self,
-            params,
-            normal=normal,
-            friction=friction,
-            progress=progress,
-            linear_algebra=linear_algebra,
-            instrument=instrument,
-        )
+    def run(self, params, **options):
+        """Build, simulate and measure, and with ``error_bars`` the error bands (module function ``run``, whose
+        keywords ``options`` are; run_scene and the command line ask for the bands by default)."""
+        return run(self, params, **options)
+
+    def with_values(self, params, overrides):
+        """Resolved ``params`` with ``overrides`` (a coarser level of a ladder), each value checked as
+        a user's is (ValueError naming the parameter and its range)."""
+        values = parse_all(self.params, dict(params, **overrides))
+        if self.check is not None:
+            self.check(values)
+        return values
 
     def param(self, name):
         for p in self.params:
@@ -188,7 +227,9 @@ class Scene:
                 )
         if self.check is not None:
             self.check(values)
-        return values
+        from .time_integration import at_tolerance_values
+
+        return at_tolerance_values(values)
 
     def law_param_kind(self, name, value=None):
         """The kind of law ("friction", "normal") the parameter `name` (= value) builds, or None."""

@@ -25,10 +25,13 @@ CONTACT_INTEGRATION_PARAM = Param(
 )
 
 
-def newmark_params(delta, beta, source):
+def newmark_params(delta, beta, source, tolerance=True):
     """The Params delta and beta_newmark with the scene's defaults and Newmark's own ranges
     (solver.newmark: delta in [0.5, 1], beta in (0, 0.5]); ``source`` says where the defaults
-    come from (e.g. "paper")."""
+    come from (e.g. "paper"). ``tolerance``: the scene takes ``accuracy`` too, and a run at a tolerance
+    integrates with the trapezoidal rule, so a delta or beta_newmark given with it is refused (they
+    apply only with accuracy = 0) and its parameters record the rule's (``at_tolerance_values``)."""
+    when = (("accuracy", (0.0,)),) if tolerance else ()
     return (
         Param(
             "delta",
@@ -37,6 +40,7 @@ def newmark_params(delta, beta, source):
             **DELTA_RANGE,
             doc=f"Newmark delta, the usual gamma ({source}: {delta:g}; 0.5 with beta 0.25 conserves energy, "
             "below 0.5 every step amplifies; a run with accuracy > 0 uses 0.5)",
+            when=when,
         ),
         Param(
             "beta_newmark",
@@ -45,8 +49,17 @@ def newmark_params(delta, beta, source):
             **BETA_RANGE,
             doc=f"Newmark beta ({source}: {beta:g}; stable for every step when beta >= (delta + 1/2)^2 / 4; "
             "a run with accuracy > 0 uses 0.25)",
+            when=when,
         ),
     )
+
+
+def at_tolerance_values(values):
+    """A run at a tolerance (values['accuracy'] > 0) integrates with the trapezoidal rule: its delta and
+    beta_newmark say so (Scene.resolve), so that the parameters a run records are the ones it used."""
+    if values.get("accuracy") and "delta" in values:
+        return dict(values, delta=TRAPEZOIDAL["delta"], beta_newmark=TRAPEZOIDAL["beta"])
+    return values
 
 
 def contact_integration(params):

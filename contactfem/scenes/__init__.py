@@ -10,6 +10,7 @@ import importlib
 import pkgutil
 
 from ..problem.scene import Limit, Model, Param, Scene, Stage, jsonable, simulate
+from ..problem.uncertainty import Discretisation, Quantity, mesh, penalty, time_step
 from ..problem.files import SceneError, is_scene_file, load_scene_file
 
 
@@ -80,6 +81,8 @@ def run_scene(
     linear_algebra=None,
     instrument=None,
     check=True,
+    error_bars=None,
+    tolerance=None,
 ):
     """Run a scene and return its JSON-able results with the parameters used, the run's own wall
     time, Newton iteration count and the linear algebra of its Systems (``linear_algebra``:
@@ -101,7 +104,10 @@ def run_scene(
     a value no law may return, a warning for a derivative that disagrees with finite
     differences. During the run every value a law object returns is checked too
     (contactfem.laws.protocol): a LawValueError ends the run.
-    ``instrument``: a solver.instrument.Timings handed to every System (the bench's timings)."""
+    ``instrument``: a solver.instrument.Timings handed to every System (the bench's timings).
+    ``error_bars``: the headline quantities with their error bands from coarser runs (the section
+    ``uncertainty``; problem/uncertainty.py); None: on, unless $CONTACTFEM_ERROR_BARS is 0 or off.
+    ``tolerance``: the relative band (and closed-form error) past which a quantity warns (default 0.05)."""
     import warnings
 
     from ..laws.protocol import as_normal_law, describe
@@ -109,8 +115,12 @@ def run_scene(
 
     from ..problem.params import check_overrides
 
+    from ..problem.uncertainty import TOLERANCE, check_tolerance, error_bars_default
+
     scene = get_scene(name)
     overrides = check_overrides(overrides)
+    tolerance = TOLERANCE if tolerance is None else check_tolerance(tolerance)
+    error_bars = error_bars_default() if error_bars is None else bool(error_bars)
     if progress is not None and not callable(progress):
         raise TypeError(
             f"parameter progress must be None or a callable progress(t0, t_end, label) (e.g. "
@@ -133,6 +143,8 @@ def run_scene(
         progress=progress,
         linear_algebra=linear_algebra or "auto",
         instrument=instrument,
+        error_bars=error_bars,
+        tolerance=tolerance,
     )
     for kind, law in laws.items():
         results[f"{kind}_law"] = describe(law)
@@ -147,7 +159,12 @@ def run_scene(
 
 
 __all__ = [
+    "Discretisation",
     "Limit",
+    "Quantity",
+    "mesh",
+    "penalty",
+    "time_step",
     "Model",
     "Param",
     "Scene",

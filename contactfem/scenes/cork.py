@@ -109,8 +109,9 @@ from ..laws.friction import SlipHardening
 from ..laws.normal import PowerLaw
 from ..problem import time_integration
 from ..problem.accuracy import indicator
-from ..problem.scene import PENALTIES, PENALTY_DOC, Limit, Model, Param, Scene, Stage
+from ..problem.scene import PENALTIES, PENALTY_DOC, Limit, Model, Param, Quantity, Scene, Stage
 from ..problem.time_integration import newmark_of, newmark_params
+from ..problem.uncertainty import mesh, time_step
 from ..solver import Adaptive, Dirichlet, Newmark, Static, System
 from ..solver.schedule import AtTolerance
 
@@ -766,4 +767,12 @@ SCENE = Scene(
     laws=("normal", "friction"),
     law_params={"friction": ("c_T", "mu", "h"), "normal": ("c_N", "m")},
     law_range=law_range,
+    # the gas is coupled explicitly (a step acts with the pressure before it): first order in the step whatever
+    # the integrator. The step's ladder scales the pop's fine step and the travel limit (the press fit's dt
+    # stays: the pop starts from its last record)
+    quantities=tuple(
+        Quantity(name, unit, ("step", "mesh"), orders={"step": 1.0})
+        for name, unit in (("exit_velocity_m_s", "m/s"), ("exit_time_ms", "ms"))
+    ),
+    discretisations=(time_step("dt_fine", also=("travel_max",)), mesh("n_r", "n_z", low={"n_z": 3})),
 )

@@ -67,7 +67,7 @@ from ..contact import BodySurface, tributary_lengths
 from ..laws import Coulomb, PowerLaw
 from ..solver import Dirichlet, History, Static, Steps, System
 from ..problem import enforcement
-from ..problem.scene import Model, Param, Scene, Stage
+from ..problem.scene import Model, Param, Quantity, Scene, Stage
 
 
 def block(xs, y0, y1, ny, name, E, nu):
@@ -208,18 +208,6 @@ def measure(m, params, records):
         s = body.cauchy_stress(system.local(body, u))
         s_dev = max(s_dev, float(np.max(np.abs(s[:, 1, 1] + p)) / p))
     result["stress_deviation_max"] = s_dev
-    from ..problem.accuracy import PRESSURE_TOL, indicator
-
-    result["accuracy"] = dict(
-        pressure_deviation=indicator(
-            result["pressure_deviation_max"],
-            PRESSURE_TOL,
-            "largest |interface pressure / p - 1| over both blocks' "
-            "interface nodes (the patch test's exact answer: p everywhere)",
-            "measured: node-to-segment stays below 0.052 "
-            "on the presets (its load transfer's own error, the paper's method); mortar: 1e-11",
-        )
-    )
     return result
 
 
@@ -313,4 +301,9 @@ SCENE = Scene(
     laws=("normal",),
     law_params={"normal": ("c_N",)},
     law_range=law_range,
+    # the patch test's answer is p at every node of both blocks: its headline is its error, the largest
+    # |pressure / p - 1| (relative to p already: scale 1), which the run knows exactly. No band: node-to-segment's
+    # error on non-matching meshes does not vanish as they are refined (measured: 2.9 %, 5.2 %, 4.9 %, 5.9 % on
+    # 4|7, 8|13, 16|27, 32|53 elements), so no ladder can estimate it; the closed form holds it to the tolerance
+    quantities=(Quantity("pressure_deviation_max", "", (), scale=1.0, exact=0.0),),
 )

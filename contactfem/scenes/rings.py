@@ -64,6 +64,11 @@ RING_PARAMS = (
 )
 
 
+# a ring of fewer than 8 elements (45 degrees each) is a polygon, not a ring (its sides lie 7.6 % of the radius
+# inside the circle): no coarser level of a ladder goes below it
+RING_FLOOR = 8
+
+
 def ring_size(p, half=False):
     """Elements and unknowns of the ring of make_ring (beam: 3 dofs a node; continuum: an
     annulus of n_el x n_radial quads)."""

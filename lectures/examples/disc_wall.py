@@ -6,7 +6,7 @@ from skfem import MeshTri
 from contactfem.bodies.continuum import Continuum
 from contactfem.contact import NodeToSegment, RigidPolyline
 from contactfem.laws import Coulomb, PowerLaw
-from contactfem.scenes import Model, Param, Scene, Stage
+from contactfem.scenes import Model, Param, Quantity, Scene, Stage, time_step
 from contactfem.solver import History, Newmark, Steps, System
 
 WALL = [(-3.0, 0.0), (1.0, 0.0), (4.0, 2.0)]  # left to right: the disc is on the wall's left side
@@ -46,9 +46,7 @@ def build(p, *, normal=None, friction=None, system_options=None):
 def measure(model, p, records):
     disc, hist = model.parts["disc"], History.of(records)
     m = disc.mass()[disc.xdofs[:, 0]]  # lumped nodal masses
-    vx, vy = (
-        m @ hist.v[disc.xdofs] / m.sum()
-    )  # the centre of mass's velocity at the end (History: u, v, a are the last)
+    vx, vy = m @ hist.v[disc.xdofs] / m.sum()  # the centre of mass's final velocity (History's v: the last)
     return dict(rebound_vx=float(vx), rebound_vy=float(vy), energy_kinetic=hist.kinetic)
 
 
@@ -65,4 +63,6 @@ SCENE = Scene(
     laws=("normal", "friction"),
     law_params={"normal": ("c_N",), "friction": ("c_T", "mu")},
     law_range=law_range,
+    quantities=(Quantity("rebound_vx", "length/time"), Quantity("rebound_vy", "length/time")),  # error bars in dt
+    discretisations=(time_step("dt", count="n_steps"),),
 )

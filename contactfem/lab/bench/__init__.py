@@ -1,10 +1,10 @@
 """`contactfem bench`: speed against accuracy, measured.
 
-Ten studies, each a module with a function returning a JSON-able dict; ``run_bench``
+Eleven studies, each a module with a function returning a JSON-able dict; ``run_bench``
 runs them all and ``write_markdown`` (report.py, the one report writer) turns the result
 into the tables of BENCHMARKS.md. Files: common.py (targets, timing, observed order),
 tangents.py, work_precision.py, cost.py, targets.py, enforcement.py, speed.py, semismooth.py,
-scaling.py, extremes.py, adaptive.py, report.py.
+scaling.py, coverage.py, adaptive.py, error_bars.py, report.py.
 
 1. tangents        the paper's central claim (Sec. 4.2): Newton with the consistent
                    non-symmetric tangent (eqs 49-50) against a symmetrised tangent, the
@@ -41,15 +41,18 @@ scaling.py, extremes.py, adaptive.py, report.py.
                    plain scikit-fem script (skfem.asm, scipy's spsolve, Newton on the active
                    set), in one process and as whole processes (imports included): the ratio
                    contactfem / plain per size (scaling.py).
-9. extremes        every scene at the ends of its numerical ranges (penalty, step, friction, mesh,
-                   enforcement, discretisation, integration): each run within 5 % of its refined
-                   reference, flagged by an accuracy indicator, refused or stopped in one line;
-                   none wrong and unflagged (extremes.py).
+9. coverage        do the error bands hold? Every scene over the ranges of its discretisations (step,
+                   mesh, penalty, enforcement, integrator, both presets) and the physics that move
+                   them, each run with its error bars against the true error (a closed form, or a
+                   reference refined in step and mesh at once until two levels agree to 0.1 %):
+                   coverage, silent-wrong runs, band efficiency (coverage.py).
 10. adaptive        a tolerance against fixed steps: for each dynamic scene (sloping impact,
                     rolling ring, bar impact, cork) Newton iterations, residual evaluations and
                     wall time against the error of its headline quantities, a ladder of fixed
                     steps and the ``accuracy`` mode at several tolerances, against a reference
                     refined in time (adaptive.py); quick: the bar impact alone.
+11. error_bars      what the error bars cost: every scene at its fast preset, (run + its ladders) /
+                    run, and the median over the scenes (error_bars.py).
 
 ``quick`` shrinks every study (fast presets, fewer points) to seconds in all.
 No timing enters a test: times depend on the machine and its load.
@@ -64,7 +67,8 @@ from ...scenes import jsonable
 from .common import PAPER_SCENES, TARGETS, observed_order, timed
 from .cost import cost_study, iteration_cost
 from .enforcement import enforcement_study
-from .extremes import extremes_study
+from .coverage import coverage_study
+from .error_bars import error_bars_study
 from .report import write_markdown, write_outputs
 from .scaling import plain_hertz, scaling_study
 from .semismooth import semismooth_study
@@ -83,8 +87,9 @@ STUDIES = {
     "speed": speed_study,
     "semismooth": semismooth_study,
     "scaling": scaling_study,
-    "extremes": extremes_study,
+    "coverage": coverage_study,
     "adaptive": adaptive_study,
+    "error_bars": error_bars_study,
 }
 
 
@@ -135,6 +140,7 @@ __all__ = [
     "semismooth_study",
     "scaling_study",
     "plain_hertz",
-    "extremes_study",
+    "coverage_study",
+    "error_bars_study",
     "adaptive_study",
 ]

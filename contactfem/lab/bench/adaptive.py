@@ -117,7 +117,7 @@ def _point(scene, preset, over, keys):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # a coarse run's indicators warn: its error is measured here
         try:
-            r, wall = timed(run_scene, scene, preset, over)
+            r, wall = timed(run_scene, scene, preset, over, error_bars=False)
         except Exception as err:  # recorded, not hidden: a failed point is a result
             return dict(over, ok=False, failure=f"{type(err).__name__}: {str(err).splitlines()[0][:160]}")
     st = r["stepping"]

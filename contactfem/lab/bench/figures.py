@@ -33,6 +33,15 @@ def load_bench(preset="fast"):
     return quick_bench()
 
 
+@lru_cache(maxsize=4)
+def quick_study(name):
+    """One study's quick run, measured in this process once (for a figure whose bench JSON lacks it)."""
+    from ...scenes import jsonable
+    from . import STUDIES
+
+    return jsonable(STUDIES[name](True))
+
+
 @lru_cache(maxsize=1)
 def quick_bench():
     """The quick bench of the four studies the figures need (measured in this process: timings
@@ -329,17 +338,12 @@ def bench_speed(preset="fast", outdir=None):
     return _save(fig, outdir, preset, "bench_speed", "speed")
 
 
-def _adaptive_section(preset):
-    """The adaptive study of the bench JSON, or a quick one run here (the bar impact, seconds)."""
+def _section(name, preset):
+    """A study of the bench JSON (adaptive, coverage), or its quick run here (seconds) where the JSON lacks it."""
     b = load_bench(preset)
-    if "adaptive" in b:
-        return b["adaptive"], dict(source=bench_json_path().name, quick=b.get("quick"), machine=b.get("machine"))
-    if "adaptive_quick" not in _CACHE:
-        from ...scenes import jsonable
-        from .adaptive import adaptive_study
-
-        _CACHE["adaptive_quick"] = jsonable(adaptive_study(quick=True))
-    return _CACHE["adaptive_quick"], dict(source="a quick bench run", quick=True)
+    if name in b:
+        return b[name], dict(source=bench_json_path().name, quick=b.get("quick"), machine=b.get("machine"))
+    return quick_study(name), dict(source="a quick bench run", quick=True)
 
 
 @figure("bench_adaptive", "bench")
@@ -347,7 +351,7 @@ def bench_adaptive(preset="fast", outdir=None):
     """Work against precision of the dynamic scenes: residual evaluations against the error of
     the headline quantities, fixed steps against the adaptive mode at several tolerances."""
     plt = pyplot()
-    study, parameters = _adaptive_section(preset)
+    study, parameters = _section("adaptive", preset)
     scenes = study["scenes"]
     fig, axes = plt.subplots(1, len(scenes), figsize=(4.6 * len(scenes), 4.0), squeeze=False)
     for ax, (name, s) in zip(axes[0], scenes.items()):
@@ -425,4 +429,53 @@ def bench_adaptive(preset="fast", outdir=None):
     fig.tight_layout()
     return save_figure(
         fig, Path(outdir or default_outdir(preset)) / "bench_adaptive.png", {"adaptive": study}, parameters
+    )
+
+
+@figure("bench_coverage", "bench")
+def bench_coverage(preset="fast", outdir=None):
+    """True error against the error band of every headline quantity of the coverage study, log-log, with the
+    diagonal: below it the band holds the error. Quantities with no band are drawn at the band axis' foot."""
+    plt = pyplot()
+    study, parameters = _section("coverage", preset)
+    pairs = [
+        (r["scene"], q, bool(r["warnings"]))
+        for r in study["rows"]
+        for q in r["quantities"].values()
+        if q["kind"] in ("covered", "uncovered", "no band") and q["error"] > 0
+    ]
+    fig, ax = plt.subplots(figsize=(6.4, 5.6))
+    floor = 1e-6
+    lo = max(floor, min([q["error"] for _, q, _ in pairs] + [q["band"] for _, q, _ in pairs if q["band"]] + [1.0]))
+    scenes = sorted({s for s, _, _ in pairs})
+    for i, name in enumerate(scenes):
+        for warned in (False, True):
+            mine = [q for s, q, w in pairs if s == name and w == warned]
+            if not mine:
+                continue
+            ax.loglog(
+                [max(q["band"] or 0.0, lo / 3) for q in mine],
+                [max(q["error"], floor) for q in mine],
+                "o" if warned else "s",
+                color=f"C{i}",
+                mfc="none" if warned else f"C{i}",
+                ms=5,
+                label=f"{name}" + (" (warned)" if warned else ""),
+            )
+    top = max([q["error"] for _, q, _ in pairs] + [q["band"] or 0 for _, q, _ in pairs] + [1.0])
+    ax.loglog([lo / 3, 2 * top], [lo / 3, 2 * top], "k-", lw=0.8, label="true error = band")
+    ax.axhline(study["tol"], color="0.5", ls=":", lw=0.8)
+    ax.axvline(study["tol"], color="0.5", ls=":", lw=0.8)
+    ax.set_xlabel("relative error band (no band: at the left edge)")
+    ax.set_ylabel("relative true error")
+    cov = study.get("coverage")
+    ax.set_title(
+        f"{study['runs']} runs: the bands hold {'-' if cov is None else f'{100 * cov:.1f} %'} of the "
+        f"{study['runs_with_bands']} with bands; {study['silent_wrong']} silent-wrong (dotted: the tolerance)",
+        fontsize=9,
+    )
+    ax.legend(fontsize=6, loc="lower right", ncol=2)
+    fig.tight_layout()
+    return save_figure(
+        fig, Path(outdir or default_outdir(preset)) / "bench_coverage.png", {"coverage": study}, parameters
     )

@@ -9,7 +9,8 @@ from ...problem.accuracy import ERROR_BUDGET
 from .adaptive import STUDY
 from .common import TARGETS
 from .enforcement import enforcement_markdown
-from .extremes import extremes_markdown
+from .coverage import coverage_markdown
+from .error_bars import error_bars_markdown
 from .scaling import scaling_markdown
 from .semismooth import semismooth_markdown
 from .speed import PARTS, RINGS, SPEED_TARGETS, STARTUP_LAYERS
@@ -535,10 +536,12 @@ def write_markdown(res):
         L += semismooth_markdown(res["semismooth"])
     if "scaling" in res:
         L += scaling_markdown(res["scaling"])
-    if "extremes" in res:
-        L += extremes_markdown(res["extremes"])
+    if "coverage" in res:
+        L += coverage_markdown(res["coverage"])
     if "adaptive" in res:
         L += adaptive_markdown(res["adaptive"])
+    if "error_bars" in res:
+        L += error_bars_markdown(res["error_bars"])
     return "\n".join(L) + "\n"
 
 

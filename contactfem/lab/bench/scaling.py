@@ -124,14 +124,15 @@ def scaling_study(quick=False):
     the plain script, their best wall times and the ratio, in this process and as whole processes."""
     sizes, repeats = (QUICK_SIZES, QUICK_REPEATS) if quick else (SIZES, REPEATS)
     processes = QUICK_PROCESS_REPEATS if quick else PROCESS_REPEATS
-    run_scene("hertz", "paper", {"n_el": 4})  # imports and first calls, not timed
+    run_scene("hertz", "paper", {"n_el": 4}, error_bars=False)  # imports and first calls, not timed
     plain_hertz(4)
     rows = []
     for n_el, repeat in zip(sizes, repeats):
-        ours, t_ours = _best(lambda: run_scene("hertz", "paper", {"n_el": n_el}), repeat)
+        ours, t_ours = _best(lambda: run_scene("hertz", "paper", {"n_el": n_el}, error_bars=False), repeat)
         plain, t_plain = _best(lambda: plain_hertz(n_el), repeat)
         p_ours = process_time(
-            ["-m", "contactfem", "run", "hertz", "--preset", "paper", "--set", f"n_el={n_el}"], processes
+            ["-m", "contactfem", "run", "hertz", "--preset", "paper", "--set", f"n_el={n_el}", "--no-error-bars"],
+            processes,
         )
         p_plain = process_time(["-c", PLAIN_PROCESS, str(n_el)], processes)
         rows.append(

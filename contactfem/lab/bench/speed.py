@@ -50,13 +50,13 @@ STARTUP_LAYERS = (
     ("skfem", ["-c", "import skfem"], '`python -c "import skfem"`'),
     (
         "run_block_canonical",
-        ["-m", "contactfem", "run", "block", "--preset", "canonical"],
+        ["-m", "contactfem", "run", "block", "--preset", "canonical", "--no-error-bars"],
         "`contactfem run block --preset canonical`",
     ),
 )
 RINGS = (
     "run_rings",
-    ["-m", "contactfem", "run", "sloping_impact", "--set", "n_steps=5"],
+    ["-m", "contactfem", "run", "sloping_impact", "--set", "n_steps=5", "--no-error-bars"],
     "`contactfem run sloping_impact --set n_steps=5`",
 )
 
@@ -100,7 +100,7 @@ def startup_study(repeat=5):
         "python": _process([py, "-c", "pass"], repeat),
         "list": _process([py, "-m", "contactfem", "list"], repeat),
         "scipy_skfem": _process([py, "-c", "import scipy.sparse.linalg, skfem"], repeat),
-        "run_block": _process([py, "-m", "contactfem", "run", "block", "--preset", "paper"], repeat),
+        "run_block": _process([py, "-m", "contactfem", "run", "block", "--preset", "paper", "--no-error-bars"], repeat),
     }
     for key, args, _ in STARTUP_LAYERS + (RINGS,):
         out[key] = _process([py, *args], repeat)
@@ -146,7 +146,7 @@ def iteration_split(scene, preset="paper", overrides=None):
 
     timings = Timings()
     t0, c0, h0 = time.perf_counter(), time.process_time(), time.thread_time()
-    res = run_scene(scene, preset, dict(overrides or {}), instrument=timings)
+    res = run_scene(scene, preset, dict(overrides or {}), instrument=timings, error_bars=False)
     wall, cpu, thread = time.perf_counter() - t0, time.process_time() - c0, time.thread_time() - h0
     sec = timings.seconds
     n = max(timings.solves, 1)

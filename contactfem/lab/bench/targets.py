@@ -53,13 +53,15 @@ def targets_study(quick=False):
         for over in variants:
             row = dict(scene=name, preset=preset, overrides=over)
             try:
-                r = run_scene(name, preset, over)
+                r = run_scene(name, preset, over, error_bars=False)
                 row.update(ok=True, solve_s=r["wall_time_s"], iterations=r["newton_iterations_total"])
             except Exception as err:
                 row.update(ok=False, error=f"{type(err).__name__}: {str(err).splitlines()[0][:160]}")
             if not quick:
                 sets = [a for k, v in over.items() for a in ("--set", f"{k}={v}")]
-                row["process_s"], row["process_cpu_s"] = _process_time(["run", name, "--preset", preset, *sets])
+                row["process_s"], row["process_cpu_s"] = _process_time(
+                    ["run", name, "--preset", preset, *sets, "--no-error-bars"]
+                )
             rows.append(row)
     total = sum(r.get("process_s", r.get("solve_s", 0.0)) or 0.0 for r in rows)
     out = dict(
@@ -74,16 +76,19 @@ def targets_study(quick=False):
     # hertz on about 4,000 quads (64^2 = 4096), whole process
     n = 32 if quick else 64
     if quick:
-        r = run_scene("hertz", "paper", {"n_el": n})
+        r = run_scene("hertz", "paper", {"n_el": n}, error_bars=False)
         process = process_cpu = None
     else:
         import tempfile
 
         with tempfile.TemporaryDirectory() as tmp:  # (the JSON written as a user would)
             out_json = os.path.join(tmp, "hertz.json")
-            runs = [_process_time(["run", "hertz", "--preset", "paper", "--json", out_json]) for _ in range(3)]
+            runs = [
+                _process_time(["run", "hertz", "--preset", "paper", "--json", out_json, "--no-error-bars"])
+                for _ in range(3)
+            ]
         process, process_cpu = min(w for w, _ in runs), min(c for _, c in runs)  # best of 3
-        r = run_scene("hertz", "paper", {"n_el": n})
+        r = run_scene("hertz", "paper", {"n_el": n}, error_bars=False)
     out["hertz"] = dict(
         n_quads=r["n_quads"],
         error_p0=r["error_p0"],

@@ -20,7 +20,7 @@ def _scene_point(scene, preset, over, keys):
 def _scene_point_run(scene, preset, over, keys):
     over = dict(over)
     try:
-        r = run_scene(scene, preset, over)
+        r = run_scene(scene, preset, over, error_bars=False)
     except Exception as err:  # recorded, not hidden: a failed point is a result
         return dict(over, ok=False, error=f"{type(err).__name__}: {str(err).splitlines()[0][:160]}")
     return dict(

@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 
-from .answers import call, compare
+from .answers import call, compare, parts
 from .exercise import exercise
 
 LECTURE = "09_speed_accuracy"
@@ -105,7 +105,10 @@ def tolerance_run(c_N, dt):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             _TOLERANCE_RUNS[key] = run_scene(
-                "sloping_impact", "fast", dict(c_N=key[0], dt=key[1], n_steps=max(1, round(TOLERANCE_END / key[1])))
+                "sloping_impact",
+                "fast",
+                dict(c_N=key[0], dt=key[1], n_steps=max(1, round(TOLERANCE_END / key[1]))),
+                error_bars=False,  # the exercise is about the indicators, not the bands (exercise 9.4)
             )
     return _TOLERANCE_RUNS[key]
 
@@ -185,6 +188,75 @@ def tolerance_budget(settings_for):
     tolerance_budget_at(settings_for, 0.05)
 
 
+# an error band by hand (ex09_band_by_hand): three levels finest first, ratio r, the scheme's order; the
+# answer against the library's own estimate (contactfem.problem.uncertainty.estimate)
+
+
+def _band_case(f_exact, C, p, r, h=0.05):
+    return tuple(f_exact + C * (h * r**k) ** p for k in range(3))
+
+
+def _band(band_from_three, f, r, p_th):
+    got = parts(call(band_from_three, "band_from_three", *f, r, p_th), 3, "band_from_three", "p, f_extrapolated, band")
+    return [float(x) for x in got]
+
+
+def _library_band(f, r, p_th, h=0.05):
+    from ....problem.uncertainty import estimate
+
+    return estimate([(h * r**k, v) for k, v in enumerate(f)], p_th)
+
+
+def band_order(band_from_three):
+    for f_exact, C, p, r in ((2.0, 0.3, 1.7, 2.0), (-1.0, -4.0, 0.8, 1.5)):
+        f = _band_case(f_exact, C, p, r)
+        got = _band(band_from_three, f, r, 1.0)[0]
+        if math.isclose(got, -p, rel_tol=1e-6):
+            raise AssertionError(
+                f"your order for f = {f_exact:g} + {C:g} h^{p:g} is {got:.4g}, its negative: p = ln(e32 / e21) / ln r "
+                "with e21 = f2 - f1, e32 = f3 - f2 (f1 the finest)"
+            )
+        compare(
+            f"observed order of f = {f_exact:g} + {C:g} h^{p:g}, r = {r:g}",
+            got,
+            p,
+            {"f": ", ".join(f"{x:.6g}" for x in f)},
+            rtol=1e-8,
+        )
+
+
+def band_richardson(band_from_three):
+    for f_exact, C, p, r in ((2.0, 0.3, 1.7, 2.0), (-1.0, -4.0, 0.8, 1.5)):
+        f = _band_case(f_exact, C, p, r)
+        got = _band(band_from_three, f, r, 1.0)[1]
+        if math.isclose(got, 2 * f[0] - f_exact, rel_tol=1e-8):
+            raise AssertionError(
+                "your extrapolated value is f1 + delta: delta = e21 / (r^p - 1) is f2's lead over f1 scaled down, "
+                "and the limit lies on the other side of f1 from f2 (f1 - delta)"
+            )
+        compare(
+            f"Richardson's value of f = {f_exact:g} + {C:g} h^{p:g}",
+            got,
+            f_exact,
+            {"f": ", ".join(f"{x:.6g}" for x in f)},
+            rtol=1e-8,
+        )
+
+
+def band_factor_of_safety(band_from_three):
+    for f, r, p_th in (((1.0, 1.06, 1.14), 2.0, 2.0), ((1.0, 1.01, 1.05), 2.0, 1.0)):  # P < 1, then P > 1
+        got = _band(band_from_three, f, r, p_th)[2]
+        want = _library_band(f, r, p_th)
+        compare(
+            f"the band of the levels {f} (r = {r:g}, p_th = {p_th:g}; P = {want['P']:.3g})",
+            got,
+            want["band"],
+            {"f": ", ".join(f"{x:.6g}" for x in f)},
+            rtol=1e-8,
+            rule="FS(P) |delta|, FS = 1.6 P + 2.45 (1 - P) for P <= 1, 1.6 P + 2.45 (P - 1) above",
+        )
+
+
 EXERCISES = [
     exercise(
         "ex09_observed_order",
@@ -215,5 +287,15 @@ EXERCISES = [
         (tolerance_indicators, 2),
         (tolerance_error, 2),
         (tolerance_budget, 1),
+    ),
+    exercise(
+        "ex09_band_by_hand",
+        LECTURE,
+        "medium",
+        False,
+        "an error band from three runs: observed order, Richardson's estimate, Xing and Stern's factor of safety",
+        (band_order, 2),
+        (band_richardson, 2),
+        (band_factor_of_safety, 2),
     ),
 ]
