@@ -249,3 +249,58 @@ def _pid_and(how, arg=None):
     if how == "once":
         time.sleep(0.3)  # the other worker is idle by now
     return os.getpid(), act(how, arg)
+
+
+IMPORT_ONLY = textwrap.dedent("""
+    import atexit, multiprocessing.util
+    held = []  # the exit hooks registered and not removed since here
+    register, unregister = atexit.register, atexit.unregister
+    atexit.register = lambda f, *a, **k: (held.append(f), register(f, *a, **k))[1]
+    atexit.unregister = lambda f: ([held.remove(g) for g in list(held) if g == f], unregister(f))[1]
+    from contactfem.lab.batch import run_batch
+    imported = len(held)
+    values = sorted(o.value for o in run_batch(abs, [(i, (-i,)) for i in range(3)], jobs=2))
+    print(imported, len(held), values)
+""")
+
+
+def test_importing_the_batch_registers_no_exit_hook():
+    """The hook that kills a batch's workers at the interpreter's exit is registered where a batch
+    starts, and removed where it ends; importing the module registers nothing."""
+    out = subprocess.run(
+        [sys.executable, "-c", IMPORT_ONLY],
+        env=dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path)),
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    assert out.stdout.strip() == "0 0 [0, 1, 2]", out.stderr
+
+
+LEFT_OPEN = textwrap.dedent("""
+    import sys
+    sys.path.insert(0, {tests!r})
+    from pathlib import Path
+    from test_batch import _start_child_and_sleep, _wait_for_pids
+    from contactfem.lab.batch import run_batch
+
+    tasks = [("first", ("pid",))] + [(i, ({folder!r} + f"/{{i}}.pid",)) for i in range(2)]
+    batch = run_batch(_start_child_and_sleep, tasks, jobs=3)
+    next(batch)  # the first task's answer; the other two workers sleep
+    _wait_for_pids(Path({folder!r}), 2)
+    sys.exit(0)  # with the batch open
+""")
+
+
+def test_an_interpreter_that_exits_inside_a_batch_leaves_no_worker(tmp_path):
+    script = LEFT_OPEN.format(tests=str(Path(__file__).parent), folder=str(tmp_path))
+    p = subprocess.run(
+        [sys.executable, "-c", script],
+        env=dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path)),
+        capture_output=True,
+        text=True,
+        timeout=30,
+    )
+    assert p.returncode == 0, p.stderr
+    pids = _wait_for_pids(tmp_path, 2)
+    assert all(gone(pid) for pid in pids), pids

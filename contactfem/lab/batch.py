@@ -36,6 +36,7 @@ import threading
 import time
 from collections import deque
 from dataclasses import dataclass
+from functools import partial
 from multiprocessing.connection import wait
 
 _POLL_S = 1.0  # the longest the batch waits without looking at every worker
@@ -81,6 +82,8 @@ def _batch(fn, todo, jobs, timeout, retries, memory_limit, initializer):
     methods = multiprocessing.get_all_start_methods()
     ctx = multiprocessing.get_context("fork" if "fork" in methods else "spawn")
     workers = []
+    leftovers = partial(_kill_all, workers)  # what the batch holds if the interpreter exits inside it
+    atexit.register(leftovers)  # (multiprocessing's exit handler, which joins them, runs after it)
     finished = False
     try:
         while todo or any(w.task for w in workers):
@@ -125,6 +128,12 @@ def _batch(fn, todo, jobs, timeout, retries, memory_limit, initializer):
             w.kill()
         for w in list(workers):
             w.stop(workers)
+        atexit.unregister(leftovers)
+
+
+def _kill_all(workers):
+    for w in list(workers):
+        w.kill()
 
 
 def _death(code):
@@ -136,15 +145,6 @@ def _death(code):
 def _describe(exc):
     text = " ".join(str(exc).split())
     return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
-
-
-_LIVE = set()  # every worker started and not yet reaped, for the exit of the interpreter
-
-
-@atexit.register
-def _kill_leftovers():
-    for w in list(_LIVE):
-        w.kill()
 
 
 class _Worker:
@@ -160,7 +160,6 @@ class _Worker:
         with _signals_held():  # no Ctrl-C between the fork and the worker's own handlers,
             self.proc.start()  # and the worker is known before one can be raised here
             workers.append(self)
-            _LIVE.add(self)
             try:
                 os.setpgid(self.proc.pid, self.proc.pid)  # its own group (the worker sets it too)
             except (AttributeError, OSError):
@@ -217,7 +216,6 @@ class _Worker:
         self.proc.join(5.0)
         self.conn.close()
         workers.remove(self)
-        _LIVE.discard(self)
 
 
 class _signals_held:
