@@ -10,7 +10,7 @@ from ..solver import Newmark, Steps
 from ..solver.schedule import AtTolerance
 from ..solver.conserving import EnergyConsistent
 from ..solver.newmark import BETA_RANGE, DELTA_RANGE
-from .scene import Param
+from .params import Param
 
 CONTACT_INTEGRATIONS = ("standard", "energy_consistent")
 

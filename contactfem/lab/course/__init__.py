@@ -34,17 +34,10 @@ import sys
 import tempfile
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parents[3]
+from .lectures import REPO, lecture_sources  # noqa: F401  (lecture_sources: the package's name for it)
+
 QUESTION = re.compile(r"^\s*#\s*BEGIN\s+QUESTION\s*$", re.I)
 END_QUESTION = re.compile(r"^\s*#\s*END\s+QUESTION\s*$", re.I)
-
-
-def lecture_sources(repo=None):
-    """The lecture notebooks of the checkout, in course order."""
-    folder = Path(repo or REPO) / "lectures"
-    if not folder.is_dir():
-        raise ValueError(f"contactfem course needs a checkout of the repository: no lectures/ in {folder.parent}")
-    return sorted(folder.glob("[0-9][0-9]_*.ipynb"))
 
 
 def _first_line(cell):

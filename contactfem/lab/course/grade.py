@@ -41,6 +41,7 @@ from .snapshot import MAX_BYTES, take
 
 REPO = PACKAGE.parent
 
+from .lectures import lecture_sources
 MANUAL_MARK = re.compile(r"<!--\s*manual:\s*(\w+)\s*-->")
 UNSAFE = "graded without a sandbox (--unsafe-no-sandbox)"
 
@@ -245,8 +246,7 @@ def grade(
     after it). `seed`: of the hidden checks' parameters (default: drawn afresh). Without a
     sandbox, NoSandbox (a ValueError) before any work, unless `unsafe_no_sandbox`. Returns
     the rows."""
-    from ...io.outputs import check_output_path
-    from . import lecture_sources
+    from ...io.outputs import check_output_dir, check_output_path
 
     out_csv = check_output_path(out_csv, "--out", (".csv",))
     if jobs < 1:
@@ -272,11 +272,10 @@ def grade(
     deadline = parse_time(deadline) if isinstance(deadline, str) else deadline
     review = Path(review) if review else out_csv.with_name(out_csv.stem + "-review")
     feedback = Path(feedback) if feedback else out_csv.with_name(out_csv.stem + "-feedback")
-    from . import check_out_dir
     from .snapshot import notebooks
 
     for path, what in ((review, "--review"), (feedback, "--feedback")):
-        check_out_dir(path, what)
+        check_output_dir(path, what)
         if path.is_symlink():
             raise ValueError(f"{what} {path}: a symbolic link; give a real folder")
     notebooks(folder)  # a folder with notebooks, or ValueError
