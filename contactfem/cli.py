@@ -293,8 +293,11 @@ def cmd_figures(args):
         if args.preset != "paper" or condition.tag():
             raise ValueError("--rounding measures the paper preset's figures: give it with --preset paper alone")
         from .plots.rounding import study
+        from .plots.summary import reprint
 
-        study(args.outdir, args.only)
+        folder = args.outdir or default_outdir("paper")
+        for path in reprint(folder, list(study(folder, args.only))):
+            print(f"{path}: redrawn from its data with the spreads recorded")
         return 0
     with rounding(condition.linear_algebra, condition.perturbation):
         for path in make_all(args.preset, args.outdir, args.only):

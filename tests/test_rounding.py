@@ -181,14 +181,16 @@ def test_the_cork_tables_say_the_same_at_either_end_of_every_spread(side):
 
 
 def test_the_printed_cork_tables_are_what_their_data_and_spreads_print(tmp_path):
-    """What the study redraws once it has recorded the spreads (plots.rounding.reprint), from a copy of the
+    """What the study redraws once it has recorded the spreads (plots.summary.reprint), from a copy of the
     committed data: the committed tables, character for character (no run: the same numbers print the same)."""
     import shutil
+
+    from contactfem.plots import summary as S
 
     stems = ["cork_exit_time", "table_cork_sensitivity"]
     for stem in stems:
         shutil.copy(FIGURES / f"{stem}.json", tmp_path)
-    written = R.reprint(tmp_path, stems)
+    written = S.reprint(tmp_path, stems)
     assert sorted(D.Path(p).name for p in written if p.endswith(".md")) == sorted(f"{s}.md" for s in stems)
     for stem in stems:
         assert (tmp_path / f"{stem}.md").read_text() == (FIGURES / f"{stem}.md").read_text(), stem

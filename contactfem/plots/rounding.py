@@ -14,7 +14,7 @@ plots.data.differences names, a series of numbers as ``NAME[]``):
     {"texts": [...]}            a text whose numbers moved: compared by its words
     {"values": [...]}           a flag or a value without digits that moved: any of these
 
-The printed files that hold numbers to these spreads are then redrawn from the committed data (reprint).
+The printed files that hold numbers to these spreads are then redrawn from the committed data (summary.reprint).
 plots.data.differences then holds a fresh run within twice each recorded spread (RTOL elsewhere;
 argued at plots.data.MARGIN), ``spread(stem, key)`` gives the spread of one headline number (the error bands
 take max(band, spread)), and the study's runs are kept per condition in
@@ -155,36 +155,7 @@ def study(folder=None, only=None, log=print):
         out[stem] = record(stem, folder, {c: draw(stem, c, base, log) for c in CONDITIONS})
         log(f"{stem}: {len(out[stem])} number(s) moved under rounding")
     (folder / "rounding.md").write_text(markdown(folder))
-    for path in reprint(folder, todo):
-        log(f"{path}: redrawn from its data with the spreads recorded")
     return out
-
-
-def reprint(folder, todo):
-    """The printed files that hold numbers to their recorded spread, redrawn from the data in ``folder``
-    (no runs): the cork's exit-time and sensitivity tables and its knife edge among the figures ``todo``;
-    for the committed figures, summary.md and the README's blocks of it and of rounding.md. Their paths."""
-    from . import cork as F
-    from . import summary as S
-
-    done = []
-    if "cork_exit_time" in todo:
-        d = load(folder / "cork_exit_time.json")
-        done += F.cork_exit_time("paper", str(folder), data={k: d[k] for k in ("preset", "slow", "cases")})
-    if "cork_knife_edge" in todo:
-        d = load(folder / "cork_knife_edge.json")
-        done += F.cork_knife_edge("paper", str(folder), data={k: d[k] for k in ("field", "runs", "p0", "preset")})
-    if "table_cork_sensitivity" in todo:
-        path = folder / "table_cork_sensitivity.md"
-        path.write_text(F.sensitivity_reprinted(load(folder / "table_cork_sensitivity.json")))
-        done.append(path)
-    repo = Path(__file__).resolve().parents[2]
-    if folder.resolve() == (repo / "figures").resolve():
-        (folder / "summary.md").write_text(S.summary_markdown("paper", S.committed(folder)))
-        S.update_readme(repo / "README.md", folder / "summary.md")
-        S.update_readme(repo / "README.md", folder / "rounding.md", S.ROUNDING_START, S.ROUNDING_END)
-        done += [folder / "summary.md", repo / "README.md"]
-    return [str(p) for p in done]
 
 
 # -- reading the recorded spread ----------------------------------------------------------------

@@ -26,7 +26,7 @@ import numpy as np
 
 from ..scenes.block import PAPER_TABLE1
 from . import cached_run, default_outdir, figure
-from .data import ROUNDOFF
+from .data import ROUNDOFF, load
 from .rounding import held, recorded
 
 START, END = "<!-- summary:start -->", "<!-- summary:end -->"
@@ -392,3 +392,29 @@ if __name__ == "__main__":
         update_readme(args.readme, Path(args.summary_md).parent / "rounding.md", ROUNDING_START, ROUNDING_END)
     except (OSError, ValueError) as err:
         sys.exit(f"python -m contactfem.plots.summary: error: {err}")
+
+
+def reprint(folder, todo):
+    """The printed files that hold numbers to their recorded spread, redrawn from the data in ``folder``
+    (no runs): the cork's exit-time and sensitivity tables and its knife edge among the figures ``todo``;
+    for the committed figures, summary.md and the README's blocks of it and of rounding.md. Their paths."""
+    from . import cork as F
+
+    folder, done = Path(folder), []
+    if "cork_exit_time" in todo:
+        d = load(folder / "cork_exit_time.json")
+        done += F.cork_exit_time("paper", str(folder), data={k: d[k] for k in ("preset", "slow", "cases")})
+    if "cork_knife_edge" in todo:
+        d = load(folder / "cork_knife_edge.json")
+        done += F.cork_knife_edge("paper", str(folder), data={k: d[k] for k in ("field", "runs", "p0", "preset")})
+    if "table_cork_sensitivity" in todo:
+        path = folder / "table_cork_sensitivity.md"
+        path.write_text(F.sensitivity_reprinted(load(folder / "table_cork_sensitivity.json")))
+        done.append(path)
+    repo = Path(__file__).resolve().parents[2]
+    if folder.resolve() == (repo / "figures").resolve():
+        (folder / "summary.md").write_text(summary_markdown("paper", committed(folder)))
+        update_readme(repo / "README.md", folder / "summary.md")
+        update_readme(repo / "README.md", folder / "rounding.md", ROUNDING_START, ROUNDING_END)
+        done += [folder / "summary.md", repo / "README.md"]
+    return [str(p) for p in done]

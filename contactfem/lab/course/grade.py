@@ -42,6 +42,7 @@ from .snapshot import MAX_BYTES, take
 REPO = PACKAGE.parent
 
 from .lectures import lecture_sources
+
 MANUAL_MARK = re.compile(r"<!--\s*manual:\s*(\w+)\s*-->")
 UNSAFE = "graded without a sandbox (--unsafe-no-sandbox)"
 

@@ -20,7 +20,7 @@ FOLDER = "hidden_checks"
 
 def hidden_folder(material=None, repo=None):
     """MATERIAL/hidden_checks if it is there, else the checkout's lectures/hidden_checks (None: neither)."""
-    from . import REPO
+    from .lectures import REPO
 
     for folder in ([Path(material)] if material else []) + [Path(repo or REPO) / "lectures"]:
         if (folder / FOLDER).is_dir():
