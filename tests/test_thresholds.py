@@ -31,10 +31,6 @@ RUNS = [
     ("cork", {"t_end": 2e-4, "n_press": 2}),
 ]
 
-# the time-resolution indicators are argued on the branch that owns them (their computation, thresholds and
-# sources); strict: this test fails the day they are argued, so that the mark goes
-ARGUED_ELSEWHERE = {"impact_steps", "penalty_steps", "local_error"}
-
 
 def _sources():
     found = {}
@@ -66,7 +62,6 @@ EXPECTED = sorted(
         "separated",
         "impact_steps",
         "penalty_steps",
-        "local_error",
         "error_budget",
         "duration",
         "rebound_velocity",
@@ -81,15 +76,7 @@ EXPECTED = sorted(
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize(
-    "name",
-    [
-        pytest.param(n, marks=pytest.mark.xfail(strict=True, reason="argued on the time-resolution branch"))
-        if n in ARGUED_ELSEWHERE
-        else n
-        for n in EXPECTED
-    ],
-)
+@pytest.mark.parametrize("name", sorted(EXPECTED))
 def test_no_threshold_cites_a_presets_value(name):
     found = sources()
     assert name in found, f"no run carried the indicator {name} (the list of runs no longer reaches it)"
