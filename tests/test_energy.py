@@ -108,7 +108,7 @@ def test_a_run_that_gains_energy_warns():
     """The energy balance counts the dissipation and the loads' work, so a run can only lose
     energy: one that gains more than 1 % (the sloping impact at dt = 5: the trapezoidal rule
     does not resolve the impact) warns, from Python and on the command line; the paper's
-    preset does not."""
+    preset gains none."""
     import subprocess
     import sys
     import warnings
@@ -119,9 +119,10 @@ def test_a_run_that_gains_energy_warns():
     with pytest.warns(AccuracyWarning, match=r"accuracy: energy_gain = "):
         r = run_scene("sloping_impact", "fast", {"dt": 5.0})
     assert r["energy_error"] > 0.01
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        assert run_scene("sloping_impact", "fast")["energy_error"] < 0.01
+    with warnings.catch_warnings(record=True) as caught:  # (its unresolved penalty spring warns: penalty_steps)
+        warnings.simplefilter("always")
+        assert run_scene("sloping_impact", "fast", error_bars=False)["energy_error"] < 0.01
+    assert not [w for w in caught if "energy_gain" in str(w.message)]
     p = subprocess.run(
         [sys.executable, "-m", "contactfem", "run", "sloping_impact", "--set", "dt=5"],
         capture_output=True,
