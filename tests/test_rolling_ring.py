@@ -88,11 +88,12 @@ def test_paper_preset_rolling_speed():
 
 @pytest.mark.slow
 def test_refinement_reduces_the_error(fast):
-    # mesh and step refined together (n_el 40 -> 80, dt 0.02 -> 0.01): both errors shrink
-    fine = run_scene("rolling_ring", "fast", {"n_el": 80, "dt": 0.01})
+    # mesh and step refined together (twice the fast preset's elements, half its step): both errors shrink
+    p = get_scene("rolling_ring").resolve("fast", {})
+    fine = run_scene("rolling_ring", "fast", {"n_el": 2 * p["n_el"], "dt": p["dt"] / 2})
     assert abs(fine["x_roll_rel_err"]) < abs(fast["x_roll_rel_err"])
     assert abs(fine["v_final_rel_err"]) < 0.5 * abs(fast["v_final_rel_err"]), (
-        f"v error {fine['v_final_rel_err']:.4f} (80 el) vs {fast['v_final_rel_err']:.4f} (40 el)"
+        f"v error {fine['v_final_rel_err']:.4f} (refined) vs {fast['v_final_rel_err']:.4f} (fast)"
     )
 
 
