@@ -13,7 +13,7 @@ generated pages:
   link into the API reference;
 * ``api/``         -- the API reference, one page per folder of the package, generated
   by autodoc from the docstrings;
-* ``benchmarks.md`` -- BENCHMARKS.md as it is.
+* ``benchmarks.md`` -- BENCHMARKS.md as it is (with the figures it shows).
 """
 
 import importlib
@@ -286,13 +286,14 @@ def stage(repo, dst, instructor=False, only=None, work=None):
     shutil.copy2(lectures / "README.md", dst / "course.md")
     gallery = gallery_page(repo)
     (dst / "gallery.md").write_text(gallery)
-    for rel in figures_used(gallery):  # images only: markdown tables are shown inline
+    benchmarks = (repo / "BENCHMARKS.md").read_text()
+    for rel in figures_used(gallery + benchmarks):  # images only: markdown tables are shown inline
         (dst / rel).parent.mkdir(parents=True, exist_ok=True)
         shutil.copy2(repo / rel, dst / rel)
     (dst / "equations.md").write_text(equations_page())
     (dst / "api").mkdir()
     for name, text in api_pages().items():
         (dst / "api" / name).write_text(text)
-    shutil.copy2(repo / "BENCHMARKS.md", dst / "benchmarks.md")
+    (dst / "benchmarks.md").write_text(benchmarks)
     copy_mathjax(dst / "_static" / "mathjax")
     return nbs
