@@ -116,13 +116,12 @@ class Wall:
     def __init__(self, body, node, y_wall, c, dissipation_per_commit=0.0):
         self.body, self.node, self.y_wall, self.c = body, node, y_wall, c
         self.per_commit = dissipation_per_commit
-        self.name, self.evaluations = "wall", 0
+        self.name = "wall"
 
     def start(self, u, t=0.0, *, offsets=None):
         return 0
 
     def evaluate(self, u, t=0.0, dt=None, u0=None, phase=None, *, history, offsets=None):
-        self.evaluations += 1
         dof = start_of(self.body, offsets) + self.body.xdofs[self.node, 1]
         return WallState(dof, self.body.X[self.node, 1] + u[dof] - self.y_wall, self.c, self.per_commit, history + 1)
 

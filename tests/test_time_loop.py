@@ -6,6 +6,7 @@ loop of its own."""
 import ast
 import io
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -211,3 +212,65 @@ def test_progress_bar_finish_draws_the_whole_bar_with_the_reason():
     bar.close()
     assert out.getvalue().rstrip("\n").split("\r")[-1].startswith("x [" + "#" * 30 + "] 100%")
     assert "(stopped early)" in out.getvalue() and out.getvalue().endswith("\n")
+
+
+# -- how often a run evaluated its System: counted in its results, not on objects -----------------
+
+
+class CountedSpring(Spring):
+    """The Spring, with the test's own count of its evaluations (what the records must add up to)."""
+
+    def __init__(self, **kw):
+        super().__init__(**kw)
+        self.calls = 0
+
+    def evaluate(self, u, t, dt=None, u0=None, mass_coefficient=0.0, phases=None, *, state):
+        self.calls += 1
+        return super().evaluate(u, t, dt, u0, mass_coefficient, phases, state=state)
+
+
+class RejectingStatic(Static):
+    """Solves every step, then rejects a step longer than 0.2 (as a step past its error share is)."""
+
+    def step(self, t, u, v, a, dt, label="", *, state):
+        u1, v1, a1, result = super().step(t, u, v, a, dt, label=label, state=state)
+        if dt > 0.2:
+            raise NewtonError(f"rejected ({label})", [], label, result.evaluations)
+        return u1, v1, a1, result
+
+
+def test_the_records_count_every_evaluation_of_the_system_the_rejected_tries_too():
+    from contactfem.solver.march import evaluations
+
+    sys = CountedSpring()
+    recs = list(march(RejectingStatic(sys), Adaptive(lambda rec: 0.25, t_end=1.0, dt=0.25, max_cuts=2), 0.0, [0.0]))
+    assert recs[0].evaluations == 1 and recs[1].cuts == 1 and len(recs) > 3
+    assert recs[1].evaluations == 2 * recs[1].result.evaluations  # the rejected try cost what the halved one did
+    assert evaluations(recs) == dict(residual_evaluations=sys.calls, contact_evaluations=0)
+
+
+def test_a_failed_newton_says_how_often_it_evaluated():
+    from contactfem.solver.newton import newton
+
+    calls = []
+
+    def fun(u):  # a residual Newton cannot bring down: G = 1 + u^2 with K = 2 u + 1
+        calls.append(1)
+        return np.array([1.0 + u[0] ** 2]), np.array([[2.0 * u[0] + 1.0]])
+
+    with pytest.raises(NewtonError) as info:
+        newton(fun, np.zeros(1), [0], maxit=3)
+    assert info.value.evaluations == len(calls) == 4
+
+
+def test_no_object_counts_its_evaluations():
+    """Counts travel in results (NewtonResult, Record, a run's results): no System, contact or
+    stepper keeps a counter of its own or has one incremented from outside."""
+    package = Path(__file__).resolve().parents[1] / "contactfem"
+    found = [
+        f"{p.relative_to(package)}:{i}: {line.strip()}"
+        for p in sorted(package.rglob("*.py"))
+        for i, line in enumerate(p.read_text().splitlines(), 1)
+        if re.search(r"\.\w*evaluations\s*\+=|\.\w*evaluations\s*=\s*0\b", line)
+    ]
+    assert not found, found

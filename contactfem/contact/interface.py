@@ -130,7 +130,6 @@ class NodeToSegment:
         self._straight = bool(getattr(master, "straight", False))  # zero second variations (masters.py)
         self._has_energy = hasattr(normal, "energy")
         self._X_s = self.slave.X[self.nodes]  # the slaves' reference positions
-        self.evaluations = 0  # how often evaluate() ran (instrumentation)
 
     def with_closing_step(self, closing_step):
         """A new contact of the same configuration with the closing step on (True) or off
@@ -139,7 +138,6 @@ class NodeToSegment:
             raise ValueError(f"parameter closing_step = {closing_step!r} is not allowed: True or False")
         other = copy.copy(self)
         other.closing_step = closing_step
-        other.evaluations = 0
         return other
 
     def with_master(self, master):
@@ -148,7 +146,6 @@ class NodeToSegment:
         other = copy.copy(self)
         other.master = master
         other._straight = bool(getattr(master, "straight", False))
-        other.evaluations = 0
         return other
 
     # -- the history ------------------------------------------------------------------
@@ -277,7 +274,6 @@ class NodeToSegment:
                 f"contact {self.name!r}: history must be a ContactHistory (from start(u) or "
                 f"commit(state)), got {type(h).__name__}"
             )
-        self.evaluations += 1
         k = self.kinematics(u, t, h, offsets)
         fr = self.friction_state(k, h, dt, phase)
         work_T = None

@@ -158,7 +158,6 @@ class LagrangeNodeToSegment(NodeToSegment):
         h = history
         if phase is not None:
             raise ValueError(f"contact {self.name!r}: enforcement = lagrange has no staggered phases")
-        self.evaluations += 1
         k = self.kinematics(u, t, h, offsets)
         t_N, t_T, dN, dT = multipliers(self, u, offsets)
         on = k["inside"]

@@ -213,7 +213,6 @@ class MortarContact:
         self.unbounded = isinstance(master, RigidLine)
         self._law = None if friction is None else as_friction_law(friction)
         self._reference = None  # small kinematics: the integrals of the reference configuration
-        self.evaluations = 0  # a counter for the benchmarks (not part of any result)
 
     # -- where the interface's unknowns are ----------------------------------------
     def slave_dofs(self, offsets=None):
@@ -324,7 +323,7 @@ class MortarContact:
         )
 
     def _check(self, phase, history):
-        """The committed history, after the checks every evaluation makes; counts the evaluation."""
+        """The committed history, after the checks every evaluation makes."""
         if phase is not None:
             raise ValueError(f"{self.name}: mortar contact has no staggered phases (phase={phase!r})")
         if not isinstance(history, MortarHistory):
@@ -332,7 +331,6 @@ class MortarContact:
                 f"{self.name}: history must be a MortarHistory (from start(u) or commit(state)), "
                 f"got {type(history).__name__}"
             )
-        self.evaluations += 1
         return history
 
     def commit(self, state):

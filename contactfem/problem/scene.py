@@ -94,12 +94,14 @@ def run(
     contactfem.clock), the linear algebra of the Systems it built (``linear_algebra``,
     ``ordering``, ``unknowns``, ``band_kl``, ``band_ku``) and how often they were evaluated
     (``residual_evaluations``: System evaluations, one per residual Newton needs;
-    ``contact_evaluations``: contact evaluations, one per contact in each), an ``accuracy`` section
+    ``contact_evaluations``: contact evaluations, one per contact in each; both counted from the records,
+    solver.march.evaluations), an ``accuracy`` section
     (problem/accuracy.py; AccuracyWarning past a threshold) and ``stepping`` where a scene takes ``accuracy``.
     With ``error_bars``, the scene's headline quantities (``scene.quantities``) get their error bands from
     coarser runs (problem/uncertainty.py: the section ``uncertainty``; a band past ``tolerance``, relative,
     warns); each closed form a quantity declares is an accuracy indicator held to ``tolerance`` too."""
     from ..clock import imports_timed
+    from ..solver.march import evaluations
     from .accuracy import collect, references, stepping, warn
 
     with imports_timed() as imported:  # modules loaded on first use: not the run's time
@@ -126,11 +128,9 @@ def run(
     widths = [s.band for s in systems if s.band is not None]
     results["band_kl"] = max((kl for kl, _ in widths), default=None)  # banded: the widest band
     results["band_ku"] = max((ku for _, ku in widths), default=None)
-    results["residual_evaluations"] = int(sum(s.evaluations for s in systems))
-    contacts = {id(c): c for s in systems for c in s.contacts}
-    results["contact_evaluations"] = int(sum(c.evaluations for c in contacts.values()))
+    results.update(evaluations(records))
     results.setdefault("newton_iterations_total", int(sum(r.iterations for r in records)))  # if not counted
-    del records, model, systems, contacts  # (the ladder's runs need the memory)
+    del records, model, systems  # (the ladder's runs need the memory)
     if error_bars and scene.quantities:
         from .uncertainty import bands, run_level
 

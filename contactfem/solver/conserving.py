@@ -106,7 +106,6 @@ class EnergyConsistent:
         rot = self.rotations
 
         def fun(d):  # d = u1 - u, Newton's unknown (newton's base: round-off of d, not of u1)
-            s.evaluations += 1
             u1 = s.apply_dirichlet(u + d, t1)
             dq, D, chord, dchord = cayley(d, rot)
             G, rows, cols, vals = self._bodies(u, u1)

@@ -56,6 +56,8 @@ class Record:
     G with its reactions and the loads P, Newton's iterations and residuals, the step's error
     estimate and stage, the SystemState). Their tangents and contact states, which follow from those, are
     not compared: a record read back by load_record equals the one saved.
+    evaluations     the System evaluations the record cost: its step's, those of the failed
+                    tries before it too (1 at k = 0); each evaluates every contact once
     """
 
     k: int
@@ -72,6 +74,7 @@ class Record:
     state: object = None
     error: StepError | None = None
     stage: int = 0
+    evaluations: int = 0
 
     def __eq__(self, other):
         if not isinstance(other, Record):
@@ -166,11 +169,12 @@ def resume(stepper, schedule, record, *, label=None):
             f"record {rec.k} holds {np.size(rec.u)} unknowns, the model {ndof}: a record resumes only a model "
             "of the run that made it (the same mesh and bodies)"
         )
-    start, flight = None, []  # an optimistic flight: the record it started at, its records held back
+    start, flight, lost = None, [], 0  # an optimistic flight: the record it started at, its records held back,
+    # and the evaluations of a flight stepped again
     try:
         while (dt := schedule.next_dt(rec)) is not None:
             optimistic = _optimistic(schedule, rec, dt)
-            cuts, failures = 0, []
+            cuts, failures, spent, lost = 0, [], lost, 0
             while True:
                 name = (
                     label(rec.k + 1, rec.t + dt, dt)
@@ -182,18 +186,25 @@ def resume(stepper, schedule, record, *, label=None):
                     error, slope = estimate(stepper, schedule, rec, trial, dt, optimistic)
                     if error is not None and schedule.rejects(error, dt):
                         raise StepRejected(
-                            f"local error {error.local:.3g} is past twice its share {error.share:.3g}", []
+                            f"local error {error.local:.3g} is past twice its share {error.share:.3g}",
+                            [],
+                            name,
+                            trial[3].evaluations,
                         )
                     break
                 except NewtonError as err:
+                    spent += err.evaluations
                     failures.append(str(err).splitlines()[0][:200] if str(err) else "Newton failed")
                     smaller = schedule.cut(dt, cuts)
                     if smaller is None:
                         err.record = rec
                         raise
                     dt, cuts = smaller, cuts + 1
-            new = accept(stepper.system, rec, schedule.end_time(rec.t, dt), dt, trial, cuts, failures, error, slope)
+            new = accept(
+                stepper.system, rec, schedule.end_time(rec.t, dt), dt, trial, cuts, failures, error, slope, spent
+            )
             if optimistic and _touching(new):  # the flight ended in a contact: again from its start, carefully
+                lost = new.evaluations + sum(r.evaluations for r in flight)  # (counted in the next record)
                 rec, start, flight = _careful(start or rec), None, []
                 continue
             if optimistic:
@@ -261,12 +272,15 @@ def initial(stepper, schedule, t0, u0, v0=None, a0=None, state=None, stage=0):
     else:
         a = acceleration(s, ev.G) if stepper.dynamic else np.zeros(s.ndof)
     energy = dict(s.energies(u, v, ev, dt), dissipation=0.0, external_work=0.0)
-    return Record(k=0, t=t0, dt=0.0, u=u, v=v, a=a, evaluation=ev, energy=energy, state=state, stage=stage)
+    return Record(
+        k=0, t=t0, dt=0.0, u=u, v=v, a=a, evaluation=ev, energy=energy, state=state, stage=stage, evaluations=1
+    )
 
 
-def accept(system, rec, t1, dt, trial, cuts=0, failures=(), error=None, slope=None):
+def accept(system, rec, t1, dt, trial, cuts=0, failures=(), error=None, slope=None, spent=0):
     """Commit a converged step and make its Record: the next SystemState from the converged
-    evaluation (with the ``slope`` the step hands on, estimate.py); the energies are those of the
+    evaluation (with the ``slope`` the step hands on, estimate.py; ``spent``: the System evaluations
+    of the tries before it that it replaces); the energies are those of the
     converged state, the dissipation that of its contact states, the external work the trapezoidal
     rule 1/2 (F_n + F_n+1) . (u_n+1 - u_n) over the loads P and the support reactions (the
     prescribed-dof part of G)."""
@@ -297,6 +311,17 @@ def accept(system, rec, t1, dt, trial, cuts=0, failures=(), error=None, slope=No
         state=state,
         error=error,
         stage=rec.stage,
+        evaluations=spent + result.evaluations,
+    )
+
+
+def evaluations(records):
+    """How often the records' Systems were evaluated: ``residual_evaluations`` (one per residual
+    Newton needed, failed and rejected tries included) and ``contact_evaluations`` (one per contact in each)."""
+    records = list(records)
+    return dict(
+        residual_evaluations=int(sum(r.evaluations for r in records)),
+        contact_evaluations=int(sum(r.evaluations * len(r.contacts) for r in records)),
     )
 
 

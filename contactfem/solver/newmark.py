@@ -185,7 +185,7 @@ class CentralDifference:
         v1 = v + 0.5 * dt * (a + a1)
         v1[s.fixed_dofs] = (u1 - u)[s.fixed_dofs] / dt
         if not (np.all(np.isfinite(u1)) and np.all(np.isfinite(a1))):
-            raise NewtonError(f"explicit step gave NaN/inf ({label or f't = {t1:.6g}'})", [], label)
+            raise NewtonError(f"explicit step gave NaN/inf ({label or f't = {t1:.6g}'})", [], label, 1)
         G = ev.G + s.mass_times(a1)
         return (
             u1,

@@ -103,12 +103,14 @@ def solve_free(K, b, free, all_free):
 class NewtonError(RuntimeError):
     """Newton did not converge. ``history`` holds the (finite) residual norms of
     all iterations done, ``label`` names the step/time (the message states the cause
-    only: print ``history`` to see the residuals)."""
+    only: print ``history`` to see the residuals); ``evaluations``: the calls of the residual it
+    made before it failed."""
 
-    def __init__(self, message, history, label=""):
+    def __init__(self, message, history, label="", evaluations=0):
         super().__init__(message)
         self.history = list(history)
         self.label = label
+        self.evaluations = evaluations
 
 
 @dataclass
@@ -232,7 +234,9 @@ def _newton(fun, u0, free, atol, rtol, maxit, label, line_search, instrument, ct
         try:
             return fun(v)
         except FloatingPointError as err:  # inverted element, failed return map
-            raise NewtonError(f"Newton: {type(err).__name__} at iteration {k}{where}: {err}", history, label) from err
+            raise NewtonError(
+                f"Newton: {type(err).__name__} at iteration {k}{where}: {err}", history, label, calls
+            ) from err
 
     evaluated = None  # fun's value at u from the line search
     for k in range(maxit + 1):
@@ -242,7 +246,7 @@ def _newton(fun, u0, free, atol, rtol, maxit, label, line_search, instrument, ct
         G_f = G if all_free else G[free]
         r = math.sqrt(G_f.dot(G_f))  # ||G_f|| (as np.linalg.norm computes it)
         if not math.isfinite(r):
-            raise NewtonError(f"Newton: non-finite residual at iteration {k}{where}", history, label)
+            raise NewtonError(f"Newton: non-finite residual at iteration {k}{where}", history, label, calls)
         history.append(r)
         r_max = float(np.max(np.abs(G_f), initial=0.0))
         largest.append(r_max)
@@ -272,10 +276,12 @@ def _newton(fun, u0, free, atol, rtol, maxit, label, line_search, instrument, ct
             with timed(instrument, "solve"):
                 du = solve_free(out[1], -G_f, free, all_free)
         except RuntimeError as err:  # "Factor is exactly singular"
-            raise NewtonError(f"Newton: singular tangent at iteration {k}{where}: {err}", history, label) from err
+            raise NewtonError(
+                f"Newton: singular tangent at iteration {k}{where}: {err}", history, label, calls
+            ) from err
         # every value finite: du.du is, unless a value is not (or the sum overflows: then each is checked)
         if not (math.isfinite(du.dot(du)) or np.isfinite(du).all()):
-            raise NewtonError(f"Newton: non-finite correction at iteration {k}{where}", history, label)
+            raise NewtonError(f"Newton: non-finite correction at iteration {k}{where}", history, label, calls)
         if line_search:
             step = 1.0
             for _ in range(int(line_search) + 1):
@@ -299,6 +305,7 @@ def _newton(fun, u0, free, atol, rtol, maxit, label, line_search, instrument, ct
         f"{share} against the tolerance {tol:.3g}{_stall(largest, tol)}",
         history,
         label,
+        calls,
     )
 
 

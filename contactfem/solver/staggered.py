@@ -121,14 +121,17 @@ def staggered(
                 )
             except NewtonError as err:
                 raise NewtonError(
-                    f"staggered: {kind} phase of cycle {cycle} failed{where}: {err}", history, label
+                    f"staggered: {kind} phase of cycle {cycle} failed{where}: {err}",
+                    history,
+                    label,
+                    calls + err.evaluations,
                 ) from err
             u, solves, calls = res.u, solves + res.iterations, calls + res.evaluations
             per_phase.append(res.iterations)
         ev, calls = fun(u, None), calls + 1
         r = float(np.linalg.norm(ev.G[free]))
         if not np.isfinite(r):
-            raise NewtonError(f"staggered: residual is NaN/inf after cycle {cycle}{where}", history, label)
+            raise NewtonError(f"staggered: residual is NaN/inf after cycle {cycle}{where}", history, label, calls)
         history.append(r)
     if converged(ev):
         return StaggeredResult(
@@ -147,6 +150,7 @@ def staggered(
         f"{', '.join(f'{x:.3e}' for x in history[-5:])} (last 5)",
         history,
         label,
+        calls,
     )
 
 

@@ -144,8 +144,8 @@ class System:
     Attributes: ``ndof``, ``fixed_dofs`` and ``free_dofs`` (global, sorted), ``contact_dofs``
     (the unknowns the contacts own, after the bodies' ``body_ndof`` dofs; module docstring),
     ``linear_algebra`` ("dense", "sparse" or "banded"; "banded+sparse" if the choice changed
-    as the contact pattern grew), ``ordering`` (of the factorisation) and ``evaluations``
-    (how often the System was evaluated: one per residual Newton needs).
+    as the contact pattern grew) and ``ordering`` (of the factorisation). How often it was evaluated
+    travels in the results (NewtonResult.evaluations, Record.evaluations), not on the System.
     """
 
     def __init__(self, bodies, contacts=(), loads=(), fixed=(), linear_algebra="auto", instrument=None):
@@ -174,7 +174,6 @@ class System:
             linear_algebra = current().linear_algebra or "auto"
         self._requested = linear_algebra
         self._tangent = TangentAssembler(self.ndof, linear_algebra, self.free_dofs)
-        self.evaluations = 0
         self.instrument = instrument
 
     def _place(self):
@@ -329,7 +328,6 @@ class System:
         if u.shape != (self.ndof,):
             raise ValueError(f"u must have shape ({self.ndof},), got {u.shape}")
         self._check_state(state)
-        self.evaluations += 1
         G = np.zeros(self.ndof)
         blocks = []  # (rows, cols, vals, offset, key)
 

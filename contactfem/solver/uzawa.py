@@ -86,9 +86,12 @@ class Uzawa:
         start = u
         residuals, per_outer, viols, gaps, calls = [], [], [], [], [0]
         for k in range(self.max_updates + 1):
-            u1, v1, a1, res = self.stepper.step(
-                t, start, v, a, dt, label=f"{label} (outer iteration {k + 1})" if label else "", state=state
-            )
+            try:
+                u1, v1, a1, res = self.stepper.step(
+                    t, start, v, a, dt, label=f"{label} (outer iteration {k + 1})" if label else "", state=state
+                )
+            except NewtonError as err:  # the outer iterations' evaluations before it count too
+                raise NewtonError(str(err), err.history, err.label, calls[0] + err.evaluations) from err
             out = self._outer(k, u1, v1, a1, res, residuals, per_outer, viols, gaps, calls)
             if isinstance(out, tuple):
                 return out
@@ -101,6 +104,7 @@ class Uzawa:
             f"{', '.join(f'{x:.2e}' for x in viols[-5:])} (last 5)",
             residuals,
             label,
+            calls[0],
         )
 
     def _outer(self, k, u1, v1, a1, res, residuals, per_outer, viols, gaps, calls):
