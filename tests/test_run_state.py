@@ -264,3 +264,17 @@ def test_the_cork_twice_gives_the_same_records():
     assert len(first) == len(second) > 4
     for r, q in zip(first, second):
         same(r, q)
+    assert np.array_equal(first["pressures"], second["pressures"])
+
+
+def test_start_leaves_the_system_as_it_is():
+    """``System.start`` gives a SystemState and changes nothing of the System: its assembly plan is
+    the cache it was built with, a run before it included."""
+    scene, params, model = model_of("block", {})
+    system, st = model.system, model.stage
+    simulate(model, params)
+    before = dict(vars(system))
+    system.start(st.u0, st.t0)
+    after = vars(system)
+    assert after.keys() == before.keys()
+    assert not [k for k in after if after[k] is not before[k]]

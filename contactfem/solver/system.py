@@ -140,6 +140,12 @@ class System:
                the band LU is cheap, else sparse), "dense", "sparse" or "banded"
     instrument : None, or a solver.instrument.Timings that times the parts of every evaluation
                and of the Newton solves of the steppers (the bench's split of an iteration)
+    plan     : the assembly plan of K (assembly.TangentAssembler for ``ndof`` unknowns and this
+               ``linear_algebra``), an explicit cache: K's sparsity pattern, made at the first
+               assembly and grown where a contact couples new dofs, and the factorisation's plan of
+               it; default: one made here. ``start`` leaves it as it is, so a second run of the
+               System starts from the pattern the first one grew (the same records, bit for bit,
+               unless a pattern grew and reorders the factorisation; give a new plan to rule it out)
 
     Attributes: ``ndof``, ``fixed_dofs`` and ``free_dofs`` (global, sorted), ``contact_dofs``
     (the unknowns the contacts own, after the bodies' ``body_ndof`` dofs; module docstring),
@@ -148,7 +154,7 @@ class System:
     travels in the results (NewtonResult.evaluations, Record.evaluations), not on the System.
     """
 
-    def __init__(self, bodies, contacts=(), loads=(), fixed=(), linear_algebra="auto", instrument=None):
+    def __init__(self, bodies, contacts=(), loads=(), fixed=(), linear_algebra="auto", instrument=None, plan=None):
         self.bodies = list(bodies)
         self.contacts = list(contacts)
         self.loads = list(loads)
@@ -172,8 +178,7 @@ class System:
         self._cM = (None, None)  # (c, c M) of the last lumped effective tangent
         if linear_algebra == "auto":  # a solver.rounding condition may name another factorisation
             linear_algebra = current().linear_algebra or "auto"
-        self._requested = linear_algebra
-        self._tangent = TangentAssembler(self.ndof, linear_algebra, self.free_dofs)
+        self.plan = TangentAssembler(self.ndof, linear_algebra, self.free_dofs) if plan is None else plan
         self.instrument = instrument
 
     def _place(self):
@@ -204,18 +209,18 @@ class System:
     @property
     def linear_algebra(self):
         """How K is held and solved: dense, sparse or banded (assembly.py)."""
-        return self._tangent.describe()[0]
+        return self.plan.describe()[0]
 
     @property
     def ordering(self):
         """The ordering of the factorisation (e.g. the band's kl and ku)."""
-        return self._tangent.describe()[1]
+        return self.plan.describe()[1]
 
     @property
     def band(self):
         """(kl, ku), the half-bandwidths below and above the diagonal of K renumbered by reverse
         Cuthill-McKee, of the last K solved banded; None when no K was."""
-        plan = self._tangent.banded_plan  # of the last K solved banded
+        plan = self.plan.banded_plan  # of the last K solved banded
         return (plan.kl, plan.ku) if plan is not None else None
 
     def offset(self, obj):
@@ -370,7 +375,7 @@ class System:
                 else:  # consistent: one more constant block, c M
                     r, c, v = self._mass_coo
                     blocks.append((r, c, mass_coefficient * v, 0, "mass"))
-            K = self._tangent.assemble(blocks, diagonal)
+            K = self.plan.assemble(blocks, diagonal)
         return Evaluation(G, K, tuple(states), P, state)
 
     def residual_tangent(self, u, t, mass_coefficient=0.0, dt=None, u0=None, *, state):
@@ -380,11 +385,8 @@ class System:
     # -- the state carried from step to step ----------------------------------------------
     def start(self, u, t=0.0):
         """The SystemState at the initial state (u, t): each contact's, body's and load's own
-        ``start``. The System's assembly plan starts afresh too (the sparsity pattern of K grows
-        with the contact set during a run: a run starts from the pattern of its own initial
-        state, whatever ran before), so every run from the start is solved the same way."""
+        ``start``. The System is left as it is."""
         u = np.asarray(u, dtype=float)
-        self._tangent = TangentAssembler(self.ndof, self._requested, self.free_dofs)
         return SystemState(
             contacts=tuple(c.start(u, t, offsets=self.offsets) for c in self.contacts),
             bodies=tuple(b.start(self.local(b, u).copy()) for b in self.bodies),
