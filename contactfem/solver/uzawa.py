@@ -91,7 +91,7 @@ class Uzawa:
                     t, start, v, a, dt, label=f"{label} (outer iteration {k + 1})" if label else "", state=state
                 )
             except NewtonError as err:  # the outer iterations' evaluations before it count too
-                raise NewtonError(str(err), err.history, err.label, calls[0] + err.evaluations) from err
+                raise type(err)(str(err), err.history, err.label, calls[0] + err.evaluations) from err
             out = self._outer(k, u1, v1, a1, res, residuals, per_outer, viols, gaps, calls)
             if isinstance(out, tuple):
                 return out
