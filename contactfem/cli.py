@@ -25,6 +25,7 @@ _LOADING = time.perf_counter()
 import argparse  # noqa: E402  (timed: the command line's own import is import time too)
 
 from .clock import defer_interrupt, imports_timed  # noqa: E402
+from . import environment
 
 _OWN_IMPORT_S = [time.perf_counter() - _LOADING]  # counted once, by the first command of the process
 _CLOCK = {}  # the import clock of the command running (contactfem.clock)
@@ -1044,7 +1045,7 @@ def _catch_interrupts():
 
 
 def _report_ready():
-    path = os.environ.get("CONTACTFEM_READY_FILE")
+    path = environment.read("CONTACTFEM_READY_FILE")
     if path:
         try:
             with open(path, "w"):
@@ -1105,7 +1106,7 @@ def _main(argv):
             )
             return 1
         if not isinstance(exc, (FloatingPointError, NewtonError)):  # Newton, return map, inverted elements
-            if os.environ.get("CONTACTFEM_DEBUG") == "1":
+            if environment.read("CONTACTFEM_DEBUG") == "1":
                 raise
             print(
                 f"contactfem: internal error: {type(exc).__name__}: {_one_line(exc)} "

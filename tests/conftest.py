@@ -6,10 +6,41 @@ import numpy as np
 import pytest
 
 
+# the suite's own switches (pytest options, not environment variables), for the test modules to read
+OPTIONS = {}
+
+
+def pytest_addoption(parser):
+    group = parser.getgroup("contactfem")
+    group.addoption(
+        "--require-browser",
+        action="store_true",
+        help="the course website's browser tests fail, not skip, where Chromium or the site extra is missing "
+        "(.ci/run sets it)",
+    )
+    group.addoption(
+        "--fuzz",
+        choices=("quick", "long"),
+        default="quick",
+        help="the fuzz tests' profile: quick (about two minutes) or long (>= 500 cases, every scene)",
+    )
+    group.addoption(
+        "--every-case",
+        action="store_true",
+        help="the tests that sample a study (the graded lectures, the sloping impact's discretisation rows) "
+        "run every case",
+    )
+
+
 def pytest_configure(config):
     """The tests' own caches: $CONTACTFEM_CACHE (the inverse study's results) is a temporary
     folder for the session, so no test reads or writes the user's ~/.cache/contactfem (and a
     later command never answers from the tests' cache); and runs without error bars by default."""
+    OPTIONS.update(
+        require_browser=config.getoption("require_browser"),
+        fuzz=config.getoption("fuzz"),
+        every_case=config.getoption("every_case"),
+    )
     config._contactfem_cache = tempfile.mkdtemp(prefix="contactfem-test-cache-")
     os.environ["CONTACTFEM_CACHE"] = config._contactfem_cache
     # every run of the suite (and of the command lines it starts) without error bars, which repeat a run at
@@ -33,7 +64,7 @@ def _skip_reason(report):
 def pytest_report_teststatus(report, config):
     """A skipped browser test (marked `site`) is counted under its reason, so that pytest's last
     line says why ("15 skipped (Chromium not installed (apt-get install -y chromium))"), not a
-    bare "15 skipped"; .ci/run sets CONTACTFEM_REQUIRE_BROWSER=1, which makes it a failure."""
+    bare "15 skipped"; .ci/run gives --require-browser, which makes it a failure."""
     if report.skipped and "site" in report.keywords and not hasattr(report, "wasxfail"):
         return f"skipped ({_skip_reason(report)})", "s", "SKIPPED"
     return None

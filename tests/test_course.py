@@ -8,7 +8,7 @@ Two levels: the checks called in this process on the solution, the stub and the 
 of every exercise (fast), and the real path, the notebooks built by otter assign (every
 lecture) and graded by otter on a folder of submissions: solution, stub and wrong answer of
 a sample of lectures, GRADED (each grading executes the whole lecture in the fast preset: all
-twelve lectures three times over would take many minutes; CONTACTFEM_SLOW=1 grades them all).
+twelve lectures three times over would take many minutes; pytest --every-case grades them all).
 
 Needs the course extra (otter-grader): skipped without it, except on CI (CI=true),
 where a missing package is a failure.
@@ -24,10 +24,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import OPTIONS
 
 ON_CI = os.environ.get("CI", "").lower() in ("true", "1", "yes")
 # the lectures graded through otter: an early one (its check cells the command-line test grades
-# too), a paper example whose checks run a scene, the newest; CONTACTFEM_SLOW=1: every lecture
+# too), a paper example whose checks run a scene, the newest; --every-case: every lecture
 GRADED_SAMPLE = ("01_interface_laws", "07_funnel", "12_beyond_node_to_segment")
 REPO = Path(__file__).resolve().parents[1]
 WRONG = REPO / "tests" / "course" / "wrong"
@@ -65,7 +66,7 @@ EXERCISE_NAMES = list(_exercises())
 
 def graded_lectures():
     lectures = sorted({e.lecture for e in _exercises().values()})
-    return lectures if os.environ.get("CONTACTFEM_SLOW") else [lec for lec in lectures if lec in GRADED_SAMPLE]
+    return lectures if OPTIONS["every_case"] else [lec for lec in lectures if lec in GRADED_SAMPLE]
 
 
 GRADED_NAMES = [n for n, e in _exercises().items() if e.lecture in graded_lectures()]

@@ -19,7 +19,7 @@ besides the contract above, no run exits 0 after its law returned a value no law
 return (the law file records every value it returned: NaN or inf, Y < 0, t_N > 0 in
 contact) or with a stick stiffness c_T that is not finite and > 0.
 
-Profiles: the quick one runs in CI (about two minutes); CONTACTFEM_FUZZ=long runs the long
+Profiles: the quick one runs in CI (about two minutes); `pytest --fuzz long` runs the long
 one (>= 500 cases, every scene, >= 300 law files). The summary line with the counts is
 printed either way.
 """
@@ -41,12 +41,13 @@ hypothesis = pytest.importorskip("hypothesis")
 from hypothesis import HealthCheck, assume, given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
+from conftest import OPTIONS  # noqa: E402
 from contactfem.cli import main  # noqa: E402
 from contactfem.io import load_run, save_run  # noqa: E402
 from contactfem.scenes import all_scenes  # noqa: E402
 from contactfem.problem.resources import LIMITS  # noqa: E402
 
-LONG = os.environ.get("CONTACTFEM_FUZZ") == "long"
+LONG = OPTIONS["fuzz"] == "long"
 EXAMPLES = (
     dict(params=330, cli=120, files=120, laws=80, lawfiles=320)
     if LONG
@@ -118,7 +119,7 @@ def non_finite(obj):
 def run_case(kind, argv, folder, outputs=()):
     """Run the command line in-process in `folder` and check the contract."""
     out, err = io.StringIO(), io.StringIO()
-    cwd, env = os.getcwd(), os.environ.get("CONTACTFEM_PROGRESS")
+    cwd = os.getcwd()
     os.chdir(folder)
     old = signal.signal(signal.SIGALRM, _alarm)
     signal.alarm(TIMEOUT)
@@ -138,8 +139,6 @@ def run_case(kind, argv, folder, outputs=()):
         signal.alarm(0)
         signal.signal(signal.SIGALRM, old)
         os.chdir(cwd)
-        if env is None:
-            os.environ.pop("CONTACTFEM_PROGRESS", None)
     COUNTS[f"exit {rc}"] += 1
     COUNTS["cases"] += 1
     COUNTS[kind] += 1

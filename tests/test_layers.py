@@ -23,7 +23,7 @@ import pytest
 PACKAGE = Path(__file__).resolve().parents[1] / "contactfem"
 
 ORDER = [
-    ("clock",),
+    ("clock", "environment"),
     ("laws",),
     ("contact",),
     ("bodies",),
@@ -34,7 +34,19 @@ ORDER = [
     ("lab",),
     ("cli", "__main__"),
 ]
-LIBRARY = ("clock", "laws", "contact", "bodies", "solver", "problem", "scenes", "plots", "io", "equations")
+LIBRARY = (
+    "clock",
+    "environment",
+    "laws",
+    "contact",
+    "bodies",
+    "solver",
+    "problem",
+    "scenes",
+    "plots",
+    "io",
+    "equations",
+)
 LAYER = {name: level for level, names in enumerate(ORDER) for name in names}
 
 

@@ -3,7 +3,7 @@ would (equations typeset, images loaded, no broken link), and the checker itself
 to fail on a page with a missing image, a broken equation, a raw '$$' or a dead link.
 
 The tests marked `site` need the site extra and Debian's Chromium (/usr/bin/chromium);
-they skip where either is missing, except under CONTACTFEM_REQUIRE_BROWSER=1 (set by
+they skip where either is missing, except under pytest's --require-browser (given by
 .ci/run, which installs both), where a missing piece is a failure.
 """
 
@@ -18,6 +18,7 @@ import time
 from pathlib import Path
 
 import pytest
+from conftest import OPTIONS
 
 REPO = Path(__file__).resolve().parents[1]
 LECTURES = sorted((REPO / "lectures").glob("*.ipynb"))
@@ -27,7 +28,7 @@ pytestmark = [pytest.mark.site, pytest.mark.slow]
 
 def _require(ok, why):
     if not ok:
-        if os.environ.get("CONTACTFEM_REQUIRE_BROWSER") == "1":
+        if OPTIONS["require_browser"]:
             pytest.fail(why, pytrace=False)
         pytest.skip(why)
 

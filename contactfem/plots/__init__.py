@@ -13,6 +13,7 @@ from functools import lru_cache
 from pathlib import Path
 
 from ..solver.rounding import current
+from .. import environment
 
 REGISTRY = {}  # file stem -> (paper label, function)
 
@@ -32,7 +33,7 @@ def default_outdir(preset=None):
     """$CONTACTFEM_FIGURES if set (the tests use a temporary folder), else the repo's figures/
     for the paper preset (the figures kept with the code) and figures/<preset>/ for another
     (default: $CONTACTFEM_PRESET or fast), so a quick run never writes over the paper's figures."""
-    env = os.environ.get("CONTACTFEM_FIGURES")
+    env = environment.read("CONTACTFEM_FIGURES")
     if env:
         return env
     preset = preset or default_preset()
@@ -43,7 +44,7 @@ def default_outdir(preset=None):
 
 def default_preset():
     """$CONTACTFEM_PRESET if set, else "fast" (what the lectures use)."""
-    return os.environ.get("CONTACTFEM_PRESET", "fast")
+    return environment.read("CONTACTFEM_PRESET", "fast")
 
 
 def load_all():
@@ -77,7 +78,7 @@ def cache_dir():
     ~/.cache/contactfem/figures); under a rounding condition (solver.rounding) a folder of its own,
     figures-TAG, so that runs of one condition never answer for another."""
     tag = current().tag()
-    base = Path(os.environ.get("CONTACTFEM_CACHE") or Path.home() / ".cache" / "contactfem")
+    base = Path(environment.read("CONTACTFEM_CACHE") or Path.home() / ".cache" / "contactfem")
     return base / (f"figures-{tag}" if tag else "figures")
 
 

@@ -28,6 +28,7 @@ from ..contact.masters import bottle_neck
 from . import cached_run, default_outdir, figure, pyplot, stored
 from .data import RTOL, save_figure, write_data
 from .rounding import held, recorded
+from .. import environment
 
 # the cork run's headline numbers, in the data of each of Figs 14-17 (the summary's row reads them)
 CORK_KEYS = (
@@ -330,7 +331,7 @@ KNIFE_GRID_SLOW = dict(
 
 def knife_grid():
     """The coarse grid, or the full one when CONTACTFEM_SLOW is set."""
-    return KNIFE_GRID_SLOW if os.environ.get("CONTACTFEM_SLOW") else KNIFE_GRID
+    return KNIFE_GRID_SLOW if environment.read("CONTACTFEM_SLOW") else KNIFE_GRID
 
 
 def _margin_case(preset, over):
@@ -512,7 +513,7 @@ EXIT_CASES_SLOW = EXIT_CASES_QUICK + (
 
 def exit_cases():
     """The quick profile, or every case when CONTACTFEM_SLOW is set."""
-    return EXIT_CASES_SLOW if os.environ.get("CONTACTFEM_SLOW") else EXIT_CASES_QUICK
+    return EXIT_CASES_SLOW if environment.read("CONTACTFEM_SLOW") else EXIT_CASES_QUICK
 
 
 def exit_case(case, preset=EXIT_PRESET):

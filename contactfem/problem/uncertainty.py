@@ -59,6 +59,7 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 from .accuracy import TOLERANCE, indicator  # TOLERANCE: the relative band a quantity may have (--tolerance)
+from .. import environment
 
 FS0, FS1 = 2.45, 1.6  # Xing & Stern (2010): the factor of safety at P = 0 and P = 1
 P_MAX = 2.0  # beyond, the coarsest level of the triplet is outside the asymptotic range
@@ -200,7 +201,7 @@ def error_bars_default():
     runs, whose tests of the bands turn them on)."""
     import os
 
-    return os.environ.get("CONTACTFEM_ERROR_BARS", "on").strip().lower() not in ("0", "off", "no", "false")
+    return environment.read("CONTACTFEM_ERROR_BARS", "on").strip().lower() not in ("0", "off", "no", "false")
 
 
 def factor_of_safety(P):

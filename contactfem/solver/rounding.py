@@ -23,6 +23,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
+from .. import environment
 
 ENV = dict(linear_algebra="CONTACTFEM_LINEAR_ALGEBRA", perturbation="CONTACTFEM_PERTURB")
 LARGEST = 1e-6  # a larger perturbation is a change of the problem, not of its rounding
@@ -57,7 +58,7 @@ def checked(linear_algebra=None, perturbation=0.0):
 
 def current():
     """The rounding condition in force (from the environment; Condition(): none)."""
-    return checked(os.environ.get(ENV["linear_algebra"]), os.environ.get(ENV["perturbation"]))
+    return checked(environment.read(ENV["linear_algebra"]), environment.read(ENV["perturbation"]))
 
 
 @contextmanager

@@ -46,6 +46,7 @@ from pathlib import Path
 from ...problem.accuracy import AccuracyWarning
 from ...problem.uncertainty import NOISE, line
 from ...scenes import get_scene, run_scene
+from ... import environment
 
 TOL = 0.05  # the tolerance every run of the study has (the default): a true error past it is wrong
 REF_AGREE = 1e-3  # two successive levels of a reference ladder agree to this (relative)
@@ -287,7 +288,7 @@ class Checkpoint:
 
 
 def default_checkpoint():
-    root = Path(os.environ.get("CONTACTFEM_CACHE") or Path.home() / ".cache" / "contactfem")
+    root = Path(environment.read("CONTACTFEM_CACHE") or Path.home() / ".cache" / "contactfem")
     return root / "coverage"
 
 

@@ -14,11 +14,12 @@ import numpy as np
 
 from ...plots import default_outdir, figure, pyplot
 from ...plots.data import save_figure
+from ... import environment
 
 
 def bench_json_path():
     """$CONTACTFEM_BENCH if set, else bench.json at the repository root (may not exist)."""
-    env = os.environ.get("CONTACTFEM_BENCH")
+    env = environment.read("CONTACTFEM_BENCH")
     if env:
         return Path(env)
     return Path(__file__).resolve().parents[3] / "bench.json"
