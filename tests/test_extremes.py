@@ -9,7 +9,8 @@ penalty is resolved by the time step (omega_p dt <= 2, omega_p = sqrt(c_N w / m_
 the total energy (kinetic + strain + interface) never exceeds the initial energy
 (Newmark 0.7/0.4 is dissipative) and the recorded frictional dissipation is not more
 than the energy lost (+5 %: the return map records lambda |t_T| at the end of the step,
-which over-counts the first slipping step by up to a factor 2, see test_energy.py). Where the penalty is NOT resolved, implicit Newmark
+which over-counts the first slipping step by up to a factor 2, see test_energy.py). Where the penalty is NOT
+resolved, implicit Newmark
 pumps energy into an impact (see test_unresolved_penalty_gains_energy).
 """
 

@@ -103,8 +103,8 @@ def test_no_import_from_a_higher_layer(path):
         if target in LAYER and LAYER[target] > LAYER[own]
     ]
     assert not back, (
-        "back edges against clock < laws < contact < bodies < solver < problem < scenes < plots/io/equations < lab < cli:\n"
-        + "\n".join(back)
+        "back edges against clock < laws < contact < bodies < solver < problem < scenes < plots/io/equations < lab "
+        "< cli:\n" + "\n".join(back)
     )
 
 

@@ -327,7 +327,8 @@ def test_fig8_claim_is_the_studys(study):
         d = data["readings"][name]
         row = (
             f"| preset `{name}` | {r['rank']} | {r['n_facts']} of {len(r['facts'])} | "
-            f"{round(d['fig8_fraction'] * d['fig8_nodes'])} of {d['fig8_nodes']} | {100 * d['fig8_min_reduction']:+.1f} % |"
+            f"{round(d['fig8_fraction'] * d['fig8_nodes'])} of {d['fig8_nodes']} | "
+            f"{100 * d['fig8_min_reduction']:+.1f} % |"
         )
         assert row in README, f"README lacks the row {row!r}"
 

@@ -229,7 +229,8 @@ class Beam:
         exactly (R(+-Dtheta/2) = cos(Dtheta/2) (I +- tan(Dtheta/2) J)); with phi_bar = N_a phi_a +
         N_b phi_b, psi = phi_bar - (phi_b - phi_a) h, h = (phi_bar - psi) / (phi_b - phi_a) (psi =
         phi_bar exactly where the nodes turn alike: then h is its series); kappa_1 - kappa_0 =
-        (phi_b - phi_a) k / L0, k = (Dtheta_b - Dtheta_a) / (phi_b - phi_a). So F . dq = sigma . DGamma + M Dkappa summed = W(u1) - W(u0) exactly; no
+        (phi_b - phi_a) k / L0, k = (Dtheta_b - Dtheta_a) / (phi_b - phi_a). So F . dq = sigma . DGamma + M Dkappa
+        summed = W(u1) - W(u0) exactly; no
         translation enters, and a rigid rotation of the midpoint rule (Da = phi J a_mid, phi the
         same at every node) is orthogonal to F: no resultant and no moment. The tangent: the
         complex-step derivative of these element forces (exact to rounding)."""

@@ -291,7 +291,8 @@ class Continuum:
         return R, last[2], last[1], K.data
 
     def internal(self, u, dt=None, state=None):
-        """Internal force R(u) and consistent tangent K = dR/du (scipy sparse: CSC for the linear material, CSR else)."""
+        """Internal force R(u) and consistent tangent K = dR/du (scipy sparse: CSC for the linear material,
+        CSR else)."""
         u = np.asarray(u, dtype=float)
         if self.material == "linear":
             K = self._linear_stiffness()

@@ -78,7 +78,8 @@ def multipliers(contact, u, offsets=None):
 
 def conditions(contact, t_N, t_T, g_N, dg_T, eligible):
     """The complementarity functions of every node (complementarity.py) at its gap and
-    slip increment (eqs 17, 20), and their derivatives, in a dict: C_N, C_T, and dN_t (dC_N/dt_N), dN_g (dC_N/dg_N), dT_t
+    slip increment (eqs 17, 20), and their derivatives, in a dict: C_N, C_T, and dN_t (dC_N/dt_N), dN_g
+    (dC_N/dg_N), dT_t
     (dC_T/dt_T), dT_tN (dC_T/dt_N), dT_g (dC_T/dg_N), dT_dg (dC_T/d Delta g_T), slip (set)."""
     C_N, dN_t, dN_g, xi = normal_complementarity(t_N, g_N, contact.c_N, eligible)
     nc = len(t_N)

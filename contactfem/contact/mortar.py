@@ -66,7 +66,8 @@ t_N,j) on the relative virtual displacement (as Popp, Gee & Wall 2009 write it):
 
 summed over the current pairs of j. On a flat interface a uniform traction gives the
 consistent nodal loads on both meshes whatever the gap: the contact patch test holds,
-also with the penalty's gap (node-to-segment fails it). Tangent (contact_forces): the moduli times the linearised gap and slip,
+also with the penalty's gap (node-to-segment fails it). Tangent (contact_forces): the moduli times the linearised
+gap and slip,
 plus the tractions times Delta f (Delta D, Delta M, Delta n_e, Delta t_e, including the
 moving overlap ends), all exact through the jets of contact/variations.py.
 

@@ -678,7 +678,8 @@ def sloping_table(rows, top=25):
             d = (
                 "-"
                 if b is None
-                else f"{r['frictionless_vy'] - b['frictionless_vy']:+.2f}, {r['frictionless_angle'] - b['frictionless_angle']:+.1f}; "
+                else f"{r['frictionless_vy'] - b['frictionless_vy']:+.2f}, "
+                f"{r['frictionless_angle'] - b['frictionless_angle']:+.1f}; "
                 f"{r['frictional_vx'] - b['frictional_vx']:+.2f}, {r['frictional_vy'] - b['frictional_vy']:+.2f}, "
                 f"{r['frictional_angle'] - b['frictional_angle']:+.1f}"
             )

@@ -293,7 +293,8 @@ def _check_friction_law(law, normal, scale, rtol, dt, p_max, q_max, v_max):
         return rep
     rep.add(
         worst_f < 1e-8,
-        f"the return mapping lands on the slip surface when slipping and stays inside when sticking (worst |f|/Y = {worst_f:.1e})",
+        f"the return mapping lands on the slip surface when slipping and stays inside when sticking (worst |f|/Y = "
+        f"{worst_f:.1e})",
         f"the return mapping misses the slip surface: worst |f|/Y = {worst_f:.2e} (should be < 1e-8)",
     )
     rep.add(

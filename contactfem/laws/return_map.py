@@ -146,7 +146,8 @@ def return_map(law, t_N, dt_N, dg_T, t_T_bar, q_bar, z_bar=None, dt=None, tol=1e
             lam_i = np.where(bad, 0.5 * (lo + hi), trial)  # bisection where Newton leaves the bracket
         else:
             raise ReturnMapError(
-                f"return map: local Newton for lambda did not converge in {maxit} iterations (max |phi| = {np.max(np.abs(phi)):.3e})"
+                f"return map: local Newton for lambda did not converge in {maxit} iterations (max |phi| = "
+                f"{np.max(np.abs(phi)):.3e})"
             )
         D = c_T + Y_lam
         if (D == 0.0).any():

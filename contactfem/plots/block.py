@@ -357,7 +357,8 @@ def table1_markdown(hist):
         "(scan?): exponent garbled in the scan, value uncertain. Ours are printed to the digits rounding leaves "
         f"them, down to {RESIDUAL_DIGITS:.0e} of the first residual; below that, their order (round-off).",
         "",
-        f"| iteration | paper conical | ours conical | paper parabolic | ours parabolic | ours Coulomb mu = {P['mu']:g} |",
+        f"| iteration | paper conical | ours conical | paper parabolic | ours parabolic | ours Coulomb mu = "
+        f"{P['mu']:g} |",
         "|---:|---:|---:|---:|---:|---:|",
     ]
     for k in range(n):

@@ -166,8 +166,8 @@ def row_block_stresses(preset, record=None):
     f = fig8_remark(preset, record)
     ours = (
         f"at the {f['n_top']} nodes of highest pressure (top quartile) the parabolic friction stress "
-        f"differs from the conical by {100 * f['change_min']:+.0f} % to {100 * f['change_max']:+.0f} %; nodes slipping: "
-        f"conical {f['n_slip_conical']}, parabolic {f['n_slip_parabolic']}"
+        f"differs from the conical by {100 * f['change_min']:+.0f} % to {100 * f['change_max']:+.0f} %; "
+        f"nodes slipping: conical {f['n_slip_conical']}, parabolic {f['n_slip_parabolic']}"
     )
     return (
         "Figs 7-8",

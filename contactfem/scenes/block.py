@@ -242,7 +242,8 @@ PARAMS = (
         0.0,
         1e-3,
         low_open=True,
-        doc="Newton: largest residual <= atol + rtol * the step's force scale (loads, reactions, contact forces; tighter than the solver's 1e-8: the block's tables read the residuals to 1e-10)",
+        doc="Newton: largest residual <= atol + rtol * the step's force scale (loads, reactions, contact forces; "
+        "tighter than the solver's 1e-8: the block's tables read the residuals to 1e-10)",
     ),
     Param("atol", 1e-12, "F", 0.0, doc="Newton absolute tolerance (a floor for a step without forces)"),
     Param("maxit", 40, "", 1, 500, doc="Newton: maximal number of linear solves"),

@@ -84,7 +84,8 @@ Stage 2 (pop, ``Newmark`` delta = 0.7, beta = 0.4; the trapezoidal rule at a tol
 cork's bottom face, raised by p_step n_ramp times over t_ramp (the paper: 8 x 0.1 MPa, one per
 step of its dt = 1e-4 s: 0.8 ms, whatever our dt), then Boyle's
 law evaluated ONCE PER STEP from the last converged state (explicit coupling, as
-the paper; the gas pressure load's state, GasPressure.update at each commit): p = p0 V0 / V, V0 = pi R_neck^2 * gas_column, V = V0 + (volume swept
+the paper; the gas pressure load's state, GasPressure.update at each commit): p = p0 V0 / V, V0 = pi R_neck^2 *
+gas_column, V = V0 + (volume swept
 by the bottom face since the start of stage 2), i.e. V0 + pi R^2 * (its axial
 displacement). When the bottom corner of the cork reaches the mouth (z = 24 mm)
 the gas escapes: p = 0 from then on (ambient; no gas jet is modelled).

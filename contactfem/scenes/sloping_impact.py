@@ -403,8 +403,8 @@ SCENE = Scene(
     # earlier reading (every elastic ring integrated with the midpoint rule)
     presets={"fast": {}, "paper": {}, "midpoint": {"integration": "1"}},
     notes=(
-        "Read from the scan: R, A, E, nu, rho, 16 beam elements, v = (2, -2), Newmark 0.7 / 0.4, lumped mass, dt = 0.1, "
-        "200 steps, m, c_N = 50, c_T = 30, n, alpha, beta, N0, Q0, M0.\n"
+        "Read from the scan: R, A, E, nu, rho, 16 beam elements, v = (2, -2), Newmark 0.7 / 0.4, lumped mass, "
+        "dt = 0.1, 200 steps, m, c_N = 50, c_T = 30, n, alpha, beta, N0, Q0, M0.\n"
         "Chosen (the scan does not say): no gravity, eta; and gap0, penalty per node, contact at the outer "
         "fibre, rotary inertia, which move Table 2's velocities by a few hundredths (contactfem reconstruct "
         "sloping_impact).\n"

@@ -18,7 +18,8 @@ of rejected and halved steps too (``newton_iterations`` counts the accepted step
 the cork's reference and the rolling ring's runs at a tolerance take the longest).
 
 A fixed step matches an error only if it and every finer step of its ladder are within it
-(``matching_fixed``; an error below the reference's own change is matched at that change); each run at a tolerance also gets the largest fixed step that stays within
+(``matching_fixed``; an error below the reference's own change is matched at that change); each run at a tolerance
+also gets the largest fixed step that stays within
 the tolerance itself (``tolerance_match``): a run that lands far inside its tolerance has paid for
 accuracy it did not ask for, and the study says how much."""
 

@@ -9,7 +9,8 @@ patch test's uniform pressure), else a ladder refined in every discretisation th
 at once (the step halved and the elements doubled, level after level, with the trapezoidal rule) until
 two successive levels agree to REF_AGREE (0.1 %); the finest level is the reference and the ladder is
 recorded (where the ladder ends before every quantity agrees, the quantities whose last two levels agree
-are judged by them and the others are not judged). Runs that differ only in their discretisation (step, mesh, integrator, penalty where it
+are judged by them and the others are not judged). Runs that differ only in their discretisation (step, mesh,
+integrator, penalty where it
 regularises a constraint, enforcement) share their reference. Errors are relative to the quantity's
 reference value, or to the scale below which it counts as near zero (the Quantity's own), never
 inflated otherwise.

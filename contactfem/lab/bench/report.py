@@ -127,8 +127,9 @@ def startup_account(s):
         "(Basis, BilinearForm, asm), and `import skfem.assembly` runs the package's `__init__`, which loads "
         f"{', '.join(loads['skfem_assembly'])} ({skfem - sparse:+.3f} s over scipy.sparse, scikit-fem's own "
         f"modules included; scipy.sparse itself {sparse - base:+.3f} s over numpy). The block's run loads "
-        f"{', '.join(loads['run_block_canonical'])}; contactfem's code, the model and the run add {block - skfem:+.3f} s "
-        f"to `import skfem`. The run of rings loads {rings}: {s['run_rings_over_numpy']:.2f} x `import numpy`.",
+        f"{', '.join(loads['run_block_canonical'])}; contactfem's code, the model and the run add "
+        f"{block - skfem:+.3f} s to `import skfem`. The run of rings loads {rings}: "
+        f"{s['run_rings_over_numpy']:.2f} x `import numpy`.",
         "",
     ]
     return L
@@ -167,8 +168,8 @@ def iteration_account(sp):
         "",
         "| part | us per iteration | what it is |",
         "|---|---|---|",
-        f"| bulk | {us(r['bulk_s'])} | the ring's internal forces and tangent (R and the {lim['entries']} entries of K, "
-        "bodies/beam.py) |",
+        f"| bulk | {us(r['bulk_s'])} | the ring's internal forces and tangent (R and the {lim['entries']} entries "
+        "of K, bodies/beam.py) |",
         f"| contact | {us(r['contact_s'])} | the contact's kinematics, return map, element and scatter |",
         f"| assembly | {us(r['assembly_s'])} | summing the contributions and c M into K (one bincount) |",
         f"| solve | {us(r['solve_s'])} | LAPACK's LU of K (numpy.linalg.solve) |",
@@ -248,9 +249,9 @@ def speed_section(sp):
     ]
     L += startup_account(s)
     L += [
-        "One Newton iteration, CPU milliseconds of the thread that runs it: the run's totals inside Newton divided by its "
-        "linear solves (the initial state's evaluation, before the first step, is not in them: it also pays for what a first "
-        "evaluation loads and builds, scipy's modules and the tangent's pattern), each scene "
+        "One Newton iteration, CPU milliseconds of the thread that runs it: the run's totals inside Newton divided "
+        "by its linear solves (the initial state's evaluation, before the first step, is not in them: it also pays "
+        "for what a first evaluation loads and builds, scipy's modules and the tangent's pattern), each scene "
         "run in a fresh interpreter, " + ("one run" if sp.get("preset") == "fast" else "best of 3 runs") + " "
         "(contactfem/lab/bench/speed.py). bulk: the bodies' internal forces and tangents; contact: every "
         "contact's residual and tangent; assembly: summing them into K, loads included; solve: factorisation "
@@ -308,7 +309,8 @@ def speed_section(sp):
                 continue
             L.append(
                 f"| {r['variant']} | {r['n_el']} | {r['dt']:g} | {r['rebound_vx']:.3f} | {r['rebound_vy']:.3f} | "
-                f"{r['rebound_angle_deg']:.1f} | {r['rebound_spin']:.4f} | {int(r['newton_iterations_total'])} | {ref} |"
+                f"{r['rebound_angle_deg']:.1f} | {r['rebound_spin']:.4f} | {int(r['newton_iterations_total'])} | "
+                f"{ref} |"
             )
     return L + [""]
 
@@ -382,8 +384,8 @@ def write_markdown(res):
         L += [
             "",
             f"Observed order of |error p0| in h = 1/n_el: {_f(wp['hertz_mesh']['order_p0'])}"
-            + " (a least-squares slope through all points: an order of convergence only where the error falls steadily, not where it levels off at another error's floor or changes sign)"
-            + ".",
+            + " (a least-squares slope through all points: an order of convergence only where the error falls "
+            "steadily, not where it levels off at another error's floor or changes sign)" + ".",
             "",
         ]
         L += [
@@ -418,8 +420,8 @@ def write_markdown(res):
                 f"{k}: {_f(wp[k]['order_x_roll'])}"
                 for k in ("ring_dt_newmark_0.7/0.4", "ring_dt_newmark_0.5/0.25", "ring_mesh")
             )
-            + " (a least-squares slope through all points: an order of convergence only where the error falls steadily, not where it levels off at another error's floor or changes sign)"
-            + ".",
+            + " (a least-squares slope through all points: an order of convergence only where the error falls "
+            "steadily, not where it levels off at another error's floor or changes sign)" + ".",
             "",
         ]
         b = wp["bar_implicit_explicit"]
@@ -443,9 +445,11 @@ def write_markdown(res):
         L += [
             "## Cost of one Newton iteration, part by part (isolated calls at one state)",
             "",
-            "Best of a few repeats. bulk: the bodies' R and K as the System evaluates them (a beam's COO triplets, a continuum's sparse K); contact: contact.assemble; "
-            "assembly: the rest of System.residual_tangent (loads, summing the triplets into K); solve: factorisation + solve "
-            "of the free block by LAPACK's band LU where the System solves banded (band), by SuperLU after the "
+            "Best of a few repeats. bulk: the bodies' R and K as the System evaluates them (a beam's COO triplets, "
+            "a continuum's sparse K); contact: contact.assemble; "
+            "assembly: the rest of System.residual_tangent (loads, summing the triplets into K); solve: "
+            "factorisation + solve of the free block by LAPACK's band LU where the System solves banded (band), "
+            "by SuperLU after the "
             "pattern's nested-dissection renumbering where it has one (ND: from 1e4 free unknowns; METIS's "
             "ordering, made once per pattern like the band plan, not included), else by splu with "
             "the ordering newton() uses (MMD_AT_PLUS_A); SuperLU with each ordering for comparison (COLAMD is "
@@ -466,7 +470,8 @@ def write_markdown(res):
             )
             L.append(
                 f"| {name} | {r['ndof']} | {r['n_contact_nodes']} | {_f(r['bulk_s'])} | {_f(r['contact_s'])} | "
-                f"{_f(r['assembly_s']) if r['assembly_s'] > 0 else '~0 (noise)'} | {_f(r['solve_s'])}{band} | {_f(r['solve_splu_MMD_AT_PLUS_A_s'])} | "
+                f"{_f(r['assembly_s']) if r['assembly_s'] > 0 else '~0 (noise)'} | {_f(r['solve_s'])}{band} | "
+                f"{_f(r['solve_splu_MMD_AT_PLUS_A_s'])} | "
                 f"{_f(r['solve_splu_COLAMD_s'])} | {_f(r['solve_pypardiso_s'])} | {r['contact_s'] / tot:.1%} |"
             )
         n = np.array([r["n_contact_nodes"] for r in c["contact_scaling"]], float)

@@ -7,7 +7,8 @@ checks' arguments. Everything that crosses is plain data in JSON: numbers, strin
 tuples and dicts of them, arrays as ``.npy`` bytes read without pickle, a handle (a number) for
 an object that stays here, and two kinds of recipe for the library objects a check hands to an
 answer, built here from the students' edition: an object of a class of the library from plain
-data (a dataclass from its fields, a schedule from its steps), and a part of a scene's model. Nothing of the checks is here; nothing from here runs in the grader.
+data (a dataclass from its fields, a schedule from its steps), and a part of a scene's model. Nothing of the checks
+is here; nothing from here runs in the grader.
 
 Before the first request, :func:`main` sets the process up: when the grader is root, it takes
 an unprivileged user id in a user namespace of its own (so that its limits bind); then its
