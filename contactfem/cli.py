@@ -277,6 +277,7 @@ def cmd_figures(args):
     check_output_dir(
         default_outdir(args.preset) if args.outdir is None else args.outdir, "--outdir"
     )  # before anything heavy
+    from .lab import reconstruct as _reconstruct  # noqa: F401  (registers the inverse study's table)
     from .lab.bench import figures as _bench  # noqa: F401  (registers the bench figures)
     from .plots import load_all, make_all
 

@@ -168,9 +168,6 @@ def test_discretisation_study_kept_with_the_figures_is_the_run():
     assert base.with_suffix(".md").read_text() == F.discretisation_markdown(kept["rows"])
     assert [r["label"] for r in kept["rows"]] == [label for label, _, _ in F.DISCRETISATION]
     by_label = {r["label"]: r for r in kept["rows"]}
-    readme = " ".join((base.parents[1] / "README.md").read_text().split())
-    converged = by_label["128, 0.0125, 1/2 / 1/4"]["frictionless"]["angle"]
-    assert f"brings the frictionless angle to {converged:.1f} deg" in readme  # the README's Table 2 section
     rows = F.discretisation_rows(kept["preset"], quick=not os.environ.get("CONTACTFEM_SLOW"))
     assert rows
     for row in rows:
