@@ -147,13 +147,13 @@ def test_course_and_site_check_their_outputs_before_any_work(argv, pattern, tmp_
 
 
 def test_the_student_zip_holds_no_solution(tmp_path):
-    """The handout of `course build`: every lecture's student notebook and a README, and in
+    """The handout of `course build`: every lecture's student notebook and a page for students, and in
     none of its files any `BEGIN SOLUTION` marker or any line of any solution (each found in
     the instructor version, so the search can fail)."""
     import nbformat
 
     from contactfem.lab.course import build_versions, lecture_sources, solution_lines
-    from contactfem.lab.course.handout import STUDENT_ZIP
+    from contactfem.lab.course.handout import STUDENT_GUIDE, STUDENT_ZIP
 
     outs = {"student": tmp_path / "student", "instructor": tmp_path / "instructor"}
     build_versions(outs)
@@ -162,7 +162,7 @@ def test_the_student_zip_holds_no_solution(tmp_path):
     sources = lecture_sources()
     examples = sorted(f.name for f in (REPO / "lectures" / "examples").glob("*.*"))
     assert sorted(files) == sorted(
-        ["README.md"] + [s.name for s in sources] + examples
+        [STUDENT_GUIDE] + [s.name for s in sources] + examples
     )  # the lectures' example files too
     nbs = {s.name: nbformat.read(s, as_version=4) for s in sources}
     public = {name: _public_text(nb) for name, nb in nbs.items()}  # a lecture may show another's line as text

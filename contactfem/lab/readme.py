@@ -12,12 +12,13 @@ The prose around the blocks is written by hand.
 ``contactfem readme`` writes it, ``contactfem readme --check`` names the first block that differs.
 """
 
+import inspect
 import json
 import re
 import textwrap
 from pathlib import Path
 
-from ..laws.check import DEFAULT_RANGE
+from ..laws.check import DEFAULT_RANGE, check_friction_law, check_law, check_normal_law
 from ..plots import rounding, summary
 from ..scenes.block import PAPER_TABLE1
 from ..scenes.sloping_impact import PAPER_TABLE2
@@ -64,6 +65,11 @@ def _json(repo, name):
 
 
 # -- the blocks ------------------------------------------------------------------------------------
+
+
+def resume_example_block(repo):
+    """The example of a run resumed from a saved record: examples/resume.py, which a test runs."""
+    return lines("```python", (Path(repo) / "examples" / "resume.py").read_text().rstrip("\n"), "```")
 
 
 def summary_block(repo):
@@ -113,11 +119,32 @@ def banded_block(repo):
     return f"{min(ratios):.1f} to {max(ratios):.1f} times"
 
 
+def example_length_block(repo):
+    """The length of the scene file the README shows."""
+    return f"{len((Path(repo) / 'lectures' / 'examples' / 'disc_wall.py').read_text().splitlines())} lines"
+
+
 def law_range_block(repo):
     """check_law's default range."""
     r = DEFAULT_RANGE
     qv = f"q and v up to {r['q']:g}" if r["q"] == r["v"] else f"q up to {r['q']:g}, v up to {r['v']:g}"
     return f"p up to {r['p']:g}, {qv}, g up to {r['g']:g}"
+
+
+def check_law_block(repo):
+    """check_law's keywords as its docstring gives them, each with the laws whose check takes it."""
+    entries = re.findall(r"^    ``(\w+)``\s+(.*?)(?=^    ``|^\s*$)", check_law.__doc__, re.M | re.S)
+    takes = {
+        k: inspect.signature(f).parameters for k, f in (("friction", check_friction_law), ("normal", check_normal_law))
+    }
+    rows = ["| keyword | law | meaning (default) |", "|---|---|---|"]
+    for name, text in entries:
+        laws = [k for k, params in takes.items() if name in params]
+        text = " ".join(text.split()).removeprefix(f"{laws[0]}: ")
+        rows.append(
+            f"| `{name}` | {'both' if len(laws) == 2 else laws[0]} | {text.replace('``', '`').replace('|', '&#124;')} |"
+        )
+    return lines(*rows)
 
 
 def exercises_block(repo):
@@ -418,6 +445,7 @@ def sloping_mass_block(repo):
 
 
 BLOCKS = {
+    "resume-example": resume_example_block,
     "summary": summary_block,
     "rounding": rounding_block,
     "coverage": coverage_block,
@@ -425,6 +453,8 @@ BLOCKS = {
     "tangents": tangents_block,
     "banded": banded_block,
     "law-range": law_range_block,
+    "example-length": example_length_block,
+    "check-law": check_law_block,
     "exercises": exercises_block,
     "refined-angle": refined_angle_block,
     "cork-refined": cork_refined_block,
