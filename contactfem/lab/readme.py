@@ -124,6 +124,12 @@ def example_length_block(repo):
     return f"{len((Path(repo) / 'lectures' / 'examples' / 'disc_wall.py').read_text().splitlines())} lines"
 
 
+def hertz_block(repo):
+    """Hertz's peak pressure on the finest mesh of the verification figure, against the closed form."""
+    d = _json(repo, "figures/verif_hertz_pressure.json")
+    return f"p0 within {100 * abs(d['error_p0']):.2f} % on {d['n_quads']:,} quads"
+
+
 def law_range_block(repo):
     """check_law's default range."""
     r = DEFAULT_RANGE
@@ -453,6 +459,7 @@ BLOCKS = {
     "tangents": tangents_block,
     "banded": banded_block,
     "law-range": law_range_block,
+    "hertz": hertz_block,
     "example-length": example_length_block,
     "check-law": check_law_block,
     "exercises": exercises_block,
