@@ -105,8 +105,8 @@ def tangents_block(repo):
 
     return lines(
         paragraph(
-            f"The consistent non-symmetric tangent {needs('consistent')} (Coulomb and parabolic); dropping the coupling "
-            f"term of eq (50) {needs('frozen')}; the symmetrised tangent {needs('symmetric')}; the two-step "
+            f"The consistent non-symmetric tangent {needs('consistent')} (Coulomb and parabolic); dropping the "
+            f"coupling term of eq (50) {needs('frozen')}; the symmetrised tangent {needs('symmetric')}; the two-step "
             f"normal-then-friction algorithm {needs('staggered')}."
         )
     )
@@ -155,7 +155,8 @@ def check_law_block(repo):
 
 def exercises_block(repo):
     """The course's graded exercises, from the checks' register."""
-    return f"{len(EXERCISES)} in all, {sum(e.implements for e in EXERCISES.values())} of which implement part of the method"
+    implements = sum(e.implements for e in EXERCISES.values())
+    return f"{len(EXERCISES)} in all, {implements} of which implement part of the method"
 
 
 def refined_angle_block(repo):
@@ -310,7 +311,10 @@ def block_fig8(f, repo):
             "conical slip that Table 1 needs, the highest pressure sits at the far corner where the nodes stick "
             "under both laws, so the parabolic law cannot lower the friction there."
         )
-    text += " The parabolic law lowers the friction at the slipping nodes (lecture 04). Fig 8 of both readings, side by side:"
+    text += (
+        " The parabolic law lowers the friction at the slipping nodes (lecture 04). Fig 8 of both readings, side "
+        "by side:"
+    )
     d = _json(repo, "figures/fig08b_block_fig8_readings.json")["readings"]
     rows = []
     for name, r, links in (
@@ -320,7 +324,8 @@ def block_fig8(f, repo):
         x = d[name]
         rows.append(
             f"  | preset `{name}` | {r['rank']} | {r['n_facts']} of {f['facts']} | "
-            f"{round(x['fig8_fraction'] * x['fig8_nodes'])} of {x['fig8_nodes']} | {100 * x['fig8_min_reduction']:+.1f} % "
+            f"{round(x['fig8_fraction'] * x['fig8_nodes'])} of {x['fig8_nodes']} | "
+            f"{100 * x['fig8_min_reduction']:+.1f} % "
             f"| {links} |"
         )
     head = [
@@ -385,7 +390,8 @@ def sloping_table_block(repo):
             out.append(f"| {label} | {r}|")
         else:
             out.append(
-                f"| {label} | {_velocities(r, 'frictionless')} | {_velocities(r, 'frictional')} | {r['n_facts']} of {n} |"
+                f"| {label} | {_velocities(r, 'frictionless')} | {_velocities(r, 'frictional')} | "
+                f"{r['n_facts']} of {n} |"
             )
     return lines(*out)
 
