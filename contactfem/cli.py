@@ -278,6 +278,7 @@ def cmd_figures(args):
     check_output_dir(
         default_outdir(args.preset) if args.outdir is None else args.outdir, "--outdir"
     )  # before anything heavy
+    from .lab import reconstruct as _reconstruct  # noqa: F401  (registers the inverse study's table)
     from .lab.bench import figures as _bench  # noqa: F401  (registers the bench figures)
     from .plots import load_all, make_all
 
@@ -299,10 +300,24 @@ def cmd_figures(args):
         folder = args.outdir or default_outdir("paper")
         for path in reprint(folder, list(study(folder, args.only))):
             print(f"{path}: redrawn from its data with the spreads recorded")
+        refill_readme(folder)
         return 0
     with rounding(condition.linear_algebra, condition.perturbation):
         for path in make_all(args.preset, args.outdir, args.only):
             print(path)
+    refill_readme(args.outdir or default_outdir(args.preset))
+
+
+def refill_readme(folder):
+    """After the checkout's own figures/ are written: the README's blocks filled from them (lab.readme)."""
+    from pathlib import Path
+
+    from .lab import readme
+
+    repo = Path(__file__).resolve().parents[1]
+    if Path(folder).resolve() == (repo / "figures").resolve() and (repo / "README.md").is_file():
+        if readme.write(repo):
+            print(f"{repo / 'README.md'}: its blocks filled from the figures' data")
 
 
 def cmd_sweep(args):
@@ -378,6 +393,24 @@ def said_at_once():
         warnings.simplefilter("always")
         warnings.showwarning = say
         yield
+
+
+def cmd_readme(args):
+    from .lab import readme
+
+    repo = readme.checkout()
+    if args.check:
+        name = readme.first_difference(repo)
+        if name is not None:
+            print(
+                f"contactfem readme: README.md's block {name!r} is not what the data give: run contactfem readme",
+                file=sys.stderr,
+            )
+            return 1
+        print("README.md: every block is what the data give")
+        return 0
+    print(f"{repo / 'README.md'}: {'written' if readme.write(repo) else 'unchanged'}")
+    return 0
 
 
 def cmd_equations(args):
@@ -718,6 +751,13 @@ def build_parser():
     ep = sub.add_parser("equations", help="the equation index: paper equation -> implementing function")
     ep.add_argument("--markdown", action="store_true", help="a Markdown table (the default when not on a terminal)")
     ep.set_defaults(func=cmd_equations)
+    mp = sub.add_parser(
+        "readme",
+        help="fill the README's generated blocks (every number it states from a run) from the committed data: "
+        "figures/*.json, bench.json; writes README.md in place",
+    )
+    mp.add_argument("--check", action="store_true", help="write nothing; exit 1 naming the first block that differs")
+    mp.set_defaults(func=cmd_readme)
     sw = sub.add_parser("sweep", help="run a scene over a grid of parameter values, in parallel")
     sw.add_argument("scene")
     sw.add_argument(

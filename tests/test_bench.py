@@ -209,28 +209,22 @@ def test_a_quick_bench_never_replaces_or_mixes_with_a_full_run(tmp_path, monkeyp
     assert ran == [True]  # nothing ran for the refused ones
 
 
-def test_readme_states_the_committed_benchmark_numbers():
-    """The README's sentence on the tangents gives the numbers of the committed bench.json
-    (the run that BENCHMARKS.md shows)."""
+def test_the_committed_tangent_and_cost_studies_show_the_papers_claim():
+    """The committed bench.json (the front page's blocks of it: tests/test_readme.py): on the block the
+    consistent tangent needs the fewest iterations of the tangents that converge and the symmetrised one
+    diverges once nodes slip; the banded LU is faster than SuperLU in every banded case of the cost study."""
     from pathlib import Path
 
     root = Path(__file__).resolve().parents[1]
     bench = json.loads((root / "bench.json").read_text())
-    readme = " ".join((root / "README.md").read_text().split())
     blk = bench["tangents"]["block"]
-    n = {law: {v: blk[law][v]["iterations"] for v in ("consistent", "frozen", "staggered")} for law in blk}
-    assert (
-        f"the consistent non-symmetric tangent needs {n['coulomb']['consistent']} (Coulomb) and "
-        f"{n['parabolic']['consistent']} (parabolic)"
-    ) in readme
-    assert f"eq (50) needs {n['coulomb']['frozen']} and {n['parabolic']['frozen']}" in readme
-    assert f"algorithm needs {n['coulomb']['staggered']} and {n['parabolic']['staggered']}" in readme
-    assert not any(blk[law]["symmetric"]["converged"] for law in blk)  # "diverges once nodes slip"
-    # "two to four times faster than SuperLU there": every banded case of the cost study
+    for law in blk:
+        n = {v: blk[law][v]["iterations"] for v in ("consistent", "frozen", "staggered")}
+        assert n["consistent"] == min(n.values()), (law, n)
+    assert not any(blk[law]["symmetric"]["converged"] for law in blk)
     speedups = [
         r["solve_splu_MMD_AT_PLUS_A_s"] / r["solve_banded_s"]
         for r in bench["cost"]["cases"].values()
         if r.get("solve_banded_s")
     ]
-    assert "two to four times faster than SuperLU" in readme and speedups
-    assert all(1.5 <= x <= 4.5 for x in speedups), speedups  # "two to four": the ratios rounded
+    assert speedups and all(x > 1 for x in speedups), speedups

@@ -99,7 +99,7 @@ def test_mortar_hertz_on_non_matching_meshes(hertz_elastic):
 
 
 def test_mortar_on_the_rigid_foundation_misses_hertz_by_a_few_percent():
-    """What the README's known limitations say: on the rigid foundation mortar's tractions act
+    """A known limitation: on the rigid foundation mortar's tractions act
     along the cylinder's segment normals, and p0 and the contact half-width miss Hertz by up
     to a few percent (below 10 %), more than node-to-segment's errors there."""
     m = run_scene("hertz", "fast", dict(contact_discretization="mortar"))

@@ -114,7 +114,7 @@ def test_the_friction_law_barely_changes_the_normal_stress(results):
     (Fig 8's remark, a lower friction stress where the pressure is high, is a property of the
     parabolic slip surface at equal pressure: test_laws.py,
     test_parabolic_lowers_friction_coefficient_at_high_pressure; the preset's run does not show it at
-    the highest pressures, the preset fig8 does: test_reconstruct.py and the README.)"""
+    the highest pressures, the preset fig8 does: test_reconstruct.py.)"""
     c = results["parabolic"]["contact"]
     p_m = 800.0 / 3.4
     mu_m = 0.3 + 0.2 / np.sqrt(p_m)

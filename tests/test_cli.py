@@ -164,8 +164,8 @@ def test_every_command_checks_its_outputs_before_any_work(argv, target, pattern,
 
 
 def test_one_rule_for_missing_folders(tmp_path, monkeypatch, capsys):
-    """Every command's outputs make the missing folders of their path when written (README's
-    promises): run --json as figures --outdir and site --out do; a run that writes nothing
+    """Every command's outputs make the missing folders of their path when written (the command
+    line's promises): run --json as figures --outdir and site --out do; a run that writes nothing
     (refused, or failed) leaves no folder behind."""
     target = tmp_path / "a" / "b" / "r.json"
     assert main(["run", "block", "--preset", "canonical", "--json", str(target)]) == 0

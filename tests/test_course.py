@@ -149,7 +149,7 @@ def test_each_exercise_is_in_its_lecture_labelled_and_last():
 
 
 def test_course_plan_lists_every_exercise_as_graded():
-    """The README's tables of exercises (plan and checks) say what checks.EXERCISES holds."""
+    """The course guide's tables of exercises (plan and checks) say what checks.EXERCISES holds."""
     text = (REPO / "lectures" / "README.md").read_text()
     ex = _exercises()
     rows = {
@@ -161,7 +161,7 @@ def test_course_plan_lists_every_exercise_as_graded():
         e = ex[name]
         assert (difficulty, implements == "yes", float(points)) == (e.difficulty, e.implements, e.points), name
         shown = [float(x) for x in re.findall(r"\((\d+)\)", what)]
-        assert sum(shown) == e.points, f"{name}: the parts' points in the README add up to {sum(shown)}"
+        assert sum(shown) == e.points, f"{name}: the parts' points in the course guide add up to {sum(shown)}"
     plan = dict(re.findall(r"`(ex\w+)` \((\d+)\)", text))
     assert {k: float(v) for k, v in plan.items()} == {n: e.points for n, e in ex.items()}
 

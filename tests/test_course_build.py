@@ -2,7 +2,7 @@
 overwrite a notebook that was answered or edited (one line naming it, exit 2, nothing
 written) and with --force keeps it in a backup; the student version is also one zip, the
 handout, that holds no solution; every output is checked before the work; a Ctrl-C says
-what was written. And the README's account of the course against the code.
+what was written. And the course guide's account of the course against the code.
 
 Needs the course extra (otter-grader): skipped without it, except on CI (CI=true).
 """
@@ -147,13 +147,13 @@ def test_course_and_site_check_their_outputs_before_any_work(argv, pattern, tmp_
 
 
 def test_the_student_zip_holds_no_solution(tmp_path):
-    """The handout of `course build`: every lecture's student notebook and a README, and in
+    """The handout of `course build`: every lecture's student notebook and a page for students, and in
     none of its files any `BEGIN SOLUTION` marker or any line of any solution (each found in
     the instructor version, so the search can fail)."""
     import nbformat
 
     from contactfem.lab.course import build_versions, lecture_sources, solution_lines
-    from contactfem.lab.course.handout import STUDENT_ZIP
+    from contactfem.lab.course.handout import STUDENT_GUIDE, STUDENT_ZIP
 
     outs = {"student": tmp_path / "student", "instructor": tmp_path / "instructor"}
     build_versions(outs)
@@ -162,7 +162,7 @@ def test_the_student_zip_holds_no_solution(tmp_path):
     sources = lecture_sources()
     examples = sorted(f.name for f in (REPO / "lectures" / "examples").glob("*.*"))
     assert sorted(files) == sorted(
-        ["README.md"] + [s.name for s in sources] + examples
+        [STUDENT_GUIDE] + [s.name for s in sources] + examples
     )  # the lectures' example files too
     nbs = {s.name: nbformat.read(s, as_version=4) for s in sources}
     public = {name: _public_text(nb) for name, nb in nbs.items()}  # a lecture may show another's line as text
@@ -224,38 +224,24 @@ def test_ctrl_c_during_the_course_build_says_nothing_was_written(tmp_path):
     assert list(tmp.iterdir()) == []
 
 
-def test_the_readme_counts_the_exercises_the_course_has():
-    """The README's account of the exercises (which lectures have them, how many, how many
-    implement part of the method) is the checks' register."""
+def test_every_lecture_has_exercises():
+    """Every lecture ends with graded exercises (the front page counts them from the checks' register:
+    tests/test_readme.py)."""
     from contactfem.lab.course import lecture_sources
     from contactfem.lab.course.checks import EXERCISES
 
-    text = (REPO / "README.md").read_text()
-    section = text[text.index("## The course: exercises") :]
-    section = " ".join(section[: section.index("\n## ", 1)].split())
-    m = re.search(
-        r"Every lecture opens with [^.]*?, and ends with graded\s+exercises: (\d+) in all, (\d+) of which "
-        r"implement part of the method",
-        section,
-    )
-    assert m, "the README no longer says which lectures have exercises and how many"
-    assert {e.lecture for e in EXERCISES.values()} == {s.stem for s in lecture_sources()}  # every lecture
-    assert int(m.group(1)) == len(EXERCISES)
-    assert int(m.group(2)) == sum(e.implements for e in EXERCISES.values())
-    assert not re.search(r"lectures \d\d-\d\d", section), "a range of lectures the code does not check"
+    assert {e.lecture for e in EXERCISES.values()} == {s.stem for s in lecture_sources()}
+    assert 0 < sum(e.implements for e in EXERCISES.values()) <= len(EXERCISES)
 
 
-def test_the_readmes_send_students_to_the_handout():
-    """README and lectures/README name the handout the build writes, tell students to use it
-    and instructors the checkout, and say that the repository holds the solutions."""
+def test_the_course_guide_sends_students_to_the_handout():
+    """The course guide names the handout the build writes, tells students to use it and instructors
+    the checkout, and says that the repository holds the solutions."""
     from contactfem.lab.course.handout import STUDENT_ZIP
 
-    readme = (REPO / "README.md").read_text()
     guide = (REPO / "lectures" / "README.md").read_text()
-    assert "**This repository holds the solutions.**" in readme
     assert "**This folder of the repository, `lectures/`, holds the solutions**" in guide
-    for text in (readme, guide):
-        assert STUDENT_ZIP in text
-        assert re.search(r"[Ii]nstructors work in a checkout", text)
+    assert STUDENT_ZIP in guide
+    assert re.search(r"[Ii]nstructors work in a checkout", guide)
     assert f"**Hand out** `{STUDENT_ZIP}`, never the checkout" in guide
     assert not re.search(r"instructor and students\)?:? `python -m pip install -e", guide)

@@ -124,12 +124,14 @@ SLOW = (
     "table_cork_sensitivity",
     "cork_knife_edge",
     "cork_exit_time",
+    "table_reconstruct",
 )
 # the committed exit-time study is the full one (every case); the others are the default profiles
 SLOW_ENV = {"cork_exit_time": "1"}
 
 
 def registry():
+    from contactfem.lab import reconstruct as _reconstruct  # noqa: F401  (registers the inverse study's table)
     from contactfem.lab.bench import figures as _bench  # noqa: F401  (registers the bench figures)
     from contactfem.plots import load_all
 

@@ -30,7 +30,7 @@ ON_CI = os.environ.get("CI", "").lower() in ("true", "1", "yes")
 
 REPO = Path(__file__).resolve().parents[1]
 LECTURES = sorted((REPO / "lectures").glob("*.ipynb"))
-TEXTS = sorted(p for p in (REPO / "lectures").glob("*.md") if p.name != "README.md")
+TEXTS = sorted(p for p in (REPO / "lectures").glob("[0-9][0-9]_*.md"))  # the lectures' texts
 CELL_TIMEOUT = 300  # seconds per cell
 MAX_STORED_OUTPUT = 2000  # characters of stored output allowed per notebook ("small ones")
 

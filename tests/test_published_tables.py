@@ -4,7 +4,7 @@ Each table is made again here, from paper-preset runs (the figures' own function
 cache, ``plots.cached_run``: the runs are shared with test_cork, test_summary and the other
 tests of this session), and compared with the committed file cell by cell:
 
-    figures/summary.md                    every row (the README's table; test_summary keeps the two equal)
+    figures/summary.md                    every row (the front page's block of it: tests/test_readme.py)
     figures/table1_block_newton_residuals.md   the whole file
     figures/table2_sloping_impact.md      the whole file
     figures/table_cork_sensitivity.md     the row the quick profile runs ("as chosen", both pressures);
@@ -36,10 +36,7 @@ NUMBER = re.compile(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?")
 # first residual (1.7e-8). Below 1e-9 a number is the rounding of the run, not its result.
 ROUNDOFF = 1e-9
 
-SUMMARY = (
-    "`contactfem figures --only summary --preset paper`, then `python -m contactfem.plots.summary` "
-    "(copies it into the README)"
-)
+SUMMARY = "`contactfem figures --only summary --preset paper` (fills the front page's blocks too)"
 HOW = {
     "summary.md": SUMMARY,
     "table1_block_newton_residuals.md": "`contactfem figures --only table1 --preset paper`",
@@ -136,7 +133,7 @@ def test_the_comparison_finds_a_changed_number_and_ignores_roundoff():
 
 @pytest.mark.slow
 def test_summary_md_is_what_the_paper_preset_runs_give():
-    """Every row of figures/summary.md (and so of the README's table) from paper-preset runs.
+    """Every row of figures/summary.md (and so of the front page's block of it) from paper-preset runs.
     The cork's row is the slowest part: its paper run and the two refined exit cases are
     shared with test_cork (plots.cached_run, plots.cork.cached_exit_case)."""
     from contactfem.plots import summary as S

@@ -196,16 +196,10 @@ def test_the_printed_cork_tables_are_what_their_data_and_spreads_print(tmp_path)
         assert (tmp_path / f"{stem}.md").read_text() == (FIGURES / f"{stem}.md").read_text(), stem
 
 
-def test_the_readme_shows_the_table_of_what_rounding_moves():
-    from contactfem.plots import summary as S
-
-    readme = (REPO / "README.md").read_text()
-    block = readme.split(S.ROUNDING_START, 1)[1].split(S.ROUNDING_END, 1)[0]
-    lines = [ln for ln in block.splitlines() if ln.startswith("|")]
-    assert lines == R.table_lines(FIGURES), (
-        "README.md's table of what rounding moves is not what figures/*.json record: `contactfem figures "
-        "--preset paper --rounding`, then `python -m contactfem.plots.summary`"
-    )
+def test_the_table_of_what_rounding_moves_says_how_each_number_is_printed():
+    """rounding.md is the figures' rounding sections' table (the front page's block of it: tests/test_readme.py),
+    and every number in it says how it is printed."""
+    lines = R.table_lines(FIGURES)
     assert (FIGURES / "rounding.md").read_text() == R.markdown(FIGURES)
     unsaid = [ln for ln in lines[2:] if ln.split(" | ")[4] == "-"]
     assert not unsaid, "plots.rounding.PRINTED does not say how these numbers are printed:\n" + "\n".join(unsaid)

@@ -234,17 +234,14 @@ def test_a_lectures_march_cell_run_twice_gives_the_same_records(name, monkeypatc
 
 
 @pytest.mark.slow
-def test_the_readme_example_resumes_a_run(tmp_path, monkeypatch):
-    """The README's example, run as written (in a scratch folder): the rest of the run from its
-    saved record 10 is the run's records 11 on."""
-    import re
+def test_the_example_resumes_a_run(tmp_path, monkeypatch):
+    """The example of a resumed run (examples/resume.py, shown on the front page), run as written (in a
+    scratch folder): the rest of the run from its saved record 10 is the run's records 11 on."""
+    import runpy
     from pathlib import Path
 
-    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
-    block = next(b for b in re.findall(r"```python\n(.*?)```", readme, re.S) if "save_record" in b)
     monkeypatch.chdir(tmp_path)
-    namespace = {}
-    exec(compile(block, "README.md", "exec"), namespace)
+    namespace = runpy.run_path(str(Path(__file__).resolve().parents[1] / "examples" / "resume.py"))
     rest, records = namespace["rest"], namespace["records"]
     assert len(rest) == len(records) - 11 > 0
     for r, q in zip(rest, records[11:]):

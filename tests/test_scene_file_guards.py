@@ -171,14 +171,6 @@ def test_a_law_that_returns_nan_is_refused_before_the_run(tmp_path, capsys, scen
     assert line.startswith("contactfem: error: friction law NaNAbove.slip_bound returned NaN or inf"), line
 
 
-def test_the_readme_states_the_default_law_range():
-    from contactfem.laws.check import DEFAULT_RANGE as r
-
-    readme = " ".join((Path(__file__).resolve().parents[1] / "README.md").read_text().split())
-    assert r["q"] == r["v"]
-    assert f"(p up to {r['p']:g}, q and v up to {r['q']:g}, g up to {r['g']:g})" in readme
-
-
 @pytest.mark.parametrize(
     "returned, expected",
     [

@@ -42,7 +42,7 @@ def cli(*args, cwd=None):
 
 
 def test_the_example_is_short():
-    assert len(EXAMPLE.read_text().splitlines()) < 70  # what README says: under 70 lines, all told
+    assert len(EXAMPLE.read_text().splitlines()) < 70  # under 70 lines, all told
 
 
 def test_cli_and_python_give_the_same_run(tmp_path):

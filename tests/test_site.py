@@ -241,14 +241,14 @@ def _assert_student_zip(site, lectures):
     import nbformat
 
     from contactfem.lab.course import solution_lines
-    from contactfem.lab.course.handout import STUDENT_ZIP
+    from contactfem.lab.course.handout import STUDENT_GUIDE, STUDENT_ZIP
 
     link = re.search(rf'href="(_downloads/[^"]+/{re.escape(STUDENT_ZIP)})"', (site / "index.html").read_text())
     assert link, "the front page does not link the student zip"
     with zipfile.ZipFile(site / link.group(1)) as z:
         files = {Path(n).name: z.read(n).decode() for n in z.namelist()}
     examples = [f.name for f in (REPO / "lectures" / "examples").glob("*.*")]  # the files lectures read
-    assert sorted(files) == sorted(["README.md"] + [nb.name for nb in lectures] + examples)
+    assert sorted(files) == sorted([STUDENT_GUIDE] + [nb.name for nb in lectures] + examples)
     for nb_path in lectures:
         text = files[nb_path.name]
         assert not re.search(r"BEGIN\s+SOLUTION", text, re.I), nb_path.name
@@ -280,26 +280,26 @@ def _tables(text):
     return tables
 
 
-def test_gallery_page_keeps_the_readmes_tables_intact():
-    """The gallery page (generated, no build needed): the summary table is the README's,
-    row for row; every other table keeps its own columns (Table 2's readings are not merged
-    into the summary); one section per summary row, none made of a table's separator."""
-    from contactfem.lab.site.pages import gallery_page, readme_section
+def test_gallery_page_keeps_the_tables_intact():
+    """The gallery page (generated, no build needed): the summary table is the generated block's, row for
+    row, and so is Table 2's table of readings (not merged into the summary); every other table keeps its
+    own columns; one section per summary row, none made of a table's separator."""
+    from contactfem.lab import readme
+    from contactfem.lab.site.pages import gallery_page
 
     page = gallery_page(REPO)
-    readme = _tables("\n".join(readme_section((REPO / "README.md").read_text())))
+    summary_block, readings_block = (_tables(readme.BLOCKS[name](REPO))[0] for name in ("summary", "sloping-table"))
     tables = _tables(page)
-    assert len(readme) >= 2
     summary = tables[0]
-    assert [r[:4] for r in summary] == [r[:4] for r in readme[0]]
+    assert [r[:4] for r in summary] == [r[:4] for r in summary_block]
     for t in tables:
         assert all(len(r) == len(t[0]) for r in t), t[0]
         assert all(set(c) <= set("-: ") for c in t[1]), t[1]  # the separator is the second row
     readings = [t for t in tables if t[0][0] == "reading"]
-    assert len(readings) == 1 and readings[0] == readme[1]
+    assert len(readings) == 1 and readings[0] == readings_block
     heads = [ln for ln in page.splitlines() if ln.startswith("## ")]
     assert not any(set(h[3:].replace(":", "").strip()) <= set("- ") for h in heads), heads
-    assert len([h for h in heads if h != "## Verification problems and more"]) == len(readme[0]) - 2
+    assert len([h for h in heads if h != "## Verification problems and more"]) == len(summary_block) - 2
 
 
 def test_gallery_shows_the_figures_beside_the_papers_values(site):

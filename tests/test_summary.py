@@ -1,5 +1,5 @@
-"""figures/summary.md (written by `contactfem figures --preset paper`) is the README's
-table of the paper's examples: the two must agree, and every "ours" cell comes from a run."""
+"""figures/summary.md (written by `contactfem figures --preset paper`): the table of the paper's
+examples, every "ours" cell from a run."""
 
 from pathlib import Path
 
@@ -8,17 +8,6 @@ import pytest
 from contactfem.plots import summary as S
 
 REPO = Path(__file__).resolve().parents[1]
-
-
-def test_readme_table_is_figures_summary():
-    readme = S.table_lines((REPO / "README.md").read_text(), prefix="figures/")
-    written = S.table_lines((REPO / "figures" / "summary.md").read_text())
-    assert readme, "README.md has no table between " + S.START + " and " + S.END
-    assert readme == written, (
-        "README.md and figures/summary.md disagree: regenerate with "
-        "`contactfem figures --only summary --preset paper` and copy it with "
-        "`python -m contactfem.plots.summary`"
-    )
 
 
 def test_summary_has_one_row_per_example():
@@ -41,29 +30,14 @@ def test_ours_is_computed_from_the_figures_data():
     assert "; 123 down, 45 along" in S.row_block_equilibrium("paper", data.get)[3]
 
 
-def test_readme_table_is_the_committed_figures_data():
-    """The README's table (and summary.md) made again from the JSON files beside the committed
-    figures: every "ours" cell is a number the figures carry (test_figure_data keeps those
+def test_summary_is_the_committed_figures_data():
+    """summary.md (and the front page's block of it, tests/test_readme.py) made again from the JSON files beside
+    the committed figures: every "ours" cell is a number the figures carry (test_figure_data keeps those
     files equal to fresh runs)."""
-    readme = S.table_lines((REPO / "README.md").read_text(), prefix="figures/")
-    assert readme == S.summary_table("paper", S.committed(REPO / "figures")), (
-        "README.md's table is not what figures/*.json hold: regenerate with `contactfem figures --preset paper` "
-        "and copy it with `python -m contactfem.plots.summary`"
+    written = S.table_lines((REPO / "figures" / "summary.md").read_text())
+    assert written == S.summary_table("paper", S.committed(REPO / "figures")), (
+        "figures/summary.md is not what figures/*.json hold: regenerate with `contactfem figures --preset paper`"
     )
-
-
-def test_update_readme_round_trip(tmp_path):
-    readme = tmp_path / "README.md"
-    readme.write_text(f"intro\n\n{S.START}\n| old |\n{S.END}\n\nafter\n")
-    md = tmp_path / "summary.md"
-    md.write_text("# t\n\n" + "\n".join(S.HEAD + ["| a | b | c | d | [1](fig.png) |"]) + "\n")
-    S.update_readme(readme, md)
-    text = readme.read_text()
-    assert "[1](figures/fig.png)" in text and "| old |" not in text and text.endswith("after\n")
-    assert S.table_lines(text, prefix="figures/") == S.table_lines(md.read_text())
-    readme.write_text("no markers")
-    with pytest.raises(ValueError, match="summary:start"):
-        S.update_readme(readme, md)
 
 
 def test_describe_newton_reads_the_history():

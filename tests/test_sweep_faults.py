@@ -168,19 +168,16 @@ def test_a_worker_killed_twice_mid_sweep_is_a_failed_row_and_every_other_point_c
 
 
 def test_a_law_that_ends_its_process_fails_its_point_only(tmp_path, law):
-    """The README's example, run: the law ends its process (os._exit(7)) above a pressure of
-    800 that only p_y = 300 reaches (the runs' largest pressures: about 620, 710 and 910);
-    the lines it prints are the README's."""
-    readme = (Path(__file__).parents[1] / "README.md").read_text().splitlines()
-    at = next(
-        i
-        for i, line in enumerate(readme)
-        if line.startswith("$ contactfem sweep block --no-check --friction fragile.py:Fragile")
-    )
-    argv = readme[at][len("$ contactfem ") :].split()
-    shown = readme[at + 1 : readme.index("```", at)]
+    """The example of the sweep's last lines, run: the law ends its process (os._exit(7)) above a pressure
+    of 800 that only p_y = 300 reaches (the runs' largest pressures: about 620, 710 and 910); the sweep
+    prints its summary and the failed point, and exits 1."""
+    argv = "sweep block --no-check --friction fragile.py:Fragile --set law.p_exit=800 --set p_y=100,200,300 --jobs 2"
+    shown = [
+        "3 points: 2 done, 1 failed, 0 left -> sweep.csv",
+        "  failed: law.p_exit=800, p_y=300: worker exited with code 7",
+    ]
     p = subprocess.run(
-        [sys.executable, "-m", "contactfem", *argv], cwd=tmp_path, capture_output=True, text=True, timeout=60
+        [sys.executable, "-m", "contactfem", *argv.split()], cwd=tmp_path, capture_output=True, text=True, timeout=60
     )
     assert p.returncode == 1, p.stderr
     assert p.stdout.splitlines() == shown

@@ -65,6 +65,9 @@ from pathlib import Path
 
 import numpy as np
 
+from ..plots import default_outdir, figure
+from ..plots.data import write_data
+
 PAPER_FIRST_RESIDUAL = 171.3709  # Table 1, 0.1713709e3, 7 printed digits
 RESIDUAL_FLOOR = 1e-3
 # The physical screen of the block's readings. The paper's foundation is rigid; the penalty c_N
@@ -806,3 +809,114 @@ def main(scene, quick=False, top=25, json_path=None, cache=True):
         with open(json_path, "w") as fh:
             json.dump(_finite(out), fh, indent=1)
     return rows
+
+
+# -- the studies' findings: what the README states of them (figures/table_reconstruct.json) ---------------
+
+BLOCK_SHOWN = BLOCK_KEYS + (
+    "first_residual",
+    "rank",
+    "n_facts",
+    "distance",
+    "n_conical",
+    "n_parabolic",
+    "n_slip_conical",
+    "fig8_fraction",
+    "fig8_min_reduction",
+)
+SLOPING_SHOWN = SLOPING_KEYS + (
+    "rank",
+    "n_facts",
+    "frictionless_vx",
+    "frictionless_vy",
+    "frictionless_angle",
+    "frictional_vx",
+    "frictional_vy",
+    "frictional_angle",
+    "frictionless_energy_final",
+    "frictional_energy_final",
+)
+
+
+def _shown(row, keys):
+    return None if row is None else {k: row[k] for k in keys}
+
+
+def _same(row, reading, keys):
+    return all(row[k] == reading[k] for k in keys)
+
+
+def block_findings(readings):
+    """What the block's study finds, from its readings: how many end how, the preset's reading, the best,
+    the best that pulls, the readings tied with the best and those that show Fig 8's remark."""
+    rows = [r for r in readings if r["rank"]]
+    paper = block_paper_reading()
+    mine = next(r for r in rows if _same(r, paper, BLOCK_KEYS))
+    best = rows[0]
+    shows = [r for r in rows if r["facts"]["fig8_remark"]]
+    return dict(
+        readings=len(readings),
+        admissible=len(rows),
+        outcomes=outcome_counts(readings),
+        penetration_fraction=PENETRATION_FRACTION,
+        facts=len(mine["facts"]),
+        preset=_shown(mine, BLOCK_SHOWN),
+        best=_shown(best, BLOCK_SHOWN),
+        pulled=_shown(pulled_reading(readings), BLOCK_SHOWN),
+        tied=[_shown(r, BLOCK_SHOWN) for r in rows if r["n_facts"] == best["n_facts"]],
+        fig8=[_shown(r, BLOCK_SHOWN) for r in shows],
+        fig8_with_table1_conical=sum(r["facts"]["conical_4_residuals"] and r["facts"]["conical_slips"] for r in shows),
+    )
+
+
+def _spread(rows, k):
+    return max(abs(r[k]) for r in rows) - min(abs(r[k]) for r in rows)
+
+
+def sloping_findings(readings):
+    """What the sloping impact's study finds, from its readings: the preset's, the midpoint's and the
+    closest reading; how far the unknowns move the scored numbers; the readings against the text."""
+    rows = [r for r in readings if r["rank"]]
+    scored = [f"{v}_{q}" for v, q in TABLE2_SCORED]
+    preset = dict(SLOPING_PAPER_READING)
+    midpoint = dict(SLOPING_PAPER_READING, integration="1")
+
+    def find(reading, pool=readings):
+        return next(r for r in pool if _same(r, reading, SLOPING_KEYS))
+
+    groups = {}
+    for r in rows:
+        groups.setdefault(tuple(r[k] for k in SLOPING_KEYS if k != "c_N"), []).append(r)
+    c_N_groups = [g for g in groups.values() if len({r["c_N"] for r in g}) > 1]
+    return dict(
+        scored=scored,
+        best_n_facts=max(r["n_facts"] for r in rows),
+        two_point_first=max(r["rank"] for r in rows if r["integration"] == "2")
+        < min(r["rank"] for r in rows if r["integration"] == "1"),
+        preset=_shown(find(preset), SLOPING_SHOWN),
+        midpoint=_shown(find(midpoint), SLOPING_SHOWN),
+        best=_shown(rows[0], SLOPING_SHOWN),
+        minor_spread=max(
+            _spread([r for r in rows if r["integration"] == i and r["c_N"] == preset["c_N"]], k)
+            for i in ("1", "2")
+            for k in scored
+        ),
+        c_N_range=[min(r["c_N"] for r in rows), max(r["c_N"] for r in rows)],
+        c_N_spread=max(_spread(g, k) for g in c_N_groups for k in scored),
+        consistent_mass=_shown(find(dict(preset, mass_matrix="consistent")), SLOPING_SHOWN),
+        energy_consistent=_shown(find(dict(preset, contact_integration="energy_consistent")), SLOPING_SHOWN),
+        both=_shown(find(dict(preset, **SLOPING_AGAINST_TEXT)), SLOPING_SHOWN),
+        steps=SLOPING_STEPS,
+    )
+
+
+@figure("table_reconstruct", "the scan's lost values: what the two studies find")
+def findings_table(preset="fast", outdir=None):
+    """figures/table_reconstruct.json: both studies' findings, from their full runs (cached as `contactfem
+    reconstruct` caches them). The studies have no fast profile of their findings: written with the paper
+    preset's figures only."""
+    if preset != "paper":
+        return []
+    block, _ = reconstruct_block()
+    data = dict(block=block_findings(block), sloping_impact=sloping_findings(reconstruct_sloping_impact()))
+    return [write_data(Path(outdir or default_outdir(preset)) / "table_reconstruct.json", data, dict(quick=False))]

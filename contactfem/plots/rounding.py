@@ -47,9 +47,11 @@ CONDITIONS = {
 
 
 def stems():
-    """The figures the study reruns: every registered figure that runs the library and writes its data
-    (not the bench's, which draw bench.json, nor the summary, which reads the others' data)."""
-    return sorted(s for s in load_all() if not s.startswith("bench_") and s != "summary")
+    """The figures the study reruns: every figure of this package that runs the library and writes its data
+    (not the summary, which reads the others' data; not those the lab registers: the bench's draw bench.json,
+    the inverse study's table is a study of readings, not of the paper's runs)."""
+    here = __name__.rsplit(".", 1)[0]
+    return sorted(s for s, (_, fn) in load_all().items() if fn.__module__.startswith(here + ".") and s != "summary")
 
 
 def work_dir(condition):

@@ -1,24 +1,20 @@
-"""The README's table of the paper's examples, ours beside the paper's: every "ours"
-cell is computed here from the figures' data (the runs the figures use), never typed.
+"""The table of the paper's examples, ours beside the paper's: every "ours" cell is computed
+here from the figures' data (the runs the figures use), never typed.
 
     summary     figures/summary.md: one row per example of the paper
 
-``contactfem figures --preset paper`` writes it with the other figures; the README
-carries the same table between the markers ``<!-- summary:start -->`` and
-``<!-- summary:end -->`` (``python -m contactfem.plots.summary`` copies it there), and
-``tests/test_summary.py`` fails when the two disagree.
+``contactfem figures --preset paper`` writes it with the other figures; the README carries the
+same table in its block ``summary`` (contactfem/lab/readme.py builds it from the committed JSON).
 
 The "paper's value" column quotes the paper (NOTES.md); where the scan lost a digit it
 says so. Which rows depend on which scene and preset: ``ROWS`` below (one function a row).
 
 The rows read the figures' data (plots.data: what NAME.json holds beside NAME.png): a row
 function takes ``record(stem)``, the data of the figure ``stem``: ``fresh(preset)`` computes it
-from this code's runs as the figure does, ``committed(folder)`` reads the figures' JSON files,
-so the README's table is the committed figures' numbers (tests/test_summary.py).
+from this code's runs as the figure does, ``committed(folder)`` reads the figures' JSON files.
 """
 
 import json
-import sys
 from functools import lru_cache
 from pathlib import Path
 
@@ -29,8 +25,6 @@ from . import cached_run, default_outdir, figure
 from .data import ROUNDOFF, load
 from .rounding import held, recorded
 
-START, END = "<!-- summary:start -->", "<!-- summary:end -->"
-ROUNDING_START, ROUNDING_END = "<!-- rounding:start -->", "<!-- rounding:end -->"  # plots/rounding.py's table
 HEAD = ["| paper | what | paper's value | ours | figure |", "|---|---|---|---|---|"]
 
 
@@ -346,13 +340,9 @@ def summary_markdown(preset="paper", record=None):
     )
 
 
-def table_lines(text, prefix=""):
-    """The markdown table lines of summary.md, or of the README's marked block with the
-    link prefix `prefix` ("figures/") removed, so that the two compare equal."""
-    if START in text:
-        text = text.split(START, 1)[1].split(END, 1)[0]
-    lines = [ln.strip() for ln in text.splitlines() if ln.strip().startswith("|")]
-    return [ln.replace(f"]({prefix}", "](") for ln in lines] if prefix else lines
+def table_lines(text):
+    """The markdown table lines of summary.md."""
+    return [ln.strip() for ln in text.splitlines() if ln.strip().startswith("|")]
 
 
 @figure("summary", "README table")
@@ -363,41 +353,10 @@ def summary(preset="fast", outdir=None):
     return [str(path)]
 
 
-def update_readme(readme="README.md", summary_md="figures/summary.md", start=START, end=END):
-    """Copy the table of summary.md (or another generated file's) into the README between the markers."""
-    text = Path(readme).read_text()
-    if start not in text or end not in text:
-        raise ValueError(f"{readme} has no {start} ... {end} block")
-    lines = [ln.strip() for ln in Path(summary_md).read_text().splitlines() if ln.strip().startswith("|")]
-    table = "\n".join(ln.replace("](", "](figures/") for ln in lines)
-    head, rest = text.split(start, 1)
-    tail = rest.split(end, 1)[1]
-    Path(readme).write_text(f"{head}{start}\n{table}\n{end}{tail}")
-
-
-if __name__ == "__main__":
-    import argparse
-
-    repo = Path(__file__).resolve().parents[2]
-    cli = argparse.ArgumentParser(
-        prog="python -m contactfem.plots.summary",
-        description="Copy the tables of figures/summary.md and figures/rounding.md into the README, between "
-        "their markers.",
-    )
-    cli.add_argument("readme", nargs="?", default=repo / "README.md")
-    cli.add_argument("summary_md", nargs="?", default=repo / "figures" / "summary.md")
-    args = cli.parse_args()
-    try:
-        update_readme(args.readme, args.summary_md)
-        update_readme(args.readme, Path(args.summary_md).parent / "rounding.md", ROUNDING_START, ROUNDING_END)
-    except (OSError, ValueError) as err:
-        sys.exit(f"python -m contactfem.plots.summary: error: {err}")
-
-
 def reprint(folder, todo):
     """The printed files that hold numbers to their recorded spread, redrawn from the data in ``folder``
     (no runs): the cork's exit-time and sensitivity tables and its knife edge among the figures ``todo``;
-    for the committed figures, summary.md and the README's blocks of it and of rounding.md. Their paths."""
+    for the committed figures, summary.md. Their paths. (The README's blocks: lab.readme.)"""
     from . import cork as F
 
     folder, done = Path(folder), []
@@ -414,7 +373,5 @@ def reprint(folder, todo):
     repo = Path(__file__).resolve().parents[2]
     if folder.resolve() == (repo / "figures").resolve():
         (folder / "summary.md").write_text(summary_markdown("paper", committed(folder)))
-        update_readme(repo / "README.md", folder / "summary.md")
-        update_readme(repo / "README.md", folder / "rounding.md", ROUNDING_START, ROUNDING_END)
-        done += [folder / "summary.md", repo / "README.md"]
+        done.append(folder / "summary.md")
     return [str(p) for p in done]

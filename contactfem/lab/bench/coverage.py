@@ -648,7 +648,7 @@ def _quantity_text(row, name, ref=None):
 
 
 def readme_lines(res):
-    """The README's account of the study (a test holds the README to these lines): coverage, the defaults
+    """The README's account of the study (its block coverage, lab/readme.py): coverage, the defaults
     and Table 2 at the paper's data."""
     c = res["counts"]
     pct = lambda x: "-" if x is None else f"{100 * x:.1f} %"

@@ -59,7 +59,7 @@ def error_bars_markdown(res):
 
 
 def error_bars_sentence(res):
-    """The README's line on the study (a test holds the README to it)."""
+    """The README's line on the study (in its block coverage, lab/readme.py)."""
     rows = ", ".join(f"{r['scene']} {r['ratio']:.2g}" for r in sorted(res["rows"], key=lambda r: r["ratio"]))
     met = "within" if res["median_ratio"] <= res["target"] else "**above**"
     return (

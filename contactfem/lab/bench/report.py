@@ -656,7 +656,7 @@ def _match_text(step, m, integrator):
 
 
 def adaptive_sentences(ad):
-    """The README's account of study 10, one line per scene, from the study's numbers."""
+    """The README's account of study 10 (its block adaptive, lab/readme.py), one line per scene."""
     lines = []
     for name, s in ad["scenes"].items():
         if not s.get("fixed"):

@@ -111,6 +111,7 @@ def write_manifest(out, version, names):
     (Path(out) / MANIFEST).write_text(json.dumps({"version": version, "files": files}, indent=1) + "\n")
 
 
+STUDENT_GUIDE = "README.md"  # the handout's page for students, beside the notebooks
 STUDENT_README = """\
 # contactfem: the course, student notebooks
 
@@ -136,7 +137,7 @@ def student_zip(notebooks, path, extras=()):
     path = Path(path)
     tmp = path.with_name(f".{path.name}.part")
     with zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_DEFLATED) as z:
-        entries = [("contactfem-course/README.md", STUDENT_README.encode())]
+        entries = [(f"contactfem-course/{STUDENT_GUIDE}", STUDENT_README.encode())]
         entries += [(f"contactfem-course/{Path(nb).name}", Path(nb).read_bytes()) for nb in sorted(notebooks)]
         entries += [(f"contactfem-course/{name}", Path(f).read_bytes()) for name, f in sorted(extras)]
         for name, data in entries:
