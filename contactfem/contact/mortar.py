@@ -98,13 +98,16 @@ reference surfaces, like the bulk's dead loads.
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy import sparse
 
-from .element import to_coo
-from .segmentation import gap_at, overlap, pair_geometry
+from .. import lazy
+
+sparse = lazy.module("scipy.sparse")
+
 from ..laws.friction import Frictionless
 from ..laws.protocol import as_friction_law
 from ..laws.return_map import return_map
+from .element import to_coo
+from .segmentation import gap_at, overlap, pair_geometry
 
 FRICTIONLESS = as_friction_law(Frictionless())
 
@@ -154,8 +157,8 @@ class MortarIntegrals:
     pairs: Pairs
     w: np.ndarray
     g: np.ndarray
-    dw: sparse.csr_matrix
-    dg: sparse.csr_matrix
+    dw: "sparse.csr_matrix"  # (a string: scipy is loaded on first use)
+    dg: "sparse.csr_matrix"  # (a string: scipy is loaded on first use)
     D: np.ndarray
     M: np.ndarray
     f_N: np.ndarray
@@ -170,7 +173,7 @@ class WeightedSlip:
 
     pairs: Pairs
     g_T: np.ndarray
-    dg_T: sparse.csr_matrix
+    dg_T: "sparse.csr_matrix"  # (a string: scipy is loaded on first use)
 
 
 def _nodal(jets, pairs, ns, n):
