@@ -24,15 +24,18 @@ import importlib
 
 
 class _Lazy:
-    """A module not loaded yet: imported on the first attribute read."""
+    """A module not loaded yet: imported on the first attribute read, then kept."""
 
-    __slots__ = ("_name",)
+    __slots__ = ("_name", "_module")
 
     def __init__(self, name):
         object.__setattr__(self, "_name", name)
+        object.__setattr__(self, "_module", None)
 
     def __getattr__(self, attr):
-        return getattr(importlib.import_module(self._name), attr)
+        if self._module is None:
+            object.__setattr__(self, "_module", importlib.import_module(self._name))
+        return getattr(self._module, attr)
 
     def __setattr__(self, attr, value):
         raise AttributeError(f"set {attr!r} on the module {self._name!r}, not on its lazy name")
