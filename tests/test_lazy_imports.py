@@ -16,15 +16,8 @@ PACKAGE = Path(__file__).resolve().parents[1] / "contactfem"
 
 NOT_YET = {
     "lab/batch.py": 1,
-    "lab/bench/__init__.py": 1,
-    "lab/bench/cost.py": 5,
     "lab/bench/coverage.py": 1,
-    "lab/bench/figures.py": 6,
     "lab/bench/scaling.py": 5,
-    "lab/bench/speed.py": 11,
-    "lab/bench/tangents.py": 2,
-    "lab/bench/targets.py": 4,
-    "lab/bench/work_precision.py": 1,
     "lab/course/__init__.py": 11,
     "lab/course/checks/beyond_node_to_segment.py": 4,
     "lab/course/checks/block.py": 6,
