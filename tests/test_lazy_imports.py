@@ -15,7 +15,6 @@ from contactfem import lazy
 PACKAGE = Path(__file__).resolve().parents[1] / "contactfem"
 
 NOT_YET = {
-    "lab/batch.py": 1,
     "lab/bench/coverage.py": 1,
     "lab/bench/scaling.py": 5,
     "lab/course/__init__.py": 11,
@@ -36,10 +35,7 @@ NOT_YET = {
     "lab/course/hidden.py": 1,
     "lab/course/sandbox.py": 9,
     "lab/course/serve.py": 3,
-    "lab/lawfile.py": 2,
     "lab/reconstruct.py": 17,
-    "lab/site/__init__.py": 3,
-    "lab/site/pages.py": 5,
     "plots/summary.py": 4,
 }
 
