@@ -44,9 +44,6 @@ from functools import cached_property
 import numpy as np
 
 from .. import lazy
-
-sparse = lazy.module("scipy.sparse")
-
 from ..laws.return_map import SLIP
 from .complementarity import check_laws, friction_complementarity, normal_complementarity
 from .element import contact_element
@@ -55,6 +52,8 @@ from .mortar import _pair_rows, contact_forces
 from .mortar_contact import MortarContact, MortarHistory, MortarState
 from .placement import placed, start_of
 from .state import ContactState
+
+sparse = lazy.module("scipy.sparse")
 
 
 def _lagrange_checks(contact):
