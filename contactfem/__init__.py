@@ -9,6 +9,8 @@ and answers Ctrl-C from its first moment; what it offers at the top, loaded on f
 (AccuracyWarning: the one warning class of a run's accuracy indicators, for warnings filters.)
 """
 
+from .lazy import attach
+
 __version__ = "0.1.0"
 __all__ = ["run_scene", "check_law", "LawError", "LawValueError", "AccuracyWarning"]
 _HOMES = {
@@ -20,13 +22,4 @@ _HOMES = {
 }
 
 
-def __dir__():
-    return sorted(list(globals()) + __all__)
-
-
-def __getattr__(name):
-    if name in _HOMES:
-        import importlib
-
-        return getattr(importlib.import_module(f".{_HOMES[name]}", __name__), name)
-    raise AttributeError(f"module 'contactfem' has no attribute {name!r}")
+__getattr__, __dir__ = attach(__name__, _HOMES, globals())

@@ -18,14 +18,48 @@ answers Ctrl-C with its one line (for a supervisor, or a test, that interrupts i
 
 import contextlib
 import os
+import re
+import signal
 import sys
 import time
+import warnings
+from pathlib import Path
 
 _LOADING = time.perf_counter()
 import argparse  # noqa: E402  (timed: the command line's own import is import time too)
 
 from .clock import defer_interrupt, imports_timed  # noqa: E402
-from . import environment
+from . import environment, lazy
+
+# What the commands use, loaded on first use (contactfem/lazy.py): `contactfem list` loads neither
+# scipy, scikit-fem nor matplotlib, nor the plots or the lab, and the command line answers Ctrl-C
+# before any of them is loaded
+np = lazy.module("numpy")
+json = lazy.module("json")
+secrets = lazy.module("secrets")
+shutil = lazy.module("shutil")
+traceback = lazy.module("traceback")
+scenes = lazy.module("contactfem.scenes")
+equations = lazy.module("contactfem.equations")
+protocol = lazy.module("contactfem.laws.protocol")
+newton = lazy.module("contactfem.solver.newton")
+rounding = lazy.module("contactfem.solver.rounding")
+problem_scene = lazy.module("contactfem.problem.scene")
+uncertainty = lazy.module("contactfem.problem.uncertainty")
+outputs = lazy.module("contactfem.io.outputs")
+progress_bars = lazy.module("contactfem.io.progress")
+runs = lazy.module("contactfem.io.runs")
+animate = lazy.module("contactfem.io.animate")
+plots = lazy.module("contactfem.plots")
+plots_rounding = lazy.module("contactfem.plots.rounding")
+summary = lazy.module("contactfem.plots.summary")
+lawfile = lazy.module("contactfem.lab.lawfile")
+sweeps = lazy.module("contactfem.lab.sweep")
+bench = lazy.module("contactfem.lab.bench")
+reconstruct = lazy.module("contactfem.lab.reconstruct")
+site = lazy.module("contactfem.lab.site")
+course_layer = lazy.module("contactfem.lab.course")
+handout = lazy.module("contactfem.lab.course.handout")
 
 _OWN_IMPORT_S = [time.perf_counter() - _LOADING]  # counted once, by the first command of the process
 _CLOCK = {}  # the import clock of the command running (contactfem.clock)
@@ -60,15 +94,11 @@ def parse_sets(items):
 
 
 def cmd_list(args):
-    from . import scenes
-
     for name, sc in scenes.all_scenes().items():
         print(f"{name:16s} {sc.title}")
 
 
 def cmd_show(args):
-    from . import scenes
-
     sc = scenes.get_scene(args.scene)
     print(f"{sc.name}: {sc.title}")
     fast = sc.resolve("fast")
@@ -137,18 +167,12 @@ def _show_value(v):
 
 
 def cmd_run(args):
-    from . import scenes
-    from .io.outputs import Outputs
-    from .problem.scene import check_resources, describe
-
-    from .problem.uncertainty import check_tolerance, error_bars_default, line
-
     scene = scenes.get_scene(args.scene)
     overrides, laws, notes = laws_from_args(args)  # law.NAME=... go to --friction / --normal
     params = scene.resolve(args.preset, overrides)
-    tolerance = check_tolerance(args.tolerance)
-    error_bars = not args.no_error_bars and error_bars_default()
-    out = Outputs()  # every output checked before the run
+    tolerance = uncertainty.check_tolerance(args.tolerance)
+    error_bars = not args.no_error_bars and uncertainty.error_bars_default()
+    out = outputs.Outputs()  # every output checked before the run
     if args.json is not None:  # (an empty name is refused, not skipped)
         out.add("--json", args.json, (".json",))
     if args.save is not None:
@@ -159,22 +183,23 @@ def cmd_run(args):
             animated = ", ".join(n for n, s in scenes.all_scenes().items() if s.outlines)
             raise ValueError(f"--gif: scene {scene.name} records no outlines to animate (these do: {animated})")
         if args.gif.lower().endswith(".mp4"):
-            import shutil
-
             if shutil.which("ffmpeg") is None:
                 raise ValueError(f"--gif {args.gif}: writing .mp4 needs ffmpeg on the PATH; write a .gif instead")
-    est = check_resources(scene, params, args.force, args.linear_algebra)
+    est = problem_scene.check_resources(scene, params, args.force, args.linear_algebra)
     warnings = scene.preflight(params, laws) if laws and not args.no_check else []  # the laws over the scene's range
     for note in notes:  # (after every refusal: a refusal is one line)
         print(f"contactfem: note: {note}", file=sys.stderr)
     for warning in warnings:
         print(f"contactfem: warning: {warning}", file=sys.stderr)
     if est is not None and est.get("elements", 0) > 1e5:
-        print(f"{scene.name}: building the mesh and the system ({describe(est)}) ...", file=sys.stderr, flush=True)
+        print(
+            f"{scene.name}: building the mesh and the system ({problem_scene.describe(est)}) ...",
+            file=sys.stderr,
+            flush=True,
+        )
     progress = None
     if args.progress:
-        from .io import progress_bar as progress
-
+        progress = progress_bars.progress_bar
         _RUN["progress"] = True
     _RUN["phase"] = "run"
     res, notes = run_quietly(
@@ -195,13 +220,9 @@ def cmd_run(args):
     _RUN["phase"] = "write"
     with out:  # temporaries first, then all renamed at once
         if args.json is not None:
-            import json
-
             out.temp("--json").write_text(json.dumps(res, indent=1, allow_nan=False))
         if args.save is not None:
-            from .io import as_arrays, save_run
-
-            save_run(as_arrays(res), out.temp("--save"))
+            runs.save_run(runs.as_arrays(res), out.temp("--save"))
         if args.gif is not None:
             write_animation(res, out.temp("--gif"))
         out.commit()
@@ -216,7 +237,7 @@ def cmd_run(args):
     bars = res.get("uncertainty")
     if bars:  # each headline quantity with its band, and what the bands cost
         for name, entry in bars["quantities"].items():
-            print(line(name, entry))
+            print(uncertainty.line(name, entry))
         print(
             f"error bars: {bars['runs']} coarser or finer runs in {bars['wall_time_s']:.3g} s (the run alone: "
             f"{res['wall_time_s']:.3g} s); tolerance {bars['tolerance']:g}"
@@ -237,10 +258,6 @@ def run_quietly(fn):
     """fn() with numpy's floating-point warnings off (a non-finite value is caught by the
     solver and reported as the cause) and other libraries' warnings dropped; returns
     (result, contactfem's own warning messages) so they are printed once, after the run."""
-    import warnings
-
-    import numpy as np
-
     with warnings.catch_warnings(record=True) as caught, np.errstate(all="ignore"):
         warnings.simplefilter("always")
         res = fn()
@@ -253,57 +270,49 @@ def laws_from_args(args, sets=None):
     and the notes to print (fields a law took from the scene). Checks, before anything is
     built, that the scene has those laws and that no parameter is set that builds a law they
     replace."""
-    from . import scenes
-    from .lab.lawfile import laws_from_options, load_class, split_sets
-
-    overrides, law_sets = split_sets(parse_sets(args.set) if sets is None else sets)
+    overrides, law_sets = lawfile.split_sets(parse_sets(args.set) if sets is None else sets)
     if args.friction is None and args.normal is None and not any(law_sets.values()):
         return overrides, {}, []
     scene = scenes.get_scene(args.scene)
     classes = {
-        k: load_class(s, f"--{k}") for k, s in (("friction", args.friction), ("normal", args.normal)) if s is not None
+        k: lawfile.load_class(s, f"--{k}")
+        for k, s in (("friction", args.friction), ("normal", args.normal))
+        if s is not None
     }
     scenes.check_laws(scene, classes, overrides)
     params = scene.resolve(args.preset, overrides)
     from_scene = {k: {n: params[n] for n in scene.law_params.get(k, ()) if n in params} for k in classes}
     notes = []
-    laws = laws_from_options(args.friction, args.normal, law_sets, from_scene, notes)
+    laws = lawfile.laws_from_options(args.friction, args.normal, law_sets, from_scene, notes)
     return overrides, laws, notes
 
 
 def cmd_figures(args):
-    from .io.outputs import check_output_dir
-    from .plots import default_outdir
-
-    check_output_dir(
-        default_outdir(args.preset) if args.outdir is None else args.outdir, "--outdir"
+    outputs.check_output_dir(
+        plots.default_outdir(args.preset) if args.outdir is None else args.outdir, "--outdir"
     )  # before anything heavy
-    from .lab import reconstruct as _reconstruct  # noqa: F401  (registers the inverse study's table)
-    from .lab.bench import figures as _bench  # noqa: F401  (registers the bench figures)
-    from .plots import load_all, make_all
+    from .lab import reconstruct as _reconstruct  # noqa: F401  (imported for its effect: registers a figure)
+    from .lab.bench import figures as _bench  # noqa: F401  (imported for its effect: registers the bench figures)
 
-    if args.only and not any(args.only in stem for stem in load_all()):
-        raise ValueError(f"--only {args.only!r} matches no figure: the figures are {', '.join(sorted(load_all()))}")
-    from .solver.rounding import checked, current, rounding
-
+    if args.only and not any(args.only in stem for stem in plots.load_all()):
+        raise ValueError(
+            f"--only {args.only!r} matches no figure: the figures are {', '.join(sorted(plots.load_all()))}"
+        )
     # an option overrides the condition in the environment (the rounding study's processes carry theirs there)
-    given = current()
-    condition = checked(  # before any work
+    given = rounding.current()
+    condition = rounding.checked(  # before any work
         args.linear_algebra or given.linear_algebra, given.perturbation if args.perturb is None else args.perturb
     )
     if args.rounding:
         if args.preset != "paper" or condition.tag():
             raise ValueError("--rounding measures the paper preset's figures: give it with --preset paper alone")
-        from .plots.rounding import study
-        from .plots.summary import reprint
-
-        folder = args.outdir or default_outdir("paper")
-        for path in reprint(folder, list(study(folder, args.only))):
+        folder = args.outdir or plots.default_outdir("paper")
+        for path in summary.reprint(folder, list(plots_rounding.study(folder, args.only))):
             print(f"{path}: redrawn from its data with the spreads recorded")
         refill_readme(folder)
         return 0
-    with rounding(condition.linear_algebra, condition.perturbation):
-        for path in make_all(args.preset, args.outdir, args.only):
+    with rounding.rounding(condition.linear_algebra, condition.perturbation):
+        for path in plots.make_all(args.preset, args.outdir, args.only):
             print(path)
     refill_readme(args.outdir or default_outdir(args.preset))
 
@@ -321,28 +330,23 @@ def refill_readme(folder):
 
 
 def cmd_sweep(args):
-    from .io.outputs import check_output_path
-    from .lab.sweep import Table, parse_grid, point_text, sweep
-
-    from .problem.uncertainty import check_tolerance, error_bars_default
-
     if args.jobs < 1:
         raise ValueError(f"parameter jobs = {args.jobs} is out of range: allowed [1, inf)")
-    tolerance = check_tolerance(args.tolerance)
+    tolerance = uncertainty.check_tolerance(args.tolerance)
     if args.time_limit is not None and not args.time_limit > 0:
         raise ValueError(f"parameter time-limit = {args.time_limit:g} is out of range: allowed (0, inf) seconds")
     if args.time_limit is not None and args.scheduler:
         raise ValueError("--time-limit applies to local workers; with --scheduler, the cluster's own limits apply")
-    check_output_path(args.out, "--out", (".csv", ".json"))
+    outputs.check_output_path(args.out, "--out", (".csv", ".json"))
     if not args.set:
         raise ValueError(
             "sweep needs at least one --set NAME=V1,V2,... (the values to sweep); for one run use contactfem run"
         )
-    grid = parse_grid(parse_sets(args.set))
-    table = Table(args.out, resume=args.resume)  # with --resume, the rows already done are read now
+    grid = sweeps.parse_grid(parse_sets(args.set))
+    table = sweeps.Table(args.out, resume=args.resume)  # with --resume, the rows already done are read now
     _RUN.update(phase="sweep", table=table)
     with said_at_once():  # the laws' check, then each flagged point as it ends: one line each
-        rows = sweep(
+        rows = sweeps.sweep(
             args.scene,
             grid,
             args.preset,
@@ -354,7 +358,7 @@ def cmd_sweep(args):
             force=args.force,
             table=table,
             timeout=args.time_limit,
-            error_bars=not args.no_error_bars and error_bars_default(),
+            error_bars=not args.no_error_bars and uncertainty.error_bars_default(),
             tolerance=tolerance,
         )
     _RUN["phase"] = "done"
@@ -364,7 +368,7 @@ def cmd_sweep(args):
     marked = f" ({len(flagged)} flagged)" if flagged and not args.strict else ""
     print(f"{len(table.points)} points: {done} done{kept}{marked}, {failed} failed, {left} left -> {args.out}")
     for r in rows:
-        point = point_text({k[6:]: v for k, v in r.items() if k.startswith("param.")})
+        point = sweeps.point_text({k[6:]: v for k, v in r.items() if k.startswith("param.")})
         if r.get("error"):
             print(f"  failed: {point}: {r['error']}")
         elif r in flagged:
@@ -383,7 +387,6 @@ def cmd_sweep(args):
 def said_at_once():
     """contactfem's warnings printed as they come, one line each (`contactfem: warning: ...`);
     other libraries' dropped, as a run drops them (run_quietly)."""
-    import warnings
 
     def say(message, category, filename, lineno, file=None, line=None):
         if issubclass(category, UserWarning) and "contactfem" in str(filename):
@@ -414,9 +417,7 @@ def cmd_readme(args):
 
 
 def cmd_equations(args):
-    from .equations import markdown_table
-
-    table = markdown_table()
+    table = equations.markdown_table()
     if args.markdown or not sys.stdout.isatty():
         print(table)
     else:
@@ -425,8 +426,6 @@ def cmd_equations(args):
 
 def plain_table(markdown):
     """A Markdown table as aligned plain text for a terminal: no pipes, escapes or backquotes."""
-    import re
-
     rows = []
     for line in markdown.splitlines():
         if re.fullmatch(r"\|?(\s*:?-+:?\s*\|)+\s*", line):
@@ -442,22 +441,16 @@ def _course_layer(otter=True):
     needs it not: its sandbox says what it lacks)."""
     if otter:
         try:
-            import otter  # noqa: F401
+            import otter  # noqa: F401  (optional extra, course: may be absent)
         except ImportError:
             raise ValueError("contactfem course needs the course extra: pip install -e '.[course]'") from None
-    from .lab import course
-
-    return course
+    return course_layer
 
 
 def cmd_course_build(args):
-    from .io.outputs import check_output_dir
-
     course = _course_layer()
     if args.out is not None:
-        check_output_dir(args.out, "--out")
-    from .lab.course.handout import STUDENT_ZIP
-
+        outputs.check_output_dir(args.out, "--out")
     out = course.check_out_dir(course.default_out(args.instructor) if args.out is None else args.out)
     _RUN["said"] = f"during the course build; nothing written in {out}"
     written = course.build_versions(
@@ -468,24 +461,21 @@ def cmd_course_build(args):
     version = (
         "instructor (solutions, check cells, autograder/)"
         if args.instructor
-        else f"student (no solutions; the handout: {out / STUDENT_ZIP})"
+        else f"student (no solutions; the handout: {out / handout.STUDENT_ZIP})"
     )
     print(f"{len(next(iter(written.values())))} lectures, {version} -> {out}")
 
 
 def cmd_course_grade(args):
-    import secrets
-    import time
-
-    from .io.outputs import check_output_path, make_parents
-
     course = _course_layer(otter=False)
     limits = course.Limits(
         notebook=args.notebook_timeout,
         check=args.check_timeout,
         memory=int(args.memory * 2**20) if args.memory else None,
     )
-    make_parents(check_output_path(args.out, "--out", (".csv",)))  # the table's folder, as every output's
+    outputs.make_parents(
+        outputs.check_output_path(args.out, "--out", (".csv",))
+    )  # the table's folder, as every output's
     seed = secrets.randbits(63) if args.seed is None else args.seed  # said at the end: --seed repeats the grading
     t0 = time.perf_counter()
 
@@ -517,20 +507,18 @@ def cmd_course_grade(args):
 
 
 def cmd_site(args):
-    from .lab.site import build, check_out, default_out, work_dir
-
-    out = check_out(default_out(args.instructor) if args.out is None else args.out)
+    out = site.check_out(site.default_out(args.instructor) if args.out is None else args.out)
     pages = f"the site in {out} is unchanged" if (out / "index.html").exists() else f"no page written in {out}"
 
     def said():  # read when the interrupt is reported, after the clean-up
-        cache = work_dir(out) / "cache"
+        cache = site.work_dir(out) / "cache"
         return f"during the site build; {pages}" + (
-            f" (notebooks executed so far are cached in {work_dir(out)})" if cache.is_dir() else ""
+            f" (notebooks executed so far are cached in {site.work_dir(out)})" if cache.is_dir() else ""
         )
 
     _RUN["said"] = said
     try:
-        index = build(out, instructor=args.instructor, on_write=lambda: _RUN.update(phase="done"))
+        index = site.build(out, instructor=args.instructor, on_write=lambda: _RUN.update(phase="done"))
     except RuntimeError as err:  # Sphinx's own messages, then one line of ours
         head, _, detail = str(err).partition("\n")
         head = head.rstrip(":")
@@ -542,13 +530,9 @@ def cmd_site(args):
 
 
 def cmd_reconstruct(args):
-    from .io.outputs import check_output_path
-
     if args.json is not None:
-        check_output_path(args.json, "--json", (".json",))  # before anything heavy
-    from .lab.reconstruct import main as reconstruct
-
-    reconstruct(args.scene, quick=args.quick, top=args.top, json_path=args.json, cache=not args.no_cache)
+        outputs.check_output_path(args.json, "--json", (".json",))  # before anything heavy
+    reconstruct.main(args.scene, quick=args.quick, top=args.top, json_path=args.json, cache=not args.no_cache)
 
 
 BENCH_STUDIES = (
@@ -568,17 +552,10 @@ BENCH_STUDIES = (
 
 def cmd_bench(args):
     """`contactfem bench [--quick] [--out DIR] [--only NAME ...]`: bench.json and BENCHMARKS.md."""
-    import json
-    from pathlib import Path
-
-    from .lab.bench import run_bench, write_outputs
-
-    from .io.outputs import check_output_dir
-
     out = ("bench-quick" if args.quick else ".") if args.out is None else args.out
     if Path(out).exists() and not Path(out).is_dir():
         raise ValueError(f"--out {out}: is a file; give a folder (it gets bench.json and BENCHMARKS.md)")
-    check_output_dir(out, "--out")
+    outputs.check_output_dir(out, "--out")
     old = Path(out) / "bench.json"
     earlier = None
     if old.exists():
@@ -592,29 +569,23 @@ def cmd_bench(args):
             f"--out {out}: {old} holds {kind} bench run; a {'quick' if args.quick else 'full'} run "
             "would replace or mix with it: write it to another folder (--out DIR)"
         )
-    res = run_bench(quick=args.quick, only=args.only, progress=lambda m: print(m, file=sys.stderr, flush=True))
+    res = bench.run_bench(quick=args.quick, only=args.only, progress=lambda m: print(m, file=sys.stderr, flush=True))
     if args.only and earlier is not None:  # keep the other studies of an earlier run (those the bench still has)
-        from .lab.bench import STUDIES
-
         meta = ("quick", "machine", "target_values")
-        kept = {k: v for k, v in earlier.items() if k in meta or k.removesuffix("_bench_s") in STUDIES}
+        kept = {k: v for k, v in earlier.items() if k in meta or k.removesuffix("_bench_s") in bench.STUDIES}
         res = dict(kept, **res)
-    for path in write_outputs(res, out):
+    for path in bench.write_outputs(res, out):
         print(path)
 
 
 def write_animation(res, path):
     """Animate the outlines a scene recorded (rings, the cork) into a GIF or MP4."""
-    from .io import animate_outlines
-
     if not res.get("outlines"):
         raise ValueError(f"--gif: scene {res['scene']} records no outlines to animate")
-    import numpy as np
-
     anim = res.get("animation") or {}
     outlines = anim.get("outlines", res["outlines"])
     frames = [[np.asarray(f)] if np.asarray(f).ndim == 2 else [np.asarray(p) for p in f] for f in outlines]
-    animate_outlines(
+    animate.animate_outlines(
         frames,
         path,
         times=anim.get("t", res.get("outline_t")),
@@ -1044,8 +1015,6 @@ def main(argv=None):
     finally:
         _CLOCK.clear()
         if argv is None:
-            import signal
-
             signal.signal(signal.SIGINT, signal.SIG_IGN)
     if argv is None and code == 130:
         # an interrupt met inside a library's import leaves CPython's "unhandled KeyboardInterrupt"
@@ -1076,8 +1045,6 @@ def _catch_interrupts():
     SIGTERM (a `kill`, a job's time limit) ends the program with exit code 143 the way an
     exception would: the outputs' temporaries are removed and a child process (Sphinx for
     `site`) is stopped with it, rather than left running."""
-    import signal
-
     if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
         signal.signal(signal.SIGINT, _on_sigint)
     if signal.getsignal(signal.SIGTERM) is signal.SIG_DFL:
@@ -1112,9 +1079,7 @@ def _main(argv):
         if _INTERRUPTED:  # the interrupt, turned into another error by a library
             print(("\n" if _RUN.get("progress") else "") + interrupted(exc), file=sys.stderr)
             return 130
-        from .laws.protocol import LawValueError
-
-        if isinstance(exc, LawValueError):  # a law returned a bad value during the run: the run failed
+        if isinstance(exc, protocol.LawValueError):  # a law returned a bad value during the run: the run failed
             print(("\n" if _RUN.get("progress") else "") + f"contactfem: law failed: {_one_line(exc)}", file=sys.stderr)
             return 1
         print(f"contactfem: error: {_one_line(exc)}", file=sys.stderr)
@@ -1130,10 +1095,7 @@ def _main(argv):
         if _INTERRUPTED:  # the interrupt, turned into another error by a library
             print(("\n" if _RUN.get("progress") else "") + interrupted(exc), file=sys.stderr)
             return 130
-        from .scenes import SceneError
-        from .solver.newton import NewtonError
-
-        if isinstance(exc, SceneError):  # a scene file's own code failed during the run
+        if isinstance(exc, scenes.SceneError):  # a scene file's own code failed during the run
             print(
                 ("\n" if _RUN.get("progress") else "") + f"contactfem: scene failed: {_one_line(exc)}", file=sys.stderr
             )
@@ -1145,7 +1107,7 @@ def _main(argv):
                 file=sys.stderr,
             )
             return 1
-        if not isinstance(exc, (FloatingPointError, NewtonError)):  # Newton, return map, inverted elements
+        if not isinstance(exc, (FloatingPointError, newton.NewtonError)):  # Newton, return map, inverted elements
             if environment.read("CONTACTFEM_DEBUG") == "1":
                 raise
             print(
@@ -1165,8 +1127,6 @@ def _main(argv):
 
 def _where(exc):
     """The innermost function of contactfem the exception passed through: 'name (module)'."""
-    import traceback
-
     frames = [f for f in traceback.extract_tb(exc.__traceback__) if "contactfem" in f.filename]
     if not frames:
         return "a library"

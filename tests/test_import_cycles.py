@@ -1,7 +1,8 @@
 """No import circle between the modules of contactfem, with the imports inside functions included.
 
 A module depends on another when it imports it anywhere in its text: at the top or inside a
-function (a lazy import delays a dependency, it does not remove it). ``from package import name``
+function (a lazy import delays a dependency, it does not remove it), or as a lazy module
+(``lazy.module("contactfem.x")``). ``from package import name``
 depends on the submodule ``package.name`` where there is one, else on the package (a name its
 ``__init__`` defines). A circle of such dependencies is a failure, named module by module.
 """
@@ -38,7 +39,17 @@ def imports(name, path, known):
             for alias in node.names:
                 sub = f"{mod}.{alias.name}"
                 found.add(sub if sub in known else mod)
+        elif lazy_name(node):
+            found.add(lazy_name(node))
     return {m for m in found if m in known and m != name}
+
+
+def lazy_name(node):
+    """The module of a lazy import, ``lazy.module("contactfem.x.y")`` (contactfem/lazy.py), else None."""
+    if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and node.func.attr == "module":
+        if node.args and isinstance(node.args[0], ast.Constant) and isinstance(node.args[0].value, str):
+            return node.args[0].value
+    return None
 
 
 def graph(root=PACKAGE):

@@ -19,11 +19,12 @@ import ast
 from pathlib import Path
 
 import pytest
+from test_import_cycles import lazy_name
 
 PACKAGE = Path(__file__).resolve().parents[1] / "contactfem"
 
 ORDER = [
-    ("clock", "environment"),
+    ("clock", "environment", "lazy"),
     ("laws",),
     ("contact",),
     ("bodies",),
@@ -37,6 +38,7 @@ ORDER = [
 LIBRARY = (
     "clock",
     "environment",
+    "lazy",
     "laws",
     "contact",
     "bodies",
@@ -77,6 +79,8 @@ def imported_units(path, root=PACKAGE):
                 mod = node.module or ""
             # `from . import scenes` / `from .. import x`: the names may be modules
             targets = [mod] if node.module else [f"{mod}.{a.name}" for a in node.names]
+        elif lazy_name(node):
+            targets = [lazy_name(node)]
         else:
             continue
         for name in targets:
@@ -116,8 +120,9 @@ def test_the_walk_finds_a_back_edge(tmp_path):
     src.write_text(
         "from .newton import newton\nfrom .. import laws\n\n"
         "def f():\n    from ..scenes import block\n    return block\n"
+        'cork = lazy.module("contactfem.plots.cork")\n'
     )
-    assert imported_units(src, tmp_path / "contactfem") == [(1, "solver"), (2, "laws"), (5, "scenes")]
+    assert imported_units(src, tmp_path / "contactfem") == [(1, "solver"), (2, "laws"), (5, "scenes"), (7, "plots")]
 
 
 def test_the_library_imports_nothing_of_the_lab():

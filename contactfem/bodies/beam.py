@@ -41,8 +41,12 @@ Backward Euler gives the closed-form return map (see ``return_map``).
 
 import numpy as np
 
+from .. import lazy
 from ..contact.placement import start_of
 from .interfaces import MASS_MATRICES
+
+sp = lazy.module("scipy.sparse")
+skfem = lazy.module("skfem")
 
 
 def _check(name, value, low, low_open=True):
@@ -328,10 +332,8 @@ class Beam:
     # ---- body interface ------------------------------------------------------------
     def internal(self, u, dt=None, state=None):
         """Internal force R = dW/du and consistent tangent K = dR/du (CSR); see internal_coo."""
-        from scipy.sparse import coo_matrix
-
         R, rows, cols, vals = self.internal_coo(u, dt, state)
-        return R, coo_matrix((vals, (rows, cols)), shape=(self.ndof, self.ndof)).tocsr()
+        return R, sp.coo_matrix((vals, (rows, cols)), shape=(self.ndof, self.ndof)).tocsr()
 
     def internal_coo(self, u, dt=None, state=None):
         """Internal force R = dW/du and consistent tangent K = dR/du (virtual work, midpoint rule,
@@ -509,9 +511,7 @@ class Beam:
     def mesh(self):
         """scikit-fem's MeshLine in the reference arc length s (made on first use)."""
         if self._mesh is None:
-            from skfem import MeshLine
-
-            self._mesh = MeshLine(self.s)
+            self._mesh = skfem.MeshLine(self.s)
         return self._mesh
 
     def _inertias(self):
@@ -529,8 +529,6 @@ class Beam:
         rho (A or I) L0 / 6 [[2, 1], [1, 2]]; the rotations are not coupled to the translations.
         """
         if consistent:
-            from scipy.sparse import coo_matrix
-
             a, b = self.conn.T
             rows, cols, vals = [], [], []
             for k, m in enumerate(self._inertias()):
@@ -538,7 +536,7 @@ class Beam:
                 rows += [i, i, j, j]
                 cols += [i, j, i, j]
                 vals += [2 * e, e, e, 2 * e]
-            return coo_matrix(
+            return sp.coo_matrix(
                 (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(self.ndof, self.ndof)
             ).tocsr()
         if self._mass is None:  # computed once, then reused

@@ -37,6 +37,7 @@ from skfem import (
     asm,
 )
 
+from .discrete_gradient import algorithmic_stress
 from .interfaces import MASS_MATRICES
 from .materials import MATERIAL_FUNCTIONS, MATERIALS, _eye
 
@@ -378,8 +379,6 @@ class Continuum:
         moment. The tangent: the complex-step derivative of P with respect to F(u1), A = dP/dF1,
         in the tangent form. The linear material (W quadratic in u, not frame-indifferent):
         R(u_mid), the midpoint rule is exact for it."""
-        from .discrete_gradient import algorithmic_stress
-
         u0, u1 = np.asarray(u0, dtype=float), np.asarray(u1, dtype=float)
         if self.material == "linear":
             R, K = self.internal(0.5 * (u0 + u1))

@@ -27,7 +27,10 @@ mismatch it removes). The linear continuum (c = 0: R(u_mid)) and a body of one's
 
 import numpy as np
 
+from .. import lazy
 from .materials import _eye
+
+sp = lazy.module("scipy.sparse")
 
 
 def cayley(d, rotations):
@@ -72,8 +75,6 @@ def gonzalez(body, u0, u1, modes):
     correction for a quadratic W (the midpoint rule is exact: gap = 0 up to the rounding of
     R = K u, a sum of large cancelling terms when the body moves rigidly), nor where the gap
     is at the rounding of W."""
-    import scipy.sparse as sp  # (imported here: listing the scenes loads no scipy)
-
     um = 0.5 * (u0 + u1)
     R, K = body.internal(um)
     d = u1 - u0

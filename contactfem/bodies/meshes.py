@@ -5,12 +5,14 @@ annulus is in ring.py.)"""
 
 import numpy as np
 
+from .. import lazy
+
+skfem = lazy.module("skfem")
+
 
 def block_mesh(width, height, nx, ny):
     """MeshQuad of the block [0, width] x [0, height] with boundaries bottom/top/left/right."""
-    from skfem import MeshQuad
-
-    mesh = MeshQuad.init_tensor(np.linspace(0.0, width, nx + 1), np.linspace(0.0, height, ny + 1))
+    mesh = skfem.MeshQuad.init_tensor(np.linspace(0.0, width, nx + 1), np.linspace(0.0, height, ny + 1))
     tx, ty = 1e-9 * width, 1e-9 * height
     return mesh.with_boundaries(
         {
@@ -52,8 +54,6 @@ def quarter_disk(R, n_el, k):
     xi = 0 -> symmetry line x = 0, xi = 1 -> arc from -45 deg to A = (R, 0).
     Both coordinates are stretched with sinh(k s)/sinh(k), so the mesh is finest at B.
     Boundaries: 'symmetry' (x = 0), 'top' (y = 0), 'arc'."""
-    from skfem import MeshQuad
-
     xi = stretching(n_el, k)
     XI, ETA = np.meshgrid(xi, xi, indexing="ij")  # (n+1, n+1)
 
@@ -81,7 +81,7 @@ def quarter_disk(R, n_el, k):
     if np.mean(area) < 0:
         t = t[::-1]
     tol = 1e-9 * R
-    return MeshQuad(p, t).with_boundaries(
+    return skfem.MeshQuad(p, t).with_boundaries(
         {
             "symmetry": lambda x: np.abs(x[0]) < tol,
             "top": lambda x: np.abs(x[1]) < tol,
@@ -99,9 +99,7 @@ def cork_radius(z, R_tip, R_cork, L_taper):
 def cork_mesh(R_tip, R_cork, L_taper, length, n_r, n_z):
     """MeshQuad of the cork's meridian (x = r, y = z): n_r x n_z elements, radius
     ``cork_radius(z)``, with boundaries axis, outer, bottom, top."""
-    from skfem import MeshQuad
-
-    mesh = MeshQuad.init_tensor(np.linspace(0.0, 1.0, n_r + 1), np.linspace(0.0, length, n_z + 1))
+    mesh = skfem.MeshQuad.init_tensor(np.linspace(0.0, 1.0, n_r + 1), np.linspace(0.0, length, n_z + 1))
     tr, tz = 1e-9, 1e-9 * length
     mesh = mesh.with_boundaries(
         {
@@ -113,7 +111,7 @@ def cork_mesh(R_tip, R_cork, L_taper, length, n_r, n_z):
     )
     p = mesh.p.copy()
     p[0] = p[0] * cork_radius(p[1], R_tip, R_cork, L_taper)
-    return MeshQuad(p, mesh.t, _boundaries=mesh.boundaries)
+    return skfem.MeshQuad(p, mesh.t, _boundaries=mesh.boundaries)
 
 
 def graded(h, zone, L, growth=1.25):
@@ -130,6 +128,4 @@ def graded_block_mesh(R, h, zone_x, zone_y):
     """MeshQuad of the square [0, R] x [-2R, -R] (an elastic foundation under a cylinder of
     radius R touching it at (0, -R)): elements h wide over [0, zone_x] and h high over the
     top zone_y, growing geometrically beyond (``graded``)."""
-    from skfem import MeshQuad
-
-    return MeshQuad.init_tensor(graded(h, zone_x, R), -R - graded(h, zone_y, R)[::-1])
+    return skfem.MeshQuad.init_tensor(graded(h, zone_x, R), -R - graded(h, zone_y, R)[::-1])

@@ -40,7 +40,12 @@ from functools import cached_property
 
 import numpy as np
 
+from .. import lazy
 from .beam import Beam, BeamGravity, ring as ring_nodes
+
+skfem = lazy.module("skfem")
+continuum = lazy.module("contactfem.bodies.continuum")  # loads scikit-fem
+loads = lazy.module("contactfem.bodies.loads")
 
 KINDS = ("beam", "continuum")
 
@@ -77,8 +82,6 @@ def annulus_mesh(R_in, R_out, n_el, n_radial, center=(0.0, 0.0), half=False):
     in the plane (radial step first, then the angular step). Boundaries "outer",
     "inner" (and "symmetry" for the half annulus).
     """
-    from skfem import MeshQuad
-
     a = _angles(n_el, half)
     n_ang = len(a)
     r = np.linspace(R_in, R_out, n_radial + 1)
@@ -90,7 +93,7 @@ def annulus_mesh(R_in, R_out, n_el, n_radial, center=(0.0, 0.0), half=False):
     J, I = J.ravel(), I.ravel()
     I1 = (I + 1) % n_ang
     t = np.vstack([J * n_ang + I, (J + 1) * n_ang + I, (J + 1) * n_ang + I1, J * n_ang + I1])
-    mesh = MeshQuad(p, t)
+    mesh = skfem.MeshQuad(p, t)
     rad = lambda x: np.hypot(x[0] - c[0], x[1] - c[1])  # noqa: E731
     tol = 1e-6 * (R_out - R_in)
     bnd = {"outer": lambda x: rad(x) > R_out - tol, "inner": lambda x: rad(x) < R_in + tol}
@@ -289,9 +292,7 @@ class RingModel:
         g = float(g)
         if self.kind == "beam":
             return BeamGravity(self.body, g)
-        from .loads import BodyForce
-
-        return BodyForce(self.body, (0.0, -self.body.rho * g))
+        return loads.BodyForce(self.body, (0.0, -self.body.rho * g))
 
     def symmetry_dofs(self):
         """Local dofs to fix (value 0) on the symmetry plane x = x_c of a half ring:
@@ -386,10 +387,8 @@ def make_ring(
     n_radial = _count("n_radial", n_radial, 1)
     if material not in ("svk", "neohooke"):
         raise ValueError(f"parameter material = {material!r} is not allowed: one of svk|neohooke")
-    from .continuum import Continuum  # scikit-fem is loaded when a continuum ring is built
-
     mesh, n_ang = annulus_mesh(R - h / 2, R + h / 2, n_el, n_radial, center, half)
-    body = Continuum(
+    body = continuum.Continuum(
         mesh,
         E=E,
         nu=nu,

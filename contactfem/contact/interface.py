@@ -34,6 +34,7 @@ import numpy as np
 
 from ..laws.protocol import as_friction_law
 from ..laws.return_map import OPEN, STICK, return_map
+from .conserving import conserving_force
 from .element import contact_element, normal_element, pattern, to_coo
 from .placement import start_of
 from .state import ContactHistory, ContactState
@@ -278,8 +279,6 @@ class NodeToSegment:
         fr = self.friction_state(k, h, dt, phase)
         work_T = None
         if self.integration == "energy_consistent" and u0 is not None:
-            from .conserving import conserving_force
-
             R, K, on, work_T = conserving_force(self, u0, u, t, h, k, fr, offsets)
             element_dofs = k["dofs"][on]
         else:

@@ -42,16 +42,18 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
-from scipy import sparse
 
+from .. import lazy
 from ..laws.return_map import SLIP
 from .complementarity import check_laws, friction_complementarity, normal_complementarity
-from .element import contact_element, to_coo
+from .element import contact_element
 from .interface import NodeToSegment
 from .mortar import _pair_rows, contact_forces
 from .mortar_contact import MortarContact, MortarHistory, MortarState
 from .placement import placed, start_of
 from .state import ContactState
+
+sparse = lazy.module("scipy.sparse")
 
 
 def _lagrange_checks(contact):

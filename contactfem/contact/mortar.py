@@ -96,15 +96,21 @@ reference surfaces, like the bulk's dead loads.
 """
 
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy import sparse
 
-from .element import to_coo
-from .segmentation import gap_at, overlap, pair_geometry
+from .. import lazy
 from ..laws.friction import Frictionless
 from ..laws.protocol import as_friction_law
 from ..laws.return_map import return_map
+from .element import to_coo
+from .segmentation import gap_at, overlap, pair_geometry
+
+sparse = lazy.module("scipy.sparse")
+
+if TYPE_CHECKING:  # the fields' type, for the type checker; scipy is loaded on first use
+    from scipy.sparse import csr_matrix
 
 FRICTIONLESS = as_friction_law(Frictionless())
 
@@ -154,8 +160,8 @@ class MortarIntegrals:
     pairs: Pairs
     w: np.ndarray
     g: np.ndarray
-    dw: sparse.csr_matrix
-    dg: sparse.csr_matrix
+    dw: "csr_matrix"
+    dg: "csr_matrix"
     D: np.ndarray
     M: np.ndarray
     f_N: np.ndarray
@@ -170,7 +176,7 @@ class WeightedSlip:
 
     pairs: Pairs
     g_T: np.ndarray
-    dg_T: sparse.csr_matrix
+    dg_T: "csr_matrix"
 
 
 def _nodal(jets, pairs, ns, n):

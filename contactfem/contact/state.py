@@ -15,7 +15,7 @@ from functools import cached_property
 
 import numpy as np
 
-from ..laws.return_map import STATE_NAMES
+from ..laws.return_map import SLIP, STATE_NAMES
 
 
 @dataclass(frozen=True)
@@ -174,6 +174,4 @@ class ContactState:
     @property
     def n_slip(self):
         """Slave nodes slipping in this step (the return map's decision at this state)."""
-        from ..laws.return_map import SLIP
-
         return int(np.count_nonzero(self.slip == SLIP))

@@ -18,7 +18,7 @@ progress.py  ProgressBar: a progress bar on stderr (called with each record's t)
              integrate(..., progress=), solver.march.watch and run_scene(..., progress=)
 """
 
-import importlib
+from ..lazy import attach
 
 # each name from its module, loaded on first use (PEP 562): checking an output path
 # (outputs.py) loads neither scikit-fem nor matplotlib
@@ -65,13 +65,4 @@ __all__ = [
 ]
 
 
-def __getattr__(name):
-    if name in _WHERE:
-        value = getattr(importlib.import_module(f"{__name__}.{_WHERE[name]}"), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__():
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = attach(__name__, _WHERE, globals())

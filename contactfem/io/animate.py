@@ -11,7 +11,11 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import lazy
 from ..bodies.continuum import boundary_loop  # noqa: F401  (public here too)
+
+plt = lazy.module("matplotlib.pyplot")
+animation = lazy.module("matplotlib.animation")
 
 
 def _polylines(frame):
@@ -33,9 +37,6 @@ def animate_outlines(
     (bool or one bool per polyline) joins the last point to the first. `marks`: per frame,
     polylines drawn in red that move with a body (a spoke of a ring shows it turning).
     Returns the path."""
-    import matplotlib.pyplot as plt
-    from matplotlib import animation
-
     path = Path(path)
     frames = [_polylines(f) for f in frames]
     if not frames:

@@ -14,10 +14,14 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import lazy
+
+saxutils = lazy.module("xml.sax.saxutils")  # (pulls in urllib: ~0.1 s, only when writing)
+
 
 def _meshio():
     try:
-        import meshio
+        import meshio  # optional extra (io): may be absent
     except ImportError:
         raise ImportError("export to ParaView needs the optional package meshio: pip install meshio") from None
     return meshio
@@ -33,11 +37,10 @@ def _pad3(x):
 
 def write_pvd(path, files, times):
     """The ParaView collection: one <DataSet timestep=...> per file (paths relative to the .pvd)."""
-    from xml.sax.saxutils import quoteattr  # (pulls in urllib: ~0.1 s, only when writing)
-
     path = Path(path)
     rows = "\n".join(
-        f'    <DataSet timestep="{float(t)!r}" part="0" file={quoteattr(Path(f).name)}/>' for f, t in zip(files, times)
+        f'    <DataSet timestep="{float(t)!r}" part="0" file={saxutils.quoteattr(Path(f).name)}/>'
+        for f, t in zip(files, times)
     )
     path.write_text(
         '<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1">\n  <Collection>\n'

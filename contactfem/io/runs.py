@@ -24,6 +24,7 @@ SystemState, and ``load_record(path)`` gives it back, every number bit for bit, 
     rest = resume(stepper, schedule, load_record("step.npz"))   # the run from k on, as it went
 """
 
+import dataclasses
 import json
 import os
 import secrets
@@ -32,7 +33,18 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import lazy
+from ..contact.augmented import AugmentedHistory
+from ..contact.mortar import Pairs
+from ..contact.mortar_contact import MortarHistory
+from ..contact.state import ContactHistory
 from ..problem.scene import RUN_KEYS  # what describes how a run went: compare_runs leaves it out
+from ..solver.estimate import ErrorModel, Slope, StepError
+from ..solver.march import Record
+from ..solver.newton import NewtonResult
+from ..solver.system import Evaluation, SystemState
+
+body_loads = lazy.module("contactfem.bodies.loads")  # loads scikit-fem
 
 FORMAT = "contactfem-run/1"
 _TAG = "__ndarray__"
@@ -314,21 +326,11 @@ _STATE = "__state__"
 
 def _state_types():
     """The value types a SystemState may hold, by name (load_record builds only these)."""
-    from ..bodies.loads import GasState
-    from ..contact.augmented import AugmentedHistory
-    from ..contact.mortar import Pairs
-    from ..contact.mortar_contact import MortarHistory
-    from ..contact.state import ContactHistory
-    from ..solver.estimate import Slope
-    from ..solver.system import SystemState
-
-    types = (SystemState, ContactHistory, AugmentedHistory, MortarHistory, Pairs, GasState, Slope)
+    types = (SystemState, ContactHistory, AugmentedHistory, MortarHistory, Pairs, body_loads.GasState, Slope)
     return {t.__name__: t for t in types}
 
 
 def _state_to_plain(obj, where, types):
-    import dataclasses
-
     if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
         name = type(obj).__name__
         if types.get(name) is not type(obj):
@@ -390,11 +392,6 @@ def load_record(path):
     """The record save_record wrote, to resume a march from (contactfem.solver.march.resume):
     its numbers bit for bit, its SystemState, the residual and loads of its evaluation (no
     tangent, no contact states: those of the steps after it are recomputed)."""
-    from ..solver.estimate import ErrorModel, StepError
-    from ..solver.march import Record
-    from ..solver.newton import NewtonResult
-    from ..solver.system import Evaluation
-
     doc = load_run(path, arrays=False)
     if "record" not in doc:
         raise ValueError(f"{path} is a saved run, not a saved record (save_record)")

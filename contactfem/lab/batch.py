@@ -287,7 +287,7 @@ def _end_with(parent):
 
 def _limit_memory(nbytes):
     try:
-        import resource
+        import resource  # POSIX only: absent on Windows, where no limit is set
     except ImportError:
         return
     try:

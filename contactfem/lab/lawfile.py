@@ -21,6 +21,7 @@ and fields.
 """
 
 import dataclasses
+import importlib
 import importlib.util
 import itertools
 import sys
@@ -29,6 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import laws
 from ..laws.protocol import FrictionLaw, LawError, NormalLawView, describe  # noqa: F401 (describe: public here too)
 
 KINDS = ("friction", "normal")
@@ -37,8 +39,6 @@ KINDS = ("friction", "normal")
 def shipped_laws():
     """{kind: {name: class}} of the shipped laws, by the names the command line accepts
     (the class name in lower case, with or without underscores: stribeck, power_law)."""
-    from .. import laws
-
     out = {"friction": {}, "normal": {}}
     for cls in (
         laws.Coulomb,
@@ -136,8 +136,6 @@ def load_class(spec, option="--friction"):
 
 
 def _from_module(module, name, option, spec):
-    import importlib
-
     if not name.isidentifier():
         raise ValueError(f"{option} expects FILE.py:CLASS or package.module:CLASS, got class name {name!r}")
     try:

@@ -61,12 +61,20 @@ Sloping impact (Sec. 5.3): see ``sloping_impact_readings``.
 
 import itertools
 import json
+import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
 
+from .. import plots
+from ..io.outputs import make_parents
 from ..plots import default_outdir, figure
 from ..plots.data import write_data
+from ..problem.accuracy import AccuracyWarning
+from ..scenes import block as block_scene
+from ..scenes import sloping_impact as sloping_scene
+from ..solver.newton import NewtonError
 
 PAPER_FIRST_RESIDUAL = 171.3709  # Table 1, 0.1713709e3, 7 printed digits
 RESIDUAL_FLOOR = 1e-3
@@ -88,9 +96,7 @@ def cases(enabled=True):
     """How the studies get a case, ``case(scene, params)``: kept on disk for the same code
     (plots.stored: joblib.Memory in ``$CONTACTFEM_CACHE/figures`` or ~/.cache/contactfem) when
     ``enabled``, else solved every time."""
-    from ..plots import stored
-
-    return stored(_case) if enabled else _case
+    return plots.stored(_case) if enabled else _case
 
 
 def _case(scene, params):
@@ -145,10 +151,6 @@ def residual_distance(ours, paper, floor=RESIDUAL_FLOOR):
 def _quiet_run(scene, params):
     """scene.run(params) without its accuracy warnings: a reading is screened by the study's own
     outcomes (penetration, inverted elements, energy gain, no rebound), not warned about one by one."""
-    import warnings
-
-    from ..problem.accuracy import AccuracyWarning
-
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", AccuracyWarning)
         return scene.run(params)
@@ -156,11 +158,8 @@ def _quiet_run(scene, params):
 
 def _block_case(params):
     """One solve of the block, reduced to what the score and the physical screen need."""
-    from ..scenes.block import SCENE
-    from ..solver.newton import NewtonError
-
     try:
-        r = _quiet_run(SCENE, params)
+        r = _quiet_run(block_scene.SCENE, params)
     except (NewtonError, FloatingPointError, np.linalg.LinAlgError) as exc:
         return dict(converged=False, error=str(exc).splitlines()[0][:120])
     c = r["contact"]
@@ -196,30 +195,26 @@ def fig8_remark(conical, parabolic):
     measure the figures use): the fraction of the nodes in the top quartile of the conical
     normal pressure where the parabolic |t_T| is at least 5 % below the conical one, and the
     smallest relative reduction there."""
-    from ..scenes.block import fig8_remark as measure
-
     if not (conical.get("converged") and parabolic.get("converged")):
         return 0.0, float("nan")
-    return measure(conical["t_N"], conical["t_T"], parabolic["t_T"])[:2]
+    return block_scene.fig8_remark(conical["t_N"], conical["t_T"], parabolic["t_T"])[:2]
 
 
 def score_block(reading, conical, parabolic):
     """Facts met and the residual distance of one reading (see the module docstring)."""
-    from ..scenes.block import PAPER_TABLE1
-
     r0 = conical["residuals"][0] if conical.get("converged") else reading.get("first_residual")
     n_con = len(conical["residuals"]) if conical.get("converged") else None
     n_par = len(parabolic["residuals"]) if parabolic.get("converged") else None
     frac, red = fig8_remark(conical, parabolic)
     facts = {
         "first_residual_1pct": r0 is not None and abs(r0 / PAPER_FIRST_RESIDUAL - 1) <= 0.01,
-        "conical_4_residuals": n_con == len(PAPER_TABLE1["conical"]),
-        "parabolic_7_residuals": n_par == len(PAPER_TABLE1["parabolic"]),
+        "conical_4_residuals": n_con == len(block_scene.PAPER_TABLE1["conical"]),
+        "parabolic_7_residuals": n_par == len(block_scene.PAPER_TABLE1["parabolic"]),
         "conical_slips": bool(conical.get("converged") and conical["n_slip"] > 0),
         "fig8_remark": frac == 1.0,
     }
-    d = residual_distance(conical.get("residuals"), PAPER_TABLE1["conical"]) + residual_distance(
-        parabolic.get("residuals"), PAPER_TABLE1["parabolic"]
+    d = residual_distance(conical.get("residuals"), block_scene.PAPER_TABLE1["conical"]) + residual_distance(
+        parabolic.get("residuals"), block_scene.PAPER_TABLE1["parabolic"]
     )
     return dict(
         reading,
@@ -250,20 +245,15 @@ def block_reading_overrides(reading, law):
 
 def block_reading_params(reading, law):
     """Scene parameters of a reading (checked: raises ValueError for a reading without equilibrium)."""
-    from ..scenes.block import SCENE
-
-    return SCENE.resolve("fast", block_reading_overrides(reading, law))
+    return block_scene.SCENE.resolve("fast", block_reading_overrides(reading, law))
 
 
 def block_equilibrium(reading, law):
     """(tangential load |p_x| H, the friction the foundation can carry at most): the block
     scene's own bound (scenes.block.friction_capacity). A reading whose load exceeds it has no
     static equilibrium: no solve can give one."""
-    from ..scenes.block import SCENE
-    from ..scenes.block import friction_capacity
-
-    p = dict(SCENE.resolve("fast"), **block_reading_overrides(reading, law))
-    return abs(p["p_x"]) * p["height"], friction_capacity(p)[0]
+    p = dict(block_scene.SCENE.resolve("fast"), **block_reading_overrides(reading, law))
+    return abs(p["p_x"]) * p["height"], block_scene.friction_capacity(p)[0]
 
 
 def reading_outcome(outcomes, kinds=OUTCOMES):
@@ -334,9 +324,7 @@ def outcome_counts(rows, kinds=OUTCOMES):
 
 def block_paper_reading():
     """The reading of the block scene's defaults (its paper preset), as a study row."""
-    from ..scenes.block import SCENE
-
-    p = SCENE.resolve("paper")
+    p = block_scene.SCENE.resolve("paper")
     rd = {k: p[k] for k in BLOCK_KEYS}
     rd["first_residual"] = block_first_residual(p["width"], p["height"], p["nx"], p["ny"], p["p_y"], p["p_x"])
     return rd
@@ -486,11 +474,8 @@ SLOPING_STEPS = 80
 
 
 def _sloping_case(params):
-    from ..scenes.sloping_impact import SCENE
-    from ..solver.newton import NewtonError
-
     try:
-        r = _quiet_run(SCENE, params)
+        r = _quiet_run(sloping_scene.SCENE, params)
     except (NewtonError, FloatingPointError, np.linalg.LinAlgError) as exc:
         return dict(converged=False, error=str(exc).splitlines()[0][:120])
     return dict(
@@ -520,19 +505,17 @@ def sloping_case_outcome(case):
 
 
 def evaluate_sloping(reading, solve):
-    from ..scenes.sloping_impact import PAPER_TABLE2, SCENE
-
     row = dict(reading)
     facts, errs, outcomes = {}, [], {}
     for variant in ("frictionless", "frictional"):
         over = dict(reading, variant=variant, n_steps=SLOPING_STEPS, outline_every=1000)
-        params = SCENE.resolve("paper", over)
+        params = sloping_scene.SCENE.resolve("paper", over)
         case = solve("sloping_impact", params)
         if case.get("converged") and not (case["rebounded"] and case["t_separation"] < SLOPING_STEPS * params["dt"]):
-            params = SCENE.resolve("paper", dict(over, n_steps=200))
+            params = sloping_scene.SCENE.resolve("paper", dict(over, n_steps=200))
             case = solve("sloping_impact", params)
         outcomes[variant] = sloping_case_outcome(case)
-        paper = PAPER_TABLE2[variant]
+        paper = sloping_scene.PAPER_TABLE2[variant]
         for q in ("vx", "vy", "angle"):
             row[f"{variant}_{q}"] = case.get(q) if case.get("converged") else None
         for q in ("vx", "vy"):
@@ -632,12 +615,10 @@ def reconstruct_sloping_impact(quick=False, cache=True, progress=None):
 
 
 def sloping_table(rows, top=25):
-    from ..scenes.sloping_impact import PAPER_TABLE2
-
     counts = outcome_counts(rows, SLOPING_OUTCOMES)
     every = rows
     rows = [r for r in rows if r["rank"]]
-    fl, fr = PAPER_TABLE2["frictionless"], PAPER_TABLE2["frictional"]
+    fl, fr = sloping_scene.PAPER_TABLE2["frictionless"], sloping_scene.PAPER_TABLE2["frictional"]
     f = lambda x, w=5, d=2: "  -  ".rjust(w) if x is None else f"{x:{w}.{d}f}"  # noqa: E731
     n = len(TABLE2_SCORED)
     head = (
@@ -706,8 +687,6 @@ def sloping_table(rows, top=25):
 # ---------------------------------------------------------------------------------------
 # command line
 def _progress(label):
-    import sys
-
     def show(i, n):
         if sys.stderr.isatty():
             print(f"\r{label}: {i}/{n} readings", end="\n" if i == n else "", file=sys.stderr, flush=True)
@@ -803,8 +782,6 @@ def main(scene, quick=False, top=25, json_path=None, cache=True):
     else:
         raise ValueError(f"parameter scene = {scene!r} is not allowed: one of block|sloping_impact")
     if json_path is not None:
-        from ..io.outputs import make_parents
-
         make_parents(json_path)
         with open(json_path, "w") as fh:
             json.dump(_finite(out), fh, indent=1)

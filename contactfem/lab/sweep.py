@@ -31,6 +31,7 @@ a run uses, the library's and the law files'); ``resume`` skips the points whose
 no error and was made by the same scene, preset, laws and code.
 """
 
+import asyncio
 import csv
 import hashlib
 import inspect
@@ -38,12 +39,19 @@ import itertools
 import json
 import os
 import secrets
+import socket
 import warnings
 from contextlib import closing
 from pathlib import Path
 
+from .. import __version__, lazy
+from ..io.outputs import hold_interrupts, make_parents
 from ..problem.accuracy import AccuracyWarning
+from ..problem.resources import LIMITS, check_resources, describe
 from ..scenes import check_laws, get_scene, is_scene_file, run_scene
+from .lawfile import laws_from_options, load_class, split_sets
+
+batch = lazy.module("contactfem.lab.batch")  # its worker pool, loaded when a sweep runs
 
 
 def parse_grid(sets):
@@ -61,8 +69,6 @@ def parse_grid(sets):
 
 def build_laws(scene, preset, point, friction=None, normal=None, notes=None):
     """(scene overrides, {kind: law}) of one sweep point, as `contactfem run` builds them."""
-    from .lawfile import laws_from_options, load_class, split_sets
-
     overrides, law_sets = split_sets(point)
     if friction is None and normal is None and not any(law_sets.values()):
         return overrides, {}
@@ -137,11 +143,7 @@ def code_version(friction=None, normal=None, scene=None):
     """'0.1.0+1a2b3c4d5e6f': contactfem's version and a digest of the sources a run uses (the
     library below the lab, the files of the laws named by ``friction`` / ``normal``, and the
     scene file where ``scene`` is one)."""
-    import contactfem
-
-    from .lawfile import load_class
-
-    root = Path(contactfem.__file__).parent
+    root = Path(__file__).parents[1]  # the package
     h = hashlib.sha256()
     for rel in LIBRARY:
         files = sorted((root / rel).rglob("*.py")) if (root / rel).is_dir() else [root / rel]
@@ -155,7 +157,7 @@ def code_version(friction=None, normal=None, scene=None):
                 h.update(spec.encode())
     if is_scene_file(scene):
         h.update(Path(scene).expanduser().read_bytes())
-    return f"{contactfem.__version__}+{h.hexdigest()[:12]}"
+    return f"{__version__}+{h.hexdigest()[:12]}"
 
 
 def plan(scene, grid, preset="fast", jobs=1, scheduler=None, friction=None, normal=None, check=True, force=False):
@@ -165,8 +167,6 @@ def plan(scene, grid, preset="fast", jobs=1, scheduler=None, friction=None, norm
     the memory of the runs that go at once (``jobs`` of them locally) together; and the
     warnings of the laws' check (a derivative that disagrees with finite differences), each
     finding once (with the numbers of the first point that shows it)."""
-    from ..problem.resources import LIMITS, check_resources, describe
-
     sc = get_scene(scene)
     points = [dict(zip(grid, combo)) for combo in itertools.product(*grid.values())]
     largest, notes = None, []
@@ -247,9 +247,7 @@ def _prepare(scene, grid, preset, jobs, scheduler, friction, normal, check, forc
 def _guarded(fn, args, laws):
     """fn(*args) in a worker process (it loads and checks the user's laws): its value, or its
     exception raised here; a worker that dies is one ValueError naming the laws."""
-    from .batch import run_batch
-
-    (outcome,) = run_batch(_capture, [(None, (fn, *args))], retries=0)
+    (outcome,) = batch.run_batch(_capture, [(None, (fn, *args))], retries=0)
     if not outcome.ok:
         raise ValueError(
             f"{laws}: the law's code ended the process that loaded and checked it ({outcome.reason}); "
@@ -270,11 +268,9 @@ def _capture(fn, *args):
 
 def _local(tasks, jobs, timeout):
     """(index, row) of each task as it ends, on `jobs` worker processes."""
-    from .batch import run_batch
-
     if not tasks:
         return
-    with closing(run_batch(_one, tasks, jobs=min(jobs, len(tasks)), timeout=timeout)) as outcomes:
+    with closing(batch.run_batch(_one, tasks, jobs=min(jobs, len(tasks)), timeout=timeout)) as outcomes:
         for o in outcomes:
             yield o.key, o.value if o.ok else {"error": o.reason}
 
@@ -282,7 +278,7 @@ def _local(tasks, jobs, timeout):
 def _on_dask(scheduler, tasks):
     """(index, row) of each task as it ends, on the Dask cluster at `scheduler`."""
     try:
-        from dask.distributed import as_completed
+        from dask.distributed import as_completed  # optional extra (cluster): may be absent
     except ImportError:
         raise ValueError("--scheduler needs dask.distributed: pip install 'dask[distributed]'") from None
     client = connect(scheduler)
@@ -308,11 +304,8 @@ def connect(address, timeout=10):
     """A dask.distributed Client of the scheduler at `address`, or one ValueError naming
     --scheduler and the address, at once if nothing listens there (a TCP address is asked for
     its identity before a Client is made)."""
-    import asyncio
-    import socket
-
-    from dask.distributed import Client
-    from distributed.comm import parse_address, parse_host_port
+    from dask.distributed import Client  # optional extra (cluster): the caller said --scheduler
+    from distributed.comm import parse_address, parse_host_port  # optional extra (cluster)
 
     try:
         scheme, location = parse_address(address)
@@ -345,9 +338,7 @@ def connect(address, timeout=10):
 
 
 async def _identity(address, timeout):
-    import asyncio
-
-    from distributed.comm import connect as open_comm
+    from distributed.comm import connect as open_comm  # optional extra (cluster)
 
     comm = await open_comm(address, timeout=timeout)
     try:
@@ -433,10 +424,6 @@ class Table:
         meanwhile: ``written`` is what the file holds)."""
         if self.path is None:
             return
-        from ..io.outputs import hold_interrupts
-
-        from ..io.outputs import make_parents
-
         make_parents(self.path)  # the folders --out names, made when the table is first written
         temp = self.path.with_name(f".{self.path.stem}.{secrets.token_hex(4)}.part{self.path.suffix}")
         try:

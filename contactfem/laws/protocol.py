@@ -53,6 +53,7 @@ when built and are exact by construction: their adapters call them directly, wit
 the checks (the small iteration pays nothing for them).
 """
 
+import dataclasses
 import inspect
 import math
 import warnings
@@ -155,8 +156,6 @@ def _real(value, what, where=lambda i: ""):
 def check_fields(law):
     """LawError unless every number among a dataclass law's fields is finite (checked when
     an adapter is made: a NaN field would only come back as NaN values during the run)."""
-    import dataclasses
-
     if not dataclasses.is_dataclass(law):
         return
     for f in dataclasses.fields(law):
@@ -683,8 +682,6 @@ def as_normal_law(law):
 
 def describe(law):
     """JSON record of a law: class, file (None for a shipped law, else the law file it came from) and fields."""
-    import dataclasses
-
     law = getattr(law, "law", law) if isinstance(law, (FrictionLaw, NormalLawView)) else law
     cls = type(law)
     fields = {f.name: getattr(law, f.name) for f in dataclasses.fields(law)} if dataclasses.is_dataclass(law) else {}

@@ -14,6 +14,12 @@ from pathlib import Path
 
 from ..solver.rounding import current
 from .. import environment
+from .data import source_hash
+import textwrap
+from .. import lazy, scenes
+
+plt = lazy.module("matplotlib.pyplot")
+joblib = lazy.module("joblib")
 
 REGISTRY = {}  # file stem -> (paper label, function)
 
@@ -68,8 +74,6 @@ def make_all(preset="fast", outdir=None, only=None):
 
 def pyplot():
     """matplotlib.pyplot, imported only when a figure is drawn."""
-    import matplotlib.pyplot as plt
-
     return plt
 
 
@@ -87,11 +91,7 @@ def stored(fn):
     arguments and the hash of the package's sources (plots.data.source_hash): a later process
     with the same code answers from the disk, a change of the code anywhere runs it again. ``fn``
     must be a module-level function of JSON-like arguments."""
-    from joblib import Memory
-
-    from .data import source_hash
-
-    kept = Memory(str(cache_dir()), verbose=0).cache(_with_code)
+    kept = joblib.Memory(str(cache_dir()), verbose=0).cache(_with_code)
 
     def call(*args, **kwargs):
         return kept(fn, source_hash(), args, kwargs)
@@ -107,9 +107,7 @@ def _with_code(fn, code, args, kwargs):
 
 
 def _run(scene, preset, changed):
-    from ..scenes import run_scene
-
-    return run_scene(scene, preset, dict(changed), error_bars=False)  # (the figures draw the runs, not bands)
+    return scenes.run_scene(scene, preset, dict(changed), error_bars=False)  # (the figures draw the runs, not bands)
 
 
 @lru_cache(maxsize=64)
@@ -122,17 +120,13 @@ def cached_run(scene, preset="fast", **overrides):
     lectures share runs, and an override equal to the preset's value is no new run. Kept in
     the process and on disk for the same code (``stored``): a second ``contactfem figures``
     reads the runs of the first."""
-    from ..scenes import get_scene
-
-    sc = get_scene(scene)
+    sc = scenes.get_scene(scene)
     base, full = sc.resolve(preset), sc.resolve(preset, overrides)
     return _cached(scene, preset, tuple(sorted((k, v) for k, v in full.items() if v != base[k])), current())
 
 
 def savefig(fig, outdir, stem):
     """Save a matplotlib figure as outdir/stem.png and close it."""
-    import matplotlib.pyplot as plt
-
     path = Path(outdir) / f"{stem}.png"
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110, bbox_inches="tight")
@@ -144,8 +138,6 @@ def fitted_words(r, to, width=95):
     """ "FITTED to <to>: name = value, ..." from a run's JSON ``fitted`` (the values the scan lost
     that a study chose so the result lands near the paper's), wrapped to ``width``; "" for a run
     without fitted values. Figures that show a fitted reading put it in their title."""
-    import textwrap
-
     fitted = r.get("fitted") or {}
     if not fitted:
         return ""

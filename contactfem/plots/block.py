@@ -27,6 +27,9 @@ from ..solver.newton import NewtonError
 from . import cached_run, default_outdir, describe_newton, diverged_at, figure  # noqa: F401
 from . import fitted_words, pyplot, savefig  # noqa: F401
 from .data import save_figure
+from .. import lazy
+
+mcollections = lazy.module("matplotlib.collections")
 
 STATE_COLORS = {"stick": "tab:blue", "slip": "tab:red", "open": "0.6"}
 
@@ -38,9 +41,7 @@ def result(preset="fast", **overrides):
 
 def draw_mesh(ax, X, t, **kw):
     """Outline every quadrilateral of the mesh (nodes X (nn, 2), connectivity t (4, nel))."""
-    from matplotlib.collections import PolyCollection
-
-    ax.add_collection(PolyCollection(X[t.T], facecolors="none", **kw))
+    ax.add_collection(mcollections.PolyCollection(X[t.T], facecolors="none", **kw))
 
 
 @figure("fig06_block_mesh_deformed", "Fig 6")

@@ -29,6 +29,12 @@ from . import cached_run, default_outdir, figure, pyplot, stored
 from .data import RTOL, save_figure, write_data
 from .rounding import held, recorded
 from .. import environment
+from .. import lazy, scenes
+from ..bodies.meshes import cork_mesh
+from ..problem.scene import simulate
+from ..scenes import cork as cork_scene
+
+joblib = lazy.module("joblib")
 
 # the cork run's headline numbers, in the data of each of Figs 14-17 (the summary's row reads them)
 CORK_KEYS = (
@@ -58,8 +64,6 @@ def result(preset="fast", **overrides):
 
 
 def _geometry(params):
-    from ..bodies.meshes import cork_mesh
-
     P = params
     mesh = cork_mesh(P["R_tip"], P["R_cork"], P["L_neck"], P["L_neck"] + P["r_mouth"] + P["L_head"], P["n_r"], P["n_z"])
     neck = bottle_neck(P["R_neck"], P["L_neck"], P["r_mouth"], z_low=-P["gas_column"])
@@ -231,14 +235,9 @@ def _case(preset, over):
 def sensitivity_runs(preset="fast", cases=SENSITIVITY, jobs=2):
     """The outcome of each case at each n_ramp of P0_STEPS (case, overrides, the run's exit
     velocity and press-fit force; "v": as the table prints it); the runs in parallel on `jobs`
-    cores (joblib, if installed; else one by one)."""
+    cores (joblib)."""
     todo = [(label, dict(over, n_ramp=n, t_ramp=n * _RAMP)) for label, over in cases for n in P0_STEPS]
-    try:
-        from joblib import Parallel, delayed
-    except ImportError:
-        out = [_case(preset, over) for _, over in todo]
-    else:
-        out = Parallel(n_jobs=jobs)(delayed(_case)(preset, over) for _, over in todo)
+    out = joblib.Parallel(n_jobs=jobs)(joblib.delayed(_case)(preset, over) for _, over in todo)
     return [dict(x, case=label, overrides=over) for (label, over), x in zip(todo, out)]
 
 
@@ -285,8 +284,6 @@ def sensitivity_reprinted(d):
 @figure("table_cork_sensitivity", "Sec 5.5")
 def table_cork_sensitivity(preset="fast", outdir=None):
     """Markdown table of the exit velocity against the reconstructed data (and its numbers, .json)."""
-    from ..scenes import get_scene
-
     path = Path(outdir or default_outdir(preset)) / "table_cork_sensitivity.md"
     path.parent.mkdir(parents=True, exist_ok=True)
     runs = sensitivity_runs(preset)
@@ -305,7 +302,7 @@ def table_cork_sensitivity(preset="fast", outdir=None):
             for x in runs
         ],
     )
-    parameters = dict(get_scene("cork").resolve(preset), cases=dict(SENSITIVITY), n_ramp=P0_STEPS)
+    parameters = dict(scenes.get_scene("cork").resolve(preset), cases=dict(SENSITIVITY), n_ramp=P0_STEPS)
     return [str(path), write_data(path.with_suffix(".json"), data, parameters)]
 
 
@@ -335,11 +332,10 @@ def knife_grid():
 
 
 def _margin_case(preset, over):
-    from ..scenes import get_scene
-    from ..scenes.cork import press_fit_only
-
     try:
-        return dict(over, **stored(press_fit_only)(get_scene("cork").resolve(preset, over)), error=None)
+        return dict(
+            over, **stored(cork_scene.press_fit_only)(scenes.get_scene("cork").resolve(preset, over)), error=None
+        )
     except Exception as err:  # a failed press fit is a point of the figure, not hidden
         return dict(over, breakaway_margin_MPa=None, error=type(err).__name__)
 
@@ -370,12 +366,7 @@ def knife_edge_data(preset=KNIFE_PRESET, grid=None, jobs=2):
     ]
     line = [dict(p_step=p0 / 8.0, n_ramp=8) for p0 in g["p0"]]
     todo = [(_margin_case, o) for o in field] + [(_run_case, o) for o in runs + line]
-    try:
-        from joblib import Parallel, delayed
-    except ImportError:
-        out = [fn(preset, o) for fn, o in todo]
-    else:
-        out = Parallel(n_jobs=jobs)(delayed(fn)(preset, o) for fn, o in todo)
+    out = joblib.Parallel(n_jobs=jobs)(joblib.delayed(fn)(preset, o) for fn, o in todo)
     nf, nr = len(field), len(runs)
     for o in out[nf + nr :]:
         o["p0"] = o["p_step"] * o["n_ramp"]
@@ -456,13 +447,11 @@ def cork_knife_edge(preset="fast", outdir=None, data=None):
         fontsize=10,
     )
     fig.tight_layout()
-    from ..scenes import get_scene
-
     return save_figure(
         fig,
         Path(outdir or default_outdir(preset)) / "cork_knife_edge.png",
         d,
-        dict(get_scene("cork").resolve(d["preset"]), grid=knife_grid()),
+        dict(scenes.get_scene("cork").resolve(d["preset"]), grid=knife_grid()),
     )
 
 
@@ -521,10 +510,6 @@ def exit_case(case, preset=EXIT_PRESET):
     closing step of its contact on or off in each stage and, with a ramp step, the time step
     refined under the unchanged pressure ramp. Returns the case with the exit time and
     velocity, the press-fit force and the slowest speed of the cork after the ramp (its stall)."""
-    from ..problem.scene import simulate
-    from ..scenes import get_scene
-    from ..scenes.cork import build, contact_forces, exit_of, history, stage_systems, stages
-
     group, label, over, (fit_rule, pop_rule), ramp = case
     row = dict(
         group=group,
@@ -535,18 +520,18 @@ def exit_case(case, preset=EXIT_PRESET):
         ramp_step_s=ramp,
     )
     try:
-        P = get_scene("cork").resolve(preset, over)  # (the ramp is t_ramp's: a finer dt keeps it)
-        model = build(P)
+        P = scenes.get_scene("cork").resolve(preset, over)  # (the ramp is t_ramp's: a finer dt keeps it)
+        model = cork_scene.build(P)
         contacts = model.parts["contacts"]
         rules = ([c.with_closing_step(fit_rule) for c in contacts], [c.with_closing_step(pop_rule) for c in contacts])
-        systems = stage_systems(model.parts, P, contacts=rules)
-        model = replace(model, systems=systems, stages=stages(systems, model.parts, P))
+        systems = cork_scene.stage_systems(model.parts, P, contacts=rules)
+        model = replace(model, systems=systems, stages=cork_scene.stages(systems, model.parts, P))
         records = simulate(model, P)
     except Exception as err:  # a failed run is a row of the study, not hidden
         return dict(row, exited=None, error=f"{type(err).__name__}: {str(err).splitlines()[0][:100]}")
     fit_last, pop = [r for r in records if r.stage == 0][-1], [r for r in records if r.stage == 1]
-    exited, exit_time, _ = exit_of(pop)
-    h = history(model, pop)
+    exited, exit_time, _ = cork_scene.exit_of(pop)
+    h = cork_scene.history(model, pop)
     after = np.flatnonzero(h["t"] > P["t_ramp"] * (1 + 1e-9))
     k = after[np.argmin(h["v_cm"][after])]
     return dict(
@@ -555,7 +540,7 @@ def exit_case(case, preset=EXIT_PRESET):
         error=None,
         exit_time_ms=exit_time * 1e3 if exited else None,
         exit_velocity_m_s=float(h["v_cm"][-1]) if exited else None,
-        press_fit_normal_force_N=contact_forces(fit_last.contacts)["normal"],
+        press_fit_normal_force_N=cork_scene.contact_forces(fit_last.contacts)["normal"],
         v_min_after_ramp_m_s=float(h["v_cm"][k]),
         t_v_min_ms=float(h["t"][k] * 1e3),
         steps=int(len(h["t"]) - 1),
@@ -577,13 +562,11 @@ def cached_exit_case(case, preset=EXIT_PRESET):
 def exit_time_data(cases=None, jobs=2):
     """Every case of ``exit_cases()`` (those not kept yet run in parallel on ``jobs`` cores with
     joblib)."""
-    from joblib import Parallel, delayed
-
     cases = cases or exit_cases()
     kept = stored(exit_case).kept
     todo = [c for c in {json.dumps(c, sort_keys=True): c for c in cases}.values() if not kept(c, EXIT_PRESET)]
     if todo:
-        Parallel(n_jobs=jobs)(delayed(stored_exit_case)(c) for c in todo)
+        joblib.Parallel(n_jobs=jobs)(joblib.delayed(stored_exit_case)(c) for c in todo)
     return dict(preset=EXIT_PRESET, slow=cases is EXIT_CASES_SLOW, cases=[cached_exit_case(c) for c in cases])
 
 
@@ -592,9 +575,7 @@ def exit_time_summary(d):
     the closing step; whether the closing step acts in the pop (the press fit alone decides);
     both rules with the press fit refined (its most increments) at the paper's time step; both
     rules at the finest time step in the neck (ramp kept)."""
-    from ..scenes import get_scene
-
-    paper = get_scene("cork").resolve(d["preset"])
+    paper = scenes.get_scene("cork").resolve(d["preset"])
     rows = [r for r in d["cases"] if r["error"] is None]
 
     def rule(r):
@@ -704,8 +685,6 @@ def cork_exit_time(preset="fast", outdir=None, data=None):
     """Exit time of every case of the study (filled: with the closing step, hollow: without),
     the paper's window shaded; the markdown table and the data beside it. Always the paper
     preset (EXIT_PRESET), whatever `preset`."""
-    from ..scenes import get_scene
-
     plt = pyplot()
     d = data or exit_time_data()
     s = exit_time_summary(d)
@@ -750,5 +729,7 @@ def cork_exit_time(preset="fast", outdir=None, data=None):
     out = Path(outdir or default_outdir(EXIT_PRESET))
     out.mkdir(parents=True, exist_ok=True)
     (out / "cork_exit_time.md").write_text(exit_time_markdown(d))
-    png, data = save_figure(fig, out / "cork_exit_time.png", dict(d, summary=s), get_scene("cork").resolve(d["preset"]))
+    png, data = save_figure(
+        fig, out / "cork_exit_time.png", dict(d, summary=s), scenes.get_scene("cork").resolve(d["preset"])
+    )
     return [png, str(out / "cork_exit_time.md"), data]

@@ -23,6 +23,10 @@ import json
 import re
 from functools import lru_cache
 from pathlib import Path
+from .. import __version__, lazy
+from ..problem.scene import jsonable
+
+plt = lazy.module("matplotlib.pyplot")
 
 RESERVED = ("figure", "code_version", "parameters", "rounding")
 
@@ -63,8 +67,6 @@ def source_hash():
 
 def code_version():
     """contactfem's version and the hash of its sources, e.g. "0.1.0+src.1a2b3c4d5e"."""
-    from .. import __version__
-
     return f"{__version__}+src.{source_hash()}"
 
 
@@ -76,8 +78,6 @@ def dumps(record):
 def figure_record(stem, data, parameters):
     """The dict written to NAME.json: figure, code_version, parameters, then ``data``'s keys
     (numpy values made plain; a key of RESERVED in ``data`` is a ValueError)."""
-    from ..problem.scene import jsonable
-
     clash = [k for k in data if k in RESERVED]
     if clash:
         raise ValueError(f"figure data of {stem} uses the reserved key(s) {', '.join(clash)}")
@@ -116,8 +116,6 @@ def save_figure(fig, path_png, data, parameters):
     json_path = write_data(path.with_suffix(".json"), data, parameters)
     if fig is None:
         return [json_path]
-    import matplotlib.pyplot as plt
-
     fig.savefig(path, dpi=110, bbox_inches="tight")
     plt.close(fig)
     return [str(path), json_path]

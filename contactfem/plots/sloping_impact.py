@@ -20,6 +20,7 @@ from ..scenes.sloping_impact import PAPER_TABLE2
 from ..problem.time_integration import newmark_of
 from . import cached_run, default_outdir, figure, fitted_words, pyplot
 from .data import save_figure, write_data
+from .. import scenes
 
 # what Figs 10-11b show of a run: the rebound (headline) and the drawn series
 IMPACT_KEYS = (
@@ -347,14 +348,12 @@ def discretisation_markdown(rows):
 def table_sloping_impact_discretisation(preset="fast", outdir=None, rows=None):
     """The discretisation study (.md, and .json with its numbers); ``rows``: discretisation_rows
     computed before (default: computed here, about a minute)."""
-    from ..scenes import get_scene
-
     rows = rows if rows is not None else discretisation_rows(preset)
     out = Path(outdir or default_outdir(preset))
     out.mkdir(parents=True, exist_ok=True)
     md = out / "table_sloping_impact_discretisation.md"
     md.write_text(discretisation_markdown(rows))
-    base = get_scene("sloping_impact").resolve(preset, {"variant": "frictionless"})
+    base = scenes.get_scene("sloping_impact").resolve(preset, {"variant": "frictionless"})
     return [
         str(md),
         write_data(

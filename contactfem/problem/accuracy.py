@@ -36,6 +36,8 @@ import warnings
 
 import numpy as np
 
+from .time_integration import integrator_of
+
 
 class AccuracyWarning(UserWarning):
     """A run's accuracy indicator is past its threshold (contactfem.problem.accuracy)."""
@@ -273,8 +275,6 @@ def _penalty_steps(model, steps):
 def stepping(params, records):
     """How a run stepped (``stepping``): the mode (fixed, or at the tolerance params['accuracy']), the
     integrator, the steps taken, the smallest and the largest step, and at_floor."""
-    from .time_integration import integrator_of
-
     dynamic = [r for r in records if r.error is not None]  # (a scene's static stage has no estimate)
     dts = [r.dt for r in dynamic]
     tol = params.get("accuracy") or 0.0

@@ -9,6 +9,9 @@ import numpy as np
 
 from ..contact import NodeToSegment
 from ..contact.augmented import AugmentedNodeToSegment
+from ..contact.lagrange import LagrangeMortar, LagrangeNodeToSegment
+from ..contact.mortar_contact import MortarContact
+from ..solver.newton import ROUNDOFF_RTOL as RTOL
 from ..solver.uzawa import Uzawa
 from .scene import Param
 
@@ -107,8 +110,6 @@ def interface(
     kinematics for a linear material, finite otherwise)."""
     enforcement = params.get("enforcement", "penalty")
     if params.get("contact_discretization", "node_to_segment") == "node_to_segment":
-        from ..contact.lagrange import LagrangeNodeToSegment
-
         cls = {"penalty": NodeToSegment, "augmented": AugmentedNodeToSegment, "lagrange": LagrangeNodeToSegment}
         return cls[enforcement](
             slave,
@@ -122,9 +123,6 @@ def interface(
             tangent=tangent,
             integration=integration,
         )
-    from ..contact.lagrange import LagrangeMortar  # (scipy: loaded when a scene builds, not by show)
-    from ..contact.mortar_contact import MortarContact
-
     assert enforcement != "augmented" and tangent == "consistent" and integration == "standard", (
         "a mortar contact with node-to-segment options (enforcement.check refuses them)"
     )
@@ -152,8 +150,6 @@ def check_roundoff(c_N, traction, length, unit=""):
     size of the coordinates) times the penalty c_N is a traction above ROUNDOFF_SHARE times
     Newton's round-off tolerance (solver.newton.ROUNDOFF_RTOL) of the scene's traction: Newton's
     force test cannot be met, and the answer is round-off (penalty, and Lagrange's steering c_N)."""
-    from ..solver.newton import ROUNDOFF_RTOL as RTOL
-
     limit = ROUNDOFF_SHARE * RTOL * traction / (np.finfo(float).eps * length)
     if c_N > limit:
         raise ValueError(

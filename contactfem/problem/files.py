@@ -42,9 +42,13 @@ from pathlib import Path
 
 import numpy as np
 
+from ..laws.protocol import LawValueError
+from ..solver.newton import NewtonError
+from ..solver.system import System
 from .model import Stage
 from .params import Param, parse_all
 from .scene import LAW_RANGE_KEYS, RUN_KEYS, Model, Scene, simulate
+from .time_integration import ACCURACY_PARAM
 
 # names of results the run sets itself (RUN_KEYS, and what scenes.run_scene and the error bars add);
 # ``accuracy`` is the run's section, where a scene adds its own indicators
@@ -117,8 +121,6 @@ def exec_file(path, what):
 
 def _guarded(fn, path, role):
     """fn, with any error of the user's code turned into one SceneError line."""
-    from ..laws.protocol import LawValueError
-    from ..solver.newton import NewtonError
 
     def call(*args, **kwargs):
         try:
@@ -158,8 +160,6 @@ def _checked_build(build, path, own_simulate):
 
 def _bad_model(model, own_simulate):
     """What is wrong with a file's Model, in words naming the key, or None."""
-    from ..solver.system import System
-
     for i, system in enumerate(model.systems):
         if not isinstance(system, System):
             return f"Model.systems[{i}] is a {type(system).__name__}, not a System (contactfem.solver.System)"
@@ -310,7 +310,6 @@ def _checked_numbers(fn, path, role, keys, positive=()):
 
 def _named_overlap(fn, path):
     """A scene's simulate ``fn``, with a run that fails after starting from overlapping bodies saying so."""
-    from ..solver.newton import NewtonError
 
     def call(model, params, progress):
         try:
@@ -345,8 +344,6 @@ def _overlap(record, model):
 
 def _check_declaration(scene, path):
     """ValueError (one line, naming the file and the key) for a Scene whose declaration is wrong."""
-    from .time_integration import ACCURACY_PARAM
-
     where = f"scene file {path.name}, SCENE"
     if not isinstance(scene.params, (tuple, list)):
         raise ValueError(f"{where}: params is a {type(scene.params).__name__}, not a tuple of Param")

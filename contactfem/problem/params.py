@@ -13,7 +13,7 @@ elements, a cork's tip between the neck's radius and its own) is part of the par
 a scene's parameter is checked; the constructors the scene calls only assert what they need."""
 
 import numbers
-
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, Callable
 
@@ -159,8 +159,6 @@ def parse_all(params, values):
 def check_overrides(overrides):
     """``overrides`` as a dict (None: no overrides); TypeError naming it unless it is a mapping of
     parameter names to values (e.g. {"nx": 12})."""
-    from collections.abc import Mapping
-
     if overrides is None:
         return {}
     if not isinstance(overrides, Mapping):

@@ -13,16 +13,25 @@ A scene module defines ``SCENE = Scene(...)``; the registry in ``contactfem.scen
 it. Parameter names follow the paper's symbols (c_N, c_T, m, n, alpha, beta, mu, E, nu, dt,
 delta, beta_newmark, ...)."""
 
+import dataclasses
 import time
 from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
 
+from .. import solver
+from ..clock import imports_timed
+from ..laws import check as law_check
+from ..solver.march import evaluations
+from .accuracy import collect, references, stepping, warn
 from .model import Model, Stage  # noqa: F401  (scene modules take them here)
 from .params import Limit, Param, check_overrides, parse_all  # noqa: F401  (scene modules take Param, Limit here)
 from .resources import check_resources, describe  # noqa: F401  (the command line takes them from here)
+from .resources import estimate as estimate_resources
+from .time_integration import at_tolerance_values
 from .uncertainty import TOLERANCE, Discretisation, Quantity  # noqa: F401  (scene modules take them here)
+from .uncertainty import bands, run_level
 
 # what a run reports of itself, how it went rather than what it computed (set by run and
 # scenes.run_scene; io.compare_runs leaves them out): a scene's measure may not return them
@@ -56,21 +65,18 @@ def simulate(model, params=None, progress=None):
     every step, as one list (``record.stage``: which stage made it); a stage given as a function is
     built from the last record of the stage before it, and its ``until`` may end it early. A
     NewtonError that ends the run carries the records so far (``error.records``)."""
-    from ..solver.march import march, watch
-    from ..solver.newton import NewtonError
-
     records = []
     try:
         for i, stage in enumerate(model.stages):
             st = stage if isinstance(stage, Stage) else stage(records[-1])
-            marched = march(
+            marched = solver.march(
                 st.stepper, st.schedule, st.t0, st.u0, st.v0, a0=st.a0, label=st.label, state=st.state, stage=i
             )
             if st.until is not None:
                 marched = st.until(marched)
-            for rec in watch(marched, progress, st.t0, st.schedule.t_end, st.name or model.name):
+            for rec in solver.watch(marched, progress, st.t0, st.schedule.t_end, st.name or model.name):
                 records.append(rec)
-    except NewtonError as err:
+    except solver.NewtonError as err:
         err.records = records
         raise
     return records
@@ -100,10 +106,6 @@ def run(
     With ``error_bars``, the scene's headline quantities (``scene.quantities``) get their error bands from
     coarser runs (problem/uncertainty.py: the section ``uncertainty``; a band past ``tolerance``, relative,
     warns); each closed form a quantity declares is an accuracy indicator held to ``tolerance`` too."""
-    from ..clock import imports_timed
-    from ..solver.march import evaluations
-    from .accuracy import collect, references, stepping, warn
-
     with imports_timed() as imported:  # modules loaded on first use: not the run's time
         t0 = time.perf_counter()
         options = dict(linear_algebra=linear_algebra, instrument=instrument)
@@ -132,7 +134,6 @@ def run(
     results.setdefault("newton_iterations_total", int(sum(r.iterations for r in records)))  # if not counted
     del records, model, systems  # (the ladder's runs need the memory)
     if error_bars and scene.quantities:
-        from .uncertainty import bands, run_level
 
         def level(p):
             return run(scene, p, normal, friction, linear_algebra=linear_algebra, error_bars=False)
@@ -227,8 +228,6 @@ class Scene:
                 )
         if self.check is not None:
             self.check(values)
-        from .time_integration import at_tolerance_values
-
         return at_tolerance_values(values)
 
     def law_param_kind(self, name, value=None):
@@ -248,8 +247,6 @@ class Scene:
         """Before anything runs: ValueError (one line) if a law object (or class) is given for a
         kind the scene's contact does not have, or a parameter is set that builds a law it
         replaces (the hint names the law's own field)."""
-        import dataclasses
-
         for kind, law in laws.items():
             if kind not in self.laws:
                 what = "is frictionless" if kind == "friction" else "has no normal law"
@@ -296,18 +293,14 @@ class Scene:
         sentences (a derivative that disagrees with finite differences); raises LawError (one
         line) for a value no law may return (NaN, Y < 0, t_N > 0), a law that breaks the
         protocol, or a block its friction cannot hold."""
-        from ..laws.check import DEFAULT_RANGE, preflight
-
         if not laws:
             return []
-        limits = DEFAULT_RANGE if self.law_range is None else self.law_range(params)
-        return preflight(laws.get("friction"), laws.get("normal"), **limits)
+        limits = law_check.DEFAULT_RANGE if self.law_range is None else self.law_range(params)
+        return law_check.preflight(laws.get("friction"), laws.get("normal"), **limits)
 
     def estimate(self, params, linear_algebra="auto"):
         """Size of the run from the resolved parameters (resources.estimate), or None."""
-        from .resources import estimate
-
-        return None if self.size is None else estimate(self.size(params), linear_algebra)
+        return None if self.size is None else estimate_resources(self.size(params), linear_algebra)
 
 
 # What a scene's law_range(params) returns, all maxima of the run (generous bounds from the

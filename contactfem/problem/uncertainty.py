@@ -58,8 +58,10 @@ import warnings
 from dataclasses import dataclass, field
 from typing import Callable
 
-from .accuracy import TOLERANCE, indicator  # TOLERANCE: the relative band a quantity may have (--tolerance)
 from .. import environment
+from .accuracy import TOLERANCE, indicator  # TOLERANCE: the relative band a quantity may have (--tolerance)
+from .resources import check_resources
+from .time_integration import contact_integration, newmark_of
 
 FS0, FS1 = 2.45, 1.6  # Xing & Stern (2010): the factor of safety at P = 0 and P = 1
 P_MAX = 2.0  # beyond, the coarsest level of the triplet is outside the asymptotic range
@@ -114,8 +116,6 @@ def integrator_order(params):
     delta = 1/2), the energy-consistent midpoint rule and central differences; 1 for Newmark with
     delta > 1/2 (its numerical damping is an error of first order in dt); 1 in the tolerance of a run
     at a tolerance (its error is held proportional to it)."""
-    from .time_integration import contact_integration, newmark_of
-
     if params.get("accuracy"):
         return 1.0
     if params.get("integrator", "newmark") != "newmark" or contact_integration(params) == "energy_consistent":
@@ -199,8 +199,6 @@ def error_bars_default():
     """Whether runs get error bars when nobody says: yes, unless the environment variable
     CONTACTFEM_ERROR_BARS is 0, off, no or false (every run of a process without them: the test suite's
     runs, whose tests of the bands turn them on)."""
-    import os
-
     return environment.read("CONTACTFEM_ERROR_BARS", "on").strip().lower() not in ("0", "off", "no", "false")
 
 
@@ -504,8 +502,6 @@ def run_level(scene_run, scene, params, overrides):
     are: a level outside a parameter's range, or past the resources a run may take without --force, is
     not taken), without error bars and without its warnings. Returns the results, or the Exception that
     stopped it."""
-    from .resources import check_resources
-
     try:
         p = scene.with_values(params, overrides)
         check_resources(scene, p)

@@ -2,16 +2,30 @@
 paper's examples (or a verification problem with a closed form) and declares its
 parameters. A module becomes a scene by defining ``SCENE = Scene(...)``.
 
-Listing the scenes imports every scene module, so a scene module imports scikit-fem
-(and the continuum bodies built on it) inside the functions that build the model:
+Listing the scenes imports every scene module, so a scene module takes scikit-fem (and the
+continuum bodies built on it) as lazy modules (contactfem/lazy.py), loaded when a model is built:
 ``contactfem list`` and ``show`` then load neither scikit-fem nor scipy nor matplotlib."""
 
 import importlib
 import pkgutil
+import warnings
+from pathlib import Path
 
-from ..problem.scene import Limit, Model, Param, Scene, Stage, jsonable, simulate
-from ..problem.uncertainty import Discretisation, Quantity, mesh, penalty, time_step
+from ..laws.protocol import as_normal_law, describe
 from ..problem.files import SceneError, is_scene_file, load_scene_file
+from ..problem.params import check_overrides
+from ..problem.scene import Limit, Model, Param, Scene, Stage, jsonable, simulate
+from ..problem.uncertainty import (
+    TOLERANCE,
+    Discretisation,
+    Quantity,
+    check_tolerance,
+    error_bars_default,
+    mesh,
+    penalty,
+    time_step,
+)
+from ..solver.assembly import KINDS
 
 
 def all_scenes():
@@ -34,8 +48,6 @@ def get_scene(name):
     if isinstance(name, Scene):
         return name
     if is_scene_file(name):
-        from pathlib import Path
-
         if not Path(name).expanduser().is_file():
             raise ValueError(
                 f"unknown scene {str(name)!r}: no scene file there (a path to a .py file that defines "
@@ -108,15 +120,6 @@ def run_scene(
     ``error_bars``: the headline quantities with their error bands from coarser runs (the section
     ``uncertainty``; problem/uncertainty.py); None: on, unless $CONTACTFEM_ERROR_BARS is 0 or off.
     ``tolerance``: the relative band (and closed-form error) past which a quantity warns (default 0.05)."""
-    import warnings
-
-    from ..laws.protocol import as_normal_law, describe
-    from ..solver.assembly import KINDS
-
-    from ..problem.params import check_overrides
-
-    from ..problem.uncertainty import TOLERANCE, check_tolerance, error_bars_default
-
     scene = get_scene(name)
     overrides = check_overrides(overrides)
     tolerance = TOLERANCE if tolerance is None else check_tolerance(tolerance)

@@ -56,12 +56,16 @@ rebound velocity (momentum / mass at the end) and the energy error.
 
 import numpy as np
 
+from .. import lazy
 from ..contact import RigidLine, tributary_lengths
 from ..laws import PowerLaw
-from ..solver import CentralDifference, History, System
 from ..problem import enforcement, time_integration
 from ..problem.scene import Model, Param, Quantity, Scene, Stage
 from ..problem.uncertainty import mesh, penalty, time_step
+from ..solver import CentralDifference, History, System
+
+skfem = lazy.module("skfem")
+continuum = lazy.module("contactfem.bodies.continuum")  # loads scikit-fem: not when the scenes are listed
 
 
 def bar_exact(L, E, rho, v0):
@@ -100,15 +104,11 @@ def check(params):
 
 def build(params, *, normal=None, friction=None, system_options=None):
     """``normal`` / ``friction``: law objects instead of the parameters' (frictionless by default)."""
-    from skfem import MeshQuad
-
-    from ..bodies.continuum import Continuum
-
     L, H = params["L"], params["h"]
     n = params["n_el"]
-    mesh = MeshQuad.init_tensor(np.linspace(0.0, L, n + 1), np.linspace(0.0, H, 2))
+    mesh = skfem.MeshQuad.init_tensor(np.linspace(0.0, L, n + 1), np.linspace(0.0, H, 2))
     mesh = mesh.translated((params["gap"], 0.0)).with_boundaries({"left": lambda x: x[0] < params["gap"] + 1e-9 * L})
-    body = Continuum(mesh, params["E"], 0.0, params["rho"], kind="plane_stress", name="bar")
+    body = continuum.Continuum(mesh, params["E"], 0.0, params["rho"], kind="plane_stress", name="bar")
     nodes = np.flatnonzero(body.X[:, 0] < params["gap"] + 1e-9 * L)
     nodes = nodes[np.argsort(body.X[nodes, 1])]
     w = tributary_lengths(body.X[nodes])

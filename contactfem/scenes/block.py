@@ -65,17 +65,22 @@ node slips with the conical law) is the preset ``canonical``.
 """
 
 import numpy as np
+
+from .. import lazy
 from ..bodies.materials import MATERIALS
+from ..bodies.meshes import block_mesh
+from ..contact import RigidLine, tributary_lengths
 from ..contact.tangents import TANGENTS
 from ..laws.friction import Coulomb, ParabolicSlip
-from ..problem import enforcement
-from ..problem.scene import PENALTIES, PENALTY_DOC, Limit, Param
-from ..contact import RigidLine, tributary_lengths
 from ..laws.normal import PowerLaw
 from ..laws.protocol import FrictionLaw
-from ..solver import Static, Steps, System
-from ..problem.scene import Model, Quantity, Scene, Stage, simulate
+from ..problem import enforcement
+from ..problem.scene import PENALTIES, PENALTY_DOC, Limit, Model, Param, Quantity, Scene, Stage, simulate
 from ..problem.uncertainty import mesh
+from ..solver import Static, Steps, System
+
+continuum = lazy.module("contactfem.bodies.continuum")  # loads scikit-fem: not when the scenes are listed
+body_loads = lazy.module("contactfem.bodies.loads")  # loads scikit-fem
 
 
 # Table 1 of the paper: norm of the residual ||G|| per Newton iteration (the first
@@ -358,13 +363,9 @@ def build(params, *, normal=None, friction=None, system_options=None):
     """Body, contact, loads, System and the load stepping of the block (no solve): a dict.
     ``normal`` / ``friction``: law objects to use instead of the ones params build
     (the penalty law of c_N, m, and params["law"]): a student's law."""
-    from ..bodies.continuum import Continuum
-    from ..bodies.loads import Pressure, Traction
-    from ..bodies.meshes import block_mesh
-
     W, H = params["width"], params["height"]
     mesh = block_mesh(W, H, params["nx"], params["ny"])
-    body = Continuum(
+    body = continuum.Continuum(
         mesh,
         E=params["E"],
         nu=params["nu"],
@@ -394,8 +395,8 @@ def build(params, *, normal=None, friction=None, system_options=None):
     )
     p_y, p_x = params["p_y"], params["p_x"]
     loads = [
-        Pressure(body, "top", lambda t: p_y * t),  # dead loads, ramped over the
-        Traction(body, params["p_x_face"], lambda t: (p_x * t, 0.0)),
+        body_loads.Pressure(body, "top", lambda t: p_y * t),  # dead loads, ramped over the
+        body_loads.Traction(body, params["p_x_face"], lambda t: (p_x * t, 0.0)),
     ]  # pseudo-time t in [0, 1]
     system = System([body], [contact], loads, **(system_options or {}))
     n = params["n_steps"]

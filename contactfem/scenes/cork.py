@@ -104,17 +104,22 @@ from functools import partial
 
 import numpy as np
 
+from .. import lazy
+from ..bodies.meshes import cork_mesh
 from ..contact import NodeToSegment, tributary_lengths
 from ..contact.masters import bottle_neck
 from ..laws.friction import SlipHardening
 from ..laws.normal import PowerLaw
 from ..problem import time_integration
 from ..problem.accuracy import indicator
-from ..problem.scene import PENALTIES, PENALTY_DOC, Limit, Model, Param, Quantity, Scene, Stage
+from ..problem.scene import PENALTIES, PENALTY_DOC, Limit, Model, Param, Quantity, Scene, Stage, simulate
 from ..problem.time_integration import newmark_of, newmark_params
 from ..problem.uncertainty import mesh, time_step
 from ..solver import Adaptive, Dirichlet, Newmark, Static, System
 from ..solver.schedule import AtTolerance
+
+continuum = lazy.module("contactfem.bodies.continuum")  # loads scikit-fem: not when the scenes are listed
+body_loads = lazy.module("contactfem.bodies.loads")  # loads scikit-fem
 
 
 # The paper's numbers (Sec. 5.5) the run is compared with.
@@ -274,8 +279,6 @@ def fit_summary(model, P, fit):
 def measure(model, P, records):
     """The cork's results (JSON-able) from both stages' records (record.stage: 0 the press fit,
     1 the pop)."""
-    from ..bodies.continuum import boundary_loop
-
     fit = fit_summary(model, P, [r for r in records if r.stage == 0])
     pop = [r for r in records if r.stage == 1]
     h = history(model, pop)
@@ -286,7 +289,7 @@ def measure(model, P, records):
     snaps = snapshot_times(P["t_ramp"], exit_time, h["t"][-1])
     idx = [int(np.argmin(np.abs(h["t"] - ts))) for ts in snaps]
     cork, states = model.parts["cork"], [rec.u for rec in pop]
-    loop = boundary_loop(cork.mesh)  # outlines for animations
+    loop = continuum.boundary_loop(cork.mesh)  # outlines for animations
     frames = np.unique(np.linspace(0, len(h["t"]) - 1, 80).astype(int))
     failures = [f for rec in pop for f in rec.failures]
     return dict(
@@ -509,8 +512,6 @@ def stages(systems, parts, P):
 def press_fit_only(params):
     """Stage 1 alone (a few seconds): the press-fit force and the static breakaway margin,
     without the pop. For studies of the knife's edge over mu, R_tip and p0."""
-    from ..problem.scene import simulate
-
     model = build(params)
     fit = fit_summary(model, params, simulate(replace(model, stages=model.stages[:1]), params))
     return dict(
@@ -670,15 +671,11 @@ PARAMS = (
 def build(params, *, normal=None, friction=None, system_options=None):
     """Cork, neck, contact, gas: everything both stages share (press_fit and pop step them).
     ``normal`` / ``friction``: law objects instead of the ones the parameters build."""
-    from ..bodies.continuum import Continuum
-    from ..bodies.loads import GasPressure
-    from ..bodies.meshes import cork_mesh
-
     P = params
     assert 0 < P["R_neck"] <= P["R_tip"] <= P["R_cork"], "R_tip, R_cork outside their Params' limits"
     length = P["L_neck"] + P["r_mouth"] + P["L_head"]
     mesh = cork_mesh(P["R_tip"], P["R_cork"], P["L_neck"], length, P["n_r"], P["n_z"])
-    cork = Continuum(mesh, P["E"], P["nu"], P["rho"], kind="axisymmetric", material="neohooke", name="cork")
+    cork = continuum.Continuum(mesh, P["E"], P["nu"], P["rho"], kind="axisymmetric", material="neohooke", name="cork")
     shift0 = P["R_cork"] - P["R_neck"]  # the press fit moves the neck in from r = R_cork
     neck = bottle_neck(P["R_neck"], P["L_neck"], P["r_mouth"], motion=lambda t: (shift0 * (1.0 - t), 0.0))
     side = cork.boundary_nodes("outer")[::-1]  # bottom corner first, upwards
@@ -695,7 +692,7 @@ def build(params, *, normal=None, friction=None, system_options=None):
     )
     axis = cork.boundary_nodes("axis")
     bottom = cork.boundary_nodes("bottom")
-    gas = GasPressure(
+    gas = body_loads.GasPressure(
         cork,
         "bottom",
         bottom,

@@ -44,13 +44,18 @@ oscillate about Hertz's profile from node to node, mortar's do not (``oscillatio
 
 import numpy as np
 
-from ..contact import RigidLine, tributary_lengths
+from .. import lazy
+from ..bodies.meshes import graded_block_mesh, grading_for, quarter_disk
+from ..contact import BodySurface, RigidLine, tributary_lengths
 from ..laws import PowerLaw
-from ..solver import Dirichlet, History, Static, Steps, System
 from ..problem import enforcement
 from ..problem.accuracy import hertz_half_width
 from ..problem.scene import PENALTIES, PENALTY_DOC, Model, Param, Quantity, Scene, Stage
 from ..problem.uncertainty import mesh, penalty
+from ..solver import Dirichlet, History, Static, Steps, System
+
+continuum = lazy.module("contactfem.bodies.continuum")  # loads scikit-fem: not when the scenes are listed
+body_loads = lazy.module("contactfem.bodies.loads")  # loads scikit-fem
 
 
 def hertz_exact(P, R, E, nu, E2=np.inf, nu2=0.0):
@@ -64,13 +69,9 @@ def hertz_exact(P, R, E, nu, E2=np.inf, nu2=0.0):
 def foundation(params, h, a):
     """The elastic foundation (module docstring): its body, the master surface on its top
     and its supports."""
-    from ..bodies.continuum import Continuum
-    from ..bodies.meshes import graded_block_mesh
-    from ..contact import BodySurface
-
     R = params["R"]
     mesh = graded_block_mesh(R, params["foundation_ratio"] * h, 2.5 * a, a)
-    body = Continuum(
+    body = continuum.Continuum(
         mesh,
         params["E_foundation"],
         params["nu"],
@@ -103,10 +104,6 @@ def fit_hertz(x, p):
 def build(params, *, normal=None, friction=None, system_options=None):
     """Body, contact, load, supports and load stepping of the quarter cylinder; returns a dict.
     ``normal`` / ``friction``: law objects instead of the parameters' (frictionless by default)."""
-    from ..bodies.continuum import Continuum
-    from ..bodies.loads import Pressure
-    from ..bodies.meshes import grading_for, quarter_disk
-
     R, E, nu, P = params["R"], params["E"], params["nu"], params["P"]
     elastic = params.get("foundation", "rigid") == "elastic"
     a_ex, p0_ex = hertz_exact(P, R, E, nu, params["E_foundation"] if elastic else np.inf, nu)
@@ -115,7 +112,7 @@ def build(params, *, normal=None, friction=None, system_options=None):
     xi_zone = min(1.0, 1.5 * a_ex / (R * np.pi / 4))
     k = grading_for(xi_zone, 1.0 / 3.0) * params["grading"]
     mesh = quarter_disk(R, n, k)
-    body = Continuum(mesh, E, nu, 0.0, kind="plane_strain", material=params["material"], name="cylinder")
+    body = continuum.Continuum(mesh, E, nu, 0.0, kind="plane_strain", material=params["material"], name="cylinder")
 
     arc = body.X[:, 0] ** 2 + body.X[:, 1] ** 2 > (R * (1 - 1e-9)) ** 2
     near = arc & (body.X[:, 0] < min(0.7 * R, 4.0 * a_ex))
@@ -146,7 +143,7 @@ def build(params, *, normal=None, friction=None, system_options=None):
     sym = np.flatnonzero(np.abs(body.X[:, 0]) < 1e-9 * R)
     fixed = [Dirichlet(body, body.xdofs[sym, 0], 0.0)] + more_fixed
     q = P / (2.0 * R)
-    load = Pressure(body, "top", lambda t: q * min(t, 1.0))
+    load = body_loads.Pressure(body, "top", lambda t: q * min(t, 1.0))
     system = System(bodies, [contact], [load], fixed, **(system_options or {}))
     # initial guess: the rigid translation that overlaps the plane over |x| < a (a^2 / 2R),
     # so that the first tangent is not singular (the plane is the only vertical support)

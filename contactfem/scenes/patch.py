@@ -63,30 +63,29 @@ carries no shear and is again the exact one.
 
 import numpy as np
 
+from .. import lazy
 from ..contact import BodySurface, tributary_lengths
 from ..laws import Coulomb, PowerLaw
-from ..solver import Dirichlet, History, Static, Steps, System
 from ..problem import enforcement
 from ..problem.scene import Model, Param, Quantity, Scene, Stage
+from ..solver import Dirichlet, History, Static, Steps, System
+
+skfem = lazy.module("skfem")
+continuum = lazy.module("contactfem.bodies.continuum")  # loads scikit-fem: not when the scenes are listed
+body_loads = lazy.module("contactfem.bodies.loads")  # loads scikit-fem
 
 
 def block(xs, y0, y1, ny, name, E, nu):
     """A block of quads on the grid xs x linspace(y0, y1, ny + 1); boundaries bottom, top."""
-    from skfem import MeshQuad
-
-    from ..bodies.continuum import Continuum
-
-    mesh = MeshQuad.init_tensor(np.asarray(xs, dtype=float), np.linspace(y0, y1, ny + 1))
+    mesh = skfem.MeshQuad.init_tensor(np.asarray(xs, dtype=float), np.linspace(y0, y1, ny + 1))
     tol = 1e-9 * (xs[-1] - xs[0])
     mesh = mesh.with_boundaries({"bottom": lambda x: np.abs(x[1] - y0) < tol, "top": lambda x: np.abs(x[1] - y1) < tol})
-    return Continuum(mesh, E, nu, 0.0, kind="plane_strain", name=name)
+    return continuum.Continuum(mesh, E, nu, 0.0, kind="plane_strain", name=name)
 
 
 def build(params, *, normal=None, friction=None, system_options=None):
     """The two blocks, the contact passes, the loads and supports and the one load step.
     ``normal`` / ``friction``: law objects instead of the parameters' (frictionless by default)."""
-    from ..bodies.loads import OverhangPressure, Pressure
-
     W, H, E, nu = params["W"], params["H"], params["E"], params["nu"]
     e, xs_lower, xs_upper = columns(params)
     lower = block(xs_lower, 0.0, H, params["ny"], "lower", E, nu)
@@ -147,7 +146,10 @@ def build(params, *, normal=None, friction=None, system_options=None):
     if friction is None:  # with friction the interface holds the upper block
         fixed.append(Dirichlet(upper, upper.xdofs[node(upper, 0.0, 2 * H), 0], 0.0))
     top_sorted = top_lower[np.argsort(lower.X[top_lower, 0])]
-    loads = [Pressure(upper, "top", params["p"]), OverhangPressure(lower, top_sorted, params["p"], 0.0, W)]
+    loads = [
+        body_loads.Pressure(upper, "top", params["p"]),
+        body_loads.OverhangPressure(lower, top_sorted, params["p"], 0.0, W),
+    ]
     system = System([lower, upper], contacts, loads, fixed, **(system_options or {}))
     p = params["p"]
     # initial guess: the upper block pushed into the lower by twice the penalty

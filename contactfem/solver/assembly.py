@@ -42,9 +42,12 @@ index arrays as before (a body's constant connectivity, ``key`` = the body).
 
 import numpy as np
 
+from .. import lazy
 from .banded import BANDED_WORK, BOUND_MIN, BandPlan, band_too_wide
 from .dissection import DISSECTION_MIN, DissectionPlan
 from .newton import DENSE_ORDERING, ORDERING
+
+sp = lazy.module("scipy.sparse")
 
 # Up to this many unknowns K is dense. Measured on the paper's ring matrices (banded, 3
 # dofs per node): LAPACK beats SuperLU below about 100-150 unknowns (48: 16 us against
@@ -117,11 +120,9 @@ class TangentAssembler:
         self._ends = np.append(self.keys, -1)  # a position beyond the last key finds no key there
         where = np.empty(merged.size, dtype=np.int64)
         where[order] = np.cumsum(first) - 1  # each merged key's place in the pattern
-        from scipy.sparse import csc_matrix
-
         indices = self.keys % self.n  # row of each entry
         indptr = np.searchsorted(self.keys, np.arange(self.n + 1) * self.n)
-        self._template = csc_matrix((np.zeros(self.keys.size), indices, indptr), shape=(self.n, self.n))
+        self._template = sp.csc_matrix((np.zeros(self.keys.size), indices, indptr), shape=(self.n, self.n))
         self.indices, self.indptr = self._template.indices, self._template.indptr  # scipy's index dtype
         self.indices.flags.writeable = self.indptr.flags.writeable = False  # shared by every K
         self.diag_pos = np.searchsorted(self.keys, diag)

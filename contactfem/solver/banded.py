@@ -19,9 +19,13 @@ to the free dofs): the permutation, kl and ku, and for every stored entry of K t
 it takes in the band storage. A solve only scatters the values there and calls LAPACK.
 """
 
-from functools import lru_cache
-
 import numpy as np
+
+from .. import lazy
+
+sp = lazy.module("scipy.sparse")
+csgraph = lazy.module("scipy.sparse.csgraph")
+lapack = lazy.module("scipy.linalg.lapack")
 
 # The band LU is used while its work per unknown, kl (kl + ku), is at most BANDED_WORK; above,
 # SuperLU. What decides is the width of the band, not the number of unknowns: SuperLU's fill
@@ -45,12 +49,9 @@ BANDED_WORK = 1.5e4
 BOUND_MIN = 10_000
 
 
-@lru_cache(maxsize=1)
 def lapack_dgbsv():
-    """LAPACK's general band solver (scipy), imported on first use (not at every solve)."""
-    from scipy.linalg.lapack import dgbsv
-
-    return dgbsv
+    """LAPACK's general band solver (scipy)."""
+    return lapack.dgbsv
 
 
 def band_too_wide(indptr, indices, n, free=None, work=BANDED_WORK):
@@ -88,8 +89,7 @@ def band_too_wide(indptr, indices, n, free=None, work=BANDED_WORK):
             break
     if 2.0 * np.ceil(b) ** 2 <= work:
         return False
-    import scipy.sparse as sp  # structural symmetry: the pattern equals its transpose
-
+    # structural symmetry: the pattern equals its transpose
     t = sp.csr_matrix((np.ones(len(indices)), indices, indptr), shape=(n, n)).tocsc()
     return bool(np.array_equal(t.indptr, indptr) and np.array_equal(t.indices, indices))
 
@@ -99,9 +99,6 @@ class BandPlan:
     storage after an RCM renumbering of the block ``free`` (None: all dofs)."""
 
     def __init__(self, indptr, indices, n, free=None):
-        import scipy.sparse as sp
-        from scipy.sparse.csgraph import reverse_cuthill_mckee
-
         self.indptr, self.indices, self.free = indptr, indices, free
         rows = np.asarray(indices, dtype=np.int64)
         cols = np.repeat(np.arange(n), np.diff(indptr))
@@ -115,7 +112,7 @@ class BandPlan:
             rows, cols = local[rows[inside]], local[cols[inside]]
         self.n = m
         graph = sp.csr_matrix((np.ones(rows.size), (rows, cols)), shape=(m, m))
-        self.perm = reverse_cuthill_mckee((graph + graph.T).tocsr(), symmetric_mode=True).astype(np.int64)
+        self.perm = csgraph.reverse_cuthill_mckee((graph + graph.T).tocsr(), symmetric_mode=True).astype(np.int64)
         new = np.empty(m, dtype=np.int64)
         new[self.perm] = np.arange(m)
         r, c = new[rows], new[cols]

@@ -42,11 +42,14 @@ with the derivative of X on the diagonal.
 
 import numpy as np
 
+from .. import lazy
 from ..bodies.discrete_gradient import cayley
 from .estimate import MIDPOINT
 from .newmark import increment, inertia_roundoff
 from .newton import newton
 from .system import Evaluation
+
+sp = lazy.module("scipy.sparse")
 
 
 class EnergyConsistent:
@@ -91,8 +94,6 @@ class EnergyConsistent:
         return G, rows, cols, vals
 
     def step(self, t, u, v, a, dt, label="", *, state):
-        import scipy.sparse as sp
-
         assert dt > 0, "a step's size comes from its Schedule, which checks it"
         s = self.system
         t1, tm = t + dt, t + 0.5 * dt

@@ -24,7 +24,12 @@ partial pivoting (the tangent with friction is not symmetric).
 
 import numpy as np
 
+from .. import lazy
 from .banded import BandPlan
+
+sp = lazy.module("scipy.sparse")
+linalg = lazy.module("scipy.sparse.linalg")
+pymetis = lazy.module("pymetis")
 
 DISSECTION_MIN = 10_000  # free unknowns from which the sparse path is renumbered by METIS
 
@@ -53,9 +58,6 @@ class DissectionPlan:
     pattern (indptr, indices, n x n), and where each stored entry goes in the renumbered block."""
 
     def __init__(self, indptr, indices, n, free=None):
-        import pymetis
-        import scipy.sparse as sp
-
         self.indptr, self.indices, self.free = indptr, indices, free
         rows = np.asarray(indices, dtype=np.int64)
         cols = np.repeat(np.arange(n), np.diff(indptr))
@@ -106,11 +108,8 @@ class DissectionPlan:
     def solve(self, data, b):
         """x from A x = b, A the matrix with values ``data`` (of the CSC pattern), on the block.
         Raises RuntimeError on an exactly singular matrix, as SuperLU does."""
-        import scipy.sparse as sp
-        from scipy.sparse.linalg import splu
-
         A = sp.csc_matrix((data[self.take], self.p_indices, self.p_indptr), shape=(self.n, self.n))
-        y = splu(A, permc_spec="NATURAL").solve(np.asarray(b, dtype=float)[self.perm])
+        y = linalg.splu(A, permc_spec="NATURAL").solve(np.asarray(b, dtype=float)[self.perm])
         out = np.empty(self.n)
         out[self.perm] = y
         return out

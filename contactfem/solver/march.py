@@ -23,15 +23,21 @@ leaving the loop. The loop estimates each dynamic step's local error (estimate.p
 (``resume``: and its flights). ``integrate`` collects a march into a ``History`` of arrays.
 """
 
+import dataclasses
+import numbers
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from .. import lazy
 from .estimate import Slope, StepError, error_vector, momentum_norm, norm
 from .newton import NewtonError
 from .rounding import perturbed
 from .schedule import StepRejected, Steps
 from .system import SystemState
+
+sparse = lazy.module("scipy.sparse")
+linalg = lazy.module("scipy.sparse.linalg")
 
 
 @dataclass(frozen=True, eq=False)
@@ -111,11 +117,6 @@ def _kept(rec):
 def same_value(a, b):
     """Whether a and b hold the same values, bit for bit (NaN equal to NaN): numbers, text, arrays,
     sparse matrices, and tuples, lists, dicts and dataclasses of them, compared element by element."""
-    import dataclasses
-    import numbers
-
-    from scipy import sparse
-
     if a is b:
         return True
     if isinstance(a, (numbers.Number, np.generic)) and isinstance(b, (numbers.Number, np.generic)):
@@ -334,10 +335,8 @@ def acceleration(system, G):
         free = system.free_dofs[M[system.free_dofs] > 0]
         a[free] = -G[free] / M[free]
         return a
-    from scipy.sparse.linalg import spsolve
-
     free = system.free_dofs[M.diagonal()[system.free_dofs] > 0]
-    a[free] = spsolve(M[free][:, free].tocsc(), -G[free])
+    a[free] = linalg.spsolve(M[free][:, free].tocsc(), -G[free])
     return a
 
 

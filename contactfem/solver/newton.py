@@ -67,7 +67,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import lazy
 from .instrument import timed
+
+sp = lazy.module("scipy.sparse")
+linalg = lazy.module("scipy.sparse.linalg")
 
 # Column ordering of SuperLU. The tangents here have a symmetric sparsity pattern (the
 # contact element couples the same dofs both ways), for which the minimum degree
@@ -90,14 +94,11 @@ def solve_free(K, b, free, all_free):
     plan = getattr(K, "band_plan", None) or getattr(K, "dissection_plan", None)
     if plan is not None and plan.fits(K, None if all_free else free):
         return plan.solve(K.data, b)
-    import scipy.sparse as sp
-    from scipy.sparse.linalg import splu
-
     if all_free:
         Kff = K if K.format == "csc" else sp.csc_matrix(K)
     else:
         Kff = sp.csr_matrix(K)[free][:, free].tocsc()
-    return splu(Kff, permc_spec=ORDERING).solve(b)
+    return linalg.splu(Kff, permc_spec=ORDERING).solve(b)
 
 
 class NewtonError(RuntimeError):

@@ -23,7 +23,9 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
+
 from .. import environment
+from .assembly import KINDS
 
 ENV = dict(linear_algebra="CONTACTFEM_LINEAR_ALGEBRA", perturbation="CONTACTFEM_PERTURB")
 LARGEST = 1e-6  # a larger perturbation is a change of the problem, not of its rounding
@@ -43,8 +45,6 @@ class Condition:
 
 def checked(linear_algebra=None, perturbation=0.0):
     """The Condition of these values; a bad one is a ValueError naming it and its range."""
-    from .assembly import KINDS
-
     if linear_algebra not in (None, "", *KINDS):
         raise ValueError(f"parameter linear_algebra = {linear_algebra!r} is not allowed: one of {'|'.join(KINDS)}")
     try:

@@ -44,9 +44,12 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .. import lazy
 from .assembly import TangentAssembler
 from .instrument import timed
 from .rounding import current
+
+sp = lazy.module("scipy.sparse")
 
 
 @dataclass(frozen=True, eq=False)
@@ -271,8 +274,6 @@ class System:
                     [np.asarray(b.mass(), dtype=float) for b in self.bodies] + [np.zeros(self.ndof - self.body_ndof)]
                 )
             else:
-                import scipy.sparse as sp
-
                 blocks = [
                     b.mass(consistent=True) if b.mass_matrix == "consistent" else sp.diags(b.mass())
                     for b in self.bodies

@@ -32,6 +32,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from ..contact.augmented import AugmentedNodeToSegment
 from .newton import NewtonError
 
 
@@ -75,8 +76,6 @@ class Uzawa:
         if int(max_updates) != max_updates or max_updates < 0:
             raise ValueError(f"parameter uzawa_max_updates = {max_updates!r} is out of range: allowed integers >= 0")
         self.stepper, self.length, self.tol, self.max_updates = stepper, float(length), float(tol), int(max_updates)
-        from ..contact.augmented import AugmentedNodeToSegment
-
         self.contacts = [c for c in contacts if isinstance(c, AugmentedNodeToSegment)]
         if not self.contacts:
             raise ValueError("Uzawa needs at least one augmented interface (enforcement = 'augmented')")

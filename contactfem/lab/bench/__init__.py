@@ -63,6 +63,7 @@ import platform
 
 import numpy as np
 
+from ... import lazy
 from ...scenes import jsonable
 from .common import PAPER_SCENES, TARGETS, observed_order, timed
 from .cost import cost_study, iteration_cost
@@ -77,6 +78,8 @@ from .tangents import VARIANTS, tangent_study
 from .targets import targets_study
 from .work_precision import work_precision
 from .adaptive import adaptive_study
+
+scipy = lazy.module("scipy")
 
 STUDIES = {
     "tangents": tangent_study,
@@ -94,8 +97,6 @@ STUDIES = {
 
 
 def machine():
-    import scipy
-
     return dict(
         python=platform.python_version(),
         numpy=np.__version__,

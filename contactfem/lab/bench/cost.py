@@ -7,8 +7,12 @@ nodes (slope ~1: linear)."""
 
 import numpy as np
 
-from ...scenes import get_scene
+from ... import lazy
+from ...scenes import block, get_scene, hertz, rolling_ring
 from .common import best_of
+
+sp = lazy.module("scipy.sparse")
+linalg = lazy.module("scipy.sparse.linalg")
 
 
 def iteration_cost(system, u, t=1.0, repeat=3, solvers=True, dt=None, state=None):
@@ -20,9 +24,6 @@ def iteration_cost(system, u, t=1.0, repeat=3, solvers=True, dt=None, state=None
     band LU if the System solves banded, SuperLU after its nested-dissection renumbering if
     the System has one (its METIS ordering, made once per pattern, not included), and
     pypardiso if installed); ``solve_s`` is the solver newton() uses (``linear_algebra``)."""
-    import scipy.sparse as sp
-    from scipy.sparse.linalg import splu
-
     state = system.start(u, t) if state is None else state  # the SystemState evaluated with
     out = dict(ndof=int(system.ndof))
     # each body as the System evaluates it (a beam's COO triplets, a continuum's sparse K)
@@ -46,7 +47,7 @@ def iteration_cost(system, u, t=1.0, repeat=3, solvers=True, dt=None, state=None
     if not solvers:
         return out
     for spec in ("COLAMD", "MMD_AT_PLUS_A"):
-        _, out[f"solve_splu_{spec}_s"] = best_of(lambda: splu(Kff, permc_spec=spec).solve(b), repeat)
+        _, out[f"solve_splu_{spec}_s"] = best_of(lambda: linalg.splu(Kff, permc_spec=spec).solve(b), repeat)
     plan = getattr(K, "band_plan", None)
     out["linear_algebra"] = system.linear_algebra
     out["solve_banded_s"] = (
@@ -57,7 +58,7 @@ def iteration_cost(system, u, t=1.0, repeat=3, solvers=True, dt=None, state=None
         best_of(lambda: nd.solve(K.data, b), repeat)[1] if nd is not None and nd.fits(K, free) else None
     )
     try:
-        import pypardiso
+        import pypardiso  # optional: Intel's PARDISO, measured where it is installed
 
         A = Kff.tocsr()
         pypardiso.spsolve(A, b)  # first call: library initialisation
@@ -80,8 +81,6 @@ def iteration_cost(system, u, t=1.0, repeat=3, solvers=True, dt=None, state=None
 
 
 def _block_system(nx, ny, material="linear", width=None):
-    from ...scenes import block
-
     # plane strain: the finite-strain materials have no plane-stress form
     p = get_scene("block").resolve("paper", {"law": "coulomb", "material": material, "plane": "strain"})
     p = dict(p, nx=nx, ny=ny)  # past the scene's nx <= 400 for the scaling study
@@ -97,8 +96,6 @@ def _block_system(nx, ny, material="linear", width=None):
 
 def cost_study(quick=False):
     """Study 3 (module docstring)."""
-    from ...scenes import hertz, rolling_ring
-
     cases = {}
     for material in ("linear", "svk"):
         system, u, state = _block_system(20, 10, material)

@@ -12,9 +12,15 @@ from pathlib import Path
 
 import numpy as np
 
+from ... import environment, lazy
 from ...plots import default_outdir, figure, pyplot
 from ...plots.data import save_figure
-from ... import environment
+from ...scenes import jsonable
+from . import STUDIES, run_bench
+from .speed import PARTS
+from .speed import SPEED_TARGETS as T
+
+ticker = lazy.module("matplotlib.ticker")
 
 
 def bench_json_path():
@@ -37,9 +43,6 @@ def load_bench(preset="fast"):
 @lru_cache(maxsize=4)
 def quick_study(name):
     """One study's quick run, measured in this process once (for a figure whose bench JSON lacks it)."""
-    from ...scenes import jsonable
-    from . import STUDIES
-
     return jsonable(STUDIES[name](True))
 
 
@@ -47,8 +50,6 @@ def quick_study(name):
 def quick_bench():
     """The quick bench of the four studies the figures need (measured in this process: timings
     are not kept on disk)."""
-    from . import run_bench
-
     return run_bench(quick=True, only=("tangents", "work_precision", "cost", "speed"), progress=None)
 
 
@@ -199,10 +200,8 @@ def bench_work_precision(preset="fast", outdir=None):
                 xytext=(3, 3),
             )
     ax.set_title(f"Bar impact ({b['n_el']} elements): contact duration")
-    from matplotlib.ticker import NullFormatter
-
     for a in axes:
-        a.xaxis.set_minor_formatter(NullFormatter())
+        a.xaxis.set_minor_formatter(ticker.NullFormatter())
     ax.set_xlabel("wall time of the run [s]")
     ax.set_ylabel("|duration / (2L/c) - 1|")
     ax.legend(fontsize=8)
@@ -254,8 +253,6 @@ def bench_cost(preset="fast", outdir=None):
 def bench_speed(preset="fast", outdir=None):
     """One Newton iteration of each paper scene split into bulk, contact, assembly, solve and
     overhead (CPU ms, with the targets), and the start-up of whole processes."""
-    from .speed import PARTS, SPEED_TARGETS as T
-
     plt = pyplot()
     sp = load_bench(preset)["speed"]
     rows = sp["iterations"]
@@ -421,9 +418,7 @@ def bench_adaptive(preset="fast", outdir=None):
             f"({s.get('reference_with', 'preset')})",
             fontsize=9,
         )
-        from matplotlib.ticker import NullFormatter
-
-        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.xaxis.set_minor_formatter(ticker.NullFormatter())
         ax.set_xlabel("largest relative error of the headline quantities")
         ax.set_ylabel("residual evaluations (Newton iterations, rejected steps too)")
         ax.legend(fontsize=7, loc="best")

@@ -41,8 +41,8 @@ OPTIMISATIONS = [
     "factorisation at 1e5 unknowns: 2.4 s | 5.5 s; 1.4 s |",
     "| all of the above | | hertz 64^2, whole process: 4.0 s; svk block 4096 quads body.internal: 1.49 s "
     "| 1.2 s; 0.45 s |",
-    "| lazy imports: a scene module imports scikit-fem and the continuum bodies inside the functions that "
-    "build; the solver imports scipy only for a sparse K; xml (and urllib) only when writing ParaView files "
+    "| lazy imports: a scene module takes scikit-fem and the continuum bodies as lazy modules (lazy.py), "
+    "loaded when it builds; the solver loads scipy on a sparse K; xml (and urllib) only when writing ParaView files "
     "| scenes/, bodies/, solver/, io/paraview.py | `contactfem list`: 0.59 s CPU (median of 5, loaded machine) "
     "| 0.20-0.25 s CPU |",
     "| K dense (LAPACK) up to 100 unknowns, a fixed CSC pattern above (values scattered with one bincount); "

@@ -24,12 +24,23 @@ Like the libraries (compiled by pip when installed), contactfem is measured with
 bytecode compiled beforehand.
 """
 
+import compileall
+import csv
+import json
 import os
 import resource
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
+from pathlib import Path
+
+import numpy as np
+
+from ...scenes import get_scene, run_scene
+from ...scenes.sloping_impact import PAPER_TABLE2
+from ...solver.instrument import Timings
 
 PARTS = ("bulk", "contact", "assembly", "solve", "overhead")
 # what the speed work aims at (whole-process and per-iteration times on 2 cores)
@@ -84,9 +95,6 @@ def compile_bytecode():
     them: pip compiles what it installs, and Python caches what it imports, unless
     PYTHONDONTWRITEBYTECODE is set (then an editable install compiles its ~50 modules on
     every start, ~0.08 s). True if the bytecode is there afterwards."""
-    import compileall
-    from pathlib import Path
-
     package = Path(__file__).resolve().parents[2]
     try:
         return bool(compileall.compile_dir(str(package), quiet=2))
@@ -145,9 +153,6 @@ def iteration_split(scene, preset="paper", overrides=None):
     use included; wall_time_s: the run's own wall time, without them).
     bulk, contact: the System's parts; assembly: loads and summing into K; solve: the linear
     solves; overhead: the rest of newton() and the stepper's effective residual."""
-    from ...scenes import run_scene
-    from ...solver.instrument import Timings
-
     timings = Timings()
     t0, c0, h0 = time.perf_counter(), time.process_time(), time.thread_time()
     res = run_scene(scene, preset, dict(overrides or {}), instrument=timings, error_bars=False)
@@ -183,10 +188,6 @@ def iteration_limit(repeat=7, number=200):
     CPU seconds of the thread per call (best of `repeat` loops of `number` calls), of the
     assembly, the solve and both; and of one small numpy call (numpy_call_s: the product of
     two arrays of 32 entries, the size of the ring's arrays), the unit of the rest."""
-    import numpy as np
-
-    from ...scenes import get_scene
-
     scene = get_scene("sloping_impact")
     params = scene.resolve("paper", {"variant": "frictional"})
     body = scene.build(params).system.bodies[0]
@@ -238,12 +239,6 @@ def table2_study(n_els=(16, 32, 64, 128), jobs=2, refine=8):
     """The Table 2 convergence study as a user runs it: `contactfem sweep sloping_impact` over
     both variants and the element counts, at the paper's dt = 0.1 (200 steps) and at dt / refine
     (200 refine steps, the same 20 s), with `--jobs`. Returns the rows and each sweep's wall time."""
-    import csv
-    import tempfile
-    from pathlib import Path
-
-    from ...scenes.sloping_impact import PAPER_TABLE2
-
     out = dict(n_el=list(n_els), jobs=jobs, sweeps=[], rows=[])
     with tempfile.TemporaryDirectory() as tmp:
         for dt, n_steps in ((0.1, 200), (0.1 / refine, 200 * refine)):
@@ -307,8 +302,6 @@ def table2_study(n_els=(16, 32, 64, 128), jobs=2, refine=8):
 def iteration_split_fresh(scene, preset="paper", overrides=None, repeat=3):
     """iteration_split in a fresh interpreter, as a user's run is (a long benchmark process
     holds results that slow Python's garbage collector down), best of `repeat` runs."""
-    import json
-
     code = (
         "import json, sys\nfrom contactfem.lab.bench.speed import iteration_split\n"
         "print(json.dumps(iteration_split(*json.loads(sys.argv[1]))))"

@@ -8,7 +8,7 @@ import time
 
 import numpy as np
 
-from ...scenes import get_scene
+from ...scenes import block, get_scene, sloping_impact
 from ...solver import Newmark, NewtonError, Static, integrate
 from ...solver.staggered import Staggered
 
@@ -16,8 +16,6 @@ from ...solver.staggered import Staggered
 def _block_variant(params, variant):
     """One block solve (whole load in one step) with a tangent variant or the staggered
     algorithm: dict(converged, iterations, time_s, u or error)."""
-    from ...scenes import block
-
     t0 = time.perf_counter()
     try:
         if variant == "staggered":
@@ -53,8 +51,6 @@ def _block_variant(params, variant):
 def _impact_variant(params, variant):
     """The frictional sloping impact (Sec. 5.3) with a tangent variant or the staggered
     algorithm: total linear solves, step cutbacks, rebound velocity."""
-    from ...scenes import sloping_impact
-
     tangent = "consistent" if variant == "staggered" else variant
     m = sloping_impact.build(dict(params, tangent=tangent))
     ring, system = m.parts["ring"], m.system

@@ -2,19 +2,20 @@
 the whole `contactfem run` process), against the targets."""
 
 import os
+import resource
 import subprocess
 import sys
+import tempfile
 import time
 
-from ...scenes import run_scene
+from ...scenes import all_scenes, run_scene
 from .common import PAPER_SCENES, TARGETS
+from .speed import compile_bytecode
 
 
 def _process_time(args):
     """Wall time and CPU time (user + sys) of a whole `python -m contactfem ...` process,
     imports included. On a loaded machine the wall time exceeds the CPU time."""
-    import resource
-
     r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     proc = subprocess.run([sys.executable, "-m", "contactfem", *args], capture_output=True, text=True)
@@ -29,10 +30,6 @@ def _process_time(args):
 def targets_study(quick=False):
     """Study 4 (module docstring). Quick: block and the frictional sloping impact at the
     fast preset, hertz on 32^2 quads, no process times."""
-    from ...scenes import all_scenes
-
-    from .speed import compile_bytecode
-
     preset = "fast" if quick else "paper"
     known = all_scenes()
     if not quick:
@@ -79,8 +76,6 @@ def targets_study(quick=False):
         r = run_scene("hertz", "paper", {"n_el": n}, error_bars=False)
         process = process_cpu = None
     else:
-        import tempfile
-
         with tempfile.TemporaryDirectory() as tmp:  # (the JSON written as a user would)
             out_json = os.path.join(tmp, "hertz.json")
             runs = [

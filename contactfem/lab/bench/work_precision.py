@@ -6,7 +6,7 @@ orders: slope of log(error) against log(h) by least squares."""
 
 from functools import lru_cache
 
-from ...scenes import get_scene, run_scene
+from ...scenes import bar_impact, get_scene, run_scene
 from .common import observed_order, timed
 
 
@@ -30,8 +30,6 @@ def _scene_point_run(scene, preset, over, keys):
 
 def _bar_run(params, explicit):
     """bar_impact (the scene) with implicit Newmark or explicit central differences."""
-    from ...scenes import bar_impact
-
     r, wall = timed(bar_impact.SCENE.run, dict(params, integrator="central_difference" if explicit else "newmark"))
     return dict(
         time_s=wall,

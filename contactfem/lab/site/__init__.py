@@ -29,6 +29,9 @@ import subprocess
 import sys
 from pathlib import Path
 
+from ...io.outputs import check_output_dir, hold_interrupts
+from . import pages
+
 REPO = Path(__file__).resolve().parents[3]
 
 
@@ -51,8 +54,6 @@ def check_out(out, option="--out"):
     """The site folder `out`, checked before any work (ValueError naming the option): a folder
     that can be written, and new, empty, or a site built before (it has the build's work
     folder, or Sphinx's .buildinfo): the build never writes its pages among other files."""
-    from ...io.outputs import check_output_dir
-
     out = check_output_dir(out, option)
     if out.is_dir() and not (work_dir(out).is_dir() or (out / ".buildinfo").is_file()):
         other = sorted(p.name for p in out.iterdir())
@@ -134,18 +135,14 @@ def build(out=None, repo=None, quiet=True, instructor=False, only=None, on_write
     (`on_write` is called first): an interrupted or failed build leaves the pages in `out` as
     they were. Raises RuntimeError with Sphinx's output if the build fails (a warning, a
     failing notebook cell, a missing reference)."""
-    from ...io.outputs import hold_interrupts
-
     repo = Path(repo or REPO)
     if not (repo / "lectures" / "_site" / "conf.py").exists():
         raise RuntimeError(f"contactfem site needs a checkout of the repository: no lectures/_site in {repo}")
     out = check_out(out or default_out(instructor))
     work = work_dir(out)
     src, cache, html = work / "src", work / "cache", work / "html"
-    from .pages import stage
-
     try:
-        stage(repo, src, instructor=instructor, only=only, work=work / "course")
+        pages.stage(repo, src, instructor=instructor, only=only, work=work / "course")
         _prepare_cache(cache)
         env = dict(os.environ)
         _kernel_env(work / "kernel", env)

@@ -17,11 +17,16 @@ generated pages:
 """
 
 import importlib
+import importlib.util
 import inspect
 import pkgutil
 import re
 import shutil
 from pathlib import Path
+
+from ...equations import INDEX, NOT_MAPPED, resolve
+from .. import course
+from ..course.handout import MANIFEST, STUDENT_ZIP
 
 GALLERY_HEADING = "## The paper's examples"
 _LINK = re.compile(r"\[([^\]]+)\]\((figures/[^)\s]+)\)")
@@ -137,8 +142,6 @@ def figures_used(page_text):
 
 
 def _role(dotted):
-    from ...equations import resolve
-
     obj = resolve(dotted)
     if inspect.ismodule(obj):
         return f"{{py:mod}}`{dotted}`"
@@ -152,8 +155,6 @@ def _escape_bars(text):
 def equations_page():
     """The equation index: each equation of the paper, what it is, and a link to the
     API entry of the function, class or module that implements it."""
-    from ...equations import INDEX, NOT_MAPPED
-
     out = [
         "# Equation index",
         "",
@@ -229,8 +230,6 @@ def copy_mathjax(dst):
     """Copy MathJax 3 (the browser part: tex-chtml.js and the components and fonts it
     loads) from the installed ``django-static-mathjax`` package into `dst`. Returns the
     path of the entry script relative to `dst`."""
-    import importlib.util
-
     spec = importlib.util.find_spec("mathjax")
     roots = list(spec.submodule_search_locations or []) if spec else []
     es5 = next(
@@ -264,9 +263,6 @@ def stage(repo, dst, instructor=False, only=None, work=None):
     student handout (the zip of the student version) for the index to link. `only`: the
     lectures (stems) to stage, default all; `work`: a folder for the course build's work
     (default: beside `dst`). Returns the list of lecture notebooks staged."""
-    from ..course import build_versions
-    from ..course.handout import MANIFEST, STUDENT_ZIP
-
     repo, dst = Path(repo), Path(dst)
     work = Path(work) if work else dst.parent / f"{dst.name}-course"
     lectures = repo / "lectures"
@@ -278,7 +274,7 @@ def stage(repo, dst, instructor=False, only=None, work=None):
     if not notebooks(lectures):
         raise RuntimeError(f"no notebooks in {lectures}")
     outs = {"instructor": dst, "student": work / "student"} if instructor else {"student": dst}
-    nbs = build_versions(outs, repo=repo, only=only, work=work)["instructor" if instructor else "student"]
+    nbs = course.build_versions(outs, repo=repo, only=only, work=work)["instructor" if instructor else "student"]
     if instructor:
         shutil.copy2(work / "student" / STUDENT_ZIP, dst / STUDENT_ZIP)
     shutil.rmtree(dst / "autograder", ignore_errors=True)  # grading configurations: not pages
