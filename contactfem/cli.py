@@ -57,6 +57,7 @@ lawfile = lazy.module("contactfem.lab.lawfile")
 sweeps = lazy.module("contactfem.lab.sweep")
 bench = lazy.module("contactfem.lab.bench")
 reconstruct = lazy.module("contactfem.lab.reconstruct")
+readme = lazy.module("contactfem.lab.readme")
 site = lazy.module("contactfem.lab.site")
 course_layer = lazy.module("contactfem.lab.course")
 handout = lazy.module("contactfem.lab.course.handout")
@@ -314,15 +315,11 @@ def cmd_figures(args):
     with rounding.rounding(condition.linear_algebra, condition.perturbation):
         for path in plots.make_all(args.preset, args.outdir, args.only):
             print(path)
-    refill_readme(args.outdir or default_outdir(args.preset))
+    refill_readme(args.outdir or plots.default_outdir(args.preset))
 
 
 def refill_readme(folder):
     """After the checkout's own figures/ are written: the README's blocks filled from them (lab.readme)."""
-    from pathlib import Path
-
-    from .lab import readme
-
     repo = Path(__file__).resolve().parents[1]
     if Path(folder).resolve() == (repo / "figures").resolve() and (repo / "README.md").is_file():
         if readme.write(repo):
@@ -399,8 +396,6 @@ def said_at_once():
 
 
 def cmd_readme(args):
-    from .lab import readme
-
     repo = readme.checkout()
     if args.check:
         name = readme.first_difference(repo)
