@@ -9,7 +9,7 @@ The test suite's own switches are pytest options (tests/conftest.py), not variab
 
 import os
 
-USER, TOOLKIT = "you", "contactfem, for the processes it starts"
+USER, TOOLKIT, CALLER = "you", "contactfem, for the processes it starts", "a program that starts contactfem"
 
 # name -> (who sets it, what it does)
 VARIABLES = {
@@ -20,13 +20,13 @@ VARIABLES = {
     "CONTACTFEM_FIGURES": (
         USER,
         "the folder the lectures and the figures write to (default figures/ for the paper preset, "
-        "figures/fast/ for the fast one)",
+        "figures/PRESET/ for another)",
     ),
     "CONTACTFEM_SLOW": (USER, "1: the cork's studies run every case, as the committed figures did"),
     "CONTACTFEM_BENCH": (USER, "the bench file the bench's figures draw (default bench.json)"),
     "CONTACTFEM_LINEAR_ALGEBRA": (TOOLKIT, "a rounding condition: the factorisation every System uses"),
     "CONTACTFEM_PERTURB": (TOOLKIT, "a rounding condition: the relative perturbation of every initial state"),
-    "CONTACTFEM_READY_FILE": (TOOLKIT, "a file the command line creates once it is ready to be signalled"),
+    "CONTACTFEM_READY_FILE": (CALLER, "a file the command line creates once it is ready to be signalled"),
     "CONTACTFEM_SITE_CACHE": (TOOLKIT, "the course website's notebook cache, for its page builder"),
     "CONTACTFEM_SITE_EXECUTE": (TOOLKIT, "how the course website's page builder runs the notebooks"),
 }

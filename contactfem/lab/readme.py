@@ -18,6 +18,7 @@ import re
 import textwrap
 from pathlib import Path
 
+from .. import environment
 from ..laws.check import DEFAULT_RANGE, check_friction_law, check_law, check_normal_law
 from ..plots import rounding, summary
 from ..scenes.block import PAPER_TABLE1
@@ -128,6 +129,11 @@ def hertz_block(repo):
     """Hertz's peak pressure on the finest mesh of the verification figure, against the closed form."""
     d = _json(repo, "figures/verif_hertz_pressure.json")
     return f"p0 within {100 * abs(d['error_p0']):.2f} % on {d['n_quads']:,} quads"
+
+
+def environment_block(repo):
+    """The environment variables contactfem reads, from their one table (contactfem.environment)."""
+    return lines(environment.table())
 
 
 def law_range_block(repo):
@@ -458,6 +464,7 @@ def sloping_mass_block(repo):
 
 BLOCKS = {
     "resume-example": resume_example_block,
+    "environment": environment_block,
     "summary": summary_block,
     "rounding": rounding_block,
     "coverage": coverage_block,
