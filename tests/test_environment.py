@@ -30,7 +30,8 @@ def test_the_package_reads_them_through_the_table():
     where = [
         f"{p.relative_to(REPO)}:{i}"
         for p in (REPO / "contactfem").rglob("*.py")
-        if p.name != "environment.py"
+        # serve.py runs alone in a submission's sandbox, importing nothing of the package (lab/course/serve.py)
+        if p.name not in ("environment.py", "serve.py")
         for i, line in enumerate(p.read_text().splitlines(), 1)
         if read.search(line)
     ]

@@ -261,7 +261,6 @@ def test_the_cork_twice_gives_the_same_records():
     assert len(first) == len(second) > 4
     for r, q in zip(first, second):
         same(r, q)
-    assert np.array_equal(first["pressures"], second["pressures"])
 
 
 def test_start_leaves_the_system_as_it_is():

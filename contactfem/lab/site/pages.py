@@ -24,9 +24,12 @@ import re
 import shutil
 from pathlib import Path
 
+from ... import lazy
 from ...equations import INDEX, NOT_MAPPED, resolve
-from .. import course
-from ..course.handout import MANIFEST, STUDENT_ZIP
+
+# the course (lazy: the students' edition a submission is graded with leaves it out, and imports this module)
+course = lazy.module("contactfem.lab.course")
+handout = lazy.module("contactfem.lab.course.handout")
 
 GALLERY_HEADING = "## The paper's examples"
 _LINK = re.compile(r"\[([^\]]+)\]\((figures/[^)\s]+)\)")
@@ -276,9 +279,9 @@ def stage(repo, dst, instructor=False, only=None, work=None):
     outs = {"instructor": dst, "student": work / "student"} if instructor else {"student": dst}
     nbs = course.build_versions(outs, repo=repo, only=only, work=work)["instructor" if instructor else "student"]
     if instructor:
-        shutil.copy2(work / "student" / STUDENT_ZIP, dst / STUDENT_ZIP)
+        shutil.copy2(work / "student" / handout.STUDENT_ZIP, dst / handout.STUDENT_ZIP)
     shutil.rmtree(dst / "autograder", ignore_errors=True)  # grading configurations: not pages
-    (dst / MANIFEST).unlink(missing_ok=True)
+    (dst / handout.MANIFEST).unlink(missing_ok=True)
     shutil.copy2(lectures / "README.md", dst / "course.md")
     gallery = gallery_page(repo)
     (dst / "gallery.md").write_text(gallery)
