@@ -209,6 +209,12 @@ PARENT = textwrap.dedent("""
 """)
 
 
+def _sigint_as_in_a_terminal():
+    """Run in the child before it starts: Ctrl-C back to its default. A test suite started in
+    the background of a shell without job control ignores SIGINT, and a child keeps that."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("sig,code", [(signal.SIGINT, 130), (signal.SIGTERM, 143), (signal.SIGKILL, -9)])
 def test_a_stopped_batch_process_leaves_no_worker(tmp_path, sig, code):
@@ -220,6 +226,7 @@ def test_a_stopped_batch_process_leaves_no_worker(tmp_path, sig, code):
         env=dict(os.environ, PYTHONPATH=os.pathsep.join(sys.path)),
         stderr=subprocess.PIPE,
         text=True,
+        preexec_fn=_sigint_as_in_a_terminal,
     )
     try:
         pids = _wait_for_pids(tmp_path, 2)

@@ -298,6 +298,7 @@ def test_ctrl_c_on_the_command_stops_at_once_and_says_what_was_written(tmp_path)
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),  # a background suite ignores Ctrl-C
     )
     deadline = time.monotonic() + 120
     while len(_sandboxes_of(proc.pid)) < 2 and time.monotonic() < deadline:  # both notebooks running
