@@ -1,4 +1,4 @@
-"""Command line: `contactfem list | show | run | figures | sweep | bench | equations |
+"""Command line: `contactfem list | show | run | figures | sweep | bench | equations | readme |
 reconstruct | site | course` (`contactfem COMMAND --help` for each).
 
 Exit codes: 0 done; 2 bad input (unknown scene, unknown, repeated, out-of-range or
@@ -226,8 +226,11 @@ def cmd_run(args):
             runs.save_run(runs.as_arrays(res), out.temp("--save"))
         if args.gif is not None:
             write_animation(res, out.temp("--gif"))
-        out.commit()
+        written = out.commit()
     _RUN["phase"] = "done"
+    for what, path, replaced in written:
+        if replaced:
+            print(f"contactfem: note: {what} {path}: the file that was there is replaced", file=sys.stderr)
     for note in notes:
         print(f"contactfem: warning: {note}", file=sys.stderr)
     for k, v in res.items():  # scalars, and short lists of numbers (the block's residuals)
@@ -341,6 +344,7 @@ def cmd_sweep(args):
         )
     grid = sweeps.parse_grid(parse_sets(args.set))
     table = sweeps.Table(args.out, resume=args.resume)  # with --resume, the rows already done are read now
+    replaced = not args.resume and Path(args.out).exists()  # said with the summary: never replaced silently
     _RUN.update(phase="sweep", table=table)
     with said_at_once():  # the laws' check, then each flagged point as it ends: one line each
         rows = sweeps.sweep(
@@ -364,6 +368,11 @@ def cmd_sweep(args):
     kept = f" ({table.kept} kept from the table)" if table.kept else ""
     marked = f" ({len(flagged)} flagged)" if flagged and not args.strict else ""
     print(f"{len(table.points)} points: {done} done{kept}{marked}, {failed} failed, {left} left -> {args.out}")
+    if replaced and table.written is not None:
+        print(
+            f"contactfem: note: --out {args.out}: the file that was there is replaced (--resume keeps its rows)",
+            file=sys.stderr,
+        )
     for r in rows:
         point = sweeps.point_text({k[6:]: v for k, v in r.items() if k.startswith("param.")})
         if r.get("error"):

@@ -91,6 +91,17 @@ def test_sloping_impact_coarse_step_is_flagged():
     assert {"impact_steps", "penalty_steps"} <= flagged and r["accuracy"]["impact_steps"]["value"] <= 3
 
 
+def test_an_impact_whose_body_never_reaches_the_obstacle_says_so():
+    """A step refined a thousandfold without more steps ends the sloping impact before the ring reaches the
+    plane: the rebound it reports is the velocity it started with, and the run flags it (missed), which the
+    preset's run does not."""
+    r, flagged = _run("sloping_impact", {"dt": 1e-4})
+    assert "missed" in flagged and r["accuracy"]["missed"]["value"] == 1.0
+    assert r["rebound_vy"] == r["parameters"]["vy0"] and not r["rebounded"]
+    r, flagged = _run("sloping_impact", {})
+    assert "missed" not in flagged and r["accuracy"]["missed"]["value"] == 0.0
+
+
 @pytest.mark.parametrize("integration", ["standard", "energy_consistent"])
 def test_rolling_ring_coarse_step_is_flagged_by_its_closed_forms(integration):
     r, flagged = _run("rolling_ring", {"dt": 0.5, "contact_integration": integration})

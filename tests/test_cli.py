@@ -61,6 +61,26 @@ def test_run_writes_json_with_the_contract_keys(tmp_path):
     assert res["parameters"]["c_T"] > 0
 
 
+def test_a_file_that_was_there_is_never_replaced_silently(tmp_path, capsys):
+    """An output onto a file that exists: the run writes it and says so in one line naming it; a new file, or a
+    sweep resumed from its table, is not remarked on."""
+    mine = tmp_path / "mine.json"
+    mine.write_text("my data")
+    assert main(["run", "block", "--no-error-bars", "--json", str(mine)]) == 0
+    err = capsys.readouterr().err
+    assert f"--json {mine}: the file that was there is replaced" in err and "parameters" in json.loads(mine.read_text())
+    fresh = tmp_path / "fresh.json"
+    assert main(["run", "block", "--no-error-bars", "--json", str(fresh)]) == 0
+    assert "replaced" not in capsys.readouterr().err
+    table = tmp_path / "grades.csv"
+    table.write_text("name,grade\nalice,A\n")
+    sweep = ["sweep", "block", "--no-error-bars", "--set", "p_y=100", "--out", str(table)]
+    assert main(sweep) == 0
+    assert f"--out {table}: the file that was there is replaced" in capsys.readouterr().err
+    assert main([*sweep, "--resume"]) == 0
+    assert "replaced" not in capsys.readouterr().err
+
+
 def test_bench_only_keeps_the_other_studies_of_an_earlier_run(tmp_path, monkeypatch):
     """`bench --only NAME` merges into DIR/bench.json: the earlier studies stay."""
     import contactfem.lab.bench as bench

@@ -129,19 +129,23 @@ class Outputs:
 
     def commit(self):
         """Rename every temporary onto its target, with Ctrl-C held back until all are done.
-        If a rename fails, the outputs already moved are removed again (none or all)."""
-        done = []
+        If a rename fails, the outputs already moved are removed again (none or all). Returns
+        (option, path, replaced) for each output written: replaced, where a file was there before
+        (the command says so: a user's file is never replaced silently)."""
+        done, written = [], []
         with hold_interrupts():
             try:
                 for what, t in self.temps.items():
+                    replaced = self.paths[what].exists()
                     os.replace(t, self.paths[what])
                     done.append(self.paths[what])
+                    written.append((what, str(self.paths[what]), replaced))
             except OSError:
                 for p in done:
                     p.unlink(missing_ok=True)
                 raise
             self.committed = True
-        return [str(p) for p in done]
+        return written
 
     def discard(self):
         for t in self.temps.values():

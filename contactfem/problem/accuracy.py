@@ -21,6 +21,8 @@ The indicators that apply to a run (``collect``), from its records and the model
                     every dynamic step in contact (an impact, a resting or a rolling contact)
     separated       an impact scene (the model's ``rebound``): the body has left the obstacle by the run's
                     end, so the rebound it reports is a rebound (0), not a velocity read mid-impact (1)
+    missed          an impact scene: the body never touched the obstacle (1), so the rebound it reports is
+                    the velocity it started with (a step refined without more steps ends the run earlier)
     error_budget    a run at a tolerance (``accuracy``): its own estimate of its time-stepping error over
                     the error the tolerance allows (the sum of its steps' local error estimates over the sum
                     of their shares, solver/schedule.py); past 2 the tolerance is not assured
@@ -160,6 +162,13 @@ def collect(model, params, records, results, tolerance=TOLERANCE):
             0.0,
             "in contact at the run's end (1: the impact is not over, the rebound it reports is read mid-impact)",
             "the scene's rebound quantities are read after the body has left the obstacle",
+        )
+        out["missed"] = indicator(
+            0.0 if any(_touching(r) for r in records) else 1.0,
+            0.0,
+            "no contact in the whole run (1: the body never reached the obstacle; the rebound it reports is the "
+            "velocity it started with)",
+            "the scene's rebound quantities are those of an impact",
         )
     shares = [(r.error.local, r.error.share) for r in steps if r.error is not None and r.error.share is not None]
     if shares:  # a run at a tolerance
