@@ -70,6 +70,7 @@ def sweep(tmp_path, *args, pause=None, out="s.csv"):
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         start_new_session=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),  # a background suite ignores Ctrl-C
     )
 
 
