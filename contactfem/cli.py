@@ -239,7 +239,7 @@ def cmd_run(args):
         elif isinstance(v, list) and 0 < len(v) <= 8 and all(isinstance(x, (int, float)) for x in v):
             print(f"{k}: [{', '.join(f'{x:.6g}' for x in v)}]")
     bars = res.get("uncertainty")
-    if bars:  # each headline quantity with its band, and what the bands cost
+    if bars and bars["quantities"]:  # each headline quantity with its band, and what the bands cost (none: no line)
         for name, entry in bars["quantities"].items():
             print(uncertainty.line(name, entry))
         print(

@@ -39,7 +39,8 @@ def build(p, *, normal=None, friction=None, system_options=None):
     steps = Steps(p["dt"], n_steps=p["n_steps"], max_cuts=4)  # a step Newton fails is halved, up to 4 times
     ends = disc.mesh.p[:, disc.mesh.facets[:, disc.mesh.boundary_facets()]]  # the surface's edges: (x|y, end, edge)
     sizes = dict(element=float(np.hypot(*(ends[:, 1] - ends[:, 0])).max()), body=2 * R)  # the penetration's yardsticks
-    stage = Stage(Newmark(system, 0.5, 0.25), steps, np.zeros(disc.ndof), v0)
+    # full Newton steps cycle between two iterates here at dt / 2 (a non-smooth contact): backtrack, 4 halvings
+    stage = Stage(Newmark(system, 0.5, 0.25, line_search=4), steps, np.zeros(disc.ndof), v0)
     return Model(systems=(system,), stage=stage, sizes=sizes, parts=dict(disc=disc))
 
 
