@@ -33,7 +33,6 @@ relative band against the same tolerance (NAME_band; no value where no band coul
 """
 
 import math
-import os
 import sys
 import warnings
 
@@ -322,9 +321,6 @@ def warn(accuracy, stacklevel=2):
     frame = sys._getframe(1)
     for _ in range(stacklevel - 2):
         frame = frame.f_back or frame
-    package = os.path.dirname(os.path.dirname(os.path.abspath(__file__))) + os.sep
-    while frame.f_back is not None and os.path.abspath(frame.f_code.co_filename).startswith(package):
-        frame = frame.f_back  # the user's line that asked for the run (run_scene's caller), not the package's
     for line in lines:
         warnings.warn_explicit(
             line,
