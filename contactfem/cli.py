@@ -576,7 +576,14 @@ def cmd_bench(args):
     res = bench.run_bench(quick=args.quick, only=args.only, progress=lambda m: print(m, file=sys.stderr, flush=True))
     if args.only and earlier is not None:  # keep the other studies of an earlier run (those the bench still has)
         meta = ("quick", "machine", "target_values")
-        kept = {k: v for k, v in earlier.items() if k in meta or k.removesuffix("_bench_s") in bench.STUDIES}
+        kept = {
+            k: v
+            for k, v in earlier.items()
+            if k in meta or k.removesuffix("_bench_s").removesuffix("_machine") in bench.STUDIES
+        }
+        for name in bench.STUDIES:  # an earlier study keeps the machine (and its load) it ran on
+            if name in kept and f"{name}_machine" not in kept and "machine" in earlier:
+                kept[f"{name}_machine"] = earlier["machine"]
         res = dict(kept, **res)
     for path in bench.write_outputs(res, out):
         print(path)

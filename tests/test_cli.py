@@ -93,6 +93,23 @@ def test_bench_only_keeps_the_other_studies_of_an_earlier_run(tmp_path, monkeypa
 
     assert main(["bench", "--only", "speed", "--out", str(tmp_path)]) == 0
     assert written[0]["tangents"] == {"kept": 1} and written[0]["speed"] == {"new": 2}
+    # the earlier study keeps the machine (and load) it ran on, whatever machine the new run records
+    assert written[0]["tangents_machine"] == {"cpu": "x"}
+
+
+def test_a_bench_figure_names_the_machine_its_own_study_ran_on(tmp_path, monkeypatch):
+    """Two studies run at different loads: each figure's parameters carry its study's machine."""
+    from contactfem.lab.bench import figures as F
+
+    bench = {
+        "quick": False,
+        "machine": {"load_average": [1.0]},
+        "adaptive": {},
+        "adaptive_machine": {"load_average": [7.0]},
+    }
+    (tmp_path / "bench.json").write_text(json.dumps(bench))
+    monkeypatch.setenv("CONTACTFEM_BENCH", str(tmp_path / "bench.json"))
+    assert F._section("adaptive", "paper")[1]["machine"] == {"load_average": [7.0]}
 
 
 def test_a_closed_pipe_is_not_an_error():

@@ -115,6 +115,7 @@ def run_bench(quick=False, only=None, progress=print):
             continue
         if progress:
             progress(f"bench: {name} ...")
+        out[f"{name}_machine"] = machine()  # each study its own: a run with --only merges into an earlier one
         res, dt = timed(fn, quick)
         out[name] = res
         out[f"{name}_bench_s"] = dt

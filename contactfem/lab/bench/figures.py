@@ -90,7 +90,9 @@ def _save(fig, outdir, preset, stem, section):
     b = load_bench(preset)
     path = bench_json_path()
     parameters = dict(
-        source=path.name if path.exists() else "a quick bench run", quick=b.get("quick"), machine=b.get("machine")
+        source=path.name if path.exists() else "a quick bench run",
+        quick=b.get("quick"),
+        machine=b.get(f"{section}_machine", b.get("machine")),
     )
     return save_figure(fig, Path(outdir or default_outdir(preset)) / f"{stem}.png", {section: b[section]}, parameters)
 
@@ -340,7 +342,8 @@ def _section(name, preset):
     """A study of the bench JSON (adaptive, coverage), or its quick run here (seconds) where the JSON lacks it."""
     b = load_bench(preset)
     if name in b:
-        return b[name], dict(source=bench_json_path().name, quick=b.get("quick"), machine=b.get("machine"))
+        machine = b.get(f"{name}_machine", b.get("machine"))
+        return b[name], dict(source=bench_json_path().name, quick=b.get("quick"), machine=machine)
     return quick_study(name), dict(source="a quick bench run", quick=True)
 
 
