@@ -32,6 +32,7 @@ import numpy as np
 
 from .. import laws
 from ..laws.protocol import FrictionLaw, LawError, NormalLawView, describe  # noqa: F401 (describe: public here too)
+from ..problem.params import did_you_mean
 
 KINDS = ("friction", "normal")
 
@@ -230,7 +231,8 @@ def make_law(cls, values=None, scene_params=None, option="--friction", notes=Non
     unknown = sorted(set(values) - set(fields))
     if unknown:
         raise ValueError(
-            f"unknown law parameter law.{unknown[0]} for {cls.__name__}: known are {', '.join(fields) or '(none)'}"
+            f"unknown law parameter law.{unknown[0]} for {cls.__name__}{did_you_mean(unknown[0], fields)}: known are "
+            f"{', '.join(fields) or '(none)'}"
         )
     kwargs, from_scene = {}, []
     for name, f in fields.items():

@@ -12,6 +12,7 @@ elements, a cork's tip between the neck's radius and its own) is part of the par
 (``limit``): ``Scene.resolve`` checks it once every value is known. The Param is the one place
 a scene's parameter is checked; the constructors the scene calls only assert what they need."""
 
+import difflib
 import numbers
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -170,3 +171,13 @@ def check_overrides(overrides):
     if bad:
         raise TypeError(f"parameter overrides: the names must be strings, got {bad[0]!r}")
     return dict(overrides)
+
+
+def did_you_mean(name, known):
+    """' (did you mean NAME?)' for the known name closest to a mistyped one, case aside (difflib's ratio at
+    least 0.6: c_n is c_N, not c_T), else ''."""
+    by_lower = {}
+    for k in known:
+        by_lower.setdefault(str(k).lower(), str(k))
+    close = difflib.get_close_matches(str(name).lower(), list(by_lower), n=1)
+    return f" (did you mean {by_lower[close[0]]!r}?)" if close else ""

@@ -26,7 +26,7 @@ from ..laws import check as law_check
 from ..solver.march import evaluations
 from .accuracy import collect, references, stepping, warn
 from .model import Model, Stage  # noqa: F401  (scene modules take them here)
-from .params import Limit, Param, check_overrides, parse_all  # noqa: F401  (scene modules take Param, Limit here)
+from .params import Limit, Param, check_overrides, did_you_mean, parse_all  # noqa: F401  (scene modules take Param, Limit here)
 from .resources import check_resources, describe  # noqa: F401  (the command line takes them from here)
 from .resources import estimate as estimate_resources
 from .time_integration import at_tolerance_values
@@ -216,7 +216,10 @@ class Scene:
                         f"set on the law object itself, e.g. friction=Coulomb(c_T, mu) "
                         f"or dataclasses.replace(law, {field}=...)"
                     )
-                raise ValueError(f"unknown parameter {k!r} for scene {self.name}: known are {', '.join(known)}")
+                raise ValueError(
+                    f"unknown parameter {k!r} for scene {self.name}{did_you_mean(k, known)}: known are "
+                    f"{', '.join(known)}"
+                )
             values[k] = v
         values = parse_all(self.params, values)  # each value, then the ranges from other parameters
         for k in overrides:  # a value the resolved variant would silently ignore

@@ -13,7 +13,7 @@ from pathlib import Path
 
 from ..laws.protocol import as_normal_law, describe
 from ..problem.files import SceneError, is_scene_file, load_scene_file
-from ..problem.params import check_overrides
+from ..problem.params import check_overrides, did_you_mean
 from ..problem.scene import Limit, Model, Param, Scene, Stage, jsonable, simulate
 from ..problem.uncertainty import (
     TOLERANCE,
@@ -66,7 +66,9 @@ def get_scene(name):
             return scene
     scenes = all_scenes()
     if name not in scenes:
-        raise ValueError(f"unknown scene {name!r}: known are {', '.join(scenes) or '(none)'}")
+        raise ValueError(
+            f"unknown scene {name!r}{did_you_mean(name, scenes)}: known are {', '.join(scenes) or '(none)'}"
+        )
     return scenes[name]
 
 
