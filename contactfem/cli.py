@@ -46,6 +46,7 @@ newton = lazy.module("contactfem.solver.newton")
 rounding = lazy.module("contactfem.solver.rounding")
 problem_scene = lazy.module("contactfem.problem.scene")
 uncertainty = lazy.module("contactfem.problem.uncertainty")
+accuracy = lazy.module("contactfem.problem.accuracy")
 outputs = lazy.module("contactfem.io.outputs")
 progress_bars = lazy.module("contactfem.io.progress")
 runs = lazy.module("contactfem.io.runs")
@@ -265,8 +266,16 @@ def run_quietly(fn):
     with warnings.catch_warnings(record=True) as caught, np.errstate(all="ignore"):
         warnings.simplefilter("always")
         res = fn()
-    own = [str(w.message) for w in caught if issubclass(w.category, UserWarning) and "contactfem" in str(w.filename)]
+    own = [str(w.message) for w in caught if own_warning(w.category, w.filename)]
     return res, list(dict.fromkeys(own))
+
+
+def own_warning(category, filename):
+    """contactfem's warnings: every AccuracyWarning (it points at the line that asked for the run, outside the
+    package), and the other UserWarnings raised in the package (or in a scene file's call into it)."""
+    return issubclass(category, accuracy.AccuracyWarning) or (
+        issubclass(category, UserWarning) and "contactfem" in str(filename)
+    )
 
 
 def laws_from_args(args, sets=None):
@@ -395,7 +404,7 @@ def said_at_once():
     other libraries' dropped, as a run drops them (run_quietly)."""
 
     def say(message, category, filename, lineno, file=None, line=None):
-        if issubclass(category, UserWarning) and "contactfem" in str(filename):
+        if own_warning(category, filename):
             print(f"contactfem: warning: {message}", file=sys.stderr, flush=True)
 
     with warnings.catch_warnings():

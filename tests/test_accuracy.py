@@ -78,6 +78,19 @@ def test_the_same_run_twice_warns_twice_under_the_default_filters():
     assert [c for c, _ in shown].count(AccuracyWarning) >= 4  # penetration and penetration_body, twice
 
 
+def test_a_warning_points_at_the_line_that_asked_for_the_run():
+    """From Python, an AccuracyWarning names the caller's file and line (where run_scene was called), not a
+    line inside the package."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        line = sys._getframe().f_lineno + 1
+        run_scene("block", "fast", {"c_N": 10})
+    mine = [w for w in caught if issubclass(w.category, AccuracyWarning)]
+    assert mine and all((w.filename, w.lineno) == (__file__, line) for w in mine), [
+        (w.filename, w.lineno) for w in mine
+    ]
+
+
 @pytest.mark.parametrize("over", [{"n_el": 4}, {"n_el": 20}, {"c_N_factor": 0.1}])
 def test_bar_impact_off_its_closed_form_is_flagged(over):
     """A coarse bar (or a soft penalty) lengthens the contact by 7.5-25 %: the closed form names it."""

@@ -200,6 +200,17 @@ def test_site_pages_carry_no_absolute_path(site):
         assert not found, f"{page.relative_to(site)} shows {found}"
 
 
+def test_a_warning_naming_a_cells_file_shows_cell(tmp_path):
+    """A lecture's AccuracyWarning points at the cell's line, a temporary file of Jupyter's kernel: the page
+    says "cell"; the other replacements still apply."""
+    from contactfem.lab.site import scrub
+
+    page = tmp_path / "09.html"
+    page.write_text("<pre>/tmp/ipykernel_4321/2718281828.py:3: AccuracyWarning: accuracy: x\n/home/u/f.png</pre>")
+    scrub(tmp_path, {"/home/u": "~"})
+    assert page.read_text() == "<pre>cell:3: AccuracyWarning: accuracy: x\n~/f.png</pre>"
+
+
 def test_site_has_a_page_per_lecture_with_outputs_and_figures(site):
     assert (site / "index.html").exists()
     for nb in LECTURES:

@@ -33,6 +33,7 @@ relative band against the same tolerance (NAME_band; no value where no band coul
 """
 
 import math
+import os
 import sys
 import warnings
 
@@ -306,9 +307,17 @@ def at_floor(steps):
     return (float(sum(dt for dt, over in shared if over) / total) if total > 0 else 0.0) if shared else None
 
 
+PACKAGE = os.path.dirname(os.path.dirname(os.path.abspath(__file__))) + os.sep
+
+
+def _in_package(filename):
+    return os.path.abspath(filename).startswith(PACKAGE)
+
+
 def warn(accuracy, stacklevel=2):
     """One AccuracyWarning per indicator past its threshold (the same run twice warns twice: no
-    registry remembers a line), pointing where warnings.warn(stacklevel) would; returns the lines. An
+    registry remembers a line), pointing at the first line outside the package from where warnings.warn(stacklevel)
+    would (a script's or a notebook cell's call of run_scene); returns the lines. An
     indicator without a value (no error band could be estimated) says what it lacks."""
     lines = [
         f"accuracy: {name}: {ind['what']} ({ind['source']})"
@@ -321,6 +330,8 @@ def warn(accuracy, stacklevel=2):
     frame = sys._getframe(1)
     for _ in range(stacklevel - 2):
         frame = frame.f_back or frame
+    while frame.f_back is not None and _in_package(frame.f_code.co_filename):
+        frame = frame.f_back  # the line that asked for the run (run_scene's caller), not the package's own
     for line in lines:
         warnings.warn_explicit(
             line,

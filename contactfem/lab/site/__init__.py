@@ -24,6 +24,7 @@ Needs the ``site`` extra (``pip install -e ".[site]"``) and a checkout of the re
 import hashlib
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -65,9 +66,14 @@ def check_out(out, option="--out"):
     return out
 
 
+# the file Jupyter's kernel gives a cell's code (a warning raised for a cell's line names it): "cell"
+CELL_FILE = re.compile(r"[^\s\"'<>]*/ipykernel_\d+/\d+\.py")
+
+
 def scrub(out, replacements):
     """Replace the builder's absolute paths in the built pages (printed by a lecture, e.g.
-    where its figures went) by the names a reader understands: {path: name}."""
+    where its figures went, or a warning naming a cell's temporary file) by the names a reader understands:
+    {path: name}, and a cell's file by "cell"."""
     pairs = sorted(
         ((str(k), v) for k, v in replacements.items() if str(k) not in ("", "/")), key=lambda kv: -len(kv[0])
     )
@@ -78,6 +84,7 @@ def scrub(out, replacements):
         new = text
         for old, name in pairs:
             new = new.replace(old, name)
+        new = CELL_FILE.sub("cell", new)
         if new != text:
             page.write_text(new, errors="surrogateescape")
 
