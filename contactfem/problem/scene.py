@@ -26,7 +26,8 @@ from ..laws import check as law_check
 from ..solver.march import evaluations
 from .accuracy import collect, references, stepping, warn
 from .model import Model, Stage  # noqa: F401  (scene modules take them here)
-from .params import Limit, Param, check_overrides, did_you_mean, parse_all  # noqa: F401  (scene modules take Param, Limit here)
+from .params import Limit, Param  # noqa: F401  (scene modules take Param, Limit here)
+from .params import check_overrides, did_you_mean, parse_all
 from .resources import check_resources, describe  # noqa: F401  (the command line takes them from here)
 from .resources import estimate as estimate_resources
 from .time_integration import at_tolerance_values
