@@ -90,7 +90,8 @@ by the bottom face since the start of stage 2), i.e. V0 + pi R^2 * (its axial
 displacement). When the bottom corner of the cork reaches the mouth (z = 24 mm)
 the gas escapes: p = 0 from then on (ambient; no gas jet is modelled).
 Adaptive step (what drives it; with ``accuracy`` > 0 the local error estimate instead,
-solver/schedule.py, under the same travel limit): dt_fine while the cork bottom is within
+solver/schedule.py, under the same travel limit, the gas's lag and its release: gas_lag_step,
+release_step): dt_fine while the cork bottom is within
 ``exit_zone`` of the mouth and for ``t_after`` after the gas release (the paper's
 5e-6 s), otherwise dt, but never more than ``travel_max`` of axial travel per step
 (so a contact node does not jump over the 2 mm mouth in one step); a step whose Newton
@@ -424,6 +425,26 @@ def gas_lag_step(P, gas, rec, tol):
     return np.inf if lag == 0 else max(rec.dt * share / lag, P["dt"] * tol)
 
 
+def release_step(P, gas, cork, rec, tol):
+    """The step at which the gas's release keeps its error within half the tolerance (a run at a
+    tolerance; no estimate of the integrator sees it): the step in which the cork's corner passes the
+    mouth still acts with the pressure p of the state before it, for the whole step, while the gas
+    escapes when the corner passes, somewhere inside it; the cork gains up to p A h / M of velocity
+    too much (A = pi R_neck^2, M the cork's mass). That is held at tol speed / 2: h = tol speed M /
+    (2 p A), once the corner could reach the mouth within two steps of its speed; before, at most
+    half the way to the mouth per step, so that the steps shrink towards it (a few steps more)."""
+    state = rec.state.loads[0]
+    if rec.k == 0 or state.released:
+        return np.inf
+    p = gas.pressure(rec.t, state)
+    speed = abs(centre_of_mass_velocity(cork, rec.v)) if p > 0 else 0.0  # mm/s
+    if speed == 0:
+        return np.inf
+    h = 0.5 * tol * speed_scale(P) * cork_mass(P) / (p * np.pi * P["R_neck"] ** 2)
+    gap = max(0.0, P["L_neck"] - gas.edge_z(rec.u))
+    return max(h, 0.5 * gap / speed)
+
+
 def cork_mass(P):
     """The cork's mass from its outline (shaft over the neck and the mouth, and the head)."""
     return P["rho"] * np.pi * P["R_cork"] ** 2 * (P["L_neck"] + P["r_mouth"] + P["L_head"])
@@ -458,7 +479,7 @@ def pop(system, parts, P, fit_last):
         # over t_end; travel_max still holds, and the gas's lag
 
         def limit(rec):
-            h = gas_lag_step(P, gas, rec, tol)
+            h = min(gas_lag_step(P, gas, rec, tol), release_step(P, gas, cork, rec, tol))
             h = min(h, P["travel_max"] / (1e3 * abs(v_cm(rec)))) if v_cm(rec) else h
             return on_ramp(rec, h)
 
