@@ -173,7 +173,7 @@ def cmd_run(args):
     overrides, laws, notes = laws_from_args(args)  # law.NAME=... go to --friction / --normal
     params = scene.resolve(args.preset, overrides)
     tolerance = uncertainty.check_tolerance(args.tolerance)
-    error_bars = not args.no_error_bars and uncertainty.error_bars_default()
+    error_bars = uncertainty.error_bars_default() if args.error_bars is None else args.error_bars
     out = outputs.Outputs()  # every output checked before the run
     if args.json is not None:  # (an empty name is refused, not skipped)
         out.add("--json", args.json, (".json",))
@@ -249,7 +249,10 @@ def cmd_run(args):
         )
     for what, path in out.paths.items():
         print(f"{what} -> {path}")
-    flagged = [note.removeprefix("accuracy: ").split(" = ")[0] for note in notes if note.startswith("accuracy:")]
+    # the indicators' names (an indicator's line: "NAME = value, ..." or "NAME: no error band of ... (why)")
+    flagged = [
+        re.match(r"\w+", note.removeprefix("accuracy: ")).group(0) for note in notes if note.startswith("accuracy:")
+    ]
     if args.strict and flagged:  # an accuracy indicator past its threshold: said last, after the results
         print(
             f"contactfem: strict: the run is flagged by {len(flagged)} accuracy warning"
@@ -368,7 +371,7 @@ def cmd_sweep(args):
             force=args.force,
             table=table,
             timeout=args.time_limit,
-            error_bars=not args.no_error_bars and uncertainty.error_bars_default(),
+            error_bars=uncertainty.error_bars_default() if args.error_bars is None else args.error_bars,
             tolerance=tolerance,
         )
     _RUN["phase"] = "done"
@@ -619,19 +622,30 @@ def write_animation(res, path):
 
 def add_error_bar_options(parser):
     """--no-error-bars and --tolerance, as run and sweep take them."""
-    parser.add_argument(
+    bars = parser.add_mutually_exclusive_group()
+    bars.add_argument(
         "--no-error-bars",
-        action="store_true",
+        dest="error_bars",
+        action="store_false",
+        default=None,
         help="skip the error bands of the headline quantities (by default each comes with its numerical "
         "uncertainty, from runs at coarser steps and meshes: the JSON's uncertainty section)",
+    )
+    bars.add_argument(
+        "--error-bars",
+        dest="error_bars",
+        action="store_true",
+        default=None,
+        help="the error bands even where the environment variable CONTACTFEM_ERROR_BARS is off",
     )
     parser.add_argument(
         "--tolerance",
         type=float,
         default=0.05,
         metavar="TOL",
-        help="the relative error band (and error against a closed form) past which a headline quantity warns "
-        "(default 0.05; --strict makes it exit 1)",
+        help="the run's tolerance, in (0, 1] (default 0.05): the relative error band (and error against a closed "
+        "form) past which a headline quantity warns, and the error the time-resolution indicators (impact_steps, "
+        "penalty_steps) hold the integrator to; --strict makes a warning exit 1",
     )
 
 

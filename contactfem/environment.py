@@ -15,7 +15,11 @@ USER, TOOLKIT, CALLER = "you", "contactfem, for the processes it starts", "a pro
 VARIABLES = {
     "CONTACTFEM_CACHE": (USER, "where studies keep their runs for the next call (default ~/.cache/contactfem)"),
     "CONTACTFEM_DEBUG": (USER, "1: an internal error prints its traceback, not one line"),
-    "CONTACTFEM_ERROR_BARS": (USER, "0 or off: runs leave out their error bars unless a call asks for them"),
+    "CONTACTFEM_ERROR_BARS": (
+        USER,
+        "0, off, no or false: runs leave out their error bars unless a call asks for them (--error-bars); 1, on, yes "
+        "or true (the default): with them",
+    ),
     "CONTACTFEM_PRESET": (USER, "the preset the lectures and the figures run (default fast)"),
     "CONTACTFEM_FIGURES": (
         USER,

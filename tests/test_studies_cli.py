@@ -386,6 +386,21 @@ def test_run_strict_ends_with_the_line_that_says_why(capsys):
     assert last == f"contactfem: strict: {said}"
 
 
+def test_run_strict_names_a_quantity_without_a_band_by_its_name_alone(capsys):
+    # the bar's duration has no band in time (its levels oscillate): the last line names the indicator, not
+    # the reason its line gives
+    assert main(["run", "bar_impact", "--strict", "--error-bars"]) == 1  # (the suite runs without them by default)
+    err = capsys.readouterr().err.strip().splitlines()
+    assert any(
+        line.startswith("contactfem: warning: accuracy: duration_band: no error band of duration") for line in err
+    )
+    names = re.fullmatch(
+        r"contactfem: strict: the run is flagged by \d+ accuracy warnings? above \((.*)\): exit code 1", err[-1]
+    )
+    assert names and "duration_band" in names.group(1).split(", "), err[-1]
+    assert all(re.fullmatch(r"\w+", name) for name in names.group(1).split(", ")), err[-1]
+
+
 @pytest.mark.slow
 def test_a_sweep_in_workers_prints_no_raw_python_warning(tmp_path):
     """The runs' warnings are raised in the worker processes: they come out as the sweep's own line,

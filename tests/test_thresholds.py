@@ -96,6 +96,6 @@ def test_the_pattern_catches_the_sources_it_retired():
         assert CITES_A_PRESET.search(old), old
     for argued in (
         "ANSYS's default penetration tolerance: 0.1 of the underlying element",
-        "the run's tolerance (--tolerance; 5 % by default)",
+        "the run's tolerance (--tolerance TOL, tolerance= in Python; 5 % by default)",
     ):
         assert not CITES_A_PRESET.search(argued), argued

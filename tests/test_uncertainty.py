@@ -13,6 +13,7 @@ import warnings
 import pytest
 
 from contactfem import AccuracyWarning, run_scene
+from contactfem.cli import main
 from contactfem.problem.uncertainty import (
     FS0,
     FS1,
@@ -20,6 +21,7 @@ from contactfem.problem.uncertainty import (
     bands,
     check_tolerance,
     classify,
+    error_bars_default,
     estimate,
     factor_of_safety,
     line,
@@ -196,9 +198,27 @@ def test_coarsening_keeps_the_end_and_the_floors():
 
 @pytest.mark.parametrize("bad", [0, -0.1, 1.5, "x", True, float("nan")])
 def test_a_tolerance_out_of_range_is_refused_in_one_line(bad):
-    with pytest.raises(ValueError, match=r"^parameter tolerance") as err:
+    with pytest.raises(ValueError, match=r"^tolerance") as err:
         check_tolerance(bad)
-    assert "\n" not in str(err.value)
+    assert "\n" not in str(err.value) and "(0, 1]" in str(err.value)
+
+
+@pytest.mark.parametrize("bad", ["no", 0, 1, "off"])
+def test_error_bars_other_than_true_false_or_none_are_refused(bad):
+    with pytest.raises(TypeError, match=r"^error_bars = .*: give True, False or None"):
+        run_scene("patch", error_bars=bad)
+
+
+def test_the_environment_switch_takes_on_or_off_and_names_itself_otherwise(monkeypatch):
+    for said, on in (("off", False), ("0", False), (" No ", False), ("on", True), ("TRUE", True), ("1", True)):
+        monkeypatch.setenv("CONTACTFEM_ERROR_BARS", said)
+        assert error_bars_default() is on
+    monkeypatch.setenv("CONTACTFEM_ERROR_BARS", "maybe")
+    with pytest.raises(ValueError, match=r"^environment variable CONTACTFEM_ERROR_BARS = 'maybe': allowed 0, off"):
+        error_bars_default()
+    # the command line turns them on where the environment has them off, in one line where both are asked
+    monkeypatch.setenv("CONTACTFEM_ERROR_BARS", "off")
+    assert main(["run", "patch", "--error-bars", "--no-error-bars"]) == 2
 
 
 def test_the_line_the_command_line_prints():
@@ -258,7 +278,7 @@ def test_the_command_line_prints_each_band_and_strict_exits_1(tmp_path):
     assert "uncertainty" not in json.loads((tmp_path / "b.json").read_text()) and " +- " not in off.stdout
     bad = subprocess.run(cmd + ["--tolerance", "2"], capture_output=True, text=True, env=ON)
     assert bad.returncode == 2 and bad.stderr.strip().splitlines() == [
-        "contactfem: error: parameter tolerance = 2.0 is out of range: allowed (0, 1]"
+        "contactfem: error: tolerance = 2.0 is out of range: allowed (0, 1]"
     ]
 
 

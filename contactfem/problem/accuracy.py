@@ -75,7 +75,7 @@ FACETS_SOURCE = (
 )
 ERROR_BUDGET = 2.0  # a step is kept with up to twice its share of the error (solver/schedule.py)
 REFERENCE_SOURCE = (
-    "the run's tolerance (--tolerance; 5 % by default): the closed form is the quantity's true value, so its "
+    "the run's tolerance (--tolerance TOL, tolerance= in Python; 5 % by default): the closed form is the quantity's true value, so its "
     "error is held to the tolerance its band is"
 )
 
@@ -205,7 +205,7 @@ def _touching(rec):
 def _time_resolution(model, records, tolerance=TOLERANCE):
     """The time resolution of a run's dynamic steps (those with a local error estimate, rec.error):
     impact_steps (closed contact episodes) and penalty_steps (every step in contact: an impact, a
-    resting or a rolling contact), held to the tolerance of the run's error bars by the integrator's
+    resting or a rolling contact), held to the run's tolerance (that of its error bars) by the integrator's
     error over half a period of a linear oscillator (one impact on a penalty spring:
     estimate.ErrorModel.half_period_error).
 
@@ -223,7 +223,7 @@ def _time_resolution(model, records, tolerance=TOLERANCE):
     omega = model_.resolving_omega_dt(tolerance)
     newmark = f"Newmark delta = {model_.delta:g}, beta = {model_.beta:g}"
     half = (
-        f"{newmark} errs by {100 * tolerance:g} % (the tolerance of the run's error bars) over half a period of a "
+        f"{newmark} errs by {100 * tolerance:g} % (the run's tolerance, --tolerance) over half a period of a "
         f"linear oscillator (an impact on a penalty spring) at w dt = {omega:.3g} (its amplification matrix: Hughes, "
         "The Finite Element Method, Sec. 9.3; the energy-consistent midpoint rule as the trapezoidal rule)"
     )

@@ -186,21 +186,32 @@ def penalty(name="c_N", enforcement="enforcement"):
 def check_tolerance(tolerance):
     """The tolerance as a float in (0, 1] (ValueError naming it and its range)."""
     if isinstance(tolerance, bool):
-        raise ValueError(f"parameter tolerance must be a number in (0, 1], got {tolerance!r}")
+        raise ValueError(f"tolerance must be a number in (0, 1], got {tolerance!r}")
     try:
         value = float(tolerance)
     except (TypeError, ValueError):
-        raise ValueError(f"parameter tolerance must be a number in (0, 1], got {tolerance!r}") from None
+        raise ValueError(f"tolerance must be a number in (0, 1], got {tolerance!r}") from None
     if not 0.0 < value <= 1.0:
-        raise ValueError(f"parameter tolerance = {tolerance!r} is out of range: allowed (0, 1]")
+        raise ValueError(f"tolerance = {tolerance!r} is out of range: allowed (0, 1]")
     return value
 
 
 def error_bars_default():
     """Whether runs get error bars when nobody says: yes, unless the environment variable
     CONTACTFEM_ERROR_BARS is 0, off, no or false (every run of a process without them: the test suite's
-    runs, whose tests of the bands turn them on)."""
-    return environment.read("CONTACTFEM_ERROR_BARS", "on").strip().lower() not in ("0", "off", "no", "false")
+    runs, whose tests of the bands turn them on); 1, on, yes or true say yes; any other value is a
+    ValueError naming it."""
+    value = environment.read("CONTACTFEM_ERROR_BARS", "on")
+    said = value.strip().lower()
+    if said not in OFF + ON:
+        raise ValueError(
+            f"environment variable CONTACTFEM_ERROR_BARS = {value!r}: allowed {', '.join(OFF)} (off) "
+            f"or {', '.join(ON)} (on)"
+        )
+    return said in ON
+
+
+OFF, ON = ("0", "off", "no", "false"), ("1", "on", "yes", "true")  # CONTACTFEM_ERROR_BARS's values
 
 
 def factor_of_safety(P):
@@ -449,7 +460,7 @@ def bands(run, params, results, quantities, discretisations, tolerance=TOLERANCE
                 tolerance,
                 f"the error band of {line(q.name, entry)} over "
                 + ("its value" if ref == abs(value) else f"its scale {ref:g}"),
-                "the run's tolerance (--tolerance; 5 % by default)",
+                "the run's tolerance (--tolerance TOL, tolerance= in Python; 5 % by default)",
             )
     section = dict(
         tolerance=tolerance,

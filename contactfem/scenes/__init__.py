@@ -125,6 +125,10 @@ def run_scene(
     scene = get_scene(name)
     overrides = check_overrides(overrides)
     tolerance = TOLERANCE if tolerance is None else check_tolerance(tolerance)
+    if error_bars is not None and not isinstance(error_bars, bool):
+        raise TypeError(
+            f"error_bars = {error_bars!r}: give True, False or None (None: on, unless $CONTACTFEM_ERROR_BARS is off)"
+        )
     error_bars = error_bars_default() if error_bars is None else bool(error_bars)
     if progress is not None and not callable(progress):
         raise TypeError(
