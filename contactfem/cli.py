@@ -154,7 +154,11 @@ def cmd_show(args):
             + "; ".join(
                 f"{q.name}"
                 + (f" [{q.unit}]" if q.unit else "")
-                + (f" ({', '.join(labels[c] for c in q.controls)})" if q.controls else " (its closed form)")
+                + (
+                    f" ({', '.join(labels[c] for c in q.controls)})"
+                    if q.controls
+                    else " (no band: checked against its closed form)"
+                )
                 for q in sc.quantities
             )
         )
@@ -243,9 +247,11 @@ def cmd_run(args):
     if bars and bars["quantities"]:  # each headline quantity with its band, and what the bands cost (none: no line)
         for name, entry in bars["quantities"].items():
             print(uncertainty.line(name, entry))
+        unused = bars.get("unused_runs", 0)
         print(
-            f"error bars: {bars['runs']} coarser or finer runs in {bars['wall_time_s']:.3g} s (the run alone: "
-            f"{res['wall_time_s']:.3g} s); tolerance {bars['tolerance']:g}"
+            f"error bars: {bars['runs']} coarser or finer runs"
+            + (f" ({unused} of them ran but are not used: the bands' parts say why)" if unused else "")
+            + f" in {bars['wall_time_s']:.3g} s (the run alone: {res['wall_time_s']:.3g} s); tolerance {bars['tolerance']:g}"
         )
     for what, path in out.paths.items():
         print(f"{what} -> {path}")

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from contactfem import run_scene
+from contactfem import AccuracyWarning, run_scene
 from contactfem.cli import main
 from contactfem.scenes import SceneError, get_scene
 
@@ -111,6 +111,46 @@ def test_a_bad_declaration_is_refused_at_load(tmp_path, capsys, case):
     assert line.startswith("contactfem: error: scene file edited.py, ") and expected in line, line
     with pytest.raises(ValueError, match="scene file edited.py, SCENE"):
         get_scene(str(path))
+
+
+QUANTITIES = '    quantities=(Quantity("rebound_vx", "length/time"), Quantity("rebound_vy", "length/time")),'
+STEP = '    discretisations=(time_step("dt", count="n_steps"),),'
+ERROR_BARS = {
+    "controls": (
+        (QUANTITIES, QUANTITIES.replace('"length/time")),', '"length/time", controls=("mesh",))),')),
+        "SCENE: quantity rebound_vy is controlled by 'mesh', not a discretisation of the file (its discretisations: step",
+    ),
+    "none": ((STEP, ""), "SCENE: quantity rebound_vx is controlled by 'step', not a discretisation of the file"),
+    "dt": ((STEP, STEP.replace('time_step("dt"', 'time_step("dtt"')), "SCENE: discretisation step reads 'dtt', not a"),
+    "count": ((STEP, STEP.replace('"n_steps"', '"nsteps"')), "SCENE: discretisation step reads 'nsteps', not a"),
+    "kind": ((STEP, '    discretisations=("step",),'), "SCENE: discretisations is not a tuple of Discretisation"),
+}
+
+
+@pytest.mark.parametrize("case", ERROR_BARS)
+def test_a_bad_error_bar_declaration_is_refused_at_load_by_run_and_show(tmp_path, capsys, case):
+    change, expected = ERROR_BARS[case]
+    path = edited(tmp_path, change)
+    line = one_line(capsys, ["run", path], 2)
+    assert line.startswith("contactfem: error: scene file edited.py, ") and expected in line, line
+    assert main(["show", str(path)]) == 2  # not an internal error
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("contactfem: error: scene file edited.py, SCENE") and "\n" not in err, err
+
+
+@pytest.mark.slow
+def test_the_example_says_why_its_velocities_get_no_band(tmp_path):
+    """The README: at its default step the example's contact is unresolved and its finer levels oscillate; each
+    velocity warns that it has no band, naming it and the time step (about 20 s: the run and four levels)."""
+    with pytest.warns(AccuracyWarning) as caught:
+        r = run_scene(str(edited(tmp_path)), "fast", error_bars=True)
+    said = [str(w.message) for w in caught]
+    assert r["accuracy"]["penalty_steps"]["ok"] is False
+    for name in ("rebound_vx", "rebound_vy"):
+        assert r["uncertainty"]["quantities"][name]["band"] is None
+        assert any(
+            f"{name}_band: no error band of {name}" in m and "time step:" in m and "oscillatory" in m for m in said
+        )
 
 
 def test_the_framework_accuracy_param_is_welcome(tmp_path):

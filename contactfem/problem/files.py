@@ -49,6 +49,7 @@ from .model import Stage
 from .params import Param, parse_all
 from .scene import LAW_RANGE_KEYS, RUN_KEYS, Model, Scene, simulate
 from .time_integration import ACCURACY_PARAM
+from .uncertainty import Discretisation, Quantity
 
 # names of results the run sets itself (RUN_KEYS, and what scenes.run_scene and the error bars add);
 # ``accuracy`` is the run's section, where a scene adds its own indicators
@@ -367,9 +368,10 @@ def _check_declaration(scene, path):
         if not callable(getattr(scene, role)):
             raise ValueError(f"{where}: {role} is a {type(getattr(scene, role)).__name__}, not a function")
     try:
-        parse_all(scene.params, {p.name: p.default for p in scene.params})
+        defaults = parse_all(scene.params, {p.name: p.default for p in scene.params})
     except ValueError as err:
         raise ValueError(f"{where}: a default is not allowed: {' '.join(str(err).split())}") from None
+    _check_error_bars(scene, where, dict(defaults, accuracy=0.0), names)
     if not isinstance(scene.presets, dict):
         raise ValueError(f"{where}: presets is a {type(scene.presets).__name__}, not a dict of name -> values")
     for preset, values in scene.presets.items():
@@ -383,6 +385,42 @@ def _check_declaration(scene, path):
             raise ValueError(f"{where}: law_params has the kind {kind!r}: the kinds of law are normal and friction")
         if unknown:
             raise ValueError(f"{where}: law_params[{kind!r}] names {unknown[0]!r}, not a parameter of the file")
+
+
+def _check_error_bars(scene, where, defaults, names):
+    """The headline quantities and the discretisations of a scene file (its error bars), checked when it is
+    loaded: Quantity and Discretisation objects, each quantity controlled by discretisations the file
+    declares, each discretisation's coarser level, size and order computed at the defaults (a parameter
+    it reads that the file lacks is named)."""
+    for what, items, kind in (
+        ("quantities", scene.quantities, Quantity),
+        ("discretisations", scene.discretisations, Discretisation),
+    ):
+        if not isinstance(items, (tuple, list)) or not all(isinstance(x, kind) for x in items):
+            raise ValueError(f"{where}: {what} is not a tuple of {kind.__name__} (contactfem.scenes.{kind.__name__})")
+    known = [d.name for d in scene.discretisations]
+    for q in scene.quantities:
+        unknown = [c for c in q.controls if c not in known]
+        if unknown:
+            raise ValueError(
+                f"{where}: quantity {q.name} is controlled by {unknown[0]!r}, not a discretisation of the file "
+                f"(its discretisations: {', '.join(known) or 'none'}; e.g. time_step(), mesh())"
+            )
+    for d in scene.discretisations:
+        try:
+            if d.applies(defaults):
+                d.size(defaults), d.order(defaults)
+                try:
+                    d.coarsen(defaults, 2.0)
+                except ValueError:  # no level that coarse at the defaults: the ladder takes another
+                    pass
+        except KeyError as err:
+            raise ValueError(
+                f"{where}: discretisation {d.name} reads {err.args[0]!r}, not a parameter of the file "
+                f"(its parameters: {', '.join(names)})"
+            ) from None
+        except Exception as err:  # noqa: BLE001 (the file's own functions: one line naming them)
+            raise ValueError(f"{where}: discretisation {d.name} at the defaults: {_cause(err)}") from None
 
 
 def load_scene_file(path):

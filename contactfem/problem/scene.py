@@ -136,8 +136,12 @@ def run(
     del records, model, systems  # (the ladder's runs need the memory)
     if error_bars and scene.quantities:
 
-        def level(p):
-            return run(scene, p, normal, friction, linear_algebra=linear_algebra, error_bars=False)
+        def level(p):  # a level's progress (if the run shows its own) names what the level changed
+            changed = ", ".join(
+                f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in p.items() if v != params.get(k)
+            )
+            shown = progress and (lambda t0, t_end, label: progress(t0, t_end, f"error bars ({changed}): {label}"))
+            return run(scene, p, normal, friction, shown, linear_algebra=linear_algebra, error_bars=False)
 
         results["uncertainty"], indicators = bands(
             lambda over: run_level(level, scene, params, over),

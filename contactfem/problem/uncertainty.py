@@ -324,21 +324,22 @@ def ladder(run, params, results, quantities, disc, tolerance=TOLERANCE):
             try:
                 over = disc.coarsen(params, r)
             except ValueError as err:  # no such level (a mesh below its floor)
-                cache[k] = dict(overrides=None, error=str(err), h=None, results=None)
+                cache[k] = dict(overrides=None, error=str(err), h=None, results=None, unused=False)
                 return cache[k]
             res = run(over)
             h = disc.size(dict(params, **over))
             if not isinstance(res, Exception) and not res.get("accuracy", {}).get("separated", {}).get("ok", True):
-                res = RuntimeError("the level ends in contact: its rebound would be read mid-impact")
+                res = Unused("the level ends in contact: its rebound would be read mid-impact")
             if not isinstance(res, Exception) and not res.get("accuracy", {}).get("missed", {}).get("ok", True):
-                res = RuntimeError("the level has no impact: its rebound would be the velocity it started with")
+                res = Unused("the level has no impact: its rebound would be the velocity it started with")
             if not isinstance(res, Exception) and k > 0 and disc.name == "step" and not resolved(res, tolerance):
-                res = RuntimeError("the level does not resolve the contacts' period (penalty_steps)")
+                res = Unused("the level does not resolve the contacts' period (penalty_steps)")
             cache[k] = dict(
                 overrides=over,
                 h=h,
                 results=None if isinstance(res, Exception) else res,
-                error=f"{type(res).__name__}: {str(res).splitlines()[0][:200]}" if isinstance(res, Exception) else None,
+                error=_why_not(res) if isinstance(res, Exception) else None,
+                unused=isinstance(res, Unused),
             )
         return cache[k]
 
@@ -357,7 +358,7 @@ def ladder(run, params, results, quantities, disc, tolerance=TOLERANCE):
             scale = max(q.reference(params, v) for v in values)
             est = dict(estimate([(L["h"], v) for L, v in zip(lv, values)], p_th, user=-start, scale=scale))
             est["levels"] = _levels(ks, lv, values)
-            tried.append(dict(levels=est["levels"], why=est["cls"]))
+            tried.append(dict(levels=est["levels"], why=_verdict(est, p_th)))
             found.append(est)
             if acceptable(est):
                 break
@@ -389,8 +390,26 @@ def ladder(run, params, results, quantities, disc, tolerance=TOLERANCE):
     return parts, runs
 
 
+class Unused(Exception):
+    """A level that ran but is not used: outside the asymptotic range (its contacts unresolved in time), or
+    read where its quantity is not defined (mid-impact, no impact)."""
+
+
+def _why_not(err):
+    """Why a level gives no value, in one line: an Unused level's reason; a failure's type and message."""
+    text = str(err).splitlines()[0][:200] if str(err) else ""
+    return text if isinstance(err, Unused) else f"{type(err).__name__}: {text}"
+
+
 def _levels(ks, lv, values):
     return [dict(factor=2.0**k, h=L["h"], value=v, overrides=L["overrides"]) for k, L, v in zip(ks, lv, values)]
+
+
+def _verdict(est, p_th):
+    """A triplet's convergence class, and why a monotone one is not taken: its order far above the scheme's."""
+    if est["cls"] == "monotone" and est["P"] > P_MAX:
+        return f"monotone, but of order {est['observed_order']:.3g}, more than {P_MAX:g} times the scheme's {p_th:g}"
+    return est["cls"]
 
 
 def _text(levels):
@@ -432,7 +451,14 @@ def bands(run, params, results, quantities, discretisations, tolerance=TOLERANCE
         runs += level_runs
         for name, part in parts.items():
             out[name]["parts"][d.name] = dict(part, label=d.label)
-    indicators = {f"{q.name}_band": _no_band(q, f"the scene's measure returns no value named {q.name}") for q in absent}
+    indicators = {
+        f"{q.name}_band": _no_band(
+            q,
+            f"the scene's measure returns no value named {q.name}",
+            "a headline quantity the scene declares is a result its measure returns (Scene.quantities)",
+        )
+        for q in absent
+    }
     for q in quantities:
         entry = out[q.name]
         parts = entry["parts"]
@@ -466,7 +492,8 @@ def bands(run, params, results, quantities, discretisations, tolerance=TOLERANCE
         tolerance=tolerance,
         quantities=out,
         runs=len(runs),
-        failed_runs=sum(1 for L in runs if L["results"] is None),
+        failed_runs=sum(1 for L in runs if L["results"] is None),  # failed, or ran and not used:
+        unused_runs=sum(1 for L in runs if L.get("unused")),  # ran, outside the asymptotic range or the quantity's
         wall_time_s=time.perf_counter() - t0,
         method="ladders of coarser runs (2 h, 4 h; finer where needed); Richardson's estimate with Xing & Stern's "
         "factor of safety; the parts by discretisation added",
@@ -482,13 +509,13 @@ def _worst(classes):
     return min(present, key=order.index, default="converged")
 
 
-def _no_band(q, why):
+def _no_band(q, why, source="an error band needs monotone levels (Roache; ASME V&V 20)"):
     return dict(
         value=None,
         threshold=None,
         ok=False,
         what=f"no error band of {q.name} could be estimated ({why})",
-        source="an error band needs monotone levels (Roache; ASME V&V 20)",
+        source=source,
         bound="at most",
     )
 
