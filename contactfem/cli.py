@@ -251,7 +251,8 @@ def cmd_run(args):
         print(
             f"error bars: {bars['runs']} coarser or finer runs"
             + (f" ({unused} of them ran but are not used: the bands' parts say why)" if unused else "")
-            + f" in {bars['wall_time_s']:.3g} s (the run alone: {res['wall_time_s']:.3g} s); tolerance {bars['tolerance']:g}"
+            + f" in {bars['wall_time_s']:.3g} s (the run alone: {res['wall_time_s']:.3g} s);"
+            + f" tolerance {bars['tolerance']:g}"
         )
     for what, path in out.paths.items():
         print(f"{what} -> {path}")

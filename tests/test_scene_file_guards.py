@@ -118,7 +118,8 @@ STEP = '    discretisations=(time_step("dt", count="n_steps"),),'
 ERROR_BARS = {
     "controls": (
         (QUANTITIES, QUANTITIES.replace('"length/time")),', '"length/time", controls=("mesh",))),')),
-        "SCENE: quantity rebound_vy is controlled by 'mesh', not a discretisation of the file (its discretisations: step",
+        "SCENE: quantity rebound_vy is controlled by 'mesh', not a discretisation of the file "
+        "(its discretisations: step",
     ),
     "none": ((STEP, ""), "SCENE: quantity rebound_vx is controlled by 'step', not a discretisation of the file"),
     "dt": ((STEP, STEP.replace('time_step("dt"', 'time_step("dtt"')), "SCENE: discretisation step reads 'dtt', not a"),

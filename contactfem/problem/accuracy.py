@@ -75,8 +75,8 @@ FACETS_SOURCE = (
 )
 ERROR_BUDGET = 2.0  # a step is kept with up to twice its share of the error (solver/schedule.py)
 REFERENCE_SOURCE = (
-    "the run's tolerance (--tolerance TOL, tolerance= in Python; 5 % by default): the closed form is the quantity's true value, so its "
-    "error is held to the tolerance its band is"
+    "the run's tolerance (--tolerance TOL, tolerance= in Python; 5 % by default): the closed form is the "
+    "quantity's true value, so its error is held to the tolerance its band is"
 )
 
 
